@@ -1,0 +1,18 @@
+// Image: an RGBA8 frame, rows top-down, and writing it as PNG (stb_image_write).
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dyn {
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgba;  // width*height*4, top row first
+  const std::uint8_t* pixel(int x, int y) const { return &rgba[(std::size_t(y) * width + x) * 4]; }
+};
+
+// Writes a PNG; returns false (and leaves no file behind) on failure.
+bool writePng(const std::string& path, const Image& image);
+
+}  // namespace dyn

@@ -1,0 +1,44 @@
+// Renderer: draws a Scene (labs/scene.h) with a shaded primitive pass, an optional Dear ImGui
+// overlay panel, 4× MSAA, and reads the frame back as an Image.
+#pragma once
+#include <memory>
+
+#include "labs/scene.h"
+#include "render/gl_context.h"
+#include "render/image.h"
+
+namespace dyn {
+
+struct RenderOptions {
+  int msaa = 4;           // samples; 0 or 1 disables
+  bool show_overlay = true;
+};
+
+class Renderer {
+ public:
+  // The context must be current and outlive the renderer.
+  explicit Renderer(GlContext& context, RenderOptions options = {});
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  // Draws one frame; overlay may be null. Deterministic: same input, same pixels.
+  void draw(const Scene& scene, const Overlay* overlay);
+  // Reads the last drawn frame (top row first).
+  Image read() const;
+  // draw + read.
+  Image render(const Scene& scene, const Overlay* overlay) {
+    draw(scene, overlay);
+    return read();
+  }
+
+  // World point -> pixel (x right, y down) under the scene camera; for tests and labels.
+  static Eigen::Vector2d project(const Camera& camera, int width, int height,
+                                 const Eigen::Vector3d& world);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace dyn
