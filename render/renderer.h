@@ -32,9 +32,16 @@ class Renderer {
     return read();
   }
 
+  // Waits until the GPU (llvmpipe) has finished the last draw; for timing without read().
+  void finish();
+  int width() const;
+  int height() const;
+
   // World point -> pixel (x right, y down) under the scene camera; for tests and labels.
   static Eigen::Vector2d project(const Camera& camera, int width, int height,
                                  const Eigen::Vector3d& world);
+  // The projection * view matrix used for drawing (GL clip space, aspect from width/height).
+  static Eigen::Matrix4d viewProjection(const Camera& camera, int width, int height);
 
  private:
   struct Impl;

@@ -1,0 +1,77 @@
+// Internal to render/: GL declarations (prototypes resolved against libOSMesa), shader programs,
+// unit meshes and the Dear ImGui overlay panel used by renderer.cpp.
+#pragma once
+#ifndef GL_GLEXT_PROTOTYPES
+#define GL_GLEXT_PROTOTYPES 1
+#endif
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <Eigen/Core>
+#include <memory>
+
+#include "labs/scene.h"
+
+struct ImGuiContext;  // Dear ImGui (global namespace)
+
+namespace dyn::gl {
+
+// ---- shaders.cpp --------------------------------------------------------------------------
+
+// Lit program for meshes: one directional light, ambient, a small specular highlight.
+struct ShadedProgram {
+  GLuint id = 0;
+  GLint view_proj = -1, model = -1, normal_matrix = -1, stretch = -1, color = -1;
+  GLint light_dir = -1, view_dir = -1, eye = -1, ortho = -1;
+};
+// Screen-space-width line program for polylines (quads expanded in the vertex shader).
+struct LineProgram {
+  GLuint id = 0;
+  GLint view_proj = -1, viewport = -1, half_width = -1, color = -1;
+};
+ShadedProgram makeShadedProgram();  // throws std::runtime_error with the compile log
+LineProgram makeLineProgram();
+
+// ---- meshes.cpp ---------------------------------------------------------------------------
+
+// Vertex of every mesh: position, normal, and `end` (capsules: 1 for vertices moved by the
+// stretch uniform, i.e. the p1 hemisphere; 0 elsewhere).
+struct Vertex {
+  float position[3];
+  float normal[3];
+  float end;
+};
+
+// An indexed triangle mesh in a VAO.
+struct Mesh {
+  GLuint vao = 0, vbo = 0, ebo = 0;
+  GLsizei index_count = 0;
+  void draw() const;
+  void destroy();
+};
+
+// Unit capsule along +z: radius 1, hemispheres at z=0 and z=0+stretch; with stretch 0 a sphere.
+Mesh makeCapsule(int slices, int half_stacks);
+// Unit cone: base radius 1 at z=0 (capped), apex at z=1.
+Mesh makeCone(int slices);
+// Box [-1,1]^3 with flat faces.
+Mesh makeBox();
+
+// ---- overlay.cpp --------------------------------------------------------------------------
+
+// The Dear ImGui panel in the top-left corner: title, label/value lines, plots.
+class OverlayPanel {
+ public:
+  OverlayPanel(int width, int height);
+  ~OverlayPanel();
+  OverlayPanel(const OverlayPanel&) = delete;
+  OverlayPanel& operator=(const OverlayPanel&) = delete;
+  // Draws into the currently bound framebuffer.
+  void draw(const Overlay& overlay);
+
+ private:
+  void buildFrame(const Overlay& overlay);
+  ::ImGuiContext* context_ = nullptr;
+};
+
+}  // namespace dyn::gl

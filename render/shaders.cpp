@@ -1,0 +1,143 @@
+// GLSL 3.30 core programs: lit meshes (directional light + ambient + soft specular) and
+// constant-width polylines expanded to quads in screen space.
+#include <stdexcept>
+#include <string>
+
+#include "render/gl_internal.h"
+
+namespace dyn::gl {
+namespace {
+
+const char* kShadedVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in float a_end;
+uniform mat4 u_view_proj;
+uniform mat4 u_model;
+uniform mat3 u_normal_matrix;
+uniform vec3 u_stretch;  // model-space offset applied to vertices with a_end = 1 (capsules)
+out vec3 v_normal;
+out vec3 v_world;
+void main() {
+  vec4 world = u_model * vec4(a_position + a_end * u_stretch, 1.0);
+  v_world = world.xyz;
+  v_normal = u_normal_matrix * a_normal;
+  gl_Position = u_view_proj * world;
+}
+)";
+
+const char* kShadedFragment = R"(#version 330 core
+in vec3 v_normal;
+in vec3 v_world;
+uniform vec4 u_color;
+uniform vec3 u_light_dir;  // towards the light, world space, unit
+uniform vec3 u_view_dir;   // towards the viewer (orthographic)
+uniform vec3 u_eye;        // camera position (perspective)
+uniform bool u_ortho;
+out vec4 frag_color;
+void main() {
+  vec3 n = normalize(v_normal);
+  vec3 v = u_ortho ? u_view_dir : normalize(u_eye - v_world);
+  // Soft key light plus a sky/ground ambient so shadowed sides keep their colour.
+  float diffuse = max(dot(n, u_light_dir), 0.0);
+  float hemi = 0.5 + 0.5 * dot(n, v);
+  vec3 h = normalize(u_light_dir + v);
+  float spec = pow(max(dot(n, h), 0.0), 48.0);
+  vec3 base = u_color.rgb;
+  vec3 rgb = base * (0.30 + 0.18 * hemi + 0.62 * diffuse) + vec3(0.16 * spec);
+  frag_color = vec4(min(rgb, vec3(1.0)), u_color.a);
+}
+)";
+
+const char* kLineVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_position;  // this end of the segment
+layout(location = 1) in vec3 a_other;     // the other end
+layout(location = 2) in float a_side;     // +1 / -1: which edge of the quad
+uniform mat4 u_view_proj;
+uniform vec2 u_viewport;   // pixels
+uniform float u_half_width;  // pixels
+void main() {
+  vec4 clip = u_view_proj * vec4(a_position, 1.0);
+  vec4 other = u_view_proj * vec4(a_other, 1.0);
+  vec2 here_px = clip.xy / clip.w * 0.5 * u_viewport;
+  vec2 other_px = other.xy / other.w * 0.5 * u_viewport;
+  vec2 d = other_px - here_px;
+  vec2 dir = length(d) > 1e-6 ? normalize(d) : vec2(1.0, 0.0);
+  // Offset sideways by half the width, and back past the end (square caps close the joints).
+  vec2 offset_px = vec2(-dir.y, dir.x) * a_side * u_half_width - dir * u_half_width;
+  clip.xy += offset_px / (0.5 * u_viewport) * clip.w;
+  gl_Position = clip;
+}
+)";
+
+const char* kLineFragment = R"(#version 330 core
+uniform vec4 u_color;
+out vec4 frag_color;
+void main() { frag_color = u_color; }
+)";
+
+// Compiles one stage; throws with the info log on failure.
+GLuint compileStage(GLenum type, const char* source, const char* name) {
+  GLuint shader = glCreateShader(type);
+  glShaderSource(shader, 1, &source, nullptr);
+  glCompileShader(shader);
+  GLint ok = 0;
+  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[2048] = {};
+    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
+    glDeleteShader(shader);
+    throw std::runtime_error(std::string("render: shader '") + name + "' failed: " + log);
+  }
+  return shader;
+}
+
+// Links a vertex + fragment program; throws with the info log on failure.
+GLuint linkProgram(const char* vertex, const char* fragment, const char* name) {
+  GLuint vs = compileStage(GL_VERTEX_SHADER, vertex, name);
+  GLuint fs = compileStage(GL_FRAGMENT_SHADER, fragment, name);
+  GLuint program = glCreateProgram();
+  glAttachShader(program, vs);
+  glAttachShader(program, fs);
+  glLinkProgram(program);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(program, GL_LINK_STATUS, &ok);
+  if (!ok) {
+    char log[2048] = {};
+    glGetProgramInfoLog(program, sizeof log, nullptr, log);
+    glDeleteProgram(program);
+    throw std::runtime_error(std::string("render: program '") + name + "' failed to link: " + log);
+  }
+  return program;
+}
+
+}  // namespace
+
+ShadedProgram makeShadedProgram() {
+  ShadedProgram p;
+  p.id = linkProgram(kShadedVertex, kShadedFragment, "shaded");
+  p.view_proj = glGetUniformLocation(p.id, "u_view_proj");
+  p.model = glGetUniformLocation(p.id, "u_model");
+  p.normal_matrix = glGetUniformLocation(p.id, "u_normal_matrix");
+  p.stretch = glGetUniformLocation(p.id, "u_stretch");
+  p.color = glGetUniformLocation(p.id, "u_color");
+  p.light_dir = glGetUniformLocation(p.id, "u_light_dir");
+  p.view_dir = glGetUniformLocation(p.id, "u_view_dir");
+  p.eye = glGetUniformLocation(p.id, "u_eye");
+  p.ortho = glGetUniformLocation(p.id, "u_ortho");
+  return p;
+}
+
+LineProgram makeLineProgram() {
+  LineProgram p;
+  p.id = linkProgram(kLineVertex, kLineFragment, "line");
+  p.view_proj = glGetUniformLocation(p.id, "u_view_proj");
+  p.viewport = glGetUniformLocation(p.id, "u_viewport");
+  p.half_width = glGetUniformLocation(p.id, "u_half_width");
+  p.color = glGetUniformLocation(p.id, "u_color");
+  return p;
+}
+
+}  // namespace dyn::gl

@@ -1,0 +1,106 @@
+// Renderer tests: the capsule is drawn where Renderer::project says, frames are reproducible,
+// and the overlay panel shows up in the top-left corner from the very first frame.
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+
+#include "tests/render/test_scene.h"
+
+using namespace dyn;
+
+namespace {
+
+bool reddish(const std::uint8_t* p) { return p[0] > 150 && p[1] < 90 && p[2] < 90; }
+
+bool nearColor(const std::uint8_t* p, const Color& c, int tolerance = 2) {
+  const float want[3] = {c.r, c.g, c.b};
+  for (int i = 0; i < 3; ++i)
+    if (std::abs(int(p[i]) - int(want[i] * 255.0f + 0.5f)) > tolerance) return false;
+  return true;
+}
+
+}  // namespace
+
+TEST_CASE("a red capsule is drawn where project() says, and nowhere else") {
+  auto context = makeOffscreenContext(320, 240);
+  CHECK(context->description().find("OSMesa") != std::string::npos);
+  Renderer renderer(*context);
+  const Scene scene = test::redCapsuleScene();
+  const Image image = renderer.render(scene, nullptr);
+  REQUIRE(image.width == 320);
+  REQUIRE(image.height == 240);
+  REQUIRE(image.rgba.size() == 320u * 240u * 4u);
+
+  // Midpoint and points along the axis are red.
+  for (double t : {0.1, 0.5, 0.9}) {
+    const Eigen::Vector2d px =
+        Renderer::project(scene.camera, 320, 240, t * Eigen::Vector3d(0.5, 0.3, 0));
+    INFO("t=" << t << " px=" << px.transpose());
+    CHECK(reddish(image.pixel(int(px.x()), int(px.y()))));
+  }
+  // The origin projects to the image centre under an orthographic camera at the origin.
+  const Eigen::Vector2d centre = Renderer::project(scene.camera, 320, 240, Eigen::Vector3d::Zero());
+  CHECK(centre.x() == doctest::Approx(160.0));
+  CHECK(centre.y() == doctest::Approx(120.0));
+  // +y world is up in the picture: p1 (y=0.3) lands above the centre.
+  CHECK(Renderer::project(scene.camera, 320, 240, {0.5, 0.3, 0}).y() < 120.0);
+
+  // Far from the capsule: exactly the background.
+  for (const Eigen::Vector3d& w :
+       {Eigen::Vector3d(-0.8, -0.8, 0), Eigen::Vector3d(0.8, -0.5, 0), Eigen::Vector3d(-0.5, 0.7, 0)}) {
+    const Eigen::Vector2d px = Renderer::project(scene.camera, 320, 240, w);
+    CHECK(nearColor(image.pixel(int(px.x()), int(px.y())), scene.background));
+  }
+  // Just beyond the radius (perpendicular to the axis) is background too.
+  const Eigen::Vector3d mid(0.25, 0.15, 0), normal = Eigen::Vector3d(-0.3, 0.5, 0).normalized();
+  const Eigen::Vector2d off = Renderer::project(scene.camera, 320, 240, mid + 0.08 * normal);
+  CHECK(nearColor(image.pixel(int(off.x()), int(off.y())), scene.background));
+}
+
+TEST_CASE("the same scene renders to identical bytes") {
+  auto context = makeOffscreenContext(320, 240);
+  Renderer renderer(*context);
+  Scene scene = test::redCapsuleScene();
+  scene.spheres.push_back({{0.5, 0.3, 0}, 0.07, {0.3f, 0.3f, 0.35f, 1.0f}});
+  scene.capsules.push_back({{0, 0, 0}, {-0.4, 0.4, 0}, 0.05, {0.2f, 0.5f, 0.9f, 0.4f}});
+  scene.polylines.push_back({{{-0.9, -0.5, 0}, {0, -0.6, 0}, {0.9, -0.4, 0}}, 2.0, {0, 0.5f, 0, 1}});
+  const Overlay overlay = test::sampleOverlay();
+  const Image first = renderer.render(scene, &overlay);
+  const Image second = renderer.render(scene, &overlay);
+  CHECK(first.rgba == second.rgba);
+  // A second renderer (fresh ImGui state) draws the same first frame.
+  Renderer other(*context);
+  CHECK(other.render(scene, &overlay).rgba == first.rgba);
+}
+
+TEST_CASE("the overlay panel is drawn top-left on the first frame") {
+  auto context = makeOffscreenContext(320, 240);
+  const Scene scene = test::redCapsuleScene();
+  const Overlay overlay = test::sampleOverlay();
+  Renderer with_panel(*context);
+  const Image with = with_panel.render(scene, &overlay);  // first frame of this renderer
+  Renderer without_panel(*context);
+  const Image without = without_panel.render(scene, nullptr);
+  // Count differing pixels in the top-left 100x60 region; elsewhere far away, none differ.
+  int changed = 0, changed_far = 0;
+  for (int y = 0; y < 60; ++y)
+    for (int x = 0; x < 100; ++x)
+      changed += std::equal(with.pixel(x, y), with.pixel(x, y) + 4, without.pixel(x, y)) ? 0 : 1;
+  for (int y = 200; y < 240; ++y)
+    for (int x = 280; x < 320; ++x)
+      changed_far += std::equal(with.pixel(x, y), with.pixel(x, y) + 4, without.pixel(x, y)) ? 0 : 1;
+  CHECK(changed > 2000);
+  CHECK(changed_far == 0);
+  // Options can switch the overlay off even when one is passed.
+  Renderer hidden(*context, RenderOptions{4, false});
+  CHECK(hidden.render(scene, &overlay).rgba == without.rgba);
+}
+
+TEST_CASE("MSAA off still renders the capsule") {
+  auto context = makeOffscreenContext(160, 120);
+  Renderer renderer(*context, RenderOptions{0, true});
+  const Scene scene = test::redCapsuleScene();
+  const Image image = renderer.render(scene, nullptr);
+  const Eigen::Vector2d px = Renderer::project(scene.camera, 160, 120, {0.25, 0.15, 0});
+  CHECK(reddish(image.pixel(int(px.x()), int(px.y()))));
+}
