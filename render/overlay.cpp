@@ -89,7 +89,10 @@ void OverlayPanel::buildFrame(const Overlay& overlay) {
                                  ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav;
   const std::string title = (overlay.title.empty() ? std::string("dynlab") : overlay.title) +
                             "###dynlab_overlay";
+  // Light title text on the dark title bar (the title is drawn inside Begin).
+  ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.97f, 0.98f, 1.0f, 1.0f));
   ImGui::Begin(title.c_str(), nullptr, flags);
+  ImGui::PopStyleColor();
 
   // Label/value lines.
   const ImVec4 muted(0.38f, 0.42f, 0.48f, 1.0f);

@@ -87,7 +87,7 @@ struct Renderer::Impl {
     createFramebuffers();
     shaded = gl::makeShadedProgram();
     line = gl::makeLineProgram();
-    capsule = gl::makeCapsule(40, 12);
+    capsule = gl::makeCapsule(28, 7);
     cone = gl::makeCone(40);
     box = gl::makeBox();
     // Polyline stream: attributes 0 position, 1 other end, 2 side.
@@ -270,17 +270,24 @@ struct Renderer::Impl {
     // Opaque polylines (depth-tested, so the arm hides what is behind it).
     drawPolylines(scene, view_proj, false);
 
-    // Translucent meshes, then translucent lines: far to near, blended, no depth writes.
-    glEnable(GL_BLEND);
-    glDepthMask(GL_FALSE);
+    // Translucent meshes: a depth-only pass first, so overlapping parts of a ghost (capsule
+    // ends, joints) blend once as one surface; then colour far to near, blended, no depth writes.
     std::vector<const DrawItem*> translucent;
     for (const auto& item : items)
       if (item.color.a < 1.0f) translucent.push_back(&item);
     std::stable_sort(translucent.begin(), translucent.end(),
                      [](const DrawItem* a, const DrawItem* b) { return a->depth > b->depth; });
     glUseProgram(shaded.id);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
     for (const DrawItem* item : translucent) drawItem(*item);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glEnable(GL_BLEND);
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_LEQUAL);
+    for (const DrawItem* item : translucent) drawItem(*item);
+    glDepthFunc(GL_LESS);
     glFrontFace(GL_CCW);
+    // Translucent lines last.
     drawPolylines(scene, view_proj, true);
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);

@@ -18,6 +18,7 @@ uniform mat3 u_normal_matrix;
 uniform vec3 u_stretch;  // model-space offset applied to vertices with a_end = 1 (capsules)
 out vec3 v_normal;
 out vec3 v_world;
+invariant gl_Position;  // the translucent colour pass re-draws the depth pass exactly
 void main() {
   vec4 world = u_model * vec4(a_position + a_end * u_stretch, 1.0);
   v_world = world.xyz;
