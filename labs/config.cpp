@@ -1,0 +1,153 @@
+// JsonView: typed, path-aware reads of lab configs and submissions (see config.h).
+#include "labs/config.h"
+
+#include <cmath>
+#include <fstream>
+#include <sstream>
+
+namespace dyn {
+
+InputError::InputError(std::string file, std::string path, const std::string& expected)
+    : std::runtime_error(file + ": " + (path.empty() ? "/" : path) + ": " + expected),
+      file_(std::move(file)), path_(std::move(path)), expected_(expected) {}
+
+json parseJsonText(const std::string& text, const std::string& file) {
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos)
+    throw InputError(file, "", "expected a JSON document, the file is empty");
+  try {
+    return json::parse(text);
+  } catch (const json::parse_error& e) {
+    // nlohmann's message names the line and column; keep only that part.
+    std::string what = e.what();
+    const auto pos = what.find("parse error");
+    throw InputError(file, "", "expected valid JSON (" + what.substr(pos == std::string::npos ? 0 : pos) + ")");
+  }
+}
+
+json loadJsonFile(const std::string& file, std::size_t max_bytes) {
+  std::ifstream in(file, std::ios::binary | std::ios::ate);
+  if (!in) throw InputError(file, "", "expected a readable file (cannot open it)");
+  const auto size = std::size_t(in.tellg());
+  if (size > max_bytes)
+    throw InputError(file, "", "expected at most " + std::to_string(max_bytes) + " bytes, the file has " +
+                                   std::to_string(size));
+  in.seekg(0);
+  std::string text(size, '\0');
+  in.read(text.data(), std::streamsize(size));
+  return parseJsonText(text, file);
+}
+
+void JsonView::fail(const std::string& expected) const { throw InputError(file_, path_, expected); }
+
+std::string JsonView::got() const {
+  std::string s = value_->dump();
+  if (s.size() > 40) s = s.substr(0, 37) + "...";
+  return ", got " + s;
+}
+
+bool JsonView::has(const std::string& key) const { return value_->is_object() && value_->contains(key); }
+
+void JsonView::requireObject() const {
+  if (!value_->is_object()) fail("expected an object" + got());
+}
+
+JsonView JsonView::operator[](const std::string& key) const {
+  requireObject();
+  const auto it = value_->find(key);
+  if (it == value_->end()) fail("missing key \"" + key + "\"");
+  return JsonView(*it, file_, path_ + "/" + key);
+}
+
+JsonView JsonView::at(std::size_t index) const {
+  if (!value_->is_array() || index >= value_->size())
+    fail("expected an array with an element " + std::to_string(index));
+  return JsonView((*value_)[index], file_, path_ + "/" + std::to_string(index));
+}
+
+std::size_t JsonView::size(std::size_t min, std::size_t max) const {
+  if (!value_->is_array()) fail("expected an array" + got());
+  const std::size_t n = value_->size();
+  if (n < min || n > max) {
+    fail(min == max ? "expected an array of " + std::to_string(min) + " elements, got " + std::to_string(n)
+                    : "expected an array of " + std::to_string(min) + " to " + std::to_string(max) +
+                          " elements, got " + std::to_string(n));
+  }
+  return n;
+}
+
+void JsonView::onlyKeys(std::initializer_list<const char*> allowed) const {
+  requireObject();
+  for (const auto& [key, _] : value_->items()) {
+    bool ok = false;
+    for (const char* a : allowed) ok = ok || key == a;
+    if (!ok) {
+      std::string list;
+      for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
+      JsonView(value_->at(key), file_, path_ + "/" + key).fail("unknown key \"" + key + "\" (expected one of: " + list + ")");
+    }
+  }
+}
+
+double JsonView::number() const {
+  if (!value_->is_number()) fail("expected a number" + got());
+  const double x = value_->get<double>();
+  if (!std::isfinite(x)) fail("expected a finite number" + got());
+  return x;
+}
+
+double JsonView::positive() const {
+  const double x = number();
+  if (!(x > 0)) fail("expected a positive number" + got());
+  return x;
+}
+
+double JsonView::nonNegative() const {
+  const double x = number();
+  if (!(x >= 0)) fail("expected a number ≥ 0" + got());
+  return x;
+}
+
+double JsonView::inRange(double lo, double hi) const {
+  const double x = number();
+  if (!(x >= lo && x <= hi)) {
+    std::ostringstream s;
+    s << "expected a number in [" << lo << ", " << hi << "]" << got();
+    fail(s.str());
+  }
+  return x;
+}
+
+long JsonView::integer(long lo, long hi) const {
+  if (!value_->is_number_integer()) fail("expected an integer" + got());
+  const long x = value_->get<long>();
+  if (x < lo || x > hi)
+    fail("expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]" + got());
+  return x;
+}
+
+bool JsonView::boolean() const {
+  if (!value_->is_boolean()) fail("expected true or false" + got());
+  return value_->get<bool>();
+}
+
+std::string JsonView::string() const {
+  if (!value_->is_string()) fail("expected a string" + got());
+  return value_->get<std::string>();
+}
+
+std::string JsonView::oneOf(std::initializer_list<const char*> choices) const {
+  std::string list;
+  for (const char* c : choices) list += std::string(list.empty() ? "" : ", ") + "\"" + c + "\"";
+  if (!value_->is_string()) fail("expected one of " + list + got());
+  const std::string s = value_->get<std::string>();
+  for (const char* c : choices)
+    if (s == c) return s;
+  fail("expected one of " + list + got());
+}
+
+json mergePatch(json target, const json& patch) {
+  target.merge_patch(patch);
+  return target;
+}
+
+}  // namespace dyn

@@ -1,0 +1,36 @@
+// The lab registry: labs add themselves at static-initialisation time (DYNLAB_REGISTER_LAB).
+#include <algorithm>
+#include <cstdlib>
+
+#include "labs/lab.h"
+
+#ifndef DYNLAB_SOURCE_DIR
+#define DYNLAB_SOURCE_DIR "."
+#endif
+
+namespace dyn {
+
+std::vector<LabEntry>& labRegistry() {
+  static std::vector<LabEntry> entries;
+  return entries;
+}
+
+bool registerLab(LabEntry entry) {
+  auto& r = labRegistry();
+  r.push_back(std::move(entry));
+  std::sort(r.begin(), r.end(), [](const LabEntry& a, const LabEntry& b) { return a.name < b.name; });
+  return true;
+}
+
+const LabEntry* findLab(const std::string& name) {
+  for (const auto& e : labRegistry())
+    if (e.name == name) return &e;
+  return nullptr;
+}
+
+std::string defaultConfigPath(const std::string& name) {
+  const char* home = std::getenv("DYNLAB_HOME");
+  return std::string(home && *home ? home : DYNLAB_SOURCE_DIR) + "/labs/" + name + "/" + name + ".json";
+}
+
+}  // namespace dyn

@@ -1,0 +1,50 @@
+// Trace helpers: column lookup, CSV, fingerprint.
+#include "labs/trace.h"
+
+#include <cstdio>
+#include <cstring>
+
+namespace dyn {
+
+int Trace::column(const std::string& name) const {
+  for (std::size_t i = 0; i < columns.size(); ++i)
+    if (columns[i] == name) return int(i);
+  return -1;
+}
+
+std::vector<double> Trace::series(const std::string& name) const {
+  const int c = column(name);
+  std::vector<double> out;
+  if (c < 0) return out;
+  out.reserve(rows());
+  for (std::size_t r = 0; r < rows(); ++r) out.push_back(at(r, c));
+  return out;
+}
+
+std::string Trace::csv() const {
+  std::string s;
+  for (std::size_t i = 0; i < columns.size(); ++i) s += (i ? "," : "") + columns[i];
+  s += '\n';
+  char buf[32];
+  for (std::size_t r = 0; r < rows(); ++r) {
+    for (std::size_t c = 0; c < columns.size(); ++c) {
+      std::snprintf(buf, sizeof buf, "%.17g", at(r, int(c)));
+      if (c) s += ',';
+      s += buf;
+    }
+    s += '\n';
+  }
+  return s;
+}
+
+std::uint64_t Trace::hash() const {
+  std::uint64_t h = 1469598103934665603ull;
+  for (double x : data) {
+    unsigned char bytes[sizeof x];
+    std::memcpy(bytes, &x, sizeof x);
+    for (unsigned char b : bytes) h = (h ^ b) * 1099511628211ull;
+  }
+  return h;
+}
+
+}  // namespace dyn

@@ -1,0 +1,27 @@
+// Trace: one row per fixed step, named columns; what engines produce and everything else reads
+// (metrics, agreement, rendering, grading). Written as CSV with a header row.
+#pragma once
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace dyn {
+
+struct Trace {
+  std::vector<std::string> columns;
+  std::vector<double> data;  // row-major
+
+  std::size_t rows() const { return columns.empty() ? 0 : data.size() / columns.size(); }
+  int column(const std::string& name) const;  // −1 if absent
+  double at(std::size_t row, int col) const { return data[row * columns.size() + std::size_t(col)]; }
+  double at(std::size_t row, const std::string& name) const { return at(row, column(name)); }
+  std::vector<double> series(const std::string& name) const;
+  void append(const std::vector<double>& row) { data.insert(data.end(), row.begin(), row.end()); }
+
+  // CSV with a header; numbers with 17 significant digits (round-trip exact, same bytes every run).
+  std::string csv() const;
+  // FNV-1a over the raw doubles: the trajectory fingerprint.
+  std::uint64_t hash() const;
+};
+
+}  // namespace dyn

@@ -1,0 +1,223 @@
+// Tree algorithms of lecture eq. (1) — RNEA, CRBA, ABA, point Jacobians — written once for
+// planar and spatial algebra and instantiated for both (see chain.h for the equations).
+#include "physics/chain.h"
+
+namespace dyn {
+
+template <class S>
+typename TreeModel<S>::Vec TreeModel<S>::motionSubspace(int i) const {
+  const Body& b = bodies[i];
+  if constexpr (S::kDim == 3) {
+    return b.joint == JointType::Revolute ? S::revoluteAxis() : S::prismaticAxis(b.axis);
+  } else {
+    return b.joint == JointType::Revolute ? S::revoluteAxis(b.axis) : S::prismaticAxis(b.axis);
+  }
+}
+
+template <class S>
+void TreeData<S>::resize(int n) {
+  X_up.resize(n);
+  X_world.resize(n);
+  S_i.resize(n);
+  v.resize(n);
+  c.resize(n);
+  a.resize(n);
+  f.resize(n);
+  Ic.resize(n);
+  U.resize(n);
+  pA.resize(n);
+  D.resize(n);
+  u.resize(n);
+}
+
+template <class S>
+void forwardKinematics(const TreeModel<S>& model, const VecN& q, const VecN& qd, TreeData<S>& data) {
+  using Vec = typename S::Vec;
+  for (int i = 0; i < model.dof(); ++i) {
+    const auto& b = model.bodies[i];
+    // Joint placement then joint motion: X_up = X_J(θ_i) X_tree.
+    data.X_up[i] = S::compose(S::jointTransform(b.joint == JointType::Revolute, b.axis, q[i]), b.X_tree);
+    data.S_i[i] = model.motionSubspace(i);
+    const Vec vJ = data.S_i[i] * qd[i];
+    if (b.parent < 0) {
+      data.X_world[i] = data.X_up[i];
+      data.v[i] = vJ;
+    } else {
+      data.X_world[i] = S::compose(data.X_up[i], data.X_world[b.parent]);
+      data.v[i] = S::motion(data.X_up[i], data.v[b.parent]) + vJ;
+    }
+    // Velocity-product acceleration of the joint: c_i = V_i ×m S_i θ'_i.
+    data.c[i] = S::crossMotion(data.v[i], vJ);
+  }
+}
+
+template <class S>
+VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const VecN& qdd,
+          bool with_gravity) {
+  const int n = model.dof();
+  (void)qd;  // velocities enter through data.v, filled by forwardKinematics
+  const typename S::Vec a0 = with_gravity ? typename S::Vec(-model.gravity) : S::Vec::Zero();
+  // Outward: accelerations, then the net force each body needs.
+  for (int i = 0; i < n; ++i) {
+    const auto& b = model.bodies[i];
+    const typename S::Vec a_parent = b.parent < 0 ? a0 : data.a[b.parent];
+    data.a[i] = S::motion(data.X_up[i], a_parent) + data.S_i[i] * qdd[i] + data.c[i];
+    data.f[i] = b.inertia * data.a[i] + S::crossForce(data.v[i], b.inertia * data.v[i]);
+  }
+  // Inward: project onto the joint axis, pass the rest to the parent.
+  VecN tau(n);
+  for (int i = n - 1; i >= 0; --i) {
+    tau[i] = data.S_i[i].dot(data.f[i]);
+    const int p = model.bodies[i].parent;
+    if (p >= 0) data.f[p] += S::forceTranspose(data.X_up[i], data.f[i]);
+  }
+  return tau;
+}
+
+template <class S>
+MatN crba(const TreeModel<S>& model, TreeData<S>& data) {
+  const int n = model.dof();
+  for (int i = 0; i < n; ++i) data.Ic[i] = model.bodies[i].inertia;
+  // Composite inertias, leaves to root: Ic_p += X^T Ic_i X.
+  for (int i = n - 1; i >= 0; --i) {
+    const int p = model.bodies[i].parent;
+    if (p >= 0) {
+      const typename S::Mat X = S::motionMatrix(data.X_up[i]);
+      data.Ic[p] += X.transpose() * data.Ic[i] * X;
+    }
+  }
+  MatN M = MatN::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    typename S::Vec F = data.Ic[i] * data.S_i[i];
+    M(i, i) = data.S_i[i].dot(F);
+    // Carry the composite force up the ancestors: M_ij = S_j · F.
+    for (int j = i; model.bodies[j].parent >= 0;) {
+      F = S::forceTranspose(data.X_up[j], F);
+      j = model.bodies[j].parent;
+      M(i, j) = M(j, i) = data.S_i[j].dot(F);
+    }
+  }
+  return M;
+}
+
+template <class S>
+VecN aba(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const VecN& tau) {
+  (void)qd;
+  const int n = model.dof();
+  using Vec = typename S::Vec;
+  using Mat = typename S::Mat;
+  for (int i = 0; i < n; ++i) {
+    data.Ic[i] = model.bodies[i].inertia;  // articulated inertia I^A
+    data.pA[i] = S::crossForce(data.v[i], model.bodies[i].inertia * data.v[i]);
+  }
+  // Inward: articulated inertias and bias forces.
+  for (int i = n - 1; i >= 0; --i) {
+    data.U[i] = data.Ic[i] * data.S_i[i];
+    data.D[i] = data.S_i[i].dot(data.U[i]);
+    data.u[i] = tau[i] - data.S_i[i].dot(data.pA[i]);
+    const int p = model.bodies[i].parent;
+    if (p >= 0) {
+      const Mat Ia = data.Ic[i] - data.U[i] * data.U[i].transpose() / data.D[i];
+      const Vec pa = data.pA[i] + Ia * data.c[i] + data.U[i] * (data.u[i] / data.D[i]);
+      const Mat X = S::motionMatrix(data.X_up[i]);
+      data.Ic[p] += X.transpose() * Ia * X;
+      data.pA[p] += S::forceTranspose(data.X_up[i], pa);
+    }
+  }
+  // Outward: accelerations.
+  VecN qdd(n);
+  const Vec a0 = -model.gravity;
+  for (int i = 0; i < n; ++i) {
+    const int p = model.bodies[i].parent;
+    const Vec a_in = S::motion(data.X_up[i], p < 0 ? a0 : data.a[p]) + data.c[i];
+    qdd[i] = (data.u[i] - data.U[i].dot(a_in)) / data.D[i];
+    data.a[i] = a_in + data.S_i[i] * qdd[i];
+  }
+  return qdd;
+}
+
+template <class S>
+typename S::Pos pointPosition(const TreeData<S>& data, int body, const typename S::Pos& point) {
+  return S::worldPoint(data.X_world[body], point);
+}
+
+template <class S>
+void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
+                   const typename S::Pos& point, MatN& J, VecN& Jdot_qd) {
+  using Vec = typename S::Vec;
+  const int n = model.dof();
+  // World origin → the world-aligned frame at the point.
+  const typename S::Transform X_pw = S::translation(pointPosition(data, body, point));
+  J.setZero(S::kDim, n);
+  // The path root → body, and the velocity-product acceleration along it (θ'' = 0, no gravity).
+  int path[kMaxDof];
+  int depth = 0;
+  for (int j = body; j >= 0; j = model.bodies[j].parent) path[depth++] = j;
+  Vec a_bias = Vec::Zero();
+  for (int k = depth - 1; k >= 0; --k) {
+    const int j = path[k];
+    a_bias = (model.bodies[j].parent < 0 ? Vec(Vec::Zero()) : Vec(S::motion(data.X_up[j], a_bias))) + data.c[j];
+    J.col(j) = S::motion(X_pw, S::motionInverse(data.X_world[j], data.S_i[j]));
+  }
+  const Vec v_p = S::motion(X_pw, S::motionInverse(data.X_world[body], data.v[body]));
+  const Vec a_p = S::motion(X_pw, S::motionInverse(data.X_world[body], a_bias));
+  Jdot_qd = S::classicalAcceleration(a_p, v_p);
+}
+
+template <class S>
+double kineticEnergy(const TreeModel<S>& model, const TreeData<S>& data) {
+  double T = 0;
+  for (int i = 0; i < model.dof(); ++i) T += 0.5 * data.v[i].dot(model.bodies[i].inertia * data.v[i]);
+  return T;
+}
+
+template <class S>
+double potentialEnergy(const TreeModel<S>& model, const TreeData<S>& data) {
+  double U = 0;
+  for (int i = 0; i < model.dof(); ++i) {
+    double m;
+    typename S::Pos c;
+    S::massAndCom(model.bodies[i].inertia, m, c);
+    U -= m * S::linear(model.gravity).dot(pointPosition(data, i, c));
+  }
+  return U;
+}
+
+VecN springTorque(const VecN& k, const VecN& q) { return springStiffnessMatrix(k) * q; }
+
+MatN springStiffnessMatrix(const VecN& k) {
+  const int n = int(k.size());
+  MatN K = MatN::Zero(n, n);
+  for (int i = 0; i < n; ++i) {
+    K(i, i) = k[i] + (i + 1 < n ? k[i + 1] : 0.0);
+    if (i + 1 < n) K(i, i + 1) = K(i + 1, i) = -k[i + 1];
+  }
+  return K;
+}
+
+double springEnergy(const VecN& k, const VecN& q) {
+  double P = 0;
+  for (int i = 0; i < k.size(); ++i) {
+    const double d = q[i] - (i > 0 ? q[i - 1] : 0.0);
+    P += 0.5 * k[i] * d * d;
+  }
+  return P;
+}
+
+#define DYNLAB_INSTANTIATE(S)                                                                     \
+  template struct TreeModel<S>;                                                                   \
+  template struct TreeData<S>;                                                                    \
+  template void forwardKinematics<S>(const TreeModel<S>&, const VecN&, const VecN&, TreeData<S>&); \
+  template VecN rnea<S>(const TreeModel<S>&, TreeData<S>&, const VecN&, const VecN&, bool);       \
+  template MatN crba<S>(const TreeModel<S>&, TreeData<S>&);                                       \
+  template VecN aba<S>(const TreeModel<S>&, TreeData<S>&, const VecN&, const VecN&);              \
+  template void pointJacobian<S>(const TreeModel<S>&, const TreeData<S>&, int, const S::Pos&,     \
+                                 MatN&, VecN&);                                                   \
+  template S::Pos pointPosition<S>(const TreeData<S>&, int, const S::Pos&);                       \
+  template double kineticEnergy<S>(const TreeModel<S>&, const TreeData<S>&);                      \
+  template double potentialEnergy<S>(const TreeModel<S>&, const TreeData<S>&);
+DYNLAB_INSTANTIATE(Planar)
+DYNLAB_INSTANTIATE(Spatial)
+#undef DYNLAB_INSTANTIATE
+
+}  // namespace dyn

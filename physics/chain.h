@@ -1,0 +1,96 @@
+// Tree (chain) dynamics, lecture eq. (1):
+//     M(θ) θ'' + C(θ,θ') θ' + G(θ) [+ K θ] = τ − J(θ)^T f
+// Written once for planar (3-vector) and spatial (6-vector) algebra (spatial.h).
+//   forwardKinematics  link transforms, velocities and velocity-product accelerations
+//   rnea               τ = ID(θ, θ', θ'')           (recursive Newton–Euler; θ''=0 gives Cθ'+G)
+//   crba               M(θ)                         (composite rigid body algorithm)
+//   aba                θ'' = FD(θ, θ', τ)           (articulated body algorithm, O(N))
+//   pointJacobian      J and J'θ' of a world-aligned frame at a point of a link
+//   springTorque       K θ, K tridiagonal: P_K = Σ K_i/2 (θ_i − θ_{i−1})²
+// Model (fixed) and Data (per-state scratch) are kept apart, as in MuJoCo.
+#pragma once
+#include <vector>
+
+#include "physics/spatial.h"
+#include "physics/types.h"
+
+namespace dyn {
+
+enum class JointType { Revolute, Prismatic };
+
+template <class S>
+struct TreeModel {
+  using Vec = typename S::Vec;
+  using Mat = typename S::Mat;
+  struct Body {
+    int parent;                      // −1: the fixed base
+    JointType joint;
+    typename S::Axis axis;           // prismatic direction (spatial: also the revolute axis)
+    typename S::Transform X_tree;    // parent frame → joint frame at θ = 0
+    Mat inertia;                     // spatial inertia at the body origin, body coordinates
+  };
+  std::vector<Body> bodies;
+  Vec gravity = Vec::Zero();         // spatial acceleration of gravity in world coordinates
+
+  int dof() const { return int(bodies.size()); }
+  int addBody(int parent, JointType joint, const typename S::Axis& axis,
+              const typename S::Transform& X_tree, const Mat& inertia) {
+    bodies.push_back({parent, joint, axis, X_tree, inertia});
+    return int(bodies.size()) - 1;
+  }
+  Vec motionSubspace(int i) const;
+};
+
+template <class S>
+struct TreeData {
+  using Vec = typename S::Vec;
+  std::vector<typename S::Transform> X_up;     // parent → body i
+  std::vector<typename S::Transform> X_world;  // world → body i
+  std::vector<Vec> S_i, v, c;                  // joint axis, body velocity, velocity-product accel
+  std::vector<Vec> a, f;                       // scratch for rnea
+  std::vector<typename S::Mat> Ic;             // scratch for crba / aba
+  std::vector<Vec> U, pA;                      // scratch for aba
+  std::vector<double> D, u;
+  explicit TreeData(const TreeModel<S>& model) { resize(model.dof()); }
+  void resize(int n);
+};
+
+// Fills X_up, X_world, v, c from (θ, θ'). Every other algorithm reads these.
+template <class S>
+void forwardKinematics(const TreeModel<S>& model, const VecN& q, const VecN& qd, TreeData<S>& data);
+
+// Inverse dynamics τ = M θ'' + C θ' + G with gravity (or without, when with_gravity is false).
+template <class S>
+VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const VecN& qdd,
+          bool with_gravity = true);
+
+// Joint-space inertia M(θ), symmetric positive definite.
+template <class S>
+MatN crba(const TreeModel<S>& model, TreeData<S>& data);
+
+// Forward dynamics θ'' = M⁻¹ (τ − C θ' − G) in O(N).
+template <class S>
+VecN aba(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const VecN& tau);
+
+// A frame at `point` (body coordinates) with world-aligned axes:
+//   V_P = J θ',  classical acceleration = J θ'' + J'θ'.
+template <class S>
+void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
+                   const typename S::Pos& point, MatN& J, VecN& Jdot_qd);
+
+// World position of a point given in body coordinates.
+template <class S>
+typename S::Pos pointPosition(const TreeData<S>& data, int body, const typename S::Pos& point);
+
+// Kinetic ½ Σ V_i·I_i V_i and gravitational potential −Σ m_i g·c_i (world centre of mass c_i).
+template <class S>
+double kineticEnergy(const TreeModel<S>& model, const TreeData<S>& data);
+template <class S>
+double potentialEnergy(const TreeModel<S>& model, const TreeData<S>& data);
+
+// Joint springs between consecutive joints: K θ with K tridiagonal (lecture §1), and P_K.
+VecN springTorque(const VecN& stiffness, const VecN& q);
+MatN springStiffnessMatrix(const VecN& stiffness);
+double springEnergy(const VecN& stiffness, const VecN& q);
+
+}  // namespace dyn

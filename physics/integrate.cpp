@@ -1,0 +1,113 @@
+// Fixed-step integrators (semi-implicit Euler, RK4) and drift handling (Baumgarte, projection,
+// independent coordinates) for any ConstrainedSystem; equations in integrate.h.
+#include "physics/integrate.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+
+namespace dyn {
+namespace {
+
+// Baumgarte's s = −2ζω G v − ω² φ, or nothing.
+const VecN* baumgarte(ConstrainedSystem& sys, const DriftOptions& d, const VecN& q, const VecN& v,
+                      VecN& s) {
+  if (d.kind != Drift::Baumgarte) return nullptr;
+  VecN phi;
+  MatN G;
+  sys.constraint(q, phi, G);
+  s = -2.0 * d.zeta * d.omega * (G * v) - d.omega * d.omega * phi;
+  return &s;
+}
+
+// Minimum-W-norm correction dx with G dx = e:  dx = W⁻¹Gᵀ (G W⁻¹ Gᵀ)⁻¹ e.
+VecN weightedCorrection(const MatN& W, const MatN& G, const VecN& e) {
+  const Eigen::LLT<MatN> w(W);
+  const MatN WinvGT = w.solve(G.transpose());
+  const MatN GWG = G * WinvGT;
+  return WinvGT * GWG.fullPivLu().solve(e);
+}
+
+}  // namespace
+
+bool projectPositions(ConstrainedSystem& sys, const DriftOptions& d, VecN& q) {
+  VecN phi;
+  MatN G, W;
+  sys.metric(q, W);
+  for (int it = 0; it < d.max_iterations; ++it) {
+    sys.constraint(q, phi, G);
+    if (phi.lpNorm<Eigen::Infinity>() <= d.tolerance) return true;
+    q -= weightedCorrection(W, G, phi);  // Newton step on φ(q) = 0
+  }
+  sys.constraint(q, phi, G);
+  return phi.lpNorm<Eigen::Infinity>() <= d.tolerance * 1e3;
+}
+
+void projectVelocities(ConstrainedSystem& sys, const VecN& q, VecN& v) {
+  VecN phi;
+  MatN G, W;
+  sys.constraint(q, phi, G);
+  sys.metric(q, W);
+  v -= weightedCorrection(W, G, G * v);
+}
+
+bool step(ConstrainedSystem& sys, const StepOptions& o, const VecN& tau, VecN& q, VecN& v) {
+  const double dt = o.dt;
+  VecN s, a;
+  if (o.integrator == Integrator::SemiImplicitEuler) {
+    sys.accelerations(q, v, tau, baumgarte(sys, o.drift, q, v, s), a);
+    v += dt * a;
+    q += dt * v;
+  } else {
+    // Classic RK4 on (q, v).
+    VecN a1, a2, a3, a4;
+    sys.accelerations(q, v, tau, baumgarte(sys, o.drift, q, v, s), a1);
+    const VecN v1 = v;
+    const VecN q2 = q + 0.5 * dt * v1, v2 = v + 0.5 * dt * a1;
+    sys.accelerations(q2, v2, tau, baumgarte(sys, o.drift, q2, v2, s), a2);
+    const VecN q3 = q + 0.5 * dt * v2, v3 = v + 0.5 * dt * a2;
+    sys.accelerations(q3, v3, tau, baumgarte(sys, o.drift, q3, v3, s), a3);
+    const VecN q4 = q + dt * v3, v4 = v + dt * a3;
+    sys.accelerations(q4, v4, tau, baumgarte(sys, o.drift, q4, v4, s), a4);
+    q += dt / 6.0 * (v1 + 2.0 * v2 + 2.0 * v3 + v4);
+    v += dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+  }
+  switch (o.drift.kind) {
+    case Drift::Projection: {
+      const bool ok = projectPositions(sys, o.drift, q);
+      projectVelocities(sys, q, v);
+      return ok;
+    }
+    case Drift::Independent:
+      return sys.recoverDependent(q, v);
+    default:
+      return true;
+  }
+}
+
+bool parseIntegrator(const std::string& n, Integrator& out) {
+  if (n == "semi_implicit_euler") out = Integrator::SemiImplicitEuler;
+  else if (n == "rk4") out = Integrator::RK4;
+  else return false;
+  return true;
+}
+
+bool parseDrift(const std::string& n, Drift& out) {
+  if (n == "none") out = Drift::None;
+  else if (n == "baumgarte") out = Drift::Baumgarte;
+  else if (n == "projection") out = Drift::Projection;
+  else if (n == "independent") out = Drift::Independent;
+  else return false;
+  return true;
+}
+
+const char* name(Integrator i) { return i == Integrator::RK4 ? "rk4" : "semi_implicit_euler"; }
+const char* name(Drift d) {
+  switch (d) {
+    case Drift::None: return "none";
+    case Drift::Baumgarte: return "baumgarte";
+    case Drift::Projection: return "projection";
+    default: return "independent";
+  }
+}
+
+}  // namespace dyn

@@ -1,0 +1,69 @@
+// Fixed-step integration of a constrained mechanism and what to do about drift (lecture §2.7).
+//
+// State: generalized coordinates q = (θ, x_c) and rates v = (θ', v_c); the position constraint
+// φ(q) = 0 with velocity form G(q) v = 0 (G = [J, −A] for the lecture's J θ' = A v_c).
+// Integrators:  semi-implicit Euler  v⁺ = v + dt a(q, v),  q⁺ = q + dt v⁺   (1st order, symplectic)
+//               RK4                  classic four-stage                     (4th order)
+// Drift:        none | Baumgarte  s = −2ζω G v − ω² φ  inside the solve
+//               | projection: q ← q − W⁻¹Gᵀ(G W⁻¹ Gᵀ)⁻¹ φ (Newton), v ← v − W⁻¹Gᵀ(G W⁻¹ Gᵀ)⁻¹ G v
+//                 with W the mass matrix (the velocity projection removes the least kinetic energy)
+//               | independent: keep only the independent coordinates and rebuild the rest
+//                 (the mechanism's recoverDependent, e.g. the slider crank from its crank angle).
+#pragma once
+#include <string>
+
+#include "physics/types.h"
+
+namespace dyn {
+
+enum class Integrator { SemiImplicitEuler, RK4 };
+enum class Drift { None, Baumgarte, Projection, Independent };
+
+struct DriftOptions {
+  Drift kind = Drift::Projection;
+  double zeta = 1.0;     // Baumgarte damping ratio
+  double omega = 50.0;   // Baumgarte natural frequency (rad/s)
+  double tolerance = 1e-12;
+  int max_iterations = 10;
+};
+
+// What an integrator needs from a mechanism. The control τ is held over the step (zero-order hold).
+class ConstrainedSystem {
+ public:
+  virtual ~ConstrainedSystem() = default;
+  virtual int nq() const = 0;
+  // Accelerations a = (θ'', α_c) from the solve (2)/(3); stab is the Baumgarte term or null.
+  virtual void accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab,
+                             VecN& a) = 0;
+  // φ(q) and G(q) (G v = 0 is the velocity constraint).
+  virtual void constraint(const VecN& q, VecN& phi, MatN& G) = 0;
+  // The projection metric W (mass matrix), positive definite.
+  virtual void metric(const VecN& q, MatN& W) = 0;
+  // Rebuild the dependent coordinates and rates from the independent ones; false if unsupported.
+  virtual bool recoverDependent(VecN& q, VecN& v) {
+    (void)q;
+    (void)v;
+    return false;
+  }
+};
+
+struct StepOptions {
+  double dt = 1e-3;
+  Integrator integrator = Integrator::RK4;
+  DriftOptions drift;
+};
+
+// One fixed step of (q, v) with τ held. Returns false if a projection failed to converge.
+bool step(ConstrainedSystem& system, const StepOptions& options, const VecN& tau, VecN& q, VecN& v);
+
+// Projection onto φ = 0 and G v = 0 (also used to make initial conditions consistent).
+bool projectPositions(ConstrainedSystem& system, const DriftOptions& options, VecN& q);
+void projectVelocities(ConstrainedSystem& system, const VecN& q, VecN& v);
+
+// Names as they appear in lab JSON; parse returns false on an unknown name.
+bool parseIntegrator(const std::string& name, Integrator& out);
+bool parseDrift(const std::string& name, Drift& out);
+const char* name(Integrator i);
+const char* name(Drift d);
+
+}  // namespace dyn

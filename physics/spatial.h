@@ -1,0 +1,197 @@
+// Spatial algebra for planar (3-vector) and spatial (6-vector) chains, lecture conventions:
+//   planar motion V = (ω, vx, vy), force f = (τ, fx, fy);  spatial V = (ω, v), f = (n, f).
+// A Transform X = {E, r} takes coordinates from frame A to frame B, where r is B's origin in A
+// and E rotates A-coordinates into B-coordinates (Featherstone's convention):
+//   motion  V_B = X V_A = (E ω, E (v − r × ω))        — with E = I this is Φ(r) of the lecture
+//   force   f_A = X^T f_B = (E^T n + r × E^T f, E^T f) — power preserved: V_B·f_B = V_A·f_A
+// The tree algorithms (chain.h) are written once against this interface.
+#pragma once
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace dyn {
+
+// ---------------------------------------------------------------- planar: 3-vectors
+struct Planar {
+  static constexpr int kDim = 3;
+  using Vec = Eigen::Vector3d;    // (ω, vx, vy) or (τ, fx, fy)
+  using Mat = Eigen::Matrix3d;
+  using Rot = Eigen::Matrix2d;
+  using Pos = Eigen::Vector2d;
+  using Axis = Eigen::Vector2d;   // prismatic direction (revolute is always about z)
+
+  struct Transform {
+    Rot E = Rot::Identity();
+    Pos r = Pos::Zero();
+  };
+
+  static Rot rotation(double angle) {  // rotates A-coords into B-coords for B turned by angle
+    const double c = std::cos(angle), s = std::sin(angle);
+    return (Rot() << c, s, -s, c).finished();
+  }
+  static double crossScalar(const Pos& a, const Pos& b) { return a.x() * b.y() - a.y() * b.x(); }
+  static Pos perp(const Pos& a) { return {-a.y(), a.x()}; }  // ẑ × a
+
+  static Vec motion(const Transform& X, const Vec& v) {
+    const Pos lin = v.tail<2>() + v[0] * perp(X.r);  // v + ω × r
+    Vec out;
+    out << v[0], X.E * lin;
+    return out;
+  }
+  static Vec motionInverse(const Transform& X, const Vec& v) {  // X^{-1} V_B = V_A
+    const Pos lin = X.E.transpose() * v.tail<2>() - v[0] * perp(X.r);
+    Vec out;
+    out << v[0], lin;
+    return out;
+  }
+  static Vec forceTranspose(const Transform& X, const Vec& f) {  // X^T f_B = f_A
+    const Pos fa = X.E.transpose() * f.tail<2>();
+    Vec out;
+    out << f[0] + crossScalar(X.r, fa), fa;
+    return out;
+  }
+  static Mat motionMatrix(const Transform& X) {
+    Mat m = Mat::Zero();
+    m(0, 0) = 1;
+    m.block<2, 1>(1, 0) = X.E * perp(X.r);
+    m.block<2, 2>(1, 1) = X.E;
+    return m;
+  }
+  // X_AC = X_BC ∘ X_AB
+  static Transform compose(const Transform& bc, const Transform& ab) {
+    return {bc.E * ab.E, ab.r + ab.E.transpose() * bc.r};
+  }
+  static Transform inverse(const Transform& X) { return {X.E.transpose(), -X.E * X.r}; }
+  static Transform translation(const Pos& p) { return {Rot::Identity(), p}; }
+
+  // v ×m w  and  v ×* f  (planar restriction of the 6-D cross products)
+  static Vec crossMotion(const Vec& v, const Vec& m) {
+    return {0.0, -v[0] * m[2] + v[2] * m[0], v[0] * m[1] - v[1] * m[0]};
+  }
+  static Vec crossForce(const Vec& v, const Vec& f) {
+    return {v[1] * f[2] - v[2] * f[1], -v[0] * f[2], v[0] * f[1]};
+  }
+  // Rigid-body inertia at the body origin: mass m, centre of mass c, inertia Ic about c.
+  static Mat inertia(double m, const Pos& c, double Ic) {
+    Mat I;
+    I << Ic + m * c.squaredNorm(), -m * c.y(), m * c.x(),  //
+        -m * c.y(), m, 0,                                 //
+        m * c.x(), 0, m;
+    return I;
+  }
+  // Joint: revolute about z, or prismatic along axis.
+  static Vec revoluteAxis() { return {1, 0, 0}; }
+  static Vec prismaticAxis(const Axis& a) { return {0, a.x(), a.y()}; }
+  static Transform jointTransform(bool revolute, const Axis& axis, double q) {
+    if (revolute) return {rotation(q), Pos::Zero()};
+    return {Rot::Identity(), axis * q};
+  }
+  // Classical acceleration of a point from the spatial acceleration and velocity at it.
+  static Vec classicalAcceleration(const Vec& a, const Vec& v) {
+    return {a[0], a[1] - v[0] * v[2], a[2] + v[0] * v[1]};
+  }
+  static Pos worldPoint(const Transform& X0, const Pos& p) { return X0.r + X0.E.transpose() * p; }
+  // Mass and centre of mass back out of a body inertia.
+  static void massAndCom(const Mat& I, double& m, Pos& c) {
+    m = I(1, 1);
+    c = m > 0 ? Pos(I(0, 2) / m, -I(0, 1) / m) : Pos::Zero();
+  }
+  static Pos linear(const Vec& v) { return v.tail<2>(); }
+};
+
+// ---------------------------------------------------------------- spatial: 6-vectors
+struct Spatial {
+  static constexpr int kDim = 6;
+  using Vec = Eigen::Matrix<double, 6, 1>;  // (ω, v) or (n, f)
+  using Mat = Eigen::Matrix<double, 6, 6>;
+  using Rot = Eigen::Matrix3d;
+  using Pos = Eigen::Vector3d;
+  using Axis = Eigen::Vector3d;
+
+  struct Transform {
+    Rot E = Rot::Identity();
+    Pos r = Pos::Zero();
+  };
+
+  static Eigen::Matrix3d skew(const Pos& p) {
+    Eigen::Matrix3d s;
+    s << 0, -p.z(), p.y(), p.z(), 0, -p.x(), -p.y(), p.x(), 0;
+    return s;
+  }
+  static Vec motion(const Transform& X, const Vec& v) {
+    Vec out;
+    out << X.E * v.head<3>(), X.E * (v.tail<3>() - X.r.cross(v.head<3>()));
+    return out;
+  }
+  static Vec motionInverse(const Transform& X, const Vec& v) {
+    const Pos w = X.E.transpose() * v.head<3>();
+    Vec out;
+    out << w, X.E.transpose() * v.tail<3>() + X.r.cross(w);
+    return out;
+  }
+  static Vec forceTranspose(const Transform& X, const Vec& f) {
+    const Pos fa = X.E.transpose() * f.tail<3>();
+    Vec out;
+    out << X.E.transpose() * f.head<3>() + X.r.cross(fa), fa;
+    return out;
+  }
+  static Mat motionMatrix(const Transform& X) {
+    Mat m = Mat::Zero();
+    m.block<3, 3>(0, 0) = X.E;
+    m.block<3, 3>(3, 0) = -X.E * skew(X.r);
+    m.block<3, 3>(3, 3) = X.E;
+    return m;
+  }
+  static Transform compose(const Transform& bc, const Transform& ab) {
+    return {bc.E * ab.E, ab.r + ab.E.transpose() * bc.r};
+  }
+  static Transform inverse(const Transform& X) { return {X.E.transpose(), -X.E * X.r}; }
+  static Transform translation(const Pos& p) { return {Rot::Identity(), p}; }
+
+  static Vec crossMotion(const Vec& v, const Vec& m) {
+    Vec out;
+    out << v.head<3>().cross(m.head<3>()),
+        v.head<3>().cross(m.tail<3>()) + v.tail<3>().cross(m.head<3>());
+    return out;
+  }
+  static Vec crossForce(const Vec& v, const Vec& f) {
+    Vec out;
+    out << v.head<3>().cross(f.head<3>()) + v.tail<3>().cross(f.tail<3>()),
+        v.head<3>().cross(f.tail<3>());
+    return out;
+  }
+  static Mat inertia(double m, const Pos& c, const Eigen::Matrix3d& Ic) {
+    const Eigen::Matrix3d C = skew(c);
+    Mat I;
+    I << Ic + m * C * C.transpose(), m * C, m * C.transpose(), m * Eigen::Matrix3d::Identity();
+    return I;
+  }
+  static Vec revoluteAxis(const Axis& a) {
+    Vec s;
+    s << a.normalized(), Pos::Zero();
+    return s;
+  }
+  static Vec prismaticAxis(const Axis& a) {
+    Vec s;
+    s << Pos::Zero(), a.normalized();
+    return s;
+  }
+  static Transform jointTransform(bool revolute, const Axis& axis, double q) {
+    if (revolute) return {Eigen::AngleAxisd(q, axis.normalized()).toRotationMatrix().transpose(), Pos::Zero()};
+    return {Rot::Identity(), axis.normalized() * q};
+  }
+  static Vec classicalAcceleration(const Vec& a, const Vec& v) {
+    Vec out;
+    out << a.head<3>(), a.tail<3>() + v.head<3>().cross(v.tail<3>());
+    return out;
+  }
+  static Pos worldPoint(const Transform& X0, const Pos& p) { return X0.r + X0.E.transpose() * p; }
+  static void massAndCom(const Mat& I, double& m, Pos& c) {
+    m = I(5, 5);
+    const Eigen::Matrix3d mC = I.block<3, 3>(0, 3);
+    c = m > 0 ? Pos(Pos(mC(2, 1), mC(0, 2), mC(1, 0)) / m) : Pos(Pos::Zero());
+  }
+  static Pos linear(const Vec& v) { return v.tail<3>(); }
+};
+
+}  // namespace dyn
