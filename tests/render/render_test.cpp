@@ -91,6 +91,10 @@ TEST_CASE("the overlay panel is drawn top-left on the first frame") {
       changed_far += std::equal(with.pixel(x, y), with.pixel(x, y) + 4, without.pixel(x, y)) ? 0 : 1;
   CHECK(changed > 2000);
   CHECK(changed_far == 0);
+  // The translucent panel keeps the frame opaque (alpha 255 everywhere).
+  bool opaque = true;
+  for (std::size_t i = 3; i < with.rgba.size(); i += 4) opaque = opaque && with.rgba[i] == 255;
+  CHECK(opaque);
   // Options can switch the overlay off even when one is passed.
   Renderer hidden(*context, RenderOptions{4, false});
   CHECK(hidden.render(scene, &overlay).rgba == without.rgba);
@@ -103,4 +107,52 @@ TEST_CASE("MSAA off still renders the capsule") {
   const Image image = renderer.render(scene, nullptr);
   const Eigen::Vector2d px = Renderer::project(scene.camera, 160, 120, {0.25, 0.15, 0});
   CHECK(reddish(image.pixel(int(px.x()), int(px.y()))));
+}
+
+TEST_CASE("perspective cameras project to the drawn pixels too") {
+  auto context = makeOffscreenContext(320, 240);
+  Renderer renderer(*context);
+  Scene scene = test::redCapsuleScene();
+  scene.camera.ortho = false;
+  scene.camera.eye = {0.6, 0.5, 1.5};
+  scene.camera.target = {0.25, 0.15, 0};
+  const Image image = renderer.render(scene, nullptr);
+  for (double t : {0.2, 0.5, 0.8}) {
+    const Eigen::Vector2d px =
+        Renderer::project(scene.camera, 320, 240, t * Eigen::Vector3d(0.5, 0.3, 0));
+    INFO("t=" << t << " px=" << px.transpose());
+    CHECK(reddish(image.pixel(int(px.x()), int(px.y()))));
+  }
+  // The look-at target is the image centre.
+  const Eigen::Vector2d centre = Renderer::project(scene.camera, 320, 240, scene.camera.target);
+  CHECK(centre.x() == doctest::Approx(160.0));
+  CHECK(centre.y() == doctest::Approx(120.0));
+}
+
+TEST_CASE("a small sphere's pixel centroid is where project() says, to half a pixel") {
+  auto context = makeOffscreenContext(320, 240);
+  Renderer renderer(*context);
+  for (bool ortho : {true, false}) {
+    Scene scene;
+    scene.camera.ortho = ortho;
+    const Eigen::Vector3d centre(0.31, -0.27, 0.05);
+    scene.spheres.push_back({centre, 0.06, {0.9f, 0.1f, 0.1f, 1.0f}});
+    const Image image = renderer.render(scene, nullptr);
+    // Coverage-weighted centroid of the red pixels (pixel centres at +0.5).
+    double sx = 0, sy = 0, sw = 0;
+    for (int y = 0; y < 240; ++y)
+      for (int x = 0; x < 320; ++x) {
+        const double w = (scene.background.g * 255.0 - image.pixel(x, y)[1]) / 255.0;
+        if (w <= 0) continue;
+        sx += w * (x + 0.5);
+        sy += w * (y + 0.5);
+        sw += w;
+      }
+    REQUIRE(sw > 20);
+    const Eigen::Vector2d px = Renderer::project(scene.camera, 320, 240, centre);
+    INFO("ortho=" << ortho << " projected " << px.transpose() << " centroid " << sx / sw << " "
+                  << sy / sw);
+    CHECK(std::abs(sx / sw - px.x()) < 0.5);
+    CHECK(std::abs(sy / sw - px.y()) < 0.5);
+  }
 }
