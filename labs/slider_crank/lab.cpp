@@ -1,0 +1,272 @@
+// Slider-crank lab: parses slider_crank.json, runs the hand-written model (eq. 2 through the
+// generic solve) or the Bullet reference with the same controller, and measures the runs.
+#include "labs/slider_crank/lab.h"
+
+#include <cmath>
+
+#include "physics/bullet/slider_crank_bullet.h"
+
+namespace dyn::slider_crank {
+namespace {
+
+const std::vector<std::string> kColumns = {
+    "t",   "q1",   "q2",   "q3",     "x_c",    "v_c",    "f_Tx",                "f_Ty", "tau_T",
+    "tau1", "tau2", "tau3", "energy", "constraint_residual", "x_d",  "f_des",  "f_meas", "work"};
+
+Link parseLink(const JsonView& j) {
+  j.onlyKeys({"length", "mass", "inertia", "com"});
+  j["com"].size(2, 2);
+  return {j["length"].positive(), j["mass"].positive(), j["inertia"].positive(),
+          {j["com"].at(0).number(), j["com"].at(1).number()}};
+}
+
+// Everything a run needs, and the one place the trace row is laid out.
+struct RowState {
+  double t;
+  Eigen::Vector3d th, thd;
+  double x_c, v_c;
+  Eigen::Vector3d f_T, tau;
+  double energy, residual, x_d, f_des, f_meas, work;
+  void write(std::vector<double>& row) const {
+    row = {t,      th[0],    th[1],    th[2],    x_c,    v_c,  f_T[1], f_T[2], f_T[0],
+           tau[0], tau[1],   tau[2],   energy,   residual, x_d, f_des, f_meas, work};
+  }
+};
+
+// The hand-written engine: eq. (2) through the generic solve, integrated by physics/integrate.
+class HandSimulation final : public Simulation {
+ public:
+  explicit HandSimulation(const Settings& s)
+      : s_(s), mech_(s.params), ctrl_(s.controller, s.reference, s.params, s.step.dt),
+        steps_(std::lround(s.duration / s.step.dt)) {
+    mech_.initialState(s.theta1, s.theta1_rate, s.branch, q_, v_);
+    e0_ = mech_.energy(q_, v_);
+  }
+  bool step(std::vector<double>& row) override {
+    if (k_ >= steps_ || !failure_.empty()) return false;
+    const double t = double(k_) * s_.step.dt;
+    const Eigen::Vector3d th = q_.head(3), thd = v_.head(3);
+    const Eigen::Vector3d tau = ctrl_.torque(t, th, thd, q_[3], v_[3]);
+    // The constraint force at this instant, from the same solve the integrator uses.
+    const ConstrainedSolution sol = mech_.solve(q_, v_, tau);
+    RowState r{t, th, thd, q_[3], v_[3], sol.f.head(3), tau, mech_.energy(q_, v_), mech_.residual(q_),
+               ctrl_.reference().position(t), s_.controller.f_des, ctrl_.measured(), work_};
+    r.write(row);
+    if (!dyn::step(mech_, s_.step, VecN(tau), q_, v_)) failure_ = "the constraint projection failed";
+    work_ += tau.dot(0.5 * (thd + Eigen::Vector3d(v_.head(3)))) * s_.step.dt;  // ∫ τ·θ' dt, trapezoid
+    ctrl_.measure(sol.f[2]);
+    if (!q_.allFinite() || !v_.allFinite()) failure_ = "the state became non-finite";
+    ++k_;
+    return true;
+  }
+  std::string failure() const override { return failure_; }
+
+ private:
+  Settings s_;
+  Mechanism mech_;
+  Controller ctrl_;
+  long steps_, k_ = 0;
+  VecN q_, v_;
+  double e0_ = 0, work_ = 0;
+  std::string failure_;
+};
+
+// The Bullet reference, driven by the same controller; energy and residual use the same formulas.
+class BulletSimulation final : public Simulation {
+ public:
+  explicit BulletSimulation(const Settings& s)
+      : s_(s), mech_(s.params), ctrl_(s.controller, s.reference, s.params, s.step.dt),
+        steps_(std::lround(s.duration / s.step.dt)) {
+    VecN q, v;
+    mech_.initialState(s.theta1, s.theta1_rate, s.branch, q, v);
+    bullet::SliderCrankModel m;
+    for (int i = 0; i < 3; ++i) {
+      const Link& l = s.params.links[i];
+      m.links[i] = {l.length, l.mass, l.inertia, l.com};
+    }
+    m.load_mass = s.params.load_mass;
+    m.gravity = s.params.gravity;
+    m.q0 = q.head(3);
+    m.qd0 = v.head(3);
+    world_ = std::make_unique<bullet::SliderCrankBullet>(m, s.step.dt);
+  }
+  bool step(std::vector<double>& row) override {
+    if (k_ >= steps_ || !failure_.empty()) return false;
+    const double t = double(k_) * s_.step.dt;
+    const Eigen::Vector3d th = world_->q(), thd = world_->qd();
+    const double x_c = world_->x_c(), v_c = world_->v_c();
+    VecN q(4), v(4);
+    q << th, x_c;
+    v << thd, v_c;
+    const Eigen::Vector3d tau = ctrl_.torque(t, th, thd, x_c, v_c);
+    const double energy = mech_.energy(q, v), residual = mech_.residual(q);
+    world_->step(tau);
+    // Bullet reports the force over the step just taken.
+    const Eigen::Vector3d f = world_->tipForce();
+    RowState r{t, th, thd, x_c, v_c, f, tau, energy, residual, ctrl_.reference().position(t),
+               s_.controller.f_des, ctrl_.measured(), work_};
+    r.write(row);
+    work_ += tau.dot(0.5 * (thd + world_->qd())) * s_.step.dt;
+    ctrl_.measure(f[2]);
+    if (!world_->q().allFinite() || !world_->qd().allFinite()) failure_ = "the Bullet state became non-finite";
+    ++k_;
+    return true;
+  }
+  std::string failure() const override { return failure_; }
+
+ private:
+  Settings s_;
+  Mechanism mech_;
+  Controller ctrl_;
+  long steps_, k_ = 0;
+  std::unique_ptr<bullet::SliderCrankBullet> world_;
+  double work_ = 0;
+  std::string failure_;
+};
+
+double rms(const std::vector<double>& x) {
+  double s = 0;
+  for (double v : x) s += v * v;
+  return x.empty() ? 0 : std::sqrt(s / double(x.size()));
+}
+
+}  // namespace
+
+Settings parseSettings(const JsonView& c) {
+  Settings s;
+  c.onlyKeys({"lab", "title", "description", "mechanism", "initial", "simulation", "controller", "gains",
+              "reference", "metrics", "rubric", "scenarios", "drawing"});
+  const JsonView m = c["mechanism"];
+  m.onlyKeys({"links", "load_mass", "gravity"});
+  m["links"].size(3, 3);
+  for (int i = 0; i < 3; ++i) s.params.links[i] = parseLink(m["links"].at(i));
+  s.params.load_mass = m["load_mass"].positive();
+  m["gravity"].size(2, 2);
+  s.params.gravity = {m["gravity"].at(0).number(), m["gravity"].at(1).number()};
+
+  const JsonView init = c["initial"];
+  init.onlyKeys({"theta1_deg", "theta1_rate", "branch"});
+  s.theta1 = init["theta1_deg"].inRange(-360, 360) * M_PI / 180.0;
+  s.theta1_rate = init.number("theta1_rate", 0.0);
+  if (init.has("branch")) s.branch = init["branch"].oneOf({"cos_positive", "cos_negative"}) == "cos_positive" ? 1 : -1;
+  const auto& L = s.params.links;
+  if (std::abs(L[0].length * std::sin(s.theta1)) > L[1].length)
+    init["theta1_deg"].fail("expected a crank angle the rod can reach (|l1 sin θ1| ≤ l2)");
+
+  const JsonView sim = c["simulation"];
+  sim.onlyKeys({"dt", "duration", "integrator", "drift", "baumgarte"});
+  s.step.dt = sim["dt"].positive();
+  if (s.step.dt > 0.05) sim["dt"].fail("expected dt ≤ 0.05 s, got " + std::to_string(s.step.dt));
+  s.duration = sim["duration"].positive();
+  if (s.duration / s.step.dt > 1e7) sim["duration"].fail("expected at most 1e7 steps (duration/dt)");
+  parseIntegrator(sim["integrator"].oneOf({"semi_implicit_euler", "rk4"}), s.step.integrator);
+  parseDrift(sim["drift"].oneOf({"none", "baumgarte", "projection", "independent"}), s.step.drift.kind);
+  if (sim.has("baumgarte")) {
+    sim["baumgarte"].onlyKeys({"zeta", "omega"});
+    s.step.drift.zeta = sim["baumgarte"]["zeta"].positive();
+    s.step.drift.omega = sim["baumgarte"]["omega"].positive();
+  }
+
+  const JsonView ctl = c["controller"];
+  ctl.onlyKeys({"kind", "force_law", "force_setpoint", "delay", "noise_std", "seed"});
+  auto& cc = s.controller;
+  cc.kind = ctl["kind"].oneOf({"none", "force_control"}) == "none" ? ControllerKind::None : ControllerKind::ForceControl;
+  const std::string law = ctl["force_law"].oneOf({"open_loop", "proportional", "integral"});
+  cc.law = law == "open_loop" ? ForceLaw::OpenLoop : law == "proportional" ? ForceLaw::Proportional : ForceLaw::Integral;
+  cc.f_des = ctl["force_setpoint"].inRange(-1e4, 1e4);
+  cc.delay = ctl["delay"].inRange(0, 1);
+  cc.noise_std = ctl.has("noise_std") ? ctl["noise_std"].nonNegative() : 0.0;
+  cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1L << 53)) : 1;
+
+  // Gains: declared with value and bounds (the submission schema comes from here).
+  const JsonView g = c["gains"];
+  g.onlyKeys({"kp_x", "kd_x", "kp_f", "ki_f"});
+  auto gain = [&](const char* key) {
+    const JsonView d = g[key];
+    const double lo = d["min"].number(), hi = d["max"].number();
+    return d["value"].inRange(lo, hi);
+  };
+  cc.gains = {gain("kp_x"), gain("kd_x"), gain("kp_f"), gain("ki_f")};
+
+  const JsonView ref = c["reference"];
+  ref.onlyKeys({"kind", "amplitude", "period"});
+  ref["kind"].oneOf({"raised_cosine"});
+  s.reference.amplitude = ref["amplitude"].inRange(-2, 2);
+  s.reference.period = ref["period"].positive();
+
+  if (c.has("metrics")) {
+    c["metrics"].onlyKeys({"settle_time"});
+    s.settle_time = c["metrics"]["settle_time"].nonNegative();
+  }
+  if (c.has("drawing")) {
+    c["drawing"].onlyKeys({"arrow_scale"});
+    s.arrow_scale = c["drawing"]["arrow_scale"].positive();
+  }
+  // The reference starts where the slider starts.
+  Mechanism mech(s.params);
+  VecN q, v;
+  if (!mech.initialState(s.theta1, s.theta1_rate, s.branch, q, v))
+    init.fail("expected an initial state the mechanism can assemble");
+  s.reference.x0 = q[3];
+  return s;
+}
+
+SliderCrankLab::SliderCrankLab(Settings s) : s_(std::move(s)) {}
+
+std::vector<std::string> SliderCrankLab::columns() const { return kColumns; }
+
+std::unique_ptr<Simulation> SliderCrankLab::simulate(Engine engine) const {
+  if (engine == Engine::Hand) return std::make_unique<HandSimulation>(s_);
+  return std::make_unique<BulletSimulation>(s_);
+}
+
+json SliderCrankLab::metrics(const Trace& tr) const {
+  std::vector<double> ex, ef;
+  double ex_max = 0, ef_max = 0, tau_max = 0, drift = 0, residual = 0;
+  const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
+  for (std::size_t r = 0; r < tr.rows(); ++r) {
+    const double e = tr.at(r, "x_c") - tr.at(r, "x_d");
+    ex.push_back(e);
+    ex_max = std::max(ex_max, std::abs(e));
+    if (tr.at(r, "t") >= s_.settle_time) {
+      const double f = tr.at(r, "f_Ty") - tr.at(r, "f_des");
+      ef.push_back(f);
+      ef_max = std::max(ef_max, std::abs(f));
+    }
+    for (const char* c : {"tau1", "tau2", "tau3"}) tau_max = std::max(tau_max, std::abs(tr.at(r, c)));
+    // Energy balance: E − E0 − ∫ τ·θ' dt (zero for exact dynamics, with or without control).
+    drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
+    residual = std::max(residual, tr.at(r, "constraint_residual"));
+  }
+  return {{"x_rms", rms(ex)},          {"x_max_error", ex_max},
+          {"f_rms", rms(ef)},          {"f_max_error", ef_max},
+          {"tau_max", tau_max},        {"energy_drift", drift},
+          {"energy_initial", e0},      {"max_constraint_residual", residual},
+          {"steps", tr.rows()},        {"settle_time", s_.settle_time}};
+}
+
+json SliderCrankLab::agreement(const Trace& a, const Trace& b) const {
+  const std::size_t n = std::min(a.rows(), b.rows());
+  double dq = 0, dx = 0, df = 0, dtau_T = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    for (const char* c : {"q1", "q2", "q3"}) dq = std::max(dq, std::abs(a.at(r, c) - b.at(r, c)));
+    dx = std::max(dx, std::abs(a.at(r, "x_c") - b.at(r, "x_c")));
+    for (const char* c : {"f_Tx", "f_Ty"}) df = std::max(df, std::abs(a.at(r, c) - b.at(r, c)));
+    dtau_T = std::max(dtau_T, std::abs(a.at(r, "tau_T") - b.at(r, "tau_T")));
+  }
+  const json ma = metrics(a), mb = metrics(b);
+  return {{"rows_compared", n},
+          {"max_dq", dq},
+          {"max_dx_c", dx},
+          {"max_df", df},
+          {"max_dtau_T", dtau_T},
+          {"hand", {{"energy_drift", ma["energy_drift"]}, {"max_constraint_residual", ma["max_constraint_residual"]}}},
+          {"bullet", {{"energy_drift", mb["energy_drift"]}, {"max_constraint_residual", mb["max_constraint_residual"]}}}};
+}
+
+DYNLAB_REGISTER_LAB(slider_crank, "Slider crank: move the slider along x_d(t) while regulating its rail force (direct force control on a closed chain)",
+                    [](const JsonView& config) -> std::unique_ptr<Lab> {
+                      return std::make_unique<SliderCrankLab>(parseSettings(config));
+                    });
+
+}  // namespace dyn::slider_crank
