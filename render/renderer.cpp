@@ -77,7 +77,11 @@ struct Renderer::Impl {
   GLuint resolve_fbo = 0, resolve_color = 0, resolve_depth = 0;
   gl::ShadedProgram shaded;
   gl::LineProgram line;
-  gl::Mesh capsule, cone, box;
+  // Capsule/sphere levels of detail by on-screen radius (silhouette error under ~1/4 pixel).
+  static constexpr int kLevels = 4;
+  static constexpr double kLevelMaxRadiusPx[kLevels] = {5, 16, 48, 1e300};
+  gl::Mesh capsules[kLevels];
+  gl::Mesh cone, box;
   GLuint line_vao = 0, line_vbo = 0;
   std::unique_ptr<gl::OverlayPanel> overlay;  // created on first use
   std::vector<DrawItem> items;                // reused between frames
@@ -87,7 +91,8 @@ struct Renderer::Impl {
     createFramebuffers();
     shaded = gl::makeShadedProgram();
     line = gl::makeLineProgram();
-    capsule = gl::makeCapsule(28, 7);
+    const int slices[kLevels] = {10, 16, 28, 48};
+    for (int i = 0; i < kLevels; ++i) capsules[i] = gl::makeCapsule(slices[i], slices[i] / 4 + 1);
     cone = gl::makeCone(40);
     box = gl::makeBox();
     // Polyline stream: attributes 0 position, 1 other end, 2 side.
@@ -109,7 +114,7 @@ struct Renderer::Impl {
 
   ~Impl() {
     overlay.reset();
-    capsule.destroy();
+    for (auto& mesh : capsules) mesh.destroy();
     cone.destroy();
     box.destroy();
     glDeleteBuffers(1, &line_vbo);
@@ -152,11 +157,24 @@ struct Renderer::Impl {
   void collectItems(const Scene& scene, const CameraBasis& basis) {
     items.clear();
     auto depthOf = [&](const Vector3d& p) { return (scene.camera.eye - p).dot(basis.back); };
+    // Pixels per metre at a point (constant for orthographic cameras).
+    const Camera& cam = scene.camera;
+    auto pixelsPerMetre = [&](const Vector3d& p) {
+      if (cam.ortho) return height / (2.0 * cam.half_height);
+      const double half_fov = std::tan(cam.fov_y_deg * M_PI / 360.0);
+      return height / (2.0 * half_fov * std::max(depthOf(p), 1e-6));
+    };
+    auto capsuleMesh = [&](const Vector3d& centre, double r) {
+      const double r_px = r * pixelsPerMetre(centre);
+      int level = 0;
+      while (r_px > kLevelMaxRadiusPx[level]) ++level;
+      return &capsules[level];
+    };
     auto addCapsule = [&](const Vector3d& p0, const Vector3d& p1, double r, const Color& color) {
       const Vector3d axis = p1 - p0;
       const double length = axis.norm();
       const Matrix3d rot = length > 1e-12 ? frameAlong(axis / length) : Matrix3d::Identity();
-      items.push_back({&capsule, affine(rot * r, p0), rot.cast<float>(),
+      items.push_back({capsuleMesh(0.5 * (p0 + p1), r), affine(rot * r, p0), rot.cast<float>(),
                        Eigen::Vector3f(0, 0, float(length / r)), color, depthOf(0.5 * (p0 + p1))});
     };
     for (const auto& c : scene.capsules)
@@ -293,18 +311,20 @@ struct Renderer::Impl {
     glDisable(GL_BLEND);
     glBindVertexArray(0);
 
-    // The panel on top (its own GL state, restored by the backend).
-    if (options.show_overlay && panel) {
-      glDisable(GL_DEPTH_TEST);
-      if (!overlay) overlay = std::make_unique<gl::OverlayPanel>(width, height);
-      overlay->draw(*panel);
-    }
-
     // Resolve the samples into the single-sample framebuffer that read() uses.
     if (samples > 0) {
       glBindFramebuffer(GL_READ_FRAMEBUFFER, msaa_fbo);
       glBindFramebuffer(GL_DRAW_FRAMEBUFFER, resolve_fbo);
       glBlitFramebuffer(0, 0, width, height, 0, 0, width, height, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+    }
+
+    // The panel on top, after the resolve: ImGui anti-aliases itself, so it skips the 4x
+    // samples (its own GL state is restored by the backend).
+    if (options.show_overlay && panel) {
+      glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo);
+      glDisable(GL_DEPTH_TEST);
+      if (!overlay) overlay = std::make_unique<gl::OverlayPanel>(width, height);
+      overlay->draw(*panel);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
   }
