@@ -1,0 +1,104 @@
+// dynlab bench: speed is measured here, never asserted in tests.
+//   hand vs Bullet: median µs per step of each engine on the lab's default config, and the ratio;
+//   render, render+PNG, render+video: frames per second at 640×480 (MSAA 4, overlay on).
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+
+#include "app/commands.h"
+#include "app/movie.h"
+#include "labs/run.h"
+#include "render/video.h"
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace dyn::app {
+namespace {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+// Median wall time of one step, µs, over `steps` steps of a fresh run.
+double stepMicros(const Lab& lab, Engine engine, int steps) {
+  auto sim = lab.simulate(engine);
+  std::vector<double> row, times;
+  times.reserve(std::size_t(steps));
+  for (int k = 0; k < steps; ++k) {
+    const auto t0 = Clock::now();
+    if (!sim->step(row)) sim = lab.simulate(engine);  // wrap around short runs
+    times.push_back(std::chrono::duration<double, std::micro>(Clock::now() - t0).count());
+  }
+  return median(times);
+}
+
+// Frames per second of draw+read (+ PNG, + video) over `frames` frames of the hand run.
+struct Fps {
+  double render = 0, png = 0, video = 0;
+};
+
+Fps frameRates(const Lab& lab, const Trace& trace, int frames) {
+  auto context = makeOffscreenContext(640, 480);
+  Renderer renderer(*context);
+  const auto rows = frameRows(trace, lab.dt(), 30);
+  const fs::path dir = fs::temp_directory_path() / "dynlab-bench";
+  fs::create_directories(dir);
+  auto run = [&](int mode) {
+    std::unique_ptr<VideoWriter> video;
+    if (mode == 2) video = std::make_unique<VideoWriter>((dir / "bench.mp4").string(), 640, 480, 30);
+    const auto t0 = Clock::now();
+    for (int k = 0; k < frames; ++k) {
+      Scene scene;
+      Overlay overlay;
+      const std::size_t row = rows[std::size_t(k) % rows.size()];
+      lab.scene(trace, row, nullptr, scene);
+      lab.overlay(trace, row, overlay);
+      const Image image = renderer.render(scene, &overlay);
+      if (mode == 1) writePng((dir / "bench.png").string(), image);
+      if (video) video->addFrame(image);
+    }
+    if (video) video->close();
+    return frames / std::chrono::duration<double>(Clock::now() - t0).count();
+  };
+  run(0);  // warm up (shader compilation, first ImGui frame)
+  Fps f{run(0), run(1), run(2)};
+  fs::remove_all(dir);
+  return f;
+}
+
+}  // namespace
+
+int bench(const BenchArgs& a) {
+  for (const auto& entry : labRegistry()) {
+    LoadedLab loaded;
+    try {
+      loaded = loadLab(entry.name);
+    } catch (const InputError& e) {
+      std::fprintf(stderr, "error: %s\n", e.what());
+      return 2;
+    }
+    const Lab& lab = *loaded.lab;
+    const double hand = stepMicros(lab, Engine::Hand, a.steps);
+    const double bullet = stepMicros(lab, Engine::Bullet, a.steps);
+    const RunResult run = runEngine(lab, Engine::Hand, long(std::min(2.0, lab.duration()) / lab.dt()));
+    const Fps fps = frameRates(lab, run.trace, a.frames);
+    if (a.json) {
+      const json j = {{"lab", entry.name},          {"hand_us_per_step", hand},
+                      {"bullet_us_per_step", bullet}, {"bullet_over_hand", bullet / hand},
+                      {"render_fps", fps.render},     {"render_png_fps", fps.png},
+                      {"render_video_fps", fps.video}, {"resolution", "640x480"}};
+      std::cout << j.dump() << "\n";
+    } else {
+      std::printf("%s\n", entry.name.c_str());
+      std::printf("  step (median)   hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx\n", hand, bullet, bullet / hand);
+      std::printf("  640x480 fps     render %.0f   +PNG %.0f   +video %.0f\n", fps.render, fps.png, fps.video);
+    }
+  }
+  return 0;
+}
+
+}  // namespace dyn::app

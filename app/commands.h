@@ -1,0 +1,30 @@
+// The dynlab subcommands. Each returns the process exit code:
+//   0 success, 1 a run or write failed, 2 bad input (nothing written).
+#pragma once
+#include <optional>
+#include <string>
+
+namespace dyn::app {
+
+struct RunArgs {
+  std::string lab, config, gains, out, engine = "both";
+  bool video = false, frames = false;
+  std::optional<double> duration;
+};
+
+struct GradeArgs {
+  std::string submission, out = "out/grade";
+};
+
+struct BenchArgs {
+  bool json = false;
+  int steps = 4000, frames = 60;
+};
+
+int listLabs();
+int runLab(const RunArgs& args);
+int gradeOne(const GradeArgs& args);
+int printSchema(const std::string& lab);
+int bench(const BenchArgs& args);
+
+}  // namespace dyn::app

@@ -1,0 +1,52 @@
+// dynlab: the command line. Dispatch only; the work is in labs/, grading/ and render/.
+#include <CLI/CLI.hpp>
+
+#include "app/commands.h"
+
+int main(int argc, char** argv) {
+  using namespace dyn::app;
+  CLI::App cli{"dynlab — a teaching lab for the dynamics of constrained mechanisms"};
+  cli.require_subcommand(1);
+  cli.set_version_flag("--version", std::string(DYNLAB_VERSION));
+
+  auto* list = cli.add_subcommand("list", "List the labs, one line each");
+
+  RunArgs run;
+  auto* r = cli.add_subcommand("run", "Run a lab with the hand-written dynamics and/or Bullet; write traces, summary, video");
+  r->add_option("LAB", run.lab, "Lab name (see `dynlab list`)")->required();
+  r->add_option("--config", run.config, "Lab config JSON (default: labs/LAB/LAB.json)");
+  r->add_option("--gains", run.gains, "Gains JSON: {\"gains\": {...}} as in a submission");
+  r->add_option("--out", run.out, "Output directory (default: out/LAB)");
+  r->add_option("--engine", run.engine, "Which engine(s) to run")->check(CLI::IsMember({"hand", "bullet", "both"}));
+  r->add_flag("--video", run.video, "Write video.mp4 (H.264, 30 fps)");
+  r->add_flag("--frames", run.frames, "Write frames/NNNNN.png (30 fps)");
+  r->add_option("--duration", run.duration, "Override the simulated duration (s)");
+
+  GradeArgs grade;
+  auto* g = cli.add_subcommand("grade", "Grade a submission (gains JSON) against its lab's rubric");
+  g->add_option("SUBMISSION", grade.submission, "Submission JSON: {\"lab\": ..., \"gains\": {...}}")->required();
+  g->add_option("--out", grade.out, "Directory for results.json (default: out/grade)");
+
+  std::string schema_lab;
+  auto* s = cli.add_subcommand("schema", "Print the JSON Schema of a lab's submission");
+  s->add_option("LAB", schema_lab, "Lab name")->required();
+
+  BenchArgs bench_args;
+  auto* b = cli.add_subcommand("bench", "Benchmark: hand-written vs Bullet step time, render/PNG/video frame rates");
+  b->add_flag("--json", bench_args.json, "One JSON object per lab");
+  b->add_option("--steps", bench_args.steps, "Steps timed per engine")->check(CLI::Range(100, 1000000));
+  b->add_option("--frames", bench_args.frames, "Frames timed per output kind")->check(CLI::Range(5, 10000));
+
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = cli.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  if (*list) return listLabs();
+  if (*r) return runLab(run);
+  if (*g) return gradeOne(grade);
+  if (*s) return printSchema(schema_lab);
+  if (*b) return bench(bench_args);
+  return 2;
+}

@@ -1,0 +1,27 @@
+// Output staging: everything a command writes goes to DIR/.staging first and is moved into
+// place only when the command succeeds, so a failure never leaves half-written results.
+#pragma once
+#include <filesystem>
+#include <string>
+
+namespace dyn::app {
+
+class Staging {
+ public:
+  explicit Staging(const std::filesystem::path& out_dir);
+  ~Staging();  // discards anything not committed
+  std::filesystem::path path(const std::string& name) const { return staging_ / name; }
+  void write(const std::string& name, const std::string& contents) const;
+  // Moves every staged entry into out_dir (replacing older ones) and removes the staging dir.
+  void commit();
+  const std::filesystem::path& outDir() const { return out_; }
+
+ private:
+  std::filesystem::path out_, staging_;
+  bool committed_ = false;
+};
+
+// Writes a file atomically (temporary name, then rename).
+void writeFileAtomic(const std::filesystem::path& path, const std::string& contents);
+
+}  // namespace dyn::app

@@ -1,0 +1,51 @@
+// Loading and running labs; see run.h.
+#include "labs/run.h"
+
+#include "labs/submission.h"
+
+namespace dyn {
+
+std::unique_ptr<Lab> buildLab(const LabEntry& entry, const json& config, const std::string& file) {
+  return entry.create(JsonView(config, file));
+}
+
+LoadedLab loadLab(const std::string& name, const std::string& config_file, const std::string& gains_file,
+                  std::optional<double> duration) {
+  LoadedLab out;
+  out.entry = findLab(name);
+  if (!out.entry) {
+    std::string list;
+    for (const auto& e : labRegistry()) list += (list.empty() ? "" : ", ") + e.name;
+    throw InputError("<command line>", "LAB", "unknown lab \"" + name + "\" (available: " + list + ")");
+  }
+  out.config_file = config_file.empty() ? defaultConfigPath(name) : config_file;
+  out.config = loadJsonFile(out.config_file);
+  // Validate the config itself first, so its errors name the config file.
+  buildLab(*out.entry, out.config, out.config_file);
+  std::string source = out.config_file;
+  if (!gains_file.empty()) {
+    const json gains = loadJsonFile(gains_file, 1u << 20);
+    out.config = applySubmission(out.config, JsonView(gains, gains_file), name, false);
+    source = gains_file;
+  }
+  if (duration) {
+    if (!(*duration > 0) || *duration > 3600)
+      throw InputError("<command line>", "--duration", "expected a duration in (0, 3600] s");
+    out.config["simulation"]["duration"] = *duration;
+  }
+  out.lab = buildLab(*out.entry, out.config, source);
+  return out;
+}
+
+RunResult runEngine(const Lab& lab, Engine engine, long max_steps) {
+  RunResult r;
+  r.trace.columns = lab.columns();
+  auto sim = lab.simulate(engine);
+  std::vector<double> row;
+  r.trace.data.reserve(std::size_t(lab.duration() / lab.dt() + 1) * r.trace.columns.size());
+  for (long k = 0; (max_steps < 0 || k < max_steps) && sim->step(row); ++k) r.trace.append(row);
+  r.failure = sim->failure();
+  return r;
+}
+
+}  // namespace dyn

@@ -1,0 +1,30 @@
+// Running a lab: build it from a config file (+ gains), and run one engine into a Trace.
+// Shared by the CLI, the grader, the benchmark and the tests.
+#pragma once
+#include <optional>
+
+#include "labs/lab.h"
+
+namespace dyn {
+
+struct LoadedLab {
+  const LabEntry* entry = nullptr;
+  json config;                 // after gains and overrides
+  std::string config_file;
+  std::unique_ptr<Lab> lab;
+};
+
+// Loads LAB's config (default path unless config_file is given), applies a gains file and a
+// duration override, and builds the lab. Throws InputError on any bad input.
+LoadedLab loadLab(const std::string& name, const std::string& config_file = "",
+                  const std::string& gains_file = "", std::optional<double> duration = std::nullopt);
+// Builds a lab from a config already in memory (file names the source for error messages).
+std::unique_ptr<Lab> buildLab(const LabEntry& entry, const json& config, const std::string& file);
+
+struct RunResult {
+  Trace trace;
+  std::string failure;  // empty when the run reached its duration
+};
+RunResult runEngine(const Lab& lab, Engine engine, long max_steps = -1);
+
+}  // namespace dyn

@@ -1,0 +1,81 @@
+// Applying a submission's gains and options to a lab config; see submission.h.
+#include "labs/submission.h"
+
+#include <sstream>
+
+namespace dyn {
+
+json applySubmission(const json& config, const JsonView& sub, const std::string& lab, bool strict) {
+  sub.requireObject();
+  json out = config;
+  const json options = config.value("submission_options", json::object());
+  // Top-level keys: lab, gains, and the declared options; nothing else.
+  for (const auto& [key, _] : sub.raw().items()) {
+    if (key == "lab" || key == "gains" || options.contains(key)) continue;
+    std::string list = "\"lab\", \"gains\"";
+    for (const auto& [o, __] : options.items()) list += ", \"" + o + "\"";
+    sub[key].fail("unknown key \"" + key + "\" (expected one of: " + list + ")");
+  }
+  if (strict || sub.has("lab")) {
+    const std::string named = sub["lab"].string();
+    if (named != lab) sub["lab"].fail("expected \"" + lab + "\", got \"" + named + "\"");
+  }
+  // Gains: declared names only, finite numbers within the declared bounds.
+  const json& declared = config.at("gains");
+  if (strict || sub.has("gains")) {
+    const JsonView gains = sub["gains"];
+    gains.requireObject();
+    for (const auto& [name, value] : gains.raw().items()) {
+      if (!declared.contains(name)) {
+        std::string list;
+        for (const auto& [d, _] : declared.items()) list += std::string(list.empty() ? "" : ", ") + d;
+        gains[name].fail("unknown gain \"" + name + "\" (this lab's gains: " + list + ")");
+      }
+      const double lo = declared[name].at("min").get<double>(), hi = declared[name].at("max").get<double>();
+      out["gains"][name]["value"] = gains[name].inRange(lo, hi);
+    }
+    if (strict)
+      for (const auto& [name, _] : declared.items())
+        if (!gains.has(name)) gains[name];  // throws "missing key"
+  }
+  // Options: one of the declared choices, written to the declared target.
+  for (const auto& [key, decl] : options.items()) {
+    if (!sub.has(key)) continue;
+    std::string value;
+    const auto& choices = decl.at("choices");
+    bool ok = false;
+    for (const auto& c : choices) ok = ok || (sub[key].raw().is_string() && sub[key].raw() == c);
+    if (!ok) {
+      std::string list;
+      for (const auto& c : choices) list += std::string(list.empty() ? "" : ", ") + c.dump();
+      sub[key].fail("expected one of " + list + ", got " + sub[key].raw().dump());
+    }
+    out[json::json_pointer(decl.at("target").get<std::string>())] = sub[key].raw();
+  }
+  return out;
+}
+
+json submissionSchema(const json& config, const std::string& lab) {
+  json gains = {{"type", "object"}, {"additionalProperties", false}, {"properties", json::object()},
+                {"required", json::array()}};
+  for (const auto& [name, d] : config.at("gains").items()) {
+    gains["properties"][name] = {{"type", "number"},
+                                 {"minimum", d.at("min")},
+                                 {"maximum", d.at("max")},
+                                 {"default", d.at("value")},
+                                 {"description", d.value("doc", "") + " [" + d.value("unit", "") + "]"}};
+    gains["required"].push_back(name);
+  }
+  json schema = {{"$schema", "https://json-schema.org/draft/2020-12/schema"},
+                 {"title", "dynlab submission: " + lab},
+                 {"type", "object"},
+                 {"additionalProperties", false},
+                 {"required", {"lab", "gains"}},
+                 {"properties", {{"lab", {{"const", lab}}}, {"gains", gains}}}};
+  const json options = config.value("submission_options", json::object());
+  for (const auto& [key, d] : options.items())
+    schema["properties"][key] = {{"enum", d.at("choices")}, {"description", d.value("doc", "")}};
+  return schema;
+}
+
+}  // namespace dyn

@@ -1,0 +1,19 @@
+// Gains files and submissions: {"lab": "...", "gains": {...}, <declared options>}. Data only;
+// nothing in it is executed. Each lab's JSON declares its gains (value, min, max, unit, doc) and
+// the submission options it accepts ("submission_options": {"force_law": {"target":
+// "/controller/force_law", "choices": [...]}}); this file applies a submission onto a config,
+// validating every value, and derives the submission's JSON Schema from the same declarations.
+#pragma once
+#include "labs/config.h"
+
+namespace dyn {
+
+// Returns the config with the submission's gains and options applied. strict (grading):
+// every declared gain must be present and "lab" must name this lab. Throws InputError naming the
+// submission file and JSON path.
+json applySubmission(const json& config, const JsonView& submission, const std::string& lab, bool strict);
+
+// JSON Schema (draft 2020-12) of a submission for this lab.
+json submissionSchema(const json& config, const std::string& lab);
+
+}  // namespace dyn
