@@ -1,9 +1,16 @@
 // dynlab list / run / grade / schema.
 #include "app/commands.h"
 
+#include <unistd.h>
+
 #include <cstdio>
+#include <cstdlib>
 #include <iostream>
 
+#if __has_include("app/autograder.h")  // TEMP until autograder lands
+#include "app/autograder.h"
+#define HAVE_AUTOGRADER 1
+#endif
 #include "app/movie.h"
 #include "app/output.h"
 #include "grading/grade.h"
@@ -86,18 +93,90 @@ int runLab(const RunArgs& a) {
   }
 }
 
+// Test hook for the batch grader's robustness tests: DYNLAB_FAULT_INJECTION="crash:NAME,hang:NAME"
+// makes grading the submission whose file stem is NAME abort or hang. Unset in normal use.
+static void injectFault(const std::string& submission) {
+  const char* spec = std::getenv("DYNLAB_FAULT_INJECTION");
+  if (!spec) return;
+  const std::string stem = fs::path(submission).stem().string(), s = spec;
+  if (s.find("crash:" + stem) != std::string::npos) std::abort();
+  if (s.find("hang:" + stem) != std::string::npos)
+    for (;;) pause();
+}
+
+static GradeOptions gradeOptions(const GradeArgs& a, const std::string& out_dir) {
+  GradeOptions o;
+  o.expected_lab = a.lab;
+  o.config_file = a.config;
+  o.time_budget = a.time_budget;
+  if (a.plots) o.out_dir = out_dir;
+  return o;
+}
+
 int gradeOne(const GradeArgs& a) {
-  const GradeOutcome g = gradeSubmission(a.submission);
+  injectFault(a.submission);
+  GradeOutcome g;
   try {
-    fs::create_directories(a.out);
-    writeFileAtomic(fs::path(a.out) / "results.json", g.results.dump(2) + "\n");
+    // Everything lands in OUT/.staging first; a failure never leaves a half-written results set.
+    Staging staging(a.out);
+    g = gradeSubmission(a.submission, gradeOptions(a, staging.path("").string()));
+    staging.write("results.json", g.results.dump(2) + "\n");
+    staging.write("report.md", g.markdown);
+    staging.write("report.html", g.html);
+    staging.commit();
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: cannot write results: %s\n", e.what());
+    std::fprintf(stderr, "error: cannot write results to %s: %s\n", a.out.c_str(), e.what());
     return 1;
   }
   std::fputs(g.report.c_str(), stdout);
-  std::printf("results: %s\n", (fs::path(a.out) / "results.json").c_str());
+  std::printf("results: %s\nreport:  %s\n", (fs::path(a.out) / "results.json").c_str(), (fs::path(a.out) / "report.html").c_str());
   return g.input_error ? 2 : 0;
+}
+
+int gradeReplay(const GradeArgs& a) {
+  json expected;
+  try {
+    expected = loadJsonFile(a.replay);
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  }
+  // Re-grade in memory (no plots, nothing written) and compare everything but execution_time.
+  GradeArgs quiet = a;
+  quiet.plots = false;
+  const GradeOutcome g = gradeSubmission(a.submission, gradeOptions(quiet, ""));
+  json actual = g.results;
+  // Plot paths are only present when plots were written; they are not part of the grade.
+  for (json* r : {&expected, &actual})
+    if (r->contains("tests"))
+      for (auto& t : (*r)["tests"])
+        if (t.contains("extra_data")) t["extra_data"].erase("plot");
+  const auto diff = compareResults(expected, actual);
+  if (diff.empty()) {
+    std::printf("replay: match (score %s, trajectory hash %s)\n", actual["score"].dump().c_str(),
+                actual["extra_data"].value("fingerprint", json::object()).value("trajectory_hash", "-").c_str());
+    return 0;
+  }
+  std::printf("replay: MISMATCH, %zu difference(s):\n", diff.size());
+  for (std::size_t i = 0; i < diff.size() && i < 20; ++i) std::printf("  %s\n", diff[i].c_str());
+  return 1;
+}
+
+int writeAutograderZip(const std::string& lab, const std::string& out) {
+  if (!findLab(lab)) {
+    std::fprintf(stderr, "error: <command line>: LAB: unknown lab \"%s\" (see dynlab list)\n", lab.c_str());
+    return 2;
+  }
+  try {
+#ifdef HAVE_AUTOGRADER
+    writeAutograder(lab, DYNLAB_SOURCE_DIR, out);
+#endif
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 1;
+  }
+  std::printf("autograder: %s (upload it as the assignment's autograder on Gradescope)\n", out.c_str());
+  return 0;
 }
 
 int printSchema(const std::string& lab) {

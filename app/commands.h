@@ -13,7 +13,10 @@ struct RunArgs {
 };
 
 struct GradeArgs {
-  std::string submission, out = "out/grade";
+  std::string submission, out = "out/grade", lab, config, replay, batch;
+  double time_budget = 300;  // s of wall time per submission
+  bool plots = true;
+  int jobs = 1;
 };
 
 struct BenchArgs {
@@ -24,6 +27,9 @@ struct BenchArgs {
 int listLabs();
 int runLab(const RunArgs& args);
 int gradeOne(const GradeArgs& args);
+int gradeReplay(const GradeArgs& args);
+int gradeBatch(const GradeArgs& args);  // app/batch.cpp
+int writeAutograderZip(const std::string& lab, const std::string& out);
 int printSchema(const std::string& lab);
 int bench(const BenchArgs& args);
 

@@ -23,9 +23,25 @@ int main(int argc, char** argv) {
   r->add_option("--duration", run.duration, "Override the simulated duration (s)");
 
   GradeArgs grade;
-  auto* g = cli.add_subcommand("grade", "Grade a submission (gains JSON) against its lab's rubric");
-  g->add_option("SUBMISSION", grade.submission, "Submission JSON: {\"lab\": ..., \"gains\": {...}}")->required();
-  g->add_option("--out", grade.out, "Directory for results.json (default: out/grade)");
+  auto* g = cli.add_subcommand("grade", "Grade a submission (gains JSON) against its lab's rubric, or a whole directory");
+  g->add_option("SUBMISSION", grade.submission, "Submission JSON: {\"lab\": ..., \"gains\": {...}}");
+  g->add_option("--out", grade.out, "Output directory: results.json, report.md/html, plots/ (default: out/grade)");
+  g->add_option("--lab", grade.lab, "The assignment's lab: a submission naming another lab scores 0");
+  g->add_option("--config", grade.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
+  g->add_option("--time-budget", grade.time_budget, "Wall-time budget per submission (s)")->check(CLI::Range(1.0, 86400.0));
+  g->add_flag("!--no-plots", grade.plots, "Skip the response plots (faster)");
+  g->add_option("--replay", grade.replay, "Re-grade SUBMISSION and check it matches this results.json");
+  g->add_option("--batch", grade.batch, "Grade every *.json in this directory (one process each)");
+  g->add_option("--jobs", grade.jobs, "Submissions graded in parallel with --batch")->check(CLI::Range(1, 256));
+  g->callback([&] {
+    if (grade.batch.empty() && grade.submission.empty())
+      throw CLI::ValidationError("SUBMISSION", "give a submission file, or --batch DIR");
+  });
+
+  std::string zip_lab, zip_out = "autograder.zip";
+  auto* z = cli.add_subcommand("autograder", "Write a Gradescope autograder zip for a lab");
+  z->add_option("LAB", zip_lab, "Lab name")->required();
+  z->add_option("--out", zip_out, "Zip file to write (default: autograder.zip)");
 
   std::string schema_lab;
   auto* s = cli.add_subcommand("schema", "Print the JSON Schema of a lab's submission");
@@ -45,7 +61,8 @@ int main(int argc, char** argv) {
   }
   if (*list) return listLabs();
   if (*r) return runLab(run);
-  if (*g) return gradeOne(grade);
+  if (*g) return !grade.batch.empty() ? gradeBatch(grade) : !grade.replay.empty() ? gradeReplay(grade) : gradeOne(grade);
+  if (*z) return writeAutograderZip(zip_lab, zip_out);
   if (*s) return printSchema(schema_lab);
   if (*b) return bench(bench_args);
   return 2;

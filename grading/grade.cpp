@@ -3,92 +3,160 @@
 
 #include <chrono>
 #include <cmath>
-#include <cstdio>
+#include <filesystem>
 #include <map>
 
+#include "grading/report.h"
+#include "grading/rubric.h"
+#include "grading/scenario.h"
 #include "labs/run.h"
 #include "labs/submission.h"
 
 namespace dyn {
-namespace {
 
-std::string number(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", x);
-  return b;
+std::string hashHex(const std::string& bytes) {
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char b : bytes) h = (h ^ b) * 1099511628211ull;
+  return hashHexOf(h);
 }
 
-json failedResults(const std::string& message) {
-  return {{"score", 0.0},
-          {"output", "Your submission could not be graded:\n\n    " + message + "\n\nFix it and resubmit."},
-          {"output_format", "md"},
-          {"tests", json::array()}};
+std::string hashHexOf(std::uint64_t h) {
+  char out[17];
+  std::snprintf(out, sizeof out, "%016llx", static_cast<unsigned long long>(h));
+  return out;
+}
+
+namespace {
+
+// A results.json for a submission that could not be graded at all.
+GradeOutcome failedOutcome(const std::string& message, const InputError* e) {
+  GradeOutcome out;
+  out.input_error = e != nullptr;
+  out.results = {{"score", 0.0},
+                 {"output", "**Your submission could not be graded.**\n\n    " + message + "\n\nFix it and resubmit."},
+                 {"output_format", "md"},
+                 {"tests", json::array()},
+                 {"extra_data", {{"dynlab_version", DYNLAB_VERSION}}}};
+  if (e) out.results["extra_data"]["error"] = {{"file", e->file()}, {"path", e->path().empty() ? "/" : e->path()}, {"expected", e->expected()}};
+  out.report = (e ? "error: " : "internal error: ") + message + "\nScore: 0\n";
+  out.markdown = "# dynlab grade\n\n**Not graded:** `" + message + "`\n";
+  out.html = renderHtml(out.markdown);
+  return out;
+}
+
+// The per-scenario seed: derived from the submission, so noise is fixed per student and scenario.
+std::uint64_t scenarioSeed(const std::string& submission_hash, const std::string& scenario) {
+  return std::stoull(hashHex(submission_hash + "/" + scenario), nullptr, 16) & ((1ull << 53) - 1);
 }
 
 }  // namespace
 
-double partialCredit(double m, double full, double zero) {
-  if (!std::isfinite(m)) return 0.0;
-  if (full == zero) return (m == full) ? 1.0 : 0.0;
-  return std::clamp((zero - m) / (zero - full), 0.0, 1.0);
-}
-
-GradeOutcome gradeSubmission(const std::string& file) {
-  GradeOutcome out;
+GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
+  const auto started = std::chrono::steady_clock::now();
+  const Deadline deadline = started + std::chrono::milliseconds(long(opt.time_budget * 1e3));
   try {
+    // The submission: a JSON object naming a lab; the lab's config with the gains applied.
     const json sub = loadJsonFile(file, 1u << 20);
     const JsonView view(sub, file);
     view.requireObject();
     const std::string lab_name = view["lab"].string();
+    if (!opt.expected_lab.empty() && lab_name != opt.expected_lab)
+      view["lab"].fail("expected \"" + opt.expected_lab + "\" (this assignment's lab), got \"" + lab_name + "\"");
     const LabEntry* entry = findLab(lab_name);
-    if (!entry) view["lab"].fail("expected the name of a dynlab lab, got \"" + lab_name + "\"");
-    const std::string config_file = defaultConfigPath(lab_name);
-    const json config = applySubmission(loadJsonFile(config_file), view, lab_name, true);
-    const auto lab = buildLab(*entry, config, file);
-
-    // Run the lab once (hand-written engine) and score each rubric test on its metrics.
-    const RunResult run = runEngine(*lab, Engine::Hand);
-    const json metrics = lab->metrics(run.trace);
-    json tests = json::array();
-    double total = 0, max_total = 0;
-    std::string report = "Grading " + file + " (" + lab_name + ")\n";
-    for (const auto& t : config.at("rubric").at("tests")) {
-      const double points = t.at("points").get<double>();
-      const std::string metric = t.at("metric");
-      double score = 0;
-      std::string text;
-      if (!run.failure.empty()) {
-        text = "The simulation did not finish: " + run.failure + ".";
-      } else {
-        const double m = metrics.at(metric).get<double>();
-        const double full = t.at("full").get<double>(), zero = t.at("zero").get<double>();
-        score = points * partialCredit(m, full, zero);
-        text = metric + " = " + number(m) + " (full credit at " + number(full) + ", zero at " + number(zero) + ")";
-      }
-      total += score;
-      max_total += points;
-      tests.push_back({{"name", t.at("name")},
-                       {"score", score},
-                       {"max_score", points},
-                       {"status", score >= points - 1e-9 ? "passed" : "failed"},
-                       {"output", text},
-                       {"visibility", t.value("visibility", "visible")}});
-      report += "  " + number(score) + "/" + number(points) + "  " + t.at("name").get<std::string>() + ": " + text + "\n";
+    if (!entry) {
+      std::string list;
+      for (const auto& e : labRegistry()) list += (list.empty() ? "" : ", ") + e.name;
+      view["lab"].fail("expected the name of a dynlab lab (" + list + "), got \"" + lab_name + "\"");
     }
-    report += "Total: " + number(total) + "/" + number(max_total) + "\n";
-    out.results = {{"score", total},
-                   {"output", "dynlab " + lab_name + ": " + number(total) + " / " + number(max_total) + " points."},
-                   {"output_format", "md"},
-                   {"tests", tests},
-                   {"extra_data", {{"lab", lab_name}, {"metrics", metrics}, {"trace_hash", run.trace.hash()}}}};
-    out.report = report;
+    const std::string config_file = opt.config_file.empty() ? defaultConfigPath(lab_name) : opt.config_file;
+    const json base = loadJsonFile(config_file);
+    buildLab(*entry, base, config_file);  // the lab config itself must be valid
+    const Rubric rubric = parseRubric(JsonView(base, config_file));
+    const json applied = applySubmission(base, view, lab_name, true);
+    buildLab(*entry, applied, file);  // the gains are valid for the lab
+
+    // Fingerprint inputs: canonical dumps (sorted keys), so whitespace does not matter.
+    GradeReport rep;
+    rep.lab = lab_name;
+    rep.submission = file;
+    rep.fingerprint = {{"dynlab_version", DYNLAB_VERSION},
+                       {"lab_config_hash", hashHex(base.dump())},
+                       {"submission_hash", hashHex(sub.dump())}};
+
+    // Run each scenario the tests use, once, in rubric order.
+    std::map<std::string, ScenarioRun> runs;
+    std::string trajectories;
+    for (const Scenario& sc : rubric.scenarios) {
+      bool used = false;
+      for (const auto& t : rubric.tests) used = used || t.scenario == sc.name;
+      for (const auto& l : rubric.leaderboard) used = used || l.scenario == sc.name;
+      if (!used) continue;
+      json cfg = mergePatch(applied, sc.patch);
+      if (!rubric.seed_target.empty())
+        cfg[json::json_pointer(rubric.seed_target)] = scenarioSeed(rep.fingerprint["submission_hash"], sc.name);
+      const auto lab = buildLab(*entry, cfg, config_file + " (scenario " + sc.name + ")");
+      ScenarioRun run = runScenario(*lab, rubric.watchdog, deadline, config_file);
+      trajectories += hashHex(std::to_string(run.trace.hash()));
+      rep.scenarios.push_back({sc, lab->dt(), run.trace.hash(), run.failure, run.failure_time, run.screen.notes,
+                               run.metrics, run.out_of_time});
+      runs.emplace(sc.name, std::move(run));
+    }
+    rep.fingerprint["trajectory_hash"] = hashHex(trajectories);
+
+    // Score each test on its scenario's metric.
+    for (std::size_t i = 0; i < rubric.tests.size(); ++i) {
+      const RubricTest& t = rubric.tests[i];
+      const ScenarioRun& run = runs.at(t.scenario);
+      GradedTest g{t, 0.0, NAN, ""};
+      if (run.metrics.contains(t.metric)) {
+        g.value = run.metrics[t.metric].get<double>();
+        g.score = t.points * partialCredit(g.value, t.full, t.zero);
+      } else if (!run.failure.empty()) {
+        g.note = run.failure;
+      } else {
+        throw InputError(config_file, "/rubric/tests/" + std::to_string(i) + "/metric",
+                         "expected a metric this lab reports, got \"" + t.metric + "\"");
+      }
+      rep.tests.push_back(g);
+    }
+    for (const auto& l : rubric.leaderboard) {
+      const ScenarioRun& run = runs.at(l.scenario);
+      if (run.metrics.contains(l.metric))
+        rep.leaderboard.push_back({{"name", l.name}, {"value", run.metrics[l.metric].get<double>() * l.scale}, {"order", l.order}});
+    }
+
+    // Plots of each test's response against its reference and tolerance band.
+    if (!opt.out_dir.empty()) writeTestPlots(rep, runs, opt.out_dir);
+
+    GradeOutcome out;
+    out.results = resultsJson(rep);
+    out.report = terminalReport(rep);
+    out.markdown = markdownReport(rep);
+    out.html = renderHtml(out.markdown);
+    out.results["execution_time"] =
+        std::round(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() * 100) / 100;
+    return out;
   } catch (const InputError& e) {
-    out.input_error = true;
-    out.results = failedResults(e.what());
-    out.report = std::string("error: ") + e.what() + "\nScore: 0\n";
+    return failedOutcome(e.what(), &e);
   } catch (const std::exception& e) {
-    out.results = failedResults(std::string("internal error: ") + e.what());
-    out.report = std::string("internal error: ") + e.what() + "\n";
+    return failedOutcome(std::string("internal error: ") + e.what(), nullptr);
+  }
+}
+
+std::vector<std::string> compareResults(const json& expected, const json& actual) {
+  json a = expected, b = actual;
+  a.erase("execution_time");
+  b.erase("execution_time");
+  std::vector<std::string> out;
+  for (const auto& op : json::diff(a, b)) {
+    const std::string path = op.at("path");
+    std::string what = op.at("op").get<std::string>() + " " + path;
+    if (op.contains("value")) {
+      std::string v = op.at("value").dump();
+      if (v.size() > 60) v = v.substr(0, 57) + "...";
+      what += ": now " + v;
+    }
+    out.push_back(what);
   }
   return out;
 }

@@ -1,24 +1,42 @@
-// The grader: a submission (gains as JSON) → the lab's rubric → Gradescope's results.json.
-// Grading only looks at traces and metrics; it never touches the physics directly.
+// The grader: a submission (gains as JSON, data only) → every scenario of its lab's rubric →
+// Gradescope's results.json, a terminal summary, and Markdown/HTML reports with plots.
 //   score of a test = points · clamp((zero − m) / (zero − full), 0, 1)   (linear partial credit)
-// Every failure (bad file, unknown lab, unstable run) becomes a message in results.json with
-// score 0; a results.json is always produced.
+// Every failure (bad file, unknown lab, unstable run, time budget) becomes a plain message in
+// results.json with score 0 for what it touched; a results.json is always produced.
+// Reproducible: grading the same file twice gives the same results.json apart from
+// "execution_time"; the fingerprint (version, lab config hash, submission hash, trajectory hash)
+// lets `dynlab grade --replay` check it.
 #pragma once
+#include <cstdint>
 #include <string>
+#include <vector>
 
 #include "labs/config.h"
 
 namespace dyn {
 
+struct GradeOptions {
+  std::string expected_lab;  // the assignment's lab (empty: whatever the submission names)
+  std::string config_file;   // lab config (empty: the lab's default JSON)
+  std::string out_dir;       // plots go to out_dir/plots/ (empty: no plots)
+  double time_budget = 300;  // s of wall time for the whole submission
+};
+
 struct GradeOutcome {
-  json results;        // Gradescope results.json
-  std::string report;  // readable summary for the terminal
+  json results;          // Gradescope results.json
+  std::string report;    // readable summary for the terminal
+  std::string markdown;  // report.md (plots linked as plots/*.png)
+  std::string html;      // report.html (same content)
   bool input_error = false;
 };
 
-GradeOutcome gradeSubmission(const std::string& submission_file);
+GradeOutcome gradeSubmission(const std::string& submission_file, const GradeOptions& options);
 
-// Linear partial credit between the full-credit and zero-credit thresholds (either order).
-double partialCredit(double metric, double full, double zero);
+// What differs between two results.json, ignoring execution_time (empty: they match).
+std::vector<std::string> compareResults(const json& expected, const json& actual);
+
+// FNV-1a 64 of a string, as 16 hex digits (fingerprints and seeds).
+std::string hashHex(const std::string& bytes);
+std::string hashHexOf(std::uint64_t h);
 
 }  // namespace dyn

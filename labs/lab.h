@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "labs/config.h"
+#include "physics/linear.h"
 #include "labs/scene.h"
 #include "labs/trace.h"
 
@@ -44,6 +45,10 @@ class Lab {
   // What to draw at a trace row; ghost (the other engine) drawn translucent when given.
   virtual void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const = 0;
   virtual void overlay(const Trace& trace, std::size_t row, Overlay& out) const = 0;
+
+  // The controller's feedback loops linearised at the start (the grader screens gains on them
+  // before simulating: poles, delay margin). Empty when the lab has no feedback.
+  virtual std::vector<LinearLoop> linearise() const { return {}; }
 };
 
 // Builds a lab from its config (already merged with gains); throws InputError on bad input.

@@ -31,6 +31,7 @@ class SliderCrankLab final : public Lab {
   json agreement(const Trace& hand, const Trace& bullet) const override;
   void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
   void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
+  std::vector<LinearLoop> linearise() const override;
   const Settings& settings() const { return s_; }
 
  private:

@@ -1,0 +1,78 @@
+// A lab's rubric, as data in its JSON ("rubric"): scenarios (merge patches on the config, applied
+// after the student's gains), tests that turn one metric of one scenario into points with linear
+// partial credit, and the watchdog that ends a run gone bad.
+//
+//   "rubric": {
+//     "seed_target": "/controller/seed",            // where each scenario's derived seed is written
+//     "scenarios": {"heavy_load": {"about": "payload +20 %", "patch": {"mechanism": {"load_mass": 0.6}}}},
+//     "watchdog": {"max_steps": 100000, "limits": [{"column": "x_c", "min": -0.5, "max": 1.5,
+//                  "what": "the slider"}]},
+//     "tests": [{"name": "...", "scenario": "nominal", "metric": "x_rms", "full": 0.003,
+//                "zero": 0.03, "points": 4, "visibility": "visible",
+//                "plot": {"columns": ["x_c"], "reference": "x_d", "band": 0.003, "ylabel": "x_c (m)"}}],
+//     "leaderboard": [{"name": "tracking RMS (mm)", "scenario": "nominal", "metric": "x_rms",
+//                      "scale": 1000, "order": "asc"}]
+//   }
+// Metrics come from the lab (Lab::metrics of the scenario's trace) or from screening the gains on
+// the linearised loops (<loop>_delay_margin, <loop>_max_real_pole, <loop>_damping, ...).
+#pragma once
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "labs/config.h"
+
+namespace dyn {
+
+struct ColumnLimit {
+  std::string column, what;
+  double min = -INFINITY, max = INFINITY;
+};
+
+struct Watchdog {
+  long max_steps = 1000000;  // step budget per scenario
+  std::vector<ColumnLimit> limits;
+};
+
+struct PlotRequest {
+  std::vector<std::string> columns;
+  std::string reference;  // optional column the response should follow
+  double band = 0;        // half-width of the tolerance band around the reference (or zero)
+  std::string ylabel;
+};
+
+struct RubricTest {
+  std::string name, scenario, metric, visibility = "visible";
+  double full = 0, zero = 1, points = 1;
+  std::optional<PlotRequest> plot;
+};
+
+struct LeaderboardEntry {
+  std::string name, scenario, metric, order = "asc";
+  double scale = 1;
+};
+
+struct Scenario {
+  std::string name, about;
+  json patch;  // RFC 7386 merge patch on the lab config
+};
+
+struct Rubric {
+  std::vector<Scenario> scenarios;  // in file order, "nominal" first
+  std::string seed_target;                               // JSON pointer, or empty
+  Watchdog watchdog;
+  std::vector<RubricTest> tests;
+  std::vector<LeaderboardEntry> leaderboard;
+  const Scenario* scenario(const std::string& name) const;
+  double maxScore() const;
+};
+
+// Reads and validates config["rubric"]; throws InputError naming file and JSON path.
+Rubric parseRubric(const JsonView& config);
+
+// Linear partial credit between the full-credit and zero-credit thresholds (either order):
+//   fraction = clamp((zero − m) / (zero − full), 0, 1); non-finite m scores 0.
+double partialCredit(double metric, double full, double zero);
+
+}  // namespace dyn

@@ -1,0 +1,42 @@
+// One rubric scenario of one submission: screen the gains on the lab's linearised loops, then run
+// the hand-written engine under the watchdog, and collect the metrics the rubric's tests read.
+// Deterministic: fixed steps, the seed comes from the submission; only the wall-time budget reads
+// a clock, and it only ever stops a run (reported as such, never scored as a result).
+#pragma once
+#include <chrono>
+#include <string>
+
+#include "grading/rubric.h"
+#include "labs/lab.h"
+
+namespace dyn {
+
+struct ScreenResult {
+  json metrics = json::object();  // <loop>_delay_margin, <loop>_max_real_pole, <loop>_damping, ...
+  std::vector<std::string> notes;  // one plain sentence per loop
+  bool unstable = false;
+};
+
+// Poles and margins of every loop the lab reports (physics/linear.h).
+ScreenResult screenLoops(const Lab& lab);
+
+struct ScenarioRun {
+  Trace trace;
+  json metrics = json::object();  // lab metrics + screening metrics
+  ScreenResult screen;
+  std::string failure;    // plain sentence when the run was stopped ("unstable: ...") else empty
+  double failure_time = -1;
+  bool out_of_time = false;  // the wall-time budget ran out (nothing is scored from this run)
+};
+
+using Deadline = std::chrono::steady_clock::time_point;
+
+// Runs the lab's hand-written engine under the watchdog; throws InputError (naming config_file)
+// if a watchdog limit names a column the lab does not have.
+ScenarioRun runScenario(const Lab& lab, const Watchdog& watchdog, Deadline deadline,
+                        const std::string& config_file);
+
+// Format a number for people: 4 significant digits.
+std::string fmtNumber(double x);
+
+}  // namespace dyn

@@ -1,0 +1,41 @@
+// The slider-crank controller's loops, linearised at the start configuration (controller.h):
+//   motion   m_eff x_c'' = k_px (x_d − x_c) + k_dx (ẋ_d − v_c)   ⇒  L(s) = (k_dx s + k_px) / (m_eff s²)
+//            m_eff = m_c + θ_xᵀ M θ_x,  θ_x = J⁻¹ A  (the arm's inertia seen along the slide)
+//            delay dt/2: the zero-order hold of a torque computed once per step
+//   force    f_Ty = ξ + d:  integral  L(s) = k_if / s,  proportional  L(s) = k_pf,  open loop: no loop
+//            delay: the measurement delay, at least one step
+#include <Eigen/LU>
+#include <cmath>
+
+#include "labs/slider_crank/lab.h"
+
+namespace dyn::slider_crank {
+
+std::vector<LinearLoop> SliderCrankLab::linearise() const {
+  const auto& c = s_.controller;
+  if (c.kind == ControllerKind::None) return {};
+  // Effective mass along the slide at the start configuration.
+  Mechanism mech(s_.params);
+  VecN q, v;
+  mech.initialState(s_.theta1, s_.theta1_rate, s_.branch, q, v);
+  MatN W, J;
+  VecN unused;
+  mech.metric(q, W);
+  mech.tipJacobian(q.head(3), Eigen::Vector3d::Zero(), J, unused);
+  Eigen::Vector4d dq;
+  dq << Eigen::Matrix3d(J).fullPivLu().solve(Eigen::Vector3d(0, 1, 0)), 1.0;
+  const double m_eff = dq.dot(Eigen::Matrix4d(W) * dq);
+
+  const double dt = s_.step.dt;
+  std::vector<LinearLoop> loops;
+  loops.push_back({"motion", "slider position loop (PD, k_px and k_dx)", {c.gains.kp_x, c.gains.kd_x},
+                   {0, 0, m_eff}, 0.5 * dt});
+  const double delay = std::max(1.0, std::round(c.delay / dt)) * dt;
+  if (c.law == ForceLaw::Integral)
+    loops.push_back({"force", "rail-force loop (integral law, k_if)", {c.gains.ki_f}, {0, 1}, delay});
+  else if (c.law == ForceLaw::Proportional)
+    loops.push_back({"force", "rail-force loop (proportional law, k_pf)", {c.gains.kp_f}, {1}, delay});
+  return loops;
+}
+
+}  // namespace dyn::slider_crank

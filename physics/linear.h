@@ -1,0 +1,48 @@
+// Linear screening of a feedback loop before any simulation (used by the grader):
+//   open loop      L(s) = N(s)/D(s) · e^{−sT}            (T: measurement delay)
+//   Padé (n, n)    e^{−sT} ≈ P(−sT)/P(sT),  P(x) = Σ_k (2n−k)! n! / ((2n)! k! (n−k)!) x^k
+//   closed loop    D(s) P(sT) + N(s) P(−sT) = 0            → poles (companion-matrix eigenvalues)
+//   margins        |L(jω_c)| = 1:  PM = π + ∠L(jω_c),  delay margin = PM / ω_c (total delay tolerated)
+// Polynomials are coefficient vectors in ascending powers of s.
+#pragma once
+#include <complex>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace dyn {
+
+using Poly = std::vector<double>;  // c0 + c1 s + c2 s² + …
+
+// One loop of a lab's controller, linearised about its operating point.
+struct LinearLoop {
+  std::string name;  // short id, e.g. "force" (metrics are named <name>_delay_margin, …)
+  std::string what;  // plain words for feedback, e.g. "force loop (integral law)"
+  Poly num, den;     // L(s) without the delay
+  double delay = 0;  // s
+};
+
+struct LoopAnalysis {
+  std::vector<std::complex<double>> poles;  // closed loop, delay as a Padé approximant
+  double max_real = 0;        // largest real part of the poles (1/s); > 0: unstable
+  double min_damping = 1;     // smallest ζ = −Re p / |p| over the complex poles (1 if none)
+  double crossover = 0;       // rad/s, 0 if |L| never crosses 1
+  double phase_margin = 0;    // rad, of the delay-free loop at the crossover
+  double delay_margin = 0;    // s, total delay the loop tolerates (kUnbounded if any)
+  bool stable = false;
+};
+
+inline constexpr double kUnboundedDelay = 1e3;  // s: reported when |L| < 1 at all frequencies
+
+Poly polyMul(const Poly& a, const Poly& b);
+Poly polyAdd(const Poly& a, const Poly& b);
+std::complex<double> polyEval(const Poly& p, std::complex<double> s);
+// Roots of p (trailing near-zero leading coefficients are dropped).
+std::vector<std::complex<double>> polyRoots(const Poly& p);
+// P(sT) of the (n, n) Padé approximant of e^{−sT}: numerator is padeDenominator with T → −T.
+Poly padeDenominator(double T, int order);
+
+LoopAnalysis analyseLoop(const LinearLoop& loop, int pade_order = 3);
+
+}  // namespace dyn
