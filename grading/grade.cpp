@@ -33,6 +33,7 @@ GradeOutcome failedOutcome(const std::string& message, const InputError* e) {
   GradeOutcome out;
   out.input_error = e != nullptr;
   out.results = {{"score", 0.0},
+                 {"execution_time", 0.0},
                  {"output", "**Your submission could not be graded.**\n\n    " + message + "\n\nFix it and resubmit."},
                  {"output_format", "md"},
                  {"tests", json::array()},

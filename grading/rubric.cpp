@@ -46,6 +46,8 @@ Rubric parseRubric(const JsonView& config) {
       r.scenarios.push_back(s);
     }
   }
+  // "nominal" first (added if absent), the others by name: JSON objects carry no order.
+  std::stable_partition(r.scenarios.begin(), r.scenarios.end(), [](const Scenario& s) { return s.name == "nominal"; });
   if (!r.scenario("nominal")) r.scenarios.insert(r.scenarios.begin(), {"nominal", "the lab as given", json::object()});
 
   if (rub.has("watchdog")) {

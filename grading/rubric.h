@@ -59,7 +59,7 @@ struct Scenario {
 };
 
 struct Rubric {
-  std::vector<Scenario> scenarios;  // in file order, "nominal" first
+  std::vector<Scenario> scenarios;  // "nominal" first, then by name
   std::string seed_target;                               // JSON pointer, or empty
   Watchdog watchdog;
   std::vector<RubricTest> tests;

@@ -1,0 +1,190 @@
+// grading/grade: good, mediocre, unstable and malformed submissions; reproducibility; the
+// Gradescope results.json contract; the watchdog and the time budget.
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "grading/grade.h"
+
+namespace fs = std::filesystem;
+using namespace dyn;
+
+namespace {
+
+const std::string kExamples = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/examples/";
+
+fs::path tempDir() {
+  const fs::path d = fs::temp_directory_path() / ("dynlab-grade-test-" + std::to_string(::getpid()));
+  fs::create_directories(d);
+  return d;
+}
+
+std::string writeFile(const std::string& name, const std::string& text) {
+  const fs::path p = tempDir() / name;
+  std::ofstream(p, std::ios::binary) << text;
+  return p.string();
+}
+
+GradeOutcome grade(const std::string& file, GradeOptions o = {}) { return gradeSubmission(file, o); }
+
+double score(const GradeOutcome& g) { return g.results.at("score").get<double>(); }
+
+double maxScore(const GradeOutcome& g) {
+  double m = 0;
+  for (const auto& t : g.results.at("tests")) m += t.at("max_score").get<double>();
+  return m;
+}
+
+bool anyTestSays(const GradeOutcome& g, const std::string& text) {
+  for (const auto& t : g.results.at("tests"))
+    if (t.at("output").get<std::string>().find(text) != std::string::npos) return true;
+  return false;
+}
+
+}  // namespace
+
+TEST_CASE("submissions score in their expected ranges, with messages that explain") {
+  const GradeOutcome good = grade(kExamples + "good.json");
+  const GradeOutcome mediocre = grade(kExamples + "mediocre.json");
+  const GradeOutcome unstable = grade(kExamples + "unstable_integral.json");
+  REQUIRE(maxScore(good) == doctest::Approx(15));
+  CHECK(score(good) >= 14.5);
+  CHECK(score(mediocre) > 6);
+  CHECK(score(mediocre) < 13);
+  CHECK(score(unstable) < 2);
+  CHECK_FALSE(good.input_error);
+  // The unstable gains: stopped by the watchdog with a time, and explained by the screening.
+  CHECK(anyTestSays(unstable, "unstable: the rail force left its safe range"));
+  CHECK(anyTestSays(unstable, "at t = "));
+  CHECK(unstable.results["output"].get<std::string>().find("unstable, closed-loop pole") != std::string::npos);
+  CHECK(unstable.results["output"].get<std::string>().find("the delay alone destabilises it") != std::string::npos);
+  // Leaderboard from the nominal run: tracking RMS in mm.
+  REQUIRE(good.results.contains("leaderboard"));
+  CHECK(good.results["leaderboard"][0]["value"].get<double>() ==
+        doctest::Approx(good.results["extra_data"]["scenarios"]["nominal"]["metrics"]["x_rms"].get<double>() * 1000));
+}
+
+TEST_CASE("malformed submissions score 0 with a message naming file, JSON path and expectation") {
+  struct Case {
+    std::string name, text, expect;
+  };
+  const std::vector<Case> cases = {
+      {"not_json.json", "{\"lab\": \"slider_crank\", gains", "expected valid JSON"},
+      {"empty.json", "", "the file is empty"},
+      {"array.json", "[1, 2]", "/: expected an object"},
+      {"unknown_lab.json", R"({"lab": "pendulum", "gains": {}})", "/lab: expected the name of a dynlab lab"},
+      {"unknown_gain.json", R"({"lab": "slider_crank", "gains": {"kp_x": 1, "kd_x": 1, "kp_f": 0, "ki_f": 1, "kq": 2}})",
+       "/gains/kq: unknown gain"},
+      {"missing_gain.json", R"({"lab": "slider_crank", "gains": {"kp_x": 1, "kd_x": 1, "kp_f": 0}})",
+       "/gains: missing key \"ki_f\""},
+      {"wrong_type.json", R"({"lab": "slider_crank", "gains": {"kp_x": "400", "kd_x": 1, "kp_f": 0, "ki_f": 1}})",
+       "/gains/kp_x: expected a number"},
+      {"out_of_range.json", R"({"lab": "slider_crank", "gains": {"kp_x": -5, "kd_x": 1, "kp_f": 0, "ki_f": 1}})",
+       "/gains/kp_x: expected a number in [0, 20000]"},
+      {"infinite.json", R"({"lab": "slider_crank", "gains": {"kp_x": 1e999, "kd_x": 1, "kp_f": 0, "ki_f": 1}})",
+       "number overflow parsing '1e999'"},
+      {"extra_key.json", R"({"lab": "slider_crank", "gains": {"kp_x": 1, "kd_x": 1, "kp_f": 0, "ki_f": 1}, "code": "rm -rf"})",
+       "/code: unknown key"},
+      {"bad_option.json", R"({"lab": "slider_crank", "force_law": "magic", "gains": {"kp_x": 1, "kd_x": 1, "kp_f": 0, "ki_f": 1}})",
+       "/force_law: expected one of"},
+  };
+  for (const Case& c : cases) {
+    CAPTURE(c.name);
+    const std::string file = writeFile(c.name, c.text);
+    const GradeOutcome g = grade(file);
+    CHECK(g.input_error);
+    CHECK(score(g) == 0.0);
+    const std::string out = g.results.at("output").get<std::string>();
+    CHECK(out.find(file) != std::string::npos);
+    CHECK(out.find(c.expect) != std::string::npos);
+  }
+  // A file far too large is refused before it is read.
+  const std::string big = writeFile("big.json", std::string(2u << 20, ' ') + "{}");
+  const GradeOutcome g = grade(big);
+  CHECK(g.input_error);
+  CHECK(g.results.at("output").get<std::string>().find("expected at most") != std::string::npos);
+  // A submission for another lab than the assignment's.
+  GradeOptions o;
+  o.expected_lab = "unicycle";
+  CHECK(grade(kExamples + "good.json", o).results.at("output").get<std::string>().find("this assignment's lab") != std::string::npos);
+}
+
+TEST_CASE("grading twice gives the same results apart from execution_time; replay detects a change") {
+  const GradeOutcome a = grade(kExamples + "mediocre.json"), b = grade(kExamples + "mediocre.json");
+  json ja = a.results, jb = b.results;
+  ja.erase("execution_time");
+  jb.erase("execution_time");
+  CHECK(ja.dump() == jb.dump());
+  CHECK(compareResults(a.results, b.results).empty());
+  // The noisy scenario's seed comes from the submission: other gains, other trajectories.
+  const auto fp = a.results["extra_data"]["fingerprint"];
+  CHECK(fp["trajectory_hash"] != grade(kExamples + "good.json").results["extra_data"]["fingerprint"]["trajectory_hash"]);
+  // A tampered score is reported.
+  json tampered = a.results;
+  tampered["tests"][0]["score"] = 3.0;
+  const auto diff = compareResults(tampered, b.results);
+  REQUIRE(diff.size() == 1);
+  CHECK(diff[0].find("/tests/0/score") != std::string::npos);
+}
+
+TEST_CASE("results.json has Gradescope's field names and types") {
+  for (const std::string& f : {kExamples + "good.json", kExamples + "unstable_integral.json", writeFile("bad.json", "{")}) {
+    CAPTURE(f);
+    const json r = grade(f).results;
+    CHECK(r.at("score").is_number());
+    CHECK(r.at("execution_time").is_number());
+    CHECK(r.at("output").is_string());
+    CHECK(r.at("output_format") == "md");
+    REQUIRE(r.at("tests").is_array());
+    for (const auto& t : r["tests"]) {
+      CHECK(t.at("name").is_string());
+      CHECK(t.at("number").is_string());
+      CHECK(t.at("score").is_number());
+      CHECK(t.at("max_score").is_number());
+      CHECK(t.at("score").get<double>() <= t.at("max_score").get<double>() + 1e-12);
+      CHECK(t.at("score").get<double>() >= 0.0);
+      const std::string status = t.at("status");
+      CHECK((status == "passed" || status == "failed"));
+      CHECK(t.at("output").is_string());
+      const std::string vis = t.at("visibility");
+      CHECK((vis == "visible" || vis == "hidden" || vis == "after_due_date" || vis == "after_published"));
+    }
+    if (r.contains("leaderboard"))
+      for (const auto& l : r["leaderboard"]) {
+        CHECK(l.at("name").is_string());
+        CHECK(l.at("value").is_number());
+        CHECK((l.at("order") == "asc" || l.at("order") == "desc"));
+      }
+  }
+}
+
+TEST_CASE("the time budget and the step budget stop runs without losing the grade") {
+  GradeOptions o;
+  o.time_budget = 1e-6;  // already over when the first run starts
+  const GradeOutcome late = grade(kExamples + "good.json", o);
+  CHECK_FALSE(late.input_error);
+  CHECK(anyTestSays(late, "not graded: the grading time budget ran out"));
+  CHECK(late.results["tests"].size() == 10);
+  // Screening needs no simulation: its tests are still scored.
+  CHECK(score(late) == doctest::Approx(2.0));
+
+  // A lab config whose watchdog allows 100 steps: every run exceeds it.
+  json config = json::parse(std::ifstream(std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/slider_crank.json"));
+  config["rubric"]["watchdog"]["max_steps"] = 100;
+  GradeOptions s;
+  s.config_file = writeFile("short_budget.json", config.dump());
+  const GradeOutcome g = grade(kExamples + "good.json", s);
+  CHECK(anyTestSays(g, "exceeded its step budget of 100 steps"));
+}
+
+TEST_CASE("a rubric naming a metric the lab does not report is the config's error, not the student's") {
+  json config = json::parse(std::ifstream(std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/slider_crank.json"));
+  config["rubric"]["tests"][0]["metric"] = "x_rsm";
+  GradeOptions o;
+  o.config_file = writeFile("typo_rubric.json", config.dump());
+  const GradeOutcome g = grade(kExamples + "good.json", o);
+  const std::string out = g.results["output"];
+  CHECK(out.find("typo_rubric.json") != std::string::npos);
+  CHECK(out.find("/rubric/tests/0/metric") != std::string::npos);
+}

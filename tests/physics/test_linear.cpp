@@ -1,0 +1,78 @@
+// physics/linear: roots, the Padé delay, and loop margins against closed-form answers.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "physics/linear.h"
+
+using namespace dyn;
+
+TEST_CASE("roots of (s+1)(s+2)(s²+2s+5) are −1, −2, −1±2j") {
+  const Poly p = polyMul(polyMul({1, 1}, {2, 1}), {5, 2, 1});
+  const auto r = polyRoots(p);
+  REQUIRE(r.size() == 4);
+  int found = 0;
+  for (const auto& z : r) {
+    for (std::complex<double> want : {std::complex<double>(-1, 0), {-2, 0}, {-1, 2}, {-1, -2}})
+      if (std::abs(z - want) < 1e-9) ++found;
+    CHECK(std::abs(polyEval(p, z)) < 1e-9);
+  }
+  CHECK(found == 4);
+}
+
+TEST_CASE("Padé (3,3) of e^{−sT} is all-pass and matches the phase at ωT ≤ 1") {
+  const double T = 0.01;
+  const Poly num = padeDenominator(-T, 3), den = padeDenominator(T, 3);
+  for (double w : {1.0, 10.0, 50.0, 100.0}) {
+    const std::complex<double> s(0, w);
+    const auto ratio = polyEval(num, s) / polyEval(den, s);
+    CHECK(std::abs(ratio) == doctest::Approx(1.0).epsilon(1e-12));
+    CHECK(std::abs(ratio - std::exp(-s * T)) < 1e-5);
+  }
+}
+
+TEST_CASE("integral loop k/s with delay T: delay margin π/(2k), stable iff T below it") {
+  const double k = 40;
+  LinearLoop loop{"force", "integral", {k}, {0, 1}, 0.0};
+  const LoopAnalysis free = analyseLoop(loop);
+  CHECK(free.crossover == doctest::Approx(k).epsilon(1e-6));
+  CHECK(free.phase_margin == doctest::Approx(M_PI / 2).epsilon(1e-6));
+  CHECK(free.delay_margin == doctest::Approx(M_PI / (2 * k)).epsilon(1e-6));
+  CHECK(free.stable);
+  // The Padé poles agree with the exact delay criterion on either side of the margin.
+  loop.delay = 0.9 * M_PI / (2 * k);
+  CHECK(analyseLoop(loop).stable);
+  loop.delay = 1.1 * M_PI / (2 * k);
+  const LoopAnalysis late = analyseLoop(loop);
+  CHECK_FALSE(late.stable);
+  CHECK(late.max_real > 0);
+}
+
+TEST_CASE("PD loop (k_d s + k_p)/(m s²): poles and damping of m s² + k_d s + k_p") {
+  const double m = 2.5, kp = 400, kd = 30;
+  const LoopAnalysis a = analyseLoop({"motion", "PD", {kp, kd}, {0, 0, m}, 0.0});
+  const double zeta = kd / (2 * std::sqrt(kp * m)), wn = std::sqrt(kp / m);
+  REQUIRE(a.poles.size() == 2);
+  CHECK(a.poles[0].real() == doctest::Approx(-zeta * wn));
+  CHECK(std::abs(a.poles[0].imag()) == doctest::Approx(wn * std::sqrt(1 - zeta * zeta)));
+  CHECK(a.min_damping == doctest::Approx(zeta));
+  CHECK(a.stable);
+}
+
+TEST_CASE("proportional loop: gain below 1 tolerates any delay, above 1 none") {
+  LinearLoop loop{"force", "P", {0.5}, {1}, 0.01};
+  LoopAnalysis a = analyseLoop(loop);
+  CHECK(a.delay_margin == kUnboundedDelay);
+  CHECK(a.stable);
+  loop.num = {2.0};
+  a = analyseLoop(loop);
+  CHECK(a.delay_margin == 0.0);
+  CHECK_FALSE(a.stable);
+}
+
+TEST_CASE("a loop unstable without delay has no delay margin") {
+  // L = 1/(s − 2): closed loop s − 1 (unstable) although |L| crosses 1.
+  const LoopAnalysis a = analyseLoop({"x", "unstable plant", {1}, {-2, 1}, 0.0});
+  CHECK_FALSE(a.stable);
+  CHECK(a.delay_margin == 0.0);
+}
