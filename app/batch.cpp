@@ -100,9 +100,11 @@ Row readRow(const Job& job, const std::string& process_status) {
     const json extra = r.value("extra_data", json::object());
     if (process_status == "graded") {
       if (extra.contains("error")) row.status = "invalid submission";
-      else
-        for (const auto& [_, s] : extra.value("scenarios", json::object()).items())
+      else {
+        const json scenarios = extra.value("scenarios", json::object());  // kept alive for the loop
+        for (const auto& [_, s] : scenarios.items())
           if (s.value("status", "completed") != "completed") row.status = "graded (unstable run)";
+      }
     }
   } catch (const std::exception&) {
     row.status = "no results";
@@ -126,7 +128,8 @@ int gradeBatch(const GradeArgs& a) {
   fs::create_directories(out);
   const bool tty = isatty(STDERR_FILENO);
   // A grader process gets its own budget plus a margin to write its results, then it is killed.
-  const auto kill_after = std::chrono::milliseconds(long((a.time_budget + 30) * 1e3));
+  const double kill_s = a.time_budget + std::clamp(a.time_budget, 2.0, 30.0);
+  const auto kill_after = std::chrono::milliseconds(long(kill_s * 1e3));
 
   std::vector<Job> pending, running;
   for (const auto& f : files) pending.push_back({f, out / f.stem()});
@@ -177,7 +180,7 @@ int gradeBatch(const GradeArgs& a) {
       std::string st = "graded";
       if (it->killed) {
         st = "timed out";
-        writeFallback(*it, "grading did not finish within " + std::to_string(long(a.time_budget + 30)) + " s", st);
+        writeFallback(*it, "grading did not finish within " + std::to_string(long(kill_s)) + " s", st);
       } else if (WIFSIGNALED(status)) {
         st = "crashed";
         writeFallback(*it, std::string("the grader stopped with signal ") + std::to_string(WTERMSIG(status)) + " (" +

@@ -1,0 +1,80 @@
+// dynlab grade --batch: one grader process per submission, N at a time. A submission that hangs
+// its grader or crashes it still gets a results.json and a gradebook row; the others are graded
+// exactly as alone, whatever --jobs is.
+#include <doctest/doctest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+const std::string kExamples = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/examples/";
+
+std::string slurp(const fs::path& p) {
+  std::ifstream f(p, std::ios::binary);
+  std::stringstream s;
+  s << f.rdbuf();
+  return s.str();
+}
+
+json withoutTime(json r) {
+  r.erase("execution_time");
+  return r;
+}
+
+// A submissions folder: good, mediocre, unstable, malformed, plus two that hang and crash the grader.
+fs::path makeBatch() {
+  const fs::path dir = fs::temp_directory_path() / ("dynlab-batch-" + std::to_string(::getpid()));
+  fs::remove_all(dir);
+  fs::create_directories(dir / "in");
+  for (const char* n : {"good", "mediocre", "unstable_integral"}) fs::copy_file(kExamples + n + ".json", dir / "in" / (std::string(n) + ".json"));
+  std::ofstream(dir / "in" / "malformed.json") << "{\"lab\": \"slider_crank\", \"gains\": {\"kp_x\": }";
+  fs::copy_file(kExamples + "good.json", dir / "in" / "hangs.json");
+  fs::copy_file(kExamples + "good.json", dir / "in" / "crashes.json");
+  return dir;
+}
+
+int runBatch(const fs::path& dir, const std::string& out, int jobs) {
+  const std::string cmd = "DYNLAB_FAULT_INJECTION=hang:hangs,crash:crashes " + std::string(DYNLAB_BIN) + " grade --batch " +
+                          (dir / "in").string() + " --jobs " + std::to_string(jobs) + " --time-budget 2 --no-plots --out " +
+                          (dir / out).string() + " > " + (dir / (out + ".log")).string() + " 2>&1";
+  return std::system(cmd.c_str());
+}
+
+}  // namespace
+
+TEST_CASE("a batch survives a hanging and a crashing grader, and --jobs does not change a byte") {
+  const fs::path dir = makeBatch();
+  REQUIRE(runBatch(dir, "one", 1) == 0);
+  REQUIRE(runBatch(dir, "two", 2) == 0);
+
+  for (const char* n : {"good", "mediocre", "unstable_integral", "malformed", "hangs", "crashes"}) {
+    CAPTURE(n);
+    const json a = json::parse(slurp(dir / "one" / n / "results.json"));
+    const json b = json::parse(slurp(dir / "two" / n / "results.json"));
+    CHECK(withoutTime(a).dump() == withoutTime(b).dump());
+    CHECK(a.at("score").is_number());
+  }
+  // The gradebook: every submission, its status, identical for any number of jobs.
+  const std::string book = slurp(dir / "one" / "gradebook.csv");
+  CHECK(book == slurp(dir / "two" / "gradebook.csv"));
+  CHECK(book.find("submission,score,max_score,status,Slider tracks x_d(t)") == 0);
+  CHECK(book.find("hangs.json,0,0,timed out") != std::string::npos);
+  CHECK(book.find("crashes.json,0,0,crashed") != std::string::npos);
+  CHECK(book.find("malformed.json,0,0,invalid submission") != std::string::npos);
+  CHECK(book.find("good.json,15,15,graded") != std::string::npos);
+  CHECK(book.find("unstable_integral.json") != std::string::npos);
+  // The crashed and timed-out submissions say what happened.
+  CHECK(slurp(dir / "one" / "crashes" / "results.json").find("signal 6") != std::string::npos);
+  CHECK(slurp(dir / "one" / "hangs" / "results.json").find("did not finish within 4 s") != std::string::npos);
+  // Without a terminal, progress is plain lines.
+  CHECK(slurp(dir / "one.log").find("graded 6/6") != std::string::npos);
+  fs::remove_all(dir);
+}
