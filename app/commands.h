@@ -4,6 +4,8 @@
 #include <optional>
 #include <string>
 
+#include "labs/config.h"
+
 namespace dyn::app {
 
 struct RunArgs {
@@ -32,5 +34,7 @@ int gradeBatch(const GradeArgs& args);  // app/batch.cpp
 int writeAutograderZip(const std::string& lab, const std::string& out);
 int printSchema(const std::string& lab);
 int bench(const BenchArgs& args);
+// CPU cost of grading the lab's examples/good.json (app/bench_grade.cpp); empty if none.
+json gradeThroughput(const std::string& lab, int repeats);
 
 }  // namespace dyn::app
