@@ -16,11 +16,12 @@ json parseJsonText(const std::string& text, const std::string& file) {
     throw InputError(file, "", "expected a JSON document, the file is empty");
   try {
     return json::parse(text);
-  } catch (const json::parse_error& e) {
-    // nlohmann's message names the line and column; keep only that part.
+  } catch (const json::exception& e) {
+    // nlohmann's message names the line and column (parse_error) or the number that does not fit a
+    // double, e.g. 1e999 (out_of_range 406); keep only that part, without the "[json.exception...]" tag.
     std::string what = e.what();
-    const auto pos = what.find("parse error");
-    throw InputError(file, "", "expected valid JSON (" + what.substr(pos == std::string::npos ? 0 : pos) + ")");
+    const auto pos = what.find("] ");
+    throw InputError(file, "", "expected valid JSON (" + what.substr(pos == std::string::npos ? 0 : pos + 2) + ")");
   }
 }
 
@@ -40,6 +41,9 @@ json loadJsonFile(const std::string& file, std::size_t max_bytes) {
 void JsonView::fail(const std::string& expected) const { throw InputError(file_, path_, expected); }
 
 std::string JsonView::got() const {
+  // dump() writes a non-finite double (only possible in memory) as null: name it instead.
+  if (value_->is_number_float() && !std::isfinite(value_->get<double>()))
+    return std::isnan(value_->get<double>()) ? ", got NaN" : value_->get<double>() > 0 ? ", got inf" : ", got -inf";
   std::string s = value_->dump();
   if (s.size() > 40) s = s.substr(0, 37) + "...";
   return ", got " + s;

@@ -1,0 +1,339 @@
+// The dynlab command line end to end: the real binary (DYNLAB_BIN) run through the shell, its exit
+// code, stdout/stderr and the files it writes. Every test works in its own directory under the
+// build tree, removed afterwards.
+//   exit codes: 0 success, 1 a run or write failed, 2 bad input (nothing written).
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <nlohmann/json.hpp>
+#include <sstream>
+#include <string>
+#include <sys/wait.h>
+#include <unistd.h>
+#include <vector>
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+
+namespace {
+
+std::string readFile(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void writeFile(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
+
+std::string quote(const std::string& s) { return "'" + s + "'"; }
+
+// A fresh directory per test case, unique to this process; removed at the end.
+struct TempDir {
+  fs::path path;
+  explicit TempDir(const std::string& name)
+      : path(fs::path(DYNLAB_TEST_TMP) / ("cli_" + name + "_" + std::to_string(::getpid()))) {
+    fs::remove_all(path);
+    fs::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ec;
+    fs::remove_all(path, ec);
+  }
+  fs::path operator/(const std::string& name) const { return path / name; }
+};
+
+struct Result {
+  int code = -1;
+  std::string out, err;
+};
+
+// Runs `dynlab ARGS` in dir (stdout/stderr captured to files there).
+Result dynlab(const TempDir& dir, const std::string& args) {
+  const fs::path out = dir / ".stdout", err = dir / ".stderr";
+  const std::string cmd = "cd " + quote(dir.path.string()) + " && " + quote(DYNLAB_BIN) + " " + args + " >" +
+                          quote(out.string()) + " 2>" + quote(err.string());
+  const int status = std::system(cmd.c_str());
+  Result r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
+  r.out = readFile(out);
+  r.err = readFile(err);
+  fs::remove(out);
+  fs::remove(err);
+  return r;
+}
+
+// Every regular file under dir (relative name → bytes).
+std::map<std::string, std::string> snapshot(const fs::path& dir) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : fs::recursive_directory_iterator(dir))
+    if (e.is_regular_file()) files[fs::relative(e.path(), dir).string()] = readFile(e.path());
+  return files;
+}
+
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::vector<double>> rows;
+  int col(const std::string& name) const {
+    const auto it = std::find(header.begin(), header.end(), name);
+    return it == header.end() ? -1 : int(it - header.begin());
+  }
+  double at(std::size_t r, const std::string& name) const { return rows[r][std::size_t(col(name))]; }
+};
+
+Csv readCsv(const fs::path& p) {
+  Csv csv;
+  std::istringstream in(readFile(p));
+  std::string line, cell;
+  REQUIRE(std::getline(in, line));
+  std::istringstream h(line);
+  while (std::getline(h, cell, ',')) csv.header.push_back(cell);
+  while (std::getline(in, line)) {
+    std::istringstream l(line);
+    std::vector<double> row;
+    while (std::getline(l, cell, ',')) {
+      char* end = nullptr;
+      row.push_back(std::strtod(cell.c_str(), &end));
+      REQUIRE_MESSAGE(*end == '\0', "not a number: " << cell);
+    }
+    REQUIRE(row.size() == csv.header.size());
+    csv.rows.push_back(row);
+  }
+  return csv;
+}
+
+// Bad input: exit code 2, one line on stderr naming what is given, nothing written at all.
+void checkBadInput(const TempDir& dir, const std::string& args, const std::vector<std::string>& names,
+                   const fs::path& out) {
+  const Result r = dynlab(dir, args);
+  INFO("dynlab ", args, "\nstderr: ", r.err);
+  CHECK(r.code == 2);
+  CHECK(r.out.empty());
+  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  CHECK(r.err.rfind("error: ", 0) == 0);
+  for (const auto& n : names) CHECK_MESSAGE(r.err.find(n) != std::string::npos, "missing: " << n);
+  CHECK_FALSE(fs::exists(out));
+}
+
+std::string defaultConfigText() { return readFile(fs::path(DYNLAB_SOURCE_DIR) / "labs/slider_crank/slider_crank.json"); }
+
+}  // namespace
+
+TEST_CASE("dynlab list and --help") {
+  TempDir dir("help");
+  const Result list = dynlab(dir, "list");
+  CHECK(list.code == 0);
+  CHECK(list.out.rfind("slider_crank ", 0) == 0);
+  for (const char* args : {"--help", "run --help", "grade --help", "bench --help", "schema --help", "list --help"}) {
+    INFO("dynlab ", args);
+    const Result r = dynlab(dir, args);
+    CHECK(r.code == 0);
+    CHECK(r.out.find("Usage:") != std::string::npos);
+    CHECK(r.err.empty());
+  }
+  CHECK(dynlab(dir, "run --help").out.find("--duration") != std::string::npos);
+  // No subcommand, an unknown one, or an unknown option: a usage error (2), not a crash.
+  CHECK(dynlab(dir, "").code == 2);
+  CHECK(dynlab(dir, "frobnicate").code == 2);
+  CHECK(dynlab(dir, "run slider_crank --no-such-option").code == 2);
+  CHECK(dynlab(dir, "run slider_crank --engine warp").code == 2);
+  CHECK(snapshot(dir.path).empty());  // none of these wrote anything
+}
+
+TEST_CASE("dynlab run writes both traces and a summary that agrees with them") {
+  TempDir dir("run");
+  const Result r = dynlab(dir, "run slider_crank --out out --duration 0.5");
+  INFO("stdout: ", r.out, "\nstderr: ", r.err);
+  REQUIRE(r.code == 0);
+  const fs::path out = dir / "out";
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(out)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  CHECK(names == std::vector<std::string>{"summary.json", "trace_bullet.csv", "trace_hand.csv"});  // no .staging left
+
+  const json summary = json::parse(readFile(out / "summary.json"));
+  const double dt = summary.at("dt").get<double>();
+  CHECK(summary.at("duration").get<double>() == 0.5);
+  CHECK(summary.at("lab") == "slider_crank");
+  CHECK(summary.at("status") == "ok");
+  std::map<std::string, Csv> traces;
+  for (const char* engine : {"hand", "bullet"}) {
+    INFO("engine ", engine);
+    const Csv csv = readCsv(out / (std::string("trace_") + engine + ".csv"));
+    for (const char* c : {"t", "q1", "q2", "q3", "x_c", "v_c", "f_Tx", "f_Ty", "tau_T", "tau1", "tau2", "tau3",
+                          "energy", "constraint_residual"})
+      CHECK_MESSAGE(csv.col(c) >= 0, "column " << c);
+    // One row per step, on the grid t = k dt.
+    REQUIRE(csv.rows.size() == std::size_t(std::lround(0.5 / dt)));
+    CHECK(csv.rows.size() == 500);
+    for (std::size_t k = 0; k < csv.rows.size(); ++k) REQUIRE(std::abs(csv.at(k, "t") - double(k) * dt) < 1e-12);
+    const json& engine_summary = summary.at("engines").at(engine);
+    CHECK(engine_summary.at("status") == "ok");
+    CHECK(engine_summary.at("trace_hash").is_number_unsigned());
+    CHECK(engine_summary.at("metrics").at("steps") == 500);
+    traces[engine] = csv;
+  }
+  // The agreement block, recomputed from the written traces (CSV numbers are round-trip exact).
+  const json& ag = summary.at("agreement");
+  const Csv &hand = traces["hand"], &bullet = traces["bullet"];
+  double dq = 0, dx = 0, df = 0;
+  for (std::size_t k = 0; k < hand.rows.size(); ++k) {
+    for (const char* c : {"q1", "q2", "q3"}) dq = std::max(dq, std::abs(hand.at(k, c) - bullet.at(k, c)));
+    dx = std::max(dx, std::abs(hand.at(k, "x_c") - bullet.at(k, "x_c")));
+    for (const char* c : {"f_Tx", "f_Ty"}) df = std::max(df, std::abs(hand.at(k, c) - bullet.at(k, c)));
+  }
+  CHECK(ag.at("rows_compared") == 500);
+  CHECK(ag.at("max_dq").get<double>() == dq);
+  CHECK(ag.at("max_dx_c").get<double>() == dx);
+  CHECK(ag.at("max_df").get<double>() == df);
+  // Hand vs Bullet at dt = 1 ms over the controlled run's first 0.5 s: Bullet's first-order error
+  // (see tests/labs: 1.7e-4 rad over 4 s, halving with dt); a loose bound, this is a plumbing test.
+  CHECK(dq < 1e-3);
+  CHECK(dq > 0);  // two different engines really ran
+  for (const char* engine : {"hand", "bullet"}) {
+    INFO("engine ", engine);
+    const Csv& tr = traces[engine];
+    double drift = 0, residual = 0;
+    for (std::size_t k = 0; k < tr.rows.size(); ++k) {
+      drift = std::max(drift, std::abs(tr.at(k, "energy") - tr.at(0, "energy") - tr.at(k, "work")));
+      residual = std::max(residual, tr.at(k, "constraint_residual"));
+    }
+    CHECK(ag.at(engine).at("energy_drift").get<double>() == doctest::Approx(drift).epsilon(1e-12));
+    CHECK(ag.at(engine).at("max_constraint_residual").get<double>() == residual);
+  }
+  CHECK(ag.at("hand").at("max_constraint_residual").get<double>() < 1e-9);
+  // The headline on stdout names the files.
+  CHECK(r.out.find("trace_hand.csv") != std::string::npos);
+  CHECK(r.out.find("summary.json") != std::string::npos);
+}
+
+TEST_CASE("dynlab run --engine hand writes only the hand trace") {
+  TempDir dir("engine");
+  const Result r = dynlab(dir, "run slider_crank --out out --duration 0.2 --engine hand");
+  INFO("stderr: ", r.err);
+  REQUIRE(r.code == 0);
+  CHECK(fs::exists(dir / "out/trace_hand.csv"));
+  CHECK_FALSE(fs::exists(dir / "out/trace_bullet.csv"));
+  const json summary = json::parse(readFile(dir / "out/summary.json"));
+  CHECK(summary.at("engines").size() == 1);
+  CHECK(summary.at("engines").contains("hand"));
+  CHECK_FALSE(summary.contains("agreement"));
+  CHECK(readCsv(dir / "out/trace_hand.csv").rows.size() == 200);
+}
+
+TEST_CASE("dynlab run --frames --video: 30 frames per second of simulated time, H.264 yuv420p") {
+  TempDir dir("video");
+  const double duration = 0.5;
+  const Result r = dynlab(dir, "run slider_crank --out out --duration 0.5 --frames --video");
+  INFO("stdout: ", r.out, "\nstderr: ", r.err);
+  REQUIRE(r.code == 0);
+  const int expected = int(std::lround(30 * duration));
+  std::vector<std::string> frames;
+  for (const auto& e : fs::directory_iterator(dir / "out/frames")) frames.push_back(e.path().filename().string());
+  std::sort(frames.begin(), frames.end());
+  CHECK(int(frames.size()) == expected);
+  for (int i = 0; i < int(frames.size()); ++i) {
+    char name[32];
+    std::snprintf(name, sizeof name, "%05d.png", i);
+    CHECK(frames[std::size_t(i)] == name);
+  }
+  // PNG signature and the IHDR size (640×480).
+  const std::string png = readFile(dir / "out/frames/00000.png");
+  REQUIRE(png.size() > 24);
+  CHECK(png.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0);
+  auto be32 = [&](std::size_t at) {
+    return (unsigned(std::uint8_t(png[at])) << 24) | (unsigned(std::uint8_t(png[at + 1])) << 16) |
+           (unsigned(std::uint8_t(png[at + 2])) << 8) | unsigned(std::uint8_t(png[at + 3]));
+  };
+  CHECK(be32(16) == 640u);
+  CHECK(be32(20) == 480u);
+  // Decode the whole video with ffprobe: every frame is read, not just the header's count.
+  const std::string cmd = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                          "stream=nb_read_frames,pix_fmt,codec_name -of csv=p=0 " +
+                          quote((dir / "out/video.mp4").string()) + " > " + quote((dir / "probe.txt").string());
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  std::string line = readFile(dir / "probe.txt");
+  line.erase(line.find_last_not_of(" \r\n") + 1);
+  CHECK(line == "h264,yuv420p," + std::to_string(expected));
+  CHECK(r.out.find(std::to_string(expected) + " frames)") != std::string::npos);
+}
+
+TEST_CASE("bad input through the CLI: exit 2, one line naming file and JSON path, nothing written") {
+  TempDir dir("bad");
+  const fs::path out = dir / "out";
+  const std::string run = "run slider_crank --out out --duration 0.2 ";
+
+  SUBCASE("config with a negative mass") {
+    json c = json::parse(defaultConfigText());
+    c["mechanism"]["links"][0]["mass"] = -1.0;
+    writeFile(dir / "negative_mass.json", c.dump(2));
+    checkBadInput(dir, run + "--config negative_mass.json", {"negative_mass.json", "/mechanism/links/0/mass", "positive"}, out);
+  }
+  SUBCASE("config with a number that overflows a double (1e999)") {
+    std::string text = defaultConfigText();
+    const std::string key = "\"load_mass\": 0.5";
+    REQUIRE(text.find(key) != std::string::npos);
+    text.replace(text.find(key), key.size(), "\"load_mass\": 1e999");
+    writeFile(dir / "overflow.json", text);
+    checkBadInput(dir, run + "--config overflow.json", {"overflow.json", "1e999"}, out);
+  }
+  SUBCASE("malformed and empty config files") {
+    writeFile(dir / "malformed.json", "{\"lab\": \"slider_crank\",,}");
+    checkBadInput(dir, run + "--config malformed.json", {"malformed.json", "expected valid JSON", "line 1"}, out);
+    writeFile(dir / "empty.json", "");
+    checkBadInput(dir, run + "--config empty.json", {"empty.json", "empty"}, out);
+  }
+  SUBCASE("missing config file") {
+    checkBadInput(dir, run + "--config no_such_config.json", {"no_such_config.json", "cannot open"}, out);
+  }
+  SUBCASE("gains out of bounds, unknown gain, wrong type") {
+    writeFile(dir / "gains_big.json", R"({"gains": {"kp_x": 1e9}})");
+    checkBadInput(dir, run + "--gains gains_big.json", {"gains_big.json", "/gains/kp_x", "[0, 20000]"}, out);
+    writeFile(dir / "gains_unknown.json", R"({"gains": {"kp_z": 1}})");
+    checkBadInput(dir, run + "--gains gains_unknown.json", {"gains_unknown.json", "/gains/kp_z", "unknown gain"}, out);
+    writeFile(dir / "gains_type.json", R"({"gains": {"ki_f": "NaN"}})");
+    checkBadInput(dir, run + "--gains gains_type.json", {"gains_type.json", "/gains/ki_f", "expected a number"}, out);
+  }
+  SUBCASE("unknown lab") {
+    checkBadInput(dir, "run no_such_lab --out out", {"unknown lab \"no_such_lab\"", "LAB", "slider_crank"}, out);
+  }
+  SUBCASE("bad duration") {
+    checkBadInput(dir, "run slider_crank --out out --duration 0", {"--duration"}, out);
+  }
+  SUBCASE("a failing run keeps the results of an earlier good run intact") {
+    REQUIRE(dynlab(dir, run).code == 0);
+    const auto before = snapshot(out);
+    REQUIRE(before.size() == 3);
+    writeFile(dir / "gains_big.json", R"({"gains": {"kd_x": -5}})");
+    const Result r = dynlab(dir, run + "--gains gains_big.json");
+    INFO("stderr: ", r.err);
+    CHECK(r.code == 2);
+    CHECK(r.err.find("/gains/kd_x") != std::string::npos);
+    CHECK(snapshot(out) == before);
+    CHECK_FALSE(fs::exists(out / ".staging"));
+  }
+}
+
+TEST_CASE("the same command twice gives byte-identical traces and summary") {
+  TempDir dir("repeat");
+  const std::string cmd = "run slider_crank --out out --duration 0.3";
+  REQUIRE(dynlab(dir, cmd).code == 0);
+  const auto first = snapshot(dir / "out");
+  REQUIRE(dynlab(dir, cmd).code == 0);
+  const auto second = snapshot(dir / "out");
+  REQUIRE(first.size() == 3);
+  CHECK(second.size() == first.size());
+  for (const auto& [name, bytes] : first) {
+    INFO("file ", name);
+    REQUIRE(second.count(name) == 1);
+    CHECK(second.at(name) == bytes);
+  }
+  // And the bytes do depend on the input: a different duration gives a different summary.
+  REQUIRE(dynlab(dir, "run slider_crank --out out2 --duration 0.2").code == 0);
+  CHECK(readFile(dir / "out2/summary.json") != first.at("summary.json"));
+}
