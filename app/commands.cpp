@@ -43,6 +43,7 @@ int runLab(const RunArgs& a) {
     if (a.engine != "hand") bullet = runEngine(lab, Engine::Bullet);
 
     Staging staging(out);
+    staging.owns({"trace_hand.csv", "trace_bullet.csv", "summary.json", "video.mp4", "frames"});
     json summary = {{"lab", a.lab},
                     {"config", loaded.config_file},
                     {"gains", a.gains.empty() ? json(nullptr) : json(a.gains)},
@@ -119,6 +120,7 @@ int gradeOne(const GradeArgs& a) {
   try {
     // Everything lands in OUT/.staging first; a failure never leaves a half-written results set.
     Staging staging(a.out);
+    staging.owns({"results.json", "report.md", "report.html", "plots"});
     g = gradeSubmission(a.submission, gradeOptions(a, staging.path("").string()));
     staging.write("results.json", g.results.dump(2) + "\n");
     staging.write("report.md", g.markdown);

@@ -34,6 +34,8 @@ void Staging::write(const std::string& name, const std::string& contents) const 
 }
 
 void Staging::commit() {
+  for (const auto& name : owned_)
+    if (!fs::exists(staging_ / name)) fs::remove_all(out_ / name);
   for (const auto& e : fs::directory_iterator(staging_)) {
     const fs::path dest = out_ / e.path().filename();
     fs::remove_all(dest);

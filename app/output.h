@@ -3,6 +3,7 @@
 #pragma once
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace dyn::app {
 
@@ -12,12 +13,16 @@ class Staging {
   ~Staging();  // discards anything not committed
   std::filesystem::path path(const std::string& name) const { return staging_ / name; }
   void write(const std::string& name, const std::string& contents) const;
+  // Names this command always owns in out_dir: on commit, any of them not staged this time is
+  // removed, so a rerun never leaves a stale file (an old video.mp4) beside fresh results.
+  void owns(std::vector<std::string> names) { owned_ = std::move(names); }
   // Moves every staged entry into out_dir (replacing older ones) and removes the staging dir.
   void commit();
   const std::filesystem::path& outDir() const { return out_; }
 
  private:
   std::filesystem::path out_, staging_;
+  std::vector<std::string> owned_;
   bool committed_ = false;
 };
 

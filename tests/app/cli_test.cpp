@@ -337,3 +337,17 @@ TEST_CASE("the same command twice gives byte-identical traces and summary") {
   REQUIRE(dynlab(dir, "run slider_crank --out out2 --duration 0.2").code == 0);
   CHECK(readFile(dir / "out2/summary.json") != first.at("summary.json"));
 }
+
+TEST_CASE("a rerun into the same directory leaves no stale output of the earlier run") {
+  TempDir dir("rerun");
+  REQUIRE(dynlab(dir, "run slider_crank --out out --duration 0.2 --video --frames").code == 0);
+  REQUIRE(fs::exists(dir / "out/video.mp4"));
+  REQUIRE(fs::exists(dir / "out/frames"));
+  std::ofstream(dir / "out/notes.txt") << "mine";  // the user's own file stays
+  REQUIRE(dynlab(dir, "run slider_crank --out out --duration 0.2 --engine hand").code == 0);
+  CHECK_FALSE(fs::exists(dir / "out/video.mp4"));
+  CHECK_FALSE(fs::exists(dir / "out/frames"));
+  CHECK_FALSE(fs::exists(dir / "out/trace_bullet.csv"));
+  CHECK(fs::exists(dir / "out/trace_hand.csv"));
+  CHECK(readFile(dir / "out/notes.txt") == "mine");
+}
