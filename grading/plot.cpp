@@ -29,6 +29,7 @@ constexpr double kHuge = 1e100;        // |values| beyond this are clamped (PLpl
 constexpr double kCharHeightPx = 9.0;  // PLplot character height: ~12 px tick labels, 15 px title
 constexpr double kGlyphWidth = 0.7;    // a generous average glyph width, in character heights
 constexpr double kMaxOutsideLegend = 0.3;  // wider legends (fraction of the page) go inside the frame
+constexpr double kXTicks = 8, kYTicks = 6;  // about this many tick intervals per axis
 
 // cmap0 slots: fixed colours first, then the series palette.
 enum Col : PLINT { kWhite = 0, kInk = 1, kGrid = 2, kBand = 3, kMarker = 4, kAxis = 5, kLegendEdge = 6, kPalette0 = 8 };
@@ -118,10 +119,11 @@ void appendThinned(const std::vector<double>& x, const std::vector<double>& y, s
   }
 }
 
-// A "nice" tick step (1, 2 or 5 × 10^k) giving about `target` intervals over the span.
+// A "nice" tick step (1, 2 or 5 × 10^k) giving about `target` intervals over the span (the
+// thresholds are the geometric midpoints between 1, 2, 5 and 10).
 double niceStep(double span, double target) {
   const double raw = span / target, mag = std::pow(10.0, std::floor(std::log10(raw))), r = raw / mag;
-  return (r < 1.5 ? 1.0 : r < 3.0 ? 2.0 : r < 7.0 ? 5.0 : 10.0) * mag;
+  return (r < 1.414 ? 1.0 : r < 3.162 ? 2.0 : r < 7.071 ? 5.0 : 10.0) * mag;
 }
 
 // Tick labels with just enough decimals for the step; "%g" for very large or small numbers.
@@ -257,6 +259,14 @@ std::pair<Range, Range> dataRanges(const std::string& path, const PlotSpec& spec
   if (yr.empty()) yr = {0.0, 0.0};
   xr.widenIfFlat();
   yr.widenIfFlat();
+  // A marker on the last sample (a run that stopped) would hide in the frame: leave it some room.
+  for (double v : spec.vlines)
+    if (std::isfinite(v) && xr.hi - v < 0.01 * (xr.hi - xr.lo)) xr.hi = v + 0.03 * (xr.hi - xr.lo);
+  // An x range ending just short of a tick (t = 0 … 3.999 s) is stretched to it (4.0 s is labelled).
+  const double span = xr.hi - xr.lo, step = niceStep(span, kXTicks);
+  const double lo = std::floor(xr.lo / step + 1e-9) * step, hi = std::ceil(xr.hi / step - 1e-9) * step;
+  if (xr.lo - lo < 0.02 * span) xr.lo = lo;
+  if (hi - xr.hi < 0.02 * span) xr.hi = hi;
   const double pad = 0.05 * (yr.hi - yr.lo);
   return {xr, {yr.lo - pad, yr.hi + pad}};
 }
@@ -368,8 +378,8 @@ void drawPlot(const PlotSpec& spec, const Range& xr, const Range& yr, double sca
   const double page_w = page_x1 - page_x0, page_h = page_y1 - page_y0;
 
   // Ticks at nice steps, labelled by our own formatter so their widths are known.
-  tick_x = {niceStep(xr.hi - xr.lo, 8), std::max(std::abs(xr.lo), std::abs(xr.hi))};
-  tick_y = {niceStep(yr.hi - yr.lo, 6), std::max(std::abs(yr.lo), std::abs(yr.hi))};
+  tick_x = {niceStep(xr.hi - xr.lo, kXTicks), std::max(std::abs(xr.lo), std::abs(xr.hi))};
+  tick_y = {niceStep(yr.hi - yr.lo, kYTicks), std::max(std::abs(yr.lo), std::abs(yr.hi))};
   plslabelfunc(tickLabel, nullptr);
   const size_t ytick_w = widestTick(tick_y, yr.lo, yr.hi), xtick_w = widestTick(tick_x, xr.lo, xr.hi);
 
@@ -378,7 +388,7 @@ void drawPlot(const PlotSpec& spec, const Range& xr, const Range& yr, double sca
   const Legend legend(spec, scale);
   const double cw = kGlyphWidth * ch;
   const bool legend_outside = !legend.empty() && legend.widthMm(ch) <= kMaxOutsideLegend * page_w;
-  const double left = 0.6 * ch + (spec.ylabel.empty() ? 0.0 : 2.1 * ch) + ytick_w * cw + 0.8 * ch;
+  const double left = 0.6 * ch + (spec.ylabel.empty() ? 0.0 : 2.5 * ch) + ytick_w * cw + 0.8 * ch;
   const double bottom = 0.6 * ch + (spec.xlabel.empty() ? 0.0 : 1.8 * ch) + 1.8 * ch;
   const double top = spec.title.empty() ? 1.2 * ch : 3.0 * ch;
   const double right = legend_outside ? legend.widthMm(ch) + 1.2 * ch : std::max(1.8 * ch, 0.5 * xtick_w * cw + 0.5 * ch);
@@ -391,9 +401,13 @@ void drawPlot(const PlotSpec& spec, const Range& xr, const Range& yr, double sca
   plwidth(scale);
   plbox("g", tick_x.step, 0, "g", tick_y.step, 0);
 
-  // Bands, then series, then the markers on top.
+  // Bands, then solid series, then dashed ones (a reference stays visible over a response that
+  // tracks it), then the markers on top.
   for (const auto& b : spec.bands) drawBand(b);
-  for (const auto& s : spec.series) drawSeries(s, kMaxPoints, scale);
+  for (const auto& s : spec.series)
+    if (s.style == PlotSeries::Style::Solid) drawSeries(s, kMaxPoints, scale);
+  for (const auto& s : spec.series)
+    if (s.style == PlotSeries::Style::Dashed) drawSeries(s, kMaxPoints, scale);
   plcol0(kMarker);
   pllsty(2);
   plwidth(1.5 * scale);
@@ -410,7 +424,7 @@ void drawPlot(const PlotSpec& spec, const Range& xr, const Range& yr, double sca
   plbox("bcnto", tick_x.step, 0, "bcntvo", tick_y.step, 0);
   plcol0(kInk);
   if (!spec.xlabel.empty()) plmtex("b", 3.3, 0.5, 0.5, plText(spec.xlabel).c_str());
-  if (!spec.ylabel.empty()) plmtex("l", ytick_w * kGlyphWidth + 1.8, 0.5, 0.5, plText(spec.ylabel).c_str());
+  if (!spec.ylabel.empty()) plmtex("l", ytick_w * kGlyphWidth + 2.2, 0.5, 0.5, plText(spec.ylabel).c_str());
   if (!spec.title.empty()) {
     plschr(ch, 1.25);
     plmtex("t", 1.2, 0.5, 0.5, ("#<bold/>" + plText(spec.title)).c_str());

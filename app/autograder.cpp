@@ -1,0 +1,326 @@
+// The Gradescope autograder zip; see autograder.h.
+// Entries are collected in memory, sorted by name and written with libzip with a fixed DOS time
+// (1980-01-01 00:00) and Unix modes, so the same tree gives the same bytes.
+#include "app/autograder.h"
+
+#include <sys/stat.h>
+#include <zip.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <vector>
+
+namespace dyn::app {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Where Gradescope unpacks the zip; the source tree lands in its source/ folder.
+constexpr const char* kRoot = "/autograder/source/source";
+// What of the dynlab tree goes into the bundle (tests/ too: the top CMakeLists adds it).
+constexpr const char* kTopFiles[] = {"CMakeLists.txt", "README.md"};
+constexpr const char* kTopDirs[] = {"app", "assets", "grading", "labs", "physics", "render", "scripts", "tests"};
+
+struct Entry {
+  std::string name;  // path inside the zip, '/'-separated
+  std::string data;
+  unsigned mode;     // Unix permission bits
+};
+
+[[noreturn]] void fail(const std::string& path, const std::string& why) {
+  throw std::runtime_error("autograder " + path + ": " + why);
+}
+
+std::string readFile(const fs::path& p, const std::string& zip_path) {
+  std::ifstream in(p, std::ios::binary);
+  if (!in) fail(zip_path, "cannot read " + p.string());
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+std::string replaceAll(std::string s, const std::string& from, const std::string& to) {
+  for (size_t at = s.find(from); at != std::string::npos; at = s.find(from, at + to.size())) s.replace(at, from.size(), to);
+  return s;
+}
+
+// Build output, run output, VCS data, staging folders and temp files stay out of the bundle.
+bool skipped(const fs::directory_entry& e) {
+  const std::string name = e.path().filename().string();
+  if (e.is_directory()) return name.rfind("build", 0) == 0 || name == "out" || name[0] == '.';
+  return name.size() > 4 && name.compare(name.size() - 4, 4, ".tmp") == 0;
+}
+
+// The listed files and folders of the dynlab tree, under source/; executables keep 0755.
+void addSourceTree(const fs::path& src, const std::string& zip_path, std::vector<Entry>& out) {
+  if (!fs::is_regular_file(src / "CMakeLists.txt")) fail(zip_path, src.string() + " is not a dynlab source tree (no CMakeLists.txt)");
+  const auto add = [&](const fs::path& file) {
+    const auto perms = fs::status(file).permissions();
+    const bool exec = (perms & fs::perms::owner_exec) != fs::perms::none;
+    out.push_back({"source/" + fs::relative(file, src).generic_string(), readFile(file, zip_path), exec ? 0755u : 0644u});
+  };
+  for (const char* f : kTopFiles)
+    if (fs::is_regular_file(src / f)) add(src / f);
+  for (const char* d : kTopDirs) {
+    if (!fs::is_directory(src / d)) continue;
+    for (auto it = fs::recursive_directory_iterator(src / d); it != fs::recursive_directory_iterator(); ++it) {
+      if (skipped(*it)) {
+        if (it->is_directory()) it.disable_recursion_pending();
+        continue;
+      }
+      if (it->is_regular_file() && !it->is_symlink()) add(it->path());
+    }
+  }
+}
+
+// setup.sh: once, as root, when Gradescope builds the image (Ubuntu 22.04).
+std::string setupScript() {
+  return replaceAll(R"SH(#!/usr/bin/env bash
+# Gradescope runs this once, as root, when it builds the autograder image (Ubuntu 22.04):
+# the packages dynlab needs (the one list is source/scripts/setup), then dynlab itself (Release).
+set -euo pipefail
+src=@ROOT@
+export DEBIAN_FRONTEND=noninteractive
+
+# Packages: the same list the developers and CI install.
+apt-get update -qq
+bash "$src/scripts/setup"
+
+# dynlab needs CMake >= 3.25; Ubuntu 22.04 ships 3.22, so take a newer one from PyPI when needed.
+have="$(cmake --version 2>/dev/null | head -n1 | awk '{print $3}')"
+if ! printf '3.25\n%s\n' "$have" | sort -V -C; then
+  apt-get install -y -qq --no-install-recommends python3-pip
+  python3 -m pip install --no-cache-dir 'cmake>=3.25'
+  hash -r
+fi
+
+# Build only the dynlab binary (tests and tools are not needed to grade).
+cmake -S "$src" -B "$src/build" -DCMAKE_BUILD_TYPE=Release
+cmake --build "$src/build" --target dynlab -j2
+"$src/build/app/dynlab" list
+)SH",
+                    "@ROOT@", kRoot);
+}
+
+// run_autograder: per submission; every way out leaves a valid results.json.
+std::string runScript(const std::string& lab) {
+  return replaceAll(replaceAll(R"SH(#!/usr/bin/env bash
+# Gradescope runs this once per submission: grade the student's JSON for the lab @LAB@ with dynlab,
+# and always leave a valid /autograder/results/results.json, also when grading itself fails.
+# To try it locally, override DYNLAB_BIN, DYNLAB_SUBMISSION_DIR, DYNLAB_RESULTS_DIR, DYNLAB_TIME_LIMIT.
+set -uo pipefail
+
+lab="@LAB@"
+dynlab="${DYNLAB_BIN:-@ROOT@/build/app/dynlab}"
+submission_dir="${DYNLAB_SUBMISSION_DIR:-/autograder/submission}"
+results_dir="${DYNLAB_RESULTS_DIR:-/autograder/results}"
+time_limit="${DYNLAB_TIME_LIMIT:-540}"  # below Gradescope's 10 minutes, so this script still reports
+[[ "$time_limit" =~ ^[0-9]+$ ]] || time_limit=540
+results="$results_dir/results.json"
+
+# Score 0 with a fixed message ($1 is already JSON-escaped; nothing from the submission goes in).
+fail() {
+  printf '{"score": 0.0, "output_format": "md", "output": "%s", "tests": []}\n' "$1" > "$results"
+  echo "run_autograder: no grade from dynlab; wrote a score-0 results.json"
+  exit 0
+}
+
+# A results.json counts when it parses as a JSON object.
+valid() {
+  [ -s "$1" ] || return 1
+  if command -v python3 >/dev/null 2>&1; then
+    python3 -c 'import json, sys; sys.exit(0 if isinstance(json.load(open(sys.argv[1])), dict) else 1)' "$1" 2>/dev/null
+  else
+    [ "$(head -c 1 "$1")" = "{" ]
+  fi
+}
+
+mkdir -p "$results_dir"
+rm -f "$results"
+
+# The student's file: submission.json, else the only *.json they uploaded.
+file=""
+if [ -f "$submission_dir/submission.json" ]; then
+  file="$submission_dir/submission.json"
+else
+  found=()
+  while IFS= read -r f; do found+=("$f"); done < <(find "$submission_dir" -type f -iname '*.json' 2>/dev/null | LC_ALL=C sort)
+  case ${#found[@]} in
+    1) file="${found[0]}" ;;
+    0) fail 'No JSON file was found in your submission.\n\nUpload one file named `submission.json` of the form `{\"lab\": \"@LAB@\", \"gains\": {...}}` (see the lab handout for the gain names).' ;;
+    *) fail 'Your submission has several JSON files and none is named `submission.json`, so the grader cannot tell which one to grade.\n\nUpload one file named `submission.json` of the form `{\"lab\": \"@LAB@\", \"gains\": {...}}`.' ;;
+  esac
+fi
+
+[ -x "$dynlab" ] || fail 'The autograder is broken: dynlab was not built when the image was set up. This is not your fault; please tell the course staff.'
+
+# Grade within the time limit; dynlab writes results.json (and report.md, plots/) itself.
+timeout --kill-after=10 "$time_limit" "$dynlab" grade "$file" --lab "$lab" --out "$results_dir"
+status=$?
+valid "$results" && exit 0
+case $status in
+  124|137) fail "Grading took longer than $time_limit seconds and was stopped. Gains that make the simulation stiff or unstable can do this: check them against the limits in the lab handout and resubmit." ;;
+  *) fail "The grader stopped (exit status $status) without writing results. This is not a judgement of your gains; please resubmit, and tell the course staff if it happens again." ;;
+esac
+)SH",
+                               "@LAB@", lab),
+                    "@ROOT@", kRoot);
+}
+
+// README.md for the course staff: upload steps, what students submit, how to try it locally.
+std::string readme(const std::string& lab, const nlohmann::json& config) {
+  const std::string title = config.value("title", lab);
+  // The example: the lab's default gains; the table: each gain's default, bounds, unit and meaning.
+  nlohmann::ordered_json example = {{"lab", lab}, {"gains", nlohmann::ordered_json::object()}};
+  std::string table = "| gain | default | allowed | unit | meaning |\n|---|---|---|---|---|\n";
+  const auto field = [](const nlohmann::json& g, const char* key) { return g.value(key, nlohmann::json()).dump(); };
+  if (config.contains("gains") && config["gains"].is_object()) {
+    for (const auto& [name, g] : config["gains"].items()) {
+      example["gains"][name] = g.value("value", 0.0);
+      table += "| `" + name + "` | " + field(g, "value") + " | " + field(g, "min") + " … " + field(g, "max") + " | " +
+               g.value("unit", std::string()) + " | " + g.value("doc", std::string()) + " |\n";
+    }
+  }
+  // Optional keys (e.g. which control law the gains are for).
+  std::string options;
+  if (config.contains("submission_options") && config["submission_options"].is_object())
+    for (const auto& [key, o] : config["submission_options"].items())
+      options += "* `\"" + key + "\"`: one of " + field(o, "choices") + " (" + o.value("doc", std::string()) + ")\n";
+  if (!options.empty()) options = "\nOptional keys besides `lab` and `gains`:\n\n" + options;
+  std::string md = R"MD(# dynlab autograder: @TITLE@
+
+This zip is a Gradescope autograder for the dynlab lab `@LAB@`. It holds:
+
+* `setup.sh`: run once when Gradescope builds the image: installs the packages (the list in
+  `source/scripts/setup`) and compiles dynlab (Release) into `source/build/`.
+* `run_autograder`: run for every submission: finds the student's JSON, runs
+  `dynlab grade FILE --lab @LAB@ --out /autograder/results`, and always leaves a valid
+  `results.json` (score 0 with an explanation when the file is missing or grading fails).
+* `source/`: the dynlab source tree the grader is built from.
+
+## Setting it up on Gradescope
+
+1. Create a **Programming Assignment** (any name; total points as in the lab's rubric).
+2. Under **Configure Autograder**, choose **Zip file upload**, base image **Ubuntu 22.04**, upload
+   this zip and press **Update Autograder**. The image build installs packages and compiles
+   dynlab: allow 10–20 minutes, and read the build log if it fails.
+3. Keep the autograder timeout at 10 minutes or more: `run_autograder` stops dynlab after 540 s
+   so that it can still explain a timeout to the student.
+4. Press **Test Autograder** and upload the example below as `submission.json`.
+
+## What students submit
+
+One JSON file, best named `submission.json` (if they upload a single JSON file under another
+name, that one is graded):
+
+```json
+@EXAMPLE@
+```
+
+The gains of this lab (all of them are required):
+
+@TABLE@@OPTIONS@
+A submission naming another lab, with unknown or missing gains, or with a gain outside its
+bounds, gets score 0 and a message saying what to fix; a run that goes unstable is explained in
+the feedback, not reported as a crash. `dynlab schema @LAB@` prints the JSON Schema of a submission.
+
+## Trying it locally
+
+Unzip, build dynlab as `setup.sh` does (or use an existing build), then:
+
+```sh
+mkdir -p sub res && cp my.json sub/submission.json
+DYNLAB_BIN=path/to/dynlab DYNLAB_SUBMISSION_DIR=sub DYNLAB_RESULTS_DIR=res bash run_autograder
+python3 -m json.tool res/results.json
+```
+)MD";
+  md = replaceAll(md, "@TITLE@", title);
+  md = replaceAll(md, "@LAB@", lab);
+  md = replaceAll(md, "@EXAMPLE@", example.dump(2));
+  md = replaceAll(md, "@OPTIONS@", options);
+  return replaceAll(md, "@TABLE@", table);
+}
+
+// Writes the entries in name order with fixed times and Unix modes (to zip_path + ".tmp", renamed at the end).
+void writeZip(std::vector<Entry> entries, const std::string& zip_path) {
+  std::sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) { return a.name < b.name; });
+  const std::string tmp = zip_path + ".tmp";
+  if (std::FILE* f = std::fopen(tmp.c_str(), "wb")) {
+    std::fclose(f);
+  } else {
+    fail(zip_path, "cannot write " + tmp + ": " + std::strerror(errno));
+  }
+  int err = 0;
+  zip_t* za = zip_open(tmp.c_str(), ZIP_CREATE | ZIP_TRUNCATE, &err);
+  if (!za) {
+    std::remove(tmp.c_str());
+    fail(zip_path, "cannot create the zip (libzip error " + std::to_string(err) + ")");
+  }
+  const auto abandon = [&](const std::string& why) {
+    const std::string detail = zip_strerror(za);
+    zip_discard(za);
+    std::remove(tmp.c_str());
+    fail(zip_path, why + ": " + detail);
+  };
+  constexpr zip_uint16_t kDosTime = 0, kDosDate = (0 << 9) | (1 << 5) | 1;  // 1980-01-01 00:00
+  for (const Entry& e : entries) {
+    // The buffers stay alive (in `entries`) until zip_close reads them.
+    zip_source_t* s = zip_source_buffer(za, e.data.data(), e.data.size(), 0);
+    if (!s) abandon("cannot add " + e.name);
+    const zip_int64_t i = zip_file_add(za, e.name.c_str(), s, ZIP_FL_ENC_UTF_8);
+    if (i < 0) {
+      zip_source_free(s);
+      abandon("cannot add " + e.name);
+    }
+    const auto idx = static_cast<zip_uint64_t>(i);
+    if (zip_set_file_compression(za, idx, ZIP_CM_DEFLATE, 9) < 0 || zip_file_set_dostime(za, idx, kDosTime, kDosDate, 0) < 0 ||
+        zip_file_set_external_attributes(za, idx, 0, ZIP_OPSYS_UNIX, (S_IFREG | e.mode) << 16) < 0)
+      abandon("cannot set the attributes of " + e.name);
+  }
+  if (zip_close(za) < 0) abandon("cannot write the zip");
+  std::error_code ec;
+  fs::rename(tmp, zip_path, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    fail(zip_path, "cannot rename " + tmp + ": " + ec.message());
+  }
+}
+
+}  // namespace
+
+void writeAutograder(const std::string& lab, const std::string& source_dir, const std::string& zip_path) {
+  // The lab: a plain name with its default config in the tree (the scripts quote it as is).
+  const bool plain = !lab.empty() && std::all_of(lab.begin(), lab.end(), [](unsigned char c) {
+    return std::isalnum(c) || c == '_' || c == '-';
+  });
+  if (!plain) fail(zip_path, "\"" + lab + "\" is not a lab name");
+  const fs::path config_file = fs::path(source_dir) / "labs" / lab / (lab + ".json");
+  if (!fs::is_regular_file(config_file)) fail(zip_path, "no lab config " + config_file.string());
+  nlohmann::json config;
+  try {
+    config = nlohmann::json::parse(readFile(config_file, zip_path));
+  } catch (const nlohmann::json::exception& e) {
+    fail(zip_path, config_file.string() + ": " + e.what());
+  }
+
+  std::vector<Entry> entries = {{"setup.sh", setupScript(), 0755u},
+                                {"run_autograder", runScript(lab), 0755u},
+                                {"README.md", readme(lab, config), 0644u}};
+  addSourceTree(source_dir, zip_path, entries);
+  // The zip being written may sit inside the tree: never pack it (or its temp file) into itself.
+  const fs::path out = fs::weakly_canonical(zip_path);
+  std::erase_if(entries, [&](const Entry& e) {
+    if (e.name.rfind("source/", 0) != 0) return false;
+    const fs::path p = fs::weakly_canonical(fs::path(source_dir) / e.name.substr(7));
+    return p == out || p.string() == out.string() + ".tmp";
+  });
+  writeZip(std::move(entries), zip_path);
+}
+
+}  // namespace dyn::app
