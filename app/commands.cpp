@@ -7,10 +7,7 @@
 #include <cstdlib>
 #include <iostream>
 
-#if __has_include("app/autograder.h")  // TEMP until autograder lands
 #include "app/autograder.h"
-#define HAVE_AUTOGRADER 1
-#endif
 #include "app/movie.h"
 #include "app/output.h"
 #include "grading/grade.h"
@@ -170,9 +167,7 @@ int writeAutograderZip(const std::string& lab, const std::string& out) {
     return 2;
   }
   try {
-#ifdef HAVE_AUTOGRADER
     writeAutograder(lab, DYNLAB_SOURCE_DIR, out);
-#endif
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;
