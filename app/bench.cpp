@@ -1,6 +1,7 @@
 // dynlab bench: speed is measured here, never asserted in tests.
 //   hand vs Bullet: median µs per step of each engine on the lab's default config, and the ratio;
-//   render, render+PNG, render+video: frames per second at 640×480 (MSAA 4, overlay on).
+//   render, render+PNG, render+video: frames per second at 640×480 (MSAA 4, overlay on);
+//   grading: CPU seconds of a full rubric grade of the lab's examples/good.json.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -86,16 +87,23 @@ int bench(const BenchArgs& a) {
     const double bullet = stepMicros(lab, Engine::Bullet, a.steps);
     const RunResult run = runEngine(lab, Engine::Hand, long(std::min(2.0, lab.duration()) / lab.dt()));
     const Fps fps = frameRates(lab, run.trace, a.frames);
+    const json grading = gradeThroughput(entry.name, 5);
     if (a.json) {
       const json j = {{"lab", entry.name},          {"hand_us_per_step", hand},
                       {"bullet_us_per_step", bullet}, {"bullet_over_hand", bullet / hand},
                       {"render_fps", fps.render},     {"render_png_fps", fps.png},
                       {"render_video_fps", fps.video}, {"resolution", "640x480"}};
-      std::cout << j.dump() << "\n";
+      json out = j;
+      for (const auto& [k, v] : grading.items()) out[k] = v;
+      std::cout << out.dump() << "\n";
     } else {
       std::printf("%s\n", entry.name.c_str());
       std::printf("  step (median)   hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx\n", hand, bullet, bullet / hand);
       std::printf("  640x480 fps     render %.0f   +PNG %.0f   +video %.0f\n", fps.render, fps.png, fps.video);
+      if (!grading.empty())
+        std::printf("  grading         %.3f s CPU per full rubric (%.3f s with plots): %.0f per s per core, 1000 on 2 cores in %.0f s\n",
+                    grading["grade_cpu_s"].get<double>(), grading["grade_cpu_s_with_plots"].get<double>(),
+                    grading["grade_per_s_per_core"].get<double>(), grading["class_of_1000_on_2_cores_s"].get<double>());
     }
   }
   return 0;
