@@ -31,24 +31,33 @@ void TreeData<S>::resize(int n) {
 }
 
 template <class S>
-void forwardKinematics(const TreeModel<S>& model, const VecN& q, const VecN& qd, TreeData<S>& data) {
-  using Vec = typename S::Vec;
+void positionKinematics(const TreeModel<S>& model, const VecN& q, TreeData<S>& data) {
   for (int i = 0; i < model.dof(); ++i) {
     const auto& b = model.bodies[i];
     // Joint placement then joint motion: X_up = X_J(θ_i) X_tree.
     data.X_up[i] = S::compose(S::jointTransform(b.joint == JointType::Revolute, b.axis, q[i]), b.X_tree);
     data.S_i[i] = model.motionSubspace(i);
+    data.X_world[i] = b.parent < 0 ? data.X_up[i] : S::compose(data.X_up[i], data.X_world[b.parent]);
+  }
+}
+
+template <class S>
+void velocityKinematics(const TreeModel<S>& model, const VecN& qd, TreeData<S>& data) {
+  using Vec = typename S::Vec;
+  for (int i = 0; i < model.dof(); ++i) {
+    const int p = model.bodies[i].parent;
+    // Body velocity: the parent's, carried across the joint, plus the joint's own S_i θ'_i.
     const Vec vJ = data.S_i[i] * qd[i];
-    if (b.parent < 0) {
-      data.X_world[i] = data.X_up[i];
-      data.v[i] = vJ;
-    } else {
-      data.X_world[i] = S::compose(data.X_up[i], data.X_world[b.parent]);
-      data.v[i] = S::motion(data.X_up[i], data.v[b.parent]) + vJ;
-    }
+    data.v[i] = p < 0 ? vJ : Vec(S::motion(data.X_up[i], data.v[p]) + vJ);
     // Velocity-product acceleration of the joint: c_i = V_i ×m S_i θ'_i.
     data.c[i] = S::crossMotion(data.v[i], vJ);
   }
+}
+
+template <class S>
+void forwardKinematics(const TreeModel<S>& model, const VecN& q, const VecN& qd, TreeData<S>& data) {
+  positionKinematics(model, q, data);
+  velocityKinematics(model, qd, data);
 }
 
 template <class S>
@@ -143,12 +152,20 @@ typename S::Pos pointPosition(const TreeData<S>& data, int body, const typename 
 
 template <class S>
 void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
-                   const typename S::Pos& point, MatN& J, VecN& Jdot_qd) {
-  using Vec = typename S::Vec;
-  const int n = model.dof();
+                   const typename S::Pos& point, MatN& J) {
   // World origin → the world-aligned frame at the point.
   const typename S::Transform X_pw = S::translation(pointPosition(data, body, point));
-  J.setZero(S::kDim, n);
+  J.setZero(S::kDim, model.dof());
+  // Column j: joint j's axis, seen from the point, for every joint on the path root → body.
+  for (int j = body; j >= 0; j = model.bodies[j].parent)
+    J.col(j) = S::motion(X_pw, S::motionInverse(data.X_world[j], data.S_i[j]));
+}
+
+template <class S>
+void pointJacobianDot(const TreeModel<S>& model, const TreeData<S>& data, int body,
+                      const typename S::Pos& point, VecN& Jdot_qd) {
+  using Vec = typename S::Vec;
+  const typename S::Transform X_pw = S::translation(pointPosition(data, body, point));
   // The path root → body, and the velocity-product acceleration along it (θ'' = 0, no gravity).
   int path[kMaxDof];
   int depth = 0;
@@ -157,11 +174,18 @@ void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
   for (int k = depth - 1; k >= 0; --k) {
     const int j = path[k];
     a_bias = (model.bodies[j].parent < 0 ? Vec(Vec::Zero()) : Vec(S::motion(data.X_up[j], a_bias))) + data.c[j];
-    J.col(j) = S::motion(X_pw, S::motionInverse(data.X_world[j], data.S_i[j]));
   }
+  // Both at the point in world axes, then the classical acceleration J'θ'.
   const Vec v_p = S::motion(X_pw, S::motionInverse(data.X_world[body], data.v[body]));
   const Vec a_p = S::motion(X_pw, S::motionInverse(data.X_world[body], a_bias));
   Jdot_qd = S::classicalAcceleration(a_p, v_p);
+}
+
+template <class S>
+void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
+                   const typename S::Pos& point, MatN& J, VecN& Jdot_qd) {
+  pointJacobian(model, data, body, point, J);
+  pointJacobianDot(model, data, body, point, Jdot_qd);
 }
 
 template <class S>
@@ -208,11 +232,16 @@ double springEnergy(const VecN& k, const VecN& q) {
   template struct TreeModel<S>;                                                                   \
   template struct TreeData<S>;                                                                    \
   template void forwardKinematics<S>(const TreeModel<S>&, const VecN&, const VecN&, TreeData<S>&); \
+  template void positionKinematics<S>(const TreeModel<S>&, const VecN&, TreeData<S>&);           \
+  template void velocityKinematics<S>(const TreeModel<S>&, const VecN&, TreeData<S>&);            \
   template VecN rnea<S>(const TreeModel<S>&, TreeData<S>&, const VecN&, const VecN&, bool);       \
   template MatN crba<S>(const TreeModel<S>&, TreeData<S>&);                                       \
   template VecN aba<S>(const TreeModel<S>&, TreeData<S>&, const VecN&, const VecN&);              \
   template void pointJacobian<S>(const TreeModel<S>&, const TreeData<S>&, int, const S::Pos&,     \
                                  MatN&, VecN&);                                                   \
+  template void pointJacobian<S>(const TreeModel<S>&, const TreeData<S>&, int, const S::Pos&, MatN&); \
+  template void pointJacobianDot<S>(const TreeModel<S>&, const TreeData<S>&, int, const S::Pos&,  \
+                                    VecN&);                                                       \
   template S::Pos pointPosition<S>(const TreeData<S>&, int, const S::Pos&);                       \
   template double kineticEnergy<S>(const TreeModel<S>&, const TreeData<S>&);                      \
   template double potentialEnergy<S>(const TreeModel<S>&, const TreeData<S>&);

@@ -1,11 +1,13 @@
 // Tree (chain) dynamics, lecture eq. (1):
 //     M(θ) θ'' + C(θ,θ') θ' + G(θ) [+ K θ] = τ − J(θ)^T f
 // Written once for planar (3-vector) and spatial (6-vector) algebra (spatial.h).
-//   forwardKinematics  link transforms, velocities and velocity-product accelerations
+//   forwardKinematics  link transforms, velocities and velocity-product accelerations, in two
+//                      stages: positionKinematics (θ alone) then velocityKinematics (θ')
 //   rnea               τ = ID(θ, θ', θ'')           (recursive Newton–Euler; θ''=0 gives Cθ'+G)
 //   crba               M(θ)                         (composite rigid body algorithm)
 //   aba                θ'' = FD(θ, θ', τ)           (articulated body algorithm, O(N))
-//   pointJacobian      J and J'θ' of a world-aligned frame at a point of a link
+//   pointJacobian      J (position stage) and J'θ' (velocity stage) of a world-aligned frame at a
+//                      point of a link
 //   springTorque       K θ, K tridiagonal: P_K = Σ K_i/2 (θ_i − θ_{i−1})²
 // Model (fixed) and Data (per-state scratch) are kept apart, as in MuJoCo.
 #pragma once
@@ -58,6 +60,13 @@ struct TreeData {
 // Fills X_up, X_world, v, c from (θ, θ'). Every other algorithm reads these.
 template <class S>
 void forwardKinematics(const TreeModel<S>& model, const VecN& q, const VecN& qd, TreeData<S>& data);
+// The two stages of forwardKinematics. Position: X_up, X_world, S_i from θ (enough for crba,
+// pointPosition, the J of pointJacobian and potentialEnergy). Velocity, after the position stage:
+// v and c from θ' (rnea, aba, J'θ', kineticEnergy).
+template <class S>
+void positionKinematics(const TreeModel<S>& model, const VecN& q, TreeData<S>& data);
+template <class S>
+void velocityKinematics(const TreeModel<S>& model, const VecN& qd, TreeData<S>& data);
 
 // Inverse dynamics τ = M θ'' + C θ' + G with gravity (or without, when with_gravity is false).
 template <class S>
@@ -77,6 +86,13 @@ VecN aba(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const Vec
 template <class S>
 void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
                    const typename S::Pos& point, MatN& J, VecN& Jdot_qd);
+// J alone (position stage only), and J'θ' alone (velocity stage).
+template <class S>
+void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
+                   const typename S::Pos& point, MatN& J);
+template <class S>
+void pointJacobianDot(const TreeModel<S>& model, const TreeData<S>& data, int body,
+                      const typename S::Pos& point, VecN& Jdot_qd);
 
 // World position of a point given in body coordinates.
 template <class S>

@@ -9,6 +9,8 @@
 //   [ H̃ A     H̃ J M⁻¹ J^T H̃^T  ] [  η  ] = [ H̃ (J M⁻¹ (τ − h) + J'θ' + H'w − A'v_c − s)     ]
 //
 // Without contacts H̃ = I and η = f: that is eq. (2). Returns α_c, η, f and θ'' together.
+// Solved by the Schur complement (M, then Λ = H̃ J M⁻¹ Jᵀ H̃ᵀ, then M_c + Ãᵀ Λ⁻¹ Ã, each by
+// Cholesky); when one of them is not positive definite, by a full-pivot LU of the block matrix.
 #pragma once
 #include <Eigen/Cholesky>
 
@@ -44,5 +46,9 @@ struct ConstrainedSolution {
 };
 
 ConstrainedSolution solveConstrained(const ConstrainedProblem& p);
+
+// The same solve by a full-pivot LU of the whole (k + r) block matrix: the reference the tests
+// compare with, and solveConstrained's fallback near singular configurations.
+ConstrainedSolution solveConstrainedBlockLU(const ConstrainedProblem& p);
 
 }  // namespace dyn

@@ -5,6 +5,8 @@
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
 
+#include "physics/cholesky.h"
+
 namespace dyn {
 namespace {
 
@@ -20,9 +22,28 @@ const VecN* baumgarte(ConstrainedSystem& sys, const DriftOptions& d, const VecN&
 }
 
 // Minimum-W-norm correction dx with G dx = e:  dx = W⁻¹Gᵀ (G W⁻¹ Gᵀ)⁻¹ e.
+// By Cholesky: W = L D Lᵀ, Y = L⁻¹ Gᵀ, G W⁻¹ Gᵀ = Yᵀ D⁻¹ Y, dx = L⁻ᵀ D⁻¹ Y x.
 VecN weightedCorrection(const MatN& W, const MatN& G, const VecN& e) {
-  const Eigen::LLT<MatN> w(W);
-  const MatN WinvGT = w.solve(G.transpose());
+  Cholesky w, g;
+  MatN Y = G.transpose(), DY;
+  if (w.compute(W)) {
+    w.forward(Y);
+    DY = Y;
+    w.scale(DY);
+    MatN GWG(Y.cols(), Y.cols());
+    GWG.noalias() = Y.transpose().lazyProduct(DY);
+    if (g.compute(GWG)) {
+      VecN x = e;
+      g.solveInPlace(x);
+      VecN dx(W.rows());
+      dx.noalias() = DY.lazyProduct(x);
+      w.backward(dx);
+      return dx;
+    }
+  }
+  // G has lost rank (or W is not positive definite): pivoted LU on G W⁻¹ Gᵀ.
+  const Eigen::LLT<MatN> llt(W);
+  const MatN WinvGT = llt.solve(G.transpose());
   const MatN GWG = G * WinvGT;
   return WinvGT * GWG.fullPivLu().solve(e);
 }
@@ -32,10 +53,10 @@ VecN weightedCorrection(const MatN& W, const MatN& G, const VecN& e) {
 bool projectPositions(ConstrainedSystem& sys, const DriftOptions& d, VecN& q) {
   VecN phi;
   MatN G, W;
-  sys.metric(q, W);
   for (int it = 0; it < d.max_iterations; ++it) {
     sys.constraint(q, phi, G);
     if (phi.lpNorm<Eigen::Infinity>() <= d.tolerance) return true;
+    if (it == 0) sys.metric(q, W);       // the metric at the starting point, kept fixed
     q -= weightedCorrection(W, G, phi);  // Newton step on φ(q) = 0
   }
   sys.constraint(q, phi, G);

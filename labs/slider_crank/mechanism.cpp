@@ -23,21 +23,41 @@ Mechanism::Mechanism(const Params& p) : params_(p), data_(tree_) {
   problem_.Mc = MatN::Constant(1, 1, p.load_mass);
 }
 
-void Mechanism::evaluate(const VecN& q, const VecN& v) {
-  forwardKinematics(tree_, VecN(q.head(3)), VecN(v.head(3)), data_);
+void Mechanism::positionStage(const Eigen::Vector3d& th) {
+  // The projection, the trace row and the next step's first stage revisit the same θ.
+  if (have_position_ && th == theta_) return;
+  // Link transforms, M from CRBA, the tip Jacobian J.
+  positionKinematics(tree_, VecN(th), data_);
+  problem_.M = crba(tree_, data_);
+  pointJacobian(tree_, data_, 2, tipPoint(), problem_.J);
+  theta_ = th;
+  have_position_ = true;
+}
+
+void Mechanism::velocityStage(const Eigen::Vector3d& thd) {
+  const VecN qd = thd;
+  // Link velocities, h = Cθ' + G from RNEA with θ'' = 0, and J'θ' at the tip.
+  velocityKinematics(tree_, qd, data_);
+  problem_.h = rnea(tree_, data_, qd, VecN::Zero(3));
+  pointJacobianDot(tree_, data_, 2, tipPoint(), problem_.Jdot_qd);
 }
 
 ConstrainedSolution Mechanism::solve(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
-  const VecN qd = v.head(3);
-  evaluate(q, v);
-  // Tree: M from CRBA, h = Cθ' + G from RNEA with θ'' = 0; tip J and J'θ'.
-  problem_.M = crba(tree_, data_);
-  problem_.h = rnea(tree_, data_, qd, VecN::Zero(3));
+  // The same state as the last solve (the trace row, then RK4's first stage): same answer.
+  if (!stab && last_q_.size() && q == last_q_ && v == last_v_ && tau == last_tau_) return last_;
+  positionStage(q.head<3>());
+  velocityStage(v.head<3>());
   problem_.tau = tau;
-  pointJacobian(tree_, data_, 2, Planar::Pos(params_.links[2].length, 0.0), problem_.J, problem_.Jdot_qd);
   if (stab) problem_.stab = *stab;
   else problem_.stab.resize(0);
-  return solveConstrained(problem_);
+  const ConstrainedSolution s = solveConstrained(problem_);
+  if (!stab) {
+    last_q_ = q;
+    last_v_ = v;
+    last_tau_ = tau;
+    last_ = s;
+  }
+  return s;
 }
 
 void Mechanism::accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a) {
@@ -47,22 +67,19 @@ void Mechanism::accelerations(const VecN& q, const VecN& v, const VecN& tau, con
 }
 
 void Mechanism::constraint(const VecN& q, VecN& phi, MatN& G) {
-  const Eigen::Vector3d th = q.head(3);
-  const Eigen::Vector2d t = tip(th);
+  positionStage(q.head<3>());
+  const Planar::Pos t = pointPosition(data_, 2, tipPoint());
   phi.resize(3);
-  phi << th.sum(), t.x() - q[3], t.y();
+  phi << q.head<3>().sum(), t.x() - q[3], t.y();
   // Planar: the position constraint's gradient is the tip Jacobian; G = [J, −A].
-  MatN J;
-  VecN unused;
-  tipJacobian(th, Eigen::Vector3d::Zero(), J, unused);
   G.resize(3, 4);
-  G << J, -kA;
+  G << problem_.J, -kA;
 }
 
 void Mechanism::metric(const VecN& q, MatN& W) {
-  evaluate(q, VecN::Zero(4));
+  positionStage(q.head<3>());
   W = MatN::Zero(4, 4);
-  W.topLeftCorner(3, 3) = crba(tree_, data_);
+  W.topLeftCorner(3, 3) = problem_.M;
   W(3, 3) = std::max(params_.load_mass, 1e-9);
 }
 
@@ -116,18 +133,22 @@ std::array<Eigen::Vector2d, 4> Mechanism::jointPoints(const Eigen::Vector3d& th)
 }
 
 void Mechanism::tipJacobian(const Eigen::Vector3d& th, const Eigen::Vector3d& rate, MatN& J, VecN& Jdot_qd) {
-  forwardKinematics(tree_, VecN(th), VecN(rate), data_);
-  pointJacobian(tree_, data_, 2, Planar::Pos(params_.links[2].length, 0.0), J, Jdot_qd);
+  positionStage(th);
+  velocityKinematics(tree_, VecN(rate), data_);
+  J = problem_.J;
+  pointJacobianDot(tree_, data_, 2, tipPoint(), Jdot_qd);
 }
 
 Eigen::Vector3d Mechanism::gravityTorque(const Eigen::Vector3d& th) {
   const VecN zero = VecN::Zero(3);
-  forwardKinematics(tree_, VecN(th), zero, data_);
+  positionStage(th);
+  velocityKinematics(tree_, zero, data_);
   return rnea(tree_, data_, zero, zero);
 }
 
 double Mechanism::energy(const VecN& q, const VecN& v) {
-  evaluate(q, v);
+  positionStage(q.head<3>());
+  velocityKinematics(tree_, VecN(v.head(3)), data_);
   // The slider stays at y = 0: only its kinetic energy counts.
   return kineticEnergy(tree_, data_) + potentialEnergy(tree_, data_) + 0.5 * params_.load_mass * v[3] * v[3];
 }

@@ -55,11 +55,21 @@ class Mechanism final : public ConstrainedSystem {
   const TreeModel<Planar>& tree() const { return tree_; }
 
  private:
-  void evaluate(const VecN& q, const VecN& v);  // kinematics into data_
+  // Position stage at θ: transforms, M and the tip J (skipped when θ is the one evaluated last).
+  void positionStage(const Eigen::Vector3d& theta);
+  // Velocity stage at θ', after the position stage: velocities, h = Cθ' + G and J'θ'.
+  void velocityStage(const Eigen::Vector3d& theta_rate);
+  Planar::Pos tipPoint() const { return {params_.links[2].length, 0.0}; }  // in link 3's frame
   Params params_;
   TreeModel<Planar> tree_;
   TreeData<Planar> data_;
-  ConstrainedProblem problem_;
+  ConstrainedProblem problem_;  // M, J from the position stage; h, J'θ' from the velocity stage
+  Eigen::Vector3d theta_;        // the θ of the position stage held in data_ and problem_
+  bool have_position_ = false;
+  // The last solve without stabilisation, and its inputs (the trace row and RK4's first stage
+  // ask for the same state).
+  VecN last_q_, last_v_, last_tau_;
+  ConstrainedSolution last_;
 };
 
 }  // namespace dyn::slider_crank
