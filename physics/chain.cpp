@@ -71,7 +71,7 @@ VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const Ve
     const auto& b = model.bodies[i];
     const typename S::Vec a_parent = b.parent < 0 ? a0 : data.a[b.parent];
     data.a[i] = S::motion(data.X_up[i], a_parent) + data.S_i[i] * qdd[i] + data.c[i];
-    data.f[i] = b.inertia * data.a[i] + S::crossForce(data.v[i], b.inertia * data.v[i]);
+    data.f[i] = S::inertiaTimes(b.inertia, data.a[i]) + S::crossForce(data.v[i], S::inertiaTimes(b.inertia, data.v[i]));
   }
   // Inward: project onto the joint axis, pass the rest to the parent.
   VecN tau(n);
@@ -90,14 +90,11 @@ MatN crba(const TreeModel<S>& model, TreeData<S>& data) {
   // Composite inertias, leaves to root: Ic_p += X^T Ic_i X.
   for (int i = n - 1; i >= 0; --i) {
     const int p = model.bodies[i].parent;
-    if (p >= 0) {
-      const typename S::Mat X = S::motionMatrix(data.X_up[i]);
-      data.Ic[p] += X.transpose() * data.Ic[i] * X;
-    }
+    if (p >= 0) data.Ic[p] += S::inertiaInParent(data.X_up[i], data.Ic[i]);
   }
   MatN M = MatN::Zero(n, n);
   for (int i = 0; i < n; ++i) {
-    typename S::Vec F = data.Ic[i] * data.S_i[i];
+    typename S::Vec F = S::inertiaTimes(data.Ic[i], data.S_i[i]);
     M(i, i) = data.S_i[i].dot(F);
     // Carry the composite force up the ancestors: M_ij = S_j · F.
     for (int j = i; model.bodies[j].parent >= 0;) {
@@ -191,7 +188,7 @@ void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
 template <class S>
 double kineticEnergy(const TreeModel<S>& model, const TreeData<S>& data) {
   double T = 0;
-  for (int i = 0; i < model.dof(); ++i) T += 0.5 * data.v[i].dot(model.bodies[i].inertia * data.v[i]);
+  for (int i = 0; i < model.dof(); ++i) T += 0.5 * data.v[i].dot(S::inertiaTimes(model.bodies[i].inertia, data.v[i]));
   return T;
 }
 

@@ -16,15 +16,6 @@
 namespace dyn {
 namespace {
 
-// The constraint row's terms that do not involve θ'': J'θ' − A'v_c + H'w − s.
-VecN constraintBias(const ConstrainedProblem& p) {
-  VecN bias = p.Jdot_qd;
-  if (p.Adot_vc.size()) bias -= p.Adot_vc;
-  if (p.Hdot_w.size()) bias += p.Hdot_w;
-  if (p.stab.size()) bias -= p.stab;
-  return bias;
-}
-
 // C = Aᵀ B (small sizes: plain loops, no temporaries).
 template <class MA, class MB>
 void transposeTimes(const MA& a, const MB& b, MatN& c) {
@@ -118,8 +109,8 @@ bool solveSchur(const ConstrainedProblem& p, ConstrainedSolution& s) {
 
 ConstrainedSolution solveConstrained(const ConstrainedProblem& p) {
   ConstrainedSolution s;
-  if (solveSchur(p, s)) return s;
-  return solveConstrainedBlockLU(p);  // singular or nearly so: let the pivoted LU judge
+  if (!solveSchur(p, s)) s = solveConstrainedBlockLU(p);  // (nearly) singular: the pivoted LU judges
+  return s;
 }
 
 ConstrainedSolution solveConstrainedBlockLU(const ConstrainedProblem& p) {

@@ -22,21 +22,24 @@ const VecN* baumgarte(ConstrainedSystem& sys, const DriftOptions& d, const VecN&
 }
 
 // Minimum-W-norm correction dx with G dx = e:  dx = W⁻¹Gᵀ (G W⁻¹ Gᵀ)⁻¹ e.
-// By Cholesky: W = L D Lᵀ, Y = L⁻¹ Gᵀ, G W⁻¹ Gᵀ = Yᵀ D⁻¹ Y, dx = L⁻ᵀ D⁻¹ Y x.
+// By Cholesky: W = L D Lᵀ, Y = L⁻¹ Gᵀ, G W⁻¹ Gᵀ = Yᵀ D⁻¹ Y, dx = L⁻ᵀ D⁻¹ Y (G W⁻¹ Gᵀ)⁻¹ e.
 VecN weightedCorrection(const MatN& W, const MatN& G, const VecN& e) {
+  const int n = int(W.rows()), m = int(G.rows());
   Cholesky w, g;
-  MatN Y = G.transpose(), DY;
+  MatN Y = G.transpose(), GWG;
   if (w.compute(W)) {
     w.forward(Y);
-    DY = Y;
-    w.scale(DY);
-    MatN GWG(Y.cols(), Y.cols());
-    GWG.noalias() = Y.transpose().lazyProduct(DY);
+    w.inner(Y, m, GWG);
     if (g.compute(GWG)) {
       VecN x = e;
       g.solveInPlace(x);
-      VecN dx(W.rows());
-      dx.noalias() = DY.lazyProduct(x);
+      VecN dx(n);
+      for (int i = 0; i < n; ++i) {
+        double s = 0;
+        for (int j = 0; j < m; ++j) s += Y(i, j) * x[j];
+        dx[i] = s;
+      }
+      w.scale(dx);
       w.backward(dx);
       return dx;
     }
@@ -44,8 +47,7 @@ VecN weightedCorrection(const MatN& W, const MatN& G, const VecN& e) {
   // G has lost rank (or W is not positive definite): pivoted LU on G W⁻¹ Gᵀ.
   const Eigen::LLT<MatN> llt(W);
   const MatN WinvGT = llt.solve(G.transpose());
-  const MatN GWG = G * WinvGT;
-  return WinvGT * GWG.fullPivLu().solve(e);
+  return WinvGT * (G * WinvGT).fullPivLu().solve(e);
 }
 
 }  // namespace

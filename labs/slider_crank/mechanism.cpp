@@ -6,7 +6,14 @@
 namespace dyn::slider_crank {
 namespace {
 const Eigen::Vector3d kA{0.0, 1.0, 0.0};  // the slider moves the tip along world x only
+
+// a = (θ'', α_c) out of a solve of eq. (2).
+void accelerationsOf(const ConstrainedSolution& s, VecN& a) {
+  a.resize(4);
+  a.head<3>() = s.qdd;
+  a[3] = s.alpha_c[0];
 }
+}  // namespace
 
 Mechanism::Mechanism(const Params& p) : params_(p), data_(tree_) {
   // Three revolute joints about z; link i+1's joint sits at the end of link i.
@@ -42,15 +49,18 @@ void Mechanism::velocityStage(const Eigen::Vector3d& thd) {
   pointJacobianDot(tree_, data_, 2, tipPoint(), problem_.Jdot_qd);
 }
 
-ConstrainedSolution Mechanism::solve(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
-  // The same state as the last solve (the trace row, then RK4's first stage): same answer.
-  if (!stab && last_q_.size() && q == last_q_ && v == last_v_ && tau == last_tau_) return last_;
+ConstrainedSolution Mechanism::evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
   positionStage(q.head<3>());
   velocityStage(v.head<3>());
   problem_.tau = tau;
   if (stab) problem_.stab = *stab;
   else problem_.stab.resize(0);
-  const ConstrainedSolution s = solveConstrained(problem_);
+  return solveConstrained(problem_);
+}
+
+ConstrainedSolution Mechanism::solve(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
+  ConstrainedSolution s = evaluate(q, v, tau, stab);
+  // Kept: the integrator's first stage usually comes back to this state (the trace row's solve).
   if (!stab) {
     last_q_ = q;
     last_v_ = v;
@@ -61,9 +71,9 @@ ConstrainedSolution Mechanism::solve(const VecN& q, const VecN& v, const VecN& t
 }
 
 void Mechanism::accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a) {
-  const ConstrainedSolution s = solve(q, v, tau, stab);
-  a.resize(4);
-  a << s.qdd, s.alpha_c[0];
+  // The state solve() was last asked about: the same answer (a pure function of q, v, τ).
+  const bool known = !stab && last_q_.size() && q == last_q_ && v == last_v_ && tau == last_tau_;
+  accelerationsOf(known ? last_ : evaluate(q, v, tau, stab), a);
 }
 
 void Mechanism::constraint(const VecN& q, VecN& phi, MatN& G) {

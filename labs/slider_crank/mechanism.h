@@ -59,6 +59,8 @@ class Mechanism final : public ConstrainedSystem {
   void positionStage(const Eigen::Vector3d& theta);
   // Velocity stage at θ', after the position stage: velocities, h = Cθ' + G and J'θ'.
   void velocityStage(const Eigen::Vector3d& theta_rate);
+  // The solve of eq. (2) at a state, without remembering it.
+  ConstrainedSolution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab);
   Planar::Pos tipPoint() const { return {params_.links[2].length, 0.0}; }  // in link 3's frame
   Params params_;
   TreeModel<Planar> tree_;
@@ -66,8 +68,8 @@ class Mechanism final : public ConstrainedSystem {
   ConstrainedProblem problem_;  // M, J from the position stage; h, J'θ' from the velocity stage
   Eigen::Vector3d theta_;        // the θ of the position stage held in data_ and problem_
   bool have_position_ = false;
-  // The last solve without stabilisation, and its inputs (the trace row and RK4's first stage
-  // ask for the same state).
+  // The last solve() without stabilisation and its inputs: the trace row's solve, which RK4's
+  // first stage then reuses.
   VecN last_q_, last_v_, last_tau_;
   ConstrainedSolution last_;
 };
