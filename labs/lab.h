@@ -27,6 +27,10 @@ class Simulation {
   virtual bool step(std::vector<double>& row) = 0;
   // Non-empty once the run has gone bad (non-finite state, failed projection): a plain sentence.
   virtual std::string failure() const { return {}; }
+  // The engine alone, for `dynlab bench`: advance the state one more step with the control of the
+  // last step() held (no controller, no trace row; it uses up one step of the run). False once the
+  // run is over, or if the lab does not offer it.
+  virtual bool advanceEngine() { return false; }
 };
 
 class Lab {

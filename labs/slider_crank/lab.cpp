@@ -47,15 +47,23 @@ class HandSimulation final : public Simulation {
     const double t = double(k_) * s_.step.dt;
     const Eigen::Vector3d th = q_.head(3), thd = v_.head(3);
     const Eigen::Vector3d tau = ctrl_.torque(t, th, thd, q_[3], v_[3]);
-    // The constraint force at this instant, from the same solve the integrator uses.
-    const ConstrainedSolution sol = mech_.solve(q_, v_, tau);
+    tau_ = tau;
+    // The constraint force at this instant, from the same solve the integrator uses (its first
+    // RK4 stage reuses this one: Mechanism::accelerations).
+    const ConstrainedSolution sol = mech_.solve(q_, v_, tau_);
     RowState r{t, th, thd, q_[3], v_[3], sol.f.head(3), tau, mech_.energy(q_, v_), mech_.residual(q_),
                ctrl_.reference().position(t), s_.controller.f_des, ctrl_.measured(), work_};
     r.write(row);
-    if (!dyn::step(mech_, s_.step, VecN(tau), q_, v_)) failure_ = "the constraint projection failed";
+    if (!dyn::step(mech_, s_.step, tau_, q_, v_)) failure_ = "the constraint projection failed";
     work_ += tau.dot(0.5 * (thd + Eigen::Vector3d(v_.head(3)))) * s_.step.dt;  // ∫ τ·θ' dt, trapezoid
     ctrl_.measure(sol.f[2]);
     if (!q_.allFinite() || !v_.allFinite()) failure_ = "the state became non-finite";
+    ++k_;
+    return true;
+  }
+  bool advanceEngine() override {
+    if (k_ >= steps_ || !failure_.empty()) return false;
+    if (!dyn::step(mech_, s_.step, tau_, q_, v_)) failure_ = "the constraint projection failed";
     ++k_;
     return true;
   }
@@ -66,7 +74,7 @@ class HandSimulation final : public Simulation {
   Mechanism mech_;
   Controller ctrl_;
   long steps_, k_ = 0;
-  VecN q_, v_;
+  VecN q_, v_, tau_ = VecN::Zero(3);  // state, and the torque held over the step
   double e0_ = 0, work_ = 0;
   std::string failure_;
 };
@@ -99,6 +107,7 @@ class BulletSimulation final : public Simulation {
     q << th, x_c;
     v << thd, v_c;
     const Eigen::Vector3d tau = ctrl_.torque(t, th, thd, x_c, v_c);
+    tau_ = tau;
     const double energy = mech_.energy(q, v), residual = mech_.residual(q);
     world_->step(tau);
     // Bullet reports the force over the step just taken.
@@ -112,6 +121,12 @@ class BulletSimulation final : public Simulation {
     ++k_;
     return true;
   }
+  bool advanceEngine() override {
+    if (k_ >= steps_ || !failure_.empty()) return false;
+    world_->step(tau_);
+    ++k_;
+    return true;
+  }
   std::string failure() const override { return failure_; }
 
  private:
@@ -119,6 +134,7 @@ class BulletSimulation final : public Simulation {
   Mechanism mech_;
   Controller ctrl_;
   long steps_, k_ = 0;
+  Eigen::Vector3d tau_ = Eigen::Vector3d::Zero();  // the torque held over the step
   std::unique_ptr<bullet::SliderCrankBullet> world_;
   double work_ = 0;
   std::string failure_;
