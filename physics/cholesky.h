@@ -1,7 +1,7 @@
 // Square-root-free Cholesky of a small symmetric positive definite matrix (Golub & Van Loan §4.1):
 //     A = L D Lᵀ,   L unit lower triangular, D diagonal > 0
 //     A⁻¹ x = L⁻ᵀ D⁻¹ L⁻¹ x          (forward substitution, scaling, back substitution)
-//     Bᵀ A⁻¹ C = Yᵀ D⁻¹ Z   with Y = L⁻¹ B, Z = L⁻¹ C   (e.g. Λ = J M⁻¹ Jᵀ)
+//     Bᵀ A⁻¹ B = Yᵀ D⁻¹ Y   with Y = L⁻¹ B                 (e.g. Λ = J M⁻¹ Jᵀ)
 // Used for M, Λ and the projection metrics. Plain loops over the bounded sizes of types.h: on the
 // 1×1 … 24×24 matrices of the labs they cost a fraction of Eigen's dynamic-size LLT/LDLT, whose
 // generic paths (blocking, BLAS-like kernels, pivoting) outweigh the arithmetic of a 3×3.
@@ -17,14 +17,15 @@ namespace dyn {
 
 class Cholesky {
  public:
-  // Factors A (only its lower triangle is read). False if A is not clearly positive definite.
+  // Factors A, or the leading square block of A (only its lower triangle is read).
+  // False if it is not clearly positive definite.
   template <class Mat>
   bool compute(const Mat& A) {
     n_ = int(A.rows());
     double largest = 0;
     for (int i = 0; i < n_; ++i) largest = std::max(largest, std::abs(A(i, i)));
     for (int j = 0; j < n_; ++j) {
-      // Row j of L: l_jk = (a_jk − Σ_{i<k} l_ji d_i l_ki) / d_k, kept as l_jk d_k until the pivot.
+      // Row j of L, l_jk = (a_jk − Σ_{i<k} l_ji d_i l_ki) / d_k, then its pivot d_j.
       double d = A(j, j);
       for (int k = 0; k < j; ++k) {
         double ld = A(j, k);

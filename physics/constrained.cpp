@@ -57,7 +57,7 @@ bool solveSchur(const ConstrainedProblem& p, ConstrainedSolution& s) {
   MatN G;
   M.inner(Y, m, G);
   Cholesky Lambda;
-  if (!Lambda.compute(G)) return false;
+  if (!Lambda.compute(G)) return false;  // factors the leading m×m block, Λ
 
   // R = Λ⁻¹ [Ã  r],  r = J̃ M⁻¹ (τ − h) + H̃ (J'θ' + H'w − A'v_c − s): the second row, η given α_c.
   VecN bias = p.Jdot_qd;
