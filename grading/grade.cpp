@@ -14,11 +14,7 @@
 
 namespace dyn {
 
-std::string hashHex(const std::string& bytes) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char b : bytes) h = (h ^ b) * 1099511628211ull;
-  return hashHexOf(h);
-}
+std::string hashHex(const std::string& bytes) { return hashHexOf(fnv1a(bytes.data(), bytes.size())); }
 
 std::string hashHexOf(std::uint64_t h) {
   char out[17];

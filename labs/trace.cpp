@@ -2,7 +2,6 @@
 #include "labs/trace.h"
 
 #include <cstdio>
-#include <cstring>
 
 namespace dyn {
 
@@ -37,14 +36,13 @@ std::string Trace::csv() const {
   return s;
 }
 
-std::uint64_t Trace::hash() const {
+std::uint64_t fnv1a(const void* bytes, std::size_t n) {
   std::uint64_t h = 1469598103934665603ull;
-  for (double x : data) {
-    unsigned char bytes[sizeof x];
-    std::memcpy(bytes, &x, sizeof x);
-    for (unsigned char b : bytes) h = (h ^ b) * 1099511628211ull;
-  }
+  const auto* p = static_cast<const unsigned char*>(bytes);
+  for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
   return h;
 }
+
+std::uint64_t Trace::hash() const { return fnv1a(data.data(), data.size() * sizeof(double)); }
 
 }  // namespace dyn

@@ -7,6 +7,9 @@
 
 namespace dyn {
 
+// FNV-1a 64 of n bytes: trace fingerprints, and the grader's config and submission hashes.
+std::uint64_t fnv1a(const void* bytes, std::size_t n);
+
 struct Trace {
   std::vector<std::string> columns;
   std::vector<double> data;  // row-major

@@ -4,6 +4,8 @@
 #include "app/autograder.h"
 
 #include <doctest/doctest.h>
+
+#include "tests/test_files.h"
 #include <sys/stat.h>
 #include <zip.h>
 
@@ -24,17 +26,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("dynlab_autograder_test_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string readBytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+fs::path scratch(const std::string& name) { return dyn::test::scratchDir("dynlab_autograder_test", name); }
+using dyn::test::readBytes;
 
 void writeText(const fs::path& p, const std::string& text, bool exec = false) {
   fs::create_directories(p.parent_path());

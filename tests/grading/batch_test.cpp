@@ -3,6 +3,8 @@
 // exactly as alone, whatever --jobs is.
 #include <doctest/doctest.h>
 
+#include "tests/test_files.h"
+
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -17,12 +19,7 @@ namespace {
 
 const std::string kExamples = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/examples/";
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p, std::ios::binary);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using dyn::test::readBytes;
 
 json withoutTime(json r) {
   r.erase("execution_time");
@@ -57,14 +54,14 @@ TEST_CASE("a batch survives a hanging and a crashing grader, and --jobs does not
 
   for (const char* n : {"good", "mediocre", "unstable_integral", "malformed", "hangs", "crashes"}) {
     CAPTURE(n);
-    const json a = json::parse(slurp(dir / "one" / n / "results.json"));
-    const json b = json::parse(slurp(dir / "two" / n / "results.json"));
+    const json a = json::parse(readBytes(dir / "one" / n / "results.json"));
+    const json b = json::parse(readBytes(dir / "two" / n / "results.json"));
     CHECK(withoutTime(a).dump() == withoutTime(b).dump());
     CHECK(a.at("score").is_number());
   }
   // The gradebook: every submission, its status, identical for any number of jobs.
-  const std::string book = slurp(dir / "one" / "gradebook.csv");
-  CHECK(book == slurp(dir / "two" / "gradebook.csv"));
+  const std::string book = readBytes(dir / "one" / "gradebook.csv");
+  CHECK(book == readBytes(dir / "two" / "gradebook.csv"));
   CHECK(book.find("submission,score,max_score,status,Slider tracks x_d(t)") == 0);
   CHECK(book.find("hangs.json,0,0,timed out") != std::string::npos);
   CHECK(book.find("crashes.json,0,0,crashed") != std::string::npos);
@@ -72,9 +69,9 @@ TEST_CASE("a batch survives a hanging and a crashing grader, and --jobs does not
   CHECK(book.find("good.json,15,15,graded") != std::string::npos);
   CHECK(book.find("unstable_integral.json") != std::string::npos);
   // The crashed and timed-out submissions say what happened.
-  CHECK(slurp(dir / "one" / "crashes" / "results.json").find("signal 6") != std::string::npos);
-  CHECK(slurp(dir / "one" / "hangs" / "results.json").find("did not finish within 4 s") != std::string::npos);
+  CHECK(readBytes(dir / "one" / "crashes" / "results.json").find("signal 6") != std::string::npos);
+  CHECK(readBytes(dir / "one" / "hangs" / "results.json").find("did not finish within 4 s") != std::string::npos);
   // Without a terminal, progress is plain lines.
-  CHECK(slurp(dir / "one.log").find("graded 6/6") != std::string::npos);
+  CHECK(readBytes(dir / "one.log").find("graded 6/6") != std::string::npos);
   fs::remove_all(dir);
 }

@@ -4,6 +4,8 @@
 #include "grading/plot.h"
 
 #include <doctest/doctest.h>
+
+#include "tests/test_files.h"
 #include <stb/stb_image.h>
 
 #include <array>
@@ -20,18 +22,8 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// A fresh directory per test under the system temp dir.
-fs::path scratch(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("dynlab_plot_test_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
-
-std::string readBytes(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
+fs::path scratch(const std::string& name) { return dyn::test::scratchDir("dynlab_plot_test", name); }
+using dyn::test::readBytes;
 
 std::vector<double> linspace(int n, double a, double b) {
   std::vector<double> v(n);
