@@ -26,7 +26,7 @@ const VecN* baumgarte(ConstrainedSystem& sys, const DriftOptions& d, const VecN&
 VecN weightedCorrection(const MatN& W, const MatN& G, const VecN& e) {
   const int n = int(W.rows()), m = int(G.rows());
   Cholesky w, g;
-  MatN Y = G.transpose(), GWG;
+  MatN Y = G.transpose(), GWG(m, m);
   if (w.compute(W)) {
     w.forward(Y);
     w.inner(Y, m, GWG);

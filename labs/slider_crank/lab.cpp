@@ -50,7 +50,7 @@ class HandSimulation final : public Simulation {
     tau_ = tau;
     // The constraint force at this instant, from the same solve the integrator uses (its first
     // RK4 stage reuses this one: Mechanism::accelerations).
-    const ConstrainedSolution sol = mech_.solve(q_, v_, tau_);
+    const Mechanism::Solution sol = mech_.solve(q_, v_, tau_);
     RowState r{t, th, thd, q_[3], v_[3], sol.f.head(3), tau, mech_.energy(q_, v_), mech_.residual(q_),
                ctrl_.reference().position(t), s_.controller.f_des, ctrl_.measured(), work_};
     r.write(row);

@@ -3,12 +3,14 @@
 
 #include <cmath>
 
+#include "physics/constrained_solve.h"
+
 namespace dyn::slider_crank {
 namespace {
 const Eigen::Vector3d kA{0.0, 1.0, 0.0};  // the slider moves the tip along world x only
 
 // a = (θ'', α_c) out of a solve of eq. (2).
-void accelerationsOf(const ConstrainedSolution& s, VecN& a) {
+void accelerationsOf(const Mechanism::Solution& s, VecN& a) {
   a.resize(4);
   a.head<3>() = s.qdd;
   a[3] = s.alpha_c[0];
@@ -36,7 +38,9 @@ void Mechanism::positionStage(const Eigen::Vector3d& th) {
   // Link transforms, M from CRBA, the tip Jacobian J.
   positionKinematics(tree_, VecN(th), data_);
   problem_.M = crba(tree_, data_);
-  pointJacobian(tree_, data_, 2, tipPoint(), problem_.J);
+  MatN J;
+  pointJacobian(tree_, data_, 2, tipPoint(), J);
+  problem_.J = J;
   theta_ = th;
   have_position_ = true;
 }
@@ -46,10 +50,12 @@ void Mechanism::velocityStage(const Eigen::Vector3d& thd) {
   // Link velocities, h = Cθ' + G from RNEA with θ'' = 0, and J'θ' at the tip.
   velocityKinematics(tree_, qd, data_);
   problem_.h = rnea(tree_, data_, qd, VecN::Zero(3));
-  pointJacobianDot(tree_, data_, 2, tipPoint(), problem_.Jdot_qd);
+  VecN Jdot_qd;
+  pointJacobianDot(tree_, data_, 2, tipPoint(), Jdot_qd);
+  problem_.Jdot_qd = Jdot_qd;
 }
 
-ConstrainedSolution Mechanism::evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
+Mechanism::Solution Mechanism::evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
   positionStage(q.head<3>());
   velocityStage(v.head<3>());
   problem_.tau = tau;
@@ -58,8 +64,8 @@ ConstrainedSolution Mechanism::evaluate(const VecN& q, const VecN& v, const VecN
   return solveConstrained(problem_);
 }
 
-ConstrainedSolution Mechanism::solve(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
-  ConstrainedSolution s = evaluate(q, v, tau, stab);
+Mechanism::Solution Mechanism::solve(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
+  Solution s = evaluate(q, v, tau, stab);
   // Kept: the integrator's first stage usually comes back to this state (the trace row's solve).
   if (!stab) {
     last_q_ = q;

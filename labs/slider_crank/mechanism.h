@@ -27,6 +27,10 @@ struct Params {
 
 class Mechanism final : public ConstrainedSystem {
  public:
+  // Eq. (2) at the mechanism's fixed sizes: 3 joints, 3 constraint rows, 1 slider coordinate.
+  using Problem = ConstrainedProblemT<3, 3, 1>;
+  using Solution = ConstrainedSolutionT<3, 3, 1>;
+
   explicit Mechanism(const Params& params);
 
   // ConstrainedSystem
@@ -37,7 +41,7 @@ class Mechanism final : public ConstrainedSystem {
   bool recoverDependent(VecN& q, VecN& v) override;
 
   // The full solve of eq. (2) at a state: α_c, f_T = (τ_T, f_Tx, f_Ty), θ''.
-  ConstrainedSolution solve(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab = nullptr);
+  Solution solve(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab = nullptr);
 
   // Consistent initial state from the crank angle on the branch sign(cos(θ1+θ2)) = branch.
   // Returns false if the crank angle cannot be reached (|l1 sin θ1| > l2).
@@ -60,18 +64,18 @@ class Mechanism final : public ConstrainedSystem {
   // Velocity stage at θ', after the position stage: velocities, h = Cθ' + G and J'θ'.
   void velocityStage(const Eigen::Vector3d& theta_rate);
   // The solve of eq. (2) at a state, without remembering it.
-  ConstrainedSolution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab);
+  Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab);
   Planar::Pos tipPoint() const { return {params_.links[2].length, 0.0}; }  // in link 3's frame
   Params params_;
   TreeModel<Planar> tree_;
   TreeData<Planar> data_;
-  ConstrainedProblem problem_;  // M, J from the position stage; h, J'θ' from the velocity stage
+  Problem problem_;  // M, J from the position stage; h, J'θ' from the velocity stage
   Eigen::Vector3d theta_;        // the θ of the position stage held in data_ and problem_
   bool have_position_ = false;
   // The last solve() without stabilisation and its inputs: the trace row's solve, which RK4's
   // first stage then reuses.
   VecN last_q_, last_v_, last_tau_;
-  ConstrainedSolution last_;
+  Solution last_;
 };
 
 }  // namespace dyn::slider_crank

@@ -220,7 +220,7 @@ TEST_CASE("the constraint force is the force the motion needs and does no work o
     REQUIRE(mech.initialState(s.theta1, s.theta1_rate, s.branch, q, v));
     const VecN tau = VecN::Zero(3);
     std::vector<VecN> Q, V;
-    std::vector<ConstrainedSolution> S;
+    std::vector<Mechanism::Solution> S;
     for (std::size_t k = 0; k < tr.rows(); ++k) {
       S.push_back(mech.solve(q, v, tau));
       REQUIRE(S.back().ok);

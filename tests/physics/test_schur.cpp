@@ -1,13 +1,14 @@
 // The fast paths of the physics against their references: the small Cholesky (cholesky.h)
 // against Eigen's LLT, and the Schur-complement solve of eqs. (2)/(3) against the full-pivot LU
-// of the whole block matrix, on random problems of many shapes, and near singular ones.
+// of the whole block matrix, on random problems of many shapes, and near singular ones; the
+// fixed-size solve (ConstrainedProblemT<n, m, k>) against the bounded-size one.
 #include <doctest/doctest.h>
 
 #include <Eigen/Cholesky>
 #include <random>
 
 #include "physics/cholesky.h"
-#include "physics/constrained.h"
+#include "physics/constrained_solve.h"
 
 using namespace dyn;
 
@@ -49,7 +50,7 @@ TEST_CASE("Cholesky L D Lᵀ: solves and inner products agree with Eigen's LLT")
     CHECK((X - ref).norm() / ref.norm() < 1e-11);
     // Bᵀ A⁻¹ B from the forward-substituted B.
     const MatN B = r.mat(n, 4);
-    MatN Y = B, G;
+    MatN Y = B, G(4, 4);
     c.forward(Y);
     c.inner(Y, 4, G);
     const MatN Gref = B.transpose() * llt.solve(B);
@@ -137,5 +138,65 @@ TEST_CASE("near singular problems go to the pivoted LU: solved when the block ma
     p.J = r.mat(3, 3);
     p.M(1, 1) = -1.0;
     CHECK_FALSE(solveConstrained(p).ok);
+  }
+}
+
+namespace {
+
+// The same problem at compile-time sizes.
+template <int N, int M, int K>
+ConstrainedProblemT<N, M, K> fixedSize(const ConstrainedProblem& p) {
+  ConstrainedProblemT<N, M, K> f;
+  f.M = p.M;
+  f.h = p.h;
+  f.tau = p.tau;
+  f.J = p.J;
+  f.Jdot_qd = p.Jdot_qd;
+  f.A = p.A;
+  f.Adot_vc = p.Adot_vc;
+  f.Mc = p.Mc;
+  f.bc_Gc = p.bc_Gc;
+  f.Ht = p.Ht;
+  f.Hdot_w = p.Hdot_w;
+  f.stab = p.stab;
+  return f;
+}
+
+template <int N, int M, int K>
+void checkFixedMatchesBounded(Random& r, int variant) {
+  ConstrainedProblem p;
+  p.M = r.spd(N);
+  p.h = r.vec(N);
+  p.tau = r.vec(N);
+  p.J = r.mat(M, N);
+  p.Jdot_qd = r.vec(M);
+  p.A = r.mat(M, K);
+  p.Mc = r.spd(K);
+  p.bc_Gc = r.vec(K);
+  if (variant == 1) p.stab = r.vec(M);
+  if (variant == 2) {
+    p.Ht = r.mat(M - 1, M);  // contacts, eq. (3)
+    p.Hdot_w = r.vec(M);
+  }
+  if (variant == 3) p.J.row(0).setZero();  // Λ singular: the fixed solve falls back to the LU too
+  const auto a = solveConstrained(fixedSize<N, M, K>(p));
+  const ConstrainedSolution b = solveConstrained(p);
+  REQUIRE(a.ok == b.ok);
+  REQUIRE(a.ok);
+  CHECK(relativeDifference(VecN(a.qdd), b.qdd) < 1e-12);
+  CHECK(relativeDifference(VecN(a.f), b.f) < 1e-12);
+  CHECK(relativeDifference(VecN(a.eta), b.eta) < 1e-12);
+  CHECK(relativeDifference(VecN(a.alpha_c), b.alpha_c) < 1e-12);
+}
+
+}  // namespace
+
+TEST_CASE("fixed-size solve equals the bounded-size one (eq. 2, Baumgarte, contacts, singular Λ)") {
+  Random r;
+  for (int variant = 0; variant < 4; ++variant) {
+    CAPTURE(variant);
+    checkFixedMatchesBounded<3, 3, 1>(r, variant);  // the slider crank
+    checkFixedMatchesBounded<6, 4, 2>(r, variant);
+    checkFixedMatchesBounded<2, 2, 1>(r, variant);
   }
 }
