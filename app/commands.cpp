@@ -3,8 +3,10 @@
 
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <iostream>
 
 #include "app/autograder.h"
@@ -185,6 +187,29 @@ int printSchema(const std::string& lab) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;
   }
+}
+
+int openUi(const UiArgs& a) {
+  // The window is its own executable (it links libGL; dynlab links OSMesa), installed beside dynlab.
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  const fs::path ui = self.parent_path() / "dynlab-ui";
+  if (ec || ::access(ui.c_str(), X_OK) != 0) {
+    std::cerr << "error: dynlab ui runs " << ui.string() << ", which is missing; it is built when "
+              << "libglfw3-dev is installed (scripts/setup, then scripts/build)\n";
+    return 1;
+  }
+  std::vector<std::string> args = {ui.string(), a.lab};
+  if (!a.config.empty()) args.insert(args.end(), {"--config", a.config});
+  if (!a.gains.empty()) args.insert(args.end(), {"--gains", a.gains});
+  args.insert(args.end(), a.extra.begin(), a.extra.end());
+  std::vector<char*> argv;
+  for (auto& s : args) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  std::cout.flush();
+  ::execv(ui.c_str(), argv.data());
+  std::cerr << "error: cannot run " << ui.string() << ": " << std::strerror(errno) << "\n";
+  return 1;
 }
 
 }  // namespace dyn::app

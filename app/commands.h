@@ -3,6 +3,7 @@
 #pragma once
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "labs/config.h"
 
@@ -21,6 +22,11 @@ struct GradeArgs {
   int jobs = 1;
 };
 
+struct UiArgs {
+  std::string lab, config, gains;
+  std::vector<std::string> extra;  // passed on to dynlab-ui as they are
+};
+
 struct BenchArgs {
   bool json = false;
   int steps = 4000, frames = 60;
@@ -34,6 +40,8 @@ int gradeBatch(const GradeArgs& args);  // app/batch.cpp
 int writeAutograderZip(const std::string& lab, const std::string& out);
 int printSchema(const std::string& lab);
 int bench(const BenchArgs& args);
+// Replaces this process with dynlab-ui (next to /proc/self/exe); returns only on failure (1).
+int openUi(const UiArgs& args);
 // CPU cost of grading the lab's examples/good.json (app/bench_grade.cpp); empty if none.
 json gradeThroughput(const std::string& lab, int repeats);
 

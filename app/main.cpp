@@ -47,6 +47,14 @@ int main(int argc, char** argv) {
   auto* s = cli.add_subcommand("schema", "Print the JSON Schema of a lab's submission");
   s->add_option("LAB", schema_lab, "Lab name")->required();
 
+  UiArgs ui;
+  auto* u = cli.add_subcommand("ui", "Tune a lab's gains in a window and watch it move (runs dynlab-ui; options after LAB "
+                                     "go to it, see `dynlab-ui --help`)");
+  u->add_option("LAB", ui.lab, "Lab name (see `dynlab list`)")->required();
+  u->add_option("--config", ui.config, "Lab config JSON (default: labs/LAB/LAB.json)");
+  u->add_option("--gains", ui.gains, "Start from these gains: a submission or gains JSON");
+  u->allow_extras();
+
   BenchArgs bench_args;
   auto* b = cli.add_subcommand("bench", "Benchmark: hand-written vs Bullet step time, render/PNG/video frame rates");
   b->add_flag("--json", bench_args.json, "One JSON object per lab");
@@ -65,5 +73,9 @@ int main(int argc, char** argv) {
   if (*z) return writeAutograderZip(zip_lab, zip_out);
   if (*s) return printSchema(schema_lab);
   if (*b) return bench(bench_args);
+  if (*u) {
+    ui.extra = u->remaining();
+    return openUi(ui);
+  }
   return 2;
 }

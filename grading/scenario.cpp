@@ -1,6 +1,7 @@
 // Screening and watched runs of one scenario; see scenario.h.
 #include "grading/scenario.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -52,19 +53,42 @@ ScreenResult screenLoops(const Lab& lab) {
   return r;
 }
 
+RowWatch::RowWatch(const Watchdog& wd, const std::vector<std::string>& columns, const std::string& config_file)
+    : columns_(columns), max_steps_(wd.max_steps) {
+  // Resolve the watchdog's columns once.
+  for (const auto& l : wd.limits) {
+    const auto it = std::find(columns.begin(), columns.end(), l.column);
+    if (it == columns.end())
+      throw InputError(config_file, "/rubric/watchdog/limits", "expected a trace column of this lab, got \"" + l.column + "\"");
+    limits_.emplace_back(int(it - columns.begin()), l);
+  }
+}
+
+std::string RowWatch::check(const std::vector<double>& row, double t) const {
+  // A non-finite value anywhere, or a watched column out of its range, ends the run.
+  for (std::size_t c = 0; c < row.size(); ++c)
+    if (!std::isfinite(row[c])) return "unstable: " + columns_[c] + " became non-finite at t = " + fmtNumber(t) + " s";
+  for (const auto& [c, lim] : limits_) {
+    const double x = row[std::size_t(c)];
+    if (x < lim.min || x > lim.max)
+      return "unstable: " + lim.what + " left its safe range [" + fmtNumber(lim.min) + ", " + fmtNumber(lim.max) +
+             "] at t = " + fmtNumber(t) + " s (" + lim.column + " = " + fmtNumber(x) + ")";
+  }
+  return {};
+}
+
+std::string RowWatch::budget(long steps) const {
+  if (steps < max_steps_) return {};
+  return "stopped: the run exceeded its step budget of " + std::to_string(max_steps_) + " steps";
+}
+
 ScenarioRun runScenario(const Lab& lab, const Watchdog& wd, Deadline deadline, const std::string& config_file) {
   ScenarioRun out;
   out.screen = screenLoops(lab);
   Trace& tr = out.trace;
   tr.columns = lab.columns();
   const int t_col = tr.column("t");
-  // Resolve the watchdog's columns once.
-  std::vector<std::pair<int, const ColumnLimit*>> limits;
-  for (const auto& l : wd.limits) {
-    const int c = tr.column(l.column);
-    if (c < 0) throw InputError(config_file, "/rubric/watchdog/limits", "expected a trace column of this lab, got \"" + l.column + "\"");
-    limits.emplace_back(c, &l);
-  }
+  const RowWatch watch(wd, tr.columns, config_file);
   auto sim = lab.simulate(Engine::Hand);
   const long expected = std::lround(lab.duration() / lab.dt());
   tr.data.reserve(std::size_t(std::min(expected, wd.max_steps) + 1) * tr.columns.size());
@@ -74,8 +98,8 @@ ScenarioRun runScenario(const Lab& lab, const Watchdog& wd, Deadline deadline, c
     out.failure_time = t;
   };
   for (long k = 0;; ++k) {
-    if (k >= wd.max_steps) {
-      stop(double(k) * lab.dt(), "stopped: the run exceeded its step budget of " + std::to_string(wd.max_steps) + " steps");
+    if (std::string why = watch.budget(k); !why.empty()) {
+      stop(double(k) * lab.dt(), std::move(why));
       break;
     }
     // The wall-time budget, checked every 1024 steps.
@@ -87,17 +111,10 @@ ScenarioRun runScenario(const Lab& lab, const Watchdog& wd, Deadline deadline, c
     if (!sim->step(row)) break;
     tr.append(row);
     const double t = t_col >= 0 ? row[std::size_t(t_col)] : double(k) * lab.dt();
-    // A non-finite value anywhere, or a watched column out of its range, ends the run.
-    for (std::size_t c = 0; c < row.size() && out.failure.empty(); ++c)
-      if (!std::isfinite(row[c])) stop(t, "unstable: " + tr.columns[c] + " became non-finite at t = " + fmtNumber(t) + " s");
-    for (const auto& [c, lim] : limits) {
-      if (!out.failure.empty()) break;
-      const double x = row[std::size_t(c)];
-      if (x < lim->min || x > lim->max)
-        stop(t, "unstable: " + lim->what + " left its safe range [" + fmtNumber(lim->min) + ", " + fmtNumber(lim->max) +
-                    "] at t = " + fmtNumber(t) + " s (" + lim->column + " = " + fmtNumber(x) + ")");
+    if (std::string why = watch.check(row, t); !why.empty()) {
+      stop(t, std::move(why));
+      break;
     }
-    if (!out.failure.empty()) break;
   }
   if (out.failure.empty() && !sim->failure().empty()) {
     const double t = tr.rows() ? tr.at(tr.rows() - 1, t_col) : 0.0;

@@ -31,6 +31,23 @@ struct ScenarioRun {
 
 using Deadline = std::chrono::steady_clock::time_point;
 
+// The watchdog's check of one trace row, shared by graded runs and the tuning window so both say
+// the same sentence. Throws InputError (naming config_file) if a limit names a column the lab lacks.
+class RowWatch {
+ public:
+  RowWatch(const Watchdog& watchdog, const std::vector<std::string>& columns, const std::string& config_file);
+  // Empty while the row is fine, else "unstable: <what> left its safe range [..] at t = .. s (..)".
+  std::string check(const std::vector<double>& row, double t) const;
+  // "stopped: the run exceeded its step budget of N steps" once steps reaches the budget, else empty.
+  std::string budget(long steps) const;
+  long maxSteps() const { return max_steps_; }
+
+ private:
+  std::vector<std::string> columns_;
+  std::vector<std::pair<int, ColumnLimit>> limits_;
+  long max_steps_;
+};
+
 // Runs the lab's hand-written engine under the watchdog; throws InputError (naming config_file)
 // if a watchdog limit names a column the lab does not have.
 ScenarioRun runScenario(const Lab& lab, const Watchdog& watchdog, Deadline deadline,

@@ -1,4 +1,5 @@
-// GlContext: where frames are drawn. OSMesa (offscreen, no display) today; a window later.
+// GlContext: where frames are drawn. OSMesa offscreen (osmesa_context.cpp, no display) or a GLFW
+// window (window_context.h, dynlab-ui); never both in one executable.
 #pragma once
 #include <memory>
 #include <string>
@@ -14,7 +15,7 @@ class GlContext {
 };
 
 // Creates an offscreen OpenGL 3.3+ core context of the given size, current on this thread.
-// Throws std::runtime_error with a readable message on failure.
+// Throws std::runtime_error with a readable message on failure. In dynlab_render_osmesa.
 std::unique_ptr<GlContext> makeOffscreenContext(int width, int height);
 
 }  // namespace dyn

@@ -37,7 +37,17 @@ void applyStyle() {
 
 }  // namespace
 
+namespace {
+// The panel has its own Dear ImGui context; whoever else uses ImGui (the tuning window) gets its
+// current context back afterwards.
+struct KeepImGuiContext {
+  ImGuiContext* saved = ImGui::GetCurrentContext();
+  ~KeepImGuiContext() { ImGui::SetCurrentContext(saved); }
+};
+}  // namespace
+
 OverlayPanel::OverlayPanel(int width, int height) {
+  const KeepImGuiContext keep;
   context_ = ImGui::CreateContext();
   ImGui::SetCurrentContext(context_);
   ImGuiIO& io = ImGui::GetIO();
@@ -55,9 +65,11 @@ OverlayPanel::OverlayPanel(int width, int height) {
 }
 
 OverlayPanel::~OverlayPanel() {
+  ImGuiContext* saved = ImGui::GetCurrentContext();
   ImGui::SetCurrentContext(context_);
   ImGui_ImplOpenGL3_Shutdown();
   ImGui::DestroyContext(context_);
+  ImGui::SetCurrentContext(saved == context_ ? nullptr : saved);
 }
 
 void OverlayPanel::buildFrame(const Overlay& overlay) {
@@ -129,6 +141,7 @@ void OverlayPanel::buildFrame(const Overlay& overlay) {
 }
 
 void OverlayPanel::draw(const Overlay& overlay) {
+  const KeepImGuiContext keep;
   ImGui::SetCurrentContext(context_);
   // First pass settles the auto-fitted height (and un-hides a new window); second is drawn.
   buildFrame(overlay);

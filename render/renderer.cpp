@@ -87,7 +87,9 @@ struct Renderer::Impl {
   std::vector<DrawItem> items;                // reused between frames
   std::vector<LineVertex> line_vertices;
 
-  Impl(GlContext& c, RenderOptions o) : context(c), options(o), width(c.width()), height(c.height()) {
+  Impl(GlContext& c, RenderOptions o)
+      : context(c), options(o), width(o.width > 0 ? o.width : c.width()),
+        height(o.height > 0 ? o.height : c.height()) {
     createFramebuffers();
     shaded = gl::makeShadedProgram();
     line = gl::makeLineProgram();
@@ -355,6 +357,14 @@ Renderer::~Renderer() = default;
 void Renderer::draw(const Scene& scene, const Overlay* overlay) { impl_->draw(scene, overlay); }
 
 Image Renderer::read() const { return impl_->read(); }
+
+void Renderer::present(int x, int y, int target_height) const {
+  const int w = impl_->width, h = impl_->height, bottom = target_height - y - h;
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, impl_->resolve_fbo);
+  glBindFramebuffer(GL_DRAW_FRAMEBUFFER, 0);
+  glBlitFramebuffer(0, 0, w, h, x, bottom, x + w, bottom + h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+  glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
 
 void Renderer::finish() { glFinish(); }
 

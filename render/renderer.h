@@ -12,6 +12,7 @@ namespace dyn {
 struct RenderOptions {
   int msaa = 4;           // samples; 0 or 1 disables
   bool show_overlay = true;
+  int width = 0, height = 0;  // frame size; 0 takes the context's (a window draws the scene smaller)
 };
 
 class Renderer {
@@ -31,6 +32,10 @@ class Renderer {
     draw(scene, overlay);
     return read();
   }
+
+  // Copies the last frame into the default framebuffer (a window's back buffer), its top-left
+  // corner at pixel (x, y) counted from the top of a target_height-tall framebuffer. Exact copy.
+  void present(int x, int y, int target_height) const;
 
   // Waits until the GPU (llvmpipe) has finished the last draw; for timing without read().
   void finish();

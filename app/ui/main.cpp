@@ -1,0 +1,252 @@
+// dynlab-ui: the interactive tuning window. Each frame: advance the run by speed × wall time (a
+// fixed 1/60 s per frame in scripted runs, so they are deterministic), draw the lab's scene with
+// the offscreen renderer and blit it in, then the tuning panel on the right. Its own executable:
+// it links libGL (GLFW), and dynlab links OSMesa; the two never meet in one process.
+#include <imgui.h>
+#include <imgui_impl_glfw.h>
+#include <imgui_impl_opengl3.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+
+#include "app/ui/panel.h"
+#include "render/renderer.h"
+#include "render/window_context.h"
+
+namespace {
+
+using namespace dyn;
+using namespace dyn::ui;
+
+struct Args {
+  std::string lab, config, gains, engine = "both", size = "1320x720", save, screenshot, state;
+  std::vector<std::string> set;
+  double speed = 1.0;
+  bool paused = false;
+  long frames = -1;  // scripted: this many frames, then exit
+};
+
+// Where the scene goes in the window: a 4:3 frame, as large as fits left of the panel.
+struct Layout {
+  int scene_x = 0, scene_y = 0, scene_w = 0, scene_h = 0;  // framebuffer pixels, y from the top
+  int panel_x = 0, panel_w = 0;
+};
+
+Layout layout(int fb_w, int fb_h) {
+  Layout l;
+  l.panel_w = std::min(std::clamp(int(fb_w * 0.34), 380, 520), fb_w);
+  l.panel_x = fb_w - l.panel_w;
+  const int area_w = l.panel_x, area_h = fb_h;
+  l.scene_w = std::min(area_w, area_h * 4 / 3) & ~1;
+  l.scene_h = (l.scene_w * 3 / 4) & ~1;
+  l.scene_x = (area_w - l.scene_w) / 2;
+  l.scene_y = (area_h - l.scene_h) / 2;
+  return l;
+}
+
+void setupImGui(GLFWwindow* window) {
+  ImGui::CreateContext();
+  ImGuiIO& io = ImGui::GetIO();
+  io.IniFilename = nullptr;  // nothing written next to the student's files
+  // DejaVu Sans when installed (Greek, ±, ≤, —, … in the notes and units); ImGui's own font otherwise.
+  const char* font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
+  static const ImWchar ranges[] = {0x0020, 0x00FF, 0x0370, 0x03FF, 0x2010, 0x206F, 0x2190, 0x22FF, 0};
+  if (std::filesystem::exists(font)) io.Fonts->AddFontFromFileTTF(font, 15.0f, nullptr, ranges);
+  ImGui::StyleColorsLight();
+  ImGuiStyle& style = ImGui::GetStyle();
+  style.WindowRounding = 0.0f;
+  style.FrameRounding = 3.0f;
+  style.GrabRounding = 3.0f;
+  style.Colors[ImGuiCol_WindowBg] = ImVec4(0.97f, 0.97f, 0.98f, 1.0f);
+  style.Colors[ImGuiCol_TitleBgActive] = style.Colors[ImGuiCol_TitleBg] = ImVec4(0.22f, 0.29f, 0.38f, 1.0f);
+  style.Colors[ImGuiCol_Text] = ImVec4(0.12f, 0.14f, 0.17f, 1.0f);
+  ImGui_ImplGlfw_InitForOpenGL(window, true);
+  if (!ImGui_ImplOpenGL3_Init("#version 330 core")) throw std::runtime_error("Dear ImGui OpenGL3 backend failed to initialise");
+}
+
+void shutdownImGui() {
+  ImGui_ImplOpenGL3_Shutdown();
+  ImGui_ImplGlfw_Shutdown();
+  ImGui::DestroyContext();
+}
+
+// What the last frame showed, for scripted runs and their tests.
+json frameState(const TuningSession& s, const WindowContext& ctx, const Layout& l, long frame) {
+  json values = json::object();
+  if (s.hasRows())
+    for (std::size_t c = 0; c < s.primary().columns.size(); ++c) values[s.primary().columns[c]] = s.primary().at(s.row(), int(c));
+  return {{"lab", s.labName()},
+          {"frame", frame},
+          {"row", s.row()},
+          {"t", s.time()},
+          {"finished", s.finished()},
+          {"problem", s.problem()},
+          {"ghost_problem", s.ghostProblem()},
+          {"engine", name(s.engine())},
+          {"values", values},
+          {"submission", s.submission()},
+          {"metrics", s.metrics()},
+          {"screening", s.screening()},
+          {"window", {{"width", ctx.width()}, {"height", ctx.height()}}},
+          {"viewport", {{"x", l.scene_x}, {"y", l.scene_y}, {"width", l.scene_w}, {"height", l.scene_h}}},
+          {"gl", ctx.description()}};
+}
+
+bool writeText(const std::string& path, const std::string& text) {
+  const std::string tmp = path + ".tmp";
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << text;
+    if (!(out.flush())) return std::remove(tmp.c_str()), false;
+  }
+  return std::rename(tmp.c_str(), path.c_str()) == 0;
+}
+
+int run(const Args& a) {
+  // Everything that can be wrong with the input is checked before a window opens.
+  TuningSession session(a.lab, a.config, a.gains);
+  for (const auto& s : a.set) session.set(s);
+  session.setEngine(parseEngineChoice(a.engine));
+  session.restart();
+  int win_w = 0, win_h = 0;
+  if (std::sscanf(a.size.c_str(), "%dx%d", &win_w, &win_h) != 2 || win_w < 400 || win_h < 300 || win_w > 8192 || win_h > 8192)
+    throw InputError("<command line>", "--size", "expected WIDTHxHEIGHT, at least 400x300, got \"" + a.size + "\"");
+
+  PanelState st;
+  st.playing = !a.paused;
+  st.speed = a.speed;
+  st.save_path = a.save.empty() ? a.lab + "_gains.json" : a.save;
+  const bool scripted = a.frames >= 0;
+
+  std::unique_ptr<WindowContext> ctx;
+  try {
+    ctx = makeWindowContext({win_w, win_h, "dynlab — " + session.title(), !scripted});
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+  setupImGui(ctx->window());
+  std::unique_ptr<Renderer> renderer;
+  double last = ctx->seconds(), carry = 0;
+  int code = 0;
+  for (long frame = 0; !ctx->shouldClose() && (!scripted || frame < a.frames); ++frame) {
+    ctx->pollEvents();
+    // Time: the run advances speed × wall time in fixed lab steps (carrying the fraction).
+    const double now = ctx->seconds();
+    const double wall = scripted ? 1.0 / 60.0 : std::min(now - last, 0.1);
+    last = now;
+    if (st.playing && session.lab() && !session.finished()) {
+      carry += st.speed * wall / session.lab()->dt();
+      const long n = long(carry);
+      carry -= double(n);
+      session.advance(n);
+    } else {
+      carry = 0;
+    }
+    if (st.loop && session.finished() && session.problem().empty()) session.restart();
+
+    const Layout l = layout(ctx->width(), ctx->height());
+    std::string scene_error;
+    Scene scene;
+    Overlay overlay;
+    if (session.hasRows()) {
+      try {
+        session.lab()->scene(session.primary(), session.row(), session.ghost(), scene);
+        session.lab()->overlay(session.primary(), session.row(), overlay);
+      } catch (const std::exception& e) {
+        scene_error = std::string("cannot draw the scene: ") + e.what();
+      }
+    }
+    ctx->clear(scene.background);  // the letterbox around the scene matches it
+    if (session.hasRows() && scene_error.empty() && l.scene_w >= 16 && l.scene_h >= 16) {
+      try {
+        if (!renderer || renderer->width() != l.scene_w || renderer->height() != l.scene_h) {
+          RenderOptions o;
+          o.width = l.scene_w;
+          o.height = l.scene_h;
+          renderer.reset();
+          renderer = std::make_unique<Renderer>(*ctx, o);
+        }
+        renderer->draw(scene, &overlay);
+        renderer->present(l.scene_x, l.scene_y, ctx->height());
+      } catch (const std::exception& e) {
+        scene_error = std::string("cannot draw the scene: ") + e.what();
+      }
+    }
+    ImGui_ImplOpenGL3_NewFrame();
+    ImGui_ImplGlfw_NewFrame();
+    ImGui::NewFrame();
+    const float scale = std::max(ImGui::GetIO().DisplayFramebufferScale.x, 1e-3f);
+    const std::string shown = !scene_error.empty() ? scene_error : !session.hasRows() ? "no run: " + session.problem() : "";
+    if (!shown.empty())
+      ImGui::GetBackgroundDrawList()->AddText(ImVec2(20, 20), IM_COL32(160, 30, 20, 255), shown.c_str());
+    drawTuningPanel(session, st, float(l.panel_x) / scale, float(l.panel_w) / scale, float(ctx->height()) / scale);
+    ImGui::Render();
+    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+
+    if (scripted && frame + 1 == a.frames) {
+      if (!a.screenshot.empty() && !writePng(a.screenshot, ctx->screenshot())) {
+        std::cerr << "error: " << a.screenshot << ": cannot write the screenshot\n";
+        code = 1;
+      }
+      if (!a.state.empty() && !writeText(a.state, frameState(session, *ctx, l, frame).dump(2) + "\n")) {
+        std::cerr << "error: " << a.state << ": cannot write the state\n";
+        code = 1;
+      }
+      if (!a.save.empty()) {
+        saveGains(session, st);
+        if (st.status_is_error) {
+          std::cerr << "error: " << st.status << "\n";
+          code = 1;
+        }
+      }
+      std::printf("dynlab-ui: %ld frames, t = %.3f s (row %zu)%s%s\n", a.frames, session.time(), session.row(),
+                  session.problem().empty() ? "" : "; stopped: ", session.problem().c_str());
+    }
+    ctx->swap();
+  }
+  renderer.reset();
+  shutdownImGui();
+  return code;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Args a;
+  CLI::App cli{"dynlab-ui — tune a lab's controller gains interactively and watch the mechanism move.\n"
+               "Space: play/pause, R: restart. \"Save gains…\" writes a submission for `dynlab grade`."};
+  cli.set_version_flag("--version", std::string(DYNLAB_VERSION));
+  cli.add_option("LAB", a.lab, "Lab name (see `dynlab list`)")->required();
+  cli.add_option("--config", a.config, "Lab config JSON (default: labs/LAB/LAB.json)");
+  cli.add_option("--gains", a.gains, "Start from these gains: a submission or gains JSON");
+  cli.add_option("--set", a.set, "NAME=VALUE: set a gain or an option (e.g. kp_x=500, force_law=integral); repeatable");
+  cli.add_option("--engine", a.engine, "hand, bullet, or both (Bullet drawn as a ghost)")->check(CLI::IsMember({"hand", "bullet", "both"}));
+  cli.add_option("--speed", a.speed, "Simulated seconds per wall second")->check(CLI::Range(0.02, 20.0));
+  cli.add_flag("--paused", a.paused, "Start paused");
+  cli.add_option("--size", a.size, "Window size WIDTHxHEIGHT (default 1320x720)");
+  cli.add_option("--save", a.save, "Where \"Save gains…\" writes (default LAB_gains.json); with --frames, saved after the last frame");
+  auto* frames = cli.add_option("--frames", a.frames, "Scripted run: draw N frames (1/60 s of simulated time × speed each), then exit")
+                     ->check(CLI::Range(1L, 1000000L));
+  cli.add_option("--screenshot", a.screenshot, "With --frames: PNG of the whole window at the last frame")->needs(frames);
+  cli.add_option("--state", a.state, "With --frames: JSON of what the last frame shows (row, t, values, scene viewport)")->needs(frames);
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = cli.exit(e);
+    return code == 0 ? 0 : 2;
+  }
+  try {
+    return run(a);
+  } catch (const InputError& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "error: " << e.what() << "\n";
+    return 1;
+  }
+}

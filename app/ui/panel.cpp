@@ -1,0 +1,318 @@
+// The tuning panel: one fixed Dear ImGui window on the right of the scene; see panel.h. Sections:
+// run, problems, gains, options, plots, metrics and screening, submission.
+#include "app/ui/panel.h"
+
+#include <imgui.h>
+#include <imgui_stdlib.h>
+
+#include <algorithm>
+#include <cfloat>
+#include <cstdio>
+
+namespace dyn::ui {
+namespace {
+
+const ImVec4 kError(0.78f, 0.12f, 0.10f, 1.0f), kWarn(0.70f, 0.40f, 0.00f, 1.0f);
+const ImVec4 kOk(0.10f, 0.50f, 0.20f, 1.0f), kMuted(0.40f, 0.43f, 0.48f, 1.0f);
+
+std::string fmt(const char* f, double x) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, x);
+  return b;
+}
+
+// A shell word: quoted only when it needs to be.
+std::string shellWord(const std::string& s) {
+  if (!s.empty() && s.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_-./+") == std::string::npos)
+    return s;
+  std::string q = "'";
+  for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+void tooltip(const std::string& text) {
+  if (!ImGui::IsItemHovered()) return;
+  ImGui::BeginTooltip();
+  ImGui::PushTextWrapPos(ImGui::GetFontSize() * 32.0f);
+  ImGui::TextUnformatted(text.c_str());
+  ImGui::PopTextWrapPos();
+  ImGui::EndTooltip();
+}
+
+// A gain or option changed: restart at once, or remember that a restart is due.
+void changed(TuningSession& session, PanelState& st) {
+  if (st.restart_on_change) {
+    session.restart();
+    st.pending_changes = false;
+  } else {
+    st.pending_changes = true;
+  }
+}
+
+void restart(TuningSession& session, PanelState& st) {
+  session.restart();
+  st.pending_changes = false;
+}
+
+// Lab::metrics of the run so far: every 100 rows while running, once more when it ends.
+void refreshMetrics(const TuningSession& session, PanelState& st) {
+  const bool fin = session.finished();
+  const std::size_t row = session.row();
+  const bool fresh = row >= st.metrics_row && st.metrics_final == fin && (fin ? row == st.metrics_row : row < st.metrics_row + 100);
+  if (fresh && !st.metrics.empty()) return;
+  st.metrics = session.metrics();
+  st.metrics_row = row;
+  st.metrics_final = fin;
+}
+
+void runSection(TuningSession& session, PanelState& st) {
+  const Lab* lab = session.lab();
+  const char* state = !session.problem().empty() ? "stopped" : session.finished() ? "finished" : st.playing ? "playing" : "paused";
+  ImGui::Text("t = %.3f / %.3f s   (%s)", session.time(), lab ? lab->duration() : 0.0, state);
+  if (ImGui::Button(st.playing ? "Pause" : "Play", ImVec2(70, 0))) st.playing = !st.playing;
+  tooltip("Space");
+  ImGui::SameLine();
+  if (ImGui::Button("Restart", ImVec2(70, 0))) restart(session, st);
+  tooltip("R: run again from t = 0 with the current gains");
+  ImGui::SameLine();
+  ImGui::BeginDisabled(st.playing || session.finished());
+  if (ImGui::Button("Step", ImVec2(70, 0))) session.advance(1);
+  ImGui::EndDisabled();
+  tooltip("one time step (while paused)");
+  ImGui::SameLine();
+  ImGui::Checkbox("loop", &st.loop);
+  tooltip("start again when the run ends");
+  const double lo = 0.02, hi = 20.0;
+  ImGui::SetNextItemWidth(-70);
+  ImGui::SliderScalar("speed", ImGuiDataType_Double, &st.speed, &lo, &hi, "%.2fx",
+                      ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
+  tooltip("simulated seconds per second of wall time; the physics always uses the lab's fixed dt");
+  ImGui::TextUnformatted("engine");
+  const EngineChoice engines[] = {EngineChoice::Hand, EngineChoice::Bullet, EngineChoice::Both};
+  const char* labels[] = {"hand", "bullet", "both (Bullet ghost)"};
+  for (int i = 0; i < 3; ++i) {
+    ImGui::SameLine();
+    if (ImGui::RadioButton(labels[i], session.engine() == engines[i]) && session.engine() != engines[i]) {
+      session.setEngine(engines[i]);
+      restart(session, st);
+    }
+  }
+}
+
+void problemSection(const TuningSession& session) {
+  if (!session.problem().empty()) {
+    ImGui::Separator();
+    ImGui::PushStyleColor(ImGuiCol_Text, kError);
+    ImGui::TextWrapped("The run stopped: %s", session.problem().c_str());
+    ImGui::PopStyleColor();
+    ImGui::TextWrapped("These gains would score 0 in this scenario. Lower them (see the screening below) or "
+                       "choose another option, then Restart.");
+  }
+  if (!session.ghostProblem().empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, kWarn);
+    ImGui::TextWrapped("%s", session.ghostProblem().c_str());
+    ImGui::PopStyleColor();
+  }
+}
+
+void gainsSection(TuningSession& session, PanelState& st) {
+  if (!ImGui::CollapsingHeader("Gains", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  for (const GainSpec& g : session.gainSpecs()) {
+    double v = session.gain(g.name);
+    std::string format = g.unit.empty() || g.unit == "1" ? "%.4g" : "%.4g " + g.unit;  // "1": dimensionless
+    for (std::size_t p = format.find('%', 1); p != std::string::npos; p = format.find('%', p + 2)) format.insert(p, "%");
+    ImGui::SetNextItemWidth(-70);
+    if (ImGui::SliderScalar(g.name.c_str(), ImGuiDataType_Double, &v, &g.min, &g.max, format.c_str(),
+                            ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp))
+      session.setGain(g.name, std::clamp(v, g.min, g.max));
+    if (ImGui::IsItemDeactivatedAfterEdit()) changed(session, st);
+    tooltip(g.doc + "\nunit: " + g.unit + "\nrange [" + fmt("%.4g", g.min) + ", " + fmt("%.4g", g.max) +
+            "], lab default " + fmt("%.4g", g.lab_default) + "\nCtrl+click to type a value.");
+  }
+  for (const OptionSpec& o : session.optionSpecs()) {
+    const std::string current = session.option(o.name);
+    ImGui::SetNextItemWidth(-70);
+    if (ImGui::BeginCombo(o.name.c_str(), current.c_str())) {
+      for (const auto& c : o.choices) {
+        if (ImGui::Selectable(c.c_str(), c == current) && c != current) {
+          session.setOption(o.name, c);
+          changed(session, st);
+        }
+      }
+      ImGui::EndCombo();
+    }
+    tooltip(o.doc + "\nchoices: " + [&] {
+      std::string l;
+      for (const auto& c : o.choices) l += (l.empty() ? "" : ", ") + c;
+      return l;
+    }() + "\nlab default: " + o.lab_default);
+  }
+  if (ImGui::Button("Lab defaults")) {
+    session.resetToLabDefaults();
+    changed(session, st);
+  }
+  tooltip("every gain and option back to the lab's JSON");
+  ImGui::SameLine();
+  ImGui::Checkbox("restart on change", &st.restart_on_change);
+  if (st.pending_changes) {
+    ImGui::TextColored(kWarn, "changed since the run started:");
+    ImGui::SameLine();
+    if (ImGui::SmallButton("Restart to apply")) restart(session, st);
+  }
+}
+
+void plot(const char* id, const std::vector<float>& values, ImVec4 color, float height) {
+  ImGui::PushStyleColor(ImGuiCol_PlotLines, color);
+  ImGui::PushStyleColor(ImGuiCol_PlotLinesHovered, color);
+  ImGui::PlotLines(id, values.data(), int(values.size()), 0, nullptr, FLT_MAX, FLT_MAX,
+                   ImVec2(ImGui::GetContentRegionAvail().x, height));
+  ImGui::PopStyleColor(2);
+}
+
+void plotsSection(const TuningSession& session, PanelState& st) {
+  if (!ImGui::CollapsingHeader("Live plots", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  const Lab* lab = session.lab();
+  if (!lab || !session.hasRows()) {
+    ImGui::TextColored(kMuted, "no run");
+    return;
+  }
+  const Trace& tr = session.primary();
+  Overlay o;
+  lab->overlay(tr, session.row(), o);  // the lab's own choice of plots
+  for (std::size_t i = 0; i < o.plots.size(); ++i) {
+    const Series& s = o.plots[i];
+    const ImVec4 color(s.color.r, s.color.g, s.color.b, 1.0f);
+    ImGui::TextColored(color, "%s", s.name.c_str());
+    if (!s.values.empty()) {
+      ImGui::SameLine();
+      ImGui::Text("%.4g", double(s.values.back()));
+    }
+    ImGui::PushID(int(i));
+    plot("##lab_plot", s.values, color, 60);
+    ImGui::PopID();
+  }
+  // Any column of the trace over the last two seconds.
+  ImGui::SetNextItemWidth(-70);
+  const char* chosen = st.plot_column >= 0 && st.plot_column < int(tr.columns.size()) ? tr.columns[st.plot_column].c_str() : "(none)";
+  if (ImGui::BeginCombo("column", chosen)) {
+    if (ImGui::Selectable("(none)", st.plot_column < 0)) st.plot_column = -1;
+    for (int c = 0; c < int(tr.columns.size()); ++c)
+      if (ImGui::Selectable(tr.columns[c].c_str(), c == st.plot_column)) st.plot_column = c;
+    ImGui::EndCombo();
+  }
+  tooltip("plot any column of the trace (the same columns as trace_hand.csv)");
+  if (st.plot_column >= 0 && st.plot_column < int(tr.columns.size())) {
+    const std::size_t row = session.row(), window = std::size_t(2.0 / lab->dt());
+    const std::size_t first = row > window ? row - window : 0, stride = std::max<std::size_t>(1, window / 300);
+    std::vector<float> values;
+    for (std::size_t r = first; r <= row; r += stride) values.push_back(float(tr.at(r, st.plot_column)));
+    ImGui::Text("%s = %.6g", tr.columns[st.plot_column].c_str(), tr.at(row, st.plot_column));
+    plot("##column_plot", values, ImVec4(0.25f, 0.35f, 0.60f, 1.0f), 60);
+  }
+}
+
+void metricsSection(const TuningSession& session, PanelState& st) {
+  if (!ImGui::CollapsingHeader("Metrics", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  refreshMetrics(session, st);
+  const char* which = !session.problem().empty() ? "up to the stop (a graded run would score 0)"
+                      : st.metrics_final          ? "final, whole run"
+                                                  : "running, so far";
+  ImGui::TextColored(kMuted, "Lab metrics, %s", which);
+  if (!st.metrics.empty() && ImGui::BeginTable("metrics", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
+    for (const auto& [key, value] : st.metrics.items()) {
+      ImGui::TableNextRow();
+      ImGui::TableSetColumnIndex(0);
+      ImGui::TextUnformatted(key.c_str());
+      ImGui::TableSetColumnIndex(1);
+      const std::string text = value.is_number() ? fmt("%.4g", value.get<double>()) : value.dump();
+      ImGui::TextUnformatted(text.c_str());
+    }
+    ImGui::EndTable();
+  }
+  if (!session.screening().empty()) {
+    ImGui::TextColored(kMuted, "Screening (the loops linearised at the start, as the grader does)");
+    for (const std::string& note : session.screening()) {
+      const bool bad = note.find("unstable") != std::string::npos || note.find("destabilises") != std::string::npos;
+      ImGui::PushStyleColor(ImGuiCol_Text, bad ? kError : ImGui::GetStyleColorVec4(ImGuiCol_Text));
+      ImGui::TextWrapped("%s", note.c_str());
+      ImGui::PopStyleColor();
+    }
+  }
+}
+
+void submissionSection(TuningSession& session, PanelState& st) {
+  if (!ImGui::CollapsingHeader("Submission", ImGuiTreeNodeFlags_DefaultOpen)) return;
+  if (ImGui::Button("Save gains…")) ImGui::OpenPopup("Save gains");
+  tooltip("write these gains and options as a submission JSON for dynlab grade");
+  if (ImGui::BeginPopupModal("Save gains", nullptr, ImGuiWindowFlags_AlwaysAutoResize)) {
+    ImGui::TextUnformatted("A submission for `dynlab grade` (data only):");
+    ImGui::TextColored(kMuted, "%s", session.submission().dump(2).c_str());
+    ImGui::SetNextItemWidth(360);
+    if (ImGui::IsWindowAppearing()) ImGui::SetKeyboardFocusHere();
+    const bool enter = ImGui::InputText("file", &st.save_path, ImGuiInputTextFlags_EnterReturnsTrue);
+    if (ImGui::Button("Save", ImVec2(90, 0)) || enter) {
+      saveGains(session, st);
+      ImGui::CloseCurrentPopup();
+    }
+    ImGui::SameLine();
+    if (ImGui::Button("Cancel", ImVec2(90, 0))) ImGui::CloseCurrentPopup();
+    ImGui::EndPopup();
+  }
+  ImGui::SameLine();
+  ImGui::TextColored(kMuted, "%s", st.save_path.c_str());
+  if (!st.status.empty()) {
+    ImGui::PushStyleColor(ImGuiCol_Text, st.status_is_error ? kError : kOk);
+    ImGui::TextWrapped("%s", st.status.c_str());
+    ImGui::PopStyleColor();
+  }
+  // The grade hint: the exact command for the saved (or about to be saved) file.
+  const std::string file = st.saved_path.empty() ? st.save_path : st.saved_path;
+  const std::string command = "dynlab grade " + shellWord(file);
+  ImGui::TextColored(kMuted, st.saved_path.empty() ? "Grade, once saved:" : "Grade:");
+  ImGui::SameLine();
+  ImGui::TextUnformatted(command.c_str());
+  ImGui::SameLine();
+  if (ImGui::SmallButton("Copy")) ImGui::SetClipboardText(command.c_str());
+  tooltip("copy the command; it writes results.json and report.html into out/grade");
+}
+
+}  // namespace
+
+void saveGains(TuningSession& session, PanelState& st) {
+  try {
+    session.saveSubmission(st.save_path);
+    st.saved_path = st.save_path;
+    st.status = "Saved " + st.save_path + (st.pending_changes ? " (with gains the current run does not use yet)" : "");
+    st.status_is_error = false;
+  } catch (const std::exception& e) {
+    st.status = e.what();
+    st.status_is_error = true;
+  }
+}
+
+void drawTuningPanel(TuningSession& session, PanelState& st, float x, float width, float height) {
+  // Shortcuts, unless a text field has the keyboard. (1.86 with the GLFW backend: KeysDown is
+  // indexed by GLFW key codes, and GLFW_KEY_R is 'R'.)
+  if (!ImGui::GetIO().WantCaptureKeyboard) {
+    if (ImGui::IsKeyPressed(ImGui::GetKeyIndex(ImGuiKey_Space), false)) st.playing = !st.playing;
+    if (ImGui::IsKeyPressed('R', false)) restart(session, st);
+  }
+  ImGui::SetNextWindowPos(ImVec2(x, 0), ImGuiCond_Always);
+  ImGui::SetNextWindowSize(ImVec2(width, height), ImGuiCond_Always);
+  const ImGuiWindowFlags flags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
+                                 ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus;
+  const std::string title = session.title() + "###tuning";
+  ImGui::Begin(title.c_str(), nullptr, flags);
+  ImGui::PushItemWidth(-70);
+  runSection(session, st);
+  problemSection(session);
+  ImGui::Spacing();
+  gainsSection(session, st);
+  plotsSection(session, st);
+  metricsSection(session, st);
+  submissionSection(session, st);
+  ImGui::PopItemWidth();
+  ImGui::End();
+}
+
+}  // namespace dyn::ui

@@ -1,0 +1,34 @@
+// The tuning panel (Dear ImGui, interactive): play/pause/restart/speed, engine, the lab's gains as
+// sliders within their declared bounds, its submission options, live plots, running metrics and
+// screening, problems in plain words, and "Save gains…" with the command that grades the file.
+// It reads and changes a TuningSession only; the window loop (main.cpp) owns time and drawing.
+#pragma once
+#include <string>
+
+#include "app/ui/session.h"
+
+namespace dyn::ui {
+
+struct PanelState {
+  bool playing = true;
+  bool loop = false;               // restart when the run ends
+  bool restart_on_change = true;   // a changed gain or option restarts the run at once
+  bool pending_changes = false;    // changed since the last restart (restart_on_change off)
+  double speed = 1.0;              // simulated seconds per wall second
+  std::string save_path;           // what "Save gains…" writes
+  std::string saved_path;          // the last file written ("" until then)
+  std::string status;              // last save result
+  bool status_is_error = false;
+  int plot_column = -1;            // extra live plot: a trace column chosen by the student
+  json metrics = json::object();   // cached Lab::metrics of the run so far
+  std::size_t metrics_row = 0;
+  bool metrics_final = false;
+};
+
+// Saves the session's gains to state.save_path and records the outcome in state.status.
+void saveGains(TuningSession& session, PanelState& state);
+
+// Draws the panel as a fixed window at (x, 0) of size width × height (window pixels).
+void drawTuningPanel(TuningSession& session, PanelState& state, float x, float width, float height);
+
+}  // namespace dyn::ui
