@@ -76,7 +76,7 @@ VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const Ve
   // Inward: project onto the joint axis, pass the rest to the parent.
   VecN tau(n);
   for (int i = n - 1; i >= 0; --i) {
-    tau[i] = data.S_i[i].dot(data.f[i]);
+    tau[i] = S::dot(data.S_i[i], data.f[i]);
     const int p = model.bodies[i].parent;
     if (p >= 0) data.f[p] += S::forceTranspose(data.X_up[i], data.f[i]);
   }
@@ -95,12 +95,12 @@ MatN crba(const TreeModel<S>& model, TreeData<S>& data) {
   MatN M = MatN::Zero(n, n);
   for (int i = 0; i < n; ++i) {
     typename S::Vec F = S::inertiaTimes(data.Ic[i], data.S_i[i]);
-    M(i, i) = data.S_i[i].dot(F);
+    M(i, i) = S::dot(data.S_i[i], F);
     // Carry the composite force up the ancestors: M_ij = S_j · F.
     for (int j = i; model.bodies[j].parent >= 0;) {
       F = S::forceTranspose(data.X_up[j], F);
       j = model.bodies[j].parent;
-      M(i, j) = M(j, i) = data.S_i[j].dot(F);
+      M(i, j) = M(j, i) = S::dot(data.S_i[j], F);
     }
   }
   return M;
@@ -119,8 +119,8 @@ VecN aba(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const Vec
   // Inward: articulated inertias and bias forces.
   for (int i = n - 1; i >= 0; --i) {
     data.U[i] = data.Ic[i] * data.S_i[i];
-    data.D[i] = data.S_i[i].dot(data.U[i]);
-    data.u[i] = tau[i] - data.S_i[i].dot(data.pA[i]);
+    data.D[i] = S::dot(data.S_i[i], data.U[i]);
+    data.u[i] = tau[i] - S::dot(data.S_i[i], data.pA[i]);
     const int p = model.bodies[i].parent;
     if (p >= 0) {
       const Mat Ia = data.Ic[i] - data.U[i] * data.U[i].transpose() / data.D[i];
@@ -136,7 +136,7 @@ VecN aba(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const Vec
   for (int i = 0; i < n; ++i) {
     const int p = model.bodies[i].parent;
     const Vec a_in = S::motion(data.X_up[i], p < 0 ? a0 : data.a[p]) + data.c[i];
-    qdd[i] = (data.u[i] - data.U[i].dot(a_in)) / data.D[i];
+    qdd[i] = (data.u[i] - S::dot(data.U[i], a_in)) / data.D[i];
     data.a[i] = a_in + data.S_i[i] * qdd[i];
   }
   return qdd;
@@ -188,7 +188,7 @@ void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
 template <class S>
 double kineticEnergy(const TreeModel<S>& model, const TreeData<S>& data) {
   double T = 0;
-  for (int i = 0; i < model.dof(); ++i) T += 0.5 * data.v[i].dot(S::inertiaTimes(model.bodies[i].inertia, data.v[i]));
+  for (int i = 0; i < model.dof(); ++i) T += 0.5 * S::dot(data.v[i], S::inertiaTimes(model.bodies[i].inertia, data.v[i]));
   return T;
 }
 

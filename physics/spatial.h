@@ -33,6 +33,7 @@ struct Planar {
     return (Rot() << c, s, -s, c).finished();
   }
   static double crossScalar(const Pos& a, const Pos& b) { return a.x() * b.y() - a.y() * b.x(); }
+  static double dot(const Vec& a, const Vec& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
   static Pos perp(const Pos& a) { return {-a.y(), a.x()}; }  // ẑ × a
   static Pos rotate(const Rot& E, double x, double y) {     // E (x, y)
     return {E(0, 0) * x + E(0, 1) * y, E(1, 0) * x + E(1, 1) * y};
@@ -144,6 +145,7 @@ struct Spatial {
     Pos r = Pos::Zero();
   };
 
+  static double dot(const Vec& a, const Vec& b) { return a.dot(b); }
   static Eigen::Matrix3d skew(const Pos& p) {
     Eigen::Matrix3d s;
     s << 0, -p.z(), p.y(), p.z(), 0, -p.x(), -p.y(), p.x(), 0;

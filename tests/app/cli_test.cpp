@@ -351,3 +351,39 @@ TEST_CASE("a rerun into the same directory leaves no stale output of the earlier
   CHECK(fs::exists(dir / "out/trace_hand.csv"));
   CHECK(readFile(dir / "out/notes.txt") == "mine");
 }
+
+TEST_CASE("dynlab bench --json: the fields of every lab, and speed with accuracy (no speed asserted)") {
+  TempDir dir("bench");
+  const Result r = dynlab(dir, "bench --json --steps 200 --frames 5");
+  INFO("stdout: ", r.out, "\nstderr: ", r.err);
+  REQUIRE(r.code == 0);
+  std::istringstream lines(r.out);
+  std::string line;
+  int labs = 0;
+  while (std::getline(lines, line)) {
+    const json j = json::parse(line);
+    ++labs;
+    for (const char* key : {"hand_us_per_step", "bullet_us_per_step", "render_fps", "render_png_fps",
+                            "render_video_fps", "bullet_over_hand"})
+      CHECK(j.at(key).get<double>() > 0);
+    CHECK(j.at("lab").is_string());
+    if (j.at("lab") != "slider_crank") continue;
+    // Bullet and the hand engine at Bullet's order (semi-implicit Euler + Baumgarte, same dt), both
+    // against the RK4 reference: first-order errors of the same size (Bullet is first order too,
+    // shared/notes/bullet-reference.md), far above RK4's own (~1e-9) and below a visible one.
+    CHECK(j.at("hand_scheme") == "rk4 + projection");
+    const json& bullet = j.at("bullet_error");
+    const json& hand1 = j.at("hand_first_order_error");
+    CHECK(j.at("hand_first_order_us_per_step").get<double>() > 0);
+    for (const char* key : {"max_dq", "max_dx_c", "max_df"}) {
+      INFO(key);
+      const double b = bullet.at(key).get<double>(), h = hand1.at(key).get<double>();
+      CHECK(b > 1e-7);
+      CHECK(b < 1e-2);
+      CHECK(h / b > 0.5);
+      CHECK(h / b < 2.0);
+    }
+  }
+  CHECK(labs >= 1);
+  CHECK(snapshot(dir.path).empty());  // the bench leaves nothing behind
+}
