@@ -69,8 +69,16 @@ void runSection(TuningSession& session, PanelState& st) {
   const Lab* lab = session.lab();
   const char* state = !session.problem().empty() ? "stopped" : session.finished() ? "finished" : st.playing ? "playing" : "paused";
   ImGui::Text("t = %.3f / %.3f s   (%s)", session.time(), lab ? lab->duration() : 0.0, state);
-  if (ImGui::Button(st.playing ? "Pause" : "Play", ImVec2(70, 0))) st.playing = !st.playing;
-  tooltip("Space");
+  if (session.finished()) {
+    if (ImGui::Button("Replay", ImVec2(70, 0))) {
+      restart(session, st);
+      st.playing = true;
+    }
+    tooltip("run again from t = 0");
+  } else {
+    if (ImGui::Button(st.playing ? "Pause" : "Play", ImVec2(70, 0))) st.playing = !st.playing;
+    tooltip("Space");
+  }
   ImGui::SameLine();
   if (ImGui::Button("Restart", ImVec2(70, 0))) restart(session, st);
   tooltip("R: run again from t = 0 with the current gains");
