@@ -1,4 +1,5 @@
-// Small file helpers shared by the tests: a fresh scratch directory and a whole file as bytes.
+// Small file helpers shared by the tests: a fresh scratch directory, a whole file as bytes, and
+// the text of an SVG.
 #pragma once
 #include <filesystem>
 #include <fstream>
@@ -19,6 +20,21 @@ inline std::filesystem::path scratchDir(const std::string& prefix, const std::st
 inline std::string readBytes(const std::filesystem::path& p) {
   std::ifstream in(p, std::ios::binary);
   return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// An SVG's characters as text: PLplot writes each one as a numeric reference (&#x53;).
+inline std::string svgText(const std::string& raw) {
+  std::string text;
+  for (std::size_t i = 0; i < raw.size(); ++i) {
+    if (raw.compare(i, 3, "&#x") == 0) {
+      const std::size_t end = raw.find(';', i);
+      text += static_cast<char>(std::stoi(raw.substr(i + 3, end - i - 3), nullptr, 16));
+      i = end;
+    } else {
+      text += raw[i];
+    }
+  }
+  return text;
 }
 
 }  // namespace dyn::test

@@ -214,16 +214,7 @@ TEST_CASE("the SVG keeps the title as text") {
   writePlot((dir / "p.svg").string(), s);
   // PLplot writes each character as a numeric reference (&#x53;); decode them.
   const std::string raw = readBytes(dir / "p.svg");
-  std::string text;
-  for (size_t i = 0; i < raw.size(); ++i) {
-    if (raw.compare(i, 3, "&#x") == 0) {
-      const size_t end = raw.find(';', i);
-      text += static_cast<char>(std::stoi(raw.substr(i + 3, end - i - 3), nullptr, 16));
-      i = end;
-    } else {
-      text += raw[i];
-    }
-  }
+  const std::string text = test::svgText(raw);
   CHECK(text.find("Slider tracking & force") != std::string::npos);
   CHECK(raw.find("width=\"800px\"") != std::string::npos);
 }
