@@ -27,6 +27,14 @@ struct UiArgs {
   std::vector<std::string> extra;  // passed on to dynlab-ui as they are
 };
 
+struct FigureArgs {
+  std::string lab, config, gains, out, engine = "both", format = "pdf", size = "1920x1080", title;
+  std::vector<std::string> plots;  // each "col,col,...": one plot
+  std::vector<double> stills;      // simulated times (s)
+  std::optional<double> duration;
+  bool overlay = true;
+};
+
 struct BenchArgs {
   bool json = false;
   int steps = 4000, frames = 60;
@@ -38,6 +46,8 @@ int gradeOne(const GradeArgs& args);
 int gradeReplay(const GradeArgs& args);
 int gradeBatch(const GradeArgs& args);  // app/batch.cpp
 int writeAutograderZip(const std::string& lab, const std::string& out);
+// Lecture figures: plots of trace columns and rendered stills (app/figure.cpp).
+int figure(const FigureArgs& args);
 int printSchema(const std::string& lab);
 int bench(const BenchArgs& args);
 // Replaces this process with dynlab-ui (next to /proc/self/exe); returns only on failure (1).

@@ -22,6 +22,28 @@ int main(int argc, char** argv) {
   r->add_flag("--frames", run.frames, "Write frames/NNNNN.png (30 fps)");
   r->add_option("--duration", run.duration, "Override the simulated duration (s)");
 
+  FigureArgs fig;
+  auto* f = cli.add_subcommand("figure", "Lecture figures from a lab's run: plots of trace columns (PDF/SVG/PNG) and "
+                                         "rendered stills (PNG); without --plot/--still, the lab's own plots and "
+                                         "stills at the start, middle and end");
+  f->add_option("LAB", fig.lab, "Lab name (see `dynlab list`)")->required();
+  f->add_option("--config", fig.config, "Lab config JSON (default: labs/LAB/LAB.json)");
+  f->add_option("--gains", fig.gains, "Gains JSON: {\"gains\": {...}} as in a submission");
+  f->add_option("--duration", fig.duration, "Override the simulated duration (s)");
+  f->add_option("--engine", fig.engine, "Which engine(s) to run: hand solid, Bullet dashed (plots) or as a ghost (stills)")
+      ->check(CLI::IsMember({"hand", "bullet", "both"}));
+  f->add_option("--out", fig.out, "Output directory (default: out/LAB/figures)");
+  f->add_option("--plot", fig.plots, "Trace columns to plot against t, e.g. f_Ty,f_des (repeatable: one plot each); "
+                                     "written as plot_<cols joined by +>.<format>")
+      ->allow_extra_args(false);
+  f->add_option("--still", fig.stills, "Render the scene at this time (s), nearest trace row (repeatable); "
+                                       "written as still_<t>.png")
+      ->allow_extra_args(false);
+  f->add_option("--format", fig.format, "Plot format: pdf, svg or png (default: pdf)");
+  f->add_option("--size", fig.size, "Still size WIDTHxHEIGHT in pixels (default: 1920x1080)");
+  f->add_flag("!--no-overlay", fig.overlay, "Stills without the overlay panel");
+  f->add_option("--title", fig.title, "Title of every plot and of the stills' panel (default: the lab and columns)");
+
   GradeArgs grade;
   auto* g = cli.add_subcommand("grade", "Grade a submission (gains JSON) against its lab's rubric, or a whole directory");
   g->add_option("SUBMISSION", grade.submission, "Submission JSON: {\"lab\": ..., \"gains\": {...}}");
@@ -69,6 +91,7 @@ int main(int argc, char** argv) {
   }
   if (*list) return listLabs();
   if (*r) return runLab(run);
+  if (*f) return figure(fig);
   if (*g) return !grade.batch.empty() ? gradeBatch(grade) : !grade.replay.empty() ? gradeReplay(grade) : gradeOne(grade);
   if (*z) return writeAutograderZip(zip_lab, zip_out);
   if (*s) return printSchema(schema_lab);

@@ -1,12 +1,19 @@
 // Rendering runs to PNG frames and H.264 video (render/), offscreen through OSMesa.
 #include "app/movie.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
 #include "render/video.h"
 
 namespace dyn::app {
+
+std::size_t rowAt(const Trace& trace, double dt, double t) {
+  const long long r = std::llround(t / dt);
+  if (trace.rows() == 0 || r <= 0) return 0;
+  return std::min(std::size_t(r), trace.rows() - 1);
+}
 
 std::vector<std::size_t> frameRows(const Trace& trace, double dt, int fps) {
   std::vector<std::size_t> rows;
@@ -19,6 +26,16 @@ std::vector<std::size_t> frameRows(const Trace& trace, double dt, int fps) {
   return rows;
 }
 
+Image renderRow(Renderer& renderer, const Lab& lab, const Trace& trace, std::size_t row, const Trace* ghost,
+                bool overlay, const std::string& title) {
+  Scene scene;
+  Overlay panel;
+  lab.scene(trace, row, ghost, scene);
+  if (overlay) lab.overlay(trace, row, panel);
+  if (!title.empty()) panel.title = title;
+  return renderer.render(scene, overlay ? &panel : nullptr);
+}
+
 int renderRun(const Lab& lab, const Trace& trace, const Trace* ghost, const MovieOptions& o,
               const std::filesystem::path& dir) {
   auto context = makeOffscreenContext(o.width, o.height);
@@ -28,11 +45,7 @@ int renderRun(const Lab& lab, const Trace& trace, const Trace* ghost, const Movi
   if (o.frames) std::filesystem::create_directories(dir / "frames");
   int n = 0;
   for (std::size_t row : frameRows(trace, lab.dt(), o.fps)) {
-    Scene scene;
-    Overlay overlay;
-    lab.scene(trace, row, ghost, scene);
-    lab.overlay(trace, row, overlay);
-    const Image image = renderer.render(scene, &overlay);
+    const Image image = renderRow(renderer, lab, trace, row, ghost);
     if (video) video->addFrame(image);
     if (o.frames) {
       char name[32];

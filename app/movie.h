@@ -1,4 +1,5 @@
-// Turning traces into pictures: PNG frames and an MP4 of a run, the Bullet run as a ghost.
+// Turning traces into pictures: PNG frames and an MP4 of a run, the Bullet run as a ghost, and
+// single frames at chosen times (dynlab figure's stills).
 #pragma once
 #include <filesystem>
 #include <functional>
@@ -13,8 +14,15 @@ struct MovieOptions {
   bool video = false, frames = false;
 };
 
+// The trace row nearest simulated time t (rows are dt apart from t = 0; clamped to the last row).
+std::size_t rowAt(const Trace& trace, double dt, double t);
 // Trace rows shown at `fps` frames per second of simulated time.
 std::vector<std::size_t> frameRows(const Trace& trace, double dt, int fps);
+
+// The frame at one trace row: the lab's scene, and its overlay panel unless overlay is false
+// (title, when not empty, replaces the panel's title).
+Image renderRow(Renderer& renderer, const Lab& lab, const Trace& trace, std::size_t row, const Trace* ghost,
+                bool overlay = true, const std::string& title = "");
 
 // Renders the run; writes video.mp4 and/or frames/NNNNN.png into dir. Returns the frame count.
 int renderRun(const Lab& lab, const Trace& trace, const Trace* ghost, const MovieOptions& options,
