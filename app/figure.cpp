@@ -122,7 +122,8 @@ std::string ylabelFor(const std::vector<std::string>& columns, const std::vector
   return join(columns, ", ");
 }
 
-// One plot of the runs: each column a colour, hand solid and Bullet dashed.
+// One plot of the runs: each column a colour, hand solid and Bullet dashed; a column the engines
+// share exactly (a reference, a setpoint) is drawn once, as both engines'.
 PlotSpec plotSpec(const FigurePlot& p, const std::string& title, const RunResult* hand, const RunResult* bullet) {
   PlotSpec spec;
   spec.title = title;
@@ -130,10 +131,14 @@ PlotSpec plotSpec(const FigurePlot& p, const std::string& title, const RunResult
   spec.ylabel = p.ylabel.empty() ? join(p.columns, ", ") : p.ylabel;
   for (std::size_t k = 0; k < p.columns.size(); ++k) {
     const std::string& c = p.columns[k];
-    if (hand)
-      spec.series.push_back({c + " (hand)", hand->trace.series("t"), hand->trace.series(c), PlotSeries::Style::Solid, int(k)});
-    if (bullet)
-      spec.series.push_back({c + " (Bullet)", bullet->trace.series("t"), bullet->trace.series(c), PlotSeries::Style::Dashed, int(k)});
+    const std::vector<double> h = hand ? hand->trace.series(c) : std::vector<double>{};
+    const std::vector<double> b = bullet ? bullet->trace.series(c) : std::vector<double>{};
+    if (hand && bullet && h == b) {
+      spec.series.push_back({c + " (hand, Bullet)", hand->trace.series("t"), h, PlotSeries::Style::Solid, int(k)});
+      continue;
+    }
+    if (hand) spec.series.push_back({c + " (hand)", hand->trace.series("t"), h, PlotSeries::Style::Solid, int(k)});
+    if (bullet) spec.series.push_back({c + " (Bullet)", bullet->trace.series("t"), b, PlotSeries::Style::Dashed, int(k)});
   }
   return spec;
 }

@@ -18,7 +18,8 @@ TEST_CASE("dynlab list and --help") {
   const Result list = dynlab(dir, "list");
   CHECK(list.code == 0);
   CHECK(list.out.rfind("slider_crank ", 0) == 0);
-  for (const char* args : {"--help", "run --help", "grade --help", "bench --help", "schema --help", "list --help"}) {
+  for (const char* args : {"--help", "run --help", "figure --help", "grade --help", "bench --help", "schema --help",
+                           "list --help"}) {
     INFO("dynlab ", args);
     const Result r = dynlab(dir, args);
     CHECK(r.code == 0);
