@@ -94,6 +94,15 @@ class CholeskyN {
         g(i, j) = s;
       }
   }
+  // g = Yᵀ D⁻¹ y (first `rows` columns of Y) for Y = L⁻¹ B and y = L⁻¹ b: Bᵀ A⁻¹ b.
+  template <class Y, class V, class G>
+  void inner(const Y& Ym, int rows, const V& y, G& g) const {
+    for (int i = 0; i < rows; ++i) {
+      double s = 0;
+      for (int k = 0; k < size(); ++k) s += Ym(k, i) * dinv_[k] * y[k];
+      g[i] = s;
+    }
+  }
 
  private:
   double& l(int i, int k) { return L_[i * kCap + k]; }

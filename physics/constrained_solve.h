@@ -13,103 +13,116 @@
 #include "physics/constrained.h"
 
 namespace dyn {
-namespace detail {
-
-// Capacity of a size that may be dynamic.
-constexpr int cap(int n) { return n == Eigen::Dynamic ? kMaxDof : n; }
-constexpr int plus1(int n) { return n == Eigen::Dynamic ? Eigen::Dynamic : n + 1; }
-
-// The Schur route on the constrained rows J̃ (m'×n) and Ã (m'×k); false if a factor is not
-// positive definite. H̃ is p.Ht when there are contacts, else the identity.
-template <int Nj, int Nr, int Nl, class JT, class AT>
-bool solveSchur(const ConstrainedProblemT<Nj, Nr, Nl>& p, const JT& J, const AT& A,
-                ConstrainedSolutionT<Nj, Nr, Nl>& s) {
-  constexpr int R = JT::RowsAtCompileTime;  // m' = m, or the contact rows (dynamic)
-  const int n = int(p.M.rows()), k = int(A.cols()), m = int(J.rows());
-  const bool contacts = p.Ht.size() > 0;
-  CholeskyN<Nj> chol_M;
-  if (!chol_M.compute(p.M)) return false;
-
-  // Y = L⁻¹ [J̃ᵀ  τ − h]: one forward substitution for the rows and the free acceleration.
-  MatRC<Nj, plus1(R), cap(Nj), cap(R) + 1> Y(n, m + 1);
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < m; ++j) Y(i, j) = J(j, i);
-    Y(i, m) = p.tau[i] - p.h[i];
-  }
-  chol_M.forward(Y);
-  // Their M⁻¹ inner products: Λ = J̃ M⁻¹ J̃ᵀ (first m columns) and J̃ M⁻¹ (τ − h) (the last).
-  MatRC<R, plus1(R), cap(R), cap(R) + 1> G(m, m + 1);
-  chol_M.inner(Y, m, G);
-  CholeskyN<R> chol_L;
-  if (!chol_L.compute(G, m)) return false;  // factors the leading m×m block, Λ
-
-  // R = Λ⁻¹ [Ã  r],  r = J̃ M⁻¹ (τ − h) + H̃ (J'θ' + H'w − A'v_c − s): the second row, η given α_c.
-  MatRC<Nr, 1> bias = p.Jdot_qd;
-  if (p.Adot_vc.size()) bias -= p.Adot_vc;
-  if (p.Hdot_w.size()) bias += p.Hdot_w;
-  if (p.stab.size()) bias -= p.stab;
-  MatRC<R, plus1(Nl), cap(R), cap(Nl) + 1> Rm(m, k + 1);
-  for (int i = 0; i < m; ++i) {
-    for (int j = 0; j < k; ++j) Rm(i, j) = A(i, j);
-    Rm(i, k) = G(i, m) + (contacts ? p.Ht.row(i).dot(bias) : bias[i]);
-  }
-  chol_L.solveInPlace(Rm);
-
-  // The first row: (M_c + Ãᵀ Λ⁻¹ Ã) α_c = −b_c − G_c + Ãᵀ Λ⁻¹ r.
-  MatRC<Nl, plus1(Nl), cap(Nl), cap(Nl) + 1> Sc(k, k + 1);
-  for (int i = 0; i < k; ++i)
-    for (int j = 0; j <= k; ++j) {
-      double x = 0;
-      for (int r = 0; r < m; ++r) x += A(r, i) * Rm(r, j);
-      Sc(i, j) = x;
-    }
-  for (int i = 0; i < k; ++i) {
-    for (int j = 0; j < k && p.Mc.size(); ++j) Sc(i, j) += p.Mc(i, j);
-    if (p.bc_Gc.size()) Sc(i, k) -= p.bc_Gc[i];
-  }
-  CholeskyN<Nl> chol_S;
-  if (!chol_S.compute(Sc, k)) return false;
-  s.alpha_c.resize(k);
-  for (int i = 0; i < k; ++i) s.alpha_c[i] = Sc(i, k);
-  chol_S.solveInPlace(s.alpha_c);
-
-  // η = Λ⁻¹ r − Λ⁻¹ Ã α_c, and the spatial force f = H̃ᵀ η.
-  s.eta.resize(m);
-  for (int i = 0; i < m; ++i) {
-    double e = Rm(i, k);
-    for (int j = 0; j < k; ++j) e -= Rm(i, j) * s.alpha_c[j];
-    s.eta[i] = e;
-  }
-  if (contacts) s.f.noalias() = p.Ht.transpose() * s.eta;
-  else s.f = s.eta;
-  // θ'' = M⁻¹ (τ − h − J̃ᵀ η) = L⁻ᵀ D⁻¹ (L⁻¹ (τ − h) − L⁻¹ J̃ᵀ η).
-  s.qdd.resize(n);
-  for (int i = 0; i < n; ++i) {
-    double a = Y(i, m);
-    for (int j = 0; j < m; ++j) a -= Y(i, j) * s.eta[j];
-    s.qdd[i] = a;
-  }
-  chol_M.scale(s.qdd);
-  chol_M.backward(s.qdd);
-  s.ok = true;
-  return true;
-}
-
-}  // namespace detail
-
+// The Schur route in two parts: factor() everything that depends on the configuration alone
+// (M, J̃, Ã, M_c: the factors of M, Λ and the Schur complement), then solve() for any right-hand
+// side (τ − h, J'θ', ... : the state's velocities and torques). A mechanism factors once per
+// configuration and solves for every stage, the trace row and the projection (which is the same
+// solve with impulses: integrate.h). Nr is m, the rows of J̃: the constraint rows without contacts,
+// H̃'s rows (dynamic) with them.
 template <int Nj, int Nr, int Nl>
-ConstrainedSolutionT<Nj, Nr, Nl> solveConstrained(const ConstrainedProblemT<Nj, Nr, Nl>& p) {
-  ConstrainedSolutionT<Nj, Nr, Nl> s;
-  const bool done = p.Ht.size() > 0
-                        ? detail::solveSchur(p, MatN(p.Ht * p.J), MatN(p.Ht * p.A), s)
-                        : detail::solveSchur(p, p.J, p.A, s);
-  if (done) return s;
-  // (Nearly) singular: the pivoted LU of the bounded-size problem judges.
+class ConstrainedFactorT {
+ public:
+  // Factors for J̃ (m×n) and Ã (m×k); false if M, Λ or the Schur complement is not clearly
+  // positive definite (then the caller goes to the pivoted LU).
+  template <class Problem, class JT, class AT>
+  bool factor(const Problem& p, const JT& J, const AT& A) {
+    n_ = int(p.M.rows());
+    m_ = int(J.rows());
+    k_ = int(A.cols());
+    const int n = this->n(), m = this->m(), k = this->k();  // compile-time where the sizes are fixed
+    if (!chol_M_.compute(p.M)) return false;
+    // Y = L⁻¹ J̃ᵀ, and Λ = J̃ M⁻¹ J̃ᵀ = Yᵀ D⁻¹ Y.
+    Y_.resize(n, m);
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < m; ++j) Y_(i, j) = J(j, i);
+    chol_M_.forward(Y_);
+    MatRC<Nr, Nr> Lambda(m, m);
+    chol_M_.inner(Y_, m, Lambda);
+    if (!chol_L_.compute(Lambda, m)) return false;
+    // Λ⁻¹ Ã, and the Schur complement S = M_c + Ãᵀ Λ⁻¹ Ã.
+    A_.resize(m, k);
+    LA_.resize(m, k);
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j < k; ++j) A_(i, j) = LA_(i, j) = A(i, j);
+    chol_L_.solveInPlace(LA_);
+    MatRC<Nl, Nl> S(k, k);
+    for (int i = 0; i < k; ++i)
+      for (int j = 0; j < k; ++j) {
+        double x = p.Mc.size() ? p.Mc(i, j) : 0.0;
+        for (int r = 0; r < m; ++r) x += A_(r, i) * LA_(r, j);
+        S(i, j) = x;
+      }
+    return chol_S_.compute(S, k);
+  }
+
+  // The solution at p's right-hand side (τ − h, J'θ', A'v_c, H'w, s, b_c + G_c), with the
+  // configuration last factored. Ht as in p (empty: eq. 2).
+  template <class Problem, class Solution>
+  void solve(const Problem& p, Solution& s) const {
+    const int n = this->n(), m = this->m(), k = this->k();  // compile-time where the sizes are fixed
+    // y = L⁻¹ (τ − h), and r = J̃ M⁻¹ (τ − h) + H̃ (J'θ' + H'w − A'v_c − s).
+    MatRC<Nj, 1> y(n);
+    for (int i = 0; i < n; ++i) y[i] = p.tau[i] - p.h[i];
+    chol_M_.forward(y);
+    MatRC<Nr, 1> r(m);
+    chol_M_.inner(Y_, m, y, r);
+    auto bias = p.Jdot_qd.eval();
+    if (p.Adot_vc.size()) bias -= p.Adot_vc;
+    if (p.Hdot_w.size()) bias += p.Hdot_w;
+    if (p.stab.size()) bias -= p.stab;
+    const bool contacts = p.Ht.size() > 0;
+    for (int i = 0; i < m; ++i) r[i] += contacts ? p.Ht.row(i).dot(bias) : bias[i];
+    chol_L_.solveInPlace(r);  // Λ⁻¹ r
+    // The first row: S α_c = −b_c − G_c + Ãᵀ Λ⁻¹ r.
+    s.alpha_c.resize(k);
+    for (int i = 0; i < k; ++i) {
+      double x = p.bc_Gc.size() ? -p.bc_Gc[i] : 0.0;
+      for (int j = 0; j < m; ++j) x += A_(j, i) * r[j];
+      s.alpha_c[i] = x;
+    }
+    chol_S_.solveInPlace(s.alpha_c);
+    // η = Λ⁻¹ r − Λ⁻¹ Ã α_c, and the spatial force f = H̃ᵀ η.
+    s.eta.resize(m);
+    for (int i = 0; i < m; ++i) {
+      double e = r[i];
+      for (int j = 0; j < k; ++j) e -= LA_(i, j) * s.alpha_c[j];
+      s.eta[i] = e;
+    }
+    if (contacts) s.f.noalias() = p.Ht.transpose() * s.eta;
+    else s.f = s.eta;
+    // θ'' = M⁻¹ (τ − h − J̃ᵀ η) = L⁻ᵀ D⁻¹ (y − Y η).
+    s.qdd.resize(n);
+    for (int i = 0; i < n; ++i) {
+      double a = y[i];
+      for (int j = 0; j < m; ++j) a -= Y_(i, j) * s.eta[j];
+      s.qdd[i] = a;
+    }
+    chol_M_.scale(s.qdd);
+    chol_M_.backward(s.qdd);
+    s.ok = true;
+  }
+
+ private:
+  int n() const { return Nj == Eigen::Dynamic ? n_ : Nj; }
+  int m() const { return Nr == Eigen::Dynamic ? m_ : Nr; }
+  int k() const { return Nl == Eigen::Dynamic ? k_ : Nl; }
+  int n_ = 0, m_ = 0, k_ = 0;
+  CholeskyN<Nj> chol_M_;
+  CholeskyN<Nr> chol_L_;
+  CholeskyN<Nl> chol_S_;
+  MatRC<Nj, Nr> Y_;       // L⁻¹ J̃ᵀ
+  MatRC<Nr, Nl> A_, LA_;  // Ã and Λ⁻¹ Ã
+};
+
+// The block LU's answer at fixed sizes (the fallback near singular configurations).
+template <int Nj, int Nr, int Nl>
+ConstrainedSolutionT<Nj, Nr, Nl> solveConstrainedBlockLU(const ConstrainedProblemT<Nj, Nr, Nl>& p) {
   if constexpr (Nj == Eigen::Dynamic && Nr == Eigen::Dynamic && Nl == Eigen::Dynamic) {
     return solveConstrainedBlockLU(p);
   } else {
-    ConstrainedProblem d{p.M, p.h, p.tau, p.J, p.Jdot_qd, p.A, p.Adot_vc, p.Mc, p.bc_Gc, p.Ht, p.Hdot_w, p.stab};
+    const ConstrainedProblem d{p.M, p.h, p.tau, p.J, p.Jdot_qd, p.A, p.Adot_vc, p.Mc, p.bc_Gc, p.Ht, p.Hdot_w, p.stab};
     const ConstrainedSolution x = solveConstrainedBlockLU(d);
+    ConstrainedSolutionT<Nj, Nr, Nl> s;
     s.alpha_c = x.alpha_c;
     s.eta = x.eta;
     s.f = x.f;
@@ -117,6 +130,21 @@ ConstrainedSolutionT<Nj, Nr, Nl> solveConstrained(const ConstrainedProblemT<Nj, 
     s.ok = x.ok;
     return s;
   }
+}
+
+template <int Nj, int Nr, int Nl>
+ConstrainedSolutionT<Nj, Nr, Nl> solveConstrained(const ConstrainedProblemT<Nj, Nr, Nl>& p) {
+  ConstrainedSolutionT<Nj, Nr, Nl> s;
+  if (p.Ht.size() > 0) {
+    ConstrainedFactorT<Nj, Eigen::Dynamic, Nl> f;  // the contact rows H̃ J, H̃ A
+    if (!f.factor(p, MatN(p.Ht * p.J), MatN(p.Ht * p.A))) return solveConstrainedBlockLU(p);
+    f.solve(p, s);
+  } else {
+    ConstrainedFactorT<Nj, Nr, Nl> f;
+    if (!f.factor(p, p.J, p.A)) return solveConstrainedBlockLU(p);
+    f.solve(p, s);
+  }
+  return s;
 }
 
 }  // namespace dyn

@@ -52,25 +52,33 @@ VecN weightedCorrection(const MatN& W, const MatN& G, const VecN& e) {
 
 }  // namespace
 
-bool projectPositions(ConstrainedSystem& sys, const DriftOptions& d, VecN& q) {
+bool ConstrainedSystem::correction(const VecN& q, const VecN& e, VecN& dx) {
   VecN phi;
   MatN G, W;
+  constraint(q, phi, G);
+  metric(q, W);
+  dx = weightedCorrection(W, G, e);
+  return dx.allFinite();
+}
+
+bool projectPositions(ConstrainedSystem& sys, const DriftOptions& d, VecN& q) {
+  VecN phi, dx;
+  MatN G;
   for (int it = 0; it < d.max_iterations; ++it) {
     sys.constraint(q, phi, G);
     if (phi.lpNorm<Eigen::Infinity>() <= d.tolerance) return true;
-    if (it == 0) sys.metric(q, W);       // the metric at the starting point, kept fixed
-    q -= weightedCorrection(W, G, phi);  // Newton step on φ(q) = 0
+    if (!sys.correction(q, phi, dx)) return false;
+    q -= dx;  // Newton step on φ(q) = 0
   }
   sys.constraint(q, phi, G);
   return phi.lpNorm<Eigen::Infinity>() <= d.tolerance * 1e3;
 }
 
 void projectVelocities(ConstrainedSystem& sys, const VecN& q, VecN& v) {
-  VecN phi;
-  MatN G, W;
+  VecN phi, dx;
+  MatN G;
   sys.constraint(q, phi, G);
-  sys.metric(q, W);
-  v -= weightedCorrection(W, G, G * v);
+  if (sys.correction(q, G * v, dx)) v -= dx;
 }
 
 bool step(ConstrainedSystem& sys, const StepOptions& o, const VecN& tau, VecN& q, VecN& v) {

@@ -39,6 +39,12 @@ class ConstrainedSystem {
   virtual void constraint(const VecN& q, VecN& phi, MatN& G) = 0;
   // The projection metric W (mass matrix), positive definite.
   virtual void metric(const VecN& q, MatN& W) = 0;
+  // The projection's step: the correction dx of least W-norm with G(q) dx = e,
+  //   dx = W⁻¹Gᵀ (G W⁻¹ Gᵀ)⁻¹ e   (W = metric(q)).
+  // With W the mass matrix this is eq. (2) solved for impulses (Gauss's principle: τ − h = 0,
+  // J'θ' = −e), so a mechanism may answer from the factors of its own solve; false on failure.
+  // The default builds W and G and factors them here.
+  virtual bool correction(const VecN& q, const VecN& e, VecN& dx);
   // Rebuild the dependent coordinates and rates from the independent ones; false if unsupported.
   virtual bool recoverDependent(VecN& q, VecN& v) {
     (void)q;

@@ -3,8 +3,6 @@
 
 #include <cmath>
 
-#include "physics/constrained_solve.h"
-
 namespace dyn::slider_crank {
 namespace {
 const Eigen::Vector3d kA{0.0, 1.0, 0.0};  // the slider moves the tip along world x only
@@ -41,6 +39,7 @@ void Mechanism::positionStage(const Eigen::Vector3d& th) {
   MatN J;
   pointJacobian(tree_, data_, 2, tipPoint(), J);
   problem_.J = J;
+  factored_ = factor_.factor(problem_, problem_.J, problem_.A);
   theta_ = th;
   have_position_ = true;
 }
@@ -61,7 +60,10 @@ Mechanism::Solution Mechanism::evaluate(const VecN& q, const VecN& v, const VecN
   problem_.tau = tau;
   if (stab) problem_.stab = *stab;
   else problem_.stab.resize(0);
-  return solveConstrained(problem_);
+  if (!factored_) return solveConstrainedBlockLU(problem_);
+  Solution s;
+  factor_.solve(problem_, s);
+  return s;
 }
 
 Mechanism::Solution Mechanism::solve(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
@@ -97,6 +99,21 @@ void Mechanism::metric(const VecN& q, MatN& W) {
   W = MatN::Zero(4, 4);
   W.topLeftCorner(3, 3) = problem_.M;
   W(3, 3) = std::max(params_.load_mass, 1e-9);
+}
+
+bool Mechanism::correction(const VecN& q, const VecN& e, VecN& dx) {
+  positionStage(q.head<3>());
+  if (!factored_) return ConstrainedSystem::correction(q, e, dx);
+  // Eq. (2) for impulses: M dθ = −Jᵀ f, m_c dx_c = Aᵀ f, J dθ − A dx_c = e (τ − h = 0, J'θ' = −e).
+  Problem impulse;
+  impulse.tau.setZero();
+  impulse.h.setZero();
+  impulse.Jdot_qd = -e;
+  Solution s;
+  factor_.solve(impulse, s);
+  dx.resize(4);
+  dx << s.qdd, s.alpha_c[0];
+  return dx.allFinite();
 }
 
 bool Mechanism::recoverDependent(VecN& q, VecN& v) {

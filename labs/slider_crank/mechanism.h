@@ -9,7 +9,7 @@
 #include <array>
 
 #include "physics/chain.h"
-#include "physics/constrained.h"
+#include "physics/constrained_solve.h"
 #include "physics/integrate.h"
 
 namespace dyn::slider_crank {
@@ -38,6 +38,7 @@ class Mechanism final : public ConstrainedSystem {
   void accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a) override;
   void constraint(const VecN& q, VecN& phi, MatN& G) override;
   void metric(const VecN& q, MatN& W) override;
+  bool correction(const VecN& q, const VecN& e, VecN& dx) override;
   bool recoverDependent(VecN& q, VecN& v) override;
 
   // The full solve of eq. (2) at a state: α_c, f_T = (τ_T, f_Tx, f_Ty), θ''.
@@ -70,6 +71,8 @@ class Mechanism final : public ConstrainedSystem {
   TreeModel<Planar> tree_;
   TreeData<Planar> data_;
   Problem problem_;  // M, J from the position stage; h, J'θ' from the velocity stage
+  ConstrainedFactorT<3, 3, 1> factor_;  // eq. (2) factored at the position stage's θ
+  bool factored_ = false;               // false near singular configurations: the pivoted LU
   Eigen::Vector3d theta_;        // the θ of the position stage held in data_ and problem_
   bool have_position_ = false;
   // The last solve() without stabilisation and its inputs: the trace row's solve, which RK4's
