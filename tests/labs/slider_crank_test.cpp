@@ -414,3 +414,27 @@ TEST_CASE("determinism: the same config gives the same trace hash, for both engi
     CHECK(run(*makeLab(other), e).hash() != a.hash());
   }
 }
+
+TEST_CASE("the projection step through eq. (2) for impulses equals the W-metric formula") {
+  // Mechanism::correction answers dx = W⁻¹Gᵀ(G W⁻¹ Gᵀ)⁻¹ e from its factored eq. (2) (τ − h = 0,
+  // J'θ' = −e); the generic ConstrainedSystem::correction builds W and G and factors them itself.
+  const auto lab = makeLab(json::object());
+  Mechanism mech(settingsOf(*lab).params);
+  for (double theta1 : {0.3, 1.0, 2.0, -1.2}) {
+    CAPTURE(theta1);
+    VecN q, v;
+    REQUIRE(mech.initialState(theta1, 0.7, 1, q, v));
+    q += 1e-3 * Eigen::Vector4d(0.3, -0.2, 0.5, 0.1);  // off φ = 0, as after an integration step
+    VecN e(3);
+    e << 1e-3, -2e-3, 5e-4;
+    VecN fast, generic;
+    REQUIRE(mech.correction(q, e, fast));
+    REQUIRE(mech.ConstrainedSystem::correction(q, e, generic));
+    CHECK((fast - generic).norm() < 1e-12 * std::max(1.0, generic.norm()));
+    // And it is the correction asked for: G dx = e.
+    VecN phi;
+    MatN G;
+    mech.constraint(q, phi, G);
+    CHECK((G * fast - e).norm() < 1e-12);
+  }
+}
