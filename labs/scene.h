@@ -2,6 +2,7 @@
 // plane for planar labs). Labs fill it from their state; render/ turns it into pixels.
 // No GL here, so labs never depend on the renderer.
 #pragma once
+#include <algorithm>
 #include <Eigen/Core>
 #include <string>
 #include <utility>
@@ -50,12 +51,17 @@ struct Polyline {
   Color color;
 };
 
-// The camera: looks from eye at target; orthographic with half_height metres when ortho.
+// The camera: looks from eye at target; orthographic when ortho, showing at least half_height
+// metres above and below the target and, when half_width > 0, at least half_width either side:
+// the frame's aspect decides which one binds, so one scene frames well at 4:3 and at 16:9.
 struct Camera {
   Eigen::Vector3d eye{0, 0, 5}, target{0, 0, 0}, up{0, 1, 0};
   bool ortho = true;
-  double half_height = 1.0;  // ortho: half the visible height in metres
+  double half_height = 1.0;  // ortho: half the visible height in metres (at least)
+  double half_width = 0.0;   // ortho: half the visible width in metres (at least); 0: no demand
   double fov_y_deg = 45.0;   // perspective only
+  // Ortho: the half height actually shown in a frame of this aspect (width / height).
+  double visibleHalfHeight(double aspect) const { return std::max(half_height, half_width / aspect); }
 };
 
 struct Scene {

@@ -72,6 +72,7 @@ class OverlayPanel {
  private:
   void buildFrame(const Overlay& overlay);
   ::ImGuiContext* context_ = nullptr;
+  float scale_ = 1.0f;  // whole multiples of the 640×480 layout, so the pixel font stays crisp
 };
 
 }  // namespace dyn::gl

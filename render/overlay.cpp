@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cfloat>
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 
@@ -57,7 +58,13 @@ OverlayPanel::OverlayPanel(int width, int height) {
   io.DisplayFramebufferScale = ImVec2(1, 1);
   io.DeltaTime = 1.0f / 30.0f;  // fixed: output must not depend on wall-clock time
   io.ConfigFlags |= ImGuiConfigFlags_NoMouseCursorChange;
+  // A 1080p still reads like a 480p frame: the panel grows by whole multiples of its 480p size.
+  scale_ = float(std::max(1, int(std::lround(height / 480.0))));
+  ImFontConfig font;
+  font.SizePixels = 13.0f * scale_;
+  io.Fonts->AddFontDefault(&font);
   applyStyle();
+  ImGui::GetStyle().ScaleAllSizes(scale_);
   if (!ImGui_ImplOpenGL3_Init("#version 330 core")) {
     ImGui::DestroyContext(context_);
     throw std::runtime_error("render: Dear ImGui OpenGL3 backend failed to initialise");
@@ -85,14 +92,14 @@ void OverlayPanel::buildFrame(const Overlay& overlay) {
     label_w = std::max(label_w, ImGui::CalcTextSize(label.c_str()).x);
     value_w = std::max(value_w, ImGui::CalcTextSize(value.c_str()).x);
   }
-  const float gap = 16.0f;
-  const float title_w = ImGui::CalcTextSize(overlay.title.c_str()).x + 8.0f;
-  const float plot_w = 240.0f, plot_h = 48.0f;
-  float content_w = std::max({label_w + gap + value_w, title_w, 160.0f});
+  const float gap = 16.0f * scale_;
+  const float title_w = ImGui::CalcTextSize(overlay.title.c_str()).x + 8.0f * scale_;
+  const float plot_w = 240.0f * scale_, plot_h = 48.0f * scale_;
+  float content_w = std::max({label_w + gap + value_w, title_w, 160.0f * scale_});
   if (!overlay.plots.empty()) content_w = std::max(content_w, plot_w);
 
   // Fixed place and width; height fits the content (built twice per draw, so never stale).
-  ImGui::SetNextWindowPos(ImVec2(10, 10), ImGuiCond_Always);
+  ImGui::SetNextWindowPos(ImVec2(10 * scale_, 10 * scale_), ImGuiCond_Always);
   ImGui::SetNextWindowSize(ImVec2(content_w + 2 * ImGui::GetStyle().WindowPadding.x, 0),
                            ImGuiCond_Always);
   const ImGuiWindowFlags flags = ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoMove |

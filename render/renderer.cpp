@@ -162,7 +162,7 @@ struct Renderer::Impl {
     // Pixels per metre at a point (constant for orthographic cameras).
     const Camera& cam = scene.camera;
     auto pixelsPerMetre = [&](const Vector3d& p) {
-      if (cam.ortho) return height / (2.0 * cam.half_height);
+      if (cam.ortho) return height / (2.0 * cam.visibleHalfHeight(double(width) / std::max(height, 1)));
       const double half_fov = std::tan(cam.fov_y_deg * M_PI / 360.0);
       return height / (2.0 * half_fov * std::max(depthOf(p), 1e-6));
     };
@@ -386,7 +386,7 @@ Matrix4d Renderer::viewProjection(const Camera& camera, int width, int height) {
   Matrix4d proj = Matrix4d::Zero();
   if (camera.ortho) {
     const double near = -distance, far = 10.0 * distance + 10.0;
-    const double top = camera.half_height, right = top * aspect;
+    const double top = camera.visibleHalfHeight(aspect), right = top * aspect;
     proj(0, 0) = 1.0 / right;
     proj(1, 1) = 1.0 / top;
     proj(2, 2) = -2.0 / (far - near);

@@ -36,12 +36,14 @@ void SliderCrankLab::scene(const Trace& tr, std::size_t row, const Trace* ghost,
   const auto& L = s_.params.links;
   const double reach = L[0].length + L[1].length + L[2].length;
   const double x_min = L[1].length + L[2].length - L[0].length - 0.15, x_max = reach + 0.15;
-  // Camera: the whole crank circle and the rail's working range, in the right 56 % of a 4:3
-  // frame, clear of the overlay panel on the left.
+  // Camera: the whole crank circle and the rail's working range in the right 56 % of the frame's
+  // width, clear of the overlay panel on the left; the circle (and the force arrow below the rail)
+  // in its height. A 4:3 frame is width-bound, a 16:9 one shows the same width a little closer.
   const double x_lo = std::min(-L[0].length, x_min) - 0.05;
   const double visible_w = (x_max - x_lo) / 0.56;
   s.camera.ortho = true;
-  s.camera.half_height = 0.5 * visible_w * 0.75;
+  s.camera.half_width = 0.5 * visible_w;
+  s.camera.half_height = L[0].length + 0.35;
   s.camera.target = {x_max + 0.02 - 0.5 * visible_w, 0.12, 0};
   s.camera.eye = s.camera.target + Eigen::Vector3d(0, 0, 5);
 

@@ -156,3 +156,46 @@ TEST_CASE("a small sphere's pixel centroid is where project() says, to half a pi
     CHECK(std::abs(sy / sw - px.y()) < 0.5);
   }
 }
+
+TEST_CASE("an ortho camera shows at least half_width and half_height, whichever binds at the aspect") {
+  Camera cam;
+  cam.target = {0.3, -0.1, 0};
+  cam.eye = cam.target + Eigen::Vector3d(0, 0, 5);
+  cam.half_width = 1.2;
+  cam.half_height = 0.5;
+  for (auto [w, h] : {std::pair{640, 480}, {1920, 1080}, {480, 480}, {1500, 400}}) {
+    CAPTURE(w);
+    CAPTURE(h);
+    // The corners of the demanded rectangle are inside the frame, and one pair of sides touches it.
+    const Eigen::Vector2d lo = Renderer::project(cam, w, h, cam.target + Eigen::Vector3d(-1.2, -0.5, 0));
+    const Eigen::Vector2d hi = Renderer::project(cam, w, h, cam.target + Eigen::Vector3d(1.2, 0.5, 0));
+    CHECK(lo.x() >= -1e-6);
+    CHECK(hi.x() <= w + 1e-6);
+    CHECK(hi.y() >= -1e-6);  // y down: the top corner has the smaller row
+    CHECK(lo.y() <= h + 1e-6);
+    const bool width_binds = std::abs(lo.x()) < 1e-6 && std::abs(hi.x() - w) < 1e-6;
+    const bool height_binds = std::abs(hi.y()) < 1e-6 && std::abs(lo.y() - h) < 1e-6;
+    CHECK((width_binds || height_binds));
+    CHECK(width_binds == (double(w) / h < 1.2 / 0.5));
+  }
+}
+
+TEST_CASE("the overlay panel grows with the frame in whole steps (a 1080p still reads like 480p)") {
+  const Scene scene = test::redCapsuleScene();
+  const Overlay overlay = test::sampleOverlay();
+  // The panel's extent: rows and columns, counted from the top-left, that differ from no panel.
+  auto panelWidth = [&](int w, int h) {
+    auto context = makeOffscreenContext(w, h);
+    Renderer with(*context), without(*context);
+    const Image a = with.render(scene, &overlay), b = without.render(scene, nullptr);
+    int right = 0;
+    for (int y = 0; y < h / 2; ++y)
+      for (int x = 0; x < w / 2; ++x)
+        if (!std::equal(a.pixel(x, y), a.pixel(x, y) + 4, b.pixel(x, y))) right = std::max(right, x);
+    return right;
+  };
+  const int small = panelWidth(640, 480), large = panelWidth(1920, 1080);
+  MESSAGE("panel right edge: ", small, " px at 480p, ", large, " px at 1080p");
+  CHECK(large > 1.8 * small);
+  CHECK(large < 2.2 * small);
+}
