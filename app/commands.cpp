@@ -60,6 +60,8 @@ int runLab(const RunArgs& a) {
       if (!(*r)->failure.empty()) status = std::string(engine) + ": " + (*r)->failure;
     }
     if (hand && bullet) summary["agreement"] = lab.agreement(hand->trace, bullet->trace);
+    for (const auto& c : lab.columns())
+      if (!lab.unit(c).empty()) summary["units"][c] = lab.unit(c);
     summary["status"] = status;
     staging.write("summary.json", summary.dump(2) + "\n");
 

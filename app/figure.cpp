@@ -113,13 +113,22 @@ std::vector<FigurePlot> overlayPlots(const Lab& lab, const Trace& trace) {
 }
 
 // The y label of a requested plot: the lab's own label for exactly these columns (from its
-// rubric), else the column names (no unit: the lab does not declare one).
-std::string ylabelFor(const std::vector<std::string>& columns, const std::vector<FigurePlot>& lab_plots) {
+// rubric), else the column names with the lab's units ("f_Ty, f_meas (N)"; "x_c (m), q1 (rad)").
+std::string ylabelFor(const Lab& lab, const std::vector<std::string>& columns,
+                      const std::vector<FigurePlot>& lab_plots) {
   for (const auto& p : lab_plots)
     if (std::set<std::string>(p.columns.begin(), p.columns.end()) ==
         std::set<std::string>(columns.begin(), columns.end()))
       return p.ylabel;
-  return join(columns, ", ");
+  std::set<std::string> units;
+  for (const auto& c : columns) units.insert(lab.unit(c));
+  if (units.size() == 1) {
+    const std::string& u = *units.begin();
+    return join(columns, ", ") + (u.empty() ? "" : " (" + u + ")");
+  }
+  std::vector<std::string> labelled;
+  for (const auto& c : columns) labelled.push_back(lab.unit(c).empty() ? c : c + " (" + lab.unit(c) + ")");
+  return join(labelled, ", ");
 }
 
 // One plot of the runs: each column a colour, hand solid and Bullet dashed; a column the engines
@@ -178,7 +187,7 @@ int figure(const FigureArgs& a) {
       if (!(t >= 0 && t <= duration))
         badOption("--still", fmt("%g", t), "expected a time in [0, " + fmt("%g", duration) + "] s (the run's duration)");
     lab_plots = rubricPlots(loaded);
-    for (const auto& cols : requested) plots.push_back({cols, ylabelFor(cols, lab_plots)});
+    for (const auto& cols : requested) plots.push_back({cols, ylabelFor(*loaded.lab, cols, lab_plots)});
     if (a.plots.empty() && stills.empty()) {
       stills = {0.0, 0.5 * duration, duration};
       plots = lab_plots;

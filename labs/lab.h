@@ -37,6 +37,12 @@ class Lab {
  public:
   virtual ~Lab() = default;
   virtual std::vector<std::string> columns() const = 0;
+  // The SI unit of a trace column ("N", "rad", "N·m"; empty: unknown or dimensionless), for
+  // summaries, plot labels and panels.
+  virtual std::string unit(const std::string& column) const {
+    (void)column;
+    return {};
+  }
   virtual double dt() const = 0;
   virtual double duration() const = 0;
   virtual std::unique_ptr<Simulation> simulate(Engine engine) const = 0;

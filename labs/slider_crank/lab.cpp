@@ -3,6 +3,7 @@
 #include "labs/slider_crank/lab.h"
 
 #include <cmath>
+#include <map>
 
 #include "physics/bullet/slider_crank_bullet.h"
 
@@ -230,6 +231,17 @@ Settings parseSettings(const JsonView& c) {
 SliderCrankLab::SliderCrankLab(Settings s) : s_(std::move(s)) {}
 
 std::vector<std::string> SliderCrankLab::columns() const { return kColumns; }
+
+std::string SliderCrankLab::unit(const std::string& c) const {
+  static const std::map<std::string, std::string> units = {
+      {"t", "s"},       {"q1", "rad"},   {"q2", "rad"},   {"q3", "rad"},    {"x_c", "m"},
+      {"v_c", "m/s"},   {"f_Tx", "N"},   {"f_Ty", "N"},   {"tau_T", "N·m"}, {"tau1", "N·m"},
+      {"tau2", "N·m"},  {"tau3", "N·m"}, {"energy", "J"}, {"x_d", "m"},     {"f_des", "N"},
+      {"f_meas", "N"},  {"work", "J"},
+      {"constraint_residual", "m, rad"}};  // |φ|∞ over (θ1+θ2+θ3, x_T − x_c, y_T)
+  const auto it = units.find(c);
+  return it == units.end() ? std::string() : it->second;
+}
 
 std::unique_ptr<Simulation> SliderCrankLab::simulate(Engine engine) const {
   if (engine == Engine::Hand) return std::make_unique<HandSimulation>(s_);

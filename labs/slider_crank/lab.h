@@ -24,6 +24,7 @@ class SliderCrankLab final : public Lab {
  public:
   explicit SliderCrankLab(Settings s);
   std::vector<std::string> columns() const override;
+  std::string unit(const std::string& column) const override;
   double dt() const override { return s_.step.dt; }
   double duration() const override { return s_.duration; }
   std::unique_ptr<Simulation> simulate(Engine engine) const override;

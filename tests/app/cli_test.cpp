@@ -51,6 +51,10 @@ TEST_CASE("dynlab run writes both traces and a summary that agrees with them") {
   CHECK(summary.at("duration").get<double>() == 0.5);
   CHECK(summary.at("lab") == "slider_crank");
   CHECK(summary.at("status") == "ok");
+  // Units of the columns, for whoever reads the CSV.
+  CHECK(summary.at("units").at("q1") == "rad");
+  CHECK(summary.at("units").at("f_Ty") == "N");
+  CHECK(summary.at("units").at("tau1") == "N·m");
   std::map<std::string, Csv> traces;
   for (const char* engine : {"hand", "bullet"}) {
     INFO("engine ", engine);

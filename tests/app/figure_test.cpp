@@ -91,7 +91,7 @@ TEST_CASE("dynlab figure --plot: valid PDF, SVG and PNG files, legend per column
     CHECK(snapshot(dir / "out") == first);
     if (format == "svg") {
       // SVG keeps its text: both engines in the legend, and the rubric's y label (with its unit)
-      // for the columns the lab plots itself; just the column name where the lab has no label.
+      // for the columns the lab plots itself; else the column name with the lab's unit.
       const std::string force = test::svgText(first.at("plot_f_Ty+f_des.svg"));
       const std::string x = test::svgText(first.at("plot_x_c.svg"));
       // The setpoint is the same in both runs: drawn once, for both engines.
@@ -100,7 +100,7 @@ TEST_CASE("dynlab figure --plot: valid PDF, SVG and PNG files, legend per column
       CHECK(force.find("f_des (Bullet)") == std::string::npos);
       CHECK(x.find("x_c (hand)") != std::string::npos);
       CHECK(x.find("x_c (Bullet)") != std::string::npos);
-      CHECK(x.find("(m)") == std::string::npos);
+      CHECK(x.find("x_c (m)") != std::string::npos);
     }
   }
   // One engine: no Bullet series; and the bytes depend on what was asked.
