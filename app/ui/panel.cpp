@@ -214,7 +214,8 @@ void plotsSection(const TuningSession& session, PanelState& st) {
     const std::size_t first = row > window ? row - window : 0, stride = std::max<std::size_t>(1, window / 300);
     std::vector<float> values;
     for (std::size_t r = first; r <= row; r += stride) values.push_back(float(tr.at(r, st.plot_column)));
-    ImGui::Text("%s = %.6g", tr.columns[st.plot_column].c_str(), tr.at(row, st.plot_column));
+    const std::string unit = lab->unit(tr.columns[st.plot_column]);
+    ImGui::Text("%s = %.6g %s", tr.columns[st.plot_column].c_str(), tr.at(row, st.plot_column), unit.c_str());
     plot("##column_plot", values, ImVec4(0.25f, 0.35f, 0.60f, 1.0f), 60);
   }
 }
