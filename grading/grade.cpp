@@ -67,8 +67,9 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     }
     const std::string config_file = opt.config_file.empty() ? defaultConfigPath(lab_name) : opt.config_file;
     const json base = loadJsonFile(config_file);
-    buildLab(*entry, base, config_file);  // the lab config itself must be valid
+    const auto base_lab = buildLab(*entry, base, config_file);  // the lab config itself must be valid
     const Rubric rubric = parseRubric(JsonView(base, config_file));
+    checkColumns(rubric, base_lab->columns(), config_file);
     const json applied = applySubmission(base, view, lab_name, true);
     buildLab(*entry, applied, file);  // the gains are valid for the lab
 
@@ -89,8 +90,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
       for (const auto& l : rubric.leaderboard) used = used || l.scenario == sc.name;
       if (!used) continue;
       json cfg = mergePatch(applied, sc.patch);
-      if (!rubric.seed_target.empty())
-        cfg[json::json_pointer(rubric.seed_target)] = scenarioSeed(rep.fingerprint["submission_hash"], sc.name);
+      writeSeed(cfg, rubric, scenarioSeed(rep.fingerprint["submission_hash"], sc.name), config_file, sc.name);
       const auto lab = buildLab(*entry, cfg, config_file + " (scenario " + sc.name + ")");
       ScenarioRun run = runScenario(*lab, rubric.watchdog, deadline, config_file);
       trajectories += hashHex(std::to_string(run.trace.hash()));

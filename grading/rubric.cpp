@@ -21,7 +21,44 @@ double Rubric::maxScore() const {
 double partialCredit(double m, double full, double zero) {
   if (!std::isfinite(m)) return 0.0;
   if (full == zero) return (m == full) ? 1.0 : 0.0;
-  return std::clamp((zero - m) / (zero - full), 0.0, 1.0);
+  const double f = (zero - m) / (zero - full);
+  return std::isnan(f) ? 0.0 : std::clamp(f, 0.0, 1.0);  // NaN: inf/inf at extreme thresholds
+}
+
+void checkColumns(const Rubric& r, const std::vector<std::string>& columns, const std::string& file) {
+  auto check = [&](const std::string& c, const std::string& path) {
+    if (std::find(columns.begin(), columns.end(), c) != columns.end()) return;
+    std::string list;
+    for (const auto& k : columns) list += (list.empty() ? "" : ", ") + k;
+    throw InputError(file, path, "expected a trace column of this lab (" + list + "), got \"" + c + "\"");
+  };
+  for (std::size_t i = 0; i < r.watchdog.limits.size(); ++i)
+    check(r.watchdog.limits[i].column, "/rubric/watchdog/limits/" + std::to_string(i) + "/column");
+  for (std::size_t i = 0; i < r.tests.size(); ++i) {
+    if (!r.tests[i].plot) continue;
+    const std::string at = "/rubric/tests/" + std::to_string(i) + "/plot/";
+    const PlotRequest& p = *r.tests[i].plot;
+    for (std::size_t k = 0; k < p.columns.size(); ++k) check(p.columns[k], at + "columns/" + std::to_string(k));
+    if (!p.reference.empty()) check(p.reference, at + "reference");
+  }
+}
+
+void writeSeed(json& config, const Rubric& rubric, std::uint64_t seed, const std::string& file,
+               const std::string& scenario) {
+  if (rubric.seed_target.empty()) return;
+  // parseRubric checked the pointer's syntax; a scenario's patch may still have replaced the
+  // object it points into (e.g. "controller": 5), which json's operator[] would throw on.
+  const json::json_pointer ptr(rubric.seed_target);
+  bool ok = false;
+  try {
+    ok = config.contains(ptr.parent_pointer()) && config.at(ptr.parent_pointer()).is_object();
+  } catch (const json::exception&) {  // an array index too large for size_t
+  }
+  if (!ok)
+    throw InputError(file, "/rubric/seed_target",
+                     "expected a pointer into an object of the config (scenario " + scenario + "), got \"" +
+                         rubric.seed_target + "\"");
+  config[ptr] = seed;
 }
 
 Rubric parseRubric(const JsonView& config) {
@@ -30,7 +67,13 @@ Rubric parseRubric(const JsonView& config) {
   rub.onlyKeys({"seed_target", "scenarios", "watchdog", "tests", "leaderboard"});
   if (rub.has("seed_target")) {
     r.seed_target = rub["seed_target"].string();
-    if (r.seed_target.empty() || r.seed_target[0] != '/') rub["seed_target"].fail("expected a JSON pointer such as \"/controller/seed\"");
+    bool ok = r.seed_target.size() > 1 && r.seed_target[0] == '/';
+    try {
+      (void)json::json_pointer(r.seed_target);
+    } catch (const json::exception&) {
+      ok = false;
+    }
+    if (!ok) rub["seed_target"].fail("expected a JSON pointer such as \"/controller/seed\", got \"" + r.seed_target + "\"");
   }
   // Scenarios: merge patches, "nominal" always exists.
   if (rub.has("scenarios")) {
@@ -61,6 +104,7 @@ Rubric parseRubric(const JsonView& config) {
         ColumnLimit lim{l["column"].string(), l.has("what") ? l["what"].string() : l["column"].string()};
         if (l.has("min")) lim.min = l["min"].number();
         if (l.has("max")) lim.max = l["max"].number();
+        if (lim.min > lim.max) l["max"].fail("expected max ≥ min (" + std::to_string(lim.min) + ")");
         r.watchdog.limits.push_back(lim);
       }
     }
@@ -77,7 +121,7 @@ Rubric parseRubric(const JsonView& config) {
     rt.metric = t["metric"].string();
     rt.full = t["full"].number();
     rt.zero = t["zero"].number();
-    rt.points = t["points"].positive();
+    rt.points = t["points"].positive(1e4);
     if (t.has("visibility")) rt.visibility = t["visibility"].oneOf({"visible", "hidden", "after_due_date", "after_published"});
     if (t.has("plot")) {
       const JsonView p = t["plot"];
@@ -100,7 +144,7 @@ Rubric parseRubric(const JsonView& config) {
                          l["metric"].string()};
       if (!r.scenario(e.scenario)) l["scenario"].fail("expected one of the rubric's scenarios");
       if (l.has("order")) e.order = l["order"].oneOf({"asc", "desc"});
-      if (l.has("scale")) e.scale = l["scale"].positive();
+      if (l.has("scale")) e.scale = l["scale"].positive(1e9);
       r.leaderboard.push_back(e);
     }
   }

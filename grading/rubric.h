@@ -17,6 +17,7 @@
 // the linearised loops (<loop>_delay_margin, <loop>_max_real_pole, <loop>_damping, ...).
 #pragma once
 #include <cmath>
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -71,8 +72,17 @@ struct Rubric {
 // Reads and validates config["rubric"]; throws InputError naming file and JSON path.
 Rubric parseRubric(const JsonView& config);
 
+// Checks that every column the rubric names (plots, references, watchdog limits) is one of the
+// lab's trace columns; throws InputError naming file and the JSON path otherwise.
+void checkColumns(const Rubric& rubric, const std::vector<std::string>& columns, const std::string& file);
+
 // Linear partial credit between the full-credit and zero-credit thresholds (either order):
 //   fraction = clamp((zero − m) / (zero − full), 0, 1); non-finite m scores 0.
 double partialCredit(double metric, double full, double zero);
+
+// Writes a scenario's derived seed at rubric.seed_target (nothing if it has none); throws
+// InputError naming file and /rubric/seed_target if the patched config has no object there.
+void writeSeed(json& config, const Rubric& rubric, std::uint64_t seed, const std::string& file,
+               const std::string& scenario);
 
 }  // namespace dyn

@@ -2,20 +2,50 @@
 #include "labs/config.h"
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
 namespace dyn {
 
+namespace {
+// The message is one line whatever the input held: control characters (a newline in a key, a
+// scenario name, a file name) are written as escapes.
+std::string oneLine(const std::string& s) {
+  std::string out;
+  out.reserve(s.size());
+  for (const char c : s) {
+    if (c == '\n') out += "\\n";
+    else if (c == '\r') out += "\\r";
+    else if (c == '\t') out += "\\t";
+    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
+      char b[8];
+      std::snprintf(b, sizeof b, "\\x%02x", static_cast<unsigned char>(c));
+      out += b;
+    } else out += c;
+  }
+  return out;
+}
+}  // namespace
+
 InputError::InputError(std::string file, std::string path, const std::string& expected)
-    : std::runtime_error(file + ": " + (path.empty() ? "/" : path) + ": " + expected),
+    : std::runtime_error(oneLine(file + ": " + (path.empty() ? "/" : path) + ": " + expected)),
       file_(std::move(file)), path_(std::move(path)), expected_(expected) {}
 
 json parseJsonText(const std::string& text, const std::string& file) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos)
     throw InputError(file, "", "expected a JSON document, the file is empty");
   try {
-    return json::parse(text);
+    // Nesting is bounded: copying, dumping or patching a json recurses once per level, so a few
+    // hundred KB of "[[[[…" would overflow the stack. Real configs nest 6 levels.
+    const json::parser_callback_t depth = [&](int level, json::parse_event_t event, json&) {
+      if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
+          level >= kMaxJsonDepth)
+        throw InputError(file, "", "expected JSON nested at most " + std::to_string(kMaxJsonDepth) + " levels deep");
+      return true;
+    };
+    return json::parse(text, depth);
   } catch (const json::exception& e) {
     // nlohmann's message names the line and column (parse_error) or the number that does not fit a
     // double, e.g. 1e999 (out_of_range 406); keep only that part, without the "[json.exception...]" tag.
@@ -26,15 +56,20 @@ json parseJsonText(const std::string& text, const std::string& file) {
 }
 
 json loadJsonFile(const std::string& file, std::size_t max_bytes) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(file, ec)) throw InputError(file, "", "expected a file, got a directory");
   std::ifstream in(file, std::ios::binary | std::ios::ate);
   if (!in) throw InputError(file, "", "expected a readable file (cannot open it)");
-  const auto size = std::size_t(in.tellg());
+  const auto end = in.tellg();
+  if (end < 0) throw InputError(file, "", "expected a regular file (cannot tell its size)");
+  const auto size = std::size_t(end);
   if (size > max_bytes)
     throw InputError(file, "", "expected at most " + std::to_string(max_bytes) + " bytes, the file has " +
                                    std::to_string(size));
   in.seekg(0);
   std::string text(size, '\0');
   in.read(text.data(), std::streamsize(size));
+  if (in.gcount() != std::streamsize(size)) throw InputError(file, "", "expected a readable file (reading it failed)");
   return parseJsonText(text, file);
 }
 
@@ -102,6 +137,16 @@ double JsonView::number() const {
 double JsonView::positive() const {
   const double x = number();
   if (!(x > 0)) fail("expected a positive number" + got());
+  return x;
+}
+
+double JsonView::positive(double max) const {
+  const double x = positive();
+  if (!(x <= max)) {
+    std::ostringstream s;
+    s << "expected a positive number ≤ " << max << got();
+    fail(s.str());
+  }
   return x;
 }
 

@@ -24,7 +24,11 @@ class InputError : public std::runtime_error {
   std::string file_, path_, expected_;
 };
 
-// Reads a whole JSON file; throws InputError for a missing, empty, oversized or malformed file.
+// Deepest nesting of arrays and objects a loaded JSON document may have.
+inline constexpr int kMaxJsonDepth = 64;
+
+// Reads a whole JSON file; throws InputError for a missing, empty, oversized, malformed or too
+// deeply nested file.
 json loadJsonFile(const std::string& file, std::size_t max_bytes = 16u << 20);
 json parseJsonText(const std::string& text, const std::string& file);
 
@@ -47,6 +51,7 @@ class JsonView {
 
   double number() const;  // finite number
   double positive() const;
+  double positive(double max) const;  // in (0, max]
   double nonNegative() const;
   double inRange(double lo, double hi) const;
   long integer(long lo, long hi) const;

@@ -1,12 +1,16 @@
 // Loading and running labs; see run.h.
 #include "labs/run.h"
 
+#include <algorithm>
+
 #include "labs/submission.h"
 
 namespace dyn {
 
 std::unique_ptr<Lab> buildLab(const LabEntry& entry, const json& config, const std::string& file) {
-  return entry.create(JsonView(config, file));
+  const JsonView view(config, file);
+  checkSubmissionOptions(view);
+  return entry.create(view);
 }
 
 LoadedLab loadLab(const std::string& name, const std::string& config_file, const std::string& gains_file,
@@ -42,7 +46,9 @@ RunResult runEngine(const Lab& lab, Engine engine, long max_steps) {
   r.trace.columns = lab.columns();
   auto sim = lab.simulate(engine);
   std::vector<double> row;
-  r.trace.data.reserve(std::size_t(lab.duration() / lab.dt() + 1) * r.trace.columns.size());
+  double rows = lab.duration() / lab.dt() + 1;
+  if (max_steps >= 0) rows = std::min(rows, double(max_steps) + 1);
+  r.trace.data.reserve(std::size_t(rows) * r.trace.columns.size());
   for (long k = 0; (max_steps < 0 || k < max_steps) && sim->step(row); ++k) r.trace.append(row);
   r.failure = sim->failure();
   return r;

@@ -55,6 +55,27 @@ json applySubmission(const json& config, const JsonView& sub, const std::string&
   return out;
 }
 
+void checkSubmissionOptions(const JsonView& config) {
+  if (!config.has("submission_options")) return;
+  const JsonView options = config["submission_options"];
+  options.requireObject();
+  for (const auto& [key, _] : options.raw().items()) {
+    const JsonView o = options[key];
+    if (key == "lab" || key == "gains") o.fail("expected an option name other than \"lab\" and \"gains\"");
+    o.onlyKeys({"target", "choices", "doc"});
+    const std::string target = o["target"].string();
+    bool found = false;
+    try {
+      const json::json_pointer ptr(target);
+      found = !target.empty() && config.raw().contains(ptr) && config.raw().at(ptr).is_string();
+    } catch (const json::exception&) {
+    }
+    if (!found) o["target"].fail("expected a JSON pointer to a string in the config, such as \"/controller/force_law\", got \"" + target + "\"");
+    for (std::size_t i = 0, n = o["choices"].size(1, 64); i < n; ++i) o["choices"].at(i).string();
+    if (o.has("doc")) o["doc"].string();
+  }
+}
+
 json submissionSchema(const json& config, const std::string& lab) {
   json gains = {{"type", "object"}, {"additionalProperties", false}, {"properties", json::object()},
                 {"required", json::array()}};

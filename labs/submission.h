@@ -13,6 +13,10 @@ namespace dyn {
 // submission file and JSON path.
 json applySubmission(const json& config, const JsonView& submission, const std::string& lab, bool strict);
 
+// Validates a config's "submission_options" (an object of {"target": JSON pointer to a string
+// value of the config, "choices": [strings], "doc": string}); buildLab calls it for every lab.
+void checkSubmissionOptions(const JsonView& config);
+
 // JSON Schema (draft 2020-12) of a submission for this lab.
 json submissionSchema(const json& config, const std::string& lab);
 

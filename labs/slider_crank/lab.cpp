@@ -10,6 +10,11 @@
 namespace dyn::slider_crank {
 namespace {
 
+// Physically sensible bounds on the config: beyond them the model is not a teaching lab any more
+// and products such as m·g·l or k·x overflow to inf/NaN mid-run.
+constexpr double kMaxLength = 100, kMaxMass = 1e6, kMaxGravity = 1e3, kMaxRate = 1e3, kMaxGain = 1e9;
+constexpr double kMinDt = 1e-6;  // the force-delay buffer holds delay/dt samples
+
 const std::vector<std::string> kColumns = {
     "t",   "q1",   "q2",   "q3",     "x_c",    "v_c",    "f_Tx",                "f_Ty", "tau_T",
     "tau1", "tau2", "tau3", "energy", "constraint_residual", "x_d",  "f_des",  "f_meas", "work"};
@@ -17,8 +22,8 @@ const std::vector<std::string> kColumns = {
 Link parseLink(const JsonView& j) {
   j.onlyKeys({"length", "mass", "inertia", "com"});
   j["com"].size(2, 2);
-  return {j["length"].positive(), j["mass"].positive(), j["inertia"].positive(),
-          {j["com"].at(0).number(), j["com"].at(1).number()}};
+  return {j["length"].positive(kMaxLength), j["mass"].positive(kMaxMass), j["inertia"].positive(kMaxMass),
+          {j["com"].at(0).inRange(-kMaxLength, kMaxLength), j["com"].at(1).inRange(-kMaxLength, kMaxLength)}};
 }
 
 // Everything a run needs, and the one place the trace row is laid out.
@@ -33,6 +38,13 @@ struct RowState {
            tau[0], tau[1],   tau[2],   energy,   residual, x_d, f_des, f_meas, work};
   }
 };
+
+// The failure sentence for a row with a non-finite value (the run stops there), or empty.
+std::string nonFiniteColumn(const std::vector<double>& row) {
+  for (std::size_t c = 0; c < row.size(); ++c)
+    if (!std::isfinite(row[c])) return kColumns[c] + " became non-finite";
+  return {};
+}
 
 // The hand-written engine: eq. (2) through the generic solve, integrated by physics/integrate.
 class HandSimulation final : public Simulation {
@@ -59,6 +71,7 @@ class HandSimulation final : public Simulation {
     work_ += tau.dot(0.5 * (thd + Eigen::Vector3d(v_.head(3)))) * s_.step.dt;  // ∫ τ·θ' dt, trapezoid
     ctrl_.measure(sol.f[2]);
     if (!q_.allFinite() || !v_.allFinite()) failure_ = "the state became non-finite";
+    if (const std::string bad = nonFiniteColumn(row); !bad.empty()) failure_ = bad;
     ++k_;
     return true;
   }
@@ -119,6 +132,7 @@ class BulletSimulation final : public Simulation {
     work_ += tau.dot(0.5 * (thd + world_->qd())) * s_.step.dt;
     ctrl_.measure(f[2]);
     if (!world_->q().allFinite() || !world_->qd().allFinite()) failure_ = "the Bullet state became non-finite";
+    if (const std::string bad = nonFiniteColumn(row); !bad.empty()) failure_ = bad;
     ++k_;
     return true;
   }
@@ -157,14 +171,15 @@ Settings parseSettings(const JsonView& c) {
   m.onlyKeys({"links", "load_mass", "gravity"});
   m["links"].size(3, 3);
   for (int i = 0; i < 3; ++i) s.params.links[i] = parseLink(m["links"].at(i));
-  s.params.load_mass = m["load_mass"].positive();
+  s.params.load_mass = m["load_mass"].positive(kMaxMass);
   m["gravity"].size(2, 2);
-  s.params.gravity = {m["gravity"].at(0).number(), m["gravity"].at(1).number()};
+  s.params.gravity = {m["gravity"].at(0).inRange(-kMaxGravity, kMaxGravity),
+                      m["gravity"].at(1).inRange(-kMaxGravity, kMaxGravity)};
 
   const JsonView init = c["initial"];
   init.onlyKeys({"theta1_deg", "theta1_rate", "branch"});
   s.theta1 = init["theta1_deg"].inRange(-360, 360) * M_PI / 180.0;
-  s.theta1_rate = init.number("theta1_rate", 0.0);
+  s.theta1_rate = init.has("theta1_rate") ? init["theta1_rate"].inRange(-kMaxRate, kMaxRate) : 0.0;
   if (init.has("branch")) s.branch = init["branch"].oneOf({"cos_positive", "cos_negative"}) == "cos_positive" ? 1 : -1;
   const auto& L = s.params.links;
   if (std::abs(L[0].length * std::sin(s.theta1)) > L[1].length)
@@ -173,15 +188,15 @@ Settings parseSettings(const JsonView& c) {
   const JsonView sim = c["simulation"];
   sim.onlyKeys({"dt", "duration", "integrator", "drift", "baumgarte"});
   s.step.dt = sim["dt"].positive();
-  if (s.step.dt > 0.05) sim["dt"].fail("expected dt ≤ 0.05 s, got " + std::to_string(s.step.dt));
+  if (s.step.dt > 0.05 || s.step.dt < kMinDt) sim["dt"].inRange(kMinDt, 0.05);
   s.duration = sim["duration"].positive();
   if (s.duration / s.step.dt > 1e7) sim["duration"].fail("expected at most 1e7 steps (duration/dt)");
   parseIntegrator(sim["integrator"].oneOf({"semi_implicit_euler", "rk4"}), s.step.integrator);
   parseDrift(sim["drift"].oneOf({"none", "baumgarte", "projection", "independent"}), s.step.drift.kind);
   if (sim.has("baumgarte")) {
     sim["baumgarte"].onlyKeys({"zeta", "omega"});
-    s.step.drift.zeta = sim["baumgarte"]["zeta"].positive();
-    s.step.drift.omega = sim["baumgarte"]["omega"].positive();
+    s.step.drift.zeta = sim["baumgarte"]["zeta"].positive(1e3);
+    s.step.drift.omega = sim["baumgarte"]["omega"].positive(1e6);
   }
 
   const JsonView ctl = c["controller"];
@@ -192,7 +207,7 @@ Settings parseSettings(const JsonView& c) {
   cc.law = law == "open_loop" ? ForceLaw::OpenLoop : law == "proportional" ? ForceLaw::Proportional : ForceLaw::Integral;
   cc.f_des = ctl["force_setpoint"].inRange(-1e4, 1e4);
   cc.delay = ctl["delay"].inRange(0, 1);
-  cc.noise_std = ctl.has("noise_std") ? ctl["noise_std"].nonNegative() : 0.0;
+  cc.noise_std = ctl.has("noise_std") ? ctl["noise_std"].inRange(0, 1e4) : 0.0;
   cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1L << 53)) : 1;
 
   // Gains: declared with value and bounds (the submission schema comes from here).
@@ -200,7 +215,10 @@ Settings parseSettings(const JsonView& c) {
   g.onlyKeys({"kp_x", "kd_x", "kp_f", "ki_f"});
   auto gain = [&](const char* key) {
     const JsonView d = g[key];
-    const double lo = d["min"].number(), hi = d["max"].number();
+    d.onlyKeys({"value", "min", "max", "unit", "doc"});
+    for (const char* text : {"unit", "doc"})
+      if (d.has(text)) d[text].string();
+    const double lo = d["min"].inRange(-kMaxGain, kMaxGain), hi = d["max"].inRange(lo, kMaxGain);
     return d["value"].inRange(lo, hi);
   };
   cc.gains = {gain("kp_x"), gain("kd_x"), gain("kp_f"), gain("ki_f")};
@@ -209,15 +227,15 @@ Settings parseSettings(const JsonView& c) {
   ref.onlyKeys({"kind", "amplitude", "period"});
   ref["kind"].oneOf({"raised_cosine"});
   s.reference.amplitude = ref["amplitude"].inRange(-2, 2);
-  s.reference.period = ref["period"].positive();
+  s.reference.period = ref["period"].inRange(1e-3, 1e6);
 
   if (c.has("metrics")) {
     c["metrics"].onlyKeys({"settle_time"});
-    s.settle_time = c["metrics"]["settle_time"].nonNegative();
+    s.settle_time = c["metrics"]["settle_time"].inRange(0, 1e6);
   }
   if (c.has("drawing")) {
     c["drawing"].onlyKeys({"arrow_scale"});
-    s.arrow_scale = c["drawing"]["arrow_scale"].positive();
+    s.arrow_scale = c["drawing"]["arrow_scale"].positive(1e3);
   }
   // The reference starts where the slider starts.
   Mechanism mech(s.params);

@@ -2,10 +2,12 @@
 // Gradescope results.json contract; the watchdog and the time budget.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
 #include "grading/grade.h"
+#include "grading/rubric.h"
 
 namespace fs = std::filesystem;
 using namespace dyn;
@@ -187,4 +189,78 @@ TEST_CASE("a rubric naming a metric the lab does not report is the config's erro
   const std::string out = g.results["output"];
   CHECK(out.find("typo_rubric.json") != std::string::npos);
   CHECK(out.find("/rubric/tests/0/metric") != std::string::npos);
+}
+
+// Regressions from sanitizing and fuzzing the grader's inputs (tests/fuzz, scripts/sanitize).
+
+namespace {
+json defaultLabConfig() {
+  return json::parse(std::ifstream(std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/slider_crank.json"));
+}
+// parseRubric's InputError for the default config with `rubric` merged into its rubric.
+std::string rubricError(const json& rubric_patch) {
+  const json config = mergePatch(defaultLabConfig(), {{"rubric", rubric_patch}});
+  try {
+    parseRubric(JsonView(config, "rubric.json"));
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+}  // namespace
+
+TEST_CASE("a deeply nested submission scores 0 as bad input (it overflowed the stack)") {
+  const std::string f = writeFile("deep.json", std::string(200000, '[') + std::string(200000, ']'));
+  const GradeOutcome g = grade(f);
+  CHECK(g.input_error);
+  CHECK(g.results["output"].get<std::string>().find("expected JSON nested at most 64 levels deep") != std::string::npos);
+}
+
+TEST_CASE("bad rubric values name /rubric/... instead of throwing json errors or scoring NaN") {
+  CHECK(rubricError({{"seed_target", "/~2"}}) ==
+        "rubric.json: /rubric/seed_target: expected a JSON pointer such as \"/controller/seed\", got \"/~2\"");
+  CHECK(rubricError({{"seed_target", "/"}}).find("/rubric/seed_target: expected a JSON pointer") != std::string::npos);
+  // Points and scale that overflow the total score or the leaderboard to inf (results.json: null).
+  json tests = defaultLabConfig()["rubric"]["tests"];
+  tests[0]["points"] = 1e308;
+  CHECK(rubricError({{"tests", tests}}).find("/rubric/tests/0/points: expected a positive number ≤ 10000") !=
+        std::string::npos);
+  CHECK(rubricError({{"leaderboard", {{{"name", "x"}, {"metric", "x_rms"}, {"scale", 1e300}}}}})
+            .find("/rubric/leaderboard/0/scale: expected a positive number ≤ 1e+09") != std::string::npos);
+  CHECK(rubricError({{"watchdog", {{"limits", {{{"column", "v_c"}, {"min", 1.0}, {"max", -1.0}}}}}}})
+            .find("/rubric/watchdog/limits/0/max: expected max ≥ min") != std::string::npos);
+  // Thresholds at the ends of the double range: (zero − m)/(zero − full) = inf/inf.
+  const double credit = partialCredit(-1e308, -1e308, 1e308);
+  CHECK_FALSE(std::isnan(credit));
+  CHECK(credit >= 0.0);
+  CHECK(credit <= 1.0);
+}
+
+TEST_CASE("a scenario patch that removes the seed's object is the config's error, not an internal one") {
+  // seed_target /controller/seed with "controller": 5 in a patch: json's operator[] threw a
+  // type_error and the grader reported "internal error".
+  json config = defaultLabConfig();
+  config["rubric"]["scenarios"]["long_delay"]["patch"] = {{"controller", 5}};
+  GradeOptions o;
+  o.config_file = writeFile("seedless_rubric.json", config.dump());
+  const GradeOutcome g = grade(kExamples + "good.json", o);
+  CHECK(g.input_error);
+  REQUIRE(g.results["extra_data"].contains("error"));
+  CHECK(g.results["extra_data"]["error"]["path"] == "/rubric/seed_target");
+  CHECK(g.results["output"].get<std::string>().find("scenario long_delay") != std::string::npos);
+}
+
+TEST_CASE("a rubric plot of a column the lab lacks is the config's error, found before any run") {
+  // The column was silently left out of the plot (a typo passing unnoticed); a plot with no known
+  // column, reference or band failed as an "internal error" after every scenario had run.
+  json config = defaultLabConfig();
+  config["rubric"]["tests"][1]["plot"]["columns"] = {"f_y"};
+  GradeOptions o;
+  o.config_file = writeFile("plot_column_rubric.json", config.dump());
+  o.out_dir = (tempDir() / "plot_column_out").string();
+  const GradeOutcome g = grade(kExamples + "good.json", o);
+  CHECK(g.input_error);
+  REQUIRE(g.results["extra_data"].contains("error"));
+  CHECK(g.results["extra_data"]["error"]["path"] == "/rubric/tests/1/plot/columns/0");
+  CHECK(g.results["output"].get<std::string>().find("expected a trace column of this lab") != std::string::npos);
 }

@@ -237,3 +237,133 @@ TEST_CASE("a bad --duration override") {
     }
   }
 }
+
+// Regressions from sanitizing and fuzzing the loaders (tests/fuzz, scripts/sanitize): each input
+// crashed, hung or slipped past validation before its fix.
+
+TEST_CASE("deeply nested JSON is an input error, not a stack overflow") {
+  // Copying or dumping a json recurses once per level: 100k levels of "[" crashed loadLab and the
+  // grader (both copy and dump the document) with SIGSEGV.
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  try {
+    parseJsonText(deep, "deep.json");
+    FAIL("expected an InputError");
+  } catch (const InputError& e) {
+    checkNames(e, "deep.json", "", "expected JSON nested at most 64 levels deep");
+  }
+  TempDir tmp;
+  const std::string f = tmp.write("deep_gains.json", R"({"gains": )" + deep + "}");
+  try {
+    loadLab("slider_crank", "", f);
+    FAIL("expected an InputError");
+  } catch (const InputError& e) {
+    checkNames(e, f, "", "nested at most 64 levels");
+  }
+  // 64 levels are fine.
+  CHECK_NOTHROW(parseJsonText(std::string(64, '[') + std::string(64, ']'), "ok.json"));
+}
+
+TEST_CASE("a directory given as a config file") {
+  TempDir tmp;
+  try {
+    loadLab("slider_crank", tmp.path.string());
+    FAIL("expected an InputError");
+  } catch (const InputError& e) {
+    // Was "expected at most 16777216 bytes, the file has 9223372036854775807".
+    checkNames(e, tmp.path.string(), "", "expected a file, got a directory");
+  }
+}
+
+TEST_CASE("error messages stay on one line whatever the input holds") {
+  const InputError e = buildError({{"simulation", {{"d\nt", 0.001}}}});
+  const std::string what = e.what();
+  CHECK(what.find('\n') == std::string::npos);
+  CHECK(what.find("unknown key \"d\\nt\"") != std::string::npos);
+}
+
+TEST_CASE("submission_options and gain declarations are validated with the config") {
+  // Each of these passed buildLab and then threw nlohmann::json's type_error or parse_error (not an
+  // InputError) from applySubmission or submissionSchema: `dynlab run --gains` and `dynlab schema`
+  // terminated, the grader said "internal error".
+  SUBCASE("not an object") {
+    checkNames(buildError({{"submission_options", 5}}), "bad_config.json", "/submission_options",
+               "expected an object, got 5");
+  }
+  SUBCASE("target is not a JSON pointer") {
+    for (const char* target : {"controller/force_law", "/~2", ""}) {
+      INFO(target);
+      checkNames(buildError({{"submission_options", {{"force_law", {{"target", target}}}}}}), "bad_config.json",
+                 "/submission_options/force_law/target", "expected a JSON pointer to a string in the config");
+    }
+  }
+  SUBCASE("target is not a string of the config") {
+    for (const char* target : {"/simulation/dt", "/simulation/nothing", "/mechanism/links/x", "/mechanism/links/99999999999999999999999"}) {
+      INFO(target);
+      checkNames(buildError({{"submission_options", {{"force_law", {{"target", target}}}}}}), "bad_config.json",
+                 "/submission_options/force_law/target", "expected a JSON pointer to a string in the config");
+    }
+  }
+  SUBCASE("choices and doc") {
+    checkNames(buildError({{"submission_options", {{"force_law", {{"choices", {"integral", 3}}}}}}}), "bad_config.json",
+               "/submission_options/force_law/choices/1", "expected a string, got 3");
+    checkNames(buildError({{"submission_options", {{"force_law", {{"choices", json::array()}}}}}}), "bad_config.json",
+               "/submission_options/force_law/choices", "expected an array of 1 to 64 elements, got 0");
+    checkNames(buildError({{"submission_options", {{"force_law", {{"doc", 1}}}}}}), "bad_config.json",
+               "/submission_options/force_law/doc", "expected a string, got 1");
+    checkNames(buildError({{"submission_options", {{"gains", {{"target", "/controller/force_law"}, {"choices", {"x"}}}}}}}),
+               "bad_config.json", "/submission_options/gains", "other than \"lab\" and \"gains\"");
+  }
+  SUBCASE("gain declarations: doc and unit are strings, min ≤ max, known keys only") {
+    checkNames(buildError({{"gains", {{"kp_x", {{"doc", 1}}}}}}), "bad_config.json", "/gains/kp_x/doc",
+               "expected a string, got 1");
+    checkNames(buildError({{"gains", {{"kp_x", {{"unit", nullptr}, {"units", "N/m"}}}}}}), "bad_config.json",
+               "/gains/kp_x/units", "unknown key \"units\"");
+    checkNames(buildError({{"gains", {{"kp_x", {{"min", 10.0}, {"max", 5.0}}}}}}), "bad_config.json", "/gains/kp_x/max",
+               "expected a number in [10, 1e+09], got 5");
+  }
+  SUBCASE("loadLab with a gains file over such a config is an InputError too") {
+    TempDir tmp;
+    json c = defaultConfig();
+    c["submission_options"]["force_law"]["target"] = "/simulation/dt/x";  // terminate() in dynlab run
+    const std::string cf = tmp.write("config.json", c.dump());
+    const std::string gf = tmp.write("gains.json", R"({"force_law": "integral"})");
+    CHECK_THROWS_AS(loadLab("slider_crank", cf), InputError);  // the config alone
+    try {
+      loadLab("slider_crank", cf, gf);
+      FAIL("expected an InputError");
+    } catch (const InputError& e) {
+      checkNames(e, cf, "/submission_options/force_law/target", "expected a JSON pointer");
+    }
+  }
+}
+
+TEST_CASE("physical parameters outside sensible bounds are rejected before they reach the physics") {
+  // Each of these built a lab: dt = 1e-12 made the force-delay buffer 1e10 doubles (std::bad_alloc),
+  // the others overflowed to inf/NaN in the first steps.
+  checkNames(buildError({{"simulation", {{"dt", 1e-12}, {"duration", 1e-6}}}}), "bad_config.json", "/simulation/dt",
+             "expected a number in [1e-06, 0.05], got 1e-12");
+  checkNames(buildError({{"simulation", {{"dt", 0.1}}}}), "bad_config.json", "/simulation/dt",
+             "expected a number in [1e-06, 0.05], got 0.1");
+  checkNames(buildError({{"mechanism", {{"load_mass", 1e300}}}}), "bad_config.json", "/mechanism/load_mass",
+             "expected a positive number ≤ 1e+06, got 1e+300");
+  checkNames(buildError({{"mechanism", {{"gravity", {0.0, -1e300}}}}}), "bad_config.json", "/mechanism/gravity/1",
+             "expected a number in [-1000, 1000]");
+  checkNames(buildError({{"initial", {{"theta1_rate", 1e200}}}}), "bad_config.json", "/initial/theta1_rate",
+             "expected a number in [-1000, 1000]");
+  checkNames(buildError({{"reference", {{"period", 1e-300}}}}), "bad_config.json", "/reference/period",
+             "expected a number in [0.001, 1e+06]");
+  json links = defaultConfig()["mechanism"]["links"];
+  links[2]["com"] = {1e300, 0.0};
+  checkNames(buildError({{"mechanism", {{"links", links}}}}), "bad_config.json", "/mechanism/links/2/com/0",
+             "expected a number in [-100, 100]");
+}
+
+TEST_CASE("a run cut short by max_steps reserves only what it needs") {
+  // 1e7 steps are allowed (dt = 1 µs, 10 s): runEngine(lab, engine, 5) used to reserve the whole
+  // run's trace, 1.4 GB, before taking five steps.
+  const LabEntry* entry = findLab("slider_crank");
+  const auto lab = buildLab(*entry, mergePatch(defaultConfig(), {{"simulation", {{"dt", 1e-6}, {"duration", 10.0}}}}), "c.json");
+  const RunResult r = runEngine(*lab, Engine::Hand, 5);
+  CHECK(r.trace.rows() == 5);
+  CHECK(r.trace.data.capacity() <= 6 * r.trace.columns.size());
+}
