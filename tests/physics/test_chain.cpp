@@ -98,7 +98,9 @@ void checkTree(TreeModel<S> model) {
     const double e = 1e-6;
     // Linear rows: d/dt of the point position.
     const VecN v = J * qd;
-    const auto dp = (pos(q + e * qd) - pos(q - e * qd)) / (2 * e);
+    // eval(): an Eigen expression held by auto would point into the two destroyed temporaries
+    // (ASan: stack-use-after-scope).
+    const auto dp = ((pos(q + e * qd) - pos(q - e * qd)) / (2 * e)).eval();
     CHECK((v.tail(dp.size()) - VecN(dp)).norm() < 1e-8);
     // J'θ' = d/dt (J θ') at fixed θ'' = 0: difference along the flow.
     const VecN Jdot_fd = (vel(q + e * qd, qd) - vel(q - e * qd, qd)) / (2 * e);
