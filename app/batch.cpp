@@ -89,7 +89,7 @@ struct Row {
 };
 
 Row readRow(const Job& job, const std::string& process_status) {
-  Row row{job.submission.filename().string(), process_status};
+  Row row{job.submission.filename().string(), process_status, 0, 0, {}};
   try {
     const json r = loadJsonFile((job.out / "results.json").string());
     row.score = r.value("score", 0.0);
@@ -132,7 +132,7 @@ int gradeBatch(const GradeArgs& a) {
   const auto kill_after = std::chrono::milliseconds(long(kill_s * 1e3));
 
   std::vector<Job> pending, running;
-  for (const auto& f : files) pending.push_back({f, out / f.stem()});
+  for (const auto& f : files) pending.push_back({f, out / f.stem(), -1, {}, false});
   std::reverse(pending.begin(), pending.end());
   std::map<std::string, Row> rows;
   std::size_t done = 0, problems = 0;

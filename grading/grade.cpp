@@ -104,7 +104,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     for (std::size_t i = 0; i < rubric.tests.size(); ++i) {
       const RubricTest& t = rubric.tests[i];
       const ScenarioRun& run = runs.at(t.scenario);
-      GradedTest g{t, 0.0, NAN, ""};
+      GradedTest g{t, 0.0, NAN, "", ""};
       if (run.metrics.contains(t.metric)) {
         g.value = run.metrics[t.metric].get<double>();
         g.score = t.points * partialCredit(g.value, t.full, t.zero);

@@ -190,7 +190,7 @@ Settings parseSettings(const JsonView& c) {
   s.step.dt = sim["dt"].positive();
   if (s.step.dt > 0.05 || s.step.dt < kMinDt) sim["dt"].inRange(kMinDt, 0.05);
   s.duration = sim["duration"].positive();
-  if (s.duration / s.step.dt > 1e7) sim["duration"].fail("expected at most 1e7 steps (duration/dt)");
+  if (s.duration / s.step.dt > 2e6) sim["duration"].fail("expected at most 2e6 steps (duration/dt); a trace of 2e6 rows is ~300 MB");
   parseIntegrator(sim["integrator"].oneOf({"semi_implicit_euler", "rk4"}), s.step.integrator);
   parseDrift(sim["drift"].oneOf({"none", "baumgarte", "projection", "independent"}), s.step.drift.kind);
   if (sim.has("baumgarte")) {

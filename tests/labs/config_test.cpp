@@ -359,11 +359,13 @@ TEST_CASE("physical parameters outside sensible bounds are rejected before they 
 }
 
 TEST_CASE("a run cut short by max_steps reserves only what it needs") {
-  // 1e7 steps are allowed (dt = 1 µs, 10 s): runEngine(lab, engine, 5) used to reserve the whole
-  // run's trace, 1.4 GB, before taking five steps.
+  // 2e6 steps are allowed (dt = 1 µs, 2 s): runEngine(lab, engine, 5) used to reserve the whole
+  // run's trace, ~300 MB, before taking five steps. More steps than that are refused up front.
   const LabEntry* entry = findLab("slider_crank");
-  const auto lab = buildLab(*entry, mergePatch(defaultConfig(), {{"simulation", {{"dt", 1e-6}, {"duration", 10.0}}}}), "c.json");
+  const auto lab = buildLab(*entry, mergePatch(defaultConfig(), {{"simulation", {{"dt", 1e-6}, {"duration", 2.0}}}}), "c.json");
   const RunResult r = runEngine(*lab, Engine::Hand, 5);
   CHECK(r.trace.rows() == 5);
   CHECK(r.trace.data.capacity() <= 6 * r.trace.columns.size());
+  checkNames(buildError({{"simulation", {{"dt", 1e-6}, {"duration", 10.0}}}}), "bad_config.json",
+             "/simulation/duration", "expected at most 2e6 steps");
 }
