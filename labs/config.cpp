@@ -27,6 +27,17 @@ std::string oneLine(const std::string& s) {
   }
   return out;
 }
+
+// A key as a JSON Pointer token (RFC 6901): "~" is written "~0" and "/" is written "~1".
+std::string pointerToken(const std::string& key) {
+  std::string out;
+  for (const char c : key) {
+    if (c == '~') out += "~0";
+    else if (c == '/') out += "~1";
+    else out += c;
+  }
+  return out;
+}
 }  // namespace
 
 InputError::InputError(std::string file, std::string path, const std::string& expected)
@@ -94,7 +105,7 @@ JsonView JsonView::operator[](const std::string& key) const {
   requireObject();
   const auto it = value_->find(key);
   if (it == value_->end()) fail("missing key \"" + key + "\"");
-  return JsonView(*it, file_, path_ + "/" + key);
+  return JsonView(*it, file_, path_ + "/" + pointerToken(key));
 }
 
 JsonView JsonView::at(std::size_t index) const {
@@ -122,7 +133,7 @@ void JsonView::onlyKeys(std::initializer_list<const char*> allowed) const {
     if (!ok) {
       std::string list;
       for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-      JsonView(value_->at(key), file_, path_ + "/" + key).fail("unknown key \"" + key + "\" (expected one of: " + list + ")");
+      JsonView(value_->at(key), file_, path_ + "/" + pointerToken(key)).fail("unknown key \"" + key + "\" (expected one of: " + list + ")");
     }
   }
 }

@@ -127,6 +127,9 @@ TEST_CASE("bad values in a lab config name the file, the JSON path and what was 
     checkNames(buildError({{"simulation", {{"dtt", 0.002}}}}), "bad_config.json", "/simulation/dtt",
                "unknown key \"dtt\"");
     checkNames(buildError({{"mechansim", json::object()}}), "bad_config.json", "/mechansim", "unknown key \"mechansim\"");
+    // The path is a JSON Pointer (RFC 6901): "/" and "~" inside a key are escaped.
+    checkNames(buildError({{"simulation", {{"d/t~", 0.002}}}}), "bad_config.json", "/simulation/d~1t~0",
+               "unknown key \"d/t~\"");
   }
   SUBCASE("wrong array length") {
     checkNames(buildError({{"mechanism", {{"gravity", {0.0, -9.81, 0.0}}}}}), "bad_config.json",
