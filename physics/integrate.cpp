@@ -2,10 +2,7 @@
 // independent coordinates) for any ConstrainedSystem; equations in integrate.h.
 #include "physics/integrate.h"
 
-#include <Eigen/Cholesky>
-#include <Eigen/LU>
-
-#include "physics/cholesky.h"
+#include "physics/constrained.h"
 
 namespace dyn {
 namespace {
@@ -21,43 +18,21 @@ const VecN* baumgarte(ConstrainedSystem& sys, const DriftOptions& d, const VecN&
   return &s;
 }
 
-// Minimum-W-norm correction dx with G dx = e:  dx = W⁻¹Gᵀ (G W⁻¹ Gᵀ)⁻¹ e.
-// By Cholesky: W = L D Lᵀ, Y = L⁻¹ Gᵀ, G W⁻¹ Gᵀ = Yᵀ D⁻¹ Y, dx = L⁻ᵀ D⁻¹ Y (G W⁻¹ Gᵀ)⁻¹ e.
-VecN weightedCorrection(const MatN& W, const MatN& G, const VecN& e) {
-  const int n = int(W.rows()), m = int(G.rows());
-  Cholesky w, g;
-  MatN Y = G.transpose(), GWG(m, m);
-  if (w.compute(W)) {
-    w.forward(Y);
-    w.inner(Y, m, GWG);
-    if (g.compute(GWG)) {
-      VecN x = e;
-      g.solveInPlace(x);
-      VecN dx(n);
-      for (int i = 0; i < n; ++i) {
-        double s = 0;
-        for (int j = 0; j < m; ++j) s += Y(i, j) * x[j];
-        dx[i] = s;
-      }
-      w.scale(dx);
-      w.backward(dx);
-      return dx;
-    }
-  }
-  // G has lost rank (or W is not positive definite): pivoted LU on G W⁻¹ Gᵀ.
-  const Eigen::LLT<MatN> llt(W);
-  const MatN WinvGT = llt.solve(G.transpose());
-  return WinvGT * (G * WinvGT).fullPivLu().solve(e);
-}
-
 }  // namespace
 
 bool ConstrainedSystem::correction(const VecN& q, const VecN& e, VecN& dx) {
+  // Minimum-W-norm dx with G dx = e is eq. (2) for impulses with M = W, J = G and no payload:
+  // W dx = −Gᵀ f, G dx + J'θ' = 0 with τ − h = 0 and J'θ' = −e (pivoted LU where G loses rank).
   VecN phi;
-  MatN G, W;
-  constraint(q, phi, G);
-  metric(q, W);
-  dx = weightedCorrection(W, G, e);
+  ConstrainedProblem p;
+  constraint(q, phi, p.J);
+  metric(q, p.M);
+  const int n = int(p.M.rows());
+  p.h = VecN::Zero(n);
+  p.tau = VecN::Zero(n);
+  p.Jdot_qd = -e;
+  p.A = MatN::Zero(p.J.rows(), 0);
+  dx = solveConstrained(p).qdd;
   return dx.allFinite();
 }
 

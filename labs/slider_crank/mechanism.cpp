@@ -7,7 +7,7 @@ namespace dyn::slider_crank {
 namespace {
 const Eigen::Vector3d kA{0.0, 1.0, 0.0};  // the slider moves the tip along world x only
 
-// a = (θ'', α_c) out of a solve of eq. (2).
+// a = (θ'', α_c) out of a solve of eq. (2) (or (dθ, dx_c) out of its impulse form).
 void accelerationsOf(const Mechanism::Solution& s, VecN& a) {
   a.resize(4);
   a.head<3>() = s.qdd;
@@ -111,8 +111,7 @@ bool Mechanism::correction(const VecN& q, const VecN& e, VecN& dx) {
   impulse.Jdot_qd = -e;
   Solution s;
   factor_.solve(impulse, s);
-  dx.resize(4);
-  dx << s.qdd, s.alpha_c[0];
+  accelerationsOf(s, dx);  // (dθ, dx_c)
   return dx.allFinite();
 }
 
