@@ -168,21 +168,20 @@ int bench(const BenchArgs& a) {
     const std::string scheme = schemeOf(loaded.config);
     const json grading = gradeThroughput(entry.name, 5);
     if (a.json) {
-      const json j = {{"lab", entry.name},
-                      {"step_timed", alone ? "engine" : "full"},
-                      {"hand_us_per_step", hand},
-                      {"bullet_us_per_step", bullet},
-                      {"bullet_over_hand", bullet / hand},
-                      {"hand_full_us_per_step", hand_t.full},
-                      {"bullet_full_us_per_step", bullet_t.full},
-                      {"bullet_over_hand_full", bullet_t.full / hand_t.full},
-                      {"hand_scheme", scheme},
-                      {"bullet_error", bullet_error},
-                      {"render_fps", fps.render},
-                      {"render_png_fps", fps.png},
-                      {"render_video_fps", fps.video},
-                      {"resolution", "640x480"}};
-      json out = j;
+      json out = {{"lab", entry.name},
+                  {"step_timed", alone ? "engine" : "full"},
+                  {"hand_us_per_step", hand},
+                  {"bullet_us_per_step", bullet},
+                  {"bullet_over_hand", bullet / hand},
+                  {"hand_full_us_per_step", hand_t.full},
+                  {"bullet_full_us_per_step", bullet_t.full},
+                  {"bullet_over_hand_full", bullet_t.full / hand_t.full},
+                  {"hand_scheme", scheme},
+                  {"bullet_error", bullet_error},
+                  {"render_fps", fps.render},
+                  {"render_png_fps", fps.png},
+                  {"render_video_fps", fps.video},
+                  {"resolution", "640x480"}};
       if (first_order) {
         out["hand_first_order_scheme"] = "semi_implicit_euler + baumgarte";
         out["hand_first_order_us_per_step"] = first_us;
