@@ -48,9 +48,8 @@ std::string fmt(const char* f, double x) {
 
 // "1920x1080" → {1920, 1080}.
 std::pair<int, int> parseSize(const std::string& s) {
-  int w = 0, h = 0, n = 0;
-  if (std::sscanf(s.c_str(), "%dx%d%n", &w, &h, &n) != 2 || n != int(s.size()) || w < 16 || h < 16 ||
-      w > 8192 || h > 8192)
+  int w = 0, h = 0;
+  if (!parseFrameSize(s, 16, 16, w, h))
     badOption("--size", s, "expected WIDTHxHEIGHT in pixels, each 16 to 8192 (e.g. 1920x1080)");
   return {w, h};
 }

@@ -30,4 +30,13 @@ bool writePng(const std::string& path, const Image& image) {
   return true;
 }
 
+bool parseFrameSize(const std::string& text, int min_width, int min_height, int& width, int& height) {
+  int w = 0, h = 0, n = 0;
+  if (std::sscanf(text.c_str(), "%dx%d%n", &w, &h, &n) != 2 || n != int(text.size())) return false;
+  if (w < min_width || h < min_height || w > 8192 || h > 8192) return false;
+  width = w;
+  height = h;
+  return true;
+}
+
 }  // namespace dyn

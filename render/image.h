@@ -15,4 +15,8 @@ struct Image {
 // Writes a PNG; returns false (and leaves no file behind) on failure.
 bool writePng(const std::string& path, const Image& image);
 
+// "1920x1080" → width and height; false unless the whole text is WIDTHxHEIGHT with each side in
+// [min, 8192] (the callers name their own option and bounds in the message).
+bool parseFrameSize(const std::string& text, int min_width, int min_height, int& width, int& height);
+
 }  // namespace dyn

@@ -113,7 +113,7 @@ int run(const Args& a) {
   session.setEngine(parseEngineChoice(a.engine));
   session.restart();
   int win_w = 0, win_h = 0;
-  if (std::sscanf(a.size.c_str(), "%dx%d", &win_w, &win_h) != 2 || win_w < 400 || win_h < 300 || win_w > 8192 || win_h > 8192)
+  if (!parseFrameSize(a.size, 400, 300, win_w, win_h))
     throw InputError("<command line>", "--size", "expected WIDTHxHEIGHT, at least 400x300, got \"" + a.size + "\"");
 
   PanelState st;

@@ -166,3 +166,16 @@ TEST_CASE("VideoWriter rejects bad sizes and frames") {
   VideoWriter writer(path, 64, 48, 30);
   CHECK_THROWS_AS(writer.addFrame(syntheticFrame(32, 24, 0)), std::runtime_error);
 }
+
+TEST_CASE("frame sizes parse only as a whole WIDTHxHEIGHT within the bounds") {
+  int w = 0, h = 0;
+  REQUIRE(parseFrameSize("1920x1080", 16, 16, w, h));
+  CHECK(w == 1920);
+  CHECK(h == 1080);
+  for (const char* bad : {"", "1920", "1920x", "x1080", "1920x1080px", "1920*1080", "15x100", "100x9000", "-5x100"}) {
+    CAPTURE(bad);
+    CHECK_FALSE(parseFrameSize(bad, 16, 16, w, h));
+  }
+  CHECK_FALSE(parseFrameSize("399x300", 400, 300, w, h));
+  CHECK(parseFrameSize("400x300", 400, 300, w, h));
+}
