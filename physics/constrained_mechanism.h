@@ -1,0 +1,99 @@
+// The generic constrained mechanism: any MechanismModel (mechanism.h) through the one solve of
+// eqs. (2)/(3) (constrained_solve.h), as a ConstrainedSystem for the integrators (integrate.h).
+//   position stage (θ, x_c):  tree transforms, M (CRBA), every constraint's φ, J, A; M_c; factor (2)
+//   velocity stage (θ', v_c): tree velocities, h = Cθ' + G + K(θ − θ_r) + B θ' + F_c sat(θ'/w) (RNEA),
+//                             every constraint's bias J'θ' − A'v_c, payload b_c + G_c
+//   solve:                    α_c, η (the constraint forces) and θ'' together
+// Both stages are cached: the projection, the trace row and the next step's first RK4 stage revisit
+// the same configuration, and the trace row's solve is the first stage's.
+// Sizes: Nj tree joints, Nr constraint rows, Nl payload coordinates: Dynamic (bounded by kMaxDof,
+// never on the heap in a step) or fixed where a lab knows them (every loop unrolled).
+#pragma once
+#include <string>
+#include <vector>
+
+#include "physics/constrained_solve.h"
+#include "physics/integrate.h"
+#include "physics/mechanism.h"
+
+namespace dyn {
+
+template <class S, int Nj = Eigen::Dynamic, int Nr = Eigen::Dynamic, int Nl = Eigen::Dynamic>
+class ConstrainedMechanism : public ConstrainedSystem {
+ public:
+  using Problem = ConstrainedProblemT<Nj, Nr, Nl>;
+  using Solution = ConstrainedSolutionT<Nj, Nr, Nl>;
+  using Vec = typename S::Vec;
+  using Pos = typename S::Pos;
+
+  // Throws std::invalid_argument when the description does not validate or does not fit the sizes.
+  explicit ConstrainedMechanism(MechanismModel<S> model);
+
+  const MechanismModel<S>& model() const { return model_; }
+  int n() const { return model_.treeDof(); }
+  int k() const { return model_.payloadDof(); }
+  int rows() const { return rows_; }
+
+  // ConstrainedSystem
+  int nq() const override { return n() + k(); }
+  void accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a) override;
+  void constraint(const VecN& q, VecN& phi, MatN& G) override;
+  void metric(const VecN& q, MatN& W) override;
+  bool correction(const VecN& q, const VecN& e, VecN& dx) override;
+
+  // The full solve at a state (τ: n tree torques): α_c, η, f and θ''. Remembered: the integrator's
+  // next first stage at the same (q, v, τ) reuses it.
+  Solution solve(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab = nullptr);
+
+  // The force constraint i applies (body a on body b, world axes at its point) in a solution.
+  Vec constraintForce(int i, const Solution& s);
+  // Its η rows, and the row where they start.
+  int rowOffset(int i) const { return offsets_[std::size_t(i)]; }
+  // Constraint i's extra reports (Constraint::reportNames) at the state last solved.
+  void constraintReport(int i, const Solution& s, double* out);
+
+  // Energy: kinetic and gravity of trees and payloads, and joint springs.
+  double energy(const VecN& q, const VecN& v);
+  double kineticEnergy(const VecN& q, const VecN& v);
+  double potentialEnergy(const VecN& q);
+  // |φ|∞ over every holonomic constraint (velocity-level kinds: |J θ' − A v_c|∞ needs v: residual(q, v)).
+  double residual(const VecN& q);
+  double residual(const VecN& q, const VecN& v);
+  // |φ_i|∞ of constraint i alone.
+  double residual(int i, const VecN& q);
+
+  // For controllers, at θ (and θ'): world position, Jacobian J (S::kDim × n) and J'θ' of a point of a link.
+  Pos pointPosition(int link, const Pos& point, const VecN& q);
+  void pointJacobian(int link, const Pos& point, const VecN& q, const VecN& qd, MatN& J, VecN& Jdot_qd);
+  MatN massMatrix(const VecN& q);                       // M(θ)
+  VecN gravityTorque(const VecN& q);                    // G(θ) (+ springs, with with_springs)
+  VecN inverseDynamics(const VecN& q, const VecN& qd, const VecN& qdd);  // M θ'' + C θ' + G (no springs, friction)
+  // Λ = (J M⁻¹ Jᵀ)⁻¹ for a task Jacobian J (rows × n); empty when J M⁻¹ Jᵀ is singular.
+  MatN operationalInertia(const VecN& q, const MatN& J);
+  // The kinematics of the state last staged (constraint kinds read it; so may drawing code).
+  const MechanismKinematics<S>& kinematics() const { return kin_; }
+  // Stages a configuration (and rates) explicitly, for queries on kinematics().
+  void stage(const VecN& q, const VecN* v = nullptr);
+
+ protected:
+  void positionStage(const VecN& q);
+  void velocityStage(const VecN& v);
+  Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab);
+
+  MechanismModel<S> model_;
+  int rows_ = 0;
+  std::vector<int> offsets_;
+  TreeData<S> data_;
+  MechanismKinematics<S> kin_;
+  Problem problem_;
+  ConstrainedFactorT<Nj, Nr, Nl> factor_;
+  bool factored_ = false;
+  VecN phi_;
+  VecN staged_q_;      // the configuration of the position stage
+  bool have_position_ = false;
+  VecN last_q_, last_v_, last_tau_;
+  Solution last_;
+  bool have_last_ = false;
+};
+
+}  // namespace dyn

@@ -1,0 +1,175 @@
+// A mechanism described as data (lecture §2): cut it into trees, add the payloads it carries and
+// the constraints that close it. physics/ does the rest, in both engines:
+//   trees      M θ'' + C θ' + G + K(θ − θ_rest) + B θ' + F_c sat(θ'/w) = τ − Jᵀ f        (1)
+//   payloads   M_c α_c + b_c + G_c = Aᵀ f                                               (§2.4)
+//   closure    J θ' (+ H w) = A v_c, written per constraint kind in the constrained directions (H̃)
+// and the generic mechanism (constrained_mechanism.h) solves (2)/(3) for α_c and f together.
+//
+// Coordinates: q = (θ, x_c), v = (θ', v_c): the tree joints in TreeModel order, then each payload's
+// free pose coordinates in its order (planar: ψ, x, y of its centre of mass, world axes).
+// Sign convention of every constraint force f: the force body a applies to body b, at the
+// constraint's point, world axes, as a spatial force (planar (τ, f_x, f_y)).
+#pragma once
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "physics/chain.h"
+
+namespace dyn {
+
+// A body of the mechanism: the world, a link of the trees, or a payload.
+struct BodyRef {
+  enum class Kind { World, Link, Payload };
+  Kind kind = Kind::World;
+  int index = -1;  // link: TreeModel body index; payload: index into payloads
+  static BodyRef world() { return {}; }
+  static BodyRef link(int i) { return {Kind::Link, i}; }
+  static BodyRef payload(int i) { return {Kind::Payload, i}; }
+  bool isWorld() const { return kind == Kind::World; }
+  bool operator==(const BodyRef&) const = default;
+};
+
+// What a tree joint carries beyond its body: a spring about a rest position (the lecture's joint
+// flexibility: in relative joint coordinates P_K = Σ k_i/2 (θ_i − θ_rest,i)², which is the
+// tridiagonal K of lecture §1 written in absolute angles), viscous friction b θ' and Coulomb
+// friction F_c sat(θ'/w) (smoothed over a rate width w so the dynamics stay smooth for RK4).
+struct JointProperties {
+  double stiffness = 0;      // N·m/rad (N/m for prismatic)
+  double rest = 0;           // rad (m)
+  double viscous = 0;        // N·m·s/rad
+  double coulomb = 0;        // N·m
+  double coulomb_width = 1e-2;  // rad/s: |θ'| above which the Coulomb torque is at full size
+};
+
+// A free body carried by the mechanism (planar): its pose (ψ, x, y) is that of its centre of mass in
+// world axes. Coordinates not marked free stay at pose0 (a body on a guide, e.g. the slider crank's
+// slider: free = {x}). Its Newton–Euler equation at the centre of mass, world axes:
+//   M_c = diag(I, m, m) on the free coordinates,  b_c = 0,  G_c = −m g.
+struct Payload {
+  std::string name;
+  double mass = 1;
+  double inertia = 1;                       // kg·m² about the centre of mass
+  Eigen::Vector3d pose0 = Eigen::Vector3d::Zero();  // (ψ, x, y)
+  std::array<bool, 3> free{true, true, true};        // (ψ, x, y)
+  int dof() const { return int(free[0]) + int(free[1]) + int(free[2]); }
+};
+
+// How a constraint ties two bodies, for engines that model it with their own joints (Bullet):
+// point_a on a held on point_b of b along the selected rows of the spatial motion vector
+// (planar (ω, x, y), spatial (ωx, ωy, ωz, x, y, z)), world axes.
+template <class S>
+struct Attachment {
+  BodyRef a, b;
+  typename S::Pos point_a = S::Pos::Zero(), point_b = S::Pos::Zero();  // body frames
+  std::array<bool, S::kDim> rows{};
+};
+
+// Choices for the Bullet reference model that the physics does not decide: where to cut loops
+// (a tree joint listed here becomes a Bullet constraint, and Bullet's trees are re-grown from the
+// world through the rest; the slider crank is 20× more accurate cut at joint 1) and solver effort.
+struct BulletHints {
+  std::vector<int> cut_joints;
+  int solver_iterations = 30;
+};
+
+template <class S>
+struct MechanismKinematics;
+
+// A constraint kind: r rows in the constrained directions only (H̃ applied; eq. (3)'s free motions H
+// are what the rows leave out). Each kind lives in its own file that opens with its maths:
+//   φ(q) = 0                                 position form (holonomic kinds)
+//   J θ' − A v_c = 0                         velocity form: J (r × n tree), A (r × k payload)
+//   J θ'' − A α_c + (J'θ' − A'v_c) = 0       acceleration form: the bias J'θ' − A'v_c (+ H̃'-terms)
+// and the force: η (r numbers out of the solve) as the spatial force f that body a applies to b.
+template <class S>
+class Constraint {
+ public:
+  using Vec = typename S::Vec;
+  virtual ~Constraint() = default;
+  virtual const char* kind() const = 0;
+  virtual int rows() const = 0;
+  // False for velocity-level kinds (rolling): no φ, no position projection, Baumgarte without ω²φ.
+  virtual bool holonomic() const { return true; }
+  // Position stage: φ (rows), J (rows × n) and A (rows × k), written at row offset `row` of the
+  // mechanism's stacked matrices (which arrive zeroed in those rows).
+  virtual void position(const MechanismKinematics<S>& k, int row, VecN& phi, MatN& J, MatN& A) const = 0;
+  // Velocity stage: the bias J'θ' − A'v_c of its rows.
+  virtual void bias(const MechanismKinematics<S>& k, int row, VecN& b) const = 0;
+  // The spatial force (world axes, at the constraint's point) body a applies to body b, from its η.
+  virtual Vec force(const MechanismKinematics<S>& k, const double* eta) const = 0;
+  // The point where force() applies, world coordinates.
+  virtual typename S::Pos point(const MechanismKinematics<S>& k) const = 0;
+  // Extra quantities a kind reports (a contact: normal and tangential force, cone margin).
+  virtual std::vector<std::string> reportNames() const { return {}; }
+  virtual void report(const MechanismKinematics<S>& k, const double* eta, double* out) const {
+    (void)k, (void)eta, (void)out;
+  }
+  // The same tie, for the Bullet builder.
+  virtual Attachment<S> attachment() const = 0;
+};
+
+template <class S>
+using ConstraintPtr = std::shared_ptr<const Constraint<S>>;
+
+// The description: data only, shared by the hand-written engine and the Bullet builder.
+template <class S>
+struct MechanismModel {
+  TreeModel<S> tree;                       // every tree: a body whose parent is −1 hangs from the world
+  std::vector<JointProperties> joints;     // per tree joint (empty: none)
+  std::vector<Payload> payloads;           // planar mechanisms only
+  std::vector<ConstraintPtr<S>> constraints;
+  BulletHints bullet;
+
+  int treeDof() const { return tree.dof(); }
+  int payloadDof() const {
+    int k = 0;
+    for (const auto& p : payloads) k += p.dof();
+    return k;
+  }
+  int rows() const {
+    int r = 0;
+    for (const auto& c : constraints) r += c->rows();
+    return r;
+  }
+  // The first coordinate of payload i within x_c (−1 if it has none).
+  int payloadOffset(int i) const {
+    int k = 0;
+    for (int j = 0; j < i; ++j) k += payloads[std::size_t(j)].dof();
+    return k;
+  }
+  // Empty if the description is usable, else what is wrong (one sentence).
+  std::string validate() const;
+};
+
+// The kinematics of every body at one state, what constraint kinds read: filled by the mechanism in
+// a position stage (θ, x_c) and a velocity stage (θ', v_c).
+template <class S>
+struct MechanismKinematics {
+  using Vec = typename S::Vec;
+  using Pos = typename S::Pos;
+  const MechanismModel<S>* model = nullptr;
+  const TreeData<S>* tree = nullptr;
+  // Payload poses and velocities (planar: (ψ, x, y) and (ω, vx, vy) of the centre of mass).
+  std::vector<Eigen::Vector3d> payload_pose, payload_rate;
+
+  // World position of a point given in a body's frame (the world's frame is the world).
+  Pos position(const BodyRef& b, const Pos& p) const;
+  // The body's orientation: planar angle (world: 0).
+  double angle(const BodyRef& b) const;
+  // Rotation taking body-frame coordinates to world coordinates.
+  typename S::Rot rotation(const BodyRef& b) const;
+  // The velocity of a world-aligned frame at world point p moving with body b: V = Jb θ' + Ab v_c.
+  // Adds sign × the rows of V (mask) into J (tree columns) and A (payload columns) at `row`; A gets
+  // −sign, so that J θ' − A v_c = sign × V's rows.
+  void addPointJacobian(const BodyRef& b, const Pos& p_world, const std::array<bool, S::kDim>& rows,
+                        double sign, int row, MatN& J, MatN& A) const;
+  // The classical acceleration at p_world of that frame when θ'' = 0 and α_c = 0: J'θ' − A'v_c's
+  // share of body b (velocity stage required).
+  Vec pointBias(const BodyRef& b, const Pos& p_world) const;
+  // The full spatial velocity of that frame (velocity stage required).
+  Vec pointVelocity(const BodyRef& b, const Pos& p_world) const;
+};
+
+}  // namespace dyn
