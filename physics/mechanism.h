@@ -153,6 +153,8 @@ struct MechanismKinematics {
   const TreeData<S>* tree = nullptr;
   // Payload poses and velocities (planar: (ψ, x, y) and (ω, vx, vy) of the centre of mass).
   std::vector<Eigen::Vector3d> payload_pose, payload_rate;
+  // Each link's velocity-product acceleration (θ'' = 0, no gravity), body coordinates: J'θ' of its points.
+  std::vector<Vec> link_bias;
 
   // World position of a point given in a body's frame (the world's frame is the world).
   Pos position(const BodyRef& b, const Pos& p) const;

@@ -1,0 +1,303 @@
+// The generic constrained mechanism's implementation (constrained_mechanism.h). Include this (not only
+// the header) to instantiate it at a lab's fixed sizes, e.g.
+//   template class dyn::ConstrainedMechanism<dyn::Planar, 3, 3, 1>;
+// physics/constrained_mechanism.cpp instantiates the bounded (Dynamic) sizes for both algebras.
+#pragma once
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "physics/constrained_mechanism.h"
+
+namespace dyn {
+
+template <class S, int Nj, int Nr, int Nl>
+ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> model)
+    : model_(std::move(model)), data_(model_.tree) {
+  if (const std::string why = model_.validate(); !why.empty()) throw std::invalid_argument(why);
+  for (const auto& c : model_.constraints) {
+    offsets_.push_back(rows_);
+    rows_ += c->rows();
+  }
+  auto fits = [](int fixed, int actual) { return fixed == Eigen::Dynamic || fixed == actual; };
+  if (!fits(Nj, n()) || !fits(Nr, rows_) || !fits(Nl, k()))
+    throw std::invalid_argument("the mechanism's sizes (" + std::to_string(n()) + " joints, " + std::to_string(rows_) +
+                                " constraint rows, " + std::to_string(k()) + " payload coordinates) do not match this instantiation");
+  kin_.model = &model_;
+  kin_.tree = &data_;
+  kin_.payload_pose.assign(model_.payloads.size(), Eigen::Vector3d::Zero());
+  kin_.payload_rate.assign(model_.payloads.size(), Eigen::Vector3d::Zero());
+  kin_.link_bias.assign(std::size_t(n()), Vec::Zero());
+  // The payloads' M_c = diag(I, m, m) on their free coordinates, and G_c = −m g: constant.
+  const int kk = k();
+  problem_.Mc = MatN::Zero(kk, kk);
+  problem_.bc_Gc = VecN::Zero(kk);
+  for (std::size_t i = 0; i < model_.payloads.size(); ++i) {
+    const Payload& p = model_.payloads[i];
+    const double diag[3] = {p.inertia, p.mass, p.mass};
+    double g[3] = {0.0, 0.0, 0.0};
+    if constexpr (S::kDim == 3) g[1] = model_.tree.gravity[1], g[2] = model_.tree.gravity[2];
+    for (int c = 0, col = model_.payloadOffset(int(i)); c < 3; ++c)
+      if (p.free[std::size_t(c)]) {
+        problem_.Mc(col, col) = diag[c];
+        problem_.bc_Gc[col] = -p.mass * g[c];
+        ++col;
+      }
+  }
+  problem_.A.setZero(rows_, kk);
+  phi_.setZero(rows_);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::positionStage(const VecN& q) {
+  // The projection, the trace row and the next step's first stage revisit the same configuration.
+  if (have_position_ && q == staged_q_) return;
+  const int nn = n(), kk = k();
+  // Tree transforms and M from CRBA.
+  positionKinematics(model_.tree, q.head(nn), data_);
+  problem_.M = crba(model_.tree, data_);
+  // Payload poses: the free coordinates from q, the others where they were put.
+  for (std::size_t i = 0, off = std::size_t(nn); i < model_.payloads.size(); ++i) {
+    const Payload& p = model_.payloads[i];
+    for (std::size_t c = 0; c < 3; ++c) kin_.payload_pose[i][Eigen::Index(c)] = p.free[c] ? q[Eigen::Index(off++)] : p.pose0[Eigen::Index(c)];
+  }
+  // Every constraint's φ, J and A rows, then eq. (2) factored at this configuration.
+  MatN J = MatN::Zero(rows_, nn), A = MatN::Zero(rows_, kk);
+  for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->position(kin_, offsets_[i], phi_, J, A);
+  problem_.J = J;
+  problem_.A = A;
+  factored_ = factor_.factor(problem_, problem_.J, problem_.A);
+  staged_q_ = q;
+  have_position_ = true;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
+  const int nn = n();
+  const VecN qd = v.head(nn);
+  // Link velocities, h = Cθ' + G from RNEA with θ'' = 0, and each link's velocity-product acceleration.
+  velocityKinematics(model_.tree, qd, data_);
+  problem_.h = rnea(model_.tree, data_, qd, VecN::Zero(nn));
+  for (int i = 0; i < nn; ++i) {
+    const int p = model_.tree.bodies[std::size_t(i)].parent;
+    kin_.link_bias[std::size_t(i)] = (p < 0 ? Vec(Vec::Zero()) : Vec(S::motion(data_.X_up[std::size_t(i)], kin_.link_bias[std::size_t(p)]))) + data_.c[std::size_t(i)];
+  }
+  // Joint springs and friction join h.
+  if (!model_.joints.empty())
+    for (int i = 0; i < nn; ++i) {
+      const JointProperties& j = model_.joints[std::size_t(i)];
+      const double w = j.coulomb_width > 0 ? j.coulomb_width : 1e-12;
+      problem_.h[i] += j.stiffness * (staged_q_[i] - j.rest) + j.viscous * qd[i] + j.coulomb * std::clamp(qd[i] / w, -1.0, 1.0);
+    }
+  // Payload rates: the free coordinates' rates, zero for the held ones.
+  for (std::size_t i = 0, off = std::size_t(nn); i < model_.payloads.size(); ++i)
+    for (std::size_t c = 0; c < 3; ++c)
+      kin_.payload_rate[i][Eigen::Index(c)] = model_.payloads[i].free[c] ? v[Eigen::Index(off++)] : 0.0;
+  // J'θ' − A'v_c of every constraint.
+  VecN bias(rows_);
+  for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->bias(kin_, offsets_[i], bias);
+  problem_.Jdot_qd = bias;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::stage(const VecN& q, const VecN* v) {
+  positionStage(q);
+  if (v) velocityStage(*v);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, Nj, Nr, Nl>::evaluate(
+    const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
+  positionStage(q);
+  velocityStage(v);
+  problem_.tau = tau;
+  if (stab) problem_.stab = *stab;
+  else problem_.stab.resize(0);
+  if (!factored_) return solveConstrainedBlockLU(problem_);
+  Solution s;
+  factor_.solve(problem_, s);
+  return s;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, Nj, Nr, Nl>::solve(
+    const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
+  Solution s = evaluate(q, v, tau, stab);
+  // Kept: the integrator's first stage usually comes back to this state (the trace row's solve).
+  if (!stab) {
+    last_q_ = q;
+    last_v_ = v;
+    last_tau_ = tau;
+    last_ = s;
+    have_last_ = true;
+  }
+  return s;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::accelerations(const VecN& q, const VecN& v, const VecN& tau,
+                                                        const VecN* stab, VecN& a) {
+  // The state solve() was last asked about: the same answer (a pure function of q, v, τ).
+  const bool known = !stab && have_last_ && q == last_q_ && v == last_v_ && tau == last_tau_;
+  const Solution s = known ? last_ : evaluate(q, v, tau, stab);
+  a.resize(n() + k());
+  a.head(n()) = s.qdd;
+  a.tail(k()) = s.alpha_c;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::constraint(const VecN& q, VecN& phi, MatN& G) {
+  positionStage(q);
+  phi = phi_;
+  // G = [J, −A]: G v = J θ' − A v_c.
+  G.resize(rows_, n() + k());
+  G.leftCols(n()) = problem_.J;
+  G.rightCols(k()) = -MatN(problem_.A);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::metric(const VecN& q, MatN& W) {
+  positionStage(q);
+  W = MatN::Zero(n() + k(), n() + k());
+  W.topLeftCorner(n(), n()) = problem_.M;
+  W.bottomRightCorner(k(), k()) = problem_.Mc;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+bool ConstrainedMechanism<S, Nj, Nr, Nl>::correction(const VecN& q, const VecN& e, VecN& dx) {
+  positionStage(q);
+  if (!factored_) return ConstrainedSystem::correction(q, e, dx);
+  // Eq. (2) for impulses: M dθ = −Jᵀ f, M_c dx_c = Aᵀ f, J dθ − A dx_c = e (τ − h = 0, J'θ' = −e).
+  Problem impulse;
+  impulse.tau.setZero(n());
+  impulse.h.setZero(n());
+  impulse.Jdot_qd = -e;
+  Solution s;
+  factor_.solve(impulse, s);
+  dx.resize(n() + k());
+  dx.head(n()) = s.qdd;
+  dx.tail(k()) = s.alpha_c;
+  return dx.allFinite();
+}
+
+template <class S, int Nj, int Nr, int Nl>
+typename S::Vec ConstrainedMechanism<S, Nj, Nr, Nl>::constraintForce(int i, const Solution& s) {
+  return model_.constraints[std::size_t(i)]->force(kin_, s.eta.data() + offsets_[std::size_t(i)]);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::constraintReport(int i, const Solution& s, double* out) {
+  model_.constraints[std::size_t(i)]->report(kin_, s.eta.data() + offsets_[std::size_t(i)], out);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+double ConstrainedMechanism<S, Nj, Nr, Nl>::kineticEnergy(const VecN& q, const VecN& v) {
+  positionStage(q);
+  velocityKinematics(model_.tree, VecN(v.head(n())), data_);
+  double T = dyn::kineticEnergy(model_.tree, data_);
+  for (std::size_t i = 0, off = std::size_t(n()); i < model_.payloads.size(); ++i) {
+    const Payload& p = model_.payloads[i];
+    const double diag[3] = {p.inertia, p.mass, p.mass};
+    for (std::size_t c = 0; c < 3; ++c)
+      if (p.free[c]) {
+        const double r = v[Eigen::Index(off++)];
+        T += 0.5 * diag[c] * r * r;
+      }
+  }
+  return T;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+double ConstrainedMechanism<S, Nj, Nr, Nl>::potentialEnergy(const VecN& q) {
+  positionStage(q);
+  double U = dyn::potentialEnergy(model_.tree, data_);
+  // Payloads in gravity, −m g·c, and joint springs ½ k (θ − θ_rest)².
+  if constexpr (S::kDim == 3)
+    for (std::size_t i = 0; i < model_.payloads.size(); ++i)
+      U -= model_.payloads[i].mass * (model_.tree.gravity[1] * kin_.payload_pose[i][1] + model_.tree.gravity[2] * kin_.payload_pose[i][2]);
+  for (std::size_t i = 0; i < model_.joints.size(); ++i) {
+    const double d = q[Eigen::Index(i)] - model_.joints[i].rest;
+    U += 0.5 * model_.joints[i].stiffness * d * d;
+  }
+  return U;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+double ConstrainedMechanism<S, Nj, Nr, Nl>::energy(const VecN& q, const VecN& v) {
+  return kineticEnergy(q, v) + potentialEnergy(q);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+double ConstrainedMechanism<S, Nj, Nr, Nl>::residual(const VecN& q) {
+  positionStage(q);
+  return rows_ ? phi_.lpNorm<Eigen::Infinity>() : 0.0;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+double ConstrainedMechanism<S, Nj, Nr, Nl>::residual(const VecN& q, const VecN& v) {
+  positionStage(q);
+  if (!rows_) return 0.0;
+  // Velocity form J θ' − A v_c as well: a velocity-level kind has only this one.
+  const VecN gv = MatN(problem_.J) * v.head(n()) - MatN(problem_.A) * v.tail(k());
+  return std::max(phi_.lpNorm<Eigen::Infinity>(), gv.lpNorm<Eigen::Infinity>());
+}
+
+template <class S, int Nj, int Nr, int Nl>
+double ConstrainedMechanism<S, Nj, Nr, Nl>::residual(int i, const VecN& q) {
+  positionStage(q);
+  const int r = model_.constraints[std::size_t(i)]->rows();
+  return r ? phi_.segment(offsets_[std::size_t(i)], r).template lpNorm<Eigen::Infinity>() : 0.0;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+typename S::Pos ConstrainedMechanism<S, Nj, Nr, Nl>::pointPosition(int link, const Pos& point, const VecN& q) {
+  positionStage(q);
+  return dyn::pointPosition(data_, link, point);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::pointJacobian(int link, const Pos& point, const VecN& q, const VecN& qd,
+                                                        MatN& J, VecN& Jdot_qd) {
+  positionStage(q);
+  velocityKinematics(model_.tree, VecN(qd.head(n())), data_);
+  dyn::pointJacobian(model_.tree, data_, link, point, J, Jdot_qd);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+MatN ConstrainedMechanism<S, Nj, Nr, Nl>::massMatrix(const VecN& q) {
+  positionStage(q);
+  return problem_.M;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+VecN ConstrainedMechanism<S, Nj, Nr, Nl>::gravityTorque(const VecN& q) {
+  const VecN zero = VecN::Zero(n());
+  positionStage(q);
+  velocityKinematics(model_.tree, zero, data_);
+  return rnea(model_.tree, data_, zero, zero);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+VecN ConstrainedMechanism<S, Nj, Nr, Nl>::inverseDynamics(const VecN& q, const VecN& qd, const VecN& qdd) {
+  positionStage(q);
+  velocityKinematics(model_.tree, VecN(qd.head(n())), data_);
+  return rnea(model_.tree, data_, qd, qdd);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+MatN ConstrainedMechanism<S, Nj, Nr, Nl>::operationalInertia(const VecN& q, const MatN& J) {
+  positionStage(q);
+  // Λ⁻¹ = J M⁻¹ Jᵀ by the small Cholesky of M, then Λ by that of Λ⁻¹ (empty if either is singular).
+  CholeskyN<> chol_M, chol_L;
+  if (!chol_M.compute(MatN(problem_.M))) return {};
+  MatN Y = J.transpose();
+  chol_M.forward(Y);
+  MatN Linv(J.rows(), J.rows());
+  chol_M.inner(Y, int(J.rows()), Linv);
+  if (!chol_L.compute(Linv)) return {};
+  MatN Lambda = MatN::Identity(J.rows(), J.rows());
+  chol_L.solveInPlace(Lambda);
+  return Lambda;
+}
+
+}  // namespace dyn

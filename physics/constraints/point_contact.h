@@ -1,0 +1,49 @@
+// Point contact with friction (lecture §2 eq. (3), §3 "Multi-finger grasp"): a point of body a (a
+// fingertip) presses on a point of body b (the object) whose surface there has the outward normal n
+// (in b's frame). The contact passes a force and no moment: the relative rotation is free,
+//   planar   H = (1, 0, 0),  H̃ = [[0, 1, 0], [0, 0, 1]]     (spatial: H spans the three rotations)
+//   rows     H̃ (V_a(P_a) − V_b(P_b)) = 0: the point rows of point_closure.h. H and H̃ are constant in
+//            world axes, so H̃'J θ' = 0 and H'w drops out of (3) (H̃ H = 0).
+//   force    f = H̃ᵀ η (a on b, at P_b), in contact axes: normal f_n = −f·n (pressing is positive: the
+//            finger pushes into b), tangential f_t = f·t, t = ẑ × n (spatial: |f − (f·n) n|)
+//   cone     margin μ f_n − |f_t|: ≥ 0 inside the friction cone; the contact would slip (or pull) below 0.
+// The contact is bilateral here (it holds whatever the sign of f_n): the margin says when a real
+// contact would have let go.
+#pragma once
+#include "physics/constraints/point_closure.h"
+
+namespace dyn {
+
+template <class S>
+class PointContact final : public Constraint<S> {
+ public:
+  using Vec = typename S::Vec;
+  using Pos = typename S::Pos;
+
+  // normal_b: b's outward surface normal at point_b, in b's frame; mu ≥ 0.
+  PointContact(BodyRef a, const Pos& point_a, BodyRef b, const Pos& point_b, const Pos& normal_b, double mu);
+
+  const char* kind() const override { return "point_contact"; }
+  int rows() const override { return rows_.rows(); }
+  void position(const MechanismKinematics<S>& k, int row, VecN& phi, MatN& J, MatN& A) const override {
+    rows_.position(k, row, phi, J, A);
+  }
+  void bias(const MechanismKinematics<S>& k, int row, VecN& b) const override { rows_.bias(k, row, b); }
+  Vec force(const MechanismKinematics<S>& k, const double* eta) const override { return rows_.force(k, eta); }
+  Pos point(const MechanismKinematics<S>& k) const override { return rows_.point(k); }
+  Attachment<S> attachment() const override { return rows_.attachment(); }
+  // f_n, f_t, cone margin.
+  std::vector<std::string> reportNames() const override { return {"f_n", "f_t", "cone_margin"}; }
+  void report(const MechanismKinematics<S>& k, const double* eta, double* out) const override;
+
+  double mu() const { return mu_; }
+  // The world outward normal of b at the contact.
+  Pos normal(const MechanismKinematics<S>& k) const;
+
+ private:
+  PointClosure<S> rows_;
+  Pos normal_b_;
+  double mu_;
+};
+
+}  // namespace dyn

@@ -1,0 +1,155 @@
+// The kinematics every constraint kind reads (mechanism.h): points of links, payloads and the world,
+// their velocities, Jacobians and velocity-product ("bias") accelerations.
+//   link point:     V_P = Φ(p − o_i) V_i (world-aligned frame at P), columns from the path root → link
+//   payload point:  V_P = Φ(p − c) (ω, v_c) with Φ(r) = [[1,0,0],[−r_y,1,0],[r_x,0,1]] (lecture §2),
+//                   on the free coordinates only; bias −ω² r (α_c = 0)
+// Written once for planar and spatial trees; payloads are planar.
+#include "physics/mechanism.h"
+
+#include <cmath>
+
+namespace dyn {
+namespace {
+
+// Φ(r) applied to a planar velocity (ω, vx, vy) at the centre of mass: the velocity at c + r.
+Eigen::Vector3d shiftPlanar(const Eigen::Vector2d& r, const Eigen::Vector3d& v) {
+  return {v[0], v[1] - v[0] * r.y(), v[2] + v[0] * r.x()};
+}
+
+}  // namespace
+
+template <class S>
+std::string MechanismModel<S>::validate() const {
+  const int n = tree.dof();
+  if (!joints.empty() && int(joints.size()) != n) return "joint properties are given for " + std::to_string(joints.size()) + " of " + std::to_string(n) + " joints";
+  if constexpr (S::kDim != 3) {
+    if (!payloads.empty()) return "payloads are planar: a spatial mechanism cannot carry one yet";
+  }
+  for (std::size_t i = 0; i < payloads.size(); ++i) {
+    const Payload& p = payloads[i];
+    if (!(p.mass > 0) || !(p.inertia > 0)) return "payload " + std::to_string(i) + " needs a positive mass and inertia";
+  }
+  auto ok = [&](const BodyRef& b) {
+    if (b.kind == BodyRef::Kind::Link) return b.index >= 0 && b.index < n;
+    if (b.kind == BodyRef::Kind::Payload) return b.index >= 0 && b.index < int(payloads.size());
+    return true;
+  };
+  for (std::size_t i = 0; i < constraints.size(); ++i) {
+    const Attachment<S> at = constraints[i]->attachment();
+    if (!ok(at.a) || !ok(at.b)) return "constraint " + std::to_string(i) + " names a body the mechanism does not have";
+    if (at.a == at.b) return "constraint " + std::to_string(i) + " ties a body to itself";
+  }
+  for (int j : bullet.cut_joints)
+    if (j < 0 || j >= n) return "Bullet cut joint " + std::to_string(j) + " is not a joint of the trees";
+  if (n + payloadDof() > kMaxDof || rows() > kMaxDof) return "the mechanism is larger than kMaxDof (" + std::to_string(kMaxDof) + ")";
+  return {};
+}
+
+template <class S>
+typename S::Pos MechanismKinematics<S>::position(const BodyRef& b, const Pos& p) const {
+  switch (b.kind) {
+    case BodyRef::Kind::Link: return pointPosition(*tree, b.index, p);
+    case BodyRef::Kind::Payload:
+      if constexpr (S::kDim == 3) {
+        const Eigen::Vector3d& x = payload_pose[std::size_t(b.index)];
+        const double c = std::cos(x[0]), s = std::sin(x[0]);
+        return {x[1] + c * p.x() - s * p.y(), x[2] + s * p.x() + c * p.y()};
+      }
+      return p;
+    default: return p;
+  }
+}
+
+template <class S>
+double MechanismKinematics<S>::angle(const BodyRef& b) const {
+  if constexpr (S::kDim == 3) {
+    if (b.kind == BodyRef::Kind::Link) {
+      const auto& E = tree->X_world[std::size_t(b.index)].E;  // world → body: rotation(−angle)ᵀ
+      return std::atan2(E(0, 1), E(0, 0));
+    }
+    if (b.kind == BodyRef::Kind::Payload) return payload_pose[std::size_t(b.index)][0];
+  }
+  return 0.0;
+}
+
+template <class S>
+typename S::Rot MechanismKinematics<S>::rotation(const BodyRef& b) const {
+  if (b.kind == BodyRef::Kind::Link) return tree->X_world[std::size_t(b.index)].E.transpose();
+  if constexpr (S::kDim == 3) {
+    if (b.kind == BodyRef::Kind::Payload) return S::rotation(angle(b)).transpose();
+  }
+  return S::Rot::Identity();
+}
+
+template <class S>
+void MechanismKinematics<S>::addPointJacobian(const BodyRef& b, const Pos& p_world,
+                                              const std::array<bool, S::kDim>& rows, double sign, int row,
+                                              MatN& J, MatN& A) const {
+  if (b.kind == BodyRef::Kind::Link) {
+    // Column j: joint j's axis seen from the world-aligned frame at p, for every joint root → link.
+    const typename S::Transform X_pw = S::translation(p_world);
+    for (int j = b.index; j >= 0; j = model->tree.bodies[std::size_t(j)].parent) {
+      const Vec col = S::motion(X_pw, S::motionInverse(tree->X_world[std::size_t(j)], tree->S_i[std::size_t(j)]));
+      for (int r = 0, out = row; r < S::kDim; ++r)
+        if (rows[std::size_t(r)]) J(out++, j) += sign * col[r];
+    }
+  } else if (b.kind == BodyRef::Kind::Payload) {
+    if constexpr (S::kDim == 3) {
+      // Φ(p − c) on the payload's free coordinates; A enters with the opposite sign (J θ' − A v_c).
+      const Payload& pl = model->payloads[std::size_t(b.index)];
+      const Eigen::Vector3d& x = payload_pose[std::size_t(b.index)];
+      const Eigen::Vector2d r(p_world.x() - x[1], p_world.y() - x[2]);
+      int col = model->payloadOffset(b.index);
+      for (int c = 0; c < 3; ++c) {
+        if (!pl.free[std::size_t(c)]) continue;
+        const Eigen::Vector3d phi_c = shiftPlanar(r, Eigen::Vector3d::Unit(c));
+        for (int i = 0, out = row; i < 3; ++i)
+          if (rows[std::size_t(i)]) A(out++, col) -= sign * phi_c[i];
+        ++col;
+      }
+    }
+  }
+}
+
+template <class S>
+typename S::Vec MechanismKinematics<S>::pointVelocity(const BodyRef& b, const Pos& p_world) const {
+  if (b.kind == BodyRef::Kind::Link) {
+    const std::size_t i = std::size_t(b.index);
+    return S::motion(S::translation(p_world), S::motionInverse(tree->X_world[i], tree->v[i]));
+  }
+  if constexpr (S::kDim == 3) {
+    if (b.kind == BodyRef::Kind::Payload) {
+      const Eigen::Vector3d& x = payload_pose[std::size_t(b.index)];
+      return shiftPlanar({p_world.x() - x[1], p_world.y() - x[2]}, payload_rate[std::size_t(b.index)]);
+    }
+  }
+  return Vec::Zero();
+}
+
+template <class S>
+typename S::Vec MechanismKinematics<S>::pointBias(const BodyRef& b, const Pos& p_world) const {
+  if (b.kind == BodyRef::Kind::Link) {
+    // The link's velocity-product acceleration (θ'' = 0), at p, as a classical acceleration.
+    const std::size_t i = std::size_t(b.index);
+    const typename S::Transform X_pw = S::translation(p_world);
+    const Vec v_p = S::motion(X_pw, S::motionInverse(tree->X_world[i], tree->v[i]));
+    const Vec a_p = S::motion(X_pw, S::motionInverse(tree->X_world[i], link_bias[i]));
+    return S::classicalAcceleration(a_p, v_p);
+  }
+  if constexpr (S::kDim == 3) {
+    if (b.kind == BodyRef::Kind::Payload) {
+      // A point of a rigid body turning at ω with α = 0: −ω² r.
+      const Eigen::Vector3d& x = payload_pose[std::size_t(b.index)];
+      const double w = payload_rate[std::size_t(b.index)][0];
+      return {0.0, -w * w * (p_world.x() - x[1]), -w * w * (p_world.y() - x[2])};
+    }
+  }
+  return Vec::Zero();
+}
+
+template struct MechanismModel<Planar>;
+template struct MechanismModel<Spatial>;
+template struct MechanismKinematics<Planar>;
+template struct MechanismKinematics<Spatial>;
+
+}  // namespace dyn
