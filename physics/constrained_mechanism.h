@@ -62,7 +62,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // |φ_i|∞ of constraint i alone.
   double residual(int i, const VecN& q);
 
-  // For controllers, at θ (and θ'): world position, Jacobian J (S::kDim × n) and J'θ' of a point of a link.
+  // For controllers, at θ (and θ'; the full q and v work too): world position, Jacobian J (S::kDim × n)
+  // and J'θ' of a point of a link.
   Pos pointPosition(int link, const Pos& point, const VecN& q);
   void pointJacobian(int link, const Pos& point, const VecN& q, const VecN& qd, MatN& J, VecN& Jdot_qd);
   MatN massMatrix(const VecN& q);                       // M(θ)
@@ -78,6 +79,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
  protected:
   void positionStage(const VecN& q);
   void velocityStage(const VecN& v);
+  // The tree's transforms alone at θ (controller queries), cached like the position stage.
+  void treeStage(const VecN& q);
   Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab);
 
   MechanismModel<S> model_;
@@ -91,6 +94,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   VecN phi_;
   VecN staged_q_;      // the configuration of the position stage
   bool have_position_ = false;
+  VecN tree_q_;        // the θ that data_'s transforms are at
+  bool have_tree_ = false;
   VecN last_q_, last_v_, last_tau_;
   Solution last_;
   bool have_last_ = false;

@@ -55,6 +55,8 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::positionStage(const VecN& q) {
   const int nn = n(), kk = k();
   // Tree transforms and M from CRBA.
   positionKinematics(model_.tree, q.head(nn), data_);
+  tree_q_ = q.head(nn);
+  have_tree_ = true;
   problem_.M = crba(model_.tree, data_);
   // Payload poses: the free coordinates from q, the others where they were put.
   for (std::size_t i = 0, off = std::size_t(nn); i < model_.payloads.size(); ++i) {
@@ -69,6 +71,15 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::positionStage(const VecN& q) {
   factored_ = factor_.factor(problem_, problem_.J, problem_.A);
   staged_q_ = q;
   have_position_ = true;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::treeStage(const VecN& q) {
+  if (have_tree_ && q.head(n()) == tree_q_) return;
+  positionKinematics(model_.tree, q.head(n()), data_);
+  tree_q_ = q.head(n());
+  have_tree_ = true;
+  have_position_ = false;  // data_ no longer holds the position stage's configuration
 }
 
 template <class S, int Nj, int Nr, int Nl>
@@ -251,45 +262,44 @@ double ConstrainedMechanism<S, Nj, Nr, Nl>::residual(int i, const VecN& q) {
 
 template <class S, int Nj, int Nr, int Nl>
 typename S::Pos ConstrainedMechanism<S, Nj, Nr, Nl>::pointPosition(int link, const Pos& point, const VecN& q) {
-  positionStage(q);
+  treeStage(q);
   return dyn::pointPosition(data_, link, point);
 }
 
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::pointJacobian(int link, const Pos& point, const VecN& q, const VecN& qd,
                                                         MatN& J, VecN& Jdot_qd) {
-  positionStage(q);
+  treeStage(q);
   velocityKinematics(model_.tree, VecN(qd.head(n())), data_);
   dyn::pointJacobian(model_.tree, data_, link, point, J, Jdot_qd);
 }
 
 template <class S, int Nj, int Nr, int Nl>
 MatN ConstrainedMechanism<S, Nj, Nr, Nl>::massMatrix(const VecN& q) {
-  positionStage(q);
-  return problem_.M;
+  treeStage(q);
+  return crba(model_.tree, data_);
 }
 
 template <class S, int Nj, int Nr, int Nl>
 VecN ConstrainedMechanism<S, Nj, Nr, Nl>::gravityTorque(const VecN& q) {
   const VecN zero = VecN::Zero(n());
-  positionStage(q);
+  treeStage(q);
   velocityKinematics(model_.tree, zero, data_);
   return rnea(model_.tree, data_, zero, zero);
 }
 
 template <class S, int Nj, int Nr, int Nl>
 VecN ConstrainedMechanism<S, Nj, Nr, Nl>::inverseDynamics(const VecN& q, const VecN& qd, const VecN& qdd) {
-  positionStage(q);
+  treeStage(q);
   velocityKinematics(model_.tree, VecN(qd.head(n())), data_);
   return rnea(model_.tree, data_, qd, qdd);
 }
 
 template <class S, int Nj, int Nr, int Nl>
 MatN ConstrainedMechanism<S, Nj, Nr, Nl>::operationalInertia(const VecN& q, const MatN& J) {
-  positionStage(q);
   // Λ⁻¹ = J M⁻¹ Jᵀ by the small Cholesky of M, then Λ by that of Λ⁻¹ (empty if either is singular).
   CholeskyN<> chol_M, chol_L;
-  if (!chol_M.compute(MatN(problem_.M))) return {};
+  if (!chol_M.compute(massMatrix(q))) return {};
   MatN Y = J.transpose();
   chol_M.forward(Y);
   MatN Linv(J.rows(), J.rows());

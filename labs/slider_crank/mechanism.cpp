@@ -1,119 +1,49 @@
-// Slider crank through the generic constrained solve, eq. (2); see mechanism.h.
+// The slider crank's description, and what is particular to it: inverse kinematics and drawing points.
 #include "labs/slider_crank/mechanism.h"
 
+#include <Eigen/LU>
 #include <cmath>
+
+#include "physics/constrained_mechanism_impl.h"
+#include "physics/constraints/point_closure.h"
+
+namespace dyn {
+template class ConstrainedMechanism<Planar, 3, 3, 1>;
+}
 
 namespace dyn::slider_crank {
 namespace {
 const Eigen::Vector3d kA{0.0, 1.0, 0.0};  // the slider moves the tip along world x only
-
-// a = (θ'', α_c) out of a solve of eq. (2) (or (dθ, dx_c) out of its impulse form).
-void accelerationsOf(const Mechanism::Solution& s, VecN& a) {
-  a.resize(4);
-  a.head<3>() = s.qdd;
-  a[3] = s.alpha_c[0];
 }
-}  // namespace
 
-Mechanism::Mechanism(const Params& p) : params_(p), data_(tree_) {
+MechanismModel<Planar> describe(const Params& p) {
+  MechanismModel<Planar> d;
   // Three revolute joints about z; link i+1's joint sits at the end of link i.
   for (int i = 0; i < 3; ++i) {
-    const Link& l = p.links[i];
-    const Planar::Pos offset = i == 0 ? Planar::Pos::Zero() : Planar::Pos(p.links[i - 1].length, 0.0);
-    tree_.addBody(i - 1, JointType::Revolute, Planar::Axis::Zero(), Planar::translation(offset),
-                  Planar::inertia(l.mass, l.com, l.inertia));
+    const Link& l = p.links[std::size_t(i)];
+    const Planar::Pos offset = i == 0 ? Planar::Pos::Zero() : Planar::Pos(p.links[std::size_t(i - 1)].length, 0.0);
+    d.tree.addBody(i - 1, JointType::Revolute, Planar::Axis::Zero(), Planar::translation(offset),
+                   Planar::inertia(l.mass, l.com, l.inertia));
   }
-  tree_.gravity << 0.0, p.gravity.x(), p.gravity.y();
-  data_ = TreeData<Planar>(tree_);
-  // The parts of eq. (2) that never change: A, M_c.
-  problem_.A = kA;
-  problem_.Mc = MatN::Constant(1, 1, p.load_mass);
+  d.tree.gravity << 0.0, p.gravity.x(), p.gravity.y();
+  // The slider: a payload on a guide along world x (its rotational inertia never matters).
+  Payload slider;
+  slider.name = "slider";
+  slider.mass = p.load_mass;
+  slider.inertia = p.load_mass * 0.05 * 0.05 / 6.0;
+  slider.free = {false, true, false};
+  d.payloads.push_back(slider);
+  // The tip welded to the slider: angle, x and y held.
+  d.constraints.push_back(std::make_shared<PointClosure<Planar>>(BodyRef::link(2), Planar::Pos(p.links[2].length, 0.0),
+                                                                 BodyRef::payload(0), Planar::Pos::Zero(),
+                                                                 PointClosure<Planar>::all()));
+  // Bullet: grow the tree from the slider and close the loop at joint 1.
+  d.bullet.cut_joints = {0};
+  d.bullet.solver_iterations = 30;
+  return d;
 }
 
-void Mechanism::positionStage(const Eigen::Vector3d& th) {
-  // The projection, the trace row and the next step's first stage revisit the same θ.
-  if (have_position_ && th == theta_) return;
-  // Link transforms, M from CRBA, the tip Jacobian J.
-  positionKinematics(tree_, VecN(th), data_);
-  problem_.M = crba(tree_, data_);
-  MatN J;
-  pointJacobian(tree_, data_, 2, tipPoint(), J);
-  problem_.J = J;
-  factored_ = factor_.factor(problem_, problem_.J, problem_.A);
-  theta_ = th;
-  have_position_ = true;
-}
-
-void Mechanism::velocityStage(const Eigen::Vector3d& thd) {
-  const VecN qd = thd;
-  // Link velocities, h = Cθ' + G from RNEA with θ'' = 0, and J'θ' at the tip.
-  velocityKinematics(tree_, qd, data_);
-  problem_.h = rnea(tree_, data_, qd, VecN::Zero(3));
-  VecN Jdot_qd;
-  pointJacobianDot(tree_, data_, 2, tipPoint(), Jdot_qd);
-  problem_.Jdot_qd = Jdot_qd;
-}
-
-Mechanism::Solution Mechanism::evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
-  positionStage(q.head<3>());
-  velocityStage(v.head<3>());
-  problem_.tau = tau;
-  if (stab) problem_.stab = *stab;
-  else problem_.stab.resize(0);
-  if (!factored_) return solveConstrainedBlockLU(problem_);
-  Solution s;
-  factor_.solve(problem_, s);
-  return s;
-}
-
-Mechanism::Solution Mechanism::solve(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
-  Solution s = evaluate(q, v, tau, stab);
-  // Kept: the integrator's first stage usually comes back to this state (the trace row's solve).
-  if (!stab) {
-    last_q_ = q;
-    last_v_ = v;
-    last_tau_ = tau;
-    last_ = s;
-  }
-  return s;
-}
-
-void Mechanism::accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a) {
-  // The state solve() was last asked about: the same answer (a pure function of q, v, τ).
-  const bool known = !stab && last_q_.size() && q == last_q_ && v == last_v_ && tau == last_tau_;
-  accelerationsOf(known ? last_ : evaluate(q, v, tau, stab), a);
-}
-
-void Mechanism::constraint(const VecN& q, VecN& phi, MatN& G) {
-  positionStage(q.head<3>());
-  const Planar::Pos t = pointPosition(data_, 2, tipPoint());
-  phi.resize(3);
-  phi << q.head<3>().sum(), t.x() - q[3], t.y();
-  // Planar: the position constraint's gradient is the tip Jacobian; G = [J, −A].
-  G.resize(3, 4);
-  G << problem_.J, -kA;
-}
-
-void Mechanism::metric(const VecN& q, MatN& W) {
-  positionStage(q.head<3>());
-  W = MatN::Zero(4, 4);
-  W.topLeftCorner(3, 3) = problem_.M;
-  W(3, 3) = std::max(params_.load_mass, 1e-9);
-}
-
-bool Mechanism::correction(const VecN& q, const VecN& e, VecN& dx) {
-  positionStage(q.head<3>());
-  if (!factored_) return ConstrainedSystem::correction(q, e, dx);
-  // Eq. (2) for impulses: M dθ = −Jᵀ f, m_c dx_c = Aᵀ f, J dθ − A dx_c = e (τ − h = 0, J'θ' = −e).
-  Problem impulse;
-  impulse.tau.setZero();
-  impulse.h.setZero();
-  impulse.Jdot_qd = -e;
-  Solution s;
-  factor_.solve(impulse, s);
-  accelerationsOf(s, dx);  // (dθ, dx_c)
-  return dx.allFinite();
-}
+Mechanism::Mechanism(const Params& p) : ConstrainedMechanism(describe(p)), params_(p) {}
 
 bool Mechanism::recoverDependent(VecN& q, VecN& v) {
   const auto& L = params_.links;
@@ -159,37 +89,17 @@ std::array<Eigen::Vector2d, 4> Mechanism::jointPoints(const Eigen::Vector3d& th)
   double angle = 0;
   for (int i = 0; i < 3; ++i) {
     angle += th[i];
-    p[i + 1] = p[i] + params_.links[i].length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    p[std::size_t(i) + 1] = p[std::size_t(i)] + params_.links[std::size_t(i)].length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
   }
   return p;
 }
 
 void Mechanism::tipJacobian(const Eigen::Vector3d& th, const Eigen::Vector3d& rate, MatN& J, VecN& Jdot_qd) {
-  positionStage(th);
-  velocityKinematics(tree_, VecN(rate), data_);
-  J = problem_.J;
-  pointJacobianDot(tree_, data_, 2, tipPoint(), Jdot_qd);
+  pointJacobian(2, tipPoint(), VecN(th), VecN(rate), J, Jdot_qd);
 }
 
 Eigen::Vector3d Mechanism::gravityTorque(const Eigen::Vector3d& th) {
-  const VecN zero = VecN::Zero(3);
-  positionStage(th);
-  velocityKinematics(tree_, zero, data_);
-  return rnea(tree_, data_, zero, zero);
-}
-
-double Mechanism::energy(const VecN& q, const VecN& v) {
-  positionStage(q.head<3>());
-  velocityKinematics(tree_, VecN(v.head(3)), data_);
-  // The slider stays at y = 0: only its kinetic energy counts.
-  return kineticEnergy(tree_, data_) + potentialEnergy(tree_, data_) + 0.5 * params_.load_mass * v[3] * v[3];
-}
-
-double Mechanism::residual(const VecN& q) {
-  VecN phi;
-  MatN G;
-  constraint(q, phi, G);
-  return phi.lpNorm<Eigen::Infinity>();
+  return ConstrainedMechanism::gravityTorque(VecN(th));
 }
 
 }  // namespace dyn::slider_crank
