@@ -5,6 +5,7 @@
 #include <cmath>
 #include <map>
 
+#include "labs/mechanism_simulation.h"
 #include "physics/bullet/slider_crank_bullet.h"
 
 namespace dyn::slider_crank {
@@ -39,72 +40,34 @@ struct RowState {
   }
 };
 
-// The failure sentence for a row with a non-finite value (the run stops there), or empty.
-std::string nonFiniteColumn(const std::vector<double>& row) {
-  for (std::size_t c = 0; c < row.size(); ++c)
-    if (!std::isfinite(row[c])) return kColumns[c] + " became non-finite";
-  return {};
-}
-
-// The hand-written engine: eq. (2) through the generic solve, integrated by physics/integrate.
-class HandSimulation final : public Simulation {
+// The lab's part of a run on either engine (labs/mechanism_simulation.h): the force controller, the
+// trace row, and the force sensor, which sees f_Ty of each step `delay` later.
+class Hooks final : public StepHooks {
  public:
-  explicit HandSimulation(const Settings& s)
-      : s_(s), mech_(s.params), ctrl_(s.controller, s.reference, s.params, s.step.dt),
-        steps_(std::lround(s.duration / s.step.dt)) {
-    mech_.initialState(s.theta1, s.theta1_rate, s.branch, q_, v_);
-    e0_ = mech_.energy(q_, v_);
+  explicit Hooks(const Settings& s) : s_(s), ctrl_(s.controller, s.reference, s.params, s.step.dt) {}
+  VecN torque(double t, const VecN& q, const VecN& v) override {
+    return ctrl_.torque(t, q.head(3), v.head(3), q[3], v[3]);
   }
-  bool step(std::vector<double>& row) override {
-    if (k_ >= steps_ || !failure_.empty()) return false;
-    const double t = double(k_) * s_.step.dt;
-    const Eigen::Vector3d th = q_.head(3), thd = v_.head(3);
-    const Eigen::Vector3d tau = ctrl_.torque(t, th, thd, q_[3], v_[3]);
-    tau_ = tau;
-    // The constraint force at this instant, from the same solve the integrator uses (its first
-    // RK4 stage reuses this one: Mechanism::accelerations).
-    const Mechanism::Solution sol = mech_.solve(q_, v_, tau_);
-    RowState r{t, th, thd, q_[3], v_[3], sol.f.head(3), tau, mech_.energy(q_, v_), mech_.residual(q_),
-               ctrl_.reference().position(t), s_.controller.f_des, ctrl_.measured(), work_};
-    r.write(row);
-    if (!dyn::step(mech_, s_.step, tau_, q_, v_)) failure_ = "the constraint projection failed";
-    work_ += tau.dot(0.5 * (thd + Eigen::Vector3d(v_.head(3)))) * s_.step.dt;  // ∫ τ·θ' dt, trapezoid
-    ctrl_.measure(sol.f[2]);
-    if (!q_.allFinite() || !v_.allFinite()) failure_ = "the state became non-finite";
-    if (const std::string bad = nonFiniteColumn(row); !bad.empty()) failure_ = bad;
-    ++k_;
-    return true;
+  void row(const StepRecord& r, std::vector<double>& out) override {
+    RowState{r.t, r.q.head(3), r.v.head(3), r.q[3], r.v[3], r.forces[0].head(3), r.tau.head(3), r.energy, r.residual,
+             ctrl_.reference().position(r.t), s_.controller.f_des, ctrl_.measured(), r.work}
+        .write(out);
   }
-  bool advanceEngine() override {
-    if (k_ >= steps_ || !failure_.empty()) return false;
-    if (!dyn::step(mech_, s_.step, tau_, q_, v_)) failure_ = "the constraint projection failed";
-    ++k_;
-    return true;
-  }
-  std::string failure() const override { return failure_; }
+  void observe(const StepRecord& r) override { ctrl_.measure(r.forces[0][2]); }
 
  private:
-  Settings s_;
-  Mechanism mech_;
+  const Settings& s_;
   Controller ctrl_;
-  long steps_, k_ = 0;
-  VecN q_, v_, tau_ = VecN::Zero(3);  // state, and the torque held over the step
-  double e0_ = 0, work_ = 0;
-  std::string failure_;
 };
 
-// The Bullet reference, driven by the same controller; energy and residual use the same formulas.
-class BulletSimulation final : public Simulation {
+// The Bullet reference of the slider crank behind the engine face (until the builder takes over).
+class SliderCrankBulletEngine final : public MechanismEngine {
  public:
-  explicit BulletSimulation(const Settings& s)
-      : s_(s), mech_(s.params), ctrl_(s.controller, s.reference, s.params, s.step.dt),
-        steps_(std::lround(s.duration / s.step.dt)) {
-    VecN q, v;
-    mech_.initialState(s.theta1, s.theta1_rate, s.branch, q, v);
+  SliderCrankBulletEngine(const Settings& s, const VecN& q, const VecN& v) : forces_(1) {
     bullet::SliderCrankModel m;
     for (int i = 0; i < 3; ++i) {
-      const Link& l = s.params.links[i];
-      m.links[i] = {l.length, l.mass, l.inertia, l.com};
+      const Link& l = s.params.links[std::size_t(i)];
+      m.links[std::size_t(i)] = {l.length, l.mass, l.inertia, l.com};
     }
     m.load_mass = s.params.load_mass;
     m.gravity = s.params.gravity;
@@ -112,47 +75,22 @@ class BulletSimulation final : public Simulation {
     m.qd0 = v.head(3);
     world_ = std::make_unique<bullet::SliderCrankBullet>(m, s.step.dt);
   }
-  bool step(std::vector<double>& row) override {
-    if (k_ >= steps_ || !failure_.empty()) return false;
-    const double t = double(k_) * s_.step.dt;
-    const Eigen::Vector3d th = world_->q(), thd = world_->qd();
-    const double x_c = world_->x_c(), v_c = world_->v_c();
-    VecN q(4), v(4);
-    q << th, x_c;
-    v << thd, v_c;
-    const Eigen::Vector3d tau = ctrl_.torque(t, th, thd, x_c, v_c);
-    tau_ = tau;
-    const double energy = mech_.energy(q, v), residual = mech_.residual(q);
-    world_->step(tau);
-    // Bullet reports the force over the step just taken.
-    const Eigen::Vector3d f = world_->tipForce();
-    RowState r{t, th, thd, x_c, v_c, f, tau, energy, residual, ctrl_.reference().position(t),
-               s_.controller.f_des, ctrl_.measured(), work_};
-    r.write(row);
-    work_ += tau.dot(0.5 * (thd + world_->qd())) * s_.step.dt;
-    ctrl_.measure(f[2]);
-    if (!world_->q().allFinite() || !world_->qd().allFinite()) failure_ = "the Bullet state became non-finite";
-    if (const std::string bad = nonFiniteColumn(row); !bad.empty()) failure_ = bad;
-    ++k_;
+  void state(VecN& q, VecN& v) const override {
+    q.resize(4);
+    v.resize(4);
+    q << world_->q(), world_->x_c();
+    v << world_->qd(), world_->v_c();
+  }
+  bool step(const VecN& tau) override {
+    world_->step(tau.head(3));
+    forces_[0] = world_->tipForce();  // over the step just taken
     return true;
   }
-  bool advanceEngine() override {
-    if (k_ >= steps_ || !failure_.empty()) return false;
-    world_->step(tau_);
-    ++k_;
-    return true;
-  }
-  std::string failure() const override { return failure_; }
+  const std::vector<VecN>& forces() const override { return forces_; }
 
  private:
-  Settings s_;
-  Mechanism mech_;
-  Controller ctrl_;
-  long steps_, k_ = 0;
-  Eigen::Vector3d tau_ = Eigen::Vector3d::Zero();  // the torque held over the step
   std::unique_ptr<bullet::SliderCrankBullet> world_;
-  double work_ = 0;
-  std::string failure_;
+  std::vector<VecN> forces_;
 };
 
 double rms(const std::vector<double>& x) {
@@ -262,8 +200,14 @@ std::string SliderCrankLab::unit(const std::string& c) const {
 }
 
 std::unique_ptr<Simulation> SliderCrankLab::simulate(Engine engine) const {
-  if (engine == Engine::Hand) return std::make_unique<HandSimulation>(s_);
-  return std::make_unique<BulletSimulation>(s_);
+  auto mech = std::make_unique<Mechanism>(s_.params);
+  VecN q, v;
+  mech->initialState(s_.theta1, s_.theta1_rate, s_.branch, q, v);
+  std::unique_ptr<MechanismEngine> stepper;
+  if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<Mechanism>>(*mech, s_.step, q, v);
+  else stepper = std::make_unique<SliderCrankBulletEngine>(s_, q, v);
+  return std::make_unique<MechanismSimulation<Mechanism>>(engine, std::move(mech), std::move(stepper),
+                                                          std::make_unique<Hooks>(s_), kColumns, s_.step.dt, s_.duration);
 }
 
 json SliderCrankLab::metrics(const Trace& tr) const {

@@ -1,0 +1,163 @@
+// The per-step harness of every mechanism lab, written once: both engines behind one face, the lab's
+// controller and trace row plugged in. A step k:
+//   (q, v) at t_k → τ = controller(t_k, q, v) → E(q, v), |φ(q)| by the hand model (both engines alike)
+//   → the engine steps with τ held, giving the constraint forces of the step (hand: eq. (2) solved at the
+//     step's start, the solve its first RK4 stage reuses; Bullet: impulses over the step / dt)
+//   → the lab writes the trace row → work += τ·(θ'_k + θ'_k+1)/2 dt → the controller observes (sensors)
+//   → a non-finite state or row ends the run with a plain sentence.
+#pragma once
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "labs/lab.h"
+#include "physics/constrained_mechanism.h"
+#include "physics/bullet/bullet_mechanism.h"
+
+namespace dyn {
+
+// One engine advancing a mechanism's state (q, v) = ((θ, x_c), (θ', v_c)) a fixed step at a time.
+class MechanismEngine {
+ public:
+  virtual ~MechanismEngine() = default;
+  virtual void state(VecN& q, VecN& v) const = 0;
+  // One step with τ held; false (and a sentence in failure()) if the engine could not take it.
+  virtual bool step(const VecN& tau) = 0;
+  // The force of each constraint over the last step (body a on body b, world axes at its point).
+  virtual const std::vector<VecN>& forces() const = 0;
+  virtual std::string failure() const { return {}; }
+};
+
+// The hand-written engine: eq. (2)/(3) through the generic mechanism M, integrated by physics/integrate.
+template <class M>
+class HandEngine final : public MechanismEngine {
+ public:
+  HandEngine(M& mech, const StepOptions& options, VecN q0, VecN v0)
+      : mech_(mech), options_(options), q_(std::move(q0)), v_(std::move(v0)), forces_(mech.model().constraints.size()) {}
+  void state(VecN& q, VecN& v) const override { q = q_, v = v_; }
+  bool step(const VecN& tau) override {
+    // The constraint forces at the step's start: the solve the first RK4 stage reuses.
+    const auto sol = mech_.solve(q_, v_, tau);
+    for (std::size_t i = 0; i < forces_.size(); ++i) forces_[i] = mech_.constraintForce(int(i), sol);
+    if (!dyn::step(mech_, options_, tau, q_, v_)) failure_ = "the constraint projection failed";
+    return failure_.empty();
+  }
+  const std::vector<VecN>& forces() const override { return forces_; }
+  std::string failure() const override { return failure_; }
+
+ private:
+  M& mech_;
+  StepOptions options_;
+  VecN q_, v_;
+  std::vector<VecN> forces_;
+  std::string failure_;
+};
+
+// The Bullet reference, built from the same description.
+template <class S>
+class BulletEngine final : public MechanismEngine {
+ public:
+  BulletEngine(const MechanismModel<S>& model, double dt, const VecN& q0, const VecN& v0)
+      : world_(model, dt, q0, v0), forces_(model.constraints.size()) {}
+  void state(VecN& q, VecN& v) const override { world_.state(q, v); }
+  bool step(const VecN& tau) override {
+    world_.step(tau);
+    for (std::size_t i = 0; i < forces_.size(); ++i) forces_[i] = world_.constraintForce(int(i));
+    return true;
+  }
+  const std::vector<VecN>& forces() const override { return forces_; }
+  std::string describe() const { return world_.describe(); }
+
+ private:
+  bullet::BulletMechanism<S> world_;
+  std::vector<VecN> forces_;
+};
+
+// Everything the lab's trace row and sensors may read about one step.
+struct StepRecord {
+  Engine engine;
+  double t;
+  const VecN& q;                     // (θ, x_c) at t
+  const VecN& v;                     // (θ', v_c) at t
+  const VecN& tau;                   // the torque held over the step
+  const std::vector<VecN>& forces;   // each constraint's force over the step
+  double energy, residual, work;     // E(q, v), |φ(q)|∞, ∫ τ·θ' dt up to t
+};
+
+// The lab's part of a run: its control law, its trace row, its sensors.
+class StepHooks {
+ public:
+  virtual ~StepHooks() = default;
+  virtual VecN torque(double t, const VecN& q, const VecN& v) = 0;
+  virtual void row(const StepRecord& r, std::vector<double>& out) = 0;
+  virtual void observe(const StepRecord& r) { (void)r; }
+};
+
+// A run of one engine: the bookkeeping every lab shares. M is the lab's hand mechanism type; it also
+// measures energy and residual of the Bullet run, with the same formulas.
+template <class M>
+class MechanismSimulation final : public Simulation {
+ public:
+  MechanismSimulation(Engine engine, std::unique_ptr<M> model, std::unique_ptr<MechanismEngine> stepper,
+                      std::unique_ptr<StepHooks> hooks, const std::vector<std::string>& columns, double dt, double duration)
+      : engine_(engine), model_(std::move(model)), stepper_(std::move(stepper)), hooks_(std::move(hooks)),
+        columns_(columns), dt_(dt), steps_(std::lround(duration / dt)) {
+    stepper_->state(q_, v_);
+  }
+
+  bool step(std::vector<double>& row) override {
+    if (k_ >= steps_ || !failure_.empty()) return false;
+    const double t = double(k_) * dt_;
+    tau_ = hooks_->torque(t, q_, v_);
+    const double energy = model_->energy(q_, v_), residual = model_->residual(q_);
+    advance();
+    const StepRecord r{engine_, t, q_, v_, tau_, stepper_->forces(), energy, residual, work_};
+    hooks_->row(r, row);
+    // The next state, the work of τ over the step (trapezoid), then what the sensors saw.
+    VecN q1, v1;
+    stepper_->state(q1, v1);
+    const int n = int(tau_.size());
+    work_ += tau_.dot(0.5 * (v_.head(n) + v1.head(n))) * dt_;
+    hooks_->observe(r);
+    q_ = std::move(q1);
+    v_ = std::move(v1);
+    if (!q_.allFinite() || !v_.allFinite())
+      failure_ = engine_ == Engine::Hand ? "the state became non-finite" : "the Bullet state became non-finite";
+    for (std::size_t c = 0; c < row.size() && c < columns_.size(); ++c)
+      if (!std::isfinite(row[c])) {
+        failure_ = columns_[c] + " became non-finite";
+        break;
+      }
+    ++k_;
+    return true;
+  }
+
+  bool advanceEngine() override {
+    if (k_ >= steps_ || !failure_.empty()) return false;
+    advance();
+    stepper_->state(q_, v_);
+    ++k_;
+    return true;
+  }
+
+  std::string failure() const override { return failure_; }
+  M& model() { return *model_; }
+
+ private:
+  void advance() {
+    if (!stepper_->step(tau_) && failure_.empty()) failure_ = stepper_->failure();
+  }
+  Engine engine_;
+  std::unique_ptr<M> model_;
+  std::unique_ptr<MechanismEngine> stepper_;
+  std::unique_ptr<StepHooks> hooks_;
+  std::vector<std::string> columns_;
+  double dt_;
+  long steps_, k_ = 0;
+  VecN q_, v_, tau_;
+  double work_ = 0;
+  std::string failure_;
+};
+
+}  // namespace dyn
