@@ -186,8 +186,16 @@ struct BulletMechanism<Planar>::Impl {
 
   // Description state → Bullet coordinates; cut joints keep the description's own angle.
   void setState(const VecN& q, const VecN& v) {
+    std::vector<LinkMotion> described;  // floating links' guides take their poses at (q, v)
+    descriptionMotion(model, q, v, described);
     for (int k = 0; k < int(plan.links.size()); ++k) {
       const PlanLink& l = plan.links[std::size_t(k)];
+      if (l.floating >= 0) {
+        const LinkMotion& d = described[std::size_t(l.floating)];
+        const int a = l.floating_axis;
+        body->setJointPos(k, a < 2 ? d.c[a] : d.phi);
+        body->setJointVel(k, a < 2 ? d.v[a] : d.omega);
+      }
       if (l.coord < 0) continue;
       body->setJointPos(k, l.sign * q[l.coord]);
       body->setJointVel(k, l.sign * v[l.coord]);

@@ -39,6 +39,7 @@ struct Builder {
   Plan plan;
   std::vector<Edge> edges;
   std::vector<char> in_tree;
+  int floating = 0;
 
   explicit Builder(const MechanismModel<Planar>& model) : m(model), n(model.tree.dof()) {}
 
@@ -143,6 +144,25 @@ struct Builder {
     return int(plan.links.size()) - 1;
   }
 
+  // Massless prismatic x then y from the world; returns the y link (the ψ link hangs from it).
+  int addPlanarGuide(int coord_x, int coord_y, int floating) {
+    PlanLink x, y;
+    x.joint = y.joint = PlanLink::Joint::Prismatic;
+    x.axis = Vec2::UnitX(), x.coord = coord_x, x.floating = floating, x.floating_axis = 0;
+    y.parent = addLink(x);
+    y.axis = Vec2::UnitY(), y.coord = coord_y, y.floating = floating, y.floating_axis = 1;
+    return addLink(y);
+  }
+  // A tree body with no path to the world: floating on a planar guide, revolute at its centre of mass.
+  int addFloating(int i) {
+    PlanLink l;
+    l.parent = addPlanarGuide(-1, -1, i);
+    l.joint = PlanLink::Joint::Revolute, l.body = BodyRef::link(i), l.floating = i, l.floating_axis = 2;
+    massOf(l.body, l.mass, l.inertia);
+    ++floating;
+    return addLink(l);
+  }
+
   // The payload's guide from the world: its free coordinate(s) as Bullet joints.
   int addGuide(int j) {
     const Payload& p = m.payloads[std::size_t(j)];
@@ -153,11 +173,8 @@ struct Builder {
     l.inertia = p.inertia;
     const double psi = p.pose0[0];
     if (p.dof() == 3) {  // x, y (massless guide links), then ψ on the payload itself
-      PlanLink x, y;
-      x.joint = y.joint = PlanLink::Joint::Prismatic;
-      x.axis = Vec2::UnitX(), x.coord = off + 1;
-      y.parent = addLink(x), y.axis = Vec2::UnitY(), y.coord = off + 2;
-      l.parent = addLink(y), l.joint = PlanLink::Joint::Revolute, l.coord = off;
+      l.parent = addPlanarGuide(off + 1, off + 2, -1);
+      l.joint = PlanLink::Joint::Revolute, l.coord = off;
     } else if (p.free[0]) {
       l.joint = PlanLink::Joint::Revolute, l.e = p.pose0.tail<2>(), l.coord = off;
     } else {
@@ -210,7 +227,14 @@ struct Builder {
     std::vector<int> link_of(std::size_t(nodes), -2);
     link_of[0] = kWorldLink;
     std::deque<int> queue{0};
-    while (!queue.empty()) {
+    for (int next = 1;;) {
+      // A part left without a path to the world floats from its first body (payloads never do).
+      if (queue.empty()) {
+        while (next < nodes && link_of[std::size_t(next)] != -2) ++next;
+        if (next >= nodes) break;
+        link_of[std::size_t(next)] = addFloating(next - 1);
+        queue.push_back(next);
+      }
       const int u = queue.front();
       queue.pop_front();
       for (std::size_t k = 0; k < edges.size(); ++k) {
@@ -225,10 +249,6 @@ struct Builder {
         queue.push_back(w);
       }
     }
-    for (int w = 1; w < nodes; ++w)
-      if (link_of[std::size_t(w)] == -2)
-        throw std::invalid_argument("BulletMechanism: " + name(body(w)) +
-                                    " is not held to the world by tree joints, guides or welds (Bullet's tree has a fixed base)");
     plan.link_of_tree_body.assign(link_of.begin() + 1, link_of.begin() + 1 + n);
     plan.link_of_payload.assign(link_of.begin() + 1 + n, link_of.end());
   }
@@ -288,6 +308,7 @@ struct Builder {
     int welds = 0, points = 0;
     for (int w : plan.weld_link) welds += w >= 0;
     for (const auto& c : plan.constraints) points += c.cut_joint < 0;
+    if (floating) s << ", " << floating << " floating part(s) on planar guides";
     if (welds) s << ", " << welds << " weld(s) as fixed joints";
     if (points) s << ", " << points << " point-to-point constraint(s)";
     s << ", PGS " << m.bullet.solver_iterations << " iterations";
@@ -316,6 +337,36 @@ struct Builder {
 }  // namespace
 
 Plan makePlan(const MechanismModel<Planar>& model) { return Builder(model).build(); }
+
+void descriptionMotion(const MechanismModel<Planar>& model, const VecN& q, const VecN& v,
+                       std::vector<LinkMotion>& out) {
+  const int n = model.tree.dof();
+  std::vector<LinkMotion> origin(static_cast<std::size_t>(n));  // body frame origins (c, v) and angles
+  out.resize(std::size_t(n));
+  const LinkMotion world;
+  for (int i = 0; i < n; ++i) {
+    const auto& b = model.tree.bodies[std::size_t(i)];
+    const LinkMotion& p = b.parent < 0 ? world : origin[std::size_t(b.parent)];
+    const auto& E = b.X_tree.E;
+    const bool rev = b.joint == JointType::Revolute;
+    LinkMotion& o = origin[std::size_t(i)];
+    // Joint frame at the parent's X_tree, then the joint's own rotation or slide.
+    o.phi = p.phi + std::atan2(E(0, 1), E(0, 0)) + (rev ? q[i] : 0.0);
+    o.omega = p.omega + (rev ? v[i] : 0.0);
+    const Vec2 r = rotate(p.phi, b.X_tree.r);
+    const Vec2 slide = rev ? Vec2::Zero() : rotate(o.phi, b.axis.normalized());
+    o.c = p.c + r + slide * q[i];
+    o.v = p.v + p.omega * perp(r) + o.omega * perp(slide) * q[i] + slide * v[i];
+    // Its centre of mass.
+    double m;
+    Vec2 c;
+    Planar::massAndCom(b.inertia, m, c);
+    const Vec2 rc = rotate(o.phi, c);
+    out[std::size_t(i)] = o;
+    out[std::size_t(i)].c = o.c + rc;
+    out[std::size_t(i)].v = o.v + o.omega * perp(rc);
+  }
+}
 
 void planarKinematics(const Plan& plan, const std::vector<double>& q, const std::vector<double>& qd,
                       const std::vector<double>* qdd, std::vector<LinkMotion>& out) {

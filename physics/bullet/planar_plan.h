@@ -12,6 +12,11 @@
 // its centre of mass, δ its angle in the parent at q = 0. Bullet's zero is the description's zero
 // (θ = 0, payload pose with its free coordinates 0), so q = sign × (description coordinate).
 // Joints traversed child → parent have sign −1 (Bullet's parent is the description's child).
+// Floating parts. A payload with all three coordinates free, and the root link of every part of the
+// trees that cutting leaves without a path to the world, hang from the world by massless guide links
+// (prismatic x, prismatic y, revolute ψ at the body's centre of mass): one fixed-base btMultiBody
+// carries everything. A floating link's guide coordinates are not description coordinates: they are
+// set from the description's pose of that link at q0 (descriptionMotion) and read back as poses.
 #pragma once
 #include <Eigen/Core>
 #include <string>
@@ -36,6 +41,8 @@ struct PlanLink {
   int coord = -1;                                  // description coordinate it moves (−1: fixed)
   double sign = 1;                                 // q_bullet = sign × coordinate
   int tree_joint = -1;                             // description tree joint it realises (−1: none)
+  int floating = -1;                               // guide of floating tree body `floating`
+  int floating_axis = -1;                          //   along its centre of mass x (0), y (1) or angle (2)
   int weld = -1;                                   // description constraint it realises (fixed joint)
 };
 
@@ -75,6 +82,10 @@ struct LinkMotion {
 // q, qd, qdd: one value per link (fixed links ignored); qdd may be null (accelerations left 0).
 void planarKinematics(const Plan& plan, const std::vector<double>& q, const std::vector<double>& qd,
                       const std::vector<double>* qdd, std::vector<LinkMotion>& out);
+
+// World pose and motion (centre of mass) of every TreeModel body at description state (q, v).
+void descriptionMotion(const MechanismModel<Planar>& model, const VecN& q, const VecN& v,
+                       std::vector<LinkMotion>& out);
 
 Eigen::Vector2d rotate(double angle, const Eigen::Vector2d& v);
 inline Eigen::Vector2d perp(const Eigen::Vector2d& v) { return {-v.y(), v.x()}; }  // ẑ × v
