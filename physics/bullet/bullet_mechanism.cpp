@@ -1,6 +1,7 @@
 // Bullet 3.24 (double precision) reference model of a planar mechanism description, built from the
-// plan of planar_plan.h: one fixed-base btMultiBody (links at their centres of mass, revolute axes z)
-// and btMultiBodyPoint2Point constraints for cut revolute joints and point attachments.
+// plan of planar_plan.h: one fixed-base btMultiBody (links at their centres of mass, revolute axes z),
+// btMultiBodyPoint2Point constraints for cut revolute joints and point attachments, and
+// btMultiBodyFixedConstraint for welds that close a loop.
 //
 // Settings (shared/notes/bullet-reference.md): gravity from the description, PGS with
 // BulletHints::solver_iterations, no damping, no joint-speed cap, never sleep, a collider with mask 0
@@ -15,6 +16,9 @@
 //
 // Constraint forces f (body a on body b, world axes, planar (τ, f_x, f_y) at its point):
 //   point-to-point   Bullet's A receives −λ/dt, B +λ/dt (rows world x, y), no moment;
+//   fixed constraint the opposite: A receives +λ/dt and the moment +λ_5/dt (row 5: A's frame z = world
+//                    z), B −λ/dt, −λ_5/dt (sign found by the slider's own Newton equation in the
+//                    tests); reported at point_b's world position;
 //   weld realised as the fixed joint P → C: Newton–Euler of the Bullet subtree S beyond it,
 //     F_PC = Σ_S m_k (a_k − g) − F_ext,   M_PC = Σ_S [(c_k − p) × m_k (a_k − g) + I_k α_k] − M_ext(p),
 //   with the link accelerations of the step Bullet took: (q_n, v_n) and a = (v_{n+1} − v_n)/dt on
@@ -27,6 +31,7 @@
 #include <BulletDynamics/Featherstone/btMultiBody.h>
 #include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
 #include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
+#include <BulletDynamics/Featherstone/btMultiBodyFixedConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
 #include <BulletDynamics/Featherstone/btMultiBodyPoint2Point.h>
 
@@ -34,6 +39,7 @@
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
+#include <tuple>
 
 #include "physics/bullet/planar_plan.h"
 
@@ -79,7 +85,7 @@ struct BulletMechanism<Planar>::Impl {
   std::unique_ptr<btMultiBody> body;
   std::unique_ptr<btSphereShape> shape;
   std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders;
-  std::vector<std::unique_ptr<btMultiBodyPoint2Point>> closures;
+  std::vector<std::unique_ptr<btMultiBodyConstraint>> closures;
 
   Impl(const MechanismModel<Planar>& m, double step, const VecN& q0, const VecN& v0)
       : model(m), plan(makePlan(m)), dt(step) {
@@ -162,10 +168,20 @@ struct BulletMechanism<Planar>::Impl {
 
     // Cut joints and point attachments: point-to-point (to the world: pivot_b in world coordinates).
     for (const PlanConstraint& pc : plan.constraints) {
-      auto c = pc.link_b == kWorldLink
-                   ? std::make_unique<btMultiBodyPoint2Point>(body.get(), pc.link_a, nullptr, bt(pc.pivot_a), bt(pc.pivot_b))
-                   : std::make_unique<btMultiBodyPoint2Point>(body.get(), pc.link_a, body.get(), pc.link_b,
-                                                               bt(pc.pivot_a), bt(pc.pivot_b));
+      const btVector3 pa = bt(pc.pivot_a), pb = bt(pc.pivot_b);
+      const btMatrix3x3 frame = btMatrix3x3::getIdentity();  // a weld keeps the body frames aligned
+      std::unique_ptr<btMultiBodyConstraint> c;
+      if (pc.kind == PlanConstraint::Kind::Weld)
+        c = pc.link_b == kWorldLink
+                ? std::unique_ptr<btMultiBodyConstraint>(
+                      new btMultiBodyFixedConstraint(body.get(), pc.link_a, nullptr, pa, pb, frame, frame))
+                : std::unique_ptr<btMultiBodyConstraint>(
+                      new btMultiBodyFixedConstraint(body.get(), pc.link_a, body.get(), pc.link_b, pa, pb, frame, frame));
+      else
+        c = pc.link_b == kWorldLink
+                ? std::unique_ptr<btMultiBodyConstraint>(new btMultiBodyPoint2Point(body.get(), pc.link_a, nullptr, pa, pb))
+                : std::unique_ptr<btMultiBodyConstraint>(
+                      new btMultiBodyPoint2Point(body.get(), pc.link_a, body.get(), pc.link_b, pa, pb));
       c->setMaxAppliedImpulse(1e12);  // pitfall 2: default cap is 100 N·s per step
       world->addMultiBodyConstraint(c.get());
       c->finalizeMultiDof();
@@ -296,9 +312,14 @@ struct BulletMechanism<Planar>::Impl {
     constraintForces(start);
   }
 
-  // Force the constraint applies to Bullet's A (−λ/dt) and B (+λ/dt), world axes.
+  // Force and moment constraint c applied to Bullet's B over the step (A receives the opposite), world
+  // axes. Point-to-point: +λ/dt; fixed constraint: −λ/dt (its rows are written for A), moment row 5.
+  double signOnB(std::size_t c) const { return plan.constraints[c].kind == PlanConstraint::Kind::Weld ? -1.0 : 1.0; }
   Vec2 impulseForce(std::size_t c) const {
-    return Vec2(closures[c]->getAppliedImpulse(0), closures[c]->getAppliedImpulse(1)) / dt;
+    return signOnB(c) * Vec2(closures[c]->getAppliedImpulse(0), closures[c]->getAppliedImpulse(1)) / dt;
+  }
+  double impulseMoment(std::size_t c) const {
+    return plan.constraints[c].kind == PlanConstraint::Kind::Weld ? -closures[c]->getAppliedImpulse(5) / dt : 0.0;
   }
 
   void constraintForces(const std::vector<LinkMotion>& start) {
@@ -306,7 +327,7 @@ struct BulletMechanism<Planar>::Impl {
       const PlanConstraint& pc = plan.constraints[c];
       if (pc.constraint < 0) continue;
       const Vec2 f = pc.sign * impulseForce(c);
-      force[std::size_t(pc.constraint)] = {0.0, f.x(), f.y()};
+      force[std::size_t(pc.constraint)] = {pc.sign * impulseMoment(c), f.x(), f.y()};
     }
     for (std::size_t c = 0; c < plan.weld_link.size(); ++c)
       if (plan.weld_link[c] >= 0) force[c] = weldForce(int(c), start);
@@ -336,12 +357,13 @@ struct BulletMechanism<Planar>::Impl {
     for (std::size_t c2 = 0; c2 < plan.constraints.size(); ++c2) {
       const PlanConstraint& pc = plan.constraints[c2];
       const Vec2 lambda = impulseForce(c2);
-      for (const auto& [link, pivot, f] : {std::tuple{pc.link_a, pc.pivot_a, Vec2(-lambda)},
-                                           std::tuple{pc.link_b, pc.pivot_b, Vec2(lambda)}}) {
+      const double mu = impulseMoment(c2);
+      for (const auto& [link, pivot, f, n] : {std::tuple{pc.link_a, pc.pivot_a, Vec2(-lambda), -mu},
+                                              std::tuple{pc.link_b, pc.pivot_b, Vec2(lambda), mu}}) {
         if (link < 0 || !in[std::size_t(link)]) continue;
         const LinkMotion& s = start[std::size_t(link)];
         F -= f;
-        M -= cross(s.c + rotate(s.phi, pivot) - p, f);
+        M -= n + cross(s.c + rotate(s.phi, pivot) - p, f);
       }
     }
     // F, M: what the parent P applies to C; the description wants a on b.

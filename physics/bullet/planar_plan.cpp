@@ -4,7 +4,8 @@
 //   joint i, forward  (P = parent, C = i)   e = r − c_P,  d = c_i,      δ = β,  q = +θ_i
 //   joint i, reversed (P = i, C = parent)   e = −c_i,     d = c_P − r,  δ = −β, q = −θ_i
 //                                           (prismatic axis, in C's frame: R(β) axis)
-//   weld (a held on b, frames aligned)      e = p_P − c_P, d = c_C − p_C, δ = 0
+//   weld (a held on b, frames aligned)      e = p_P − c_P, d = c_C − p_C, δ = 0 (a weld left out of
+//                                           the tree: a btMultiBodyFixedConstraint)
 //   payload guide (world → payload)         pivot at pose0 with the free coordinate set to 0, q = it
 #include "physics/bullet/planar_plan.h"
 
@@ -269,10 +270,6 @@ struct Builder {
       const Attachment<Planar> at = m.constraints[std::size_t(c)]->attachment();
       PlanConstraint pc;
       pc.kind = at.rows[0] ? PlanConstraint::Kind::Weld : PlanConstraint::Kind::Point;
-      if (pc.kind == PlanConstraint::Kind::Weld)
-        throw std::invalid_argument("BulletMechanism: constraint " + std::to_string(c) + " (" +
-                                    m.constraints[std::size_t(c)]->kind() +
-                                    ") is a weld that closes a loop: not supported; cut a tree joint instead");
       const bool swap = at.a.isWorld();  // Bullet's A must be a link
       pc.link_a = linkOf(swap ? at.b : at.a), pc.link_b = linkOf(swap ? at.a : at.b);
       pc.pivot_a = (swap ? at.point_b : at.point_a) - com(swap ? at.b : at.a);
@@ -310,7 +307,10 @@ struct Builder {
     for (const auto& c : plan.constraints) points += c.cut_joint < 0;
     if (floating) s << ", " << floating << " floating part(s) on planar guides";
     if (welds) s << ", " << welds << " weld(s) as fixed joints";
-    if (points) s << ", " << points << " point-to-point constraint(s)";
+    const int loop_welds = int(std::count_if(plan.constraints.begin(), plan.constraints.end(),
+                                             [](const PlanConstraint& c) { return c.kind == PlanConstraint::Kind::Weld; }));
+    if (points - loop_welds) s << ", " << points - loop_welds << " point-to-point constraint(s)";
+    if (loop_welds) s << ", " << loop_welds << " btMultiBodyFixedConstraint(s)";
     s << ", PGS " << m.bullet.solver_iterations << " iterations";
     plan.summary = s.str();
   }

@@ -46,7 +46,8 @@ struct PlanLink {
   int weld = -1;                                   // description constraint it realises (fixed joint)
 };
 
-// A Bullet multibody constraint between two links (kWorldLink: the world, pivot in world coordinates).
+// A Bullet multibody constraint between two links (kWorldLink: the world, pivot in world coordinates):
+// a point-to-point, or for a weld that closes a loop a btMultiBodyFixedConstraint (frames aligned).
 struct PlanConstraint {
   enum class Kind { Point, Weld };
   Kind kind = Kind::Point;

@@ -372,10 +372,6 @@ TEST_CASE("descriptions Bullet cannot model throw std::invalid_argument naming w
   CHECK(m2.find("constraint 0 (test attachment)") != std::string::npos);
   CHECK(m2.find("rows {ω }") != std::string::npos);
 
-  MechanismModel<Planar> loopWeld = chain({{0.5, 1.0}});
-  loopWeld.constraints.push_back(t::attach(BodyRef::link(0), {0.5, 0}, BodyRef::world(), {0, -0.5}, {true, true, true}));
-  CHECK(message(loopWeld, 1).find("weld that closes a loop") != std::string::npos);
-
   MechanismModel<Planar> slide;
   slide.tree.addBody(-1, JointType::Prismatic, {1.0, 0.0}, {}, Planar::inertia(1, {0, 0}, 0.1));
   slide.bullet.cut_joints = {0};
@@ -384,4 +380,33 @@ TEST_CASE("descriptions Bullet cannot model throw std::invalid_argument naming w
 
   CHECK_THROWS_AS(BulletMechanism<dyn::Spatial>(MechanismModel<dyn::Spatial>{}, 1e-3, VecN(), VecN()),
                   std::invalid_argument);
+}
+
+TEST_CASE("a weld that closes a loop becomes a btMultiBodyFixedConstraint with the same force") {
+  // The slider crank uncut: Bullet's tree is the arm from the world plus the slider on its guide, and
+  // the tip weld is a fixed constraint. From rest, one converged step gives the constrained solve's
+  // force in both models, so the fixed constraint's read-out (sign, moment row) must match the weld
+  // read by Newton–Euler in the cut model.
+  for (double th1 : {45.0, 20.0, -30.0}) {
+    const t::SliderCrankModel p = crankParams(th1);
+    const Vector2d s = t::sliderOf(p, p.q0, p.qd0);
+    VecN q0(4), v0 = VecN::Zero(4);
+    q0 << p.q0, s[0];
+    MechanismModel<Planar> uncut = t::sliderCrankDescription(p);
+    uncut.bullet.cut_joints.clear();
+    uncut.bullet.solver_iterations = 100;
+    BulletMechanism<Planar> loop(uncut, 1e-3, q0, v0);
+    t::SliderCrankMechanism tree(p, 1e-3);
+    loop.step(VecN::Zero(3));
+    tree.step(Vector3d::Zero());
+    VecN q, v;
+    loop.state(q, v);
+    const Vector3d f = loop.constraintForce(0), ft = tree.tipForce();
+    MESSAGE(loop.describe() << "\nθ1 = " << th1 << "°: fixed constraint f_T = " << f.transpose()
+                            << ", weld in the tree f_T = " << ft.transpose());
+    // Measured 0.2 %: the fixed constraint's redundant out-of-plane rows and position error terms
+    // (notes: the weld-closed tree is the least accurate Bullet model); the weld in the tree is ~1e-8.
+    CHECK((f - ft).norm() < 5e-3 * ft.norm());
+    CHECK(f[1] == doctest::Approx(p.load_mass * v[3] / 1e-3).epsilon(1e-9));  // the slider's Newton equation
+  }
 }
