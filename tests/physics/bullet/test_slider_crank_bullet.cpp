@@ -1,7 +1,9 @@
-// Tests of the Bullet slider crank (physics/bullet) against a small independent model of the
-// lecture's equations written here: planar recursive Newton–Euler for M, Cθ'+G and the tip
-// wrench, the tip Jacobian J, and the constrained solve of eq. (2) with the load separate.
-#include "physics/bullet/slider_crank_bullet.h"
+// Tests of the Bullet slider crank against a small independent model of the lecture's equations
+// written here: planar recursive Newton–Euler for M, Cθ'+G and the tip wrench, the tip Jacobian J,
+// and the constrained solve of eq. (2) with the load separate. The Bullet model is built from the
+// slider crank's description by BulletMechanism (slider_crank_description.h); the equivalence with
+// the hand-made physics/bullet/slider_crank_bullet.* is tested in test_bullet_mechanism.cpp.
+#include "tests/physics/bullet/slider_crank_description.h"
 
 #include <doctest/doctest.h>
 
@@ -9,9 +11,9 @@
 #include <cmath>
 #include <numbers>
 
-using dyn::bullet::PlanarLink;
-using dyn::bullet::SliderCrankBullet;
-using dyn::bullet::SliderCrankModel;
+using dyn::bullet::test::PlanarLink;
+using dyn::bullet::test::SliderCrankModel;
+using SliderCrankBullet = dyn::bullet::test::SliderCrankMechanism;
 using Eigen::Matrix3d;
 using Eigen::Vector2d;
 using Eigen::Vector3d;

@@ -1,0 +1,418 @@
+// Bullet 3.24 (double precision) reference model of a planar mechanism description, built from the
+// plan of planar_plan.h: one fixed-base btMultiBody (links at their centres of mass, revolute axes z),
+// btMultiBodyPoint2Point constraints for cut revolute joints and point attachments, and
+// btMultiBodyFixedConstraint for welds that close a loop.
+//
+// Settings (shared/notes/bullet-reference.md): gravity from the description, PGS with
+// BulletHints::solver_iterations, no damping, no joint-speed cap, never sleep, a collider with mask 0
+// on every link (pitfall 1: multibody constraints are ignored without them), impulse cap 1e12, and
+// exactly one stepSimulation(dt, 0, dt) per step.
+//
+// Torques. The description's τ_i acts +τ_i on the child about the joint axis, −τ_i on the parent.
+// On a Bullet joint (which acts +u on its Bullet child): u = sign × τ_i (sign −1 when Bullet's child
+// is the description's parent). On a cut joint: link torques +τ_i on the child, −τ_i on the parent
+// (none on the world). Joint properties add −k(θ − θ_rest) − b θ' − F_c sat(θ'/w), sat = clamp(·,−1,1),
+// from the state at the start of the step.
+//
+// Constraint forces f (body a on body b, world axes, planar (τ, f_x, f_y) at its point):
+//   point-to-point   Bullet's A receives −λ/dt, B +λ/dt (rows world x, y), no moment;
+//   fixed constraint the opposite: A receives +λ/dt and the moment +λ_5/dt (row 5: A's frame z = world
+//                    z), B −λ/dt, −λ_5/dt (sign found by the slider's own Newton equation in the
+//                    tests); reported at point_b's world position;
+//   weld realised as the fixed joint P → C: Newton–Euler of the Bullet subtree S beyond it,
+//     F_PC = Σ_S m_k (a_k − g) − F_ext,   M_PC = Σ_S [(c_k − p) × m_k (a_k − g) + I_k α_k] − M_ext(p),
+//   with the link accelerations of the step Bullet took: (q_n, v_n) and a = (v_{n+1} − v_n)/dt on
+//   Bullet's own tree (its step is M(q_n)(v_{n+1} − v_n)/dt + h(q_n, v_n) = τ + J_c(q_n)ᵀλ/dt, so
+//   these balances hold to rounding). F_ext, M_ext: constraint impulses / dt on links of S at their
+//   pivots and link torques applied to S (joint torques inside S are internal). f = ±F_PC (+ if C = b).
+#include "physics/bullet/bullet_mechanism.h"
+
+#include <btBulletDynamicsCommon.h>
+#include <BulletDynamics/Featherstone/btMultiBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
+#include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
+#include <BulletDynamics/Featherstone/btMultiBodyFixedConstraint.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
+#include <BulletDynamics/Featherstone/btMultiBodyPoint2Point.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <tuple>
+
+#include "physics/bullet/planar_plan.h"
+
+#ifndef BT_USE_DOUBLE_PRECISION
+#error "bullet_mechanism.cpp must be built against bullet-float64 (BT_USE_DOUBLE_PRECISION)"
+#endif
+
+namespace dyn::bullet {
+namespace {
+
+using Vec2 = Eigen::Vector2d;
+
+btVector3 bt(const Vec2& v) { return {v.x(), v.y(), 0.0}; }
+btVector3 inertia3(double izz) { return {izz, izz, izz}; }  // out-of-plane values only need to be ≥ 0
+btQuaternion rotParentToThis(double delta) {
+  return delta == 0.0 ? btQuaternion::getIdentity() : btQuaternion(btVector3(0, 0, 1), -delta);
+}
+// The same angle modulo 2π, nearest to `near` (exact when no turn is added).
+double unwrap(double raw, double near) {
+  constexpr double kTurn = 2.0 * std::numbers::pi;
+  return raw + kTurn * std::round((near - raw) / kTurn);
+}
+
+}  // namespace
+
+template <>
+struct BulletMechanism<Planar>::Impl {
+  MechanismModel<Planar> model;
+  Plan plan;
+  double dt;
+  std::vector<int> joint_link;                    // per tree joint: its Bullet link (−1: cut)
+  std::vector<double> qb, qdb;                    // Bullet coordinates per link (0 for fixed links)
+  std::vector<LinkMotion> now;                    // link motion at the current state
+  std::vector<double> cut_theta;                  // per tree joint: unwrapped angle if cut
+  std::vector<double> link_torque;                // link torques applied over the last step
+  std::vector<Planar::Vec> force;                 // per description constraint, last step
+
+  std::unique_ptr<btDefaultCollisionConfiguration> config;
+  std::unique_ptr<btCollisionDispatcher> dispatcher;
+  std::unique_ptr<btDbvtBroadphase> broadphase;
+  std::unique_ptr<btMultiBodyConstraintSolver> solver;
+  std::unique_ptr<btMultiBodyDynamicsWorld> world;
+  std::unique_ptr<btMultiBody> body;
+  std::unique_ptr<btSphereShape> shape;
+  std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders;
+  std::vector<std::unique_ptr<btMultiBodyConstraint>> closures;
+
+  Impl(const MechanismModel<Planar>& m, double step, const VecN& q0, const VecN& v0)
+      : model(m), plan(makePlan(m)), dt(step) {
+    if (!(dt > 0.0)) throw std::invalid_argument("BulletMechanism: dt must be > 0");
+    if (q0.size() != plan.coordinates || v0.size() != plan.coordinates)
+      throw std::invalid_argument("BulletMechanism: q0 and v0 need " + std::to_string(plan.coordinates) +
+                                  " coordinates (tree joints, then payload free coordinates)");
+    if (!m.joints.empty() && int(m.joints.size()) != m.treeDof())
+      throw std::invalid_argument("BulletMechanism: joints must be empty or one per tree joint");
+    if (m.bullet.solver_iterations < 1) throw std::invalid_argument("BulletMechanism: solver_iterations must be ≥ 1");
+    for (int p = 0; p < int(m.payloads.size()); ++p)
+      if (!(m.payloads[std::size_t(p)].mass > 0.0) || !(m.payloads[std::size_t(p)].inertia > 0.0))
+        throw std::invalid_argument("BulletMechanism: payload " + std::to_string(p) + " needs mass and inertia > 0");
+    joint_link.assign(std::size_t(m.treeDof()), -1);
+    for (int k = 0; k < int(plan.links.size()); ++k)
+      if (plan.links[std::size_t(k)].tree_joint >= 0) joint_link[std::size_t(plan.links[std::size_t(k)].tree_joint)] = k;
+    force.assign(m.constraints.size(), Planar::Vec::Zero());
+    link_torque.assign(plan.links.size(), 0.0);
+
+    config = std::make_unique<btDefaultCollisionConfiguration>();
+    dispatcher = std::make_unique<btCollisionDispatcher>(config.get());
+    broadphase = std::make_unique<btDbvtBroadphase>();
+    solver = std::make_unique<btMultiBodyConstraintSolver>();
+    world = std::make_unique<btMultiBodyDynamicsWorld>(dispatcher.get(), broadphase.get(), solver.get(), config.get());
+    world->setGravity(bt(plan.gravity));  // pitfall 2: Bullet's default is (0, −10, 0)
+    world->getSolverInfo().m_numIterations = m.bullet.solver_iterations;
+    build();
+    setState(q0, v0);
+  }
+
+  ~Impl() {
+    if (world) {
+      for (auto& c : closures) world->removeMultiBodyConstraint(c.get());
+      for (auto& c : colliders) world->removeCollisionObject(c.get());
+      if (body) world->removeMultiBody(body.get());
+    }
+    closures.clear();
+    colliders.clear();
+    body.reset();
+    world.reset();
+  }
+
+  void build() {
+    const int n = int(plan.links.size());
+    body = std::make_unique<btMultiBody>(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true, /*canSleep=*/false);
+    body->setBaseWorldTransform(btTransform::getIdentity());
+    for (int k = 0; k < n; ++k) {
+      const PlanLink& l = plan.links[std::size_t(k)];
+      const btQuaternion rot = rotParentToThis(l.delta);
+      if (l.joint == PlanLink::Joint::Revolute)
+        body->setupRevolute(k, l.mass, inertia3(l.inertia), l.parent, rot, btVector3(0, 0, 1), bt(l.e), bt(l.d), true);
+      else if (l.joint == PlanLink::Joint::Prismatic)
+        body->setupPrismatic(k, l.mass, inertia3(l.inertia), l.parent, rot, bt(l.axis), bt(l.e), bt(l.d), true);
+      else
+        body->setupFixed(k, l.mass, inertia3(l.inertia), l.parent, rot, bt(l.e), bt(l.d));
+    }
+    body->finalizeMultiDof();
+    // Pitfall 2: no damping, no velocity cap, never sleep.
+    body->setLinearDamping(0.0);
+    body->setAngularDamping(0.0);
+    body->setMaxCoordinateVelocity(1e6);
+    body->setCanSleep(false);
+    body->setHasSelfCollision(false);
+    body->setUseGyroTerm(true);
+    world->addMultiBody(body.get());
+
+    // Pitfall 1: every link needs a collider for the constraints to act; mask 0 = no contacts.
+    shape = std::make_unique<btSphereShape>(0.01);
+    for (int i = -1; i < n; ++i) {
+      auto c = std::make_unique<btMultiBodyLinkCollider>(body.get(), i);
+      c->setCollisionShape(shape.get());
+      c->setActivationState(DISABLE_DEACTIVATION);
+      world->addCollisionObject(c.get(), btBroadphaseProxy::DefaultFilter, 0);
+      if (i < 0)
+        body->setBaseCollider(c.get());
+      else
+        body->getLink(i).m_collider = c.get();
+      colliders.push_back(std::move(c));
+    }
+
+    // Cut joints and point attachments: point-to-point (to the world: pivot_b in world coordinates).
+    for (const PlanConstraint& pc : plan.constraints) {
+      const btVector3 pa = bt(pc.pivot_a), pb = bt(pc.pivot_b);
+      const btMatrix3x3 frame = btMatrix3x3::getIdentity();  // a weld keeps the body frames aligned
+      std::unique_ptr<btMultiBodyConstraint> c;
+      if (pc.kind == PlanConstraint::Kind::Weld)
+        c = pc.link_b == kWorldLink
+                ? std::unique_ptr<btMultiBodyConstraint>(
+                      new btMultiBodyFixedConstraint(body.get(), pc.link_a, nullptr, pa, pb, frame, frame))
+                : std::unique_ptr<btMultiBodyConstraint>(
+                      new btMultiBodyFixedConstraint(body.get(), pc.link_a, body.get(), pc.link_b, pa, pb, frame, frame));
+      else
+        c = pc.link_b == kWorldLink
+                ? std::unique_ptr<btMultiBodyConstraint>(new btMultiBodyPoint2Point(body.get(), pc.link_a, nullptr, pa, pb))
+                : std::unique_ptr<btMultiBodyConstraint>(
+                      new btMultiBodyPoint2Point(body.get(), pc.link_a, body.get(), pc.link_b, pa, pb));
+      c->setMaxAppliedImpulse(1e12);  // pitfall 2: default cap is 100 N·s per step
+      world->addMultiBodyConstraint(c.get());
+      c->finalizeMultiDof();
+      closures.push_back(std::move(c));
+    }
+  }
+
+  void readBullet() {
+    qb.assign(plan.links.size(), 0.0);
+    qdb.assign(plan.links.size(), 0.0);
+    for (int k = 0; k < int(plan.links.size()); ++k) {
+      if (plan.links[std::size_t(k)].joint == PlanLink::Joint::Fixed) continue;
+      qb[std::size_t(k)] = body->getJointPos(k);
+      qdb[std::size_t(k)] = body->getJointVel(k);
+    }
+    planarKinematics(plan, qb, qdb, nullptr, now);
+  }
+
+  // Description state → Bullet coordinates; cut joints keep the description's own angle.
+  void setState(const VecN& q, const VecN& v) {
+    std::vector<LinkMotion> described;  // floating links' guides take their poses at (q, v)
+    descriptionMotion(model, q, v, described);
+    for (int k = 0; k < int(plan.links.size()); ++k) {
+      const PlanLink& l = plan.links[std::size_t(k)];
+      if (l.floating >= 0) {
+        const LinkMotion& d = described[std::size_t(l.floating)];
+        const int a = l.floating_axis;
+        body->setJointPos(k, a < 2 ? d.c[a] : d.phi);
+        body->setJointVel(k, a < 2 ? d.v[a] : d.omega);
+      }
+      if (l.coord < 0) continue;
+      body->setJointPos(k, l.sign * q[l.coord]);
+      body->setJointVel(k, l.sign * v[l.coord]);
+    }
+    btAlignedObjectArray<btQuaternion> w2l;
+    btAlignedObjectArray<btVector3> origin;
+    body->forwardKinematics(w2l, origin);
+    body->updateCollisionObjectWorldTransforms(w2l, origin);
+    readBullet();
+    cut_theta.assign(std::size_t(model.treeDof()), 0.0);
+    for (int i : plan.cut_joints) cut_theta[std::size_t(i)] = unwrap(rawCutAngle(i), q[i]);
+    checkKinematics();
+  }
+
+  // Self-check of the plan's kinematics against Bullet's own link frames (catches a convention slip).
+  void checkKinematics() const {
+    for (int k = 0; k < int(plan.links.size()); ++k) {
+      const btTransform& T = colliders[std::size_t(k + 1)]->getWorldTransform();
+      const btVector3 o = T.getOrigin();
+      btScalar yaw, pitch, roll;
+      T.getBasis().getEulerZYX(yaw, pitch, roll);
+      const LinkMotion& m = now[std::size_t(k)];
+      const double dphi = std::remainder(double(yaw) - m.phi, 2.0 * std::numbers::pi);
+      if ((Vec2(o.x(), o.y()) - m.c).norm() > 1e-9 || std::abs(dphi) > 1e-9)
+        throw std::logic_error("BulletMechanism: plan kinematics disagree with Bullet's link " + std::to_string(k));
+    }
+  }
+
+  const LinkMotion& motionOf(int link, const std::vector<LinkMotion>& ms) const {
+    static const LinkMotion world;
+    return link < 0 ? world : ms[std::size_t(link)];
+  }
+
+  // Relative angle of a cut joint's child to its parent, minus the joint frame's own angle.
+  double rawCutAngle(int i) const {
+    const int p = model.tree.bodies[std::size_t(i)].parent;
+    const int lp = p < 0 ? kWorldLink : plan.link_of_tree_body[std::size_t(p)];
+    return motionOf(plan.link_of_tree_body[std::size_t(i)], now).phi - motionOf(lp, now).phi -
+           plan.tree_angle[std::size_t(i)];
+  }
+
+  void state(VecN& q, VecN& v) const {
+    q.resize(plan.coordinates);
+    v.resize(plan.coordinates);
+    for (int k = 0; k < int(plan.links.size()); ++k) {
+      const PlanLink& l = plan.links[std::size_t(k)];
+      if (l.coord < 0) continue;
+      q[l.coord] = l.sign * qb[std::size_t(k)];
+      v[l.coord] = l.sign * qdb[std::size_t(k)];
+    }
+    for (int i : plan.cut_joints) {
+      const int p = model.tree.bodies[std::size_t(i)].parent;
+      const int lp = p < 0 ? kWorldLink : plan.link_of_tree_body[std::size_t(p)];
+      q[i] = cut_theta[std::size_t(i)];
+      v[i] = motionOf(plan.link_of_tree_body[std::size_t(i)], now).omega - motionOf(lp, now).omega;
+    }
+  }
+
+  void step(const VecN& tau_in) {
+    const int n = model.treeDof();
+    if (tau_in.size() != n) throw std::invalid_argument("BulletMechanism::step: τ needs one value per tree joint");
+    VecN q, v;
+    state(q, v);
+    std::fill(link_torque.begin(), link_torque.end(), 0.0);
+    for (int i = 0; i < n; ++i) {
+      double tau = tau_in[i];
+      if (!model.joints.empty()) {  // spring, viscous and Coulomb friction from the step's start
+        const JointProperties& jp = model.joints[std::size_t(i)];
+        tau -= jp.stiffness * (q[i] - jp.rest) + jp.viscous * v[i] +
+               jp.coulomb * std::clamp(v[i] / jp.coulomb_width, -1.0, 1.0);
+      }
+      // Pitfall 3: applied torques are cleared after each step; apply them every step.
+      const int k = joint_link[std::size_t(i)];
+      if (k >= 0) {
+        body->addJointTorque(k, plan.links[std::size_t(k)].sign * tau);
+        continue;
+      }
+      const int p = model.tree.bodies[std::size_t(i)].parent;
+      const int lc = plan.link_of_tree_body[std::size_t(i)];
+      body->addLinkTorque(lc, btVector3(0, 0, tau));
+      link_torque[std::size_t(lc)] += tau;
+      if (p >= 0) {
+        const int lp = plan.link_of_tree_body[std::size_t(p)];
+        body->addLinkTorque(lp, btVector3(0, 0, -tau));
+        link_torque[std::size_t(lp)] -= tau;
+      }
+    }
+    const std::vector<double> q0 = qb, v0 = qdb;
+    world->stepSimulation(dt, 0, dt);  // exactly one step of dt
+    readBullet();
+    for (int i : plan.cut_joints) cut_theta[std::size_t(i)] = unwrap(rawCutAngle(i), cut_theta[std::size_t(i)]);
+
+    // The step Bullet took: accelerations on its tree at (q_n, v_n).
+    std::vector<double> qdd(qb.size());
+    for (std::size_t k = 0; k < qb.size(); ++k) qdd[k] = (qdb[k] - v0[k]) / dt;
+    std::vector<LinkMotion> start;
+    planarKinematics(plan, q0, v0, &qdd, start);
+    constraintForces(start);
+  }
+
+  // Force and moment constraint c applied to Bullet's B over the step (A receives the opposite), world
+  // axes. Point-to-point: +λ/dt; fixed constraint: −λ/dt (its rows are written for A), moment row 5.
+  double signOnB(std::size_t c) const { return plan.constraints[c].kind == PlanConstraint::Kind::Weld ? -1.0 : 1.0; }
+  Vec2 impulseForce(std::size_t c) const {
+    return signOnB(c) * Vec2(closures[c]->getAppliedImpulse(0), closures[c]->getAppliedImpulse(1)) / dt;
+  }
+  double impulseMoment(std::size_t c) const {
+    return plan.constraints[c].kind == PlanConstraint::Kind::Weld ? -closures[c]->getAppliedImpulse(5) / dt : 0.0;
+  }
+
+  void constraintForces(const std::vector<LinkMotion>& start) {
+    for (std::size_t c = 0; c < plan.constraints.size(); ++c) {
+      const PlanConstraint& pc = plan.constraints[c];
+      if (pc.constraint < 0) continue;
+      const Vec2 f = pc.sign * impulseForce(c);
+      force[std::size_t(pc.constraint)] = {pc.sign * impulseMoment(c), f.x(), f.y()};
+    }
+    for (std::size_t c = 0; c < plan.weld_link.size(); ++c)
+      if (plan.weld_link[c] >= 0) force[c] = weldForce(int(c), start);
+  }
+
+  // Newton–Euler of the Bullet subtree beyond the weld's fixed joint (see the top of the file).
+  Planar::Vec weldForce(int c, const std::vector<LinkMotion>& start) const {
+    const int w = plan.weld_link[std::size_t(c)];
+    const PlanLink& lw = plan.links[std::size_t(w)];
+    std::vector<char> in(plan.links.size(), 0);
+    for (int k = w; k < int(plan.links.size()); ++k) {
+      const int p = plan.links[std::size_t(k)].parent;
+      in[std::size_t(k)] = k == w || (p >= 0 && in[std::size_t(p)]);
+    }
+    const LinkMotion& P = motionOf(lw.parent, start);
+    const Vec2 p = P.c + rotate(P.phi, lw.e);  // the weld point
+    Vec2 F = Vec2::Zero();
+    double M = 0;
+    for (std::size_t k = 0; k < plan.links.size(); ++k) {
+      if (!in[k]) continue;
+      const PlanLink& l = plan.links[k];
+      const LinkMotion& s = start[k];
+      const Vec2 D = l.mass * (s.a - plan.gravity);
+      F += D;
+      M += cross(s.c - p, D) + l.inertia * s.alpha - link_torque[k];
+    }
+    for (std::size_t c2 = 0; c2 < plan.constraints.size(); ++c2) {
+      const PlanConstraint& pc = plan.constraints[c2];
+      const Vec2 lambda = impulseForce(c2);
+      const double mu = impulseMoment(c2);
+      for (const auto& [link, pivot, f, n] : {std::tuple{pc.link_a, pc.pivot_a, Vec2(-lambda), -mu},
+                                              std::tuple{pc.link_b, pc.pivot_b, Vec2(lambda), mu}}) {
+        if (link < 0 || !in[std::size_t(link)]) continue;
+        const LinkMotion& s = start[std::size_t(link)];
+        F -= f;
+        M -= n + cross(s.c + rotate(s.phi, pivot) - p, f);
+      }
+    }
+    // F, M: what the parent P applies to C; the description wants a on b.
+    const double sign = lw.body == model.constraints[std::size_t(c)]->attachment().b ? 1.0 : -1.0;
+    return sign * Planar::Vec(M, F.x(), F.y());
+  }
+};
+
+// Spatial mechanisms are not built yet: the constructor says so.
+template <>
+struct BulletMechanism<Spatial>::Impl {
+  void step(const VecN&) {}
+  void state(VecN&, VecN&) const {}
+  Spatial::Vec force(int) const { return Spatial::Vec::Zero(); }
+  std::string describe() const { return {}; }
+};
+
+template <>
+BulletMechanism<Planar>::BulletMechanism(const MechanismModel<Planar>& model, double dt, const VecN& q0, const VecN& v0)
+    : impl_(std::make_unique<Impl>(model, dt, q0, v0)) {}
+template <>
+BulletMechanism<Spatial>::BulletMechanism(const MechanismModel<Spatial>&, double, const VecN&, const VecN&) {
+  throw std::invalid_argument("BulletMechanism: spatial mechanisms: not yet");
+}
+
+template <class S>
+BulletMechanism<S>::~BulletMechanism() = default;
+
+template <>
+void BulletMechanism<Planar>::step(const VecN& tau) { impl_->step(tau); }
+template <>
+void BulletMechanism<Spatial>::step(const VecN& tau) { impl_->step(tau); }
+template <>
+void BulletMechanism<Planar>::state(VecN& q, VecN& v) const { impl_->state(q, v); }
+template <>
+void BulletMechanism<Spatial>::state(VecN& q, VecN& v) const { impl_->state(q, v); }
+template <>
+Planar::Vec BulletMechanism<Planar>::constraintForce(int i) const {
+  if (i < 0 || i >= int(impl_->force.size())) throw std::out_of_range("BulletMechanism::constraintForce: no such constraint");
+  return impl_->force[std::size_t(i)];
+}
+template <>
+Spatial::Vec BulletMechanism<Spatial>::constraintForce(int i) const { return impl_->force(i); }
+template <>
+std::string BulletMechanism<Planar>::describe() const { return impl_->plan.summary; }
+template <>
+std::string BulletMechanism<Spatial>::describe() const { return impl_->describe(); }
+
+template class BulletMechanism<Planar>;
+template class BulletMechanism<Spatial>;
+
+}  // namespace dyn::bullet
