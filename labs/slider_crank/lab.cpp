@@ -6,7 +6,6 @@
 #include <map>
 
 #include "labs/mechanism_simulation.h"
-#include "physics/bullet/slider_crank_bullet.h"
 
 namespace dyn::slider_crank {
 namespace {
@@ -58,39 +57,6 @@ class Hooks final : public StepHooks {
  private:
   const Settings& s_;
   Controller ctrl_;
-};
-
-// The Bullet reference of the slider crank behind the engine face (until the builder takes over).
-class SliderCrankBulletEngine final : public MechanismEngine {
- public:
-  SliderCrankBulletEngine(const Settings& s, const VecN& q, const VecN& v) : forces_(1) {
-    bullet::SliderCrankModel m;
-    for (int i = 0; i < 3; ++i) {
-      const Link& l = s.params.links[std::size_t(i)];
-      m.links[std::size_t(i)] = {l.length, l.mass, l.inertia, l.com};
-    }
-    m.load_mass = s.params.load_mass;
-    m.gravity = s.params.gravity;
-    m.q0 = q.head(3);
-    m.qd0 = v.head(3);
-    world_ = std::make_unique<bullet::SliderCrankBullet>(m, s.step.dt);
-  }
-  void state(VecN& q, VecN& v) const override {
-    q.resize(4);
-    v.resize(4);
-    q << world_->q(), world_->x_c();
-    v << world_->qd(), world_->v_c();
-  }
-  bool step(const VecN& tau) override {
-    world_->step(tau.head(3));
-    forces_[0] = world_->tipForce();  // over the step just taken
-    return true;
-  }
-  const std::vector<VecN>& forces() const override { return forces_; }
-
- private:
-  std::unique_ptr<bullet::SliderCrankBullet> world_;
-  std::vector<VecN> forces_;
 };
 
 double rms(const std::vector<double>& x) {
@@ -205,7 +171,7 @@ std::unique_ptr<Simulation> SliderCrankLab::simulate(Engine engine) const {
   mech->initialState(s_.theta1, s_.theta1_rate, s_.branch, q, v);
   std::unique_ptr<MechanismEngine> stepper;
   if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<Mechanism>>(*mech, s_.step, q, v);
-  else stepper = std::make_unique<SliderCrankBulletEngine>(s_, q, v);
+  else stepper = std::make_unique<BulletEngine<Planar>>(mech->model(), s_.step.dt, q, v);
   return std::make_unique<MechanismSimulation<Mechanism>>(engine, std::move(mech), std::move(stepper),
                                                           std::make_unique<Hooks>(s_), kColumns, s_.step.dt, s_.duration);
 }
