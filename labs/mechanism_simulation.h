@@ -22,8 +22,9 @@ class MechanismEngine {
  public:
   virtual ~MechanismEngine() = default;
   virtual void state(VecN& q, VecN& v) const = 0;
-  // One step with τ held; false (and a sentence in failure()) if the engine could not take it.
-  virtual bool step(const VecN& tau) = 0;
+  // One step with τ held; false (and a sentence in failure()) if the engine could not take it. Without
+  // forces (the bench's engine alone), forces() may keep the last step's.
+  virtual bool step(const VecN& tau, bool with_forces = true) = 0;
   // The force of each constraint over the last step (body a on body b, world axes at its point).
   virtual const std::vector<VecN>& forces() const = 0;
   virtual std::string failure() const { return {}; }
@@ -36,10 +37,12 @@ class HandEngine final : public MechanismEngine {
   HandEngine(M& mech, const StepOptions& options, VecN q0, VecN v0)
       : mech_(mech), options_(options), q_(std::move(q0)), v_(std::move(v0)), forces_(mech.model().constraints.size()) {}
   void state(VecN& q, VecN& v) const override { q = q_, v = v_; }
-  bool step(const VecN& tau) override {
+  bool step(const VecN& tau, bool with_forces) override {
     // The constraint forces at the step's start: the solve the first RK4 stage reuses.
-    const auto sol = mech_.solve(q_, v_, tau);
-    for (std::size_t i = 0; i < forces_.size(); ++i) forces_[i] = mech_.constraintForce(int(i), sol);
+    if (with_forces) {
+      const auto sol = mech_.solve(q_, v_, tau);
+      for (std::size_t i = 0; i < forces_.size(); ++i) forces_[i] = mech_.constraintForce(int(i), sol);
+    }
     if (!dyn::step(mech_, options_, tau, q_, v_)) failure_ = "the constraint projection failed";
     return failure_.empty();
   }
@@ -61,7 +64,8 @@ class BulletEngine final : public MechanismEngine {
   BulletEngine(const MechanismModel<S>& model, double dt, const VecN& q0, const VecN& v0)
       : world_(model, dt, q0, v0), forces_(model.constraints.size()) {}
   void state(VecN& q, VecN& v) const override { world_.state(q, v); }
-  bool step(const VecN& tau) override {
+  bool step(const VecN& tau, bool with_forces) override {
+    (void)with_forces;  // Bullet's impulses come with every step
     world_.step(tau);
     for (std::size_t i = 0; i < forces_.size(); ++i) forces_[i] = world_.constraintForce(int(i));
     return true;
@@ -111,7 +115,7 @@ class MechanismSimulation final : public Simulation {
     const double t = double(k_) * dt_;
     tau_ = hooks_->torque(t, q_, v_);
     const double energy = model_->energy(q_, v_), residual = model_->residual(q_);
-    advance();
+    advance(true);
     const StepRecord r{engine_, t, q_, v_, tau_, stepper_->forces(), energy, residual, work_};
     hooks_->row(r, row);
     // The next state, the work of τ over the step (trapezoid), then what the sensors saw.
@@ -135,7 +139,7 @@ class MechanismSimulation final : public Simulation {
 
   bool advanceEngine() override {
     if (k_ >= steps_ || !failure_.empty()) return false;
-    advance();
+    advance(false);
     stepper_->state(q_, v_);
     ++k_;
     return true;
@@ -145,8 +149,8 @@ class MechanismSimulation final : public Simulation {
   M& model() { return *model_; }
 
  private:
-  void advance() {
-    if (!stepper_->step(tau_) && failure_.empty()) failure_ = stepper_->failure();
+  void advance(bool with_forces) {
+    if (!stepper_->step(tau_, with_forces) && failure_.empty()) failure_ = stepper_->failure();
   }
   Engine engine_;
   std::unique_ptr<M> model_;

@@ -94,6 +94,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
   VecN phi_;
   VecN staged_q_;      // the configuration of the position stage
   bool have_position_ = false;
+  std::vector<double> tree_angle_;  // planar: each placement's fixed rotation angle
   VecN tree_q_;        // the θ that data_'s transforms are at
   bool have_tree_ = false;
   VecN last_q_, last_v_, last_tau_;

@@ -28,6 +28,11 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
   kin_.payload_pose.assign(model_.payloads.size(), Eigen::Vector3d::Zero());
   kin_.payload_rate.assign(model_.payloads.size(), Eigen::Vector3d::Zero());
   kin_.link_bias.assign(std::size_t(n()), Vec::Zero());
+  kin_.payload_cs.assign(model_.payloads.size(), Eigen::Vector2d(1, 0));
+  kin_.link_angle.assign(std::size_t(n()), 0.0);
+  // Planar: the fixed part of each link's angle, its placement's rotation (X_tree.E = rotation(angle)).
+  if constexpr (S::kDim == 3)
+    for (const auto& b : model_.tree.bodies) tree_angle_.push_back(std::atan2(b.X_tree.E(0, 1), b.X_tree.E(0, 0)));
   // The payloads' M_c = diag(I, m, m) on their free coordinates, and G_c = −m g: constant.
   const int kk = k();
   problem_.Mc = MatN::Zero(kk, kk);
@@ -58,10 +63,19 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::positionStage(const VecN& q) {
   tree_q_ = q.head(nn);
   have_tree_ = true;
   problem_.M = crba(model_.tree, data_);
+  // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
+  if constexpr (S::kDim == 3)
+    for (int i = 0; i < nn; ++i) {
+      const auto& b = model_.tree.bodies[std::size_t(i)];
+      kin_.link_angle[std::size_t(i)] = (b.parent < 0 ? 0.0 : kin_.link_angle[std::size_t(b.parent)]) + tree_angle_[std::size_t(i)] +
+                                        (b.joint == JointType::Revolute ? q[i] : 0.0);
+    }
   // Payload poses: the free coordinates from q, the others where they were put.
   for (std::size_t i = 0, off = std::size_t(nn); i < model_.payloads.size(); ++i) {
     const Payload& p = model_.payloads[i];
     for (std::size_t c = 0; c < 3; ++c) kin_.payload_pose[i][Eigen::Index(c)] = p.free[c] ? q[Eigen::Index(off++)] : p.pose0[Eigen::Index(c)];
+    const double psi = kin_.payload_pose[i][0];
+    kin_.payload_cs[i] = p.free[0] || psi != 0.0 ? Eigen::Vector2d(std::cos(psi), std::sin(psi)) : Eigen::Vector2d(1.0, 0.0);
   }
   // Every constraint's φ, J and A rows, then eq. (2) factored at this configuration.
   MatN J = MatN::Zero(rows_, nn), A = MatN::Zero(rows_, kk);

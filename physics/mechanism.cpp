@@ -52,7 +52,7 @@ typename S::Pos MechanismKinematics<S>::position(const BodyRef& b, const Pos& p)
     case BodyRef::Kind::Payload:
       if constexpr (S::kDim == 3) {
         const Eigen::Vector3d& x = payload_pose[std::size_t(b.index)];
-        const double c = std::cos(x[0]), s = std::sin(x[0]);
+        const double c = payload_cs[std::size_t(b.index)].x(), s = payload_cs[std::size_t(b.index)].y();
         return {x[1] + c * p.x() - s * p.y(), x[2] + s * p.x() + c * p.y()};
       }
       return p;
@@ -63,10 +63,7 @@ typename S::Pos MechanismKinematics<S>::position(const BodyRef& b, const Pos& p)
 template <class S>
 double MechanismKinematics<S>::angle(const BodyRef& b) const {
   if constexpr (S::kDim == 3) {
-    if (b.kind == BodyRef::Kind::Link) {
-      const auto& E = tree->X_world[std::size_t(b.index)].E;  // world → body: rotation(−angle)ᵀ
-      return std::atan2(E(0, 1), E(0, 0));
-    }
+    if (b.kind == BodyRef::Kind::Link) return link_angle[std::size_t(b.index)];
     if (b.kind == BodyRef::Kind::Payload) return payload_pose[std::size_t(b.index)][0];
   }
   return 0.0;
@@ -76,7 +73,10 @@ template <class S>
 typename S::Rot MechanismKinematics<S>::rotation(const BodyRef& b) const {
   if (b.kind == BodyRef::Kind::Link) return tree->X_world[std::size_t(b.index)].E.transpose();
   if constexpr (S::kDim == 3) {
-    if (b.kind == BodyRef::Kind::Payload) return S::rotation(angle(b)).transpose();
+    if (b.kind == BodyRef::Kind::Payload) {
+      const Eigen::Vector2d& cs = payload_cs[std::size_t(b.index)];
+      return (typename S::Rot() << cs.x(), -cs.y(), cs.y(), cs.x()).finished();
+    }
   }
   return S::Rot::Identity();
 }

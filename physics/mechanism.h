@@ -151,8 +151,12 @@ struct MechanismKinematics {
   using Pos = typename S::Pos;
   const MechanismModel<S>* model = nullptr;
   const TreeData<S>* tree = nullptr;
-  // Payload poses and velocities (planar: (ψ, x, y) and (ω, vx, vy) of the centre of mass).
+  // Payload poses and velocities (planar: (ψ, x, y) and (ω, vx, vy) of the centre of mass), and
+  // (cos ψ, sin ψ) of each pose.
   std::vector<Eigen::Vector3d> payload_pose, payload_rate;
+  std::vector<Eigen::Vector2d> payload_cs;
+  // Planar: each link's absolute angle (the sum of its path's joint angles and fixed placements).
+  std::vector<double> link_angle;
   // Each link's velocity-product acceleration (θ'' = 0, no gravity), body coordinates: J'θ' of its points.
   std::vector<Vec> link_bias;
 
