@@ -50,7 +50,8 @@ struct Arrow {
 
 // A polyline (trajectories, reference paths, ink), width_px wide on screen. Points may lie exactly
 // on a Plane: planes are drawn pushed back in depth, so a path or ink on a table shows without
-// lifting it. An ink trail with pen lifts is one Polyline per stroke (see inkStrokes below).
+// lifting it; where lines overlap at the same depth, the later one is on top. An ink trail with
+// pen lifts is one Polyline per stroke (see inkStrokes below).
 struct Polyline {
   std::vector<Eigen::Vector3d> points;
   double width_px = 2.0;

@@ -95,8 +95,11 @@ class Collector {
   // The cylinder, then each spoke as a thin bar on both faces (half inside, half standing out).
   void cylinder(const Cylinder& c) {
     if (c.radius <= 0 || c.half_length < 0) return;
+    // The body's facets ignore the spin (any frame along the axis), so a turning wheel's outline
+    // stays put; only the spokes turn.
     const Matrix3d& rot = c.rotation;
-    scaled(meshes_.cylinder, rot, {c.radius, c.radius, c.half_length}, c.center, c.color);
+    const Vector3d axis = rot.col(2).normalized();
+    scaled(meshes_.cylinder, frameAlong(axis), {c.radius, c.radius, c.half_length}, c.center, c.color);
     const double bar_half_len = 0.46 * c.radius, bar_half_width = 0.035 * c.radius;
     const double bar_half_depth = std::min(0.03 * c.radius, 0.5 * c.half_length + 0.01 * c.radius);
     for (int k = 0; k < c.spokes; ++k) {

@@ -148,6 +148,8 @@ struct Renderer::Impl {
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(line_vertices.size() * sizeof(LineVertex)),
                  line_vertices.data(), GL_STREAM_DRAW);
     glDisable(GL_CULL_FACE);
+    // Where lines overlap at the same depth (a path and the ink on a table), the later one wins.
+    glDepthFunc(GL_LEQUAL);
     for (std::size_t i = 0; i < polylines.size(); ++i) {
       if (ranges[i].second == 0) continue;
       const auto& pl = polylines[i];
@@ -155,6 +157,7 @@ struct Renderer::Impl {
       glUniform4f(line.color, pl.color.r, pl.color.g, pl.color.b, pl.color.a);
       glDrawArrays(GL_TRIANGLES, ranges[i].first, ranges[i].second);
     }
+    glDepthFunc(GL_LESS);
     glEnable(GL_CULL_FACE);
   }
 
