@@ -96,7 +96,7 @@ struct Cone {
 };
 
 // A coil spring glyph from p0 to p1: `turns` turns of a helix of `radius`, drawn with a wire of
-// wire_radius, with straight leads (lead of the length at each end) so it attaches to points.
+// wire_radius; the first and last `lead` (a fraction of the length) are straight, on the axis.
 struct Spring {
   Eigen::Vector3d p0, p1;
   double radius;

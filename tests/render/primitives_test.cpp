@@ -321,3 +321,30 @@ TEST_CASE("the pen's ink is drawn on the table, with a gap where the pen was lif
   CHECK_FALSE(isInk(inkAt(0.5 * (d.lift_from + d.lift_to))));
   CHECK_FALSE(isInk(inkAt(d.pen_angle + 0.6)));  // not drawn yet
 }
+
+TEST_CASE("perspective scenes of 0.1 m to 5 m keep their depth order and lose nothing to near/far") {
+  auto context = makeOffscreenContext(kW, kH);
+  Renderer renderer(*context);
+  for (double s : {0.1, 1.0, 5.0}) {
+    CAPTURE(s);
+    Scene scene;
+    scene.camera.ortho = false;
+    scene.camera.up = Vector3d::UnitZ();
+    const Vector3d from(0.5, -1.0, 0.7);
+    scene.camera.lookAtBox(Vector3d::Constant(-s), Vector3d::Constant(s), from, double(kW) / kH);
+    // A red ball at the centre with a blue one just in front of it (towards the camera).
+    scene.spheres.push_back({Vector3d::Zero(), 0.2 * s, kRed});
+    scene.spheres.push_back({0.3 * s * from.normalized(), 0.08 * s, kBlue});
+    // Small green balls at the box's corners: the nearest and farthest test the clip planes.
+    std::vector<Vector3d> corners;
+    for (int i = 0; i < 8; ++i) corners.push_back({i & 1 ? s : -s, i & 2 ? s : -s, i & 4 ? s : -s});
+    for (const auto& c : corners) scene.spheres.push_back({c, 0.03 * s, kGreen});
+    const Image image = renderer.render(scene, nullptr);
+    CHECK(bluish(at(image, scene.camera, Vector3d::Zero())));
+    CHECK(reddish(at(image, scene.camera, 0.15 * s * Vector3d(from.y(), -from.x(), 0).normalized())));
+    for (const auto& c : corners) {
+      CAPTURE(c.transpose());
+      CHECK(greenish(at(image, scene.camera, c)));
+    }
+  }
+}
