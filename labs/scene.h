@@ -3,7 +3,11 @@
 // No GL here, so labs never depend on the renderer.
 #pragma once
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <Eigen/Core>
+#include <Eigen/Geometry>
+#include <numbers>
 #include <string>
 #include <utility>
 #include <vector>
@@ -44,11 +48,67 @@ struct Arrow {
   Color color;
 };
 
-// A polyline (trajectories, reference paths).
+// A polyline (trajectories, reference paths, ink), width_px wide on screen. Points may lie exactly
+// on a Plane: planes are drawn pushed back in depth, so a path or ink on a table shows without
+// lifting it; where lines overlap at the same depth, the later one is on top. An ink trail with
+// pen lifts is one Polyline per stroke (see inkStrokes below).
 struct Polyline {
   std::vector<Eigen::Vector3d> points;
   double width_px = 2.0;
   Color color;
+};
+
+// A solid cylinder (wheel, disk, axle, puck); a disk is a short one. rotation maps the cylinder's
+// axes to world axes: local z is the axis (faces at +-half_length), local x the first spoke.
+// spokes > 0 draws that many bars, evenly spaced, on both faces from the centre to near the rim, so
+// a spinning wheel shows its rotation (see axisSpin below to build rotation from axis and angle).
+struct Cylinder {
+  Eigen::Vector3d center;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  double radius, half_length;
+  Color color;
+  int spokes = 0;
+  Color spoke_color{0.15f, 0.15f, 0.18f, 1.0f};
+};
+
+// A finite rectangle (ground, table top): rotation maps its axes to world axes (local z is the
+// normal, local x/y span half_size). thickness > 0 makes it a slab that deep below the surface
+// (a table top). grid > 0 draws lines every `grid` metres, through the centre, in grid_color.
+// Planes are pushed back in depth, so polylines (paths, ink) lying on them are always visible.
+struct Plane {
+  Eigen::Vector3d center;
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector2d half_size;
+  Color color;
+  double thickness = 0.0;
+  double grid = 0.0;
+  Color grid_color{0.55f, 0.55f, 0.55f, 1.0f};
+};
+
+// A cone opening from apex along axis (direction, any length) to `length` metres, capped at the
+// far end: friction cones (apex at the contact, half_angle = atan(mu)); usually translucent
+// (color.a < 1). Seen side-on, as in a planar scene, it reads as a 2-D wedge.
+struct Cone {
+  Eigen::Vector3d apex, axis;
+  double half_angle;  // radians
+  double length;      // metres along the axis
+  Color color;
+};
+
+// A coil spring glyph from p0 to p1: `turns` turns of a helix of `radius`, drawn with a wire of
+// wire_radius; the first and last `lead` (a fraction of the length) are straight, on the axis.
+struct Spring {
+  Eigen::Vector3d p0, p1;
+  double radius;
+  Color color;
+  int turns = 8;
+  double wire_radius = 0.0;  // 0: radius / 8
+  double lead = 0.1;         // fraction of the length that is straight at each end
+};
+
+// The camera's orthonormal frame: right, up, and back (from the target towards the eye).
+struct CameraBasis {
+  Eigen::Vector3d right, up, back;
 };
 
 // The camera: looks from eye at target; orthographic when ortho, showing at least half_height
@@ -62,8 +122,17 @@ struct Camera {
   double fov_y_deg = 45.0;   // perspective only
   // Ortho: the half height actually shown in a frame of this aspect (width / height).
   double visibleHalfHeight(double aspect) const { return std::max(half_height, half_width / aspect); }
+  // The view frame; `up` only picks the roll (a world axis stands in when it is along the view).
+  CameraBasis basis() const;
+  // Looks at the axis-aligned box [lo, hi] from direction `from` (target towards eye, any length)
+  // and fits it in a frame of this aspect (width / height) with margin (1.1: 10 % spare): moves
+  // the eye (perspective) or sets half_width/half_height (ortho). Keeps up, fov_y_deg and ortho.
+  void lookAtBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, const Eigen::Vector3d& from,
+                 double aspect, double margin = 1.1);
 };
 
+// Everything a frame shows. Opaque things are drawn first, then polylines, then everything with
+// alpha < 1 (back to front, each translucent shape blended once over what is behind it).
 struct Scene {
   std::vector<Capsule> capsules;
   std::vector<Sphere> spheres;
@@ -72,7 +141,115 @@ struct Scene {
   std::vector<Polyline> polylines;
   Camera camera;
   Color background{0.96f, 0.96f, 0.94f, 1.0f};
+  std::vector<Cylinder> cylinders;
+  std::vector<Plane> planes;
+  std::vector<Cone> cones;
+  std::vector<Spring> springs;
 };
+
+// ---- Pure helpers for labs (no GL) ----------------------------------------------------------
+
+// Linear blend a -> b by t in [0, 1] (e.g. a friction cone from green to red as |f_t| nears mu f_n).
+inline Color mix(const Color& a, const Color& b, double t) {
+  const float u = float(std::clamp(t, 0.0, 1.0));
+  return {a.r + u * (b.r - a.r), a.g + u * (b.g - a.g), a.b + u * (b.b - a.b), a.a + u * (b.a - a.a)};
+}
+
+// A rotation whose z axis is `axis` (normalised) and whose x axis is turned by `spin` radians
+// (right-handed about the axis) from a reference: world z projected onto the plane normal to the
+// axis ("up" for an upright wheel), or world x when the axis is within ~1 degree of world z (a
+// planar scene's disk). For Cylinder::rotation: axisSpin(axle, wheel_angle).
+inline Eigen::Matrix3d axisSpin(const Eigen::Vector3d& axis, double spin) {
+  const Eigen::Vector3d z = axis.norm() > 1e-12 ? axis.normalized() : Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d ref = Eigen::Vector3d::UnitZ() - z.z() * z;
+  if (ref.norm() < 0.02) ref = Eigen::Vector3d::UnitX() - z.x() * z;
+  const Eigen::Vector3d x0 = ref.normalized(), y0 = z.cross(x0);
+  Eigen::Matrix3d r;
+  r.col(0) = std::cos(spin) * x0 + std::sin(spin) * y0;
+  r.col(1) = z.cross(r.col(0));
+  r.col(2) = z;
+  return r;
+}
+
+// An ink trail from pen-tip samples: one Polyline per run of samples with down[i] (pen on the
+// paper); single-sample runs are dropped. Append the result to Scene::polylines.
+inline std::vector<Polyline> inkStrokes(const std::vector<Eigen::Vector3d>& points,
+                                        const std::vector<bool>& down, double width_px, Color color) {
+  std::vector<Polyline> strokes;
+  Polyline stroke{{}, width_px, color};
+  auto flush = [&] {
+    if (stroke.points.size() > 1) strokes.push_back(stroke);
+    stroke.points.clear();
+  };
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (i < down.size() && down[i]) stroke.points.push_back(points[i]);
+    else flush();
+  }
+  flush();
+  return strokes;
+}
+
+inline CameraBasis Camera::basis() const {
+  Eigen::Vector3d back = eye - target;
+  back = back.norm() > 1e-12 ? back.normalized() : Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d right = up.cross(back);
+  if (right.norm() < 1e-9) right = Eigen::Vector3d::UnitY().cross(back);  // up parallel to view
+  if (right.norm() < 1e-9) right = Eigen::Vector3d::UnitX();
+  right.normalize();
+  return {right, back.cross(right), back};
+}
+
+inline void Camera::lookAtBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                              const Eigen::Vector3d& from, double aspect, double margin) {
+  const Eigen::Vector3d dir = from.norm() > 1e-12 ? from.normalized() : Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d centre = 0.5 * (lo + hi);
+  const double extent = std::max((hi - lo).norm(), 1e-6);
+  std::array<Eigen::Vector3d, 8> corners;
+  for (int i = 0; i < 8; ++i)
+    corners[i] = {(i & 1 ? hi : lo).x(), (i & 2 ? hi : lo).y(), (i & 4 ? hi : lo).z()};
+  target = centre;
+  eye = target + dir;
+  const CameraBasis b = basis();
+  margin = std::max(margin, 1.0);
+  if (ortho) {
+    // The box is symmetric about its centre, so the centre stays the target.
+    double x = 0, y = 0;
+    for (const auto& c : corners) {
+      x = std::max(x, std::abs((c - centre).dot(b.right)));
+      y = std::max(y, std::abs((c - centre).dot(b.up)));
+    }
+    half_width = margin * x;
+    half_height = margin * y;
+    eye = target + dir * (extent + 1.0);
+    return;
+  }
+  // Perspective: the distance at which every corner is inside both half-angles (tan_x, tan_y),
+  // then the target slides so the corners' picture is centred; a few rounds settle it.
+  const double tan_y = std::tan(fov_y_deg * std::numbers::pi / 360.0) / margin, tan_x = tan_y * aspect;
+  auto fitDistance = [&] {
+    double d = 0;
+    for (const auto& c : corners) {
+      const Eigen::Vector3d r = c - target;
+      const double z = r.dot(b.back);
+      d = std::max({d, z + std::abs(r.dot(b.right)) / tan_x, z + std::abs(r.dot(b.up)) / tan_y,
+                    1.05 * z + 0.01 * extent});  // never at or past the nearest corner
+    }
+    return d;
+  };
+  double distance = fitDistance();
+  for (int round = 0; round < 3; ++round) {
+    double u_lo = 1e300, u_hi = -1e300, v_lo = 1e300, v_hi = -1e300;
+    for (const auto& c : corners) {
+      const Eigen::Vector3d r = c - target;
+      const double depth = distance - r.dot(b.back);
+      const double u = r.dot(b.right) / (depth * tan_x), v = r.dot(b.up) / (depth * tan_y);
+      u_lo = std::min(u_lo, u), u_hi = std::max(u_hi, u), v_lo = std::min(v_lo, v), v_hi = std::max(v_hi, v);
+    }
+    target += distance * (0.5 * (u_lo + u_hi) * tan_x * b.right + 0.5 * (v_lo + v_hi) * tan_y * b.up);
+    distance = fitDistance();
+  }
+  eye = target + dir * distance;
+}
 
 // A time series for the overlay's live plot.
 struct Series {

@@ -1,5 +1,6 @@
 // Internal to render/: GL declarations (prototypes resolved against libOSMesa), shader programs,
-// unit meshes and the Dear ImGui overlay panel used by renderer.cpp.
+// unit meshes, the scene's primitives as mesh draws, and the Dear ImGui overlay panel used by
+// renderer.cpp.
 #pragma once
 #ifndef GL_GLEXT_PROTOTYPES
 #define GL_GLEXT_PROTOTYPES 1
@@ -9,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <vector>
 
 #include "labs/scene.h"
 
@@ -56,6 +58,43 @@ Mesh makeCapsule(int slices, int half_stacks);
 Mesh makeCone(int slices);
 // Box [-1,1]^3 with flat faces.
 Mesh makeBox();
+// Unit cylinder along z: radius 1, z in [-1,1], capped.
+Mesh makeCylinder(int slices);
+// Square [-1,1]^2 at z=0, two-sided (front normal +z, back normal -z).
+Mesh makeQuad();
+
+// ---- primitives.cpp -----------------------------------------------------------------------
+
+// Every unit mesh the scene's primitives are drawn with.
+struct Meshes {
+  // Capsule/sphere levels of detail by on-screen radius (silhouette error under ~1/4 pixel).
+  static constexpr int kLevels = 4;
+  static constexpr double kLevelMaxRadiusPx[kLevels] = {5, 16, 48, 1e300};
+  Mesh capsules[kLevels];
+  Mesh cone, box, cylinder, quad;
+  void create();
+  void destroy();
+};
+
+// One mesh draw: model matrix, normal matrix, capsule stretch, colour, view depth.
+struct DrawItem {
+  const Mesh* mesh;
+  Eigen::Matrix4f model;
+  Eigen::Matrix3f normal;
+  Eigen::Vector3f stretch;
+  Color color;
+  double depth;               // distance in front of the camera of the item's centre
+  bool pushed_back = false;   // planes: drawn behind their exact depth so lines on them show
+};
+
+// A frame's primitives: mesh draws in scene order (capsules, spheres, boxes, arrows, then planes,
+// cylinders and spokes, cones, springs) and the planes' grid lines.
+struct DrawList {
+  std::vector<DrawItem> items;
+  std::vector<Polyline> grid_lines;
+};
+// Fills `out` (cleared first) for a frame of width x height.
+void collectDrawList(const Scene& scene, const Meshes& meshes, int width, int height, DrawList& out);
 
 // ---- overlay.cpp --------------------------------------------------------------------------
 

@@ -1,5 +1,6 @@
-// Unit meshes uploaded once: a stretchable capsule (also used for spheres), a capped cone and a
-// flat-shaded box. Model matrices and the capsule stretch place them in the world.
+// Unit meshes uploaded once: a stretchable capsule (also used for spheres), a capped cone, a
+// flat-shaded box, a capped cylinder and a two-sided square. Model matrices and the capsule
+// stretch place them in the world.
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -134,6 +135,49 @@ Mesh makeBox() {
       }
       indices.insert(indices.end(), {first, first + 1, first + 2, first, first + 2, first + 3});
     }
+  }
+  return upload(vertices, indices);
+}
+
+Mesh makeCylinder(int slices) {
+  const double pi = std::numbers::pi;
+  std::vector<Vertex> vertices;
+  std::vector<GLuint> indices;
+  // Side: a ring at z=-1 and one at z=+1 with radial normals.
+  for (float z : {-1.0f, 1.0f})
+    for (int s = 0; s < slices; ++s) {
+      const double lon = 2 * pi * s / slices;
+      const float c = float(std::cos(lon)), sn = float(std::sin(lon));
+      vertices.push_back({{c, sn, z}, {c, sn, 0}, 0});
+    }
+  stitchRings(indices, 0, GLuint(slices));
+  // Caps: a centre and its own ring with the flat normal, wound outward.
+  for (float z : {-1.0f, 1.0f}) {
+    const GLuint centre = GLuint(vertices.size());
+    vertices.push_back({{0, 0, z}, {0, 0, z}, 0});
+    for (int s = 0; s < slices; ++s) {
+      const double lon = 2 * pi * s / slices;
+      vertices.push_back({{float(std::cos(lon)), float(std::sin(lon)), z}, {0, 0, z}, 0});
+    }
+    for (int s = 0; s < slices; ++s) {
+      GLuint a = centre + 1 + GLuint(s), b = centre + 1 + GLuint((s + 1) % slices);
+      if (z > 0) indices.insert(indices.end(), {centre, a, b});
+      else indices.insert(indices.end(), {centre, b, a});
+    }
+  }
+  return upload(vertices, indices);
+}
+
+Mesh makeQuad() {
+  std::vector<Vertex> vertices;
+  std::vector<GLuint> indices;
+  // The front (normal +z, counter-clockwise from +z) and the back (normal -z, reversed).
+  const float corners[4][2] = {{-1, -1}, {1, -1}, {1, 1}, {-1, 1}};
+  for (float side : {1.0f, -1.0f}) {
+    const GLuint first = GLuint(vertices.size());
+    for (const auto& c : corners) vertices.push_back({{c[0], c[1], 0}, {0, 0, side}, 0});
+    if (side > 0) indices.insert(indices.end(), {first, first + 1, first + 2, first, first + 2, first + 3});
+    else indices.insert(indices.end(), {first, first + 2, first + 1, first, first + 3, first + 2});
   }
   return upload(vertices, indices);
 }

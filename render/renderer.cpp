@@ -1,5 +1,6 @@
-// Renderer: draws a Scene with GL 3.3 core into a 4x multisample framebuffer (opaque meshes,
-// polylines, then translucent meshes back to front), adds the Dear ImGui overlay, resolves into
+// Renderer: draws a Scene with GL 3.3 core into a 4x multisample framebuffer (opaque meshes with
+// planes pushed back, the planes' grid lines, polylines, then translucent meshes back to front;
+// primitives.cpp turns the scene into mesh draws), adds the Dear ImGui overlay, resolves into
 // a single-sample framebuffer and reads it back top-down.
 #include "render/renderer.h"
 
@@ -13,52 +14,8 @@
 namespace dyn {
 namespace {
 
-using Eigen::Matrix3d;
 using Eigen::Matrix4d;
 using Eigen::Vector3d;
-
-// Camera basis: right, up, back (towards the viewer), from the look-at parameters.
-struct CameraBasis {
-  Vector3d right, up, back;
-};
-
-CameraBasis basisOf(const Camera& camera) {
-  Vector3d back = camera.eye - camera.target;
-  back = back.norm() > 1e-12 ? back.normalized() : Vector3d::UnitZ();
-  Vector3d right = camera.up.cross(back);
-  if (right.norm() < 1e-9) right = Vector3d::UnitY().cross(back);  // up parallel to view
-  if (right.norm() < 1e-9) right = Vector3d::UnitX();
-  right.normalize();
-  return {right, back.cross(right), back};
-}
-
-// A rotation whose z axis is `dir` (unit); the other axes are any orthonormal completion.
-Matrix3d frameAlong(const Vector3d& dir) {
-  const Vector3d helper = std::abs(dir.z()) < 0.9 ? Vector3d::UnitZ() : Vector3d::UnitX();
-  const Vector3d x = helper.cross(dir).normalized();
-  Matrix3d r;
-  r.col(0) = x;
-  r.col(1) = dir.cross(x);
-  r.col(2) = dir;
-  return r;
-}
-
-// One mesh draw: model matrix, normal matrix, capsule stretch, colour, view depth.
-struct DrawItem {
-  const gl::Mesh* mesh;
-  Eigen::Matrix4f model;
-  Eigen::Matrix3f normal;
-  Eigen::Vector3f stretch;
-  Color color;
-  double depth;  // distance in front of the camera of the item's centre
-};
-
-Eigen::Matrix4f affine(const Matrix3d& linear, const Vector3d& translation) {
-  Matrix4d m = Matrix4d::Identity();
-  m.topLeftCorner<3, 3>() = linear;
-  m.topRightCorner<3, 1>() = translation;
-  return m.cast<float>();
-}
 
 // Polyline vertex: this end, the other end, which side of the quad.
 struct LineVertex {
@@ -77,14 +34,10 @@ struct Renderer::Impl {
   GLuint resolve_fbo = 0, resolve_color = 0, resolve_depth = 0;
   gl::ShadedProgram shaded;
   gl::LineProgram line;
-  // Capsule/sphere levels of detail by on-screen radius (silhouette error under ~1/4 pixel).
-  static constexpr int kLevels = 4;
-  static constexpr double kLevelMaxRadiusPx[kLevels] = {5, 16, 48, 1e300};
-  gl::Mesh capsules[kLevels];
-  gl::Mesh cone, box;
+  gl::Meshes meshes;
   GLuint line_vao = 0, line_vbo = 0;
   std::unique_ptr<gl::OverlayPanel> overlay;  // created on first use
-  std::vector<DrawItem> items;                // reused between frames
+  gl::DrawList draw_list;                     // reused between frames
   std::vector<LineVertex> line_vertices;
 
   Impl(GlContext& c, RenderOptions o)
@@ -93,10 +46,7 @@ struct Renderer::Impl {
     createFramebuffers();
     shaded = gl::makeShadedProgram();
     line = gl::makeLineProgram();
-    const int slices[kLevels] = {10, 16, 28, 48};
-    for (int i = 0; i < kLevels; ++i) capsules[i] = gl::makeCapsule(slices[i], slices[i] / 4 + 1);
-    cone = gl::makeCone(40);
-    box = gl::makeBox();
+    meshes.create();
     // Polyline stream: attributes 0 position, 1 other end, 2 side.
     glGenVertexArrays(1, &line_vao);
     glGenBuffers(1, &line_vbo);
@@ -116,9 +66,7 @@ struct Renderer::Impl {
 
   ~Impl() {
     overlay.reset();
-    for (auto& mesh : capsules) mesh.destroy();
-    cone.destroy();
-    box.destroy();
+    meshes.destroy();
     glDeleteBuffers(1, &line_vbo);
     glDeleteVertexArrays(1, &line_vao);
     glDeleteProgram(shaded.id);
@@ -155,71 +103,28 @@ struct Renderer::Impl {
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
   }
 
-  // Turns the scene's primitives into mesh draws.
-  void collectItems(const Scene& scene, const CameraBasis& basis) {
-    items.clear();
-    auto depthOf = [&](const Vector3d& p) { return (scene.camera.eye - p).dot(basis.back); };
-    // Pixels per metre at a point (constant for orthographic cameras).
-    const Camera& cam = scene.camera;
-    auto pixelsPerMetre = [&](const Vector3d& p) {
-      if (cam.ortho) return height / (2.0 * cam.visibleHalfHeight(double(width) / std::max(height, 1)));
-      const double half_fov = std::tan(cam.fov_y_deg * M_PI / 360.0);
-      return height / (2.0 * half_fov * std::max(depthOf(p), 1e-6));
-    };
-    auto capsuleMesh = [&](const Vector3d& centre, double r) {
-      const double r_px = r * pixelsPerMetre(centre);
-      int level = 0;
-      while (r_px > kLevelMaxRadiusPx[level]) ++level;
-      return &capsules[level];
-    };
-    auto addCapsule = [&](const Vector3d& p0, const Vector3d& p1, double r, const Color& color) {
-      const Vector3d axis = p1 - p0;
-      const double length = axis.norm();
-      const Matrix3d rot = length > 1e-12 ? frameAlong(axis / length) : Matrix3d::Identity();
-      items.push_back({capsuleMesh(0.5 * (p0 + p1), r), affine(rot * r, p0), rot.cast<float>(),
-                       Eigen::Vector3f(0, 0, float(length / r)), color, depthOf(0.5 * (p0 + p1))});
-    };
-    for (const auto& c : scene.capsules)
-      if (c.radius > 0) addCapsule(c.p0, c.p1, c.radius, c.color);
-    for (const auto& s : scene.spheres)
-      if (s.radius > 0) addCapsule(s.center, s.center, s.radius, s.color);
-    for (const auto& b : scene.boxes) {
-      const Vector3d half = b.half_extents.cwiseMax(1e-9);
-      items.push_back({&box, affine(b.rotation * half.asDiagonal(), b.center),
-                       (b.rotation * half.cwiseInverse().asDiagonal()).cast<float>(),
-                       Eigen::Vector3f::Zero(), b.color, depthOf(b.center)});
-    }
-    for (const auto& a : scene.arrows) {
-      const double length = a.vector.norm();
-      if (length < 1e-9 || a.radius <= 0) continue;
-      const Vector3d dir = a.vector / length;
-      // Head: 2.2 radii wide, 5 radii long, at most half the arrow.
-      const double head_r = 2.2 * a.radius, head_len = std::min(5.0 * a.radius, 0.5 * length);
-      const Vector3d neck = a.origin + dir * (length - head_len);
-      addCapsule(a.origin, neck, a.radius, a.color);
-      const Matrix3d rot = frameAlong(dir);
-      const Vector3d scale(head_r, head_r, head_len);
-      items.push_back({&cone, affine(rot * scale.asDiagonal(), neck),
-                       (rot * scale.cwiseInverse().asDiagonal()).cast<float>(),
-                       Eigen::Vector3f::Zero(), a.color, depthOf(neck)});
-    }
-  }
-
-  void drawItem(const DrawItem& item) {
+  void drawItem(const gl::DrawItem& item) {
     glUniformMatrix4fv(shaded.model, 1, GL_FALSE, item.model.data());
     glUniformMatrix3fv(shaded.normal_matrix, 1, GL_FALSE, item.normal.data());
     glUniform3fv(shaded.stretch, 1, item.stretch.data());
     glUniform4f(shaded.color, item.color.r, item.color.g, item.color.b, item.color.a);
     // A mirroring box rotation flips the winding; keep culling the back faces.
     glFrontFace(item.model.topLeftCorner<3, 3>().determinant() < 0 ? GL_CW : GL_CCW);
+    // Planes sit a little behind their depth (about 2 pixels of their slope), so lines on them win.
+    if (item.pushed_back) {
+      glEnable(GL_POLYGON_OFFSET_FILL);
+      glPolygonOffset(2.0f, 2.0f);
+    }
     item.mesh->draw();
+    if (item.pushed_back) glDisable(GL_POLYGON_OFFSET_FILL);
   }
 
   // Polylines as screen-space quads of width_px, one draw per polyline.
-  void drawPolylines(const Scene& scene, const Eigen::Matrix4f& view_proj, bool translucent) {
+  void drawPolylines(const std::vector<Polyline>& polylines, const Eigen::Matrix4f& view_proj,
+                     bool translucent) {
     line_vertices.clear();
     std::vector<std::pair<GLint, GLsizei>> ranges;
-    for (const auto& pl : scene.polylines) {
+    for (const auto& pl : polylines) {
       const GLint first = GLint(line_vertices.size());
       if ((pl.color.a < 1.0f) == translucent) {
         for (std::size_t i = 0; i + 1 < pl.points.size(); ++i) {
@@ -243,13 +148,16 @@ struct Renderer::Impl {
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(line_vertices.size() * sizeof(LineVertex)),
                  line_vertices.data(), GL_STREAM_DRAW);
     glDisable(GL_CULL_FACE);
-    for (std::size_t i = 0; i < scene.polylines.size(); ++i) {
+    // Where lines overlap at the same depth (a path and the ink on a table), the later one wins.
+    glDepthFunc(GL_LEQUAL);
+    for (std::size_t i = 0; i < polylines.size(); ++i) {
       if (ranges[i].second == 0) continue;
-      const auto& pl = scene.polylines[i];
+      const auto& pl = polylines[i];
       glUniform1f(line.half_width, float(std::max(0.5, pl.width_px) / 2));
       glUniform4f(line.color, pl.color.r, pl.color.g, pl.color.b, pl.color.a);
       glDrawArrays(GL_TRIANGLES, ranges[i].first, ranges[i].second);
     }
+    glDepthFunc(GL_LESS);
     glEnable(GL_CULL_FACE);
   }
 
@@ -271,7 +179,7 @@ struct Renderer::Impl {
     // Alpha stays 1 where the background is opaque.
     glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
 
-    const CameraBasis basis = basisOf(scene.camera);
+    const CameraBasis basis = scene.camera.basis();
     const Eigen::Matrix4f view_proj = viewProjection(scene.camera, width, height).cast<float>();
     // Key light from the upper left, in front of the scene; moves with the camera.
     const Vector3d light = (-0.45 * basis.right + 0.65 * basis.up + 0.75 * basis.back).normalized();
@@ -284,31 +192,37 @@ struct Renderer::Impl {
     glUniform1i(shaded.ortho, scene.camera.ortho ? 1 : 0);
 
     // Opaque meshes in scene order.
-    collectItems(scene, basis);
-    for (const auto& item : items)
+    gl::collectDrawList(scene, meshes, width, height, draw_list);
+    for (const auto& item : draw_list.items)
       if (item.color.a >= 1.0f) drawItem(item);
+    // Grid lines on the planes: depth-tested but not written, so paths on a plane cover them.
+    if (!draw_list.grid_lines.empty()) {
+      glDepthMask(GL_FALSE);
+      drawPolylines(draw_list.grid_lines, view_proj, false);
+      glDepthMask(GL_TRUE);
+    }
     // Opaque polylines (depth-tested, so the arm hides what is behind it).
-    drawPolylines(scene, view_proj, false);
+    drawPolylines(scene.polylines, view_proj, false);
 
     // Translucent meshes: a depth-only pass first, so overlapping parts of a ghost (capsule
     // ends, joints) blend once as one surface; then colour far to near, blended, no depth writes.
-    std::vector<const DrawItem*> translucent;
-    for (const auto& item : items)
+    std::vector<const gl::DrawItem*> translucent;
+    for (const auto& item : draw_list.items)
       if (item.color.a < 1.0f) translucent.push_back(&item);
     std::stable_sort(translucent.begin(), translucent.end(),
-                     [](const DrawItem* a, const DrawItem* b) { return a->depth > b->depth; });
+                     [](const gl::DrawItem* a, const gl::DrawItem* b) { return a->depth > b->depth; });
     glUseProgram(shaded.id);
     glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    for (const DrawItem* item : translucent) drawItem(*item);
+    for (const gl::DrawItem* item : translucent) drawItem(*item);
     glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
     glEnable(GL_BLEND);
     glDepthMask(GL_FALSE);
     glDepthFunc(GL_LEQUAL);
-    for (const DrawItem* item : translucent) drawItem(*item);
+    for (const gl::DrawItem* item : translucent) drawItem(*item);
     glDepthFunc(GL_LESS);
     glFrontFace(GL_CCW);
     // Translucent lines last.
-    drawPolylines(scene, view_proj, true);
+    drawPolylines(scene.polylines, view_proj, true);
     glDepthMask(GL_TRUE);
     glDisable(GL_BLEND);
     glBindVertexArray(0);
@@ -373,7 +287,7 @@ int Renderer::width() const { return impl_->width; }
 int Renderer::height() const { return impl_->height; }
 
 Matrix4d Renderer::viewProjection(const Camera& camera, int width, int height) {
-  const CameraBasis b = basisOf(camera);
+  const CameraBasis b = camera.basis();
   // View: world -> camera (x right, y up, looking down -z).
   Matrix4d view = Matrix4d::Identity();
   view.block<1, 3>(0, 0) = b.right.transpose();
