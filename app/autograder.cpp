@@ -213,7 +213,9 @@ This zip is a Gradescope autograder for the dynlab lab `@LAB@`. It holds:
   `source/scripts/setup`) and compiles dynlab (Release) into `source/build/`.
 * `run_autograder`: run for every submission: finds the student's JSON, runs
   `dynlab grade FILE --lab @LAB@ --out /autograder/results`, and always leaves a valid
-  `results.json` (score 0 with an explanation when the file is missing or grading fails).
+  `results.json` (score 0 with an explanation when the file is missing, grading fails, or what
+  dynlab wrote does not pass `dynlab check-results`). Set `DYNLAB_TIME_LIMIT` (whole seconds,
+  1–86400; default 540) to change how long dynlab may grade.
 * `source/`: the dynlab source tree the grader is built from.
 
 ## Setting it up on Gradescope
