@@ -561,3 +561,13 @@ TEST_CASE("run_autograder: DYNLAB_TIME_LIMIT must be whole seconds from 1 to 864
   const auto r = box.run("DYNLAB_TIME_LIMIT=02");
   CHECK(r.at("output").get<std::string>().find("longer than 2 seconds") != std::string::npos);
 }
+
+TEST_CASE("run_autograder with the real dynlab: an example is graded and its results pass the check") {
+  Sandbox box("real");
+  box.dynlab = DYNLAB_BIN;
+  fs::copy_file(fs::path(DYNLAB_SOURCE_DIR) / "labs/slider_crank/examples/mediocre.json", box.submission / "submission.json");
+  const auto r = box.run();
+  CHECK(r.at("score").get<double>() > 0.0);
+  CHECK(r.at("tests").size() > 3);
+  CHECK(box.log().find("no grade from dynlab") == std::string::npos);
+}
