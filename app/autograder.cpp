@@ -25,9 +25,9 @@ namespace fs = std::filesystem;
 
 // Where Gradescope unpacks the zip; the source tree lands in its source/ folder.
 constexpr const char* kRoot = "/autograder/source/source";
-// What of the dynlab tree goes into the bundle (tests/ too: the top CMakeLists adds it).
+// What of the dynlab tree goes into the bundle (tests/ too: the top CMakeLists adds it; docs/: the README links the notes).
 constexpr const char* kTopFiles[] = {"CMakeLists.txt", "README.md"};
-constexpr const char* kTopDirs[] = {"app", "assets", "grading", "labs", "physics", "render", "scripts", "tests"};
+constexpr const char* kTopDirs[] = {"app", "assets", "docs", "grading", "labs", "physics", "render", "scripts", "tests"};
 
 struct Entry {
   std::string name;  // path inside the zip, '/'-separated
@@ -120,29 +120,34 @@ lab="@LAB@"
 dynlab="${DYNLAB_BIN:-@ROOT@/build/app/dynlab}"
 submission_dir="${DYNLAB_SUBMISSION_DIR:-/autograder/submission}"
 results_dir="${DYNLAB_RESULTS_DIR:-/autograder/results}"
-time_limit="${DYNLAB_TIME_LIMIT:-540}"  # below Gradescope's 10 minutes, so this script still reports
-[[ "$time_limit" =~ ^[0-9]+$ ]] || time_limit=540
 results="$results_dir/results.json"
 
+# The time limit: whole seconds from 1 to 86400, below Gradescope's 10 minutes by default so this
+# script still reports. Anything else (0, 10m, -5) is a staff typo: say so, and use the default.
+time_limit="${DYNLAB_TIME_LIMIT:-540}"
+if ! [[ "$time_limit" =~ ^[0-9]{1,5}$ ]] || ((10#$time_limit < 1 || 10#$time_limit > 86400)); then
+  echo "run_autograder: DYNLAB_TIME_LIMIT=\"$time_limit\": expected whole seconds from 1 to 86400; using the default, 540" >&2
+  time_limit=540
+fi
+time_limit=$((10#$time_limit))
+
+# Text as the inside of a JSON string: backslashes and quotes escaped, control characters dropped.
+json_text() {
+  printf '%s' "$1" | sed -e 's/\\/\\\\/g' -e 's/"/\\"/g' | tr -d '\000-\037\177'
+}
+
 # Score 0 with a fixed message ($1 is already JSON-escaped; nothing from the submission goes in).
+# Whatever sits at $results (a stale file, a FIFO, a folder) is replaced, never written through.
 fail() {
-  printf '{"score": 0.0, "output_format": "md", "output": "%s", "tests": []}\n' "$1" > "$results"
+  rm -rf -- "$results" "$results.tmp"
+  printf '{"score": 0.0, "output_format": "md", "output": "%s", "tests": []}\n' "$1" > "$results.tmp"
+  mv -f -- "$results.tmp" "$results"
   echo "run_autograder: no grade from dynlab; wrote a score-0 results.json"
   exit 0
 }
 
-# A results.json counts when it parses as a JSON object.
-valid() {
-  [ -s "$1" ] || return 1
-  if command -v python3 >/dev/null 2>&1; then
-    python3 -c 'import json, sys; sys.exit(0 if isinstance(json.load(open(sys.argv[1])), dict) else 1)' "$1" 2>/dev/null
-  else
-    [ "$(head -c 1 "$1")" = "{" ]
-  fi
-}
-
 mkdir -p "$results_dir"
-rm -f "$results"
+rm -rf -- "$results"
 
 # The student's file: submission.json, else the only *.json they uploaded.
 file=""
@@ -163,11 +168,18 @@ fi
 # Grade within the time limit; dynlab writes results.json (and report.md, plots/) itself.
 timeout --kill-after=10 "$time_limit" "$dynlab" grade "$file" --lab "$lab" --out "$results_dir"
 status=$?
-valid "$results" && exit 0
+# Its results.json stands only if Gradescope would accept it, checked by dynlab check-results.
+problem=""
+if [ -e "$results" ] || [ -L "$results" ]; then
+  problem="$(timeout 60 "$dynlab" check-results "$results" 2>&1 >/dev/null)" && exit 0
+  [ -n "$problem" ] || problem="dynlab check-results stopped without saying why"
+  echo "run_autograder: $problem" >&2
+fi
 case $status in
   124|137) fail "Grading took longer than $time_limit seconds and was stopped. Gains that make the simulation stiff or unstable can do this: check them against the limits in the lab handout and resubmit." ;;
-  *) fail "The grader stopped (exit status $status) without writing results. This is not a judgement of your gains; please resubmit, and tell the course staff if it happens again." ;;
 esac
+[ -z "$problem" ] || fail "The grader wrote a results.json that Gradescope would not accept, so this one replaces it. This is not a judgement of your gains; please tell the course staff.\n\n    $(json_text "$problem")"
+fail "The grader stopped (exit status $status) without writing results. This is not a judgement of your gains; please resubmit, and tell the course staff if it happens again."
 )SH",
                                "@LAB@", lab),
                     "@ROOT@", kRoot);
@@ -201,7 +213,9 @@ This zip is a Gradescope autograder for the dynlab lab `@LAB@`. It holds:
   `source/scripts/setup`) and compiles dynlab (Release) into `source/build/`.
 * `run_autograder`: run for every submission: finds the student's JSON, runs
   `dynlab grade FILE --lab @LAB@ --out /autograder/results`, and always leaves a valid
-  `results.json` (score 0 with an explanation when the file is missing or grading fails).
+  `results.json` (score 0 with an explanation when the file is missing, grading fails, or what
+  dynlab wrote does not pass `dynlab check-results`). Set `DYNLAB_TIME_LIMIT` (whole seconds,
+  1–86400; default 540) to change how long dynlab may grade.
 * `source/`: the dynlab source tree the grader is built from.
 
 ## Setting it up on Gradescope
@@ -237,7 +251,7 @@ Unzip, build dynlab as `setup.sh` does (or use an existing build), then:
 ```sh
 mkdir -p sub res && cp my.json sub/submission.json
 DYNLAB_BIN=path/to/dynlab DYNLAB_SUBMISSION_DIR=sub DYNLAB_RESULTS_DIR=res bash run_autograder
-python3 -m json.tool res/results.json
+path/to/dynlab check-results res/results.json   # the check run_autograder makes
 ```
 )MD";
   md = replaceAll(md, "@TITLE@", title);

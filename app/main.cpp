@@ -1,6 +1,7 @@
 // dynlab: the command line. Dispatch only; the work is in labs/, grading/ and render/.
 #include <CLI/CLI.hpp>
 
+#include "app/check_results.h"
 #include "app/commands.h"
 
 int main(int argc, char** argv) {
@@ -65,6 +66,11 @@ int main(int argc, char** argv) {
   z->add_option("LAB", zip_lab, "Lab name")->required();
   z->add_option("--out", zip_out, "Zip file to write (default: autograder.zip)");
 
+  std::string results_file;
+  auto* c = cli.add_subcommand("check-results", "Check that a results.json has the shape Gradescope accepts "
+                                                "(exit 0 valid, 2 invalid with the JSON path)");
+  c->add_option("FILE", results_file, "The results.json to check")->required();
+
   std::string schema_lab;
   auto* s = cli.add_subcommand("schema", "Print the JSON Schema of a lab's submission");
   s->add_option("LAB", schema_lab, "Lab name")->required();
@@ -94,6 +100,7 @@ int main(int argc, char** argv) {
   if (*f) return figure(fig);
   if (*g) return !grade.batch.empty() ? gradeBatch(grade) : !grade.replay.empty() ? gradeReplay(grade) : gradeOne(grade);
   if (*z) return writeAutograderZip(zip_lab, zip_out);
+  if (*c) return checkResults(results_file);
   if (*s) return printSchema(schema_lab);
   if (*b) return bench(bench_args);
   if (*u) {

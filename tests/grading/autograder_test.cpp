@@ -1,13 +1,20 @@
 // Tests for app/autograder: what the Gradescope zip holds (scripts executable, the source tree
 // without build output), byte-identical rewrites, errors naming the path, and run_autograder's
-// promise of a valid results.json, run for real against fake dynlab binaries.
+// promise of a valid results.json, run for real against fake dynlab binaries (whose check-results
+// is the real one); and `dynlab check-results` itself, through the real binary (DYNLAB_BIN).
 #include "app/autograder.h"
 
 #include <doctest/doctest.h>
 
 #include "tests/test_files.h"
 #include <sys/stat.h>
+#include <sys/wait.h>
 #include <zip.h>
+
+#include <algorithm>
+#include <regex>
+#include <sstream>
+#include <vector>
 
 #include <chrono>
 #include <cstdlib>
@@ -70,6 +77,32 @@ std::map<std::string, ZipEntry> asMap(const std::vector<std::pair<std::string, Z
   return {v.begin(), v.end()};
 }
 
+struct Ran {
+  int code = -1;
+  std::string out, err;
+};
+
+// A path in single quotes for the shell (the scratch paths hold no quote).
+std::string quoted(const std::string& s) {
+  std::string q = "'";
+  q += s;
+  q += '\'';
+  return q;
+}
+
+// Runs a shell command with stdout and stderr captured (in files of a scratch folder of their own).
+Ran shell(const std::string& cmd) {
+  static const fs::path dir = scratch("capture");
+  const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
+  const int status = std::system((cmd + " >" + quoted(out.string()) + " 2>" + quoted(err.string())).c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), readBytes(out), readBytes(err)};
+}
+
+// The real `dynlab check-results FILE` (under a timeout, so a hang fails instead of blocking the suite).
+Ran checkResults(const fs::path& file) {
+  return shell("timeout 20 " + quoted(DYNLAB_BIN) + " check-results " + quoted(file.string()));
+}
+
 std::string thrown(const std::function<void()>& f) {
   try {
     f();
@@ -122,6 +155,16 @@ TEST_CASE("the bundle for slider_crank: scripts, README and the source tree") {
   CHECK(setup.find("--target dynlab") != std::string::npos);
   CHECK(entries.at("README.md").data.find("\"lab\": \"slider_crank\"") != std::string::npos);
   CHECK(entries.at("README.md").data.find("kp_x") != std::string::npos);
+  CHECK(entries.at("README.md").data.find("check-results") != std::string::npos);  // the local check needs no python3
+
+  // Every relative link of the packed README (the course notes, its images) is packed too.
+  const std::string top = entries.at("source/README.md").data;
+  const std::regex link(R"(\]\(([^)#:]+)(#[^)]*)?\))");
+  int links = 0;
+  for (auto it = std::sregex_iterator(top.begin(), top.end(), link); it != std::sregex_iterator(); ++it, ++links)
+    CHECK_MESSAGE(entries.count("source/" + (*it)[1].str()), "README.md links to " << (*it)[1].str());
+  CHECK(links >= 2);
+  CHECK(entries.count("source/docs/constrained-dynamics.md"));
 }
 
 TEST_CASE("two writes give the same bytes") {
@@ -194,18 +237,39 @@ struct Sandbox {
     script = dir / "run_autograder";
     dynlab = dir / "dynlab";
     fs::create_directories(submission);
-    writeAutograder("slider_crank", DYNLAB_SOURCE_DIR, (dir / "bundle.zip").string());
-    writeText(script, asMap(readZip(dir / "bundle.zip")).at("run_autograder").data, true);
+    writeText(script, runAutograderText(), true);
   }
-  void fakeDynlab(const std::string& body) { writeText(dynlab, "#!/usr/bin/env bash\n" + body + "\n", true); }
-  // Runs the script; returns results.json parsed (it must parse).
+  // run_autograder as the real bundle holds it (packed once: the zip takes a while).
+  static const std::string& runAutograderText() {
+    static const std::string text = [] {
+      const fs::path zip = scratch("run_bundle") / "bundle.zip";
+      writeAutograder("slider_crank", DYNLAB_SOURCE_DIR, zip.string());
+      return asMap(readZip(zip)).at("run_autograder").data;
+    }();
+    return text;
+  }
+  // A fake `dynlab grade` (body); `dynlab check-results` stays the real one.
+  void fakeDynlab(const std::string& body) {
+    writeText(dynlab, "#!/usr/bin/env bash\n[ \"$1\" = check-results ] && exec '" + std::string(DYNLAB_BIN) + "' \"$@\"\n" +
+                          body + "\n", true);
+  }
+  // A fake that writes `json` as its results.json and exits 0.
+  void fakeResults(const std::string& json) {
+    writeText(dir / "fake_results.json", json);
+    fakeDynlab("out=\"${@: -1}\"; cp '" + (dir / "fake_results.json").string() + "' \"$out/results.json\"; exit 0");
+  }
+  std::string log() const { return readBytes(dir / "log.txt"); }
+  // Runs the script (under a timeout); returns results.json parsed. It must parse, and the real
+  // check-results must accept it.
   nlohmann::json run(const std::string& env = "") {
     const std::string cmd = "env DYNLAB_BIN='" + dynlab.string() + "' DYNLAB_SUBMISSION_DIR='" + submission.string() +
-                            "' DYNLAB_RESULTS_DIR='" + results.string() + "' " + env + " bash '" + script.string() +
-                            "' > '" + (dir / "log.txt").string() + "' 2>&1";
+                            "' DYNLAB_RESULTS_DIR='" + results.string() + "' " + env + " timeout 60 bash '" +
+                            script.string() + "' > '" + (dir / "log.txt").string() + "' 2>&1";
     CHECK(std::system(cmd.c_str()) == 0);
-    INFO(readBytes(dir / "log.txt"));
-    REQUIRE(fs::exists(results / "results.json"));
+    INFO(log());
+    REQUIRE(fs::is_regular_file(results / "results.json"));
+    const Ran check = checkResults(results / "results.json");
+    CHECK_MESSAGE(check.code == 0, check.err);
     return nlohmann::json::parse(readBytes(results / "results.json"));
   }
 };
@@ -271,4 +335,239 @@ TEST_CASE("run_autograder: garbage, timeouts, a missing binary and missing files
     box.fakeDynlab("exit 0");
     CHECK(box.run().at("output").get<std::string>().find("several JSON files") != std::string::npos);
   }
+}
+
+// --- dynlab check-results, and run_autograder's use of it ---
+
+namespace {
+
+// A results.json using every field Gradescope documents, each with an allowed value.
+const char* kValidResults = R"({"score": 7.5, "execution_time": 12, "output": "é ✓ 😀", "output_format": "md",
+  "test_output_format": "ansi", "test_name_format": "text", "visibility": "after_due_date",
+  "stdout_visibility": "hidden", "extra_data": {"lab": "slider_crank", "n": [1, 2]},
+  "tests": [{"name": "a", "number": "1.2", "score": 2, "max_score": 5.0, "status": "failed", "output": "...",
+             "output_format": "simple_format", "name_format": "html", "tags": ["nominal"],
+             "visibility": "after_published", "extra_data": {}},
+            {"name": "b", "status": "passed"}],
+  "leaderboard": [{"name": "tracking RMS", "value": 0.012, "order": "asc"}, {"name": "speed", "value": -3}]})";
+
+struct BadCase {
+  const char* json;
+  const char* pointer;   // where check-results must point
+  const char* expected;  // a part of what it must say was expected
+};
+
+// One wrong type or value per field; each must be reported at its JSON pointer.
+const BadCase kBadCases[] = {
+    {R"({"score": "lots", "tests": 5})", "/score", "a number"},
+    {R"({"score": 1, "tests": 5})", "/tests", "an array"},
+    {R"({"score": true})", "/score", "a number"},
+    {R"({"score": 1, "execution_time": "12 s"})", "/execution_time", "a number"},
+    {R"({"score": 1, "output": 3})", "/output", "a string"},
+    {R"({"score": 1, "output_format": "markdown"})", "/output_format", "\"md\""},
+    {R"({"score": 1, "test_output_format": null})", "/test_output_format", "\"ansi\""},
+    {R"({"score": 1, "visibility": "public"})", "/visibility", "\"after_due_date\""},
+    {R"({"score": 1, "stdout_visibility": 1})", "/stdout_visibility", "\"hidden\""},
+    {R"({"score": 1, "extra_data": []})", "/extra_data", "an object"},
+    {R"({"score": 1, "scroe": 2})", "/scroe", "Gradescope's keys"},
+    {R"({"score": 1, "tests": [3]})", "/tests/0", "an object"},
+    {R"({"score": 1, "tests": [{"name": 1}]})", "/tests/0/name", "a string"},
+    {R"({"score": 1, "tests": [{"name": "a"}, {"score": "2"}]})", "/tests/1/score", "a number"},
+    {R"({"score": 1, "tests": [{"max_score": [5]}]})", "/tests/0/max_score", "a number"},
+    {R"({"score": 1, "tests": [{"status": "ok"}]})", "/tests/0/status", "\"passed\", \"failed\""},
+    {R"({"score": 1, "tests": [{"visibility": "later"}]})", "/tests/0/visibility", "\"visible\""},
+    {R"({"score": 1, "tests": [{"output_format": "rst"}]})", "/tests/0/output_format", "\"text\""},
+    {R"({"score": 1, "tests": [{"extra_data": "x"}]})", "/tests/0/extra_data", "an object"},
+    {R"({"score": 1, "tests": [{"tags": ["a", 2]}]})", "/tests/0/tags/1", "a string"},
+    {R"({"score": 1, "tests": [{"number": 1.2}]})", "/tests/0/number", "a string"},
+    {R"({"score": 1, "tests": [{"naem": "a"}]})", "/tests/0/naem", "Gradescope's keys"},
+    {R"({"tests": [{"name": "a"}]})", "/tests/0/score", "a number"},
+    {R"({"output": "no score anywhere"})", "/score", "a number"},
+    {R"({"score": 1, "leaderboard": {}})", "/leaderboard", "an array"},
+    {R"({"score": 1, "leaderboard": [{"name": "a", "value": "fast"}]})", "/leaderboard/0/value", "a number"},
+    {R"({"score": 1, "leaderboard": [{"name": "a"}]})", "/leaderboard/0/value", "required"},
+    {R"({"score": 1, "leaderboard": [{"value": 1}]})", "/leaderboard/0/name", "required"},
+    {R"({"score": 1, "leaderboard": [{"name": "a", "value": 1, "order": "up"}]})", "/leaderboard/0/order", "\"asc\", \"desc\""},
+    {R"({"score": 1, "tests": [{"a/b~c": 1}]})", "/tests/0/a~1b~0c", "Gradescope's keys"},
+    {R"([{"score": 1}])", "(the whole file)", "a JSON object"},
+};
+
+// The bad-input contract: exit 2, nothing on stdout, one line "error: FILE: ..." holding each part.
+void checkRejected(const Ran& r, const std::vector<std::string>& parts) {
+  INFO("stderr: " << r.err);
+  CHECK(r.code == 2);
+  CHECK(r.out.empty());
+  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  CHECK(r.err.rfind("error: ", 0) == 0);
+  for (const auto& p : parts) CHECK_MESSAGE(r.err.find(p) != std::string::npos, "missing: " << p);
+}
+
+}  // namespace
+
+TEST_CASE("dynlab check-results: a valid results.json passes, and so do dynlab grade's own") {
+  const fs::path dir = scratch("check_valid");
+  writeText(dir / "full.json", kValidResults);
+  const Ran r = checkResults(dir / "full.json");
+  CHECK(r.code == 0);
+  CHECK(r.err.empty());
+  CHECK(r.out == (dir / "full.json").string() + ": a valid Gradescope results.json\n");
+  writeText(dir / "minimal.json", R"({"score": 0})");
+  CHECK(checkResults(dir / "minimal.json").code == 0);
+  writeText(dir / "tests_only.json", R"({"tests": [{"score": 1}, {"score": 2, "max_score": 2}]})");
+  CHECK(checkResults(dir / "tests_only.json").code == 0);
+
+  // The real grader's results: a graded example and a rejected submission.
+  const std::string bin = DYNLAB_BIN, src = DYNLAB_SOURCE_DIR;
+  writeText(dir / "bad_gains.json", R"({"lab": "slider_crank", "gains": {"kp_x": "high"}})");
+  for (const std::string& sub : {src + "/labs/slider_crank/examples/mediocre.json", (dir / "bad_gains.json").string()}) {
+    INFO(sub);
+    const fs::path out = dir / fs::path(sub).stem();
+    shell(quoted(bin) + " grade " + quoted(sub) + " --no-plots --out " + quoted(out.string()));
+    const Ran own = checkResults(out / "results.json");
+    CHECK_MESSAGE(own.code == 0, own.err);
+  }
+}
+
+TEST_CASE("dynlab check-results: each wrong type or value fails, naming the file and the JSON path") {
+  const fs::path dir = scratch("check_types");
+  for (const BadCase& c : kBadCases) {
+    INFO(c.json);
+    writeText(dir / "results.json", c.json);
+    checkRejected(checkResults(dir / "results.json"),
+                  {(dir / "results.json").string() + ": ", std::string(c.pointer) + ": expected ", c.expected});
+  }
+}
+
+TEST_CASE("dynlab check-results: not UTF-8, not JSON, or not a regular file") {
+  const fs::path dir = scratch("check_bytes");
+  const std::pair<std::string, std::string> cases[] = {
+      {"{\"score\": 1, \"output\": \"\xff\"}", "expected UTF-8 text, got byte 0xff at offset 24"},
+      {"{\"score\": 1, \"output\": \"\xc0\x80\"}", "expected UTF-8 text, got byte 0xc0"},      // overlong NUL
+      {"{\"score\": 1, \"output\": \"\xed\xa0\x80\"}", "expected UTF-8 text, got byte 0xed"},  // a surrogate
+      {"{\"score\": 1, \"output\": \"\xe2\x9c\"}", "expected UTF-8 text, got byte 0xe2"},      // cut short
+      {"\xef\xbb\xbf{\"score\": 1}", "byte-order mark"},
+      {"", "got an empty file"},
+      {"{\"score\": ", "expected JSON, got parse error at line 1"},
+      {"{\"score\": 1e400}", "expected JSON, got number overflow"},
+      {"{\"score\": 1} {}", "expected JSON, got parse error"},
+  };
+  for (const auto& [bytes, says] : cases) {
+    INFO(bytes);
+    writeText(dir / "results.json", bytes);
+    checkRejected(checkResults(dir / "results.json"), {(dir / "results.json").string() + ": ", says});
+  }
+  // A FIFO nobody writes to must be refused at once, not waited on; so must folders and devices.
+  REQUIRE(::mkfifo((dir / "fifo.json").c_str(), 0644) == 0);
+  const auto started = std::chrono::steady_clock::now();
+  checkRejected(checkResults(dir / "fifo.json"), {"fifo.json: expected a regular file, got a FIFO"});
+  CHECK(std::chrono::steady_clock::now() - started < std::chrono::seconds(10));
+  fs::create_directories(dir / "folder.json");
+  checkRejected(checkResults(dir / "folder.json"), {"folder.json: expected a regular file, got a directory"});
+  checkRejected(checkResults("/dev/null"), {"/dev/null: expected a regular file, got a device"});
+  checkRejected(checkResults(dir / "missing.json"), {"missing.json: expected a readable file, got no such file"});
+  CHECK(shell(quoted(DYNLAB_BIN) + " check-results").code == 2);  // FILE is required
+}
+
+TEST_CASE("run_autograder: dynlab's results.json of the wrong shape is replaced by a valid one naming the path") {
+  SUBCASE("a valid results.json is kept as it is") {
+    Sandbox box("kept");
+    writeText(box.submission / "submission.json", "{}");
+    box.fakeResults(kValidResults);
+    CHECK(box.run() == nlohmann::json::parse(kValidResults));
+  }
+  SUBCASE("each wrong type or value") {
+    for (const BadCase& c : kBadCases) {
+      INFO(c.json);
+      Sandbox box("wrong");
+      writeText(box.submission / "submission.json", "{}");
+      box.fakeResults(c.json);
+      const auto r = box.run();
+      CHECK(r.at("score").get<double>() == 0.0);
+      const std::string out = r.at("output").get<std::string>();
+      CHECK(out.find("would not accept") != std::string::npos);
+      CHECK(out.find(std::string(c.pointer) + ": expected ") != std::string::npos);
+      CHECK(box.log().find(c.pointer) != std::string::npos);  // the staff's log says why too
+    }
+  }
+  SUBCASE("a results.json that is not UTF-8") {
+    Sandbox box("latin1");
+    writeText(box.submission / "submission.json", "{}");
+    box.fakeResults("{\"score\": 1, \"output\": \"caf\xe9\"}");
+    CHECK(box.run().at("output").get<std::string>().find("expected UTF-8 text") != std::string::npos);
+  }
+  SUBCASE("a FIFO where results.json should be: no hang, and it is replaced") {
+    Sandbox box("fifo");
+    writeText(box.submission / "submission.json", "{}");
+    box.fakeDynlab("out=\"${@: -1}\"; mkfifo \"$out/results.json\"; exit 0");
+    CHECK(box.run().at("output").get<std::string>().find("got a FIFO") != std::string::npos);
+  }
+}
+
+// A folder of links to the tools run_autograder and the fakes use, and nothing else: no python3.
+fs::path pathWithoutPython(const fs::path& dir) {
+  const fs::path bin = dir / "bin";
+  fs::create_directories(bin);
+  std::vector<std::string> system_path;
+  std::stringstream path(std::getenv("PATH") ? std::getenv("PATH") : "/usr/bin:/bin");
+  for (std::string d; std::getline(path, d, ':');) system_path.push_back(d);
+  for (const char* tool : {"bash", "env", "find", "sort", "mkdir", "rm", "mv", "cp", "timeout", "sed", "tr", "cat", "sleep"}) {
+    for (const auto& d : system_path) {
+      if (fs::exists(fs::path(d) / tool)) {
+        fs::create_symlink(fs::path(d) / tool, bin / tool);
+        break;
+      }
+    }
+  }
+  return bin;
+}
+
+TEST_CASE("run_autograder: with no python3 on PATH, results.json is still checked for real") {
+  Sandbox box("nopython");
+  const fs::path bin = pathWithoutPython(box.dir);
+  const std::string env = "PATH='" + bin.string() + "'";
+  CHECK(shell("env " + env + " bash -c 'command -v python3 || command -v python'").code != 0);
+  writeText(box.submission / "submission.json", "{}");
+
+  box.fakeResults(R"({"score": "lots", "tests": 5})");  // starts with '{': the old fallback took it
+  auto r = box.run(env);
+  CHECK(r.at("score").get<double>() == 0.0);
+  CHECK(r.at("output").get<std::string>().find("/score: expected a number, got \"lots\"") != std::string::npos);
+
+  box.fakeResults(kValidResults);
+  CHECK(box.run(env).at("score").get<double>() == 7.5);
+}
+
+TEST_CASE("run_autograder: DYNLAB_TIME_LIMIT must be whole seconds from 1 to 86400, else the default is used") {
+  for (const std::string bad : {"0", "000", "abc", "10m", "-5", "1.5", "86401", "99999999999999999999", "' '"}) {
+    INFO("DYNLAB_TIME_LIMIT=" << bad);
+    Sandbox box("limit");
+    writeText(box.submission / "submission.json", "{}");
+    box.fakeResults(R"({"score": 3})");
+    CHECK(box.run("DYNLAB_TIME_LIMIT=" + bad).at("score").get<double>() == 3.0);  // graded, under the default
+    CHECK(box.log().find("expected whole seconds from 1 to 86400; using the default, 540") != std::string::npos);
+  }
+  for (const std::string good : {"", "1", "007", "86400"}) {
+    INFO("DYNLAB_TIME_LIMIT=" << good);
+    Sandbox box("limit_ok");
+    writeText(box.submission / "submission.json", "{}");
+    box.fakeResults(R"({"score": 3})");
+    CHECK(box.run("DYNLAB_TIME_LIMIT=" + good).at("score").get<double>() == 3.0);
+    CHECK(box.log().find("DYNLAB_TIME_LIMIT") == std::string::npos);
+  }
+  // 0 no longer turns the limit off: a hanging grader is still stopped (here after a limit of 2 s).
+  Sandbox box("limit_applies");
+  writeText(box.submission / "submission.json", "{}");
+  box.fakeDynlab("sleep 30");
+  const auto r = box.run("DYNLAB_TIME_LIMIT=02");
+  CHECK(r.at("output").get<std::string>().find("longer than 2 seconds") != std::string::npos);
+}
+
+TEST_CASE("run_autograder with the real dynlab: an example is graded and its results pass the check") {
+  Sandbox box("real");
+  box.dynlab = DYNLAB_BIN;
+  fs::copy_file(fs::path(DYNLAB_SOURCE_DIR) / "labs/slider_crank/examples/mediocre.json", box.submission / "submission.json");
+  const auto r = box.run();
+  CHECK(r.at("score").get<double>() > 0.0);
+  CHECK(r.at("tests").size() > 3);
+  CHECK(box.log().find("no grade from dynlab") == std::string::npos);
 }
