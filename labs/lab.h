@@ -95,9 +95,13 @@ struct LabEntry {
   LabFactory create;
 };
 
-std::vector<LabEntry>& labRegistry();
+std::vector<LabEntry>& labRegistry();  // sorted by name
 const LabEntry* findLab(const std::string& name);
+// Adds a lab (at static initialisation, or at run time from a test); false, and nothing added, if
+// the name is taken.
 bool registerLab(LabEntry entry);
+// Removes a lab registered at run time (a test's scratch lab); false if there is none of that name.
+bool unregisterLab(const std::string& name);
 // The lab's default config: labs/<name>/<name>.json in the source tree, or $DYNLAB_HOME/labs/...
 std::string defaultConfigPath(const std::string& name);
 
