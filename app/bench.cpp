@@ -195,7 +195,7 @@ int bench(const BenchArgs& a) {
       if (first_order)
         std::printf("    hand   %-34s %6.2f µs   Bullet/hand %.1fx   %s\n", first_scheme.c_str(), first_us,
                     bullet / first_us, describeAgreement(lab, first_error).c_str());
-      std::printf("    Bullet %-34s %6.2f µs                      %s\n", lab.referenceEngine().c_str(), bullet,
+      std::printf("    %-41s %6.2f µs                      %s\n", lab.referenceEngine().c_str(), bullet,
                   describeAgreement(lab, bullet_error).c_str());
       std::printf("  640x480 fps     render %.0f   +PNG %.0f   +video %.0f\n", fps.render, fps.png, fps.video);
       if (!grading.empty())
