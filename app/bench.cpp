@@ -2,9 +2,10 @@
 //   hand vs Bullet: median µs per step of each engine on the lab's default config, and the ratio,
 //     for the engine alone (advance the state one dt with the control held: the headline) and for
 //     the full simulation step (+ controller and trace row: energy, residual, constraint force);
-//   and speed with accuracy: the hand engine also with Bullet's order of method (semi-implicit
-//     Euler + Baumgarte: one dynamics evaluation per step, as Bullet's own step), each run's error
-//     against the reference (the lab's configured hand run: RK4, whose own error is ~1e-9);
+//   and speed with accuracy: the hand engine also with Bullet's order of method (labs/settings.h
+//     firstOrderPatch: one dynamics evaluation per step, as Bullet's own step), each run's error
+//     against the reference (the lab's configured hand run) in the lab's measures of agreement;
+//     the reference engine described by the lab (Lab::referenceEngine);
 //   render, render+PNG, render+video: frames per second at 640×480 (MSAA 4, overlay on);
 //   grading: CPU seconds of a full rubric grade of the lab's examples/good.json.
 #include <algorithm>
@@ -99,41 +100,31 @@ Fps frameRates(const Lab& lab, const Trace& trace, int frames) {
   return f;
 }
 
-// The hand engine with Bullet's order of method, when the lab's JSON has a "simulation" block that
-// configures something else.
-std::unique_ptr<Lab> firstOrderVariant(const LoadedLab& loaded) {
-  const json& sim = loaded.config.value("simulation", json::object());
-  if (!sim.is_object() || sim.value("integrator", "") == "semi_implicit_euler") return nullptr;
-  json config = loaded.config;
-  config["simulation"]["integrator"] = "semi_implicit_euler";
-  config["simulation"]["drift"] = "baumgarte";
-  return buildLab(*loaded.entry, config, loaded.config_file + " (bench: semi_implicit_euler + baumgarte)");
+// "integrator + drift" of a config's simulation block, as labs/ parses it for every lab.
+std::string schemeOf(const json& config, const std::string& file) {
+  return schemeName(parseSimulation(JsonView(config, file)["simulation"]).step);
 }
 
-// "integrator + drift" as the lab's JSON configures them.
-std::string schemeOf(const json& config) {
-  const json sim = config.value("simulation", json::object());
-  if (!sim.is_object()) return "as configured";
-  return sim.value("integrator", std::string("?")) + " + " + sim.value("drift", std::string("?"));
+// The hand engine with a reference engine's order of method (labs/settings.h firstOrderPatch),
+// unless the lab is configured that way already (lab null).
+struct Variant {
+  std::unique_ptr<Lab> lab;
+  std::string scheme;
+};
+Variant firstOrderVariant(const LoadedLab& loaded) {
+  const json config = mergePatch(loaded.config, firstOrderPatch());
+  const std::string scheme = schemeOf(config, loaded.config_file);
+  if (scheme == schemeOf(loaded.config, loaded.config_file)) return {nullptr, scheme};
+  return {buildLab(*loaded.entry, config, loaded.config_file + " (bench: " + scheme + ")"), scheme};
 }
 
-// The lab's own measures of disagreement (numbers at the top level of Lab::agreement).
+// The lab's own measures of disagreement (numbers at the top level of Lab::agreement; counts left out).
 json errorAgainst(const Lab& lab, const Trace& run, const Trace& reference) {
   const json agreement = lab.agreement(run, reference);
   json out = json::object();
   for (const auto& [k, v] : agreement.items())
     if (v.is_number_float()) out[k] = v;
   return out;
-}
-
-std::string describe(const json& error) {
-  std::string s;
-  char buf[64];
-  for (const auto& [k, v] : error.items()) {
-    std::snprintf(buf, sizeof buf, "%s%s %.1e", s.empty() ? "" : ", ", k.c_str(), v.get<double>());
-    s += buf;
-  }
-  return s;
 }
 
 }  // namespace
@@ -156,7 +147,10 @@ int bench(const BenchArgs& a) {
     // Speed with accuracy: errors of whole runs against the configured hand run.
     const RunResult reference = runEngine(lab, Engine::Hand);
     const json bullet_error = errorAgainst(lab, runEngine(lab, Engine::Bullet).trace, reference.trace);
-    const std::unique_ptr<Lab> first_order = firstOrderVariant(loaded);
+    const Variant variant = firstOrderVariant(loaded);
+    const std::unique_ptr<Lab>& first_order = variant.lab;
+    const std::string& first_scheme = variant.scheme;
+    const std::string scheme = schemeOf(loaded.config, loaded.config_file);
     StepTimes first_t;
     json first_error;
     if (first_order) {
@@ -165,7 +159,6 @@ int bench(const BenchArgs& a) {
     }
     const double first_us = first_t.has_engine ? first_t.engine : first_t.full;
     const Fps fps = frameRates(lab, reference.trace, a.frames);
-    const std::string scheme = schemeOf(loaded.config);
     const json grading = gradeThroughput(entry.name, 5);
     if (a.json) {
       json out = {{"lab", entry.name},
@@ -183,7 +176,7 @@ int bench(const BenchArgs& a) {
                   {"render_video_fps", fps.video},
                   {"resolution", "640x480"}};
       if (first_order) {
-        out["hand_first_order_scheme"] = "semi_implicit_euler + baumgarte";
+        out["hand_first_order_scheme"] = first_scheme;
         out["hand_first_order_us_per_step"] = first_us;
         out["bullet_over_hand_first_order"] = bullet / first_us;
         out["hand_first_order_error"] = first_error;
@@ -200,10 +193,10 @@ int bench(const BenchArgs& a) {
       std::printf("  speed and error of whole runs against the reference (hand, %s, dt %g s):\n", scheme.c_str(), lab.dt());
       std::printf("    hand   %-34s %6.2f µs   reference\n", scheme.c_str(), hand);
       if (first_order)
-        std::printf("    hand   %-34s %6.2f µs   Bullet/hand %.1fx   %s\n", "semi_implicit_euler + baumgarte", first_us,
-                    bullet / first_us, describe(first_error).c_str());
-      std::printf("    Bullet %-34s %6.2f µs                      %s\n", "multibody, PGS 30 iterations", bullet,
-                  describe(bullet_error).c_str());
+        std::printf("    hand   %-34s %6.2f µs   Bullet/hand %.1fx   %s\n", first_scheme.c_str(), first_us,
+                    bullet / first_us, describeAgreement(lab, first_error).c_str());
+      std::printf("    %-41s %6.2f µs                      %s\n", lab.referenceEngine().c_str(), bullet,
+                  describeAgreement(lab, bullet_error).c_str());
       std::printf("  640x480 fps     render %.0f   +PNG %.0f   +video %.0f\n", fps.render, fps.png, fps.video);
       if (!grading.empty())
         std::printf("  grading         %.3f s CPU per full rubric (%.3f s with plots): %.0f per s per core, 1000 on 2 cores in %.0f s\n",

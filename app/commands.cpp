@@ -25,6 +25,19 @@ int listLabs() {
   return 0;
 }
 
+std::string describeAgreement(const Lab& lab, const json& agreement) {
+  // Every top-level number the lab reports (by key), with the lab's unit.
+  std::string s;
+  char buf[48];
+  for (const auto& [key, v] : agreement.items()) {
+    if (!v.is_number()) continue;
+    std::snprintf(buf, sizeof buf, "%.3g", v.get<double>());
+    const std::string unit = lab.agreementUnit(key);
+    s += (s.empty() ? "" : ", ") + key + " = " + buf + (unit.empty() ? "" : " " + unit);
+  }
+  return s;
+}
+
 int runLab(const RunArgs& a) {
   LoadedLab loaded;
   try {
@@ -83,11 +96,7 @@ int runLab(const RunArgs& a) {
     std::printf("  summary         %s\n", (out / "summary.json").c_str());
     if (a.video) std::printf("  video           %s (%d frames)\n", (out / "video.mp4").c_str(), frames);
     if (a.frames) std::printf("  frames          %s/ (%d PNG)\n", (out / "frames").c_str(), frames);
-    if (summary.contains("agreement")) {
-      const json& ag = summary["agreement"];
-      std::printf("  hand vs Bullet: max |dq| = %.3g rad, max |dx_c| = %.3g m, max |df| = %.3g N\n",
-                  ag["max_dq"].get<double>(), ag["max_dx_c"].get<double>(), ag["max_df"].get<double>());
-    }
+    if (summary.contains("agreement")) std::printf("  hand vs Bullet: %s\n", describeAgreement(lab, summary["agreement"]).c_str());
     return status == "ok" ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());

@@ -5,7 +5,7 @@
 #include <string>
 #include <vector>
 
-#include "labs/config.h"
+#include "labs/lab.h"
 
 namespace dyn::app {
 
@@ -39,6 +39,9 @@ struct BenchArgs {
   bool json = false;
   int steps = 4000, frames = 60;
 };
+
+// "key = value unit, ..." of every top-level number of a lab's agreement (run, bench).
+std::string describeAgreement(const Lab& lab, const json& agreement);
 
 int listLabs();
 int runLab(const RunArgs& args);

@@ -54,7 +54,7 @@ std::pair<int, int> parseSize(const std::string& s) {
   return {w, h};
 }
 
-// "f_Ty, f_des" → {"f_Ty", "f_des"}, every name a column of the lab.
+// "theta, theta_d" → {"theta", "theta_d"}, every name a column of the lab.
 std::vector<std::string> parseColumns(const std::string& spec, const std::vector<std::string>& columns) {
   std::vector<std::string> out;
   std::size_t start = 0;
@@ -98,7 +98,7 @@ std::vector<FigurePlot> rubricPlots(const LoadedLab& loaded) {
   return plots;
 }
 
-// A lab without rubric plots: the overlay panel's series that are trace columns ("f_Ty (N)").
+// A lab without rubric plots: the overlay panel's series that are trace columns ("tau (N·m)").
 std::vector<FigurePlot> overlayPlots(const Lab& lab, const Trace& trace) {
   std::vector<FigurePlot> plots;
   if (trace.rows() == 0) return plots;
@@ -112,7 +112,7 @@ std::vector<FigurePlot> overlayPlots(const Lab& lab, const Trace& trace) {
 }
 
 // The y label of a requested plot: the lab's own label for exactly these columns (from its
-// rubric), else the column names with the lab's units ("f_Ty, f_meas (N)"; "x_c (m), q1 (rad)").
+// rubric), else the column names with the lab's units ("theta, theta_d (rad)"; "x (m), theta (rad)").
 std::string ylabelFor(const Lab& lab, const std::vector<std::string>& columns,
                       const std::vector<FigurePlot>& lab_plots) {
   for (const auto& p : lab_plots)

@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
   f->add_option("--engine", fig.engine, "Which engine(s) to run: hand solid, Bullet dashed (plots) or as a ghost (stills)")
       ->check(CLI::IsMember({"hand", "bullet", "both"}));
   f->add_option("--out", fig.out, "Output directory (default: out/LAB/figures)");
-  f->add_option("--plot", fig.plots, "Trace columns to plot against t, e.g. f_Ty,f_des (repeatable: one plot each); "
+  f->add_option("--plot", fig.plots, "Trace columns to plot against t, e.g. theta,theta_d (repeatable: one plot each); "
                                      "written as plot_<cols joined by +>.<format>")
       ->allow_extra_args(false);
   f->add_option("--still", fig.stills, "Render the scene at this time (s), nearest trace row (repeatable); "

@@ -4,13 +4,13 @@
 //
 //   "rubric": {
 //     "seed_target": "/controller/seed",            // where each scenario's derived seed is written
-//     "scenarios": {"heavy_load": {"about": "payload +20 %", "patch": {"mechanism": {"load_mass": 0.6}}}},
-//     "watchdog": {"max_steps": 100000, "limits": [{"column": "x_c", "min": -0.5, "max": 1.5,
-//                  "what": "the slider"}]},
-//     "tests": [{"name": "...", "scenario": "nominal", "metric": "x_rms", "full": 0.003,
+//     "scenarios": {"heavy": {"about": "bob mass +20 %", "patch": {"plant": {"mass": 1.2}}}},
+//     "watchdog": {"max_steps": 100000, "limits": [{"column": "theta", "min": -3, "max": 3,
+//                  "what": "the pendulum angle"}]},
+//     "tests": [{"name": "...", "scenario": "nominal", "metric": "theta_rms", "full": 0.003,
 //                "zero": 0.03, "points": 4, "visibility": "visible",
-//                "plot": {"columns": ["x_c"], "reference": "x_d", "band": 0.003, "ylabel": "x_c (m)"}}],
-//     "leaderboard": [{"name": "tracking RMS (mm)", "scenario": "nominal", "metric": "x_rms",
+//                "plot": {"columns": ["theta"], "reference": "theta_d", "band": 0.003, "ylabel": "theta (rad)"}}],
+//     "leaderboard": [{"name": "tracking RMS (mrad)", "scenario": "nominal", "metric": "theta_rms",
 //                      "scale": 1000, "order": "asc"}]
 //   }
 // Metrics come from the lab (Lab::metrics of the scenario's trace) or from screening the gains on

@@ -18,18 +18,42 @@ namespace {
 std::string fmtMs(double s) { return s >= kUnboundedDelay ? "unbounded" : fmtNumber(s * 1e3) + " ms"; }
 
 std::string fmtPole(std::complex<double> p) {
-  std::string s = (p.real() >= 0 ? "+" : "") + fmtNumber(p.real());
+  std::string s = (p.real() > 0 ? "+" : "") + fmtNumber(p.real());
   if (std::abs(p.imag()) > 1e-9) s += " ± " + fmtNumber(std::abs(p.imag())) + "j";
   return s + " rad/s";
 }
+
+// A loop with zero loop gain (an open-loop law, or zero gains) closes nothing.
+bool hasFeedback(const LinearLoop& loop) {
+  return std::any_of(loop.num.begin(), loop.num.end(), [](double c) { return c != 0; });
+}
+
+// Poles within this fraction of the largest pole's size of the imaginary axis do not decay: a pole
+// at 0 (an integrator left without position feedback) is not stable.
+constexpr double kMarginal = 1e-9;
 
 }  // namespace
 
 ScreenResult screenLoops(const Lab& lab) {
   ScreenResult r;
   for (const LinearLoop& loop : lab.linearise()) {
-    const LoopAnalysis a = analyseLoop(loop);
     const std::string& n = loop.name;
+    if (!hasFeedback(loop)) {
+      // Reported all the same, so every rubric metric exists: nothing to award.
+      for (const char* m : {"_max_real_pole", "_damping", "_delay_margin", "_phase_margin_deg", "_crossover"})
+        r.metrics[n + m] = 0.0;
+      r.notes.push_back(loop.what + ": no feedback — no margin to award.");
+      continue;
+    }
+    LoopAnalysis a = analyseLoop(loop);
+    double size = 0;
+    for (const auto& p : a.poles) size = std::max(size, std::abs(p));
+    const bool marginal = std::abs(a.max_real) <= kMarginal * size;  // the slowest pole on the axis
+    if (marginal) a.stable = false;
+    // A loop that is not stable has no damping to award (real poles in the right half plane
+    // would otherwise read ζ = 1), and a marginal one no delay margin.
+    if (!a.stable) a.min_damping = 0;
+    if (marginal) a.delay_margin = 0;
     r.metrics[n + "_max_real_pole"] = a.max_real;
     r.metrics[n + "_damping"] = a.min_damping;
     r.metrics[n + "_delay_margin"] = a.delay_margin;
@@ -40,14 +64,19 @@ ScreenResult screenLoops(const Lab& lab) {
     if (!a.stable) {
       r.unstable = true;
       std::string poles;
-      for (const auto& p : a.poles)
-        if (p.real() >= 0 && p.imag() >= 0) poles += (poles.empty() ? "" : ", ") + fmtPole(p);
-      note += "unstable, closed-loop pole" + std::string(poles.find(',') != std::string::npos ? "s" : "") + " at " + poles;
+      for (auto p : a.poles) {
+        if (p.real() < -kMarginal * size || p.imag() < 0) continue;
+        if (std::abs(p.real()) <= kMarginal * size) p.real(0.0);  // on the axis, up to rounding
+        poles += (poles.empty() ? "" : ", ") + fmtPole(p);
+      }
+      note += marginal ? "not stable (a pole on the imaginary axis does not decay)" : "unstable";
+      note += poles.find(',') != std::string::npos ? ", closed-loop poles at " : ", closed-loop pole at ";
+      note += poles;
     } else {
       note += "stable (slowest pole " + fmtPole(a.poles.front()) + ", damping ζ = " + fmtNumber(a.min_damping) + ")";
     }
     note += "; delay margin " + fmtMs(a.delay_margin) + " against " + fmtMs(loop.delay) + " of delay";
-    if (a.delay_margin < loop.delay) note += " — the delay alone destabilises it";
+    if (!marginal && a.delay_margin < loop.delay) note += " — the delay alone destabilises it";
     r.notes.push_back(note + ".");
   }
   return r;

@@ -1,7 +1,15 @@
 // Lab: the interface every lab implements, and the registry they add themselves to
-// (like Box2D's samples): a new lab is a new folder under labs/ with one
+// (like Box2D's samples): a new lab is a new folder under labs/<name>/ (its JSON, controller,
+// metrics, scene, examples/, README) with one
 //   DYNLAB_REGISTER_LAB(name, summary, factory)
-// and no change anywhere else.
+// and no change anywhere else. app/, grading/ and render/ know labs only through this interface.
+// The contract every lab keeps (tests/labs/every_lab_test.cpp checks it for each registered lab):
+//   * its JSON has the shared "simulation" block and declared "gains" (labs/settings.h), and may
+//     declare "submission_options" (labs/submission.h);
+//   * it accepts passivePatch() ({"controller": {"kind": "none"}}: τ = 0), and its trace has
+//     columns "t" and "energy";
+//   * linearise() reports the same loops whatever the submission options (a loop an option does
+//     not close is reported with no feedback), so every rubric metric exists for every option.
 #pragma once
 #include <functional>
 #include <memory>
@@ -9,6 +17,7 @@
 #include <vector>
 
 #include "labs/config.h"
+#include "labs/settings.h"
 #include "physics/linear.h"
 #include "labs/scene.h"
 #include "labs/trace.h"
@@ -49,15 +58,31 @@ class Lab {
 
   // Lab metrics of a run (tracking error, force error, energy drift, constraint residual ...).
   virtual json metrics(const Trace& trace) const = 0;
-  // Where the engines disagree (the summary's "agreement").
+  // Where the engines disagree (the summary's "agreement"): its top-level numbers are the
+  // measures of disagreement, printed with agreementUnit(key) ("rad", "m"; empty: none or a count).
   virtual json agreement(const Trace& hand, const Trace& bullet) const = 0;
+  virtual std::string agreementUnit(const std::string& key) const {
+    (void)key;
+    return {};
+  }
+  // Engine::Bullet in one line, e.g. "Bullet 3.24 btMultiBody, PGS 30 iterations" (dynlab bench).
+  virtual std::string referenceEngine() const { return "Bullet"; }
+
+  // The passive check: with passivePatch() applied, the hand engine keeps the "energy" column
+  // within |E − E0| ≤ tolerance·|E0| (absolute when E0 = 0) over `duration` s (0: the whole run).
+  struct PassiveEnergy {
+    double tolerance = 1e-6;
+    double duration = 0;
+  };
+  virtual PassiveEnergy passiveEnergy() const { return {}; }
 
   // What to draw at a trace row; ghost (the other engine) drawn translucent when given.
   virtual void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const = 0;
   virtual void overlay(const Trace& trace, std::size_t row, Overlay& out) const = 0;
 
   // The controller's feedback loops linearised at the start (the grader screens gains on them
-  // before simulating: poles, delay margin). Empty when the lab has no feedback.
+  // before simulating: poles, delay margin). The same loops for every submission option and gain:
+  // a loop without feedback (open loop, zero gains) has a zero numerator and is reported as such.
   virtual std::vector<LinearLoop> linearise() const { return {}; }
 };
 
@@ -70,9 +95,13 @@ struct LabEntry {
   LabFactory create;
 };
 
-std::vector<LabEntry>& labRegistry();
+std::vector<LabEntry>& labRegistry();  // sorted by name
 const LabEntry* findLab(const std::string& name);
+// Adds a lab (at static initialisation, or at run time from a test); false, and nothing added, if
+// the name is taken.
 bool registerLab(LabEntry entry);
+// Removes a lab registered at run time (a test's scratch lab); false if there is none of that name.
+bool unregisterLab(const std::string& name);
 // The lab's default config: labs/<name>/<name>.json in the source tree, or $DYNLAB_HOME/labs/...
 std::string defaultConfigPath(const std::string& name);
 

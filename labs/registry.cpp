@@ -16,9 +16,18 @@ std::vector<LabEntry>& labRegistry() {
 }
 
 bool registerLab(LabEntry entry) {
+  if (findLab(entry.name)) return false;
   auto& r = labRegistry();
   r.push_back(std::move(entry));
   std::sort(r.begin(), r.end(), [](const LabEntry& a, const LabEntry& b) { return a.name < b.name; });
+  return true;
+}
+
+bool unregisterLab(const std::string& name) {
+  auto& r = labRegistry();
+  const auto it = std::find_if(r.begin(), r.end(), [&](const LabEntry& e) { return e.name == name; });
+  if (it == r.end()) return false;
+  r.erase(it);
   return true;
 }
 

@@ -10,7 +10,9 @@ namespace dyn {
 std::unique_ptr<Lab> buildLab(const LabEntry& entry, const json& config, const std::string& file) {
   const JsonView view(config, file);
   checkSubmissionOptions(view);
-  return entry.create(view);
+  auto lab = entry.create(view);
+  parseSimulation(view["simulation"]);  // every lab has the shared simulation block (labs/settings.h)
+  return lab;
 }
 
 LoadedLab loadLab(const std::string& name, const std::string& config_file, const std::string& gains_file,

@@ -2,6 +2,7 @@
 #include "labs/trace.h"
 
 #include <cstdio>
+#include <stdexcept>
 
 namespace dyn {
 
@@ -9,6 +10,12 @@ int Trace::column(const std::string& name) const {
   for (std::size_t i = 0; i < columns.size(); ++i)
     if (columns[i] == name) return int(i);
   return -1;
+}
+
+int Trace::require(const std::string& name) const {
+  const int c = column(name);
+  if (c < 0) throw std::out_of_range("the trace has no column \"" + name + "\"");
+  return c;
 }
 
 std::vector<double> Trace::series(const std::string& name) const {

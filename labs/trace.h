@@ -17,7 +17,9 @@ struct Trace {
   std::size_t rows() const { return columns.empty() ? 0 : data.size() / columns.size(); }
   int column(const std::string& name) const;  // −1 if absent
   double at(std::size_t row, int col) const { return data[row * columns.size() + std::size_t(col)]; }
-  double at(std::size_t row, const std::string& name) const { return at(row, column(name)); }
+  // By name: a column the trace lacks throws std::out_of_range naming it (never a stray read).
+  double at(std::size_t row, const std::string& name) const { return at(row, require(name)); }
+  int require(const std::string& name) const;
   std::vector<double> series(const std::string& name) const;
   void append(const std::vector<double>& row) { data.insert(data.end(), row.begin(), row.end()); }
 

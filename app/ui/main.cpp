@@ -224,7 +224,7 @@ int main(int argc, char** argv) {
   cli.add_option("LAB", a.lab, "Lab name (see `dynlab list`)")->required();
   cli.add_option("--config", a.config, "Lab config JSON (default: labs/LAB/LAB.json)");
   cli.add_option("--gains", a.gains, "Start from these gains: a submission or gains JSON");
-  cli.add_option("--set", a.set, "NAME=VALUE: set a gain or an option (e.g. kp_x=500, force_law=integral); repeatable");
+  cli.add_option("--set", a.set, "NAME=VALUE: set a gain or an option (e.g. kp=500, law=integral: names the lab's JSON declares); repeatable");
   cli.add_option("--engine", a.engine, "hand, bullet, or both (Bullet drawn as a ghost)")->check(CLI::IsMember({"hand", "bullet", "both"}));
   cli.add_option("--speed", a.speed, "Simulated seconds per wall second")->check(CLI::Range(0.02, 20.0));
   cli.add_flag("--paused", a.paused, "Start paused");

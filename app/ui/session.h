@@ -14,13 +14,13 @@
 
 namespace dyn::ui {
 
-// A gain as the lab's JSON declares it: "gains": {"kp_x": {"value", "min", "max", "unit", "doc"}}.
+// A gain as the lab's JSON declares it: "gains": {"kp": {"value", "min", "max", "unit", "doc"}}.
 struct GainSpec {
   std::string name, unit, doc;
   double min = 0, max = 0, lab_default = 0;
 };
 
-// A submission option: "submission_options": {"force_law": {"target", "choices", "doc"}}.
+// A submission option: "submission_options": {"law": {"target", "choices", "doc"}}.
 struct OptionSpec {
   std::string name, doc, target;
   std::vector<std::string> choices;

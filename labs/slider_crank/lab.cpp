@@ -6,14 +6,14 @@
 #include <map>
 
 #include "labs/mechanism_simulation.h"
+#include "labs/settings.h"
 
 namespace dyn::slider_crank {
 namespace {
 
 // Physically sensible bounds on the config: beyond them the model is not a teaching lab any more
 // and products such as m·g·l or k·x overflow to inf/NaN mid-run.
-constexpr double kMaxLength = 100, kMaxMass = 1e6, kMaxGravity = 1e3, kMaxRate = 1e3, kMaxGain = 1e9;
-constexpr double kMinDt = 1e-6;  // the force-delay buffer holds delay/dt samples
+constexpr double kMaxLength = 100, kMaxMass = 1e6, kMaxGravity = 1e3, kMaxRate = 1e3;
 
 const std::vector<std::string> kColumns = {
     "t",   "q1",   "q2",   "q3",     "x_c",    "v_c",    "f_Tx",                "f_Ty", "tau_T",
@@ -89,19 +89,9 @@ Settings parseSettings(const JsonView& c) {
   if (std::abs(L[0].length * std::sin(s.theta1)) > L[1].length)
     init["theta1_deg"].fail("expected a crank angle the rod can reach (|l1 sin θ1| ≤ l2)");
 
-  const JsonView sim = c["simulation"];
-  sim.onlyKeys({"dt", "duration", "integrator", "drift", "baumgarte"});
-  s.step.dt = sim["dt"].positive();
-  if (s.step.dt > 0.05 || s.step.dt < kMinDt) sim["dt"].inRange(kMinDt, 0.05);
-  s.duration = sim["duration"].positive();
-  if (s.duration / s.step.dt > 2e6) sim["duration"].fail("expected at most 2e6 steps (duration/dt); a trace of 2e6 rows is ~300 MB");
-  parseIntegrator(sim["integrator"].oneOf({"semi_implicit_euler", "rk4"}), s.step.integrator);
-  parseDrift(sim["drift"].oneOf({"none", "baumgarte", "projection", "independent"}), s.step.drift.kind);
-  if (sim.has("baumgarte")) {
-    sim["baumgarte"].onlyKeys({"zeta", "omega"});
-    s.step.drift.zeta = sim["baumgarte"]["zeta"].positive(1e3);
-    s.step.drift.omega = sim["baumgarte"]["omega"].positive(1e6);
-  }
+  const SimulationSettings sim = parseSimulation(c["simulation"]);
+  s.step = sim.step;
+  s.duration = sim.duration;
 
   const JsonView ctl = c["controller"];
   ctl.onlyKeys({"kind", "force_law", "force_setpoint", "delay", "noise_std", "seed"});
@@ -115,17 +105,8 @@ Settings parseSettings(const JsonView& c) {
   cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1L << 53)) : 1;
 
   // Gains: declared with value and bounds (the submission schema comes from here).
-  const JsonView g = c["gains"];
-  g.onlyKeys({"kp_x", "kd_x", "kp_f", "ki_f"});
-  auto gain = [&](const char* key) {
-    const JsonView d = g[key];
-    d.onlyKeys({"value", "min", "max", "unit", "doc"});
-    for (const char* text : {"unit", "doc"})
-      if (d.has(text)) d[text].string();
-    const double lo = d["min"].inRange(-kMaxGain, kMaxGain), hi = d["max"].inRange(lo, kMaxGain);
-    return d["value"].inRange(lo, hi);
-  };
-  cc.gains = {gain("kp_x"), gain("kd_x"), gain("kp_f"), gain("ki_f")};
+  const auto g = parseGains(c["gains"], {"kp_x", "kd_x", "kp_f", "ki_f"});
+  cc.gains = {g.at("kp_x"), g.at("kd_x"), g.at("kp_f"), g.at("ki_f")};
 
   const JsonView ref = c["reference"];
   ref.onlyKeys({"kind", "amplitude", "period"});
@@ -219,6 +200,20 @@ json SliderCrankLab::agreement(const Trace& a, const Trace& b) const {
           {"hand", {{"energy_drift", ma["energy_drift"]}, {"max_constraint_residual", ma["max_constraint_residual"]}}},
           {"bullet", {{"energy_drift", mb["energy_drift"]}, {"max_constraint_residual", mb["max_constraint_residual"]}}}};
 }
+
+std::string SliderCrankLab::agreementUnit(const std::string& key) const {
+  static const std::map<std::string, std::string> units = {
+      {"max_dq", "rad"}, {"max_dx_c", "m"}, {"max_df", "N"}, {"max_dtau_T", "N·m"}};
+  const auto it = units.find(key);
+  return it == units.end() ? std::string() : it->second;
+}
+
+std::string SliderCrankLab::referenceEngine() const {
+  return "Bullet 3.24 btMultiBody, loop cut at joint 1, PGS 30 iterations";
+}
+
+// Passive (τ = 0) the arm falls through its whole range; RK4 + projection keeps E within 1e-6·|E0|.
+Lab::PassiveEnergy SliderCrankLab::passiveEnergy() const { return {1e-6, 0}; }
 
 DYNLAB_REGISTER_LAB(slider_crank, "Slider crank: move the slider along x_d(t) while regulating its rail force (direct force control on a closed chain)",
                     [](const JsonView& config) -> std::unique_ptr<Lab> {

@@ -30,6 +30,9 @@ class SliderCrankLab final : public Lab {
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
   json metrics(const Trace& trace) const override;
   json agreement(const Trace& hand, const Trace& bullet) const override;
+  std::string agreementUnit(const std::string& key) const override;
+  std::string referenceEngine() const override;
+  PassiveEnergy passiveEnergy() const override;
   void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
   void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
   std::vector<LinearLoop> linearise() const override;

@@ -2,8 +2,10 @@
 //   motion   m_eff x_c'' = k_px (x_d − x_c) + k_dx (ẋ_d − v_c)   ⇒  L(s) = (k_dx s + k_px) / (m_eff s²)
 //            m_eff = m_c + θ_xᵀ M θ_x,  θ_x = J⁻¹ A  (the arm's inertia seen along the slide)
 //            delay dt/2: the zero-order hold of a torque computed once per step
-//   force    f_Ty = ξ + d:  integral  L(s) = k_if / s,  proportional  L(s) = k_pf,  open loop: no loop
+//   force    f_Ty = ξ + d:  integral  L(s) = k_if / s,  proportional  L(s) = k_pf,  open loop: L = 0
 //            delay: the measurement delay, at least one step
+// Both loops are reported for every force law and with the controller off: a loop the
+// configuration does not close has L = 0 (no feedback), so the screening metrics always exist.
 #include <Eigen/LU>
 #include <cmath>
 
@@ -13,7 +15,8 @@ namespace dyn::slider_crank {
 
 std::vector<LinearLoop> SliderCrankLab::linearise() const {
   const auto& c = s_.controller;
-  if (c.kind == ControllerKind::None) return {};
+  const bool on = c.kind != ControllerKind::None;
+  const Gains g = on ? c.gains : Gains{};  // the controller off closes no loop
   // Effective mass along the slide at the start configuration.
   Mechanism mech(s_.params);
   VecN q, v;
@@ -28,13 +31,15 @@ std::vector<LinearLoop> SliderCrankLab::linearise() const {
 
   const double dt = s_.step.dt;
   std::vector<LinearLoop> loops;
-  loops.push_back({"motion", "slider position loop (PD, k_px and k_dx)", {c.gains.kp_x, c.gains.kd_x},
-                   {0, 0, m_eff}, 0.5 * dt});
+  loops.push_back({"motion", on ? "slider position loop (PD, k_px and k_dx)" : "slider position loop (controller off)",
+                   {g.kp_x, g.kd_x}, {0, 0, m_eff}, 0.5 * dt});
   const double delay = std::max(1.0, std::round(c.delay / dt)) * dt;
-  if (c.law == ForceLaw::Integral)
-    loops.push_back({"force", "rail-force loop (integral law, k_if)", {c.gains.ki_f}, {0, 1}, delay});
-  else if (c.law == ForceLaw::Proportional)
-    loops.push_back({"force", "rail-force loop (proportional law, k_pf)", {c.gains.kp_f}, {1}, delay});
+  if (on && c.law == ForceLaw::Integral)
+    loops.push_back({"force", "rail-force loop (integral law, k_if)", {g.ki_f}, {0, 1}, delay});
+  else if (on && c.law == ForceLaw::Proportional)
+    loops.push_back({"force", "rail-force loop (proportional law, k_pf)", {g.kp_f}, {1}, delay});
+  else
+    loops.push_back({"force", on ? "rail-force loop (open loop)" : "rail-force loop (controller off)", {}, {1}, delay});
   return loops;
 }
 

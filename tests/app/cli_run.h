@@ -50,11 +50,11 @@ struct Result {
   std::string out, err;
 };
 
-// Runs `dynlab ARGS` in dir (stdout/stderr captured to files there).
-inline Result dynlab(const TempDir& dir, const std::string& args) {
+// Runs a shell command in dir (stdout/stderr captured to files there).
+inline Result shell(const TempDir& dir, const std::string& command) {
   const fs::path out = dir / ".stdout", err = dir / ".stderr";
-  const std::string cmd = "cd " + quote(dir.path.string()) + " && " + quote(DYNLAB_BIN) + " " + args + " >" +
-                          quote(out.string()) + " 2>" + quote(err.string());
+  const std::string cmd = "cd " + quote(dir.path.string()) + " && " + command + " >" + quote(out.string()) + " 2>" +
+                          quote(err.string());
   const int status = std::system(cmd.c_str());
   Result r;
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
@@ -64,6 +64,9 @@ inline Result dynlab(const TempDir& dir, const std::string& args) {
   fs::remove(err);
   return r;
 }
+
+// Runs `dynlab ARGS` in dir.
+inline Result dynlab(const TempDir& dir, const std::string& args) { return shell(dir, quote(DYNLAB_BIN) + " " + args); }
 
 // Every regular file under dir (relative name → bytes).
 inline std::map<std::string, std::string> snapshot(const fs::path& dir) {

@@ -1,0 +1,48 @@
+// The simulation block and declared gains every lab shares; see settings.h.
+#include "labs/settings.h"
+
+namespace dyn {
+
+SimulationSettings parseSimulation(const JsonView& sim) {
+  SimulationSettings s;
+  sim.onlyKeys({"dt", "duration", "integrator", "drift", "baumgarte"});
+  s.step.dt = sim["dt"].positive();
+  if (s.step.dt > kMaxDt || s.step.dt < kMinDt) sim["dt"].inRange(kMinDt, kMaxDt);
+  s.duration = sim["duration"].positive();
+  if (s.duration / s.step.dt > kMaxSteps)
+    sim["duration"].fail("expected at most 2e6 steps (duration/dt); a trace of 2e6 rows is ~300 MB");
+  parseIntegrator(sim["integrator"].oneOf({"semi_implicit_euler", "rk4"}), s.step.integrator);
+  parseDrift(sim["drift"].oneOf({"none", "baumgarte", "projection", "independent"}), s.step.drift.kind);
+  if (sim.has("baumgarte")) {
+    sim["baumgarte"].onlyKeys({"zeta", "omega"});
+    s.step.drift.zeta = sim["baumgarte"]["zeta"].positive(1e3);
+    s.step.drift.omega = sim["baumgarte"]["omega"].positive(1e6);
+  }
+  return s;
+}
+
+std::map<std::string, double> parseGains(const JsonView& g, std::initializer_list<const char*> names) {
+  g.onlyKeys(names);
+  std::map<std::string, double> out;
+  for (const char* key : names) {
+    const JsonView d = g[key];
+    d.onlyKeys({"value", "min", "max", "unit", "doc"});
+    for (const char* text : {"unit", "doc"})
+      if (d.has(text)) d[text].string();
+    const double lo = d["min"].inRange(-kMaxGain, kMaxGain), hi = d["max"].inRange(lo, kMaxGain);
+    out[key] = d["value"].inRange(lo, hi);
+  }
+  return out;
+}
+
+std::string schemeName(const StepOptions& step) {
+  return std::string(name(step.integrator)) + " + " + name(step.drift.kind);
+}
+
+json firstOrderPatch() {
+  return {{"simulation", {{"integrator", name(Integrator::SemiImplicitEuler)}, {"drift", name(Drift::Baumgarte)}}}};
+}
+
+json passivePatch() { return {{"controller", {{"kind", "none"}}}}; }
+
+}  // namespace dyn

@@ -1,0 +1,41 @@
+// What every lab's JSON shares, parsed once here for all labs:
+//   "simulation": {"dt", "duration", "integrator", "drift", "baumgarte": {"zeta", "omega"}}
+//   "gains":      {"<name>": {"value", "min", "max", "unit", "doc"}, ...}
+// (submission options: labs/submission.h). Errors are InputErrors naming file and JSON path.
+#pragma once
+#include <initializer_list>
+#include <map>
+#include <string>
+
+#include "labs/config.h"
+#include "physics/integrate.h"
+
+namespace dyn {
+
+inline constexpr double kMinDt = 1e-6, kMaxDt = 0.05;  // s
+inline constexpr double kMaxSteps = 2e6;                 // duration/dt: a trace of 2e6 rows is ~300 MB
+inline constexpr double kMaxGain = 1e9;                  // |min|, |max| of a declared gain
+
+struct SimulationSettings {
+  StepOptions step;
+  double duration = 1;  // s
+};
+
+// The "simulation" block (pass config["simulation"]).
+SimulationSettings parseSimulation(const JsonView& simulation);
+
+// The "gains" block: exactly the names given, each {"value", "min", "max"} with min ≤ value ≤ max
+// and optional "unit" and "doc" strings; returns name → value.
+std::map<std::string, double> parseGains(const JsonView& gains, std::initializer_list<const char*> names);
+
+// The simulation block's scheme in words, e.g. "rk4 + projection".
+std::string schemeName(const StepOptions& step);
+
+// A merge patch giving any lab the first-order scheme (semi-implicit Euler + Baumgarte drift
+// correction: one dynamics evaluation per step, the order of a typical reference engine's step).
+json firstOrderPatch();
+
+// The merge patch that turns any lab's controller off (τ = 0): every lab accepts it.
+json passivePatch();
+
+}  // namespace dyn
