@@ -209,7 +209,11 @@ std::string SliderCrankLab::agreementUnit(const std::string& key) const {
 }
 
 std::string SliderCrankLab::referenceEngine() const {
-  return "Bullet 3.24 btMultiBody, loop cut at joint 1, PGS 30 iterations";
+  // How the builder models this description (the tree it grew, where it cut, the solver's effort).
+  Mechanism mech(s_.params);
+  VecN q, v;
+  mech.initialState(s_.theta1, s_.theta1_rate, s_.branch, q, v);
+  return bullet::BulletMechanism<Planar>(mech.model(), s_.step.dt, q, v).describe();
 }
 
 // Passive (τ = 0) the arm falls through its whole range; RK4 + projection keeps E within 1e-6·|E0|.

@@ -126,12 +126,13 @@ class PendulumLab final : public Lab {
 }  // namespace
 
 TEST_CASE("a lab described in a test file keeps the whole lab contract, on both engines") {
-  REQUIRE(registerLab({"scratch_pendulum", "A double pendulum made in a test",
-                       [](const JsonView& c) -> std::unique_ptr<Lab> { return std::make_unique<PendulumLab>(c); }}));
-  const cli::TempDir dir("scratch_lab_examples");
-  cli::writeFile((dir / "good.json").string(), R"({"lab": "scratch_pendulum", "gains": {"kp": 60, "kd": 6}})");
+  const LabFactory make = [](const JsonView& c) -> std::unique_ptr<Lab> { return std::make_unique<PendulumLab>(c); };
+  REQUIRE(registerLab({"scratch_pendulum", "A double pendulum made in a test", make}));
+  CHECK_FALSE(registerLab({"scratch_pendulum", "the same name again", make}));  // a name is taken once
+  const test::cli::TempDir dir("scratch_lab_examples");
+  test::cli::writeFile(dir / "good.json", R"({"lab": "scratch_pendulum", "gains": {"kp": 60, "kd": 6}})");
   test::LabCheckOptions options;
-  options.examples_dir = dir.string();
+  options.examples_dir = dir.path.string();
   options.cli = false;  // the dynlab binary does not know a lab made here
   test::checkLab(*findLab("scratch_pendulum"), json::parse(kConfig), options);
   // Both engines really ran the same pendulum: Bullet's first-order step stays close to RK4 over 1 s.
@@ -142,4 +143,5 @@ TEST_CASE("a lab described in a test file keeps the whole lab contract, on both 
   CHECK(dq > 0);
   CHECK(dq < 1e-2);
   CHECK(unregisterLab("scratch_pendulum"));
+  CHECK(findLab("scratch_pendulum") == nullptr);
 }
