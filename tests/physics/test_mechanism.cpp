@@ -348,3 +348,64 @@ TEST_CASE("descriptions that cannot work are refused with a sentence") {
   CHECK_THROWS_WITH_AS(ConstrainedMechanism<Planar>{d}, doctest::Contains("names a body"), std::invalid_argument);
   CHECK_THROWS_WITH_AS((ConstrainedMechanism<Planar, 3, 2, 1>{sliderCrank()}), doctest::Contains("do not match"), std::invalid_argument);
 }
+
+TEST_CASE("joint springs and friction in h: the damped oscillator's closed form, spring energy conserved") {
+  // One link about z, no gravity, I about the joint: I θ'' + b θ' + k (θ − θ_r) = 0 from θ(0) = θ_r + a:
+  // θ(t) = θ_r + a e^{−ζω t}(cos ω_d t + ζω/ω_d sin ω_d t), ω = √(k/I), ζω = b/(2I), ω_d = √(ω² − (ζω)²).
+  MechanismModel<Planar> d;
+  addLink(d.tree, -1, Pos::Zero(), 0.5, 2.0);
+  const double I = 2.0 * 0.25 / 3, k = 3.0, rest = 0.2, a = 0.3;
+  for (double b : {0.0, 0.1}) {
+    CAPTURE(b);
+    d.joints = {JointProperties{k, rest, b, 0.0, 1e-2}};
+    ConstrainedMechanism<Planar> mech(d);
+    StepOptions o;
+    o.drift.kind = Drift::None;
+    VecN q(1), v(1);
+    q << rest + a;
+    v << 0.0;
+    const double e0 = mech.energy(q, v), w = std::sqrt(k / I), zw = b / (2 * I), wd = std::sqrt(w * w - zw * zw);
+    double err = 0, de = 0;
+    for (int n = 1; n <= 3000; ++n) {
+      REQUIRE(step(mech, o, VecN::Zero(1), q, v));
+      const double t = n * o.dt;
+      err = std::max(err, std::abs(q[0] - (rest + a * std::exp(-zw * t) * (std::cos(wd * t) + zw / wd * std::sin(wd * t)))));
+      de = std::max(de, std::abs(mech.energy(q, v) - e0));
+    }
+    MESSAGE("b = ", b, ": max |θ − closed form| = ", err, ", max |E − E0| = ", de, " J (E0 = ", e0, ")");
+    CHECK(err < 1e-10);  // RK4 at 1 ms on a 2 rad/s oscillator
+    if (b == 0.0) CHECK(de < 1e-10 * e0);  // ½ k (θ − θ_r)² is in the energy
+    else CHECK(de > 1e-3 * e0);            // and viscous friction really dissipates
+  }
+  SUBCASE("Coulomb friction: a torque below F_c creeps at w τ / F_c inside the smoothing width") {
+    d.joints = {JointProperties{0.0, 0.0, 0.0, 2.0, 1e-2}};
+    ConstrainedMechanism<Planar> mech(d);
+    VecN q = VecN::Zero(1), v = VecN::Zero(1), tau(1);
+    tau << 0.5;
+    for (int n = 0; n < 2000; ++n) REQUIRE(step(mech, StepOptions{}, tau, q, v));
+    CHECK(std::abs(v[0] - 1e-2 * 0.5 / 2.0) < 1e-9);
+  }
+}
+
+TEST_CASE("what controllers read: inverse dynamics, M, G and Λ = (J M⁻¹ Jᵀ)⁻¹") {
+  ConstrainedMechanism<Planar> mech(sliderCrank());
+  Random r;
+  for (int trial = 0; trial < 5; ++trial) {
+    const VecN q = r.vec(3, 2.0), qd = r.vec(3, 2.0), qdd = r.vec(3, 2.0);
+    const MatN M = mech.massMatrix(q);
+    const VecN h = mech.inverseDynamics(q, qd, VecN::Zero(3));
+    CHECK((mech.inverseDynamics(q, qd, qdd) - (M * qdd + h)).norm() < 1e-12 * std::max(1.0, h.norm()));
+    CHECK((mech.gravityTorque(q) - mech.inverseDynamics(q, VecN::Zero(3), VecN::Zero(3))).norm() < 1e-12);
+    MatN J;
+    VecN Jdot;
+    mech.pointJacobian(2, Pos(0.2, 0), q, qd, J, Jdot);
+    const MatN Jt = J.bottomRows(2);
+    const MatN Lambda = mech.operationalInertia(q, Jt);
+    const MatN direct = (Jt * M.inverse() * Jt.transpose()).inverse();
+    CHECK((Lambda - direct).norm() < 1e-9 * direct.norm());
+  }
+  // A task Jacobian with dependent rows has no Λ.
+  MatN Jbad(2, 3);
+  Jbad << 1, 2, 3, 2, 4, 6;
+  CHECK(mech.operationalInertia(VecN::Zero(3), Jbad).size() == 0);
+}
