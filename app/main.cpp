@@ -3,6 +3,7 @@
 
 #include "app/check_results.h"
 #include "app/commands.h"
+#include "app/course.h"
 
 int main(int argc, char** argv) {
   using namespace dyn::app;
@@ -89,6 +90,8 @@ int main(int argc, char** argv) {
   b->add_option("--steps", bench_args.steps, "Steps timed per engine")->check(CLI::Range(100, 1000000));
   b->add_option("--frames", bench_args.frames, "Frames timed per output kind")->check(CLI::Range(5, 10000));
 
+  CourseCommands course(cli);  // dynlab handout, dynlab map (app/course.h)
+
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -103,6 +106,7 @@ int main(int argc, char** argv) {
   if (*c) return checkResults(results_file);
   if (*s) return printSchema(schema_lab);
   if (*b) return bench(bench_args);
+  if (course.chosen()) return course.run();
   if (*u) {
     ui.extra = u->remaining();
     return openUi(ui);

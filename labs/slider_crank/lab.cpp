@@ -70,7 +70,8 @@ double rms(const std::vector<double>& x) {
 Settings parseSettings(const JsonView& c) {
   Settings s;
   c.onlyKeys({"lab", "title", "description", "mechanism", "initial", "simulation", "controller", "gains",
-              "reference", "metrics", "rubric", "scenarios", "drawing", "submission_options"});
+              "reference", "metrics", "rubric", "scenarios", "drawing", "submission_options",
+              "metric_docs", "map"});
   const JsonView m = c["mechanism"];
   m.onlyKeys({"links", "load_mass", "gravity"});
   m["links"].size(3, 3);

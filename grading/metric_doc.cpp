@@ -1,0 +1,86 @@
+// Metric definitions for people; see metric_doc.h.
+#include "grading/metric_doc.h"
+
+#include <cmath>
+#include <cstdio>
+
+namespace dyn {
+
+std::string fmtConfigNumber(double x) {
+  char b[40];
+  if (std::isfinite(x) && x == std::round(x) && std::abs(x) < 1e12) std::snprintf(b, sizeof b, "%.0f", x);
+  else std::snprintf(b, sizeof b, "%.6g", x);
+  return b;
+}
+
+std::string fillFromConfig(const std::string& text, const JsonView& config, const std::string& path) {
+  std::string out;
+  for (std::size_t i = 0; i < text.size();) {
+    // Copy up to the next "{/", then substitute the pointer inside the braces.
+    const std::size_t open = text.find("{/", i);
+    if (open == std::string::npos) {
+      out += text.substr(i);
+      break;
+    }
+    out += text.substr(i, open - i);
+    const std::size_t close = text.find('}', open);
+    const std::string pointer = text.substr(open + 1, close == std::string::npos ? std::string::npos : close - open - 1);
+    const json* value = nullptr;
+    try {
+      const json::json_pointer ptr(pointer);
+      if (close != std::string::npos && config.raw().contains(ptr)) value = &config.raw().at(ptr);
+    } catch (const json::exception&) {
+    }
+    if (!value || !(value->is_number() || value->is_string()))
+      throw InputError(config.file(), path, "expected \"{" + pointer + "}\" to name a number or string of the config");
+    out += value->is_number() ? fmtConfigNumber(value->get<double>()) : value->get<std::string>();
+    i = close + 1;
+  }
+  return out;
+}
+
+std::map<std::string, MetricDoc> parseMetricDocs(const JsonView& config) {
+  std::map<std::string, MetricDoc> docs;
+  if (!config.has("metric_docs")) return docs;
+  const JsonView all = config["metric_docs"];
+  all.requireObject();
+  for (const auto& [name, _] : all.raw().items()) {
+    const JsonView d = all[name];
+    d.onlyKeys({"what", "unit", "window"});
+    docs[name] = {fillFromConfig(d["what"].string(), config, d["what"].path()), d["unit"].string(),
+                  fillFromConfig(d["window"].string(), config, d["window"].path())};
+  }
+  return docs;
+}
+
+std::optional<MetricDoc> screeningMetricDoc(const std::string& metric, const std::vector<LinearLoop>& loops) {
+  // Each kind the screening reports, defined as grading/scenario.h computes it.
+  static const std::vector<std::pair<std::string, MetricDoc>> kinds = {
+      {"_delay_margin",
+       {"the total measurement delay the loop tolerates before it goes unstable (phase margin / crossover "
+        "frequency; reported as 1000 s when |L| < 1 at every frequency, 0 when the loop is not stable even "
+        "without delay or closes no feedback)",
+        "s", ""}},
+      {"_max_real_pole",
+       {"the largest real part of the closed-loop poles (the delay as a Padé approximant): above 0 the loop "
+        "is unstable",
+        "1/s", ""}},
+      {"_damping",
+       {"the smallest damping ratio ζ = −Re p / |p| of the closed-loop poles (0 when the loop is not stable "
+        "or closes no feedback)",
+        "1", ""}},
+      {"_phase_margin_deg", {"the phase margin of the delay-free loop at its crossover", "°", ""}},
+      {"_crossover", {"the crossover frequency, where |L(jω)| = 1 (0 if it never crosses)", "rad/s", ""}}};
+  for (const auto& loop : loops)
+    for (const auto& [suffix, doc] : kinds)
+      if (metric == loop.name + suffix) {
+        MetricDoc d = doc;
+        d.what = "screening of the " + loop.what + ": " + d.what;
+        d.window = "no simulation: the loop linearised at the start (L(s) with its delay of " +
+                   fmtConfigNumber(loop.delay * 1e3) + " ms)";
+        return d;
+      }
+  return std::nullopt;
+}
+
+}  // namespace dyn

@@ -1,0 +1,38 @@
+// What a metric means, for people (the handout, feedback): its definition, unit and time window.
+// Lab metrics are documented by the lab's JSON,
+//   "metric_docs": {"x_rms": {"unit": "m", "window": "whole run", "what": "RMS of x_c − x_d"}, ...}
+// where "{/json/pointer}" in window or what stands for the config's value there (so a window such
+// as "from t = {/metrics/settle_time} s on" never disagrees with the grader); the screening
+// metrics (<loop>_delay_margin, <loop>_damping, ... from grading/scenario.h) are documented here,
+// once for every lab, from the loops the lab reports.
+#pragma once
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "labs/config.h"
+#include "physics/linear.h"
+
+namespace dyn {
+
+struct MetricDoc {
+  std::string what, unit, window;  // unit "1": dimensionless
+};
+
+// config["metric_docs"] (none: empty), placeholders filled from config; throws InputError naming the
+// file and JSON path of a malformed entry or a placeholder pointing at nothing.
+std::map<std::string, MetricDoc> parseMetricDocs(const JsonView& config);
+
+// The definition of a screening metric <loop>_<kind> for one of these loops, if it is one.
+std::optional<MetricDoc> screeningMetricDoc(const std::string& metric, const std::vector<LinearLoop>& loops);
+
+// A config number as people read it and as the JSON has it: integers plain (20000), else 6
+// significant digits (0.003, 0.00167).
+std::string fmtConfigNumber(double x);
+
+// Replaces every "{/pointer}" in text by the config's value there (numbers by fmtConfigNumber);
+// throws InputError naming the config file and `path` if the pointer is malformed or missing.
+std::string fillFromConfig(const std::string& text, const JsonView& config, const std::string& path);
+
+}  // namespace dyn
