@@ -291,9 +291,9 @@ int map(const MapArgs& a) {
                 + law;
     pic.xlabel = g.x.label();
     pic.ylabel = g.y.label();
-    pic.stable_label = a.sim ? "stable: the run completes" : "stable (screening)";
-    pic.unstable_label = a.sim ? "unstable: watchdog stop" : "unstable (screening)";
-    pic.boundary_label = "screening boundary (delay margin)";
+    pic.stable_label = a.sim ? "stable (run completes)" : "stable";
+    pic.unstable_label = a.sim ? "unstable (watchdog)" : "unstable";
+    pic.boundary_label = "screening boundary";
     if (!g.metric.empty()) {
       const auto docs = parseMetricDocs(JsonView(g.config, g.file));
       std::string unit = docs.count(g.metric) ? docs.at(g.metric).unit : "";

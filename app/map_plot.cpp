@@ -70,9 +70,13 @@ void draw(const MapPicture& m, int width_px, int height_px) {
   const double scale = std::clamp(std::min(width_px / 900.0, height_px / 600.0), 0.6, 4.0);
   plschr(0, 1.05 * scale);
   // The frame on the left, the legend (and colour bar) in a column on the right.
-  plvpor(0.11, 0.70, 0.12, 0.90);
+  plvpor(0.10, 0.64, 0.12, 0.90);
   plwind(std::min(ex.front(), ex.back()), std::max(ex.front(), ex.back()), std::min(ey.front(), ey.back()),
          std::max(ey.front(), ey.back()));
+
+  // Plain tick labels (no "×10⁻²" factor that a reader has to find).
+  plsxax(8, 0);
+  plsyax(8, 0);
 
   // The cells.
   for (std::size_t j = 0; j < ny; ++j)
@@ -107,8 +111,10 @@ void draw(const MapPicture& m, int width_px, int height_px) {
   plbox("bcnts", 0, 0, "bcntsv", 0, 0);
   plcol0(kInk);
   pllab(m.xlabel.c_str(), m.ylabel.c_str(), "");
+  // The title across the whole page (it may be wider than the frame).
+  plvpor(0.0, 1.0, 0.0, 0.96);
   plschr(0, 1.15 * scale);
-  plmtex("t", 1.6, 0.5, 0.5, m.title.c_str());
+  plmtex("t", 0.0, 0.5, 0.5, m.title.c_str());
   plschr(0, 1.05 * scale);
 
   // Legend: the cell kinds shown, then the boundary line.
@@ -125,7 +131,7 @@ void draw(const MapPicture& m, int width_px, int height_px) {
   std::vector<PLINT> text_colours(texts.size(), kInk), patterns(texts.size(), 0);
   std::vector<PLFLT> box_scales(texts.size(), 1.1), box_widths(texts.size(), 0), line_widths(texts.size(), 2.5 * scale);
   PLFLT lw, lh;
-  plvpor(0.72, 0.99, 0.12, 0.90);
+  plvpor(0.655, 0.995, 0.12, 0.90);
   plwind(0, 1, 0, 1);
   plschr(0, 0.9 * scale);
   pllegend(&lw, &lh, PL_LEGEND_BACKGROUND, PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE, 0.02, 0.0, 0.12,

@@ -1,0 +1,121 @@
+// dynlab handout end to end: for every registered lab the handout names every gain, rubric test,
+// scenario and metric with the JSON's own numbers (a changed threshold, bound or window in a
+// --config shows up changed); the HTML is self-contained; bad input is one line and exit 2.
+#include <doctest/doctest.h>
+
+#include <cstdio>
+#include <nlohmann/json.hpp>
+
+#include "tests/app/cli_run.h"
+
+using namespace dyn::test::cli;
+using nlohmann::json;
+
+namespace {
+
+// A JSON number as the handout prints it (integers plain, else 6 significant digits).
+std::string num(double x) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.6g", x);
+  return b;
+}
+
+std::vector<std::string> labNames(const TempDir& dir) {
+  const Result r = dynlab(dir, "list");
+  REQUIRE(r.code == 0);
+  std::vector<std::string> names;
+  std::istringstream in(r.out);
+  for (std::string line; std::getline(in, line);)
+    if (!line.empty()) names.push_back(line.substr(0, line.find(' ')));
+  REQUIRE_FALSE(names.empty());
+  return names;
+}
+
+bool has(const std::string& text, const std::string& what) { return text.find(what) != std::string::npos; }
+
+}  // namespace
+
+TEST_CASE("every lab's handout names every gain, test, scenario and metric with the JSON's numbers") {
+  TempDir dir("handout_every");
+  for (const auto& lab : labNames(dir)) {
+    INFO("lab ", lab);
+    const Result r = dynlab(dir, "handout " + lab + " --out h_" + lab);
+    REQUIRE_MESSAGE(r.code == 0, r.err);
+    const std::string md = readFile(dir / ("h_" + lab + "/handout.md"));
+    const std::string html = readFile(dir / ("h_" + lab + "/handout.html"));
+    const json config = json::parse(readFile(fs::path(DYNLAB_SOURCE_DIR) / "labs" / lab / (lab + ".json")));
+    for (const auto& [gain, g] : config.at("gains").items()) {
+      INFO("gain ", gain);
+      CHECK(has(md, "| `" + gain + "` | " + num(g.at("value")) + " | " + num(g.at("min")) + " | " + num(g.at("max")) + " |"));
+      CHECK(has(html, "<code>" + gain + "</code>"));
+    }
+    for (const auto& [name, _] : config.at("rubric").at("scenarios").items()) CHECK_MESSAGE(has(md, "`" + name + "`"), name);
+    for (const auto& t : config.at("rubric").at("tests")) {
+      const std::string name = t.at("name"), metric = t.at("metric");
+      INFO("test ", name);
+      CHECK(has(md, "**" + name + "**"));
+      // Its row: scenario, metric, both thresholds, points.
+      const std::size_t row = md.find("| " + name + " | `" + t.at("scenario").get<std::string>() + "` | `" + metric + "` | ");
+      REQUIRE(row != std::string::npos);
+      const std::string line = md.substr(row, md.find('\n', row) - row);
+      CHECK(has(line, "| " + num(t.at("full"))));
+      CHECK(has(line, "| " + num(t.at("zero"))));
+      CHECK(has(line, "| " + num(t.at("points")) + " |"));
+      // The metric is defined in the metrics table, with a unit and a window.
+      CHECK(has(md, "| `" + metric + "` | "));
+    }
+    for (const auto& l : config.at("rubric").value("leaderboard", json::array())) CHECK(has(md, l.at("name").get<std::string>()));
+    for (const std::string& how : {"dynlab run " + lab, "dynlab ui " + lab, "dynlab grade my_gains.json --lab " + lab, "dynlab schema " + lab})
+      CHECK_MESSAGE(has(md, how), how);
+  }
+}
+
+TEST_CASE("the handout follows the config: a changed threshold, bound and window show up changed") {
+  TempDir dir("handout_config");
+  json config = json::parse(defaultConfigText());
+  config["rubric"]["tests"][0]["full"] = 0.0042;
+  config["rubric"]["tests"][1]["points"] = 7;
+  config["gains"]["kp_x"]["max"] = 12345;
+  config["metrics"]["settle_time"] = 0.75;
+  writeFile(dir / "changed.json", config.dump());
+  REQUIRE(dynlab(dir, "handout slider_crank --out a").code == 0);
+  const Result r = dynlab(dir, "handout slider_crank --config changed.json --out b --format md");
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  const std::string before = readFile(dir / "a/handout.md"), after = readFile(dir / "b/handout.md");
+  CHECK_FALSE(has(before, "0.0042"));
+  CHECK(has(after, "≤ 0.0042 m"));
+  CHECK(has(after, "| `kp_x` | 400 | 0 | 12345 |"));
+  CHECK(has(before, "from t = 0.5 s on"));
+  CHECK(has(after, "from t = 0.75 s on"));
+  CHECK_FALSE(has(after, "from t = 0.5 s on"));
+  CHECK(has(after, "(7 points, scenario `nominal`"));
+  CHECK(has(after, "**" + num(15 - 3 + 7) + "**"));  // the total follows
+  CHECK_FALSE(fs::exists(dir / "b/handout.html"));  // only the format asked for
+  // The same inputs give the same bytes.
+  REQUIRE(dynlab(dir, "handout slider_crank --out c").code == 0);
+  CHECK(readFile(dir / "c/handout.md") == before);
+  CHECK(readFile(dir / "c/handout.html") == readFile(dir / "a/handout.html"));
+}
+
+TEST_CASE("the HTML handout is self-contained: no external reference of any kind") {
+  TempDir dir("handout_html");
+  REQUIRE(dynlab(dir, "handout slider_crank --out h --format html").code == 0);
+  const std::string html = readFile(dir / "h/handout.html");
+  CHECK(html.rfind("<!doctype html>", 0) == 0);
+  CHECK(has(html, "<table>"));
+  for (const char* ref : {"src=", "<link", "@import", "url(", "href=\"http", "href=\"//", "<script", "<iframe"})
+    CHECK_MESSAGE(!has(html, ref), "external reference: ", ref);
+}
+
+TEST_CASE("bad LAB, --out or --format: one line, exit 2, nothing written") {
+  TempDir dir("handout_bad");
+  checkBadInput(dir, "handout no_such_lab --out h", {"no_such_lab"}, dir / "h");
+  writeFile(dir / "a_file", "x");
+  checkBadInput(dir, "handout slider_crank --out a_file/h", {"a_file"}, dir / "a_file/h");
+  checkBadInput(dir, "handout slider_crank --out h --format pdf", {"pdf"}, dir / "h");
+  checkBadInput(dir, "handout slider_crank --out h --format docx", {"docx"}, dir / "h");
+  json config = json::parse(defaultConfigText());
+  config["metric_docs"]["f_rms"]["window"] = "from t = {/metrics/no_such} s on";
+  writeFile(dir / "bad.json", config.dump());
+  checkBadInput(dir, "handout slider_crank --config bad.json --out h", {"bad.json", "/metric_docs/f_rms/window", "/metrics/no_such"}, dir / "h");
+}
