@@ -184,7 +184,7 @@ budget=$((time_limit * 3 / 4))
 ((budget >= 1)) || budget=1
 ((budget <= 300)) || budget=300
 started=$SECONDS
-timeout --kill-after=10 "$time_limit" "$dynlab" grade "$file" --lab "$lab" --out "$results_dir" --time-budget "$budget"
+timeout --kill-after=10 "$time_limit" "$dynlab" grade "$file" --time-budget "$budget" --lab "$lab" --out "$results_dir"
 status=$?
 elapsed=$((SECONDS - started))
 # Its results.json stands only if Gradescope would accept it, checked by dynlab check-results.
@@ -233,7 +233,8 @@ This zip is a Gradescope autograder for the dynlab lab `@LAB@`. It holds:
   `source/scripts/setup`) and compiles dynlab (Release) into `source/build/`.
 * `run_autograder`: run for every submission: finds the student's JSON (a symbolic link out of the
   submission, a FIFO or a device is refused unread), runs
-  `dynlab grade FILE --lab @LAB@ --out /autograder/results`, and always leaves a valid
+  `dynlab grade FILE --time-budget B --lab @LAB@ --out /autograder/results` (B: 3/4 of the time
+  limit, at most 300 s, so dynlab explains a slow run itself), and always leaves a valid
   `results.json` (score 0 with an explanation when the file is missing, grading fails, or what
   dynlab wrote does not pass `dynlab check-results`). Set `DYNLAB_TIME_LIMIT` (whole seconds,
   1–86400; default 540) to change how long dynlab may grade.

@@ -296,8 +296,8 @@ TEST_CASE("run_autograder: dynlab's own results.json is kept, and it gets the la
   const auto r = box.run();
   CHECK(r.at("score").get<double>() == 7.5);
   const std::string args = readBytes(box.dir / "args.txt");
-  CHECK(args == "grade\n" + (box.submission / "my gains.json").string() + "\n--lab\nslider_crank\n--out\n" +
-                    box.results.string() + "\n--time-budget\n300\n");
+  CHECK(args == "grade\n" + (box.submission / "my gains.json").string() + "\n--time-budget\n300\n--lab\nslider_crank\n--out\n" +
+                    box.results.string() + "\n");
 }
 
 TEST_CASE("run_autograder: garbage, timeouts, a missing binary and missing files become score 0") {
