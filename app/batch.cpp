@@ -141,21 +141,28 @@ Row finish(const Job& job, int status, double kill_s) {
 int gradeBatch(const GradeArgs& a) {
   const fs::path out = a.out;
   std::error_code ec;
+  // OUT must not be DIR itself: its result folders would be taken for students on the next run.
+  if (fs::equivalent(a.batch, out, ec)) {
+    std::fprintf(stderr, "error: %s: --out must not be the submissions folder itself; give a folder beside or inside it\n",
+                 out.c_str());
+    return 2;
+  }
+  // Read-only first: a DIR with nothing to grade is an error that writes nothing.
+  batch::Found found = batch::findSubmissions(a.batch, out);
+  if (!found.error.empty()) {
+    std::fprintf(stderr, "error: %s: %s\n", a.batch.c_str(), found.error.c_str());
+    return 2;
+  }
   fs::create_directories(out, ec);
   if (ec) {
     std::fprintf(stderr, "error: %s: cannot create the output folder (%s)\n", out.c_str(), ec.message().c_str());
     return 1;
   }
-  // One batch per OUT at a time: a second one refuses before touching anything.
+  // One batch per OUT at a time: a second one refuses before touching anything in it.
   std::string why;
   const int lock_fd = lockOut(out, why);
   if (lock_fd < 0) {
     std::fprintf(stderr, "error: %s: %s\n", out.c_str(), why.c_str());
-    return 2;
-  }
-  batch::Found found = batch::findSubmissions(a.batch, out);
-  if (!found.error.empty()) {
-    std::fprintf(stderr, "error: %s: %s\n", a.batch.c_str(), found.error.c_str());
     return 2;
   }
   batch::assignFolders(found.submissions, out);
@@ -181,7 +188,8 @@ int gradeBatch(const GradeArgs& a) {
   };
 
   std::vector<Job> pending, running;
-  for (auto it = found.submissions.rbegin(); it != found.submissions.rend(); ++it) pending.push_back({*it, out / it->folder, -1, {}, false});
+  for (auto it = found.submissions.rbegin(); it != found.submissions.rend(); ++it)
+    pending.push_back({*it, out / it->folder, -1, {}, false});
   while (!pending.empty() || !running.empty()) {
     // Keep N graders busy; a submission with nothing to grade gets its row (and results.json) at once.
     while (!pending.empty() && int(running.size()) < std::max(1, a.jobs)) {

@@ -76,8 +76,12 @@ Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, 
   const json error = extra.is_object() ? extra.value("error", json()) : json();
   // Exit 2 is an invalid submission: its results.json says what is wrong (where and what was expected).
   if (exit_code == 2 && error.is_object()) {
-    const std::string where = error.value("path", ""), expected = error.value("expected", "");
-    return failedRow(s, "invalid submission", where + (where.empty() ? "" : ": ") + expected);
+    const std::string file = error.value("file", ""), where = error.value("path", ""), expected = error.value("expected", "");
+    const std::string what = where + (where.empty() ? "" : ": ") + expected;
+    // An error in another file (the lab config) is the course's problem, not the student's.
+    if (!file.empty() && file != fs::absolute(s.file).string())
+      return failedRow(s, "internal error", "internal error: " + file + ": " + what);
+    return failedRow(s, "invalid submission", what);
   }
   if (exit_code != 0 || !error.is_null() || !r.value("score", json()).is_number())
     return failedRow(s, "internal error", "internal error: the grader exited with status " + std::to_string(exit_code) +

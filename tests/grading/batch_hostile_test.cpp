@@ -82,7 +82,9 @@ std::set<std::string> tree(const fs::path& dir, const fs::path& except) {
       it.disable_recursion_pending();
       continue;
     }
-    paths.insert(fs::relative(it->path(), dir).string() + (it->is_directory() ? "/" : " " + readFile(it->path())));
+    std::string entry = fs::relative(it->path(), dir).string();
+    entry += it->is_directory() ? std::string("/") : ' ' + readFile(it->path());
+    paths.insert(entry);
   }
   return paths;
 }
@@ -101,8 +103,9 @@ void copyExample(const std::string& example, const fs::path& to) {
 // `dynlab grade --batch IN --out OUT` in dir, with a time limit and optional fault injection.
 Result batch(const TempDir& dir, const std::string& in, const std::string& out, const std::string& faults = "",
              const std::string& extra = "--jobs 2") {
-  return shell(dir, (faults.empty() ? "" : "DYNLAB_FAULT_INJECTION=" + faults + " ") + "timeout 300 " + quote(DYNLAB_BIN) +
-                        " grade --batch " + quote(in) + " --out " + quote(out) + " --lab slider_crank --no-plots --time-budget 1 " + extra);
+  const std::string env = faults.empty() ? "" : "DYNLAB_FAULT_INJECTION=" + faults + " ";
+  return shell(dir, env + "timeout 300 " + quote(DYNLAB_BIN) + " grade --batch " + quote(in) + " --out " + quote(out) +
+                        " --lab slider_crank --no-plots --time-budget 1 " + extra);
 }
 
 // Starts the same batch in the background (its own pid, via exec); the caller waits for it.
@@ -350,7 +353,10 @@ TEST_CASE("a Gradescope export: one folder per student, macOS leftovers ignored"
   CHECK(none.code == 2);
   CHECK(none.err.rfind("error: empty: found no submissions", 0) == 0);
   CHECK(none.err.find("1 other file(s)") != std::string::npos);
-  CHECK(!fs::exists(dir / "out2" / "gradebook.csv"));
+  CHECK(!fs::exists(dir / "out2"));  // nothing written
+  const Result same = batch(dir, "export", "export/.");
+  CHECK(same.code == 2);
+  CHECK(same.err.find("--out must not be the submissions folder itself") != std::string::npos);
 }
 
 TEST_CASE("OUT inside the submissions folder is not taken for a student" * doctest::timeout(300)) {
@@ -361,4 +367,34 @@ TEST_CASE("OUT inside the submissions folder is not taken for a student" * docte
   const auto book = readBook(dir / "in" / "graded" / "gradebook.csv");
   CHECK(book.size() == 1);
   CHECK(book.at("good.json").at("score") == "15");
+
+  // --out . around the submissions: folders dynlab did not write (plots/, the submissions) are left alone.
+  TempDir here("batch_here");
+  put(here / "plots" / "figure.png", "not dynlab's");
+  copyExample("good", here / "in" / "plots.json");
+  copyExample("good", here / "in" / "in.json");
+  const auto before = tree(here.path, here / "nothing");
+  REQUIRE(batch(here, "in", ".").code == 0);
+  CHECK(readFile(here / "plots" / "figure.png") == "not dynlab's");
+  CHECK(std::distance(fs::directory_iterator(here / "plots"), fs::directory_iterator()) == 1);
+  CHECK(std::distance(fs::directory_iterator(here / "in"), fs::directory_iterator()) == 2);
+  const auto here_book = readBook(here / "gradebook.csv");
+  CHECK(here_book.at("plots.json").at("folder").rfind("plots-", 0) == 0);
+  CHECK(here_book.at("in.json").at("folder").rfind("in-", 0) == 0);
+  const auto after = tree(here.path, here / "nothing");
+  for (const auto& p : before) CHECK_MESSAGE(after.count(p), "gone or changed: " << p);
+}
+
+TEST_CASE("a broken lab config is an internal error in every row, not the students' mistake" * doctest::timeout(120)) {
+  TempDir dir("batch_config");
+  copyExample("good", dir / "in" / "good.json");
+  json config = json::parse(defaultConfigText());
+  config["rubric"]["tests"][0]["points"] = "lots";
+  put(dir / "broken.json", config.dump());
+  const Result r = shell(dir, "timeout 120 " + quote(DYNLAB_BIN) + " grade --batch in --out out --config broken.json --no-plots");
+  REQUIRE(r.code == 0);
+  const auto row = readBook(dir / "out" / "gradebook.csv").at("good.json");
+  CHECK(row.at("status") == "internal error");
+  CHECK(row.at("reason").find("internal error: ") == 0);
+  CHECK(row.at("reason").find("broken.json: /rubric/tests/0/points: expected") != std::string::npos);
 }
