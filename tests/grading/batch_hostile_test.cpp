@@ -216,6 +216,7 @@ TEST_CASE("a rerun grades afresh: a stale results.json never counts, a failing g
   copyExample("mediocre", dir / "in" / "mediocre.json");
   REQUIRE(batch(dir, "in", "out").code == 0);
   CHECK(readBook(dir / "out" / "gradebook.csv").at("good.json").at("score") == "15");
+  REQUIRE(fs::exists(dir / "out" / "good" / "report.md"));
 
   SUBCASE("the grader exits 1 without writing anything") {
     const Result r = batch(dir, "in", "out", "fail:good");
@@ -228,6 +229,9 @@ TEST_CASE("a rerun grades afresh: a stale results.json never counts, a failing g
     const json results = json::parse(readFile(dir / "out" / "good" / "results.json"));
     CHECK(results.at("score") == 0.0);
     CHECK(results.at("output").get<std::string>().find("exited with status 1") != std::string::npos);
+    // Last run's report (15/15) is not left beside it.
+    CHECK(!fs::exists(dir / "out" / "good" / "report.md"));
+    CHECK(!fs::exists(dir / "out" / "good" / "report.html"));
   }
   SUBCASE("the submission became unreadable bytes") {
     put(dir / "in" / "good.json", "\xff\xfe{\0\"");
