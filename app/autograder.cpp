@@ -149,13 +149,14 @@ fail() {
 mkdir -p "$results_dir"
 rm -rf -- "$results"
 
-# The student's file: submission.json, else the only *.json they uploaded.
+# The student's file: submission.json, else the only *.json they uploaded (macOS ._* copies and
+# __MACOSX/ aside). Links, FIFOs and devices are found too, so that they are refused, not skipped.
 file=""
-if [ -f "$submission_dir/submission.json" ]; then
+if [ -e "$submission_dir/submission.json" ] || [ -L "$submission_dir/submission.json" ]; then
   file="$submission_dir/submission.json"
 else
   found=()
-  while IFS= read -r f; do found+=("$f"); done < <(find "$submission_dir" -type f -iname '*.json' 2>/dev/null | LC_ALL=C sort)
+  while IFS= read -r -d '' f; do found+=("$f"); done < <(find "$submission_dir" -iname '*.json' ! -type d ! -name '._*' ! -path '*/__MACOSX/*' -print0 2>/dev/null | LC_ALL=C sort -z)
   case ${#found[@]} in
     1) file="${found[0]}" ;;
     0) fail 'No JSON file was found in your submission.\n\nUpload one file named `submission.json` of the form `{\"lab\": \"@LAB@\", \"gains\": {...}}` (see the lab handout for the gain names).' ;;
@@ -163,11 +164,29 @@ else
   esac
 fi
 
+# Only a regular file inside the submission folder is read. A symbolic link out of it, a FIFO or a
+# device is refused without being opened: nothing of what it points to reaches the feedback.
+if [ -L "$file" ]; then
+  target="$(realpath -e -- "$file" 2>/dev/null)"
+  root="$(realpath -e -- "$submission_dir" 2>/dev/null)"
+  case "$target" in
+    "$root"/*) file="$target" ;;
+    *) fail 'Your JSON file is a symbolic link to something outside your submission, so it was not read.\n\nUpload the file itself (not a link), named `submission.json`.' ;;
+  esac
+fi
+[ -f "$file" ] || fail 'Your JSON file is not a regular file (it is a folder, a FIFO or a device), so it was not read.\n\nUpload one ordinary file named `submission.json`.'
+
 [ -x "$dynlab" ] || fail 'The autograder is broken: dynlab was not built when the image was set up. This is not your fault; please tell the course staff.'
 
-# Grade within the time limit; dynlab writes results.json (and report.md, plots/) itself.
-timeout --kill-after=10 "$time_limit" "$dynlab" grade "$file" --lab "$lab" --out "$results_dir"
+# Grade within the time limit; dynlab writes results.json (and report.md, plots/) itself. Its own
+# time budget (3/4 of the limit, at most 300 s) lets it explain a slow run before it is stopped.
+budget=$((time_limit * 3 / 4))
+((budget >= 1)) || budget=1
+((budget <= 300)) || budget=300
+started=$SECONDS
+timeout --kill-after=10 "$time_limit" "$dynlab" grade "$file" --time-budget "$budget" --lab "$lab" --out "$results_dir"
 status=$?
+elapsed=$((SECONDS - started))
 # Its results.json stands only if Gradescope would accept it, checked by dynlab check-results.
 problem=""
 if [ -e "$results" ] || [ -L "$results" ]; then
@@ -175,9 +194,10 @@ if [ -e "$results" ] || [ -L "$results" ]; then
   [ -n "$problem" ] || problem="dynlab check-results stopped without saying why"
   echo "run_autograder: $problem" >&2
 fi
-case $status in
-  124|137) fail "Grading took longer than $time_limit seconds and was stopped. Gains that make the simulation stiff or unstable can do this: check them against the limits in the lab handout and resubmit." ;;
-esac
+# 124: stopped at the time limit; 137 after it: killed when it ignored the stop (before it, a crash).
+if ((status == 124 || (status == 137 && elapsed >= time_limit))); then
+  fail "Grading took longer than $time_limit seconds and was stopped. Gains that make the simulation stiff or unstable can do this: check them against the limits in the lab handout and resubmit."
+fi
 [ -z "$problem" ] || fail "The grader wrote a results.json that Gradescope would not accept, so this one replaces it. This is not a judgement of your gains; please tell the course staff.\n\n    $(json_text "$problem")"
 fail "The grader stopped (exit status $status) without writing results. This is not a judgement of your gains; please resubmit, and tell the course staff if it happens again."
 )SH",
@@ -211,8 +231,10 @@ This zip is a Gradescope autograder for the dynlab lab `@LAB@`. It holds:
 
 * `setup.sh`: run once when Gradescope builds the image: installs the packages (the list in
   `source/scripts/setup`) and compiles dynlab (Release) into `source/build/`.
-* `run_autograder`: run for every submission: finds the student's JSON, runs
-  `dynlab grade FILE --lab @LAB@ --out /autograder/results`, and always leaves a valid
+* `run_autograder`: run for every submission: finds the student's JSON (a symbolic link out of the
+  submission, a FIFO or a device is refused unread), runs
+  `dynlab grade FILE --time-budget B --lab @LAB@ --out /autograder/results` (B: 3/4 of the time
+  limit, at most 300 s, so dynlab explains a slow run itself), and always leaves a valid
   `results.json` (score 0 with an explanation when the file is missing, grading fails, or what
   dynlab wrote does not pass `dynlab check-results`). Set `DYNLAB_TIME_LIMIT` (whole seconds,
   1–86400; default 540) to change how long dynlab may grade.

@@ -1,26 +1,25 @@
 // dynlab grade --batch DIR --jobs N --out OUT: every submission in DIR graded in its own child
-// process (`dynlab grade FILE --out OUT/<name>`), N at a time. A child that crashes or hangs
-// (killed after its time budget) still gets a results.json saying so; the batch goes on.
-// Then OUT/gradebook.csv: submission, score, max_score, status, one column per test.
+// process (`dynlab grade FILE --out OUT/<folder>`), N at a time, under a lock on OUT. A grader
+// that exits with anything but 0 (graded) or 2 (invalid submission), crashes or hangs (killed after
+// its time budget) gets a results.json saying so; the batch goes on. Then OUT/gradebook.csv.
 #include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/file.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
-#include <cstring>
 #include <cstdio>
-#include <filesystem>
-#include <map>
+#include <cstring>
+#include <fstream>
 #include <thread>
 
+#include "app/batch.h"
 #include "app/commands.h"
 #include "app/output.h"
-#include "labs/config.h"
-
-extern char** environ;
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -28,8 +27,15 @@ using Clock = std::chrono::steady_clock;
 namespace dyn::app {
 namespace {
 
+using batch::Row;
+using batch::Submission;
+
+// The names a grade writes into its folder: cleared before each grade, so none is left from the last run.
+constexpr const char* kGradeOutputs[] = {"results.json", "report.md", "report.html", "plots", ".staging"};
+
 struct Job {
-  fs::path submission, out;
+  Submission sub;
+  fs::path out;  // OUT/<folder>
   pid_t pid = -1;
   Clock::time_point started;
   bool killed = false;
@@ -41,10 +47,45 @@ std::string selfExe() {
   return ec ? std::string("dynlab") : p.string();
 }
 
-// Starts `dynlab grade` for one submission, output and errors into OUT/<name>/grade.log.
-pid_t spawnGrade(const GradeArgs& a, const Job& job) {
-  fs::create_directories(job.out);
-  std::vector<std::string> args = {selfExe(), "grade", job.submission.string(), "--out", job.out.string(),
+// OUT/.dynlab-batch.lock, flocked for the batch's life (the kernel drops it if the batch is killed).
+// Returns the fd, or -1 with `why` set when another batch holds it or it cannot be opened.
+int lockOut(const fs::path& out, std::string& why) {
+  const fs::path file = out / ".dynlab-batch.lock";
+  const int fd = ::open(file.c_str(), O_RDWR | O_CREAT | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (fd < 0) {
+    why = "cannot open the lock file " + file.string() + " (" + std::strerror(errno) + ")";
+    return -1;
+  }
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    why = errno == EWOULDBLOCK ? "another dynlab grade --batch is writing into this folder (" + file.string() +
+                                     " is locked); wait for it to finish, or give another --out"
+                               : "cannot lock " + file.string() + " (" + std::strerror(errno) + ")";
+    ::close(fd);
+    return -1;
+  }
+  return fd;
+}
+
+// Empties a submission's folder of the last grade's outputs and opens a fresh grade.log in it.
+// Returns the log's fd (-1 with `why` set if the folder cannot be prepared).
+int prepareFolder(const fs::path& folder, std::string& why) {
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  for (const char* name : kGradeOutputs)
+    if (!ec) fs::remove_all(folder / name, ec);
+  if (ec) {
+    why = "cannot prepare " + folder.string() + " (" + ec.message() + ")";
+    return -1;
+  }
+  const int fd = ::open((folder / "grade.log").c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | O_NOFOLLOW, 0644);
+  if (fd < 0) why = "cannot write " + (folder / "grade.log").string() + " (" + std::strerror(errno) + ")";
+  return fd;
+}
+
+// Starts `dynlab grade` for one submission, output and errors into its grade.log. The child dies
+// with the batch (PR_SET_PDEATHSIG), so a killed batch leaves no grader writing into OUT.
+pid_t spawnGrade(const GradeArgs& a, const Job& job, int log_fd) {
+  std::vector<std::string> args = {selfExe(), "grade", fs::absolute(job.sub.file).string(), "--out", job.out.string(),
                                    "--time-budget", std::to_string(a.time_budget)};
   if (!a.lab.empty()) args.insert(args.end(), {"--lab", a.lab});
   if (!a.config.empty()) args.insert(args.end(), {"--config", a.config});
@@ -52,62 +93,45 @@ pid_t spawnGrade(const GradeArgs& a, const Job& job) {
   std::vector<char*> argv;
   for (auto& s : args) argv.push_back(s.data());
   argv.push_back(nullptr);
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  const std::string log = (job.out / "grade.log").string();
-  posix_spawn_file_actions_addopen(&fa, 1, log.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_adddup2(&fa, 1, 2);
-  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-  pid_t pid = -1;
-  const int rc = posix_spawn(&pid, argv[0], &fa, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  return rc == 0 ? pid : -1;
+  const pid_t parent = ::getpid();
+  const pid_t pid = ::fork();
+  if (pid != 0) return pid;
+  // The child: only async-signal-safe calls until exec.
+  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
+  if (::getppid() != parent) ::_exit(127);
+  const int null_fd = ::open("/dev/null", O_RDONLY);
+  if (null_fd < 0 || ::dup2(null_fd, 0) < 0 || ::dup2(log_fd, 1) < 0 || ::dup2(log_fd, 2) < 0) ::_exit(127);
+  ::execv(argv[0], argv.data());
+  ::_exit(127);
 }
 
-// A results.json for a submission whose grader process did not produce one.
-void writeFallback(const Job& job, const std::string& why, const std::string& status) {
-  const json r = {{"score", 0.0},
-                  {"output", "**This submission could not be graded:** " + why + "\n\nThe course staff have been told."},
-                  {"output_format", "md"},
-                  {"tests", json::array()},
-                  {"extra_data", {{"status", status}}}};
-  writeFileAtomic(job.out / "results.json", r.dump(2) + "\n");
+// The last non-empty line of a grader's log (what it said before it failed), at most 300 bytes.
+std::string logTail(const fs::path& log) {
+  std::ifstream in(log, std::ios::binary);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (line.find_first_not_of(" \t\r") != std::string::npos) last = line;
+  if (last.size() > 300) last = last.substr(0, 300) + "...";
+  return last;
 }
 
-std::string csvField(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
-// One gradebook row from a results.json (status from how the grade went).
-struct Row {
-  std::string name, status;
-  double score = 0, max_score = 0;
-  std::vector<std::pair<std::string, double>> tests;  // in rubric order
-};
-
-Row readRow(const Job& job, const std::string& process_status) {
-  Row row{job.submission.filename().string(), process_status, 0, 0, {}};
+// The row of a finished grader, from how it ended; a results.json is written for every failure.
+Row finish(const Job& job, int status, double kill_s) {
+  const fs::path results = job.out / "results.json";
+  Row row;
+  if (job.killed) {
+    row = batch::failedRow(job.sub, "timed out", "grading did not finish within " + std::to_string(long(kill_s)) + " s");
+  } else if (WIFSIGNALED(status)) {
+    row = batch::failedRow(job.sub, "crashed", "internal error: the grader stopped with signal " +
+                                                   std::to_string(WTERMSIG(status)) + " (" + strsignal(WTERMSIG(status)) + ")");
+  } else {
+    row = batch::rowFromResults(job.sub, results, WEXITSTATUS(status), logTail(job.out / "grade.log"));
+    if (row.status != "internal error") return row;
+  }
   try {
-    const json r = loadJsonFile((job.out / "results.json").string());
-    row.score = r.value("score", 0.0);
-    for (const auto& t : r.value("tests", json::array())) {
-      row.tests.emplace_back(t.value("name", "?"), t.value("score", 0.0));
-      row.max_score += t.value("max_score", 0.0);
-    }
-    const json extra = r.value("extra_data", json::object());
-    if (process_status == "graded") {
-      if (extra.contains("error")) row.status = "invalid submission";
-      else {
-        const json scenarios = extra.value("scenarios", json::object());  // kept alive for the loop
-        for (const auto& [_, s] : scenarios.items())
-          if (s.value("status", "completed") != "completed") row.status = "graded (unstable run)";
-      }
-    }
-  } catch (const std::exception&) {
-    row.status = "no results";
+    batch::writeFallbackResults(results, row);
+  } catch (const std::exception& e) {
+    row.reason += " (and its results.json could not be written: " + std::string(e.what()) + ")";
   }
   return row;
 }
@@ -115,118 +139,113 @@ Row readRow(const Job& job, const std::string& process_status) {
 }  // namespace
 
 int gradeBatch(const GradeArgs& a) {
-  std::vector<fs::path> files;
+  const fs::path out = a.out;
   std::error_code ec;
-  for (const auto& e : fs::directory_iterator(a.batch, ec))
-    if (e.path().extension() == ".json" && !e.is_directory()) files.push_back(e.path());
-  if (ec) {
-    std::fprintf(stderr, "error: %s: cannot read the submissions directory (%s)\n", a.batch.c_str(), ec.message().c_str());
+  // OUT must not be DIR itself: its result folders would be taken for students on the next run.
+  if (fs::equivalent(a.batch, out, ec)) {
+    std::fprintf(stderr, "error: %s: --out must not be the submissions folder itself; give a folder beside or inside it\n",
+                 out.c_str());
     return 2;
   }
-  std::sort(files.begin(), files.end());
-  const fs::path out = a.out;
-  fs::create_directories(out);
+  // Read-only first: a DIR with nothing to grade is an error that writes nothing.
+  batch::Found found = batch::findSubmissions(a.batch, out);
+  if (!found.error.empty()) {
+    std::fprintf(stderr, "error: %s: %s\n", a.batch.c_str(), found.error.c_str());
+    return 2;
+  }
+  fs::create_directories(out, ec);
+  if (ec) {
+    std::fprintf(stderr, "error: %s: cannot create the output folder (%s)\n", out.c_str(), ec.message().c_str());
+    return 1;
+  }
+  // One batch per OUT at a time: a second one refuses before touching anything in it.
+  std::string why;
+  const int lock_fd = lockOut(out, why);
+  if (lock_fd < 0) {
+    std::fprintf(stderr, "error: %s: %s\n", out.c_str(), why.c_str());
+    return 2;
+  }
+  batch::assignFolders(found.submissions, out);
+  const std::size_t total = found.submissions.size();
   const bool tty = isatty(STDERR_FILENO);
   // A grader process gets its own budget plus a margin to write its results, then it is killed.
   const double kill_s = a.time_budget + std::clamp(a.time_budget, 2.0, 30.0);
   const auto kill_after = std::chrono::milliseconds(long(kill_s * 1e3));
 
-  std::vector<Job> pending, running;
-  for (const auto& f : files) pending.push_back({f, out / f.stem(), -1, {}, false});
-  std::reverse(pending.begin(), pending.end());
-  std::map<std::string, Row> rows;
-  std::size_t done = 0, problems = 0;
-  auto progress = [&](const Row& r) {
-    ++done;
+  std::vector<Row> rows;
+  std::size_t problems = 0;
+  auto progress = [&](Row r) {
     if (r.status != "graded") ++problems;
     if (tty) {
-      const int width = 30, filled = int(width * done / std::max<std::size_t>(1, files.size()));
+      const int width = 30, filled = int(width * (rows.size() + 1) / std::max<std::size_t>(1, total));
       std::fprintf(stderr, "\r[%s%s] %zu/%zu graded, %zu need a look ", std::string(std::size_t(filled), '#').c_str(),
-                   std::string(std::size_t(width - filled), ' ').c_str(), done, files.size(), problems);
+                   std::string(std::size_t(width - filled), ' ').c_str(), rows.size() + 1, total, problems);
     } else {
-      std::fprintf(stderr, "graded %zu/%zu: %s %.2f/%.2f %s\n", done, files.size(), r.name.c_str(), r.score, r.max_score,
-                   r.status.c_str());
+      // The folder name, not the raw file name: it is plain ASCII and says where the results are.
+      std::fprintf(stderr, "graded %zu/%zu: %s %.2f %s\n", rows.size() + 1, total, r.folder.c_str(), r.score, r.status.c_str());
     }
+    rows.push_back(std::move(r));
   };
+
+  std::vector<Job> pending, running;
+  for (auto it = found.submissions.rbegin(); it != found.submissions.rend(); ++it)
+    pending.push_back({*it, out / it->folder, -1, {}, false});
   while (!pending.empty() || !running.empty()) {
-    // Keep N graders busy.
+    // Keep N graders busy; a submission with nothing to grade gets its row (and results.json) at once.
     while (!pending.empty() && int(running.size()) < std::max(1, a.jobs)) {
-      Job j = pending.back();
+      Job j = std::move(pending.back());
       pending.pop_back();
-      j.started = Clock::now();
-      j.pid = spawnGrade(a, j);
-      if (j.pid < 0) {
-        writeFallback(j, "the grader could not be started", "not started");
-        rows[j.submission.filename()] = readRow(j, "not started");
-        progress(rows[j.submission.filename()]);
+      std::string problem;
+      const int log_fd = prepareFolder(j.out, problem);
+      if (log_fd >= 0 && j.sub.problem.empty()) {
+        j.started = Clock::now();
+        j.pid = spawnGrade(a, j, log_fd);
+        if (j.pid < 0) problem = std::string("internal error: the grader could not be started (") + std::strerror(errno) + ")";
+      }
+      if (log_fd >= 0) ::close(log_fd);
+      if (j.pid > 0) {
+        running.push_back(std::move(j));
         continue;
       }
-      running.push_back(j);
+      const Row row = j.sub.problem.empty() ? batch::failedRow(j.sub, "internal error", problem)
+                                            : batch::failedRow(j.sub, "invalid submission", j.sub.problem);
+      try {
+        if (log_fd >= 0) batch::writeFallbackResults(j.out / "results.json", row);
+      } catch (const std::exception&) {
+        // Its row says what happened; the gradebook is the record.
+      }
+      progress(row);
     }
     // Reap finished graders; kill the ones past their budget.
     bool any = false;
     for (auto it = running.begin(); it != running.end();) {
       int status = 0;
-      const pid_t r = waitpid(it->pid, &status, WNOHANG);
-      if (r == 0) {
+      if (::waitpid(it->pid, &status, WNOHANG) == 0) {
         if (!it->killed && Clock::now() - it->started > kill_after) {
-          kill(it->pid, SIGKILL);
+          ::kill(it->pid, SIGKILL);
           it->killed = true;
         }
         ++it;
         continue;
       }
       any = true;
-      std::string st = "graded";
-      if (it->killed) {
-        st = "timed out";
-        writeFallback(*it, "grading did not finish within " + std::to_string(long(kill_s)) + " s", st);
-      } else if (WIFSIGNALED(status)) {
-        st = "crashed";
-        writeFallback(*it, std::string("the grader stopped with signal ") + std::to_string(WTERMSIG(status)) + " (" +
-                               strsignal(WTERMSIG(status)) + ")", st);
-      } else if (!fs::exists(it->out / "results.json")) {
-        st = "no results";
-        writeFallback(*it, "the grader exited without writing results", st);
-      }
-      const Row row = readRow(*it, st);
-      rows[row.name] = row;
-      progress(row);
+      progress(finish(*it, status, kill_s));
       it = running.erase(it);
     }
     if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   if (tty) std::fprintf(stderr, "\n");
 
-  // The gradebook: one row per submission (sorted), one column per test (rubric order).
-  std::vector<std::string> tests;
-  for (const auto& [_, r] : rows)
-    for (const auto& [t, __] : r.tests)
-      if (std::find(tests.begin(), tests.end(), t) == tests.end()) tests.push_back(t);
-  std::string csv = "submission,score,max_score,status";
-  for (const auto& t : tests) csv += "," + csvField(t);
-  csv += "\n";
-  char num[32];
-  for (const auto& [name, r] : rows) {
-    csv += csvField(name);
-    for (double x : {r.score, r.max_score}) {
-      std::snprintf(num, sizeof num, ",%.4g", x);
-      csv += num;
-    }
-    csv += "," + csvField(r.status);
-    for (const auto& t : tests) {
-      const auto it = std::find_if(r.tests.begin(), r.tests.end(), [&](const auto& p) { return p.first == t; });
-      if (it == r.tests.end()) csv += ",";
-      else {
-        std::snprintf(num, sizeof num, ",%.4g", it->second);
-        csv += num;
-      }
-    }
-    csv += "\n";
+  const fs::path book = out / "gradebook.csv";
+  try {
+    writeFileAtomic(book, batch::gradebookCsv(rows, batch::labMaxScore(a.lab, a.config, rows)));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s: cannot write the gradebook (%s)\n", book.c_str(), e.what());
+    return 1;
   }
-  writeFileAtomic(out / "gradebook.csv", csv);
-  std::printf("graded %zu submission(s) into %s; gradebook: %s\n", files.size(), out.c_str(), (out / "gradebook.csv").c_str());
-  if (problems) std::printf("%zu submission(s) need a look (see the status column)\n", problems);
+  std::printf("graded %zu submission(s) into %s; gradebook: %s\n", total, out.c_str(), book.c_str());
+  if (problems) std::printf("%zu submission(s) need a look (see the status and reason columns)\n", problems);
+  ::close(lock_fd);
   return 0;
 }
 

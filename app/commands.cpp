@@ -104,8 +104,9 @@ int runLab(const RunArgs& a) {
   }
 }
 
-// Test hook for the batch grader's robustness tests: DYNLAB_FAULT_INJECTION="crash:NAME,hang:NAME"
-// makes grading the submission whose file stem is NAME abort or hang. Unset in normal use.
+// Test hook for the batch grader's robustness tests: DYNLAB_FAULT_INJECTION="crash:NAME,hang:NAME,fail:NAME"
+// makes grading the submission whose file stem is NAME abort, hang, or exit 1 writing nothing (as
+// on a full disk). Unset in normal use.
 static void injectFault(const std::string& submission) {
   const char* spec = std::getenv("DYNLAB_FAULT_INJECTION");
   if (!spec) return;
@@ -113,6 +114,7 @@ static void injectFault(const std::string& submission) {
   if (s.find("crash:" + stem) != std::string::npos) std::abort();
   if (s.find("hang:" + stem) != std::string::npos)
     for (;;) pause();
+  if (s.find("fail:" + stem) != std::string::npos) std::exit(1);
 }
 
 static GradeOptions gradeOptions(const GradeArgs& a, const std::string& out_dir) {

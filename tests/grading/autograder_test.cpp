@@ -296,7 +296,7 @@ TEST_CASE("run_autograder: dynlab's own results.json is kept, and it gets the la
   const auto r = box.run();
   CHECK(r.at("score").get<double>() == 7.5);
   const std::string args = readBytes(box.dir / "args.txt");
-  CHECK(args == "grade\n" + (box.submission / "my gains.json").string() + "\n--lab\nslider_crank\n--out\n" +
+  CHECK(args == "grade\n" + (box.submission / "my gains.json").string() + "\n--time-budget\n300\n--lab\nslider_crank\n--out\n" +
                     box.results.string() + "\n");
 }
 
@@ -570,4 +570,74 @@ TEST_CASE("run_autograder with the real dynlab: an example is graded and its res
   CHECK(r.at("score").get<double>() > 0.0);
   CHECK(r.at("tests").size() > 3);
   CHECK(box.log().find("no grade from dynlab") == std::string::npos);
+}
+
+TEST_CASE("run_autograder: a link out of the submission, a FIFO or a device is refused unread") {
+  // A fake dynlab that leaves a mark: it must not even be started on such a file.
+  const auto refused = [](Sandbox& box) {
+    box.fakeDynlab("touch '" + (box.dir / "ran").string() + "'; exit 0");
+    const auto started = std::chrono::steady_clock::now();
+    const auto r = box.run();
+    CHECK(std::chrono::steady_clock::now() - started < std::chrono::seconds(30));
+    CHECK(!fs::exists(box.dir / "ran"));
+    CHECK(r.at("score").get<double>() == 0.0);
+    return r.at("output").get<std::string>();
+  };
+  SUBCASE("submission.json is a symlink to a file outside: none of its content is quoted") {
+    Sandbox box("symlink_out");
+    writeText(box.dir / "secret.txt", "{\"TOPSECRET-7f3a\": oops");
+    fs::create_symlink(box.dir / "secret.txt", box.submission / "submission.json");
+    const std::string out = refused(box);
+    CHECK(out.find("symbolic link") != std::string::npos);
+    CHECK(readBytes(box.results / "results.json").find("TOPSECRET") == std::string::npos);
+    CHECK(box.log().find("TOPSECRET") == std::string::npos);
+  }
+  SUBCASE("the only JSON file is a relative symlink climbing out") {
+    Sandbox box("symlink_rel");
+    writeText(box.dir / "secret.json", "{\"TOPSECRET-7f3a\": 1}");
+    fs::create_symlink("../secret.json", box.submission / "answer.json");
+    CHECK(refused(box).find("symbolic link") != std::string::npos);
+    CHECK(readBytes(box.results / "results.json").find("TOPSECRET") == std::string::npos);
+  }
+  SUBCASE("submission.json is a FIFO nobody writes to") {
+    Sandbox box("fifo_in");
+    REQUIRE(::mkfifo((box.submission / "submission.json").c_str(), 0644) == 0);
+    CHECK(refused(box).find("not a regular file") != std::string::npos);
+  }
+  SUBCASE("submission.json is a link to a device") {
+    Sandbox box("device_in");
+    fs::create_symlink("/dev/zero", box.submission / "submission.json");
+    CHECK(refused(box).find("symbolic link") != std::string::npos);
+  }
+  SUBCASE("submission.json is a folder") {
+    Sandbox box("folder_in");
+    fs::create_directories(box.submission / "submission.json");
+    CHECK(refused(box).find("not a regular file") != std::string::npos);
+  }
+}
+
+TEST_CASE("run_autograder: a link inside the submission is graded as its target; macOS leftovers are ignored") {
+  Sandbox box("inside");
+  writeText(box.submission / "work" / "gains.json", "{}");
+  fs::create_symlink("work/gains.json", box.submission / "submission.json");
+  box.fakeDynlab("printf '%s\\n' \"$2\" > '" + (box.dir / "file.txt").string() + "'\n" + "out=\"\"; while [ $# -gt 0 ]; do [ \"$1\" = --out ] && out=\"$2\"; shift; done\n" +
+                 "echo '{\"score\": 4, \"tests\": []}' > \"$out/results.json\"; exit 0");
+  CHECK(box.run().at("score").get<double>() == 4.0);
+  CHECK(readBytes(box.dir / "file.txt") == fs::canonical(box.submission / "work" / "gains.json").string() + "\n");
+
+  Sandbox mac("macos");
+  writeText(mac.submission / "x.json", "{}");
+  writeText(mac.submission / "._x.json", "\x05");
+  writeText(mac.submission / "__MACOSX" / "._x.json", "\x05");
+  mac.fakeResults(R"({"score": 2})");
+  CHECK(mac.run().at("score").get<double>() == 2.0);  // not "several JSON files"
+}
+
+TEST_CASE("run_autograder: a grader killed by a signal before the limit is a crash, not a timeout") {
+  Sandbox box("killed");
+  writeText(box.submission / "submission.json", "{}");
+  box.fakeDynlab("kill -KILL $$");
+  const std::string out = box.run("DYNLAB_TIME_LIMIT=100").at("output").get<std::string>();
+  CHECK(out.find("exit status 137") != std::string::npos);
+  CHECK(out.find("longer than") == std::string::npos);
 }

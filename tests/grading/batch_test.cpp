@@ -62,11 +62,13 @@ TEST_CASE("a batch survives a hanging and a crashing grader, and --jobs does not
   // The gradebook: every submission, its status, identical for any number of jobs.
   const std::string book = readBytes(dir / "one" / "gradebook.csv");
   CHECK(book == readBytes(dir / "two" / "gradebook.csv"));
-  CHECK(book.find("submission,score,max_score,status,Slider tracks x_d(t)") == 0);
-  CHECK(book.find("hangs.json,0,0,timed out") != std::string::npos);
-  CHECK(book.find("crashes.json,0,0,crashed") != std::string::npos);
-  CHECK(book.find("malformed.json,0,0,invalid submission") != std::string::npos);
-  CHECK(book.find("good.json,15,15,graded") != std::string::npos);
+  CHECK(book.find("submission,score,max_score,status,reason,folder,Slider tracks x_d(t)") == 0);
+  // Rows that are not grades still carry the lab's max_score, and the reason.
+  CHECK(book.find("hangs.json,0,15,timed out,grading did not finish within 4 s,hangs,,") != std::string::npos);
+  CHECK(book.find("crashes.json,0,15,crashed,internal error: the grader stopped with signal 6 (Aborted),crashes,,") !=
+        std::string::npos);
+  CHECK(book.find("malformed.json,0,15,invalid submission,") != std::string::npos);
+  CHECK(book.find("good.json,15,15,graded,,good,") != std::string::npos);
   CHECK(book.find("unstable_integral.json") != std::string::npos);
   // The crashed and timed-out submissions say what happened.
   CHECK(readBytes(dir / "one" / "crashes" / "results.json").find("signal 6") != std::string::npos);

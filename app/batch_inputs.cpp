@@ -1,0 +1,149 @@
+// The submissions of a batch and their output folders; see batch.h.
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cctype>
+#include <map>
+#include <set>
+
+#include "app/batch.h"
+#include "grading/grade.h"
+
+namespace fs = std::filesystem;
+
+namespace dyn::app::batch {
+namespace {
+
+std::string lower(std::string s) {
+  for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+bool endsWithJson(const std::string& name) { return name.size() > 5 && lower(name.substr(name.size() - 5)) == ".json"; }
+
+// macOS zip leftovers: __MACOSX/ folders and ._NAME AppleDouble files beside the real ones.
+bool macOsLeftover(const std::string& name) { return name == "__MACOSX" || name.rfind("._", 0) == 0; }
+
+// What kind of file a path is, for "expected a regular file, got a FIFO" (symlinks followed).
+std::string kindOf(const fs::path& p) {
+  struct stat st {};
+  if (::stat(p.c_str(), &st) != 0) return "a dangling link";
+  if (S_ISREG(st.st_mode)) return "";
+  if (S_ISFIFO(st.st_mode)) return "a FIFO";
+  if (S_ISDIR(st.st_mode)) return "a directory";
+  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) return "a device";
+  if (S_ISSOCK(st.st_mode)) return "a socket";
+  return "not a regular file";
+}
+
+// The entries of a folder, by name (byte order), without macOS leftovers.
+std::vector<fs::directory_entry> listed(const fs::path& dir, std::error_code& ec) {
+  std::vector<fs::directory_entry> v;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec))
+    if (!macOsLeftover(it->path().filename().string())) v.push_back(*it);
+  std::sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.path().filename() < b.path().filename(); });
+  return v;
+}
+
+// One student's folder: its submission.json, else its only *.json, else why it has none.
+Submission fromFolder(const fs::directory_entry& folder) {
+  const std::string name = folder.path().filename().string();
+  std::error_code ec;
+  std::vector<std::string> json_files;
+  for (const auto& e : listed(folder.path(), ec))
+    if (endsWithJson(e.path().filename().string()) && !e.is_directory()) json_files.push_back(e.path().filename().string());
+  Submission s{name + "/", {}, {}, {}};
+  const bool named = std::find(json_files.begin(), json_files.end(), "submission.json") != json_files.end();
+  if (ec) s.problem = "the folder cannot be read (" + ec.message() + ")";
+  else if (named || json_files.size() == 1) {
+    s.name += named ? "submission.json" : json_files[0];
+    s.file = folder.path() / (named ? "submission.json" : json_files[0]);
+  } else if (json_files.empty()) {
+    s.problem = "no JSON file in this folder";
+  } else {
+    s.problem = "several JSON files in this folder and none is named submission.json";
+  }
+  return s;
+}
+
+// A name reduced to letters, digits, _ . - (no leading dot or dash), at most 60 bytes.
+std::string cleaned(const std::string& raw) {
+  std::string s;
+  for (unsigned char c : raw) s += (std::isalnum(c) || c == '_' || c == '.' || c == '-') && c < 0x80 ? char(c) : '_';
+  s.erase(0, s.find_first_not_of(".-"));
+  if (s.size() > 60) s.resize(60);
+  return s;
+}
+
+// The name an output folder would get before uniqueness: the file's stem, or the student's folder.
+std::string stemOf(const Submission& s) {
+  if (const auto slash = s.name.find('/'); slash != std::string::npos) return s.name.substr(0, slash);
+  return s.name.substr(0, s.name.size() - 5);  // without ".json"
+}
+
+}  // namespace
+
+Found findSubmissions(const fs::path& dir, const fs::path& out) {
+  Found found;
+  std::error_code ec;
+  const auto entries = listed(dir, ec);
+  if (ec) {
+    found.error = "cannot read the submissions directory (" + ec.message() + ")";
+    return found;
+  }
+  std::size_t other_files = 0, skipped_folders = 0;
+  for (const auto& e : entries) {
+    const std::string name = e.path().filename().string();
+    std::error_code dir_ec;
+    if (e.is_directory(dir_ec)) {
+      // OUT inside DIR, and hidden folders (.git, .staging), are not students.
+      if (name[0] == '.' || fs::equivalent(e.path(), out, dir_ec)) {
+        ++skipped_folders;
+        continue;
+      }
+      found.submissions.push_back(fromFolder(e));
+    } else if (endsWithJson(name)) {
+      Submission s{name, e.path(), {}, {}};
+      if (const std::string kind = kindOf(e.path()); !kind.empty()) {
+        s.file.clear();
+        s.problem = "expected a regular file, got " + kind;
+      }
+      found.submissions.push_back(std::move(s));
+    } else {
+      ++other_files;
+    }
+  }
+  if (found.submissions.empty())
+    found.error = "found no submissions: no *.json file at its top and no folder below it (one per student, as in a "
+                  "Gradescope export); " + std::to_string(other_files) + " other file(s), " +
+                  std::to_string(skipped_folders) + " hidden or output folder(s)";
+  std::sort(found.submissions.begin(), found.submissions.end(),
+            [](const Submission& a, const Submission& b) { return a.name < b.name; });
+  return found;
+}
+
+void assignFolders(std::vector<Submission>& subs, const fs::path& out) {
+  // How many submissions want each clean name (case folded: case-insensitive disks fold them too).
+  std::map<std::string, int> wanted;
+  for (const auto& s : subs) ++wanted[lower(cleaned(stemOf(s)))];
+  std::set<std::string> taken;  // case folded
+  // A folder in OUT that no batch wrote (no grade.log in it) is someone else's: never reused.
+  const auto foreign = [&](const std::string& folder) {
+    std::error_code ec;
+    const auto st = fs::symlink_status(out / folder, ec);
+    return fs::exists(st) && (!fs::is_directory(st) || !fs::exists(out / folder / "grade.log", ec));
+  };
+  for (auto& s : subs) {
+    const std::string stem = stemOf(s), clean = cleaned(stem), base = clean.empty() ? "submission" : clean;
+    const bool plain = !clean.empty() && clean == stem && wanted[lower(clean)] == 1 && lower(clean).rfind("gradebook", 0) != 0;
+    const std::string hashed = base + "-" + hashHex(s.name).substr(0, 8);
+    std::string folder = plain ? clean : hashed;
+    // Taken or foreign: the hashed name, then a counter.
+    for (int n = 2; taken.count(lower(folder)) || foreign(folder); ++n)
+      folder = folder == clean ? hashed : hashed + "-" + std::to_string(n);
+    taken.insert(lower(folder));
+    s.folder = folder;
+  }
+}
+
+}  // namespace dyn::app::batch

@@ -1,0 +1,404 @@
+// dynlab grade --batch against hostile file names, stale results, a kill -9, a second batch on the
+// same OUT, a Gradescope export and graders that fail: always through the real binary (DYNLAB_BIN),
+// every command under `timeout` so a hang fails the test instead of blocking the suite.
+#include <doctest/doctest.h>
+#include <signal.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <regex>
+#include <set>
+#include <thread>
+
+#include <nlohmann/json.hpp>
+
+#include "tests/app/cli_run.h"
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using namespace dyn::test::cli;
+
+namespace {
+
+const fs::path kExamples = fs::path(DYNLAB_SOURCE_DIR) / "labs/slider_crank/examples";
+
+// A gradebook parsed as RFC 4180: quoted fields may hold commas, quotes ("") and line breaks.
+std::vector<std::vector<std::string>> parseCsv(const std::string& text) {
+  std::vector<std::vector<std::string>> rows(1);
+  std::string cell;
+  bool quoted = false, was_quoted = false;
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (quoted) {
+      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') cell += '"', ++i;
+      else if (c == '"') quoted = false;
+      else cell += c;
+    } else if (c == '"') {
+      REQUIRE_MESSAGE(cell.empty(), "a quote inside an unquoted field");
+      quoted = was_quoted = true;
+    } else if (c == ',' || c == '\n') {
+      rows.back().push_back(cell);
+      cell.clear();
+      was_quoted = false;
+      if (c == '\n') rows.emplace_back();
+    } else {
+      REQUIRE_MESSAGE(!was_quoted, "text after a closing quote");
+      cell += c;
+    }
+  }
+  REQUIRE_MESSAGE(!quoted, "an unterminated quoted field");
+  REQUIRE_MESSAGE(rows.back().empty(), "the last line has no line break");
+  rows.pop_back();
+  return rows;
+}
+
+// The gradebook as maps (column → cell), keyed by the submission column; checks its shape.
+std::map<std::string, std::map<std::string, std::string>> readBook(const fs::path& file) {
+  const auto rows = parseCsv(readFile(file));
+  REQUIRE(!rows.empty());
+  const auto& head = rows[0];
+  REQUIRE(head.size() >= 6);
+  CHECK(std::vector<std::string>(head.begin(), head.begin() + 6) ==
+        std::vector<std::string>{"submission", "score", "max_score", "status", "reason", "folder"});
+  std::map<std::string, std::map<std::string, std::string>> book;
+  for (std::size_t r = 1; r < rows.size(); ++r) {
+    REQUIRE(rows[r].size() == head.size());
+    for (const auto& cell : rows[r]) {
+      // No cell a spreadsheet would run as a formula.
+      CHECK_MESSAGE((cell.empty() || std::string("=+-@\t\r").find(cell[0]) == std::string::npos), "cell: " << cell);
+    }
+    for (std::size_t c = 0; c < head.size(); ++c) book[rows[r][0]][head[c]] = rows[r][c];
+  }
+  return book;
+}
+
+// Every path below dir (files and folders), except those under `except`.
+std::set<std::string> tree(const fs::path& dir, const fs::path& except) {
+  std::set<std::string> paths;
+  for (auto it = fs::recursive_directory_iterator(dir); it != fs::recursive_directory_iterator(); ++it) {
+    if (it->path() == except) {
+      it.disable_recursion_pending();
+      continue;
+    }
+    std::string entry = fs::relative(it->path(), dir).string();
+    entry += it->is_directory() ? std::string("/") : ' ' + readFile(it->path());
+    paths.insert(entry);
+  }
+  return paths;
+}
+
+// A file with its folders made first.
+void put(const fs::path& p, const std::string& text) {
+  fs::create_directories(p.parent_path());
+  writeFile(p, text);
+}
+
+void copyExample(const std::string& example, const fs::path& to) {
+  fs::create_directories(to.parent_path());
+  fs::copy_file(kExamples / (example + ".json"), to, fs::copy_options::overwrite_existing);
+}
+
+// `dynlab grade --batch IN --out OUT` in dir, with a time limit and optional fault injection.
+Result batch(const TempDir& dir, const std::string& in, const std::string& out, const std::string& faults = "",
+             const std::string& extra = "--jobs 2") {
+  const std::string env = faults.empty() ? "" : "DYNLAB_FAULT_INJECTION=" + faults + " ";
+  return shell(dir, env + "timeout 300 " + quote(DYNLAB_BIN) + " grade --batch " + quote(in) + " --out " + quote(out) +
+                        " --lab slider_crank --no-plots --time-budget 1 " + extra);
+}
+
+// Starts the same batch in the background (its own pid, via exec); the caller waits for it.
+pid_t batchInBackground(const TempDir& dir, const std::string& in, const std::string& out, const std::string& faults) {
+  const std::string cmd = "cd " + quote(dir.path.string()) + " && exec env DYNLAB_FAULT_INJECTION=" + faults + " " +
+                          quote(DYNLAB_BIN) + " grade --batch " + quote(in) + " --out " + quote(out) +
+                          " --lab slider_crank --no-plots --time-budget 1 --jobs 1 >" + quote(out + ".log") + " 2>&1";
+  const pid_t pid = ::fork();
+  if (pid == 0) {
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  return pid;
+}
+
+// Waits (up to 60 s) until a path exists.
+bool waitFor(const fs::path& p) {
+  for (int i = 0; i < 6000; ++i, std::this_thread::sleep_for(std::chrono::milliseconds(10)))
+    if (fs::exists(p)) return true;
+  return false;
+}
+
+// Any process whose command line mentions text (a grader left running).
+bool processMentions(const std::string& text) {
+  for (const auto& e : fs::directory_iterator("/proc")) {
+    const std::string cmdline = readFile(e.path() / "cmdline");
+    if (cmdline.find(text) != std::string::npos && e.path().filename() != std::to_string(::getpid())) return true;
+  }
+  return false;
+}
+
+// The submissions of the kill and lock tests: graded, invalid, crashing, one that hangs (3 s).
+void standardBatch(const TempDir& dir) {
+  for (const char* n : {"good", "mediocre", "unstable_integral"}) copyExample(n, dir / "in" / (std::string(n) + ".json"));
+  copyExample("good", dir / "in" / "crashes.json");
+  copyExample("good", dir / "in" / "hangs.json");
+  put(dir / "in" / "malformed.json", "{\"lab\": \"slider_crank\", \"gains\": {\"kp_x\": }");
+}
+const char* kFaults = "crash:crashes,hang:hangs";
+
+}  // namespace
+
+TEST_CASE("hostile submission names: each its own safe folder inside OUT, nothing written outside it" * doctest::timeout(400)) {
+  TempDir dir("batch_names");
+  const fs::path in = dir / "in", out = dir / "out";
+  const std::vector<std::string> names = {
+      "...json", "..json", "gradebook.csv.json", "gradebook.json", "a\nb.json", "-rf.json", "--help.json",
+      "<img src=x onerror=alert(1)>.json", "=HYPERLINK(1).json", "+1.json", "@SUM(A1).json", "\ttab.json",
+      "caf\xe9\xff.json", "a b.json", "a_b.json", "Same.json", "same.json", ".staging.json", "x.json",
+      std::string(200, 'L') + ".json", "\xe2\x80\xae" "gnp.json"};
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    if (i % 4 == 0) copyExample("good", in / names[i]);
+    else put(in / names[i], R"({"lab": "slider_crank", "gains": {"kp_x": "high"}})");
+  }
+  // Around OUT: a plots/ folder `...json` used to remove, and a folder in OUT that no batch wrote.
+  put(dir / "keep.txt", "mine");
+  fs::create_directories(dir / "plots");
+  put(dir / "plots" / "figure.png", "not dynlab's");
+  fs::create_directories(out / "x");
+  put(out / "x" / "notes.txt", "the TA's notes");
+  const auto before = tree(dir.path, out);
+
+  const Result r = batch(dir, "in", "out");
+  INFO("stderr: " << r.err);
+  REQUIRE(r.code == 0);
+  CHECK(tree(dir.path, out) == before);  // nothing outside OUT changed, nothing new
+  CHECK(readFile(out / "x" / "notes.txt") == "the TA's notes");
+
+  const auto book = readBook(out / "gradebook.csv");
+  CHECK(book.size() == names.size());
+  std::set<std::string> folders;
+  const std::regex safe("[A-Za-z0-9_][A-Za-z0-9_.-]{0,80}");
+  for (const auto& [name, row] : book) {
+    INFO("row " << name);
+    const std::string folder = row.at("folder");
+    CHECK(std::regex_match(folder, safe));
+    for (const char* own : {"gradebook.csv", "gradebook.csv.tmp", ".dynlab-batch.lock"}) CHECK(folder != own);
+    CHECK(folder != "x");  // the TA's folder is not reused
+    CHECK(folders.insert(folder).second);  // one folder each
+    const json results = json::parse(readFile(out / folder / "results.json"));
+    CHECK(results.at("score").is_number());
+    CHECK(row.at("max_score") == "15");
+    CHECK((row.at("status") == "graded" || row.at("status") == "invalid submission"));
+  }
+  // The rows name the submissions, neutralised and as valid UTF-8.
+  CHECK(book.count("'=HYPERLINK(1).json"));
+  CHECK(book.count("'-rf.json"));
+  CHECK(book.count("'+1.json"));
+  CHECK(book.count("'@SUM(A1).json"));
+  CHECK(book.count("a\nb.json"));
+  CHECK(book.count("caf\xef\xbf\xbd\xef\xbf\xbd.json"));
+  CHECK(book.at("...json").at("status") == "graded");
+  CHECK(book.at("...json").at("score") == "15");
+  CHECK(book.at("a_b.json").at("reason") == "/gains/kp_x: expected a number, got \"high\"");
+  // OUT holds the gradebook, the lock and one folder per submission (plus the TA's), nothing else.
+  std::size_t entries = 0;
+  for (const auto& e : fs::directory_iterator(out)) {
+    ++entries;
+    const std::string n = e.path().filename().string();
+    CHECK_MESSAGE((n == "gradebook.csv" || n == ".dynlab-batch.lock" || n == "x" || folders.count(n)), n);
+  }
+  CHECK(entries == names.size() + 3);
+}
+
+TEST_CASE("a rerun grades afresh: a stale results.json never counts, a failing grader is a failure" * doctest::timeout(300)) {
+  TempDir dir("batch_stale");
+  copyExample("good", dir / "in" / "good.json");
+  copyExample("mediocre", dir / "in" / "mediocre.json");
+  REQUIRE(batch(dir, "in", "out").code == 0);
+  CHECK(readBook(dir / "out" / "gradebook.csv").at("good.json").at("score") == "15");
+  REQUIRE(fs::exists(dir / "out" / "good" / "report.md"));
+
+  SUBCASE("the grader exits 1 without writing anything") {
+    const Result r = batch(dir, "in", "out", "fail:good");
+    REQUIRE(r.code == 0);
+    const auto row = readBook(dir / "out" / "gradebook.csv").at("good.json");
+    CHECK(row.at("score") == "0");
+    CHECK(row.at("max_score") == "15");
+    CHECK(row.at("status") == "internal error");
+    CHECK(row.at("reason").find("internal error: the grader exited with status 1") == 0);
+    const json results = json::parse(readFile(dir / "out" / "good" / "results.json"));
+    CHECK(results.at("score") == 0.0);
+    CHECK(results.at("output").get<std::string>().find("exited with status 1") != std::string::npos);
+    // Last run's report (15/15) is not left beside it.
+    CHECK(!fs::exists(dir / "out" / "good" / "report.md"));
+    CHECK(!fs::exists(dir / "out" / "good" / "report.html"));
+  }
+  SUBCASE("the submission became unreadable bytes") {
+    put(dir / "in" / "good.json", "\xff\xfe{\0\"");
+    REQUIRE(batch(dir, "in", "out").code == 0);
+    const auto row = readBook(dir / "out" / "gradebook.csv").at("good.json");
+    CHECK(row.at("score") == "0");
+    // Invalid once the grader reports bad UTF-8 as such (inputs branch); until then its exit 1 is an internal error.
+    CHECK((row.at("status") == "invalid submission" || row.at("status") == "internal error"));
+    CHECK(!row.at("reason").empty());
+  }
+  SUBCASE("the submission became a FIFO: refused, not waited on") {
+    fs::remove(dir / "in" / "good.json");
+    REQUIRE(::mkfifo((dir / "in" / "good.json").c_str(), 0644) == 0);
+    const auto started = std::chrono::steady_clock::now();
+    REQUIRE(batch(dir, "in", "out").code == 0);
+    CHECK(std::chrono::steady_clock::now() - started < std::chrono::seconds(60));
+    const auto row = readBook(dir / "out" / "gradebook.csv").at("good.json");
+    CHECK(row.at("score") == "0");
+    CHECK(row.at("reason") == "expected a regular file, got a FIFO");
+    CHECK(json::parse(readFile(dir / "out" / "good" / "results.json")).at("score") == 0.0);
+  }
+  // The other submission is graded as before.
+  CHECK(readBook(dir / "out" / "gradebook.csv").at("mediocre.json").at("status") == "graded");
+}
+
+TEST_CASE("a batch killed with SIGKILL and rerun gives the gradebook of an uninterrupted one" * doctest::timeout(300)) {
+  TempDir dir("batch_kill");
+  standardBatch(dir);
+  REQUIRE(batch(dir, "in", "clean", kFaults, "--jobs 1").code == 0);
+  const std::string clean = readFile(dir / "clean" / "gradebook.csv");
+
+  // Killed while the hanging submission is being graded (crashes and good are done by then).
+  const pid_t pid = batchInBackground(dir, "in", "out", kFaults);
+  REQUIRE(pid > 0);
+  REQUIRE(waitFor(dir / "out" / "hangs" / "grade.log"));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  REQUIRE(::kill(pid, SIGKILL) == 0);
+  int status = 0;
+  REQUIRE(::waitpid(pid, &status, 0) == pid);
+  CHECK(WIFSIGNALED(status));
+  CHECK(!fs::exists(dir / "out" / "gradebook.csv"));
+  CHECK(fs::exists(dir / "out" / "good" / "results.json"));
+  // Its graders died with it: none is left writing into OUT.
+  bool gone = false;
+  for (int i = 0; i < 200 && !(gone = !processMentions((dir / "in" / "hangs.json").string())); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  CHECK(gone);
+
+  REQUIRE(batch(dir, "in", "out", kFaults, "--jobs 1").code == 0);
+  CHECK(readFile(dir / "out" / "gradebook.csv") == clean);
+  for (const char* n : {"good", "mediocre", "malformed", "crashes", "hangs"}) {
+    CAPTURE(n);
+    json a = json::parse(readFile(dir / "clean" / n / "results.json")), b = json::parse(readFile(dir / "out" / n / "results.json"));
+    a.erase("execution_time");
+    b.erase("execution_time");
+    CHECK(a == b);
+  }
+}
+
+TEST_CASE("a second batch into the same OUT refuses at once; the first finishes intact" * doctest::timeout(300)) {
+  TempDir dir("batch_lock");
+  standardBatch(dir);
+  const pid_t first = batchInBackground(dir, "in", "out", kFaults);
+  REQUIRE(first > 0);
+  REQUIRE(waitFor(dir / "out" / "crashes" / "grade.log"));
+
+  const auto started = std::chrono::steady_clock::now();
+  const Result second = batch(dir, "in", "out", kFaults);
+  CHECK(std::chrono::steady_clock::now() - started < std::chrono::seconds(5));
+  INFO("stderr: " << second.err);
+  CHECK(second.code == 2);
+  CHECK(second.out.empty());
+  CHECK(std::count(second.err.begin(), second.err.end(), '\n') == 1);
+  CHECK(second.err.rfind("error: out: another dynlab grade --batch is writing into this folder", 0) == 0);
+
+  int status = 0;
+  REQUIRE(::waitpid(first, &status, 0) == first);
+  CHECK((WIFEXITED(status) && WEXITSTATUS(status) == 0));
+  const auto book = readBook(dir / "out" / "gradebook.csv");
+  CHECK(book.size() == 6);
+  CHECK(book.at("good.json").at("score") == "15");
+  CHECK(book.at("hangs.json").at("status") == "timed out");
+  CHECK(book.at("crashes.json").at("status") == "crashed");
+  CHECK(book.at("malformed.json").at("status") == "invalid submission");
+  // Once the first is done, OUT is free again.
+  CHECK(batch(dir, "in", "out", kFaults).code == 0);
+}
+
+TEST_CASE("a Gradescope export: one folder per student, macOS leftovers ignored" * doctest::timeout(300)) {
+  TempDir dir("batch_export");
+  const fs::path in = dir / "export";
+  put(dir / "submission_metadata.yml", "");
+  fs::create_directories(in);
+  put(in / "submission_metadata.yml", "submission_1: {}\n");
+  copyExample("good", in / "submission_1" / "submission.json");
+  copyExample("mediocre", in / "submission_1" / "scratch.json");          // submission.json wins
+  copyExample("good", in / "submission_2" / "my gains.json");             // the only JSON
+  put(in / "submission_2" / "._my gains.json", "\x00\x05\x16\x07");  // AppleDouble beside it
+  put(in / "__MACOSX" / "submission_2" / "._my gains.json", "\x00\x05\x16\x07");
+  copyExample("good", in / "submission_3" / "a.json");
+  copyExample("good", in / "submission_3" / "b.json");
+  put(in / "submission_4" / "answer.pdf", "%PDF");
+  copyExample("good", in / "top.json");  // a file at the top is a submission too
+
+  const Result r = batch(dir, "export", "out");
+  INFO("stderr: " << r.err);
+  REQUIRE(r.code == 0);
+  const auto book = readBook(dir / "out" / "gradebook.csv");
+  CHECK(book.size() == 5);
+  CHECK(book.at("submission_1/submission.json").at("score") == "15");
+  CHECK(book.at("submission_1/submission.json").at("folder") == "submission_1");
+  CHECK(book.at("submission_2/my gains.json").at("status") == "graded");
+  CHECK(book.at("submission_3/").at("reason") == "several JSON files in this folder and none is named submission.json");
+  CHECK(book.at("submission_4/").at("reason") == "no JSON file in this folder");
+  CHECK(book.at("submission_4/").at("max_score") == "15");
+  CHECK(book.at("top.json").at("status") == "graded");
+  CHECK(json::parse(readFile(dir / "out" / "submission_4" / "results.json")).at("score") == 0.0);
+
+  // A folder with nothing to grade is an error that says what it found, not an empty success.
+  fs::create_directories(dir / "empty" / ".git");
+  put(dir / "empty" / "notes.txt", "");
+  const Result none = batch(dir, "empty", "out2");
+  CHECK(none.code == 2);
+  CHECK(none.err.rfind("error: empty: found no submissions", 0) == 0);
+  CHECK(none.err.find("1 other file(s)") != std::string::npos);
+  CHECK(!fs::exists(dir / "out2"));  // nothing written
+  const Result same = batch(dir, "export", "export/.");
+  CHECK(same.code == 2);
+  CHECK(same.err.find("--out must not be the submissions folder itself") != std::string::npos);
+}
+
+TEST_CASE("OUT inside the submissions folder is not taken for a student" * doctest::timeout(300)) {
+  TempDir dir("batch_inside");
+  copyExample("good", dir / "in" / "good.json");
+  REQUIRE(batch(dir, "in", "in/graded").code == 0);
+  REQUIRE(batch(dir, "in", "in/graded").code == 0);  // the rerun sees the graded folder again
+  const auto book = readBook(dir / "in" / "graded" / "gradebook.csv");
+  CHECK(book.size() == 1);
+  CHECK(book.at("good.json").at("score") == "15");
+
+  // --out . around the submissions: folders dynlab did not write (plots/, the submissions) are left alone.
+  TempDir here("batch_here");
+  put(here / "plots" / "figure.png", "not dynlab's");
+  copyExample("good", here / "in" / "plots.json");
+  copyExample("good", here / "in" / "in.json");
+  const auto before = tree(here.path, here / "nothing");
+  REQUIRE(batch(here, "in", ".").code == 0);
+  CHECK(readFile(here / "plots" / "figure.png") == "not dynlab's");
+  CHECK(std::distance(fs::directory_iterator(here / "plots"), fs::directory_iterator()) == 1);
+  CHECK(std::distance(fs::directory_iterator(here / "in"), fs::directory_iterator()) == 2);
+  const auto here_book = readBook(here / "gradebook.csv");
+  CHECK(here_book.at("plots.json").at("folder").rfind("plots-", 0) == 0);
+  CHECK(here_book.at("in.json").at("folder").rfind("in-", 0) == 0);
+  const auto after = tree(here.path, here / "nothing");
+  for (const auto& p : before) CHECK_MESSAGE(after.count(p), "gone or changed: " << p);
+}
+
+TEST_CASE("a broken lab config is an internal error in every row, not the students' mistake" * doctest::timeout(120)) {
+  TempDir dir("batch_config");
+  copyExample("good", dir / "in" / "good.json");
+  json config = json::parse(defaultConfigText());
+  config["rubric"]["tests"][0]["points"] = "lots";
+  put(dir / "broken.json", config.dump());
+  const Result r = shell(dir, "timeout 120 " + quote(DYNLAB_BIN) + " grade --batch in --out out --config broken.json --no-plots");
+  REQUIRE(r.code == 0);
+  const auto row = readBook(dir / "out" / "gradebook.csv").at("good.json");
+  CHECK(row.at("status") == "internal error");
+  CHECK(row.at("reason").find("internal error: ") == 0);
+  CHECK(row.at("reason").find("broken.json: /rubric/tests/0/points: expected") != std::string::npos);
+}
