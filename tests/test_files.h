@@ -6,11 +6,27 @@
 #include <iterator>
 #include <string>
 
+#include <unistd.h>
+
 namespace dyn::test {
 
-// An empty directory under the system temp dir, named prefix_name (removed and recreated).
+// This test process's own folder under the system temp dir (two runs of a test at once never share
+// one), removed with everything in it when the process ends.
+inline const std::filesystem::path& scratchRoot() {
+  struct Root {
+    std::filesystem::path path = std::filesystem::temp_directory_path() / ("dynlab_test_" + std::to_string(::getpid()));
+    ~Root() {
+      std::error_code ec;
+      std::filesystem::remove_all(path, ec);
+    }
+  };
+  static const Root root;
+  return root.path;
+}
+
+// An empty directory in scratchRoot(), named prefix_name (removed and recreated).
 inline std::filesystem::path scratchDir(const std::string& prefix, const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / (prefix + "_" + name);
+  const std::filesystem::path dir = scratchRoot() / (prefix + "_" + name);
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;
