@@ -9,6 +9,7 @@
 #include <cstring>
 #include <iostream>
 #include <limits>
+#include <stdexcept>
 
 #include "app/autograder.h"
 #include "app/movie.h"
@@ -134,8 +135,9 @@ int runLab(const RunArgs& a) {
   }
 }
 
-// Test hook for the batch grader's robustness tests: DYNLAB_FAULT_INJECTION="crash:NAME,hang:NAME"
-// makes grading the submission whose file stem is NAME abort or hang. Unset in normal use.
+// Test hook for the robustness tests: DYNLAB_FAULT_INJECTION="crash:NAME,hang:NAME,throw:NAME"
+// makes grading the submission whose file stem is NAME abort, hang or throw past every command's
+// own handler (to main's). Unset in normal use.
 static void injectFault(const std::string& submission) {
   const char* spec = std::getenv("DYNLAB_FAULT_INJECTION");
   if (!spec) return;
@@ -143,6 +145,7 @@ static void injectFault(const std::string& submission) {
   if (s.find("crash:" + stem) != std::string::npos) std::abort();
   if (s.find("hang:" + stem) != std::string::npos)
     for (;;) pause();
+  if (s.find("throw:" + stem) != std::string::npos) throw std::logic_error("injected fault for " + stem);
 }
 
 static GradeOptions gradeOptions(const GradeArgs& a, const std::string& out_dir) {
