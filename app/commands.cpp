@@ -8,13 +8,18 @@
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <limits>
+#include <stdexcept>
 
 #include "app/autograder.h"
 #include "app/movie.h"
 #include "app/output.h"
 #include "grading/grade.h"
+#include "grading/rubric.h"
+#include "grading/scenario.h"
 #include "labs/run.h"
 #include "labs/submission.h"
+#include "labs/utf8.h"
 
 namespace fs = std::filesystem;
 
@@ -38,10 +43,25 @@ std::string describeAgreement(const Lab& lab, const json& agreement) {
   return s;
 }
 
+// The watchdog `dynlab run` uses: the rubric's limits (so a run stops where a grade would, with
+// the same sentence) without its step budget, since a run's length is its own --duration.
+static Watchdog runWatchdog(const LoadedLab& loaded) {
+  Watchdog wd;
+  if (loaded.config.contains("rubric")) {
+    const Rubric rubric = parseRubric(JsonView(loaded.config, loaded.config_file));
+    checkColumns(rubric, loaded.lab->columns(), loaded.config_file);
+    wd = rubric.watchdog;
+  }
+  wd.max_steps = std::numeric_limits<long>::max();
+  return wd;
+}
+
 int runLab(const RunArgs& a) {
   LoadedLab loaded;
+  Watchdog watchdog;
   try {
     loaded = loadLab(a.lab, a.config, a.gains, a.duration);
+    watchdog = runWatchdog(loaded);
   } catch (const InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;
@@ -49,10 +69,11 @@ int runLab(const RunArgs& a) {
   const Lab& lab = *loaded.lab;
   const fs::path out = a.out.empty() ? fs::path("out") / a.lab : fs::path(a.out);
   try {
-    // Simulate first; nothing is written until every run is done.
-    std::optional<RunResult> hand, bullet;
-    if (a.engine != "bullet") hand = runEngine(lab, Engine::Hand);
-    if (a.engine != "hand") bullet = runEngine(lab, Engine::Bullet);
+    // Simulate first, each engine under the grader's watchdog; nothing is written until every run is done.
+    std::optional<WatchedRun> hand, bullet;
+    const Deadline never = Deadline::max();
+    if (a.engine != "bullet") hand = runWatched(lab, Engine::Hand, watchdog, never, loaded.config_file);
+    if (a.engine != "hand") bullet = runWatched(lab, Engine::Bullet, watchdog, never, loaded.config_file);
 
     Staging staging(out);
     staging.owns({"trace_hand.csv", "trace_bullet.csv", "summary.json", "video.mp4", "frames"});
@@ -62,21 +83,29 @@ int runLab(const RunArgs& a) {
                     {"dt", lab.dt()},
                     {"duration", lab.duration()},
                     {"dynlab_version", DYNLAB_VERSION}};
-    std::string status = "ok";
+    std::string status;
     for (auto* r : {&hand, &bullet}) {
       if (!*r) continue;
       const char* engine = r == &hand ? "hand" : "bullet";
+      const bool complete = (*r)->failure.empty();
       staging.write(std::string("trace_") + engine + ".csv", (*r)->trace.csv());
-      summary["engines"][engine] = {{"metrics", lab.metrics((*r)->trace)},
-                                    {"status", (*r)->failure.empty() ? "ok" : (*r)->failure},
-                                    {"trace_hash", (*r)->trace.hash()}};
-      if (!(*r)->failure.empty()) status = std::string(engine) + ": " + (*r)->failure;
+      // A stopped run's trace is kept (it shows the blow-up) but its metrics are omitted: numbers
+      // over part of a run read as if they described all of it.
+      json& e = summary["engines"][engine];
+      e = {{"status", complete ? "ok" : (*r)->failure}, {"complete", complete}, {"trace_hash", (*r)->trace.hash()}};
+      if (complete) e["metrics"] = lab.metrics((*r)->trace);
+      else {
+        e["stopped_at"] = (*r)->failure_time;
+        status += (status.empty() ? "" : "; ") + std::string(engine) + ": " + (*r)->failure;
+      }
     }
-    if (hand && bullet) summary["agreement"] = lab.agreement(hand->trace, bullet->trace);
+    if (status.empty()) status = "ok";
+    if (hand && bullet && hand->failure.empty() && bullet->failure.empty())
+      summary["agreement"] = lab.agreement(hand->trace, bullet->trace);
     for (const auto& c : lab.columns())
       if (!lab.unit(c).empty()) summary["units"][c] = lab.unit(c);
     summary["status"] = status;
-    staging.write("summary.json", summary.dump(2) + "\n");
+    staging.write("summary.json", summary.dump(2, ' ', false, json::error_handler_t::replace) + "\n");
 
     int frames = 0;
     if (a.video || a.frames) {
@@ -86,12 +115,14 @@ int runLab(const RunArgs& a) {
     }
     staging.commit();
 
-    // Tell the user where things are and the headline numbers.
+    // Tell the user where things are, how each engine ended and the headline numbers.
     std::printf("dynlab run %s: %.2f s at dt = %g s (%s)\n", a.lab.c_str(), lab.duration(), lab.dt(), status.c_str());
     for (auto* r : {&hand, &bullet}) {
       if (!*r) continue;
       const char* engine = r == &hand ? "hand" : "bullet";
       std::printf("  %-6s trace    %s\n", engine, (out / (std::string("trace_") + engine + ".csv")).c_str());
+      if (!(*r)->failure.empty())
+        std::printf("  %-6s STOPPED  %s (trace up to there; metrics omitted)\n", engine, (*r)->failure.c_str());
     }
     std::printf("  summary         %s\n", (out / "summary.json").c_str());
     if (a.video) std::printf("  video           %s (%d frames)\n", (out / "video.mp4").c_str(), frames);
@@ -104,9 +135,9 @@ int runLab(const RunArgs& a) {
   }
 }
 
-// Test hook for the batch grader's robustness tests: DYNLAB_FAULT_INJECTION="crash:NAME,hang:NAME,fail:NAME"
-// makes grading the submission whose file stem is NAME abort, hang, or exit 1 writing nothing (as
-// on a full disk). Unset in normal use.
+// Test hook for the robustness tests: DYNLAB_FAULT_INJECTION="crash:NAME,hang:NAME,fail:NAME,throw:NAME"
+// makes grading the submission whose file stem is NAME abort, hang, exit 1 writing nothing (as on a
+// full disk) or throw past every command's own handler (to main's). Unset in normal use.
 static void injectFault(const std::string& submission) {
   const char* spec = std::getenv("DYNLAB_FAULT_INJECTION");
   if (!spec) return;
@@ -115,6 +146,7 @@ static void injectFault(const std::string& submission) {
   if (s.find("hang:" + stem) != std::string::npos)
     for (;;) pause();
   if (s.find("fail:" + stem) != std::string::npos) std::exit(1);
+  if (s.find("throw:" + stem) != std::string::npos) throw std::logic_error("injected fault for " + stem);
 }
 
 static GradeOptions gradeOptions(const GradeArgs& a, const std::string& out_dir) {
@@ -142,15 +174,20 @@ int gradeOne(const GradeArgs& a) {
     std::fprintf(stderr, "error: cannot write results to %s: %s\n", a.out.c_str(), e.what());
     return 1;
   }
+  if (!g.error.empty()) std::fprintf(stderr, "error: %s\n", g.error.c_str());
   std::fputs(g.report.c_str(), stdout);
   std::printf("results: %s\nreport:  %s\n", (fs::path(a.out) / "results.json").c_str(), (fs::path(a.out) / "report.html").c_str());
-  return g.input_error ? 2 : 0;
+  // A grade the time budget cut short is written (score 0 for what it stopped) but is not a grade.
+  if (g.out_of_time) std::fprintf(stderr, "error: %s: the grading time budget of %g s ran out; the grade is incomplete\n",
+                                  utf8Quotable(a.submission).c_str(), a.time_budget);
+  return g.input_error ? 2 : !g.error.empty() ? 3 : g.out_of_time ? 4 : 0;
 }
 
 int gradeReplay(const GradeArgs& a) {
   json expected;
   try {
     expected = loadJsonFile(a.replay);
+    JsonView(expected, a.replay).requireObject();  // a results.json is an object
   } catch (const InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

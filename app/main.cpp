@@ -1,11 +1,44 @@
 // dynlab: the command line. Dispatch only; the work is in labs/, grading/ and render/.
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
+#include <string>
+
 #include "app/check_results.h"
 #include "app/commands.h"
 #include "app/course.h"
+#include "labs/utf8.h"
 
+namespace {
+int dispatch(int argc, char** argv);
+
+// Exit code of an error that is dynlab's, not the input's: distinct from 1 (a run or write
+// failed) and 2 (bad input), so a batch or the autograder can tell them apart.
+constexpr int kInternalError = 3;
+
+// What escaped every command, as one line of valid UTF-8 on stderr.
+int internalError(const std::string& what) {
+  std::string line = dyn::utf8Quotable(what);
+  for (char& c : line)
+    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+  std::fprintf(stderr, "error: internal: %s\n", line.c_str());
+  return kInternalError;
+}
+}  // namespace
+
+// Whatever escapes a command is reported on one line and exits 3: never an abort.
 int main(int argc, char** argv) {
+  try {
+    return dispatch(argc, argv);
+  } catch (const std::exception& e) {
+    return internalError(e.what());
+  } catch (...) {
+    return internalError("an exception that is not a std::exception");
+  }
+}
+
+namespace {
+int dispatch(int argc, char** argv) {
   using namespace dyn::app;
   CLI::App cli{"dynlab — a teaching lab for the dynamics of constrained mechanisms"};
   cli.require_subcommand(1);
@@ -113,3 +146,4 @@ int main(int argc, char** argv) {
   }
   return 2;
 }
+}  // namespace

@@ -11,6 +11,7 @@
 #include "grading/scenario.h"
 #include "labs/run.h"
 #include "labs/submission.h"
+#include "labs/utf8.h"
 
 namespace dyn {
 
@@ -35,7 +36,8 @@ GradeOutcome failedOutcome(const std::string& message, const InputError* e) {
                  {"tests", json::array()},
                  {"extra_data", {{"dynlab_version", DYNLAB_VERSION}}}};
   if (e) out.results["extra_data"]["error"] = {{"file", e->file()}, {"path", e->path().empty() ? "/" : e->path()}, {"expected", e->expected()}};
-  out.report = (e ? "error: " : "internal error: ") + message + "\nScore: 0\n";
+  out.error = message;
+  out.report = "Score: 0 (not graded)\n";
   out.markdown = "# dynlab grade\n\n**Not graded:** `" + message + "`\n";
   out.html = renderHtml(out.markdown);
   return out;
@@ -76,7 +78,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     // Fingerprint inputs: canonical dumps (sorted keys), so whitespace does not matter.
     GradeReport rep;
     rep.lab = lab_name;
-    rep.submission = file;
+    rep.submission = utf8Quotable(file);  // a file name is not always UTF-8; results.json must be
     rep.fingerprint = {{"dynlab_version", DYNLAB_VERSION},
                        {"lab_config_hash", hashHex(base.dump())},
                        {"submission_hash", hashHex(sub.dump())}};
@@ -126,6 +128,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     if (!opt.out_dir.empty()) writeTestPlots(rep, runs, opt.out_dir);
 
     GradeOutcome out;
+    for (const auto& s : rep.scenarios) out.out_of_time = out.out_of_time || s.out_of_time;
     out.results = resultsJson(rep);
     out.report = terminalReport(rep);
     out.markdown = markdownReport(rep);
@@ -136,7 +139,8 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
   } catch (const InputError& e) {
     return failedOutcome(e.what(), &e);
   } catch (const std::exception& e) {
-    return failedOutcome(std::string("internal error: ") + e.what(), nullptr);
+    // Not the input's fault; what() may quote a path that is not UTF-8.
+    return failedOutcome("internal error: " + utf8Quotable(e.what()), nullptr);
   }
 }
 

@@ -27,7 +27,9 @@ struct GradeOutcome {
   std::string report;    // readable summary for the terminal
   std::string markdown;  // report.md (plots linked as plots/*.png)
   std::string html;      // report.html (same content)
+  std::string error;     // one line when the submission could not be graded (else empty)
   bool input_error = false;
+  bool out_of_time = false;  // the time budget stopped a scenario: the grade is incomplete
 };
 
 GradeOutcome gradeSubmission(const std::string& submission_file, const GradeOptions& options);

@@ -111,14 +111,14 @@ std::string RowWatch::budget(long steps) const {
   return "stopped: the run exceeded its step budget of " + std::to_string(max_steps_) + " steps";
 }
 
-ScenarioRun runScenario(const Lab& lab, const Watchdog& wd, Deadline deadline, const std::string& config_file) {
-  ScenarioRun out;
-  out.screen = screenLoops(lab);
+WatchedRun runWatched(const Lab& lab, Engine engine, const Watchdog& wd, Deadline deadline,
+                      const std::string& config_file) {
+  WatchedRun out;
   Trace& tr = out.trace;
   tr.columns = lab.columns();
   const int t_col = tr.column("t");
   const RowWatch watch(wd, tr.columns, config_file);
-  auto sim = lab.simulate(Engine::Hand);
+  auto sim = lab.simulate(engine);
   const long expected = std::lround(lab.duration() / lab.dt());
   tr.data.reserve(std::size_t(std::min(expected, wd.max_steps) + 1) * tr.columns.size());
   std::vector<double> row;
@@ -149,7 +149,19 @@ ScenarioRun runScenario(const Lab& lab, const Watchdog& wd, Deadline deadline, c
     const double t = tr.rows() ? tr.at(tr.rows() - 1, t_col) : 0.0;
     stop(t, "unstable: " + sim->failure() + " at t = " + fmtNumber(t) + " s");
   }
-  if (out.failure.empty()) out.metrics = lab.metrics(tr);
+  return out;
+}
+
+ScenarioRun runScenario(const Lab& lab, const Watchdog& wd, Deadline deadline, const std::string& config_file) {
+  ScenarioRun out;
+  out.screen = screenLoops(lab);
+  WatchedRun run = runWatched(lab, Engine::Hand, wd, deadline, config_file);
+  out.trace = std::move(run.trace);
+  out.failure = std::move(run.failure);
+  out.failure_time = run.failure_time;
+  out.out_of_time = run.out_of_time;
+  // A stopped run has no metrics of its own: only the screening's are scored.
+  if (out.failure.empty()) out.metrics = lab.metrics(out.trace);
   for (const auto& [k, v] : out.screen.metrics.items()) out.metrics[k] = v;
   return out;
 }

@@ -48,6 +48,19 @@ class RowWatch {
   long max_steps_;
 };
 
+// One engine's run under the watchdog: the trace up to where it stopped, and why.
+struct WatchedRun {
+  Trace trace;
+  std::string failure;  // the watchdog's sentence, the step budget, the time budget or the engine's own
+  double failure_time = -1;
+  bool out_of_time = false;
+};
+
+// Runs one engine of the lab, checking every row with RowWatch, the step budget and (every 1024
+// steps) the deadline; `dynlab run` watches both engines with it, the grader the hand-written one.
+WatchedRun runWatched(const Lab& lab, Engine engine, const Watchdog& watchdog, Deadline deadline,
+                      const std::string& config_file);
+
 // Runs the lab's hand-written engine under the watchdog; throws InputError (naming config_file)
 // if a watchdog limit names a column the lab does not have.
 ScenarioRun runScenario(const Lab& lab, const Watchdog& watchdog, Deadline deadline,

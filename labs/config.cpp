@@ -4,8 +4,11 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <set>
 #include <sstream>
+#include <vector>
+
+#include "labs/utf8.h"
 
 namespace dyn {
 
@@ -41,8 +44,38 @@ std::string pointerToken(const std::string& key) {
 }  // namespace
 
 InputError::InputError(std::string file, std::string path, const std::string& expected)
-    : std::runtime_error(oneLine(file + ": " + (path.empty() ? "/" : path) + ": " + expected)),
-      file_(std::move(file)), path_(std::move(path)), expected_(expected) {}
+    : std::runtime_error(oneLine(utf8Quotable(file + ": " + (path.empty() ? "/" : path) + ": " + expected))),
+      file_(utf8Quotable(file)), path_(utf8Quotable(path)), expected_(utf8Quotable(expected)) {}
+
+namespace {
+// Where the parser is, for the JSON path of a duplicate key: one frame per open object or array.
+struct ParseFrame {
+  bool object;
+  std::set<std::string> keys;  // keys seen so far (objects)
+  std::string key;             // the current key (objects)
+  std::size_t done = 0;        // elements completed so far (arrays): the next one's index
+};
+
+std::string framePath(const std::vector<ParseFrame>& frames) {
+  std::string path;
+  for (const ParseFrame& f : frames) path += "/" + (f.object ? pointerToken(f.key) : std::to_string(f.done));
+  return path;
+}
+
+// nlohmann's parse error without its tag and without "last read: '...'", which quotes the input
+// (a symlinked /etc/passwd must not be echoed into a student's feedback).
+std::string parseErrorText(const std::string& what) {
+  const auto tag = what.find("] ");
+  std::string s = what.substr(tag == std::string::npos ? 0 : tag + 2);
+  const auto read = s.find("; last read: '");
+  if (read != std::string::npos) {
+    // What follows the quoted token is nlohmann's own text ("'; expected ..."), found from the end.
+    const auto expected = s.rfind("'; expected ");
+    s = s.substr(0, read) + (expected != std::string::npos && expected > read ? s.substr(expected + 1) : "");
+  }
+  return s;
+}
+}  // namespace
 
 json parseJsonText(const std::string& text, const std::string& file) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos)
@@ -50,38 +83,37 @@ json parseJsonText(const std::string& text, const std::string& file) {
   try {
     // Nesting is bounded: copying, dumping or patching a json recurses once per level, so a few
     // hundred KB of "[[[[…" would overflow the stack. Real configs nest 6 levels.
-    const json::parser_callback_t depth = [&](int level, json::parse_event_t event, json&) {
-      if ((event == json::parse_event_t::object_start || event == json::parse_event_t::array_start) &&
-          level >= kMaxJsonDepth)
-        throw InputError(file, "", "expected JSON nested at most " + std::to_string(kMaxJsonDepth) + " levels deep");
+    // Keys are tracked per object: a duplicate is refused (nlohmann would keep the last silently).
+    std::vector<ParseFrame> frames;
+    const auto completed = [&] {
+      if (!frames.empty() && !frames.back().object) ++frames.back().done;
+    };
+    const json::parser_callback_t check = [&](int level, json::parse_event_t event, json& parsed) {
+      using E = json::parse_event_t;
+      const bool opens = event == E::object_start || event == E::array_start;
+      if (opens && level >= kMaxJsonDepth)
+        throw InputError(file, framePath(frames),
+                         "expected JSON nested at most " + std::to_string(kMaxJsonDepth) + " levels deep");
+      if (opens) frames.push_back({event == E::object_start, {}, {}, 0});
+      if (event == E::key) {
+        ParseFrame& f = frames.back();
+        f.key = parsed.get<std::string>();
+        if (!f.keys.insert(f.key).second)
+          throw InputError(file, framePath(frames), "duplicate key \"" + f.key + "\" (each key may appear once in an object)");
+      }
+      if (event == E::object_end || event == E::array_end) {
+        frames.pop_back();
+        completed();
+      }
+      if (event == E::value) completed();
       return true;
     };
-    return json::parse(text, depth);
+    return json::parse(text, check);
   } catch (const json::exception& e) {
     // nlohmann's message names the line and column (parse_error) or the number that does not fit a
-    // double, e.g. 1e999 (out_of_range 406); keep only that part, without the "[json.exception...]" tag.
-    std::string what = e.what();
-    const auto pos = what.find("] ");
-    throw InputError(file, "", "expected valid JSON (" + what.substr(pos == std::string::npos ? 0 : pos + 2) + ")");
+    // double, e.g. 1e999 (out_of_range 406).
+    throw InputError(file, "", "expected valid JSON (" + parseErrorText(e.what()) + ")");
   }
-}
-
-json loadJsonFile(const std::string& file, std::size_t max_bytes) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(file, ec)) throw InputError(file, "", "expected a file, got a directory");
-  std::ifstream in(file, std::ios::binary | std::ios::ate);
-  if (!in) throw InputError(file, "", "expected a readable file (cannot open it)");
-  const auto end = in.tellg();
-  if (end < 0) throw InputError(file, "", "expected a regular file (cannot tell its size)");
-  const auto size = std::size_t(end);
-  if (size > max_bytes)
-    throw InputError(file, "", "expected at most " + std::to_string(max_bytes) + " bytes, the file has " +
-                                   std::to_string(size));
-  in.seekg(0);
-  std::string text(size, '\0');
-  in.read(text.data(), std::streamsize(size));
-  if (in.gcount() != std::streamsize(size)) throw InputError(file, "", "expected a readable file (reading it failed)");
-  return parseJsonText(text, file);
 }
 
 void JsonView::fail(const std::string& expected) const { throw InputError(file_, path_, expected); }
@@ -90,8 +122,13 @@ std::string JsonView::got() const {
   // dump() writes a non-finite double (only possible in memory) as null: name it instead.
   if (value_->is_number_float() && !std::isfinite(value_->get<double>()))
     return std::isnan(value_->get<double>()) ? ", got NaN" : value_->get<double>() > 0 ? ", got inf" : ", got -inf";
-  std::string s = value_->dump();
-  if (s.size() > 40) s = s.substr(0, 37) + "...";
+  // A value built in memory may hold invalid UTF-8: replaced, so the message can always be made.
+  std::string s = value_->dump(-1, ' ', false, json::error_handler_t::replace);
+  if (s.size() > 40) {
+    std::size_t n = 37;
+    while (n > 0 && (static_cast<unsigned char>(s[n]) & 0xC0) == 0x80) --n;  // not mid-character
+    s = s.substr(0, n) + "...";
+  }
   return ", got " + s;
 }
 

@@ -12,7 +12,8 @@ namespace dyn {
 
 using nlohmann::json;
 
-// Bad input: the file, the JSON path and what was expected.
+// Bad input: the file, the JSON path and what was expected. All three are kept as valid UTF-8
+// (an invalid byte of a file name or value is written \xNN), so they can go into JSON as they are.
 class InputError : public std::runtime_error {
  public:
   InputError(std::string file, std::string path, const std::string& expected);
@@ -27,8 +28,16 @@ class InputError : public std::runtime_error {
 // Deepest nesting of arrays and objects a loaded JSON document may have.
 inline constexpr int kMaxJsonDepth = 64;
 
-// Reads a whole JSON file; throws InputError for a missing, empty, oversized, malformed or too
-// deeply nested file.
+// Reads a whole text file: a regular file only (a FIFO, device, socket or directory is refused
+// at once, never waited on), at most max_bytes, valid UTF-8 without NUL bytes (UTF-16 is named as
+// such). Throws InputError naming the file, and the offset of a bad byte.
+std::string readTextFile(const std::string& file, std::size_t max_bytes);
+// The UTF-8 part of readTextFile, for text from elsewhere.
+void checkUtf8Text(const std::string& text, const std::string& file);
+
+// Reads a whole JSON file (readTextFile; a leading UTF-8 byte order mark is accepted and skipped);
+// throws InputError for a missing, empty, oversized, non-UTF-8, malformed or too deeply nested
+// file, and for a key repeated in one object (with its JSON path).
 json loadJsonFile(const std::string& file, std::size_t max_bytes = 16u << 20);
 json parseJsonText(const std::string& text, const std::string& file);
 

@@ -42,8 +42,8 @@ TuningSession::TuningSession(const std::string& lab, const std::string& config_f
   // Gains in the order the lab's JSON lists them (json objects sort their keys).
   std::vector<std::string> order;
   {
-    std::ifstream in(config_file_, std::ios::binary);
-    const auto ordered = nlohmann::ordered_json::parse(in, nullptr, false);
+    // Read as every input is (a regular file, UTF-8): the file was checked above, not trusted since.
+    const auto ordered = nlohmann::ordered_json::parse(readTextFile(config_file_, 16u << 20), nullptr, false);
     if (ordered.is_object() && ordered.contains("gains") && ordered["gains"].is_object())
       for (const auto& [gname, _] : ordered["gains"].items()) order.push_back(gname);
   }
