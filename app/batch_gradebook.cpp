@@ -83,7 +83,9 @@ Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, 
       return failedRow(s, "internal error", "internal error: " + file + ": " + what);
     return failedRow(s, "invalid submission", what);
   }
-  if (exit_code != 0 || !error.is_null() || !r.value("score", json()).is_number())
+  // Exit 4: the grader's time budget ran out; what it scored before is in its results.json.
+  const bool budget = exit_code == 4;
+  if ((exit_code != 0 && !budget) || !error.is_null() || !r.value("score", json()).is_number())
     return failedRow(s, "internal error", "internal error: the grader exited with status " + std::to_string(exit_code) +
                                               (exit_code == 0 ? " but its results.json holds no grade" : "") + said);
   Row row{s.name, s.folder, "graded", "", r.value("score", 0.0), 0, true, {}};
@@ -103,6 +105,10 @@ Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, 
     }
   } catch (const json::exception& e) {
     return failedRow(s, "internal error", std::string("internal error: a results.json of an unexpected shape: ") + e.what());
+  }
+  if (budget && row.status != "timed out") {
+    row.status = "timed out";
+    row.reason += std::string(row.reason.empty() ? "" : "; ") + "the grading time budget ran out";
   }
   row.reason = utf8Text(row.reason);
   return row;
