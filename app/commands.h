@@ -1,5 +1,7 @@
 // The dynlab subcommands. Each returns the process exit code:
 //   0 success, 1 a run or write failed, 2 bad input (nothing written).
+// grade: 0 graded, 2 the submission is invalid (results.json says how), 3 an internal error (the
+// grader or the machine: results.json says so when it could be written, else a one-line error).
 #pragma once
 #include <optional>
 #include <string>

@@ -1,6 +1,8 @@
 // The escaping functions of every output format; see escape.h.
 #include "grading/escape.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cstdio>
 
 namespace dyn {
@@ -126,9 +128,28 @@ std::string dumpJson(const nlohmann::json& v, int indent) {
 }
 
 std::string mdText(std::string_view s) {
+  // Punctuation that starts no Markdown construct in the middle of a line stays readable: "[-5, 5]",
+  // kp_x, (ζ = 0.7). Escaped: what could start emphasis, code, strikethrough or a table cell, a
+  // leading block marker (# - + > = …), . or ) after leading digits (an ordered list), ] before
+  // ( [ or : (a link or a reference definition), _ outside a word; < > & become entities.
+  constexpr std::string_view kPlain = ".,:;?/'\"%=()-+!@$^{}[]#", kLineStart = "#-+*>=`~|:!_[";
+  const auto alnum = [](char c) { return std::isalnum(static_cast<unsigned char>(c)) != 0; };
+  const std::string line = visibleLine(s, false);
   std::string out;
-  for (char c : visibleLine(s, false)) {
-    if (isAsciiPunct(c)) out += '\\';
+  bool digits_only = true;
+  for (std::size_t i = 0; i < line.size(); ++i) {
+    const char c = line[i], next = i + 1 < line.size() ? line[i + 1] : '\0';
+    const bool list_marker = (c == '.' || c == ')') && digits_only && i > 0;
+    digits_only = digits_only && c >= '0' && c <= '9';
+    if (c == '<' || c == '>' || c == '&') {  // entities: not even the source holds a tag
+      out += c == '<' ? "&lt;" : c == '>' ? "&gt;" : "&amp;";
+      continue;
+    }
+    const bool in_word = c == '_' && i > 0 && alnum(line[i - 1]) && alnum(next);
+    const bool opens_link = c == ']' && (next == '(' || next == '[' || next == ':');
+    const bool plain = kPlain.find(c) != std::string_view::npos || in_word;
+    if (isAsciiPunct(c) && (!plain || list_marker || opens_link || (i == 0 && kLineStart.find(c) != std::string_view::npos)))
+      out += '\\';
     out += c;
   }
   return out;
@@ -164,6 +185,16 @@ std::string htmlText(std::string_view s) {
 }
 
 std::string termText(std::string_view s) { return visibleLine(s, true); }
+
+std::string shellWord(std::string_view s) {
+  const std::string text = jsonText(s);
+  const bool plain = !text.empty() && text.find_first_not_of(
+      "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._/+-") == std::string::npos && text[0] != '-';
+  if (plain) return text;
+  std::string out = "'";
+  for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
 
 std::string csvField(const std::string& raw) {
   std::string s = jsonText(raw);

@@ -6,6 +6,7 @@
 //   HTML      htmlText (& < > " ' as entities)
 //   terminal  termText (control characters, bidi overrides and invalid bytes as visible escapes)
 //   CSV       csvField (RFC 4180 quoting; formula lead characters neutralised)
+//   shell     shellWord (a file name in a command to copy)
 // Each returns valid UTF-8 whatever the input: an invalid byte becomes U+FFFD.
 #pragma once
 #include <string>
@@ -27,13 +28,15 @@ nlohmann::json jsonSanitized(const nlohmann::json& v);
 // v.dump(indent) that replaces invalid UTF-8 instead of throwing (the second line of defence).
 std::string dumpJson(const nlohmann::json& v, int indent = -1);
 
-// Text for the middle of a Markdown line (also a table cell): ASCII punctuation backslash-escaped
-// (no emphasis, links, code, HTML, entities, headings or list markers can start), line breaks and
-// other control characters shown as \n, \r, \xNN, so one value stays on one line.
+// Text for a Markdown line or table cell: ASCII punctuation that could start a construct is
+// backslash-escaped (no emphasis, link, code, HTML, entity, heading, quote or list marker can
+// start; < > & become entities, so not even the source holds a tag), line breaks and other control
+// characters shown as \n, \r, \xNN: one value, one line.
 std::string mdText(std::string_view s);
 
 // An inline code span holding s literally: fenced by a backtick run longer than any inside, control
-// characters shown as \n, \xNN; a | is escaped so the span can sit in a table cell.
+// characters shown as \n, \xNN; a | is escaped so the span can sit in a table cell. Markup inside
+// stays text when rendered, but is there in the source: for names from the lab's own config.
 std::string mdCode(std::string_view s);
 
 // Text for HTML element content or a quoted attribute value.
@@ -42,6 +45,9 @@ std::string htmlText(std::string_view s);
 // One line for a terminal: control characters (C0, DEL, C1), U+2028/U+2029 and bidi controls as
 // \n, \t, \xNN or \u{XXXX}; invalid UTF-8 bytes as \xNN.
 std::string termText(std::string_view s);
+
+// A word for a POSIX shell command line shown to a user: as it is when plain, else '...' quoted.
+std::string shellWord(std::string_view s);
 
 // One CSV field: a leading = + - @ tab or CR gets a ' prefix (no spreadsheet formula), then the
 // field is quoted when it holds , " CR or LF or starts/ends with a space ("" inside). Pass numbers

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <map>
 
+#include "grading/escape.h"
 #include "grading/report.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
@@ -24,19 +25,28 @@ std::string hashHexOf(std::uint64_t h) {
 
 namespace {
 
-// A results.json for a submission that could not be graded at all.
+// A results.json for a submission that could not be graded at all: the submission's fault (e is
+// its InputError) or an internal error, whose details go to the staff (extra_data, the terminal
+// and report.md), not into the student's feedback.
 GradeOutcome failedOutcome(const std::string& message, const InputError* e) {
   GradeOutcome out;
   out.input_error = e != nullptr;
+  out.internal_error = e == nullptr;
+  const std::string feedback =
+      e ? "**Your submission could not be graded.**\n\n" + mdText(message) + "\n\nFix it and resubmit."
+        : "**The grader failed while grading your submission.** This is an internal error, not a problem with your "
+          "submission, and no score was given. Please resubmit later, and tell the course staff if it happens again.";
   out.results = {{"score", 0.0},
                  {"execution_time", 0.0},
-                 {"output", "**Your submission could not be graded.**\n\n    " + message + "\n\nFix it and resubmit."},
+                 {"output", feedback},
                  {"output_format", "md"},
                  {"tests", json::array()},
-                 {"extra_data", {{"dynlab_version", DYNLAB_VERSION}}}};
+                 {"extra_data", {{"dynlab_version", DYNLAB_VERSION}, {"status", out.status()}}}};
   if (e) out.results["extra_data"]["error"] = {{"file", e->file()}, {"path", e->path().empty() ? "/" : e->path()}, {"expected", e->expected()}};
-  out.report = (e ? "error: " : "internal error: ") + message + "\nScore: 0\n";
-  out.markdown = "# dynlab grade\n\n**Not graded:** `" + message + "`\n";
+  else out.results["extra_data"]["internal_error"] = message;
+  out.results = jsonSanitized(out.results);
+  out.report = (e ? "error: " : "internal error: ") + termText(message) + "\nScore: 0\n";
+  out.markdown = std::string("# dynlab grade\n\n**Not graded") + (e ? "" : " (internal error)") + ":** " + mdText(message) + "\n";
   out.html = renderHtml(out.markdown);
   return out;
 }
@@ -78,8 +88,8 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     rep.lab = lab_name;
     rep.submission = file;
     rep.fingerprint = {{"dynlab_version", DYNLAB_VERSION},
-                       {"lab_config_hash", hashHex(base.dump())},
-                       {"submission_hash", hashHex(sub.dump())}};
+                       {"lab_config_hash", hashHex(dumpJson(base))},
+                       {"submission_hash", hashHex(dumpJson(sub))}};
 
     // Run each scenario the tests use, once, in rubric order.
     std::map<std::string, ScenarioRun> runs;
@@ -127,16 +137,17 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
 
     GradeOutcome out;
     out.results = resultsJson(rep);
+    out.results["extra_data"]["status"] = out.status();
     out.report = terminalReport(rep);
     out.markdown = markdownReport(rep);
-    out.html = renderHtml(out.markdown);
+    out.html = renderHtml(out.markdown, "dynlab grade: " + lab_name);
     out.results["execution_time"] =
         std::round(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() * 100) / 100;
     return out;
   } catch (const InputError& e) {
     return failedOutcome(e.what(), &e);
   } catch (const std::exception& e) {
-    return failedOutcome(std::string("internal error: ") + e.what(), nullptr);
+    return failedOutcome(e.what(), nullptr);
   }
 }
 
@@ -149,8 +160,8 @@ std::vector<std::string> compareResults(const json& expected, const json& actual
     const std::string path = op.at("path");
     std::string what = op.at("op").get<std::string>() + " " + path;
     if (op.contains("value")) {
-      std::string v = op.at("value").dump();
-      if (v.size() > 60) v = v.substr(0, 57) + "...";
+      std::string v = dumpJson(op.at("value"));
+      if (v.size() > 60) v = v.substr(0, 57) + "...";  // may cut a character: shown through termText
       what += ": now " + v;
     }
     out.push_back(what);
