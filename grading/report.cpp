@@ -45,6 +45,9 @@ std::string testText(const GradeReport& r, const GradedTest& g) {
   return s;
 }
 
+// A note with nothing to show is left out: an empty "- " item under a line would make it a heading.
+bool blank(const std::string& s) { return s.find_first_not_of(" \t") == std::string::npos; }
+
 std::string scenarioStatus(const ScenarioSummary& s) { return s.failure.empty() ? "completed" : s.failure; }
 
 }  // namespace
@@ -92,7 +95,8 @@ json resultsJson(const GradeReport& r) {
   std::string output = "**dynlab " + mdText(r.lab) + ": " + points(r.score()) + " / " + points(r.maxScore()) + " points.**\n\n";
   for (const auto& s : r.scenarios) {
     if (s.scenario.name != "nominal") continue;
-    for (const auto& n : s.screen_notes) output += "- " + mdText(n) + "\n";
+    for (const auto& n : s.screen_notes)
+      if (!blank(n)) output += "- " + mdText(n) + "\n";
   }
   for (const auto& s : r.scenarios)
     if (!s.failure.empty()) output += "- Scenario **" + mdText(s.scenario.name) + "**: " + mdText(s.failure) + ".\n";
@@ -143,13 +147,14 @@ std::string markdownReport(const GradeReport& r) {
     const GradedTest& g = r.tests[i];
     md += "\n### " + std::to_string(i + 1) + ". " + mdText(g.test.name) + " — " + points(g.score) + " / " + points(g.test.points) + "\n\n";
     md += testText(r, g) + "\n";
-    // The plot path is ours (plots/NN-slug.png): only the alt text comes from the rubric.
-    if (!g.plot.empty()) md += "\n![" + mdText(g.test.name) + "](" + g.plot + ")\n";
+    // The image is all ours (plots/NN-slug.png, alt text by number): the heading above names it.
+    if (!g.plot.empty()) md += "\n![plot of test " + std::to_string(i + 1) + "](" + g.plot + ")\n";
   }
   md += "\n## Scenarios and gain screening\n\n";
   for (const auto& s : r.scenarios) {
     md += "- **" + mdText(s.scenario.name) + "** (" + mdText(s.scenario.about) + "): " + mdText(scenarioStatus(s)) + ".\n";
-    for (const auto& n : s.screen_notes) md += "  - " + mdText(n) + "\n";
+    for (const auto& n : s.screen_notes)
+      if (!blank(n)) md += "  - " + mdText(n) + "\n";
   }
   md += "\n## Fingerprint\n\n";
   for (const auto& [k, v] : r.fingerprint.items())
