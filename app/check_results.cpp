@@ -19,6 +19,8 @@
 #include <string>
 #include <vector>
 
+#include "grading/escape.h"
+
 namespace dyn::app {
 namespace {
 
@@ -202,21 +204,9 @@ bool readRegular(const std::string& file, std::string& bytes, std::string& why) 
   return true;
 }
 
-// One line for a terminal and for a JSON string: control bytes (in keys, say) become \xNN.
-std::string oneLine(const std::string& s) {
-  std::string out;
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c >= 0x20 && c != 0x7F) {
-      out += ch;
-    } else {
-      char hex[5];
-      std::snprintf(hex, sizeof hex, "\\x%02x", c);
-      out += hex;
-    }
-  }
-  return clip(out, 400);
-}
+// One line for a terminal and for a JSON string: grading/escape.h's terminal text (control bytes,
+// in keys say, and bytes that are not UTF-8 become \xNN), clipped.
+std::string oneLine(const std::string& s) { return clip(termText(s), 400); }
 
 }  // namespace
 

@@ -14,6 +14,7 @@
 #include "app/autograder.h"
 #include "app/movie.h"
 #include "app/output.h"
+#include "grading/escape.h"
 #include "grading/grade.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
@@ -166,21 +167,25 @@ int gradeOne(const GradeArgs& a) {
     Staging staging(a.out);
     staging.owns({"results.json", "report.md", "report.html", "plots"});
     g = gradeSubmission(a.submission, gradeOptions(a, staging.path("").string()));
-    staging.write("results.json", g.results.dump(2) + "\n");
+    // An internal error's plots may be partial: none are published (the old ones are removed).
+    if (g.internal_error) fs::remove_all(staging.path("plots"));
+    staging.write("results.json", dumpJson(g.results, 2) + "\n");
     staging.write("report.md", g.markdown);
     staging.write("report.html", g.html);
     staging.commit();
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: cannot write results to %s: %s\n", a.out.c_str(), e.what());
-    return 1;
+    // A disk or folder error: the grader's fault, not the submission's; the old results stay.
+    std::fprintf(stderr, "error: results not written: %s\n", termText(e.what()).c_str());
+    return 3;
   }
   if (!g.error.empty()) std::fprintf(stderr, "error: %s\n", g.error.c_str());
   std::fputs(g.report.c_str(), stdout);
-  std::printf("results: %s\nreport:  %s\n", (fs::path(a.out) / "results.json").c_str(), (fs::path(a.out) / "report.html").c_str());
+  std::printf("results: %s\nreport:  %s\n", termText((fs::path(a.out) / "results.json").string()).c_str(),
+              termText((fs::path(a.out) / "report.html").string()).c_str());
   // A grade the time budget cut short is written (score 0 for what it stopped) but is not a grade.
   if (g.out_of_time) std::fprintf(stderr, "error: %s: the grading time budget of %g s ran out; the grade is incomplete\n",
                                   utf8Quotable(a.submission).c_str(), a.time_budget);
-  return g.input_error ? 2 : !g.error.empty() ? 3 : g.out_of_time ? 4 : 0;
+  return g.input_error ? 2 : g.internal_error ? 3 : g.out_of_time ? 4 : 0;
 }
 
 int gradeReplay(const GradeArgs& a) {
@@ -204,12 +209,12 @@ int gradeReplay(const GradeArgs& a) {
         if (t.contains("extra_data")) t["extra_data"].erase("plot");
   const auto diff = compareResults(expected, actual);
   if (diff.empty()) {
-    std::printf("replay: match (score %s, trajectory hash %s)\n", actual["score"].dump().c_str(),
-                actual["extra_data"].value("fingerprint", json::object()).value("trajectory_hash", "-").c_str());
+    std::printf("replay: match (score %s, trajectory hash %s)\n", dumpJson(actual["score"]).c_str(),
+                termText(actual["extra_data"].value("fingerprint", json::object()).value("trajectory_hash", "-")).c_str());
     return 0;
   }
   std::printf("replay: MISMATCH, %zu difference(s):\n", diff.size());
-  for (std::size_t i = 0; i < diff.size() && i < 20; ++i) std::printf("  %s\n", diff[i].c_str());
+  for (std::size_t i = 0; i < diff.size() && i < 20; ++i) std::printf("  %s\n", termText(diff[i]).c_str());
   return 1;
 }
 

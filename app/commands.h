@@ -1,7 +1,8 @@
 // The dynlab subcommands. Each returns the process exit code:
 //   0 success, 1 a run or write failed (a diverging run stopped by the watchdog included),
 //   2 bad input (nothing written; a grade still writes its score-0 results.json),
-//   3 internal error (caught at the top of main), 4 a grade cut short by its time budget.
+//   3 internal error (the grader or the machine; caught at the top of main, or reported in
+//     results.json when it could be written), 4 a grade cut short by its time budget.
 #pragma once
 #include <optional>
 #include <string>

@@ -13,6 +13,7 @@
 #include "app/commands.h"
 #include "app/movie.h"
 #include "app/output.h"
+#include "grading/escape.h"
 #include "grading/plot.h"
 #include "grading/rubric.h"
 #include "labs/run.h"
@@ -192,7 +193,7 @@ int figure(const FigureArgs& a) {
       plots = lab_plots;
     }
   } catch (const InputError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
     return 2;
   }
   const Lab& lab = *loaded.lab;
@@ -227,7 +228,7 @@ int figure(const FigureArgs& a) {
         if (!names.insert(name).second) continue;
         const std::size_t row = rowAt(shown.trace, lab.dt(), t);
         const Image image = renderRow(renderer, lab, shown.trace, row, ghost, a.overlay, a.title);
-        if (!writePng(staging.path(name).string(), image)) throw std::runtime_error("cannot write " + staging.path(name).string());
+        if (std::string why; !writePng(staging.path(name).string(), image, &why)) throw std::runtime_error(why);
         written.push_back(name);
       }
     }
@@ -241,7 +242,7 @@ int figure(const FigureArgs& a) {
     for (const auto& name : written) std::printf("  %s\n", (out / name).c_str());
     return status == "ok" ? 0 : 1;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
     return 1;
   }
 }

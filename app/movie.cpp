@@ -50,8 +50,7 @@ int renderRun(const Lab& lab, const Trace& trace, const Trace* ghost, const Movi
     if (o.frames) {
       char name[32];
       std::snprintf(name, sizeof name, "%05d.png", n);
-      if (!writePng((dir / "frames" / name).string(), image))
-        throw std::runtime_error("cannot write " + (dir / "frames" / name).string());
+      if (std::string why; !writePng((dir / "frames" / name).string(), image, &why)) throw std::runtime_error(why);
     }
     ++n;
   }

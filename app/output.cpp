@@ -1,21 +1,16 @@
 // Staged, atomic output; see output.h.
 #include "app/output.h"
 
-#include <fstream>
-#include <stdexcept>
+#include <system_error>
+
+#include "labs/file_write.h"
 
 namespace fs = std::filesystem;
 
 namespace dyn::app {
 
 void writeFileAtomic(const fs::path& path, const std::string& contents) {
-  const fs::path tmp = path.string() + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary | std::ios::trunc);
-    f << contents;
-    if (!f.good()) throw std::runtime_error("cannot write " + tmp.string());
-  }
-  fs::rename(tmp, path);
+  writeFileChecked(path.string(), contents, true);
 }
 
 Staging::Staging(const fs::path& out) : out_(out), staging_(out / ".staging") {
@@ -30,7 +25,13 @@ Staging::~Staging() {
 }
 
 void Staging::write(const std::string& name, const std::string& contents) const {
-  writeFileAtomic(path(name), contents);
+  // Staged files are fsynced; the folder is synced once, on commit. The error names the file the
+  // user knows (OUT/name), not its staging copy.
+  try {
+    writeFileChecked(path(name).string(), contents, false);
+  } catch (const std::system_error& e) {
+    throw std::system_error(e.code(), "cannot write " + (out_ / name).string());
+  }
 }
 
 void Staging::commit() {
@@ -38,10 +39,12 @@ void Staging::commit() {
     if (!fs::exists(staging_ / name)) fs::remove_all(out_ / name);
   for (const auto& e : fs::directory_iterator(staging_)) {
     const fs::path dest = out_ / e.path().filename();
-    fs::remove_all(dest);
+    // rename() replaces a file in one step (the old one stays until then); a folder must go first.
+    if (fs::is_directory(e.symlink_status()) || fs::is_directory(fs::symlink_status(dest))) fs::remove_all(dest);
     fs::rename(e.path(), dest);
   }
   fs::remove_all(staging_);
+  syncDirectory(out_.string());
   committed_ = true;
 }
 

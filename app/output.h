@@ -1,5 +1,7 @@
 // Output staging: everything a command writes goes to DIR/.staging first and is moved into
 // place only when the command succeeds, so a failure never leaves half-written results.
+// Every write is checked through close (labs/file_write.h): a full disk is an exception naming
+// the file with the system's error text, never a short file left as if it were valid.
 #pragma once
 #include <filesystem>
 #include <string>
@@ -16,7 +18,8 @@ class Staging {
   // Names this command always owns in out_dir: on commit, any of them not staged this time is
   // removed, so a rerun never leaves a stale file (an old video.mp4) beside fresh results.
   void owns(std::vector<std::string> names) { owned_ = std::move(names); }
-  // Moves every staged entry into out_dir (replacing older ones) and removes the staging dir.
+  // Moves every staged entry into out_dir (a file replaces the older one in one rename), removes
+  // the staging dir and fsyncs out_dir, so the new results are on disk when commit returns.
   void commit();
   const std::filesystem::path& outDir() const { return out_; }
 
@@ -26,7 +29,7 @@ class Staging {
   bool committed_ = false;
 };
 
-// Writes a file atomically (temporary name, then rename).
+// Writes a file atomically and durably (temporary name, fsync, rename, fsync of the folder).
 void writeFileAtomic(const std::filesystem::path& path, const std::string& contents);
 
 }  // namespace dyn::app

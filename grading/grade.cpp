@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <map>
 
+#include "grading/escape.h"
 #include "grading/report.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
@@ -25,20 +26,30 @@ std::string hashHexOf(std::uint64_t h) {
 
 namespace {
 
-// A results.json for a submission that could not be graded at all.
+// A results.json for a submission that could not be graded at all: the submission's fault (e is
+// its InputError) or an internal error, whose details go to the staff (extra_data, the terminal
+// and report.md), not into the student's feedback.
 GradeOutcome failedOutcome(const std::string& message, const InputError* e) {
   GradeOutcome out;
   out.input_error = e != nullptr;
+  out.internal_error = e == nullptr;
+  const std::string feedback =
+      e ? "**Your submission could not be graded.**\n\n" + mdText(message) + "\n\nFix it and resubmit."
+        : "**The grader failed while grading your submission.** This is an internal error, not a problem with your "
+          "submission, and no score was given. Please resubmit later, and tell the course staff if it happens again.";
   out.results = {{"score", 0.0},
                  {"execution_time", 0.0},
-                 {"output", "**Your submission could not be graded.**\n\n    " + message + "\n\nFix it and resubmit."},
+                 {"output", feedback},
                  {"output_format", "md"},
                  {"tests", json::array()},
-                 {"extra_data", {{"dynlab_version", DYNLAB_VERSION}}}};
+                 {"extra_data", {{"dynlab_version", DYNLAB_VERSION}, {"status", out.status()}}}};
   if (e) out.results["extra_data"]["error"] = {{"file", e->file()}, {"path", e->path().empty() ? "/" : e->path()}, {"expected", e->expected()}};
-  out.error = message;
-  out.report = "Score: 0 (not graded)\n";
-  out.markdown = "# dynlab grade\n\n**Not graded:** `" + message + "`\n";
+  else out.results["extra_data"]["internal_error"] = message;
+  out.results = jsonSanitized(out.results);
+  // The terminal: the one-line error goes to stderr (dynlab grade), the report says what kind it was.
+  out.error = termText(e ? message : "internal error: " + message);
+  out.report = std::string("Score: 0 (not graded") + (e ? "" : ": internal error") + ")\n";
+  out.markdown = std::string("# dynlab grade\n\n**Not graded") + (e ? "" : " (internal error)") + ":** " + mdText(message) + "\n";
   out.html = renderHtml(out.markdown);
   return out;
 }
@@ -80,8 +91,8 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     rep.lab = lab_name;
     rep.submission = utf8Quotable(file);  // a file name is not always UTF-8; results.json must be
     rep.fingerprint = {{"dynlab_version", DYNLAB_VERSION},
-                       {"lab_config_hash", hashHex(base.dump())},
-                       {"submission_hash", hashHex(sub.dump())}};
+                       {"lab_config_hash", hashHex(dumpJson(base))},
+                       {"submission_hash", hashHex(dumpJson(sub))}};
 
     // Run each scenario the tests use, once, in rubric order.
     std::map<std::string, ScenarioRun> runs;
@@ -130,9 +141,10 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     GradeOutcome out;
     for (const auto& s : rep.scenarios) out.out_of_time = out.out_of_time || s.out_of_time;
     out.results = resultsJson(rep);
+    out.results["extra_data"]["status"] = out.status();
     out.report = terminalReport(rep);
     out.markdown = markdownReport(rep);
-    out.html = renderHtml(out.markdown);
+    out.html = renderHtml(out.markdown, "dynlab grade: " + lab_name);
     out.results["execution_time"] =
         std::round(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() * 100) / 100;
     return out;
@@ -140,7 +152,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     return failedOutcome(e.what(), &e);
   } catch (const std::exception& e) {
     // Not the input's fault; what() may quote a path that is not UTF-8.
-    return failedOutcome("internal error: " + utf8Quotable(e.what()), nullptr);
+    return failedOutcome(utf8Quotable(e.what()), nullptr);
   }
 }
 
@@ -153,8 +165,8 @@ std::vector<std::string> compareResults(const json& expected, const json& actual
     const std::string path = op.at("path");
     std::string what = op.at("op").get<std::string>() + " " + path;
     if (op.contains("value")) {
-      std::string v = op.at("value").dump();
-      if (v.size() > 60) v = v.substr(0, 57) + "...";
+      std::string v = dumpJson(op.at("value"));
+      if (v.size() > 60) v = v.substr(0, 57) + "...";  // may cut a character: shown through termText
       what += ": now " + v;
     }
     out.push_back(what);

@@ -2,7 +2,11 @@
 // Gradescope's results.json, a terminal summary, and Markdown/HTML reports with plots.
 //   score of a test = points · clamp((zero − m) / (zero − full), 0, 1)   (linear partial credit)
 // Every failure (bad file, unknown lab, unstable run, time budget) becomes a plain message in
-// results.json with score 0 for what it touched; a results.json is always produced.
+// results.json with score 0 for what it touched; a results.json is always produced, valid UTF-8
+// with every user-controlled text escaped for its format (grading/escape.h).
+// Its extra_data.status tells a gradebook whose fault a missing grade is: "graded",
+// "invalid_submission" (the student's file; they are told to fix it) or "internal_error" (the
+// grader or the machine: a plot that cannot be written, an exception; never blamed on the student).
 // Reproducible: grading the same file twice gives the same results.json apart from
 // "execution_time"; the fingerprint (version, lab config hash, submission hash, trajectory hash)
 // lets `dynlab grade --replay` check it.
@@ -27,9 +31,11 @@ struct GradeOutcome {
   std::string report;    // readable summary for the terminal
   std::string markdown;  // report.md (plots linked as plots/*.png)
   std::string html;      // report.html (same content)
-  std::string error;     // one line when the submission could not be graded (else empty)
-  bool input_error = false;
-  bool out_of_time = false;  // the time budget stopped a scenario: the grade is incomplete
+  std::string error;            // one line when the submission could not be graded (else empty)
+  bool input_error = false;     // the submission's fault (results say how to fix it)
+  bool internal_error = false;  // the grader's or the machine's fault
+  bool out_of_time = false;     // the time budget stopped a scenario: the grade is incomplete
+  const char* status() const { return input_error ? "invalid_submission" : internal_error ? "internal_error" : "graded"; }
 };
 
 GradeOutcome gradeSubmission(const std::string& submission_file, const GradeOptions& options);

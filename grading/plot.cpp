@@ -19,6 +19,8 @@
 #include <mutex>
 #include <stdexcept>
 
+#include "labs/file_write.h"
+
 namespace dyn {
 namespace {
 
@@ -346,25 +348,38 @@ PLINT emptiestCorner(const PlotSpec& spec, const Range& xr, const Range& yr, dou
 // Two fixes to PLplot's files, both byte-length neutral or header-only: the svg device sizes the
 // picture in points (say pixels, to match the PNG); pdfcairo stamps the creation date (pin it to
 // 1980-01-01 so the PDF is deterministic too; same length, so the xref offsets stay valid).
-void fixupFile(const std::string& file, const std::string& device, int width_px, int height_px) {
-  if (device != "svg" && device != "pdfcairo") return;
-  std::ifstream in(file, std::ios::binary);
-  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  in.close();
+void fixupFile(std::string& text, const std::string& device, int width_px, int height_px) {
   if (device == "svg") {
     for (auto [key, px] : {std::pair{"width=\"", width_px}, std::pair{"height=\"", height_px}}) {
       const std::string from = key + std::to_string(px) + "pt\"", to = key + std::to_string(px) + "px\"";
       const size_t at = text.find(from);
       if (at != std::string::npos && at < 1024) text.replace(at, from.size(), to);
     }
-  } else {
+  } else if (device == "pdfcairo") {
     const std::string key = "/CreationDate (D:", fixed = "19800101000000";
     const size_t at = text.find(key);
     if (at != std::string::npos && at + key.size() + fixed.size() <= text.size() &&
         std::all_of(text.begin() + at + key.size(), text.begin() + at + key.size() + fixed.size(), [](unsigned char c) { return std::isdigit(c) != 0; }))
       text.replace(at + key.size(), fixed.size(), fixed);
   }
-  std::ofstream(file, std::ios::binary | std::ios::trunc) << text;
+}
+
+// PLplot cannot report a failed write (its drivers ignore fwrite/fclose results), so its file is
+// checked instead: complete from signature to end marker, or it was cut short.
+bool completeFile(const std::string& text, const std::string& device) {
+  const auto trimmed = [&] {
+    std::size_t end = text.find_last_not_of(" \t\r\n");
+    return end == std::string::npos ? std::string() : text.substr(0, end + 1);
+  };
+  if (device == "pngcairo")  // signature ... IEND chunk (length 0, type, CRC)
+    return text.size() >= 20 && text.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0 &&
+           text.compare(text.size() - 12, 12, std::string("\0\0\0\0IEND\xae\x42\x60\x82", 12)) == 0;
+  if (device == "pdfcairo") {
+    const std::string t = trimmed();
+    return text.compare(0, 5, "%PDF-") == 0 && t.size() >= 5 && t.compare(t.size() - 5, 5, "%%EOF") == 0;
+  }
+  const std::string t = trimmed();
+  return t.size() >= 6 && t.compare(t.size() - 6, 6, "</svg>") == 0;
 }
 
 // Everything PLplot draws for one plot, on the current (fresh, initialised) stream.
@@ -452,12 +467,12 @@ void writePlot(const std::string& path, const PlotSpec& spec, int width_px, int 
     fail(path, "size " + std::to_string(width_px) + "x" + std::to_string(height_px) + " is out of range");
   const auto [xr, yr] = dataRanges(path, spec);
 
-  // The output file must be writable before PLplot (which would exit() on failure) opens it.
-  const std::string tmp = path + ".tmp";
-  if (std::FILE* f = std::fopen(tmp.c_str(), "wb")) {
+  // PLplot writes to a scratch file (it would exit() if it could not open one: check first).
+  const std::string scratch = path + ".plplot";
+  if (std::FILE* f = std::fopen(scratch.c_str(), "wb")) {
     std::fclose(f);
   } else {
-    fail(path, std::string("cannot write ") + tmp + ": " + std::strerror(errno));
+    fail(path, std::string("cannot write ") + scratch + ": " + std::strerror(errno));
   }
 
   // One fresh PLplot stream: device, file, size in pixels, colours; ended (file closed) on scope exit.
@@ -467,29 +482,34 @@ void writePlot(const std::string& path, const PlotSpec& spec, int width_px, int 
       plsexit(throwOnPlplotExit);
       Stream stream;
       plsdev(device.c_str());
-      plsfnam(tmp.c_str());
+      plsfnam(scratch.c_str());
       plspage(kDpi, kDpi, width_px, height_px, 0, 0);
       plsfam(0, 0, 0);
       setColours();
       plinit();
       drawPlot(spec, xr, yr, std::clamp(std::min(width_px / 800.0, height_px / 450.0), 0.8, 4.0));
     } catch (const std::exception& e) {
-      std::remove(tmp.c_str());
+      std::remove(scratch.c_str());
       fail(path, e.what());
     }
   }
-  fixupFile(tmp, device, width_px, height_px);
 
-  // Publish: the finished file replaces path in one step.
-  std::error_code ec;
-  if (std::filesystem::file_size(tmp, ec) == 0 || ec) {
-    std::remove(tmp.c_str());
-    fail(path, "PLplot wrote nothing");
-  }
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) {
-    std::remove(tmp.c_str());
-    fail(path, "cannot rename " + tmp + ": " + ec.message());
+  // Read back, fix up, check it is whole, and publish it through the checked writer.
+  std::ifstream in(scratch, std::ios::binary);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const bool read_ok = !in.bad();
+  in.close();
+  std::remove(scratch.c_str());
+  if (!read_ok) fail(path, "cannot read back " + scratch);
+  if (writeFaultInjected(std::filesystem::path(path).filename().string())) text.resize(text.size() / 2);
+  if (!completeFile(text, device))
+    fail(path, text.empty() ? "PLplot wrote nothing" : "PLplot's output is incomplete (" + std::to_string(text.size()) +
+                                                            " bytes; is the disk full?)");
+  fixupFile(text, device, width_px, height_px);
+  try {
+    writeFileChecked(path, text);
+  } catch (const std::exception& e) {
+    throw std::runtime_error(std::string("writePlot: ") + e.what());
   }
 }
 

@@ -6,6 +6,7 @@
 
 #include <filesystem>
 
+#include "grading/escape.h"
 #include "grading/grade.h"
 #include "grading/plot.h"
 
@@ -30,19 +31,22 @@ std::string slug(const std::string& s) {
   return out.substr(0, 40);
 }
 
-// The one-paragraph explanation of a test, shared by every output form.
+// The one-paragraph explanation of a test (Markdown), shared by results.json and report.md.
 std::string testText(const GradeReport& r, const GradedTest& g) {
   const ScenarioSummary& sc = scenarioOf(r, g.test.scenario);
-  std::string s = "Scenario **" + sc.scenario.name + "** (" + sc.scenario.about + "). ";
+  std::string s = "Scenario **" + mdText(sc.scenario.name) + "** (" + mdText(sc.scenario.about) + "). ";
   if (std::isfinite(g.value)) {
-    s += "`" + g.test.metric + "` = **" + fmtNumber(g.value) + "**; full credit at " + fmtNumber(g.test.full) +
+    s += mdCode(g.test.metric) + " = **" + fmtNumber(g.value) + "**; full credit at " + fmtNumber(g.test.full) +
          ", zero at " + fmtNumber(g.test.zero) + ".";
   } else {
-    s += "**No credit:** " + g.note + ".";
+    s += "**No credit:** " + mdText(g.note) + ".";
   }
-  if (!sc.failure.empty() && std::isfinite(g.value)) s += " (The run itself: " + sc.failure + ".)";
+  if (!sc.failure.empty() && std::isfinite(g.value)) s += " (The run itself: " + mdText(sc.failure) + ".)";
   return s;
 }
+
+// A note with nothing to show is left out: an empty "- " item under a line would make it a heading.
+bool blank(const std::string& s) { return s.find_first_not_of(" \t") == std::string::npos; }
 
 std::string scenarioStatus(const ScenarioSummary& s) { return s.failure.empty() ? "completed" : s.failure; }
 
@@ -87,14 +91,15 @@ json resultsJson(const GradeReport& r) {
                                   {"screening", s.screen_notes}};
     if (s.failure_time >= 0) scenarios[s.scenario.name]["failure_time"] = s.failure_time;
   }
-  // The top of the page: the score, and what the screening says about the gains.
-  std::string output = "**dynlab " + r.lab + ": " + points(r.score()) + " / " + points(r.maxScore()) + " points.**\n\n";
+  // The top of the page (Markdown): the score, and what the screening says about the gains.
+  std::string output = "**dynlab " + mdText(r.lab) + ": " + points(r.score()) + " / " + points(r.maxScore()) + " points.**\n\n";
   for (const auto& s : r.scenarios) {
     if (s.scenario.name != "nominal") continue;
-    for (const auto& n : s.screen_notes) output += "- " + n + "\n";
+    for (const auto& n : s.screen_notes)
+      if (!blank(n)) output += "- " + mdText(n) + "\n";
   }
   for (const auto& s : r.scenarios)
-    if (!s.failure.empty()) output += "- Scenario **" + s.scenario.name + "**: " + s.failure + ".\n";
+    if (!s.failure.empty()) output += "- Scenario **" + mdText(s.scenario.name) + "**: " + mdText(s.failure) + ".\n";
   json results = {{"score", r.score()},
                   {"output", output},
                   {"output_format", "md"},
@@ -104,67 +109,75 @@ json resultsJson(const GradeReport& r) {
                   {"tests", tests},
                   {"extra_data", {{"lab", r.lab}, {"fingerprint", r.fingerprint}, {"scenarios", scenarios}}}};
   if (!r.leaderboard.empty()) results["leaderboard"] = r.leaderboard;
-  return results;
+  return jsonSanitized(results);  // names, notes and keys as valid UTF-8: dump() cannot throw
 }
 
 std::string terminalReport(const GradeReport& r) {
-  std::string s = "Grading " + r.submission + " (" + r.lab + ")\n";
+  std::string s = "Grading " + termText(r.submission) + " (" + termText(r.lab) + ")\n";
   for (const auto& g : r.tests) {
-    s += "  " + points(g.score) + "/" + points(g.test.points) + "  " + g.test.name + " [" + g.test.scenario + "]: ";
-    s += std::isfinite(g.value) ? g.test.metric + " = " + fmtNumber(g.value) + " (full " + fmtNumber(g.test.full) +
+    s += "  " + points(g.score) + "/" + points(g.test.points) + "  " + termText(g.test.name) + " [" + termText(g.test.scenario) + "]: ";
+    s += std::isfinite(g.value) ? termText(g.test.metric) + " = " + fmtNumber(g.value) + " (full " + fmtNumber(g.test.full) +
                                       ", zero " + fmtNumber(g.test.zero) + ")"
-                                : g.note;
+                                : termText(g.note);
     s += "\n";
   }
   for (const auto& sc : r.scenarios)
     if (sc.scenario.name == "nominal")
-      for (const auto& n : sc.screen_notes) s += "  screening: " + n + "\n";
+      for (const auto& n : sc.screen_notes) s += "  screening: " + termText(n) + "\n";
   for (const auto& sc : r.scenarios)
-    if (!sc.failure.empty()) s += "  scenario " + sc.scenario.name + ": " + sc.failure + "\n";
+    if (!sc.failure.empty()) s += "  scenario " + termText(sc.scenario.name) + ": " + termText(sc.failure) + "\n";
   s += "Total: " + points(r.score()) + "/" + points(r.maxScore()) + "\n";
   return s;
 }
 
 std::string markdownReport(const GradeReport& r) {
-  std::string md = "# dynlab grade: " + r.lab + "\n\n";
-  md += "Submission `" + std::filesystem::path(r.submission).filename().string() + "`: **" + points(r.score()) +
-        " / " + points(r.maxScore()) + " points**.\n\n";
+  const std::string file = std::filesystem::path(r.submission).filename().string();
+  std::string md = "# dynlab grade: " + mdText(r.lab) + "\n\n";
+  md += "Submission " + mdText(file) + ": **" + points(r.score()) + " / " + points(r.maxScore()) + " points**.\n\n";
   md += "| # | test | scenario | metric | value | full credit | zero credit | score |\n";
   md += "|---|---|---|---|---|---|---|---|\n";
   for (std::size_t i = 0; i < r.tests.size(); ++i) {
     const GradedTest& g = r.tests[i];
-    md += "| " + std::to_string(i + 1) + " | " + g.test.name + " | " + g.test.scenario + " | `" + g.test.metric + "` | " +
-          (std::isfinite(g.value) ? fmtNumber(g.value) : "—") + " | " + fmtNumber(g.test.full) + " | " +
-          fmtNumber(g.test.zero) + " | " + points(g.score) + " / " + points(g.test.points) + " |\n";
+    md += "| " + std::to_string(i + 1) + " | " + mdText(g.test.name) + " | " + mdText(g.test.scenario) + " | " +
+          mdCode(g.test.metric) + " | " + (std::isfinite(g.value) ? fmtNumber(g.value) : "—") + " | " +
+          fmtNumber(g.test.full) + " | " + fmtNumber(g.test.zero) + " | " + points(g.score) + " / " + points(g.test.points) + " |\n";
   }
   md += "\n## Tests\n";
   for (std::size_t i = 0; i < r.tests.size(); ++i) {
     const GradedTest& g = r.tests[i];
-    md += "\n### " + std::to_string(i + 1) + ". " + g.test.name + " — " + points(g.score) + " / " + points(g.test.points) + "\n\n";
+    md += "\n### " + std::to_string(i + 1) + ". " + mdText(g.test.name) + " — " + points(g.score) + " / " + points(g.test.points) + "\n\n";
     md += testText(r, g) + "\n";
-    if (!g.plot.empty()) md += "\n![" + g.test.name + "](" + g.plot + ")\n";
+    // The image is all ours (plots/NN-slug.png, alt text by number): the heading above names it.
+    if (!g.plot.empty()) md += "\n![plot of test " + std::to_string(i + 1) + "](" + g.plot + ")\n";
   }
   md += "\n## Scenarios and gain screening\n\n";
   for (const auto& s : r.scenarios) {
-    md += "- **" + s.scenario.name + "** (" + s.scenario.about + "): " + scenarioStatus(s) + ".\n";
-    for (const auto& n : s.screen_notes) md += "  - " + n + "\n";
+    md += "- **" + mdText(s.scenario.name) + "** (" + mdText(s.scenario.about) + "): " + mdText(scenarioStatus(s)) + ".\n";
+    for (const auto& n : s.screen_notes)
+      if (!blank(n)) md += "  - " + mdText(n) + "\n";
   }
   md += "\n## Fingerprint\n\n";
-  for (const auto& [k, v] : r.fingerprint.items()) md += "- " + k + ": `" + v.get<std::string>() + "`\n";
-  md += "\nRe-check with `dynlab grade --replay results.json " + std::filesystem::path(r.submission).filename().string() + "`.\n";
+  for (const auto& [k, v] : r.fingerprint.items())
+    md += "- " + mdText(k) + ": " + mdCode(v.is_string() ? v.get<std::string>() : dumpJson(v)) + "\n";
+  // The command to copy, with the file name in it when that holds no markup.
+  const bool plain_name = file.find_first_of("<>&") == std::string::npos;
+  md += "\nRe-check with " + mdCode("dynlab grade --replay results.json " + (plain_name ? shellWord(file) : "SUBMISSION")) +
+        (plain_name ? "" : " (SUBMISSION: the file named above)") + ".\n";
   return md;
 }
 
-std::string renderHtml(const std::string& markdown) {
-  // GitHub-flavoured Markdown (tables) through cmark-gfm.
+std::string renderHtml(const std::string& markdown, const std::string& title) {
+  // GitHub-flavoured Markdown (tables) through cmark-gfm, safe mode (the default since 0.29; named
+  // for older versions): raw HTML and javascript: links are dropped, not passed through.
   cmark_gfm_core_extensions_ensure_registered();
-  cmark_parser* parser = cmark_parser_new(CMARK_OPT_DEFAULT);
+  const int options = CMARK_OPT_DEFAULT | CMARK_OPT_SAFE;
+  cmark_parser* parser = cmark_parser_new(options);
   if (cmark_syntax_extension* table = cmark_find_syntax_extension("table")) cmark_parser_attach_syntax_extension(parser, table);
   cmark_parser_feed(parser, markdown.data(), markdown.size());
   cmark_node* doc = cmark_parser_finish(parser);
-  char* body = cmark_render_html(doc, CMARK_OPT_DEFAULT, cmark_parser_get_syntax_extensions(parser));
+  char* body = cmark_render_html(doc, options, cmark_parser_get_syntax_extensions(parser));
   std::string html =
-      "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>dynlab grade</title>\n"
+      "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>" + htmlText(title) + "</title>\n"
       "<style>body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.45}"
       "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:.25em .6em}"
       "img{max-width:100%}code{background:#f3f3f3;padding:0 .2em}</style></head><body>\n";

@@ -43,7 +43,8 @@ struct GradeReport {
 json resultsJson(const GradeReport& r);
 std::string terminalReport(const GradeReport& r);
 std::string markdownReport(const GradeReport& r);
-std::string renderHtml(const std::string& markdown);  // a standalone page
+// A standalone page; markdown must already be escaped (grading/escape.h), title is plain text.
+std::string renderHtml(const std::string& markdown, const std::string& title = "dynlab grade");
 
 // Writes out_dir/plots/NN-<slug>.png for every test with a plot request and records the path.
 void writeTestPlots(GradeReport& r, const std::map<std::string, ScenarioRun>& runs, const std::string& out_dir);

@@ -1,31 +1,34 @@
-// PNG writing with stb_image_write (implementation provided by libstb): written to a temporary
-// name and renamed, so a failed write never leaves a half-written PNG under the final name.
+// PNG writing with stb_image_write (implementation provided by libstb): encoded in memory and
+// written by writeFileChecked (temporary name, every write and the close checked, then rename), so
+// a full disk is reported and never leaves a half-written PNG under the final name.
 #include <stb_image_write.h>
 
 #include <cstdio>
-#include <filesystem>
-#include <system_error>
+#include <exception>
 
+#include "labs/file_write.h"
 #include "render/image.h"
 
 namespace dyn {
 
-bool writePng(const std::string& path, const Image& image) {
+bool writePng(const std::string& path, const Image& image, std::string* why) {
+  const auto failed = [&](const std::string& reason) {
+    if (why) *why = reason;
+    return false;
+  };
   if (image.width <= 0 || image.height <= 0 ||
       image.rgba.size() != std::size_t(image.width) * image.height * 4)
-    return false;
-  const std::string temp = path + ".tmp";
-  const int ok = stbi_write_png(temp.c_str(), image.width, image.height, 4, image.rgba.data(),
-                                image.width * 4);
-  std::error_code ec;
-  if (!ok) {
-    std::filesystem::remove(temp, ec);
-    return false;
-  }
-  std::filesystem::rename(temp, path, ec);
-  if (ec) {
-    std::filesystem::remove(temp, ec);
-    return false;
+    return failed("cannot write " + path + ": empty or inconsistent image");
+  std::string png;
+  const auto append = [](void* context, void* data, int size) {
+    static_cast<std::string*>(context)->append(static_cast<const char*>(data), std::size_t(size));
+  };
+  if (!stbi_write_png_to_func(append, &png, image.width, image.height, 4, image.rgba.data(), image.width * 4))
+    return failed("cannot write " + path + ": PNG encoding failed");
+  try {
+    writeFileChecked(path, png);
+  } catch (const std::exception& e) {
+    return failed(e.what());
   }
   return true;
 }

@@ -1,0 +1,57 @@
+// One escaping function per output format. Every piece of text a user controls (submission file
+// names, JSON string values and keys, error messages quoting input) goes through the function of
+// the format it lands in, and only there:
+//   JSON      jsonText (valid UTF-8; nlohmann escapes the rest) and dumpJson (a dump that cannot throw)
+//   Markdown  mdText (inline text, every ASCII punctuation backslash-escaped) and mdCode (a code span)
+//   HTML      htmlText (& < > " ' as entities)
+//   terminal  termText (control characters, bidi overrides and invalid bytes as visible escapes)
+//   CSV       csvField (RFC 4180 quoting; formula lead characters neutralised)
+//   shell     shellWord (a file name in a command to copy)
+// Each returns valid UTF-8 whatever the input: an invalid byte becomes U+FFFD.
+#pragma once
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+namespace dyn {
+
+// True when bytes are well-formed UTF-8 (no overlongs, surrogates or code points past U+10FFFF).
+bool isValidUtf8(std::string_view bytes);
+
+// bytes with every byte that is not part of a well-formed UTF-8 sequence replaced by U+FFFD.
+std::string jsonText(std::string_view bytes);
+
+// A copy of v with every string value and object key passed through jsonText.
+nlohmann::json jsonSanitized(const nlohmann::json& v);
+
+// v.dump(indent) that replaces invalid UTF-8 instead of throwing (the second line of defence).
+std::string dumpJson(const nlohmann::json& v, int indent = -1);
+
+// Text for a Markdown line or table cell: ASCII punctuation that could start a construct is
+// backslash-escaped (no emphasis, link, code, HTML, entity, heading, quote or list marker can
+// start; < > & become entities, so not even the source holds a tag), line breaks and other control
+// characters shown as \n, \r, \xNN: one value, one line.
+std::string mdText(std::string_view s);
+
+// An inline code span holding s literally: fenced by a backtick run longer than any inside, control
+// characters shown as \n, \xNN; a | is escaped so the span can sit in a table cell. Markup inside
+// stays text when rendered, but is there in the source: for names from the lab's own config.
+std::string mdCode(std::string_view s);
+
+// Text for HTML element content or a quoted attribute value.
+std::string htmlText(std::string_view s);
+
+// One line for a terminal: control characters (C0, DEL, C1), U+2028/U+2029 and bidi controls as
+// \n, \t, \xNN or \u{XXXX}; invalid UTF-8 bytes as \xNN.
+std::string termText(std::string_view s);
+
+// A word for a POSIX shell command line shown to a user: as it is when plain, else '...' quoted.
+std::string shellWord(std::string_view s);
+
+// One CSV field: a leading = + - @ tab or CR gets a ' prefix (no spreadsheet formula), then the
+// field is quoted when it holds , " CR or LF or starts/ends with a space ("" inside). Pass numbers
+// you format yourself directly; this is for text.
+std::string csvField(const std::string& s);
+
+}  // namespace dyn
