@@ -5,62 +5,17 @@
 
 #include "app/batch.h"
 #include "app/output.h"
+#include "grading/escape.h"
 #include "grading/rubric.h"
 #include "labs/config.h"
 #include "labs/lab.h"
 
 namespace fs = std::filesystem;
 
-namespace dyn {
-
-namespace {
-
-// The length of the well-formed UTF-8 sequence at s[i] (0 if none).
-std::size_t utf8Length(const std::string& s, std::size_t i) {
-  const auto b = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
-  const unsigned char c = b(i);
-  if (c < 0x80) return 1;
-  std::size_t n = c >= 0xC2 && c <= 0xDF ? 2 : c >= 0xE0 && c <= 0xEF ? 3 : c >= 0xF0 && c <= 0xF4 ? 4 : 0;
-  if (n == 0 || i + n > s.size()) return 0;
-  for (std::size_t k = 1; k < n; ++k)
-    if ((b(i + k) & 0xC0) != 0x80) return 0;
-  // No overlong three/four-byte forms, no surrogates, nothing past U+10FFFF.
-  if ((c == 0xE0 && b(i + 1) < 0xA0) || (c == 0xED && b(i + 1) > 0x9F) || (c == 0xF0 && b(i + 1) < 0x90) ||
-      (c == 0xF4 && b(i + 1) > 0x8F))
-    return 0;
-  return n;
-}
-
-// Text with every byte that is not well-formed UTF-8 replaced by U+FFFD.
-// TODO(merge): grading/escape.h's jsonText does this; use it once the outputs branch is merged.
-std::string utf8Text(const std::string& s) {
-  std::string t;
-  for (std::size_t i = 0; i < s.size();) {
-    const std::size_t n = utf8Length(s, i);
-    t += n ? s.substr(i, n) : std::string("\xEF\xBF\xBD");
-    i += n ? n : 1;
-  }
-  return t;
-}
-
-}  // namespace
-
-std::string csvField(const std::string& raw) {
-  std::string s = utf8Text(raw);
-  if (!s.empty() && std::string("=+-@\t\r").find(s[0]) != std::string::npos) s.insert(s.begin(), '\'');
-  const bool quote = s.find_first_of(",\"\r\n") != std::string::npos || (!s.empty() && (s.front() == ' ' || s.back() == ' '));
-  if (!quote) return s;
-  std::string q = "\"";
-  for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return q + "\"";
-}
-
-}  // namespace dyn
-
 namespace dyn::app::batch {
 
 Row failedRow(const Submission& s, const std::string& status, const std::string& reason) {
-  return {s.name, s.folder, status, utf8Text(reason), 0, 0, false, {}};
+  return {s.name, s.folder, status, jsonText(reason), 0, 0, false, {}};
 }
 
 Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, const std::string& log_tail) {
@@ -110,7 +65,7 @@ Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, 
     row.status = "timed out";
     row.reason += std::string(row.reason.empty() ? "" : "; ") + "the grading time budget ran out";
   }
-  row.reason = utf8Text(row.reason);
+  row.reason = jsonText(row.reason);
   return row;
 }
 
@@ -120,7 +75,7 @@ void writeFallbackResults(const fs::path& results, const Row& row) {
                   {"output_format", "md"},
                   {"tests", json::array()},
                   {"extra_data", {{"status", row.status}, {"reason", row.reason}}}};
-  writeFileAtomic(results, r.dump(2) + "\n");
+  writeFileAtomic(results, dumpJson(r, 2) + "\n");
 }
 
 double labMaxScore(const std::string& lab, const std::string& config, const std::vector<Row>& rows) {
