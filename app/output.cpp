@@ -34,7 +34,27 @@ void Staging::write(const std::string& name, const std::string& contents) const 
   }
 }
 
+namespace {
+// A folder dynlab may replace: its entries are only numbered figures (plots/03-force.png,
+// frames/00042.png), which dynlab wrote; anything else is the user's.
+void checkOurs(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::is_directory(fs::symlink_status(dir, ec))) return;
+  for (const auto& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string(), ext = e.path().extension().string();
+    const bool ours = e.is_regular_file(ec) && !e.is_symlink(ec) && !name.empty() && name[0] >= '0' && name[0] <= '9' &&
+                      (ext == ".png" || ext == ".svg" || ext == ".pdf");
+    if (!ours)
+      throw OutputConflict(dir.string() + " holds files dynlab did not write (" + name +
+                           "): choose another --out, or move them away");
+  }
+}
+}  // namespace
+
 void Staging::commit() {
+  // Nothing is removed unless everything that would be is dynlab's own.
+  for (const auto& name : owned_) checkOurs(out_ / name);
+  for (const auto& e : fs::directory_iterator(staging_)) checkOurs(out_ / e.path().filename());
   for (const auto& name : owned_)
     if (!fs::exists(staging_ / name)) fs::remove_all(out_ / name);
   for (const auto& e : fs::directory_iterator(staging_)) {

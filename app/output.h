@@ -4,10 +4,18 @@
 // the file with the system's error text, never a short file left as if it were valid.
 #pragma once
 #include <filesystem>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 namespace dyn::app {
+
+// OUT holds something in the way that dynlab did not write (a folder of the user's where dynlab
+// puts plots/ or frames/): nothing is removed, and the command says so (the user's choice of OUT).
+class OutputConflict : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
 
 class Staging {
  public:
@@ -19,7 +27,9 @@ class Staging {
   // removed, so a rerun never leaves a stale file (an old video.mp4) beside fresh results.
   void owns(std::vector<std::string> names) { owned_ = std::move(names); }
   // Moves every staged entry into out_dir (a file replaces the older one in one rename), removes
-  // the staging dir and fsyncs out_dir, so the new results are on disk when commit returns.
+  // the staging dir and fsyncs out_dir, so the new results are on disk when commit returns. A folder
+  // it would replace or remove must hold only what dynlab writes there (numbered .png/.svg/.pdf
+  // files): else OutputConflict, before anything is touched.
   void commit();
   const std::filesystem::path& outDir() const { return out_; }
 

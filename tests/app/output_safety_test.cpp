@@ -137,3 +137,24 @@ TEST_CASE("a plot that cannot be written is an internal error, not the student's
   CHECK_FALSE(fs::exists(dir / "out/plots"));  // no partial plots published
   CHECK(dynlab(dir, "check-results out/results.json").code == 0);
 }
+
+TEST_CASE("grade --out . never removes a plots/ folder of the user's; its own plots/ it replaces") {
+  TempDir dir("out_dot");
+  writeFile(dir / "good.json", kGood);
+  fs::create_directories(dir / "plots");
+  writeFile(dir / "plots/notes.txt", "mine");
+  Result r = shell(dir, quote(DYNLAB_BIN) + " grade good.json --out .");
+  INFO(r.out, r.err);
+  CHECK(r.code == 2);
+  CHECK(r.err.find("plots holds files dynlab did not write (notes.txt)") != std::string::npos);
+  CHECK(readFile(dir / "plots/notes.txt") == "mine");
+  CHECK_FALSE(fs::exists(dir / "results.json"));  // nothing was written
+  // Without the user's file, dynlab writes its plots there, and a rerun replaces them.
+  fs::remove(dir / "plots/notes.txt");
+  r = shell(dir, quote(DYNLAB_BIN) + " grade good.json --out .");
+  CHECK(r.code == 0);
+  CHECK(fs::exists(dir / "results.json"));
+  r = shell(dir, quote(DYNLAB_BIN) + " grade good.json --out .");
+  CHECK(r.code == 0);
+  CHECK_FALSE(fs::is_empty(dir / "plots"));
+}
