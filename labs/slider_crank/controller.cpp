@@ -1,6 +1,7 @@
 // Direct force control on the slider crank; equations in controller.h.
 #include "labs/slider_crank/controller.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace dyn::slider_crank {
@@ -17,6 +18,12 @@ Controller::Controller(const ControllerConfig& c, const Reference& r, const Para
   // The measurement is at least one step old: f depends on τ, which depends on the measurement.
   const auto steps = std::max<long>(1, std::lround(c.delay / dt));
   history_.assign(std::size_t(steps), 0.0);
+}
+
+void Controller::primeMeasurement(const VecN& q, const VecN& v) {
+  std::fill(history_.begin(), history_.end(), config_.f_des);
+  const Eigen::Vector3d tau = torque(0.0, q.head(3), v.head(3), q[3], v[3]);
+  std::fill(history_.begin(), history_.end(), model_.solve(q, v, VecN(tau)).f[2]);
 }
 
 void Controller::measure(double f_Ty) {

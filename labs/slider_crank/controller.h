@@ -48,6 +48,10 @@ class Controller {
                          double x_c, double v_c);
   // Feed the force of the step just taken; it reaches the controller `delay` later.
   void measure(double f_Ty);
+  // The sensor has been measuring before t = 0 (the lecture's loop starts from a measured force,
+  // not from 0 N): with the force loop at rest (f_meas = f_des), the force the t = 0 torque
+  // produces at the initial state (q, v) fills the delay line.
+  void primeMeasurement(const VecN& q, const VecN& v);
   double measured() const;  // what the force law currently sees
   const Reference& reference() const { return reference_; }
   const ControllerConfig& config() const { return config_; }

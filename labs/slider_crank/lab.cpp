@@ -43,7 +43,9 @@ struct RowState {
 // trace row, and the force sensor, which sees f_Ty of each step `delay` later.
 class Hooks final : public StepHooks {
  public:
-  explicit Hooks(const Settings& s) : s_(s), ctrl_(s.controller, s.reference, s.params, s.step.dt) {}
+  Hooks(const Settings& s, const VecN& q0, const VecN& v0) : s_(s), ctrl_(s.controller, s.reference, s.params, s.step.dt) {
+    ctrl_.primeMeasurement(q0, v0);
+  }
   VecN torque(double t, const VecN& q, const VecN& v) override {
     return ctrl_.torque(t, q.head(3), v.head(3), q[3], v[3]);
   }
@@ -155,7 +157,7 @@ std::unique_ptr<Simulation> SliderCrankLab::simulate(Engine engine) const {
   if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<Mechanism>>(*mech, s_.step, q, v);
   else stepper = std::make_unique<BulletEngine<Planar>>(mech->model(), s_.step.dt, q, v);
   return std::make_unique<MechanismSimulation<Mechanism>>(engine, std::move(mech), std::move(stepper),
-                                                          std::make_unique<Hooks>(s_), kColumns, s_.step.dt, s_.duration);
+                                                          std::make_unique<Hooks>(s_, q, v), kColumns, s_.step.dt, s_.duration);
 }
 
 json SliderCrankLab::metrics(const Trace& tr) const {
