@@ -6,7 +6,8 @@
 //   passive    with passivePatch() (τ = 0) the energy stays within the lab's stated tolerance
 //   columns    the rubric's plot and watchdog columns exist; metrics read only columns that exist
 //   options    every rubric metric exists for every submission option choice (metrics + screening)
-//   grading    every example and every option choice grades to a valid results.json
+//   grading    every example and every option choice grades to a valid results.json; the default
+//              gains score 20–50 % of the points (a weak, stable start)
 //   render     a frame of the scene renders non-blank (OSMesa)
 //   cli        `dynlab figure`, `dynlab grade` (and `dynlab ui` under xvfb-run): exit 0
 #pragma once
@@ -32,6 +33,7 @@ namespace dyn::test {
 struct LabCheckOptions {
   std::string examples_dir;  // default: <source>/labs/<name>/examples
   bool cli = true;           // the dynlab binary knows the lab (false for a test's scratch lab)
+  std::pair<double, double> defaults_band{0.2, 0.5};  // the share of points the default gains score
 };
 
 // The lab's example submissions (sorted paths).
@@ -170,13 +172,28 @@ inline void checkColumnsAndMetrics(const LabEntry& entry, const json& config) {
 }
 
 inline void checkGrading(const LabEntry& entry, const std::string& config_file, const json& config,
-                         const std::vector<std::string>& examples, const cli::TempDir& dir) {
+                         const std::vector<std::string>& examples, const cli::TempDir& dir,
+                         std::pair<double, double> defaults_band) {
   INFO("lab ", entry.name, ": grading");
   GradeOptions o;
   o.config_file = config_file;
   for (const std::string& file : examples) {
     INFO("example ", file);
     checkResults(gradeSubmission(file, o));
+  }
+  // The shipped defaults are a weak, stable start: the exercise is left to the student (20–50 % of
+  // the points; the scratch lab in a test states its own band through the options).
+  {
+    const std::string file = (dir / "defaults.json").string();
+    cli::writeFile(file, defaultSubmission(entry.name, config).dump());
+    const GradeOutcome g = gradeSubmission(file, o);
+    checkResults(g);
+    double max = 0;
+    for (const auto& t : g.results.at("tests")) max += t.at("max_score").get<double>();
+    const double share = g.results.at("score").get<double>() / max;
+    MESSAGE(entry.name, ": the default gains score ", g.results.at("score").get<double>(), " of ", max);
+    CHECK(share >= defaults_band.first);
+    CHECK(share <= defaults_band.second);
   }
   int k = 0;
   for (const json& sub : optionSubmissions(entry.name, config)) {
@@ -238,7 +255,7 @@ inline void checkLab(const LabEntry& entry, const json& config, const LabCheckOp
   checkEngines(entry, config);
   checkPassive(entry, config);
   checkColumnsAndMetrics(entry, config);
-  checkGrading(entry, config_file, config, examples, dir);
+  checkGrading(entry, config_file, config, examples, dir, options.defaults_band);
   checkRender(entry, config);
   if (options.cli) checkCli(entry, config, examples, dir);
 }

@@ -21,7 +21,7 @@ const char* kConfig = R"({
   "initial": {"q": [1.0, -0.5]},
   "simulation": {"dt": 0.001, "duration": 1.0, "integrator": "rk4", "drift": "projection"},
   "controller": {"kind": "pd", "target": [0.3, 0.0]},
-  "gains": {"kp": {"value": 20, "min": 0, "max": 1000, "unit": "N·m/rad", "doc": "joint stiffness"},
+  "gains": {"kp": {"value": 16, "min": 0, "max": 1000, "unit": "N·m/rad", "doc": "joint stiffness"},
             "kd": {"value": 2, "min": 0, "max": 100, "unit": "N·m·s/rad", "doc": "joint damping"}},
   "rubric": {"scenarios": {"nominal": {"about": "as given"},
                            "heavy": {"about": "second link 1 kg", "patch": {"mechanism": {"masses": [1.0, 1.0]}}}},

@@ -47,7 +47,7 @@ TEST_CASE("gains and options come from the lab's JSON, in its order, with bounds
   CHECK(g[0].max == 20000.0);
   CHECK(g[0].unit == "N/m");
   CHECK(g[0].doc == "slider position stiffness");
-  CHECK(s.gain("kp_x") == 400.0);
+  CHECK(s.gain("kp_x") == 80.0);
   REQUIRE(s.optionSpecs().size() == 1);
   CHECK(s.optionSpecs()[0].name == "force_law");
   CHECK(s.optionSpecs()[0].choices == std::vector<std::string>{"open_loop", "proportional", "integral"});
@@ -78,7 +78,7 @@ TEST_CASE("--set NAME=VALUE: gains within bounds, declared options, one clear li
   CHECK(s.gain("kp_x") == 500.0);
   CHECK(s.option("force_law") == "proportional");
   s.resetToLabDefaults();
-  CHECK(s.gain("kp_x") == 400.0);
+  CHECK(s.gain("kp_x") == 80.0);
   CHECK(s.option("force_law") == "integral");
 }
 
