@@ -9,7 +9,8 @@
 //   grading    every example and every option choice grades to a valid results.json; the default
 //              gains score 20–50 % of the points (a weak, stable start)
 //   render     a frame of the scene renders non-blank (OSMesa)
-//   cli        `dynlab figure`, `dynlab grade` (and `dynlab ui` under xvfb-run): exit 0
+//   cli        `dynlab run` (the demo: both engines, whole run), `dynlab figure`, `dynlab grade` (and
+//              `dynlab ui` under xvfb-run): exit 0
 #pragma once
 #include <doctest/doctest.h>
 
@@ -236,6 +237,10 @@ inline void checkCli(const LabEntry& entry, const json& config, const std::vecto
   INFO(r.out, r.err);
   CHECK(r.code == 0);
   CHECK(std::filesystem::exists(dir / "figures" / ("plot_" + columns[1] + "+" + columns[2] + ".png")));
+  // What scripts/demo runs: the default config, both engines, its whole duration, under the
+  // rubric's watchdog (which both engines must pass with the shipped gains).
+  r = cli::dynlab(dir, "run " + entry.name + " --out run");
+  CHECK_MESSAGE(r.code == 0, r.out << r.err);
   REQUIRE_FALSE(examples.empty());
   r = cli::dynlab(dir, "grade " + cli::quote(examples.front()) + " --out grade");
   CHECK(r.code == 0);
