@@ -37,7 +37,9 @@ std::string describeAgreement(const Lab& lab, const json& agreement) {
   char buf[48];
   for (const auto& [key, v] : agreement.items()) {
     if (!v.is_number()) continue;
-    std::snprintf(buf, sizeof buf, "%.3g", v.get<double>());
+    // A count (rows compared) as a whole number, a measure of disagreement to 3 significant digits.
+    if (v.is_number_integer() || v.is_number_unsigned()) std::snprintf(buf, sizeof buf, "%lld", v.get<long long>());
+    else std::snprintf(buf, sizeof buf, "%.3g", v.get<double>());
     const std::string unit = lab.agreementUnit(key);
     s += (s.empty() ? "" : ", ") + key + " = " + buf + (unit.empty() ? "" : " " + unit);
   }
