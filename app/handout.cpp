@@ -2,9 +2,6 @@
 // writes (labs/<name>/handout.md: ## Mechanism, ## Exercise, ## Hints) is stitched around sections
 // generated from the lab's JSON at run time — gains, submission, metrics, scenarios, tests,
 // watchdog, leaderboard — so every number in the handout is the grader's own.
-#include <cmark-gfm-core-extensions.h>
-#include <cmark-gfm.h>
-
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +13,7 @@
 #include "app/course.h"
 #include "app/output.h"
 #include "grading/metric_doc.h"
+#include "grading/report.h"
 #include "grading/rubric.h"
 #include "labs/run.h"
 #include "labs/submission.h"
@@ -254,27 +252,11 @@ struct Handout {
   }
 };
 
-// A standalone page: GitHub-flavoured Markdown through cmark-gfm, the style inline, nothing fetched.
+// A standalone page: the report's Markdown-to-HTML (cmark-gfm, safe mode, the style inline, nothing
+// fetched), with room for code blocks and print.
 std::string html(const std::string& markdown, const std::string& title) {
-  cmark_gfm_core_extensions_ensure_registered();
-  cmark_parser* parser = cmark_parser_new(CMARK_OPT_DEFAULT);
-  if (cmark_syntax_extension* table = cmark_find_syntax_extension("table")) cmark_parser_attach_syntax_extension(parser, table);
-  cmark_parser_feed(parser, markdown.data(), markdown.size());
-  cmark_node* doc = cmark_parser_finish(parser);
-  char* body = cmark_render_html(doc, CMARK_OPT_DEFAULT, cmark_parser_get_syntax_extensions(parser));
-  std::string escaped;
-  for (char c : title) escaped += c == '<' ? "&lt;" : c == '>' ? "&gt;" : c == '&' ? "&amp;" : std::string(1, c);
-  std::string page = "<!doctype html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + escaped +
-                     "</title>\n<style>body{font-family:sans-serif;max-width:56em;margin:2em auto;padding:0 1em;"
-                     "line-height:1.5}table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #ccc;"
-                     "padding:.25em .6em;vertical-align:top}code{background:#f3f3f3;padding:0 .2em}pre{background:#f6f6f6;"
-                     "padding:.6em;overflow-x:auto}@media print{pre{white-space:pre-wrap}}</style></head><body>\n";
-  page += body;
-  page += "</body></html>\n";
-  free(body);
-  cmark_node_free(doc);
-  cmark_parser_free(parser);
-  return page;
+  return renderHtml(markdown, title, "td,th{vertical-align:top}pre{background:#f6f6f6;padding:.6em;overflow-x:auto}"
+                                     "@media print{pre{white-space:pre-wrap}}");
 }
 
 }  // namespace

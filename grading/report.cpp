@@ -166,7 +166,7 @@ std::string markdownReport(const GradeReport& r) {
   return md;
 }
 
-std::string renderHtml(const std::string& markdown, const std::string& title) {
+std::string renderHtml(const std::string& markdown, const std::string& title, const std::string& extra_css) {
   // GitHub-flavoured Markdown (tables) through cmark-gfm, safe mode (the default since 0.29; named
   // for older versions): raw HTML and javascript: links are dropped, not passed through.
   cmark_gfm_core_extensions_ensure_registered();
@@ -180,7 +180,7 @@ std::string renderHtml(const std::string& markdown, const std::string& title) {
       "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>" + htmlText(title) + "</title>\n"
       "<style>body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.45}"
       "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:.25em .6em}"
-      "img{max-width:100%}code{background:#f3f3f3;padding:0 .2em}</style></head><body>\n";
+      "img{max-width:100%}code{background:#f3f3f3;padding:0 .2em}" + extra_css + "</style></head><body>\n";
   html += body;
   html += "</body></html>\n";
   free(body);

@@ -44,7 +44,7 @@ json resultsJson(const GradeReport& r);
 std::string terminalReport(const GradeReport& r);
 std::string markdownReport(const GradeReport& r);
 // A standalone page; markdown must already be escaped (grading/escape.h), title is plain text.
-std::string renderHtml(const std::string& markdown, const std::string& title = "dynlab grade");
+std::string renderHtml(const std::string& markdown, const std::string& title = "dynlab grade", const std::string& extra_css = "");
 
 // Writes out_dir/plots/NN-<slug>.png for every test with a plot request and records the path.
 void writeTestPlots(GradeReport& r, const std::map<std::string, ScenarioRun>& runs, const std::string& out_dir);
