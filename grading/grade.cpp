@@ -7,6 +7,7 @@
 #include <map>
 
 #include "grading/escape.h"
+#include "grading/metric_doc.h"
 #include "grading/report.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
@@ -113,11 +114,19 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     }
     rep.fingerprint["trajectory_hash"] = hashHex(trajectories);
 
-    // Score each test on its scenario's metric.
+    // Score each test on its scenario's metric, shown with its unit (the lab's metric_docs, or the
+    // screening's own).
+    const std::map<std::string, MetricDoc> docs = parseMetricDocs(JsonView(base, config_file));
+    const std::vector<LinearLoop> loops = base_lab->linearise();
+    auto unitOf = [&](const std::string& metric) {
+      if (const auto it = docs.find(metric); it != docs.end()) return it->second.unit;
+      const auto doc = screeningMetricDoc(metric, loops);
+      return doc ? doc->unit : std::string();
+    };
     for (std::size_t i = 0; i < rubric.tests.size(); ++i) {
       const RubricTest& t = rubric.tests[i];
       const ScenarioRun& run = runs.at(t.scenario);
-      GradedTest g{t, 0.0, NAN, "", ""};
+      GradedTest g{t, 0.0, NAN, "", "", unitOf(t.metric)};
       if (run.metrics.contains(t.metric)) {
         g.value = run.metrics[t.metric].get<double>();
         g.score = t.points * partialCredit(g.value, t.full, t.zero);

@@ -31,13 +31,21 @@ std::string slug(const std::string& s) {
   return out.substr(0, 40);
 }
 
+// A metric's value with its unit, as feedback shows it ("0.01113 m"; dimensionless: the number). The
+// number is plain digits; the unit (from the lab's JSON) is escaped for where it lands.
+std::string withUnit(double x, const std::string& unit, std::string (*escape)(const std::string&)) {
+  return fmtNumber(x) + (unit.empty() || unit == "1" ? "" : " " + escape(unit));
+}
+std::string mdUnit(double x, const std::string& unit) { return withUnit(x, unit, [](const std::string& u) { return mdText(u); }); }
+std::string termUnit(double x, const std::string& unit) { return withUnit(x, unit, [](const std::string& u) { return termText(u); }); }
+
 // The one-paragraph explanation of a test (Markdown), shared by results.json and report.md.
 std::string testText(const GradeReport& r, const GradedTest& g) {
   const ScenarioSummary& sc = scenarioOf(r, g.test.scenario);
   std::string s = "Scenario **" + mdText(sc.scenario.name) + "** (" + mdText(sc.scenario.about) + "). ";
   if (std::isfinite(g.value)) {
-    s += mdCode(g.test.metric) + " = **" + fmtNumber(g.value) + "**; full credit at " + fmtNumber(g.test.full) +
-         ", zero at " + fmtNumber(g.test.zero) + ".";
+    s += mdCode(g.test.metric) + " = **" + mdUnit(g.value, g.unit) + "**; full credit at " +
+         mdUnit(g.test.full, g.unit) + ", zero at " + mdUnit(g.test.zero, g.unit) + ".";
   } else {
     s += "**No credit:** " + mdText(g.note) + ".";
   }
@@ -116,8 +124,8 @@ std::string terminalReport(const GradeReport& r) {
   std::string s = "Grading " + termText(r.submission) + " (" + termText(r.lab) + ")\n";
   for (const auto& g : r.tests) {
     s += "  " + points(g.score) + "/" + points(g.test.points) + "  " + termText(g.test.name) + " [" + termText(g.test.scenario) + "]: ";
-    s += std::isfinite(g.value) ? termText(g.test.metric) + " = " + fmtNumber(g.value) + " (full " + fmtNumber(g.test.full) +
-                                      ", zero " + fmtNumber(g.test.zero) + ")"
+    s += std::isfinite(g.value) ? termText(g.test.metric) + " = " + termUnit(g.value, g.unit) + " (full " +
+                                      termUnit(g.test.full, g.unit) + ", zero " + termUnit(g.test.zero, g.unit) + ")"
                                 : termText(g.note);
     s += "\n";
   }
@@ -139,8 +147,9 @@ std::string markdownReport(const GradeReport& r) {
   for (std::size_t i = 0; i < r.tests.size(); ++i) {
     const GradedTest& g = r.tests[i];
     md += "| " + std::to_string(i + 1) + " | " + mdText(g.test.name) + " | " + mdText(g.test.scenario) + " | " +
-          mdCode(g.test.metric) + " | " + (std::isfinite(g.value) ? fmtNumber(g.value) : "—") + " | " +
-          fmtNumber(g.test.full) + " | " + fmtNumber(g.test.zero) + " | " + points(g.score) + " / " + points(g.test.points) + " |\n";
+          mdCode(g.test.metric) + " | " + (std::isfinite(g.value) ? mdUnit(g.value, g.unit) : "—") + " | " +
+          mdUnit(g.test.full, g.unit) + " | " + mdUnit(g.test.zero, g.unit) + " | " + points(g.score) + " / " +
+          points(g.test.points) + " |\n";
   }
   md += "\n## Tests\n";
   for (std::size_t i = 0; i < r.tests.size(); ++i) {

@@ -17,6 +17,7 @@ struct GradedTest {
   double value = NAN;  // the measured metric (NaN when the run never produced it)
   std::string note;    // why there is no value
   std::string plot;    // relative path of its plot (plots/NN-name.png), or empty
+  std::string unit;    // the metric's unit (its metric_docs or the screening's: "m", "s"; "1" or empty: none)
 };
 
 struct ScenarioSummary {
