@@ -207,7 +207,8 @@ int figure(const FigureArgs& a) {
     if (a.plots.empty() && a.stills.empty() && plots.empty()) plots = overlayPlots(lab, shown.trace);
 
     Staging staging(out);
-    staging.owns(ownedFigures(out));
+    const std::vector<std::string> earlier = ownedFigures(out);
+    staging.owns(earlier);
     std::vector<std::string> written;
     std::set<std::string> names;
     for (const FigurePlot& p : plots) {
@@ -240,6 +241,12 @@ int figure(const FigureArgs& a) {
     std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n", a.lab.c_str(), lab.duration(), lab.dt(),
                 a.engine.c_str(), status.c_str());
     for (const auto& name : written) std::printf("  %s\n", (out / name).c_str());
+    // An earlier figure run's figures this one did not remake are gone: said, never silent.
+    std::string removed;
+    for (const auto& name : earlier)
+      if (std::find(written.begin(), written.end(), name) == written.end()) removed += (removed.empty() ? "" : ", ") + name;
+    if (!removed.empty())
+      std::printf("  removed the earlier figure run's %s (use another --out to keep figures side by side)\n", termText(removed).c_str());
     return status == "ok" ? 0 : 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());

@@ -186,8 +186,11 @@ TEST_CASE("dynlab figure: a rerun replaces the figures of the earlier one and ke
   REQUIRE(names(dir / "out") == std::vector<std::string>{"plot_x_c.pdf", "still_0.100.png"});
   writeFile(dir / "out/notes.txt", "mine");
   REQUIRE(dynlab(dir, "run slider_crank --out out --duration 0.2 --engine hand").code == 0);
-  REQUIRE(dynlab(dir, "figure slider_crank --out out --duration 0.2 --plot f_Ty --format svg").code == 0);
-  // The earlier figures are gone; the user's file and dynlab run's outputs are not the figure's.
+  const Result r = dynlab(dir, "figure slider_crank --out out --duration 0.2 --plot f_Ty --format svg");
+  REQUIRE(r.code == 0);
+  // The earlier figures are gone, and the command says which; the user's file and dynlab run's
+  // outputs are not the figure's.
+  CHECK(r.out.find("removed the earlier figure run's plot_x_c.pdf, still_0.100.png") != std::string::npos);
   CHECK(names(dir / "out") ==
         std::vector<std::string>{"notes.txt", "plot_f_Ty.svg", "summary.json", "trace_hand.csv"});
 }
