@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "grading/escape.h"
+#include "labs/utf8.h"
 
 namespace dyn::app {
 namespace {
@@ -139,35 +140,6 @@ void results(const json& v) {
       fail(Pointer("/tests") / i / "score", "a number (there is no top-level /score)", "nothing");
 }
 
-// Offset of the first byte that is not well-formed UTF-8 (RFC 3629: no overlongs, surrogates or
-// code points past U+10FFFF), or npos.
-std::size_t badUtf8(const std::string& s) {
-  for (std::size_t i = 0; i < s.size();) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    if (c < 0x80) {
-      ++i;
-      continue;
-    }
-    std::size_t more = 0;
-    unsigned char lo = 0x80, hi = 0xBF;  // the allowed range of the second byte
-    if (c >= 0xC2 && c <= 0xDF) more = 1;
-    else if (c == 0xE0) more = 2, lo = 0xA0;
-    else if (c == 0xED) more = 2, hi = 0x9F;
-    else if (c >= 0xE1 && c <= 0xEF) more = 2;
-    else if (c == 0xF0) more = 3, lo = 0x90;
-    else if (c == 0xF4) more = 3, hi = 0x8F;
-    else if (c >= 0xF1 && c <= 0xF3) more = 3;
-    else return i;
-    if (i + more >= s.size()) return i;
-    for (std::size_t k = 1; k <= more; ++k) {
-      const auto d = static_cast<unsigned char>(s[i + k]);
-      if (d < (k == 1 ? lo : 0x80) || d > (k == 1 ? hi : 0xBF)) return i;
-    }
-    i += more + 1;
-  }
-  return std::string::npos;
-}
-
 // strerror's text, lower-cased to continue a sentence ("no such file or directory").
 std::string errorText(int err) {
   std::string s = std::strerror(err);
@@ -214,7 +186,7 @@ std::string resultsProblem(const std::string& file) {
   std::string bytes, why;
   if (!readRegular(file, bytes, why)) return oneLine(file + ": " + why);
   if (bytes.empty()) return oneLine(file + ": expected a JSON object, got an empty file");
-  if (const std::size_t at = badUtf8(bytes); at != std::string::npos) {
+  if (const std::size_t at = utf8ErrorAt(bytes); at != std::string::npos) {
     char got[64];
     std::snprintf(got, sizeof got, "byte 0x%02x at offset %zu", static_cast<unsigned char>(bytes[at]), at);
     return oneLine(file + ": expected UTF-8 text, got " + got);

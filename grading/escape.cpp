@@ -1,6 +1,8 @@
 // The escaping functions of every output format; see escape.h.
 #include "grading/escape.h"
 
+#include "labs/utf8.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
@@ -95,11 +97,7 @@ bool isAsciiPunct(char c) {
 
 }  // namespace
 
-bool isValidUtf8(std::string_view bytes) {
-  bool ok = true;
-  forEachChar(bytes, [](char32_t, std::string_view) {}, [&](unsigned char) { ok = false; });
-  return ok;
-}
+bool isValidUtf8(std::string_view bytes) { return utf8ErrorAt(bytes) == std::string_view::npos; }
 
 std::string jsonText(std::string_view bytes) {
   if (isValidUtf8(bytes)) return std::string(bytes);
