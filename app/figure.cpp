@@ -221,8 +221,8 @@ int figure(const FigureArgs& a) {
     Progress bar("figures", plots.size() + stills.size());
     std::size_t made = 0;
     for (const FigurePlot& p : plots) {
-      bar.set(made++);
       const std::string name = "plot_" + join(p.columns, "+") + "." + a.format;
+      bar.set(made++);
       if (!names.insert(name).second) continue;
       const std::string title = a.title.empty() ? a.lab + ": " + join(p.columns, ", ") : a.title;
       writePlot(staging.path(name).string(), plotSpec(p, title, hand ? &*hand : nullptr, bullet ? &*bullet : nullptr));
@@ -235,8 +235,8 @@ int figure(const FigureArgs& a) {
       Renderer renderer(*context, options);
       const Trace* ghost = hand && bullet ? &bullet->trace : nullptr;
       for (double t : stills) {
-        bar.set(made++);
         const std::string name = "still_" + fmt("%.3f", t + 0.0) + ".png";  // + 0.0: no "-0.000"
+        bar.set(made++);
         if (!names.insert(name).second) continue;
         const std::size_t row = rowAt(shown.trace, lab.dt(), t);
         const Image image = renderRow(renderer, lab, shown.trace, row, ghost, a.overlay, a.title);
@@ -244,6 +244,7 @@ int figure(const FigureArgs& a) {
         written.push_back(name);
       }
     }
+    bar.set(made);
     bar.done();
     staging.commit();
 
