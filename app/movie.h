@@ -24,7 +24,8 @@ std::vector<std::size_t> frameRows(const Trace& trace, double dt, int fps);
 Image renderRow(Renderer& renderer, const Lab& lab, const Trace& trace, std::size_t row, const Trace* ghost,
                 bool overlay = true, const std::string& title = "");
 
-// Renders the run; writes video.mp4 and/or frames/NNNNN.png into dir. Returns the frame count.
+// Renders the run; writes video.mp4 and/or frames/NNNNN.png (PngEncoding::Fast) into dir, with a
+// progress bar on a terminal (app/progress.h). Returns the frame count.
 int renderRun(const Lab& lab, const Trace& trace, const Trace* ghost, const MovieOptions& options,
               const std::filesystem::path& dir);
 
