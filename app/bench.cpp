@@ -88,7 +88,7 @@ Fps frameRates(const Lab& lab, const Trace& trace, int frames) {
       lab.scene(trace, row, nullptr, scene);
       lab.overlay(trace, row, overlay);
       const Image image = renderer.render(scene, &overlay);
-      if (mode == 1) writePng((dir / "bench.png").string(), image);
+      if (mode == 1) writePng((dir / "bench.png").string(), image, nullptr, PngEncoding::Fast);  // as run --frames writes them
       if (video) video->addFrame(image);
     }
     if (video) video->close();

@@ -13,6 +13,7 @@
 #include "app/commands.h"
 #include "app/movie.h"
 #include "app/output.h"
+#include "app/progress.h"
 #include "grading/escape.h"
 #include "grading/plot.h"
 #include "grading/rubric.h"
@@ -199,9 +200,15 @@ int figure(const FigureArgs& a) {
   const Lab& lab = *loaded.lab;
   const fs::path out = a.out.empty() ? fs::path("out") / a.lab / "figures" : fs::path(a.out);
   try {
+    // A bar on a terminal for each stage (nothing otherwise): the runs, then the figures.
+    auto run = [&](Engine engine) {
+      Progress bar(std::string("simulating ") + (engine == Engine::Hand ? "hand" : "Bullet"),
+                   std::size_t(std::max(1L, std::lround(lab.duration() / lab.dt()))));
+      return runEngine(lab, engine, -1, [&](long steps) { bar.set(std::size_t(steps)); });
+    };
     std::optional<RunResult> hand, bullet;
-    if (a.engine != "bullet") hand = runEngine(lab, Engine::Hand);
-    if (a.engine != "hand") bullet = runEngine(lab, Engine::Bullet);
+    if (a.engine != "bullet") hand = run(Engine::Hand);
+    if (a.engine != "hand") bullet = run(Engine::Bullet);
     const RunResult& shown = hand ? *hand : *bullet;
 
     if (a.plots.empty() && a.stills.empty() && plots.empty()) plots = overlayPlots(lab, shown.trace);
@@ -211,8 +218,11 @@ int figure(const FigureArgs& a) {
     staging.owns(earlier);
     std::vector<std::string> written;
     std::set<std::string> names;
+    Progress bar("figures", plots.size() + stills.size());
+    std::size_t made = 0;
     for (const FigurePlot& p : plots) {
       const std::string name = "plot_" + join(p.columns, "+") + "." + a.format;
+      bar.set(made++);
       if (!names.insert(name).second) continue;
       const std::string title = a.title.empty() ? a.lab + ": " + join(p.columns, ", ") : a.title;
       writePlot(staging.path(name).string(), plotSpec(p, title, hand ? &*hand : nullptr, bullet ? &*bullet : nullptr));
@@ -226,6 +236,7 @@ int figure(const FigureArgs& a) {
       const Trace* ghost = hand && bullet ? &bullet->trace : nullptr;
       for (double t : stills) {
         const std::string name = "still_" + fmt("%.3f", t + 0.0) + ".png";  // + 0.0: no "-0.000"
+        bar.set(made++);
         if (!names.insert(name).second) continue;
         const std::size_t row = rowAt(shown.trace, lab.dt(), t);
         const Image image = renderRow(renderer, lab, shown.trace, row, ghost, a.overlay, a.title);
@@ -233,6 +244,8 @@ int figure(const FigureArgs& a) {
         written.push_back(name);
       }
     }
+    bar.set(made);
+    bar.done();
     staging.commit();
 
     std::string status = "ok";

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "app/progress.h"
 #include "render/video.h"
 
 namespace dyn::app {
@@ -44,15 +45,19 @@ int renderRun(const Lab& lab, const Trace& trace, const Trace* ghost, const Movi
   if (o.video) video = std::make_unique<VideoWriter>((dir / "video.mp4").string(), o.width, o.height, o.fps);
   if (o.frames) std::filesystem::create_directories(dir / "frames");
   int n = 0;
-  for (std::size_t row : frameRows(trace, lab.dt(), o.fps)) {
+  const std::vector<std::size_t> rows = frameRows(trace, lab.dt(), o.fps);
+  // A bar on a terminal (nothing otherwise): a 20 s run is 600 frames.
+  Progress progress(o.video && o.frames ? "video and frames" : o.video ? "video" : "frames", rows.size());
+  for (std::size_t row : rows) {
     const Image image = renderRow(renderer, lab, trace, row, ghost);
     if (video) video->addFrame(image);
     if (o.frames) {
       char name[32];
       std::snprintf(name, sizeof name, "%05d.png", n);
-      if (std::string why; !writePng((dir / "frames" / name).string(), image, &why)) throw std::runtime_error(why);
+      if (std::string why; !writePng((dir / "frames" / name).string(), image, &why, PngEncoding::Fast))
+        throw std::runtime_error(why);
     }
-    ++n;
+    progress.set(std::size_t(++n));
   }
   if (video) video->close();
   return n;

@@ -43,7 +43,7 @@ LoadedLab loadLab(const std::string& name, const std::string& config_file, const
   return out;
 }
 
-RunResult runEngine(const Lab& lab, Engine engine, long max_steps) {
+RunResult runEngine(const Lab& lab, Engine engine, long max_steps, const std::function<void(long)>& on_steps) {
   RunResult r;
   r.trace.columns = lab.columns();
   auto sim = lab.simulate(engine);
@@ -51,7 +51,12 @@ RunResult runEngine(const Lab& lab, Engine engine, long max_steps) {
   double rows = lab.duration() / lab.dt() + 1;
   if (max_steps >= 0) rows = std::min(rows, double(max_steps) + 1);
   r.trace.data.reserve(std::size_t(rows) * r.trace.columns.size());
-  for (long k = 0; (max_steps < 0 || k < max_steps) && sim->step(row); ++k) r.trace.append(row);
+  long k = 0;
+  for (; (max_steps < 0 || k < max_steps) && sim->step(row); ++k) {
+    r.trace.append(row);
+    if (on_steps && (k & 1023) == 1023) on_steps(k + 1);
+  }
+  if (on_steps) on_steps(k);
   r.failure = sim->failure();
   return r;
 }

@@ -1,6 +1,7 @@
 // Running a lab: build it from a config file (+ gains), and run one engine into a Trace.
 // Shared by the CLI, the grader, the benchmark and the tests.
 #pragma once
+#include <functional>
 #include <optional>
 
 #include "labs/lab.h"
@@ -25,6 +26,9 @@ struct RunResult {
   Trace trace;
   std::string failure;  // empty when the run reached its duration
 };
-RunResult runEngine(const Lab& lab, Engine engine, long max_steps = -1);
+// Runs one engine to the lab's duration (or max_steps). on_steps, when given, hears the steps done
+// so far every 1024 steps and once at the end (a progress bar's hook; it must not throw).
+RunResult runEngine(const Lab& lab, Engine engine, long max_steps = -1,
+                    const std::function<void(long steps)>& on_steps = {});
 
 }  // namespace dyn

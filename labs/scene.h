@@ -131,6 +131,18 @@ struct Camera {
                  double aspect, double margin = 1.1);
 };
 
+// How a frame is laid out. With fit, the renderer places the camera itself, so no lab lays out
+// a frame by hand: it keeps the camera's view direction (eye − target), up and projection (ortho,
+// or fov_y_deg), and fits `bounds` (empty: the box of every primitive, render/framing.h) into the
+// part of the frame the overlay panel leaves free (the whole frame without a panel), with `margin`
+// spare (1.08: 4 % on each side). A lab sets bounds to the space its mechanism moves through over
+// the run, so the camera holds still from frame to frame.
+struct Framing {
+  bool fit = false;
+  Eigen::AlignedBox3d bounds;  // default-constructed: empty
+  double margin = 1.08;
+};
+
 // Everything a frame shows. Opaque things are drawn first, then polylines, then everything with
 // alpha < 1 (back to front, each translucent shape blended once over what is behind it).
 struct Scene {
@@ -145,6 +157,7 @@ struct Scene {
   std::vector<Plane> planes;
   std::vector<Cone> cones;
   std::vector<Spring> springs;
+  Framing framing;  // fit: the renderer chooses the camera (see Framing)
 };
 
 // ---- Pure helpers for labs (no GL) ----------------------------------------------------------

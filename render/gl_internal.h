@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "labs/scene.h"
+#include "render/framing.h"
 
 struct ImGuiContext;  // Dear ImGui (global namespace)
 
@@ -93,8 +94,9 @@ struct DrawList {
   std::vector<DrawItem> items;
   std::vector<Polyline> grid_lines;
 };
-// Fills `out` (cleared first) for a frame of width x height.
-void collectDrawList(const Scene& scene, const Meshes& meshes, int width, int height, DrawList& out);
+// Fills `out` (cleared first) for a frame of width x height seen through `camera`.
+void collectDrawList(const Scene& scene, const Camera& camera, const Meshes& meshes, int width, int height,
+                     DrawList& out);
 
 // ---- overlay.cpp --------------------------------------------------------------------------
 
@@ -105,12 +107,16 @@ class OverlayPanel {
   ~OverlayPanel();
   OverlayPanel(const OverlayPanel&) = delete;
   OverlayPanel& operator=(const OverlayPanel&) = delete;
-  // Draws into the currently bound framebuffer.
-  void draw(const Overlay& overlay);
+  // Lays the panel out for this overlay and returns where it goes (pixels, from the top left);
+  // render() then draws that layout into the currently bound framebuffer.
+  PixelRect layout(const Overlay& overlay);
+  void render();
+  void draw(const Overlay& overlay);  // layout + render
 
  private:
   void buildFrame(const Overlay& overlay);
   ::ImGuiContext* context_ = nullptr;
+  PixelRect rect_;
   float scale_ = 1.0f;  // whole multiples of the 640×480 layout, so the pixel font stays crisp
 };
 

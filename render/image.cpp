@@ -5,13 +5,14 @@
 
 #include <cstdio>
 #include <exception>
+#include <mutex>
 
 #include "labs/file_write.h"
 #include "render/image.h"
 
 namespace dyn {
 
-bool writePng(const std::string& path, const Image& image, std::string* why) {
+bool writePng(const std::string& path, const Image& image, std::string* why, PngEncoding encoding) {
   const auto failed = [&](const std::string& reason) {
     if (why) *why = reason;
     return false;
@@ -23,8 +24,19 @@ bool writePng(const std::string& path, const Image& image, std::string* why) {
   const auto append = [](void* context, void* data, int size) {
     static_cast<std::string*>(context)->append(static_cast<const char*>(data), std::size_t(size));
   };
-  if (!stbi_write_png_to_func(append, &png, image.width, image.height, 4, image.rgba.data(), image.width * 4))
-    return failed("cannot write " + path + ": PNG encoding failed");
+  bool encoded = false;
+  {
+    // stb's settings are globals: set for this image and put back, one image at a time. Fast:
+    // stb's lowest compression level (it raises anything under 5 to 5) and no per-row filter
+    // search (filter 0; on flat rendered frames it is no larger than the best filter per row).
+    static std::mutex mutex;
+    const std::lock_guard<std::mutex> lock(mutex);
+    const int level = stbi_write_png_compression_level, filter = stbi_write_force_png_filter;
+    if (encoding == PngEncoding::Fast) stbi_write_png_compression_level = 5, stbi_write_force_png_filter = 0;
+    encoded = stbi_write_png_to_func(append, &png, image.width, image.height, 4, image.rgba.data(), image.width * 4) != 0;
+    stbi_write_png_compression_level = level, stbi_write_force_png_filter = filter;
+  }
+  if (!encoded) return failed("cannot write " + path + ": PNG encoding failed");
   try {
     writeFileChecked(path, png);
   } catch (const std::exception& e) {

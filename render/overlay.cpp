@@ -1,5 +1,5 @@
 // The Dear ImGui overlay: a light panel in the top-left corner with the lab's title, aligned
-// label/value lines and one line plot per series. Deterministic: fixed time step, no inputs,
+// label/value lines and one plot per series, with its y scale (render/plot_widget.h). Deterministic: fixed time step, no inputs,
 // no ini file, and every frame is built twice so auto-sizing never lags or hides the panel.
 #include <imgui.h>
 #include <imgui_impl_opengl3.h>
@@ -11,11 +11,26 @@
 #include <stdexcept>
 
 #include "render/gl_internal.h"
+#include "render/plot_widget.h"
 
 namespace dyn::gl {
 namespace {
 
 ImVec4 toImVec4(const Color& c) { return ImVec4(c.r, c.g, c.b, c.a); }
+
+// The longest start of text (cut between UTF-8 characters) that fits in width with "...".
+std::string elide(const std::string& text, float width) {
+  if (ImGui::CalcTextSize(text.c_str()).x <= width) return text;
+  std::string cut = text;
+  while (!cut.empty()) {
+    // Drop the last character: back to its first byte (not a 10xxxxxx continuation byte).
+    std::size_t n = cut.size() - 1;
+    while (n > 0 && (static_cast<unsigned char>(cut[n]) & 0xC0) == 0x80) --n;
+    cut.resize(n);
+    if (ImGui::CalcTextSize((cut + "...").c_str()).x <= width) break;
+  }
+  return cut + "...";
+}
 
 // A calm light theme that sits on the pale scene background.
 void applyStyle() {
@@ -58,8 +73,9 @@ OverlayPanel::OverlayPanel(int width, int height) {
   io.DisplayFramebufferScale = ImVec2(1, 1);
   io.DeltaTime = 1.0f / 30.0f;  // fixed: output must not depend on wall-clock time
   io.ConfigFlags |= ImGuiConfigFlags_NoMouseCursorChange;
-  // A 1080p still reads like a 480p frame: the panel grows by whole multiples of its 480p size.
-  scale_ = float(std::max(1, int(std::lround(height / 480.0))));
+  // A 1080p still reads like a 480p frame: the panel grows by whole multiples of its 480p size,
+  // the next one from 1.8x the height on (720p keeps the 480p panel and leaves the scene room).
+  scale_ = float(std::max(1, int(std::floor(height / 480.0 + 0.2))));
   ImFontConfig font;
   font.SizePixels = 13.0f * scale_;
   io.Fonts->AddFontDefault(&font);
@@ -93,25 +109,36 @@ void OverlayPanel::buildFrame(const Overlay& overlay) {
     value_w = std::max(value_w, ImGui::CalcTextSize(value.c_str()).x);
   }
   const float gap = 16.0f * scale_;
-  const float title_w = ImGui::CalcTextSize(overlay.title.c_str()).x + 8.0f * scale_;
+  const std::string title = overlay.title.empty() ? std::string("dynlab") : overlay.title;
+  const float title_w = ImGui::CalcTextSize(title.c_str()).x + 8.0f * scale_;
   const float plot_w = 240.0f * scale_, plot_h = 48.0f * scale_;
-  float content_w = std::max({label_w + gap + value_w, title_w, 160.0f * scale_});
+  float content_w = std::max(label_w + gap + value_w, 160.0f * scale_);
   if (!overlay.plots.empty()) content_w = std::max(content_w, plot_w);
+  // A long title widens the panel up to 40 % of the frame, never more: the scene needs the rest.
+  const ImVec2 pad = ImGui::GetStyle().WindowPadding;
+  content_w = std::max(content_w, std::min(title_w, 0.4f * ImGui::GetIO().DisplaySize.x - 2 * pad.x));
+  const bool title_fits = title_w <= content_w;
 
   // Fixed place and width; height fits the content (built twice per draw, so never stale).
   ImGui::SetNextWindowPos(ImVec2(10 * scale_, 10 * scale_), ImGuiCond_Always);
-  ImGui::SetNextWindowSize(ImVec2(content_w + 2 * ImGui::GetStyle().WindowPadding.x, 0),
-                           ImGuiCond_Always);
+  ImGui::SetNextWindowSize(ImVec2(content_w + 2 * pad.x, 0), ImGuiCond_Always);
   const ImGuiWindowFlags flags = ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoMove |
                                  ImGuiWindowFlags_NoCollapse | ImGuiWindowFlags_NoSavedSettings |
                                  ImGuiWindowFlags_NoScrollbar | ImGuiWindowFlags_NoInputs |
                                  ImGuiWindowFlags_NoFocusOnAppearing | ImGuiWindowFlags_NoNav;
-  const std::string title = (overlay.title.empty() ? std::string("dynlab") : overlay.title) +
-                            "###dynlab_overlay";
-  // Light title text on the dark title bar (the title is drawn inside Begin).
-  ImGui::PushStyleColor(ImGuiCol_Text, ImVec4(0.97f, 0.98f, 1.0f, 1.0f));
-  ImGui::Begin(title.c_str(), nullptr, flags);
-  ImGui::PopStyleColor();
+  // The window's own label is empty (a title's "##" would mean something to ImGui); the title is
+  // drawn on the bar by hand: whole, or cut short with "..." and then written out in full, wrapped,
+  // as the panel's first line.
+  ImGui::Begin("###dynlab_overlay", nullptr, flags);
+  const std::string bar = title_fits ? title : elide(title, content_w - 8.0f * scale_);
+  const ImVec2 at(ImGui::GetWindowPos().x + ImGui::GetStyle().FramePadding.x, ImGui::GetWindowPos().y + ImGui::GetStyle().FramePadding.y);
+  ImGui::GetForegroundDrawList()->AddText(at, ImGui::GetColorU32(ImVec4(0.97f, 0.98f, 1.0f, 1.0f)), bar.c_str());
+  if (!title_fits) {
+    ImGui::PushTextWrapPos(ImGui::GetCursorPosX() + content_w);
+    ImGui::TextUnformatted(title.c_str());
+    ImGui::PopTextWrapPos();
+    ImGui::Separator();
+  }
 
   // Label/value lines.
   const ImVec4 muted(0.38f, 0.42f, 0.48f, 1.0f);
@@ -122,7 +149,10 @@ void OverlayPanel::buildFrame(const Overlay& overlay) {
   }
   if (!overlay.lines.empty() && !overlay.plots.empty()) ImGui::Separator();
 
-  // One plot per series: coloured name with the latest value, then the curve.
+  // One plot per series: coloured name with the latest value, then the curve (their frames
+  // lined up: one gutter for every y scale).
+  float gutter = 0;
+  for (const Series& s : overlay.plots) gutter = std::max(gutter, plotGutter(s.values));
   for (std::size_t i = 0; i < overlay.plots.size(); ++i) {
     const Series& s = overlay.plots[i];
     ImVec4 color = toImVec4(s.color);
@@ -136,24 +166,32 @@ void OverlayPanel::buildFrame(const Overlay& overlay) {
       ImGui::TextUnformatted(latest);
     }
     ImGui::PushID(int(i));
-    ImGui::PushStyleColor(ImGuiCol_PlotLines, color);
-    ImGui::PushStyleColor(ImGuiCol_PlotLinesHovered, color);
-    ImGui::PlotLines("##plot", s.values.data(), int(s.values.size()), 0, nullptr, FLT_MAX,
-                     FLT_MAX, ImVec2(content_w, plot_h));
-    ImGui::PopStyleColor(2);
+    plotWithScale("##plot", s.values, s.color, content_w, plot_h, scale_, gutter);
     ImGui::PopID();
   }
+  rect_ = {ImGui::GetWindowPos().x, ImGui::GetWindowPos().y, ImGui::GetWindowSize().x, ImGui::GetWindowSize().y};
   ImGui::End();
   ImGui::Render();
 }
 
-void OverlayPanel::draw(const Overlay& overlay) {
+PixelRect OverlayPanel::layout(const Overlay& overlay) {
   const KeepImGuiContext keep;
   ImGui::SetCurrentContext(context_);
-  // First pass settles the auto-fitted height (and un-hides a new window); second is drawn.
+  // First pass settles the auto-fitted height (and un-hides a new window); the second is drawn.
   buildFrame(overlay);
   buildFrame(overlay);
+  return rect_;
+}
+
+void OverlayPanel::render() {
+  const KeepImGuiContext keep;
+  ImGui::SetCurrentContext(context_);
   ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+}
+
+void OverlayPanel::draw(const Overlay& overlay) {
+  layout(overlay);
+  render();
 }
 
 }  // namespace dyn::gl

@@ -35,8 +35,8 @@ Eigen::Matrix4f affine(const Matrix3d& linear, const Vector3d& translation) {
 // Builds the draws of one frame; the helpers append to out.items.
 class Collector {
  public:
-  Collector(const Scene& scene, const Meshes& meshes, int width, int height, DrawList& out)
-      : cam_(scene.camera), basis_(scene.camera.basis()), meshes_(meshes), width_(width),
+  Collector(const Camera& camera, const Meshes& meshes, int width, int height, DrawList& out)
+      : cam_(camera), basis_(camera.basis()), meshes_(meshes), width_(width),
         height_(height), out_(out) {}
 
   void capsule(const Vector3d& p0, const Vector3d& p1, double r, const Color& color) {
@@ -189,10 +189,11 @@ void Meshes::destroy() {
   for (Mesh* mesh : {&cone, &box, &cylinder, &quad}) mesh->destroy();
 }
 
-void collectDrawList(const Scene& scene, const Meshes& meshes, int width, int height, DrawList& out) {
+void collectDrawList(const Scene& scene, const Camera& camera, const Meshes& meshes, int width, int height,
+                     DrawList& out) {
   out.items.clear();
   out.grid_lines.clear();
-  Collector add(scene, meshes, width, height, out);
+  Collector add(camera, meshes, width, height, out);
   for (const auto& c : scene.capsules)
     if (c.radius > 0) add.capsule(c.p0, c.p1, c.radius, c.color);
   for (const auto& s : scene.spheres)

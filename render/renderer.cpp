@@ -1,7 +1,9 @@
-// Renderer: draws a Scene with GL 3.3 core into a 4x multisample framebuffer (opaque meshes with
-// planes pushed back, the planes' grid lines, polylines, then translucent meshes back to front;
-// primitives.cpp turns the scene into mesh draws), adds the Dear ImGui overlay, resolves into
-// a single-sample framebuffer and reads it back top-down.
+// Renderer: lays out the overlay panel and, for a scene that asks (Scene::framing), fits the camera
+// into the rest of the frame (render/framing.h); draws the Scene with GL 3.3 core into a 4x
+// multisample framebuffer (opaque meshes with planes pushed back, the planes' grid lines,
+// polylines, then translucent meshes back to front; primitives.cpp turns the scene into mesh
+// draws), adds the Dear ImGui panel, resolves into a single-sample framebuffer and reads it back
+// top-down.
 #include "render/renderer.h"
 
 #include <Eigen/Geometry>
@@ -39,6 +41,8 @@ struct Renderer::Impl {
   std::unique_ptr<gl::OverlayPanel> overlay;  // created on first use
   gl::DrawList draw_list;                     // reused between frames
   std::vector<LineVertex> line_vertices;
+  Camera camera;                              // the last frame's (fitted) camera
+  PixelRect panel_rect, scene_rect;           // the last frame's panel and the part left free
 
   Impl(GlContext& c, RenderOptions o)
       : context(c), options(o), width(o.width > 0 ? o.width : c.width()),
@@ -179,20 +183,35 @@ struct Renderer::Impl {
     // Alpha stays 1 where the background is opaque.
     glBlendFuncSeparate(GL_SRC_ALPHA, GL_ONE_MINUS_SRC_ALPHA, GL_ONE, GL_ONE_MINUS_SRC_ALPHA);
 
-    const CameraBasis basis = scene.camera.basis();
-    const Eigen::Matrix4f view_proj = viewProjection(scene.camera, width, height).cast<float>();
+    // The panel's layout first: a fitted scene goes in the part of the frame it leaves free.
+    const bool show_panel = options.show_overlay && panel;
+    panel_rect = {};
+    if (show_panel) {
+      if (!overlay) overlay = std::make_unique<gl::OverlayPanel>(width, height);
+      panel_rect = overlay->layout(*panel);
+    }
+    camera = scene.camera;
+    scene_rect = {0, 0, double(width), double(height)};
+    if (scene.framing.fit) {
+      const Eigen::AlignedBox3d box = scene.framing.bounds.isEmpty() ? sceneBounds(scene) : scene.framing.bounds;
+      // As far from the panel as the panel is from the frame's edge.
+      scene_rect = freeRect(width, height, panel_rect, camera, box, panel_rect.x);
+      camera = fitCamera(camera, box, width, height, scene_rect, scene.framing.margin);
+    }
+
+    const CameraBasis basis = camera.basis();
+    const Eigen::Matrix4f view_proj = viewProjection(camera, width, height).cast<float>();
     // Key light from the upper left, in front of the scene; moves with the camera.
     const Vector3d light = (-0.45 * basis.right + 0.65 * basis.up + 0.75 * basis.back).normalized();
     glUseProgram(shaded.id);
     glUniformMatrix4fv(shaded.view_proj, 1, GL_FALSE, view_proj.data());
     glUniform3f(shaded.light_dir, float(light.x()), float(light.y()), float(light.z()));
     glUniform3f(shaded.view_dir, float(basis.back.x()), float(basis.back.y()), float(basis.back.z()));
-    glUniform3f(shaded.eye, float(scene.camera.eye.x()), float(scene.camera.eye.y()),
-                float(scene.camera.eye.z()));
-    glUniform1i(shaded.ortho, scene.camera.ortho ? 1 : 0);
+    glUniform3f(shaded.eye, float(camera.eye.x()), float(camera.eye.y()), float(camera.eye.z()));
+    glUniform1i(shaded.ortho, camera.ortho ? 1 : 0);
 
     // Opaque meshes in scene order.
-    gl::collectDrawList(scene, meshes, width, height, draw_list);
+    gl::collectDrawList(scene, camera, meshes, width, height, draw_list);
     for (const auto& item : draw_list.items)
       if (item.color.a >= 1.0f) drawItem(item);
     // Grid lines on the planes: depth-tested but not written, so paths on a plane cover them.
@@ -236,11 +255,10 @@ struct Renderer::Impl {
 
     // The panel on top, after the resolve: ImGui anti-aliases itself, so it skips the 4x
     // samples (its own GL state is restored by the backend).
-    if (options.show_overlay && panel) {
+    if (show_panel) {
       glBindFramebuffer(GL_FRAMEBUFFER, resolve_fbo);
       glDisable(GL_DEPTH_TEST);
-      if (!overlay) overlay = std::make_unique<gl::OverlayPanel>(width, height);
-      overlay->draw(*panel);
+      overlay->render();
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
   }
@@ -281,6 +299,12 @@ void Renderer::present(int x, int y, int target_height) const {
 }
 
 void Renderer::finish() { glFinish(); }
+
+const Camera& Renderer::camera() const { return impl_->camera; }
+
+PixelRect Renderer::panelRect() const { return impl_->panel_rect; }
+
+PixelRect Renderer::sceneRect() const { return impl_->scene_rect; }
 
 int Renderer::width() const { return impl_->width; }
 

@@ -1,9 +1,11 @@
 // Renderer: draws a Scene (labs/scene.h) with a shaded primitive pass, an optional Dear ImGui
-// overlay panel, 4× MSAA, and reads the frame back as an Image.
+// overlay panel, 4× MSAA, and reads the frame back as an Image. A scene that asks to be fitted
+// (Scene::framing) gets its camera placed in the part of the frame the panel leaves free.
 #pragma once
 #include <memory>
 
 #include "labs/scene.h"
+#include "render/framing.h"
 #include "render/gl_context.h"
 #include "render/image.h"
 
@@ -36,6 +38,14 @@ class Renderer {
   // Copies the last frame into the default framebuffer (a window's back buffer), its top-left
   // corner at pixel (x, y) counted from the top of a target_height-tall framebuffer. Exact copy.
   void present(int x, int y, int target_height) const;
+
+  // The last frame's camera: the scene's own, or the one fitted into the free part of the frame
+  // when the scene asks for it (Scene::framing); project() with it finds what was drawn where.
+  const Camera& camera() const;
+  // The last frame's overlay panel (empty without one) and the part of the frame the scene was
+  // fitted into (the whole frame when the scene is not fitted).
+  PixelRect panelRect() const;
+  PixelRect sceneRect() const;
 
   // Waits until the GPU (llvmpipe) has finished the last draw; for timing without read().
   void finish();

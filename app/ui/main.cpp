@@ -30,7 +30,8 @@ struct Args {
   long frames = -1;  // scripted: this many frames, then exit
 };
 
-// Where the scene goes in the window: a 4:3 frame, as large as fits left of the panel.
+// Where the scene goes in the window: all of it left of the panel (the renderer fits the lab's
+// scene into whatever that leaves beside the overlay panel).
 struct Layout {
   int scene_x = 0, scene_y = 0, scene_w = 0, scene_h = 0;  // framebuffer pixels, y from the top
   int panel_x = 0, panel_w = 0;
@@ -40,11 +41,8 @@ Layout layout(int fb_w, int fb_h) {
   Layout l;
   l.panel_w = std::min(std::clamp(int(fb_w * 0.34), 380, 520), fb_w);
   l.panel_x = fb_w - l.panel_w;
-  const int area_w = l.panel_x, area_h = fb_h;
-  l.scene_w = std::min(area_w, area_h * 4 / 3) & ~1;
-  l.scene_h = (l.scene_w * 3 / 4) & ~1;
-  l.scene_x = (area_w - l.scene_w) / 2;
-  l.scene_y = (area_h - l.scene_h) / 2;
+  l.scene_w = l.panel_x & ~1;
+  l.scene_h = fb_h & ~1;
   return l;
 }
 

@@ -6,8 +6,9 @@
 #include <imgui_stdlib.h>
 
 #include <algorithm>
-#include <cfloat>
 #include <cstdio>
+
+#include "render/plot_widget.h"
 
 namespace dyn::ui {
 namespace {
@@ -52,17 +53,6 @@ void changed(TuningSession& session, PanelState& st) {
 void restart(TuningSession& session, PanelState& st) {
   session.restart();
   st.pending_changes = false;
-}
-
-// Lab::metrics of the run so far: every 100 rows while running, once more when it ends.
-void refreshMetrics(const TuningSession& session, PanelState& st) {
-  const bool fin = session.finished();
-  const std::size_t row = session.row();
-  const bool fresh = row >= st.metrics_row && st.metrics_final == fin && (fin ? row == st.metrics_row : row < st.metrics_row + 100);
-  if (fresh && !st.metrics.empty()) return;
-  st.metrics = session.metrics();
-  st.metrics_row = row;
-  st.metrics_final = fin;
 }
 
 void runSection(TuningSession& session, PanelState& st) {
@@ -169,14 +159,6 @@ void gainsSection(TuningSession& session, PanelState& st) {
   }
 }
 
-void plot(const char* id, const std::vector<float>& values, ImVec4 color, float height) {
-  ImGui::PushStyleColor(ImGuiCol_PlotLines, color);
-  ImGui::PushStyleColor(ImGuiCol_PlotLinesHovered, color);
-  ImGui::PlotLines(id, values.data(), int(values.size()), 0, nullptr, FLT_MAX, FLT_MAX,
-                   ImVec2(ImGui::GetContentRegionAvail().x, height));
-  ImGui::PopStyleColor(2);
-}
-
 void plotsSection(const TuningSession& session, PanelState& st) {
   if (!ImGui::CollapsingHeader("Live plots", ImGuiTreeNodeFlags_DefaultOpen)) return;
   const Lab* lab = session.lab();
@@ -185,18 +167,20 @@ void plotsSection(const TuningSession& session, PanelState& st) {
     return;
   }
   const Trace& tr = session.primary();
-  Overlay o;
-  lab->overlay(tr, session.row(), o);  // the lab's own choice of plots
-  for (std::size_t i = 0; i < o.plots.size(); ++i) {
-    const Series& s = o.plots[i];
-    const ImVec4 color(s.color.r, s.color.g, s.color.b, 1.0f);
-    ImGui::TextColored(color, "%s", s.name.c_str());
+  // The lab's own plots, then the chosen column: every step up to the row on screen.
+  const std::vector<Series> plots = session.livePlots(st.plot_column);
+  const float width = ImGui::GetContentRegionAvail().x;
+  float gutter = 0;
+  for (const Series& s : plots) gutter = std::max(gutter, plotGutter(s.values));
+  for (std::size_t i = 0; i < plots.size(); ++i) {
+    const Series& s = plots[i];
+    ImGui::TextColored(ImVec4(s.color.r, s.color.g, s.color.b, 1.0f), "%s", s.name.c_str());
     if (!s.values.empty()) {
       ImGui::SameLine();
       ImGui::Text("%.4g", double(s.values.back()));
     }
     ImGui::PushID(int(i));
-    plot("##lab_plot", s.values, color, 60);
+    plotWithScale("##plot", s.values, s.color, width, 60, 1.0f, gutter);
     ImGui::PopID();
   }
   // Any column of the trace over the last two seconds.
@@ -209,26 +193,18 @@ void plotsSection(const TuningSession& session, PanelState& st) {
     ImGui::EndCombo();
   }
   tooltip("plot any column of the trace (the same columns as trace_hand.csv)");
-  if (st.plot_column >= 0 && st.plot_column < int(tr.columns.size())) {
-    const std::size_t row = session.row(), window = std::size_t(2.0 / lab->dt());
-    const std::size_t first = row > window ? row - window : 0, stride = std::max<std::size_t>(1, window / 300);
-    std::vector<float> values;
-    for (std::size_t r = first; r <= row; r += stride) values.push_back(float(tr.at(r, st.plot_column)));
-    const std::string unit = lab->unit(tr.columns[st.plot_column]);
-    ImGui::Text("%s = %.6g %s", tr.columns[st.plot_column].c_str(), tr.at(row, st.plot_column), unit.c_str());
-    plot("##column_plot", values, ImVec4(0.25f, 0.35f, 0.60f, 1.0f), 60);
-  }
 }
 
-void metricsSection(const TuningSession& session, PanelState& st) {
+void metricsSection(TuningSession& session) {
   if (!ImGui::CollapsingHeader("Metrics", ImGuiTreeNodeFlags_DefaultOpen)) return;
-  refreshMetrics(session, st);
+  // Recomputed whenever the row on screen changes: the numbers are those of this frame.
+  const json& metrics = session.currentMetrics();
   const char* which = !session.problem().empty() ? "up to the stop (a graded run would score 0)"
-                      : st.metrics_final          ? "final, whole run"
+                      : session.finished()        ? "final, whole run"
                                                   : "running, so far";
   ImGui::TextColored(kMuted, "Lab metrics, %s", which);
-  if (!st.metrics.empty() && ImGui::BeginTable("metrics", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
-    for (const auto& [key, value] : st.metrics.items()) {
+  if (!metrics.empty() && ImGui::BeginTable("metrics", 2, ImGuiTableFlags_RowBg | ImGuiTableFlags_BordersInnerV)) {
+    for (const auto& [key, value] : metrics.items()) {
       ImGui::TableNextRow();
       ImGui::TableSetColumnIndex(0);
       ImGui::TextUnformatted(key.c_str());
@@ -318,7 +294,7 @@ void drawTuningPanel(TuningSession& session, PanelState& st, float x, float widt
   ImGui::Spacing();
   gainsSection(session, st);
   plotsSection(session, st);
-  metricsSection(session, st);
+  metricsSection(session);
   submissionSection(session, st);
   ImGui::PopItemWidth();
   ImGui::End();

@@ -20,9 +20,6 @@ struct PanelState {
   std::string status;              // last save result
   bool status_is_error = false;
   int plot_column = -1;            // extra live plot: a trace column chosen by the student
-  json metrics = json::object();   // cached Lab::metrics of the run so far
-  std::size_t metrics_row = 0;
-  bool metrics_final = false;
 };
 
 // Saves the session's gains to state.save_path and records the outcome in state.status.

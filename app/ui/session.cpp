@@ -187,6 +187,7 @@ void TuningSession::saveSubmission(const std::string& path) const {
 }
 
 void TuningSession::restart() {
+  ++generation_;
   problem_.clear();
   ghost_problem_.clear();
   screen_notes_.clear();
@@ -280,6 +281,38 @@ json TuningSession::metrics() const {
   } catch (const std::exception&) {
     return json::object();
   }
+}
+
+const json& TuningSession::currentMetrics() {
+  const bool fin = finished();
+  if (metrics_cache_.generation != generation_ || metrics_cache_.row != row() || metrics_cache_.finished != fin) {
+    metrics_cache_.value = metrics();
+    metrics_cache_.generation = generation_;
+    metrics_cache_.row = row();
+    metrics_cache_.finished = fin;
+  }
+  return metrics_cache_.value;
+}
+
+std::vector<Series> TuningSession::livePlots(int column) const {
+  std::vector<Series> plots;
+  if (!lab_ || !hasRows()) return plots;
+  const Trace& tr = primary();
+  try {
+    Overlay o;
+    lab_->overlay(tr, row(), o);
+    plots = std::move(o.plots);
+  } catch (const std::exception&) {
+    plots.clear();  // a lab that cannot draw this row shows no plots rather than stopping the window
+  }
+  if (column >= 0 && column < int(tr.columns.size())) {
+    const std::string unit = lab_->unit(tr.columns[std::size_t(column)]);
+    Series s{tr.columns[std::size_t(column)] + (unit.empty() ? "" : " (" + unit + ")"), {}, {0.25f, 0.35f, 0.60f, 1.0f}};
+    const std::size_t window = std::size_t(std::lround(2.0 / lab_->dt()));
+    for (std::size_t r = row() > window ? row() - window : 0; r <= row(); ++r) s.values.push_back(float(tr.at(r, column)));
+    plots.push_back(std::move(s));
+  }
+  return plots;
 }
 
 }  // namespace dyn::ui

@@ -80,6 +80,14 @@ class TuningSession {
 
   // Lab::metrics of the primary trace so far ({} if there are no rows or the lab throws).
   json metrics() const;
+  // The same, cached for the panel: recomputed whenever the shown row or the run changes, so it
+  // always describes the frame on screen (never a frame, or 100 steps, behind).
+  const json& currentMetrics();
+
+  // What the live plots show at the shown row: the lab's overlay series (every step of their
+  // window, the last one the shown row's), then, when column is a trace column, that column over
+  // the last two seconds, every step. At a watchdog stop a plot ends on the value that tripped it.
+  std::vector<Series> livePlots(int column = -1) const;
   // One sentence per linearised loop (grading's screening), computed at restart().
   const std::vector<std::string>& screening() const { return screen_notes_; }
   bool screeningUnstable() const { return screen_unstable_; }
@@ -111,6 +119,13 @@ class TuningSession {
   std::string problem_, ghost_problem_;
   std::vector<std::string> screen_notes_;
   bool screen_unstable_ = false;
+  long generation_ = 0;  // counts restarts: a new run is never mistaken for the cached one
+  struct {
+    long generation = -1;
+    std::size_t row = 0;
+    bool finished = false;
+    json value = json::object();
+  } metrics_cache_;
 };
 
 }  // namespace dyn::ui

@@ -1,5 +1,7 @@
 // What the slider-crank lab shows: rail, slider, the arm, the constraint-force arrow, the
-// reference marker, the Bullet run as a translucent ghost, and the live overlay panel.
+// reference marker, the Bullet run as a translucent ghost, and the live overlay panel. The
+// renderer frames it (Scene::framing) around the space the run moves through.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -29,28 +31,50 @@ std::string fmt(const char* f, double x) {
   return b;
 }
 
+// The space the mechanism moves through over the run (the rows so far, both engines), with the
+// mount, the rail and the force arrow (at most 0.25 m of it: a blow-up's arrow may leave the frame).
+Eigen::AlignedBox3d runBounds(const Mechanism& mech, const Trace& tr, const Trace* ghost, double arrow_scale) {
+  Eigen::AlignedBox3d box;
+  const Eigen::Vector3d pad(0.03, 0.03, 0.03);
+  for (const Trace* t : {&tr, ghost}) {
+    if (!t || t->rows() == 0) continue;
+    const std::size_t stride = std::max<std::size_t>(1, t->rows() / 400);
+    const int fx = t->column("f_Tx"), fy = t->column("f_Ty"), xc = t->column("x_c");
+    auto add = [&](std::size_t r) {
+      for (const auto& p : mech.jointPoints(thetaAt(*t, r))) box.extend(at(p) - pad), box.extend(at(p) + pad);
+      Eigen::Vector3d f(t->at(r, fx), t->at(r, fy), 0);
+      f *= arrow_scale;
+      if (f.norm() > 0.25) f *= 0.25 / f.norm();
+      box.extend(Eigen::Vector3d(t->at(r, xc), 0, 0) + f);
+    };
+    for (std::size_t r = 0; r < t->rows(); r += stride) add(r);
+    add(t->rows() - 1);
+  }
+  return box;
+}
+
 }  // namespace
 
 void SliderCrankLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene& s) const {
   const Mechanism mech(s_.params);
   const auto& L = s_.params.links;
+  // The rail: where x_d(t) goes, 0.2 m more each way, within the slider's reach.
   const double reach = L[0].length + L[1].length + L[2].length;
-  const double x_min = L[1].length + L[2].length - L[0].length - 0.15, x_max = reach + 0.15;
-  // Camera: the whole crank circle and the rail's working range in the right 56 % of the frame's
-  // width, clear of the overlay panel on the left; the circle (and the force arrow below the rail)
-  // in its height. A 4:3 frame is width-bound, a 16:9 one shows the same width a little closer.
-  const double x_lo = std::min(-L[0].length, x_min) - 0.05;
-  const double visible_w = (x_max - x_lo) / 0.56;
+  const double reach_min = L[1].length + L[2].length - L[0].length;
+  const double x_min = std::max(reach_min, s_.reference.x0 + std::min(0.0, s_.reference.amplitude) - 0.2);
+  const double x_max = std::min(reach, s_.reference.x0 + std::max(0.0, s_.reference.amplitude) + 0.2);
+  // Side-on, orthographic; the renderer fits the run's space into the frame beside the panel.
   s.camera.ortho = true;
-  s.camera.half_width = 0.5 * visible_w;
-  s.camera.half_height = L[0].length + 0.35;
-  s.camera.target = {x_max + 0.02 - 0.5 * visible_w, 0.12, 0};
-  s.camera.eye = s.camera.target + Eigen::Vector3d(0, 0, 5);
+  s.camera.eye = {0, 0, 5};
+  s.camera.target = {0, 0, 0};
+  s.framing.fit = true;
+  s.framing.bounds = runBounds(mech, tr, ghost && row < ghost->rows() ? ghost : nullptr, s_.arrow_scale);
 
   // Ground mount and rail.
   s.boxes.push_back({{0, -0.04, -0.02}, {0.05, 0.03, 0.02}, Eigen::Matrix3d::Identity(), kRail});
   s.boxes.push_back({{0.5 * (x_min + x_max), -0.035, -0.03}, {0.5 * (x_max - x_min), 0.008, 0.02},
                      Eigen::Matrix3d::Identity(), kRail});
+  for (const Box& b : {s.boxes[0], s.boxes[1]}) s.framing.bounds.extend(b.center - b.half_extents), s.framing.bounds.extend(b.center + b.half_extents);
   // The Bullet ghost at the same time, behind the arm.
   if (ghost && row < ghost->rows()) drawArm(mech, thetaAt(*ghost, row), kGhost, kGhost, -0.05, s);
   // The arm and the slider.
@@ -58,8 +82,10 @@ void SliderCrankLab::scene(const Trace& tr, std::size_t row, const Trace* ghost,
   drawArm(mech, th, kLink, kJoint, 0.0, s);
   const double x_c = tr.at(row, "x_c");
   s.boxes.push_back({{x_c, 0, -0.01}, {0.045, 0.022, 0.03}, Eigen::Matrix3d::Identity(), kSlider});
-  // Reference marker on the rail.
-  s.spheres.push_back({{tr.at(row, "x_d"), -0.035, 0.02}, 0.012, kRef});
+  // The reference x_d: a green wedge pointing down at the rail from just above the slider, where
+  // neither the slider nor the force arrow (below it) can hide it.
+  s.cones.push_back({{tr.at(row, "x_d"), 0.03, 0.03}, {0, 1, 0}, 0.5, 0.05, kRef});
+  s.framing.bounds.extend(Eigen::Vector3d(tr.at(0, "x_d"), 0.03 + 0.05 + 0.01, 0));
   // The constraint force the arm applies to the slider, (f_Tx, f_Ty).
   const Eigen::Vector3d f(tr.at(row, "f_Tx"), tr.at(row, "f_Ty"), 0);
   if (f.norm() > 1e-9)
@@ -86,12 +112,12 @@ void SliderCrankLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const
              {"delay", fmt("%.0f ms", c.delay * 1e3)},
              {"x_c / x_d", fmt("%.3f", tr.at(row, "x_c")) + " / " + fmt("%.3f m", tr.at(row, "x_d"))},
              {"f_Ty / f_des", fmt("%.2f", tr.at(row, "f_Ty")) + " / " + fmt("%.2f N", tr.at(row, "f_des"))}};
-  // Live plots over the last two seconds.
+  // Live plots over the last two seconds: every step, up to and including this row (a plot never
+  // ends on an older value than the lines above show).
   Series force{"f_Ty (N)", {}, kForce}, err{"x error (mm)", {}, kRef};
-  const std::size_t window = std::size_t(2.0 / s_.step.dt);
+  const std::size_t window = std::size_t(std::lround(2.0 / s_.step.dt));
   const std::size_t first = row > window ? row - window : 0;
-  const std::size_t stride = std::max<std::size_t>(1, window / 200);
-  for (std::size_t r = first; r <= row; r += stride) {
+  for (std::size_t r = first; r <= row; ++r) {
     force.values.push_back(float(tr.at(r, "f_Ty")));
     err.values.push_back(float(1e3 * (tr.at(r, "x_c") - tr.at(r, "x_d"))));
   }

@@ -130,7 +130,17 @@ TEST_CASE("dynlab figure --still: the requested size, the arm and slider where t
   REQUIRE(trace.at(row, "t") == doctest::Approx(t));
   Scene scene;
   loaded.lab->scene(trace, row, nullptr, scene);
-  auto px = [&](const Eigen::Vector3d& w) { return Renderer::project(scene.camera, 960, 540, w); };
+  // The camera the renderer fits the scene with (Scene::framing), without and with the panel.
+  auto fitted = [&](bool panel) {
+    auto context = makeOffscreenContext(960, 540);
+    Renderer renderer(*context, RenderOptions{4, panel});
+    Overlay overlay;
+    loaded.lab->overlay(trace, row, overlay);
+    renderer.draw(scene, &overlay);
+    return renderer.camera();
+  };
+  Camera camera = fitted(false);
+  auto px = [&](const Eigen::Vector3d& w) { return Renderer::project(camera, 960, 540, w); };
   const Color link{0.23f, 0.42f, 0.68f, 1.0f}, slider{0.85f, 0.55f, 0.20f, 1.0f};
   // The first two links: their midpoints are link blue.
   for (int i = 0; i < 2; ++i) {
@@ -148,7 +158,8 @@ TEST_CASE("dynlab figure --still: the requested size, the arm and slider where t
   // ... and where it was at t = 0 it is not.
   CHECK_FALSE(near(png.pixel(px(Eigen::Vector3d(x_c0, 0, 0) + corner)), slider));
 
-  // With the overlay panel (default) the top-left corner shows the panel; the arm is unchanged.
+  // With the overlay panel (default) the top-left corner shows the panel, and the scene is fitted
+  // into the rest of the frame: the slider where that camera puts it.
   REQUIRE(dynlab(dir, "figure slider_crank --out panel --duration 1.5 --engine hand --still 1 --size 960x540").code == 0);
   const Png panel = loadPng(dir / "panel/still_1.000.png");
   REQUIRE(panel.width == 960);
@@ -156,6 +167,7 @@ TEST_CASE("dynlab figure --still: the requested size, the arm and slider where t
   for (int y = 0; y < 100; ++y)
     for (int x = 0; x < 200; ++x) differing += panel.rgba[(std::size_t(y) * 960 + x) * 4] != png.rgba[(std::size_t(y) * 960 + x) * 4];
   CHECK(differing > 1000);
+  camera = fitted(true);
   CHECK(near(panel.pixel(px(Eigen::Vector3d(x_c, 0, 0) + corner)), slider));
 }
 

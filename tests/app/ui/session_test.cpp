@@ -1,8 +1,12 @@
 // app/ui/session (no GL, no display): gains and options as the lab's JSON declares them, --set
 // validation, runs identical to `dynlab run`'s, the grader's watchdog sentence for unstable gains,
-// and "Save gains…" writing a strict, atomic submission that loads back to the same gains.
+// "Save gains…" writing a strict, atomic submission that loads back to the same gains, and what
+// the panel shows of the run: live plots of every step up to the row on screen, and that row's
+// metrics.
 #include <doctest/doctest.h>
 
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
@@ -169,4 +173,60 @@ TEST_CASE("a config the lab rejects becomes a problem to show, not a crash") {
   CHECK_THROWS_AS(TuningSession("slider_crank", file), InputError);
   CHECK_THROWS_AS(TuningSession("no_such_lab"), InputError);
   CHECK_THROWS_AS(parseEngineChoice("warp"), InputError);
+}
+
+TEST_CASE("the live plots hold every step up to the row on screen; at a watchdog stop they end on the tripping value") {
+  TuningSession s("slider_crank", "", kExamples + "unstable_integral.json");
+  const int f_col = s.primary().column("f_Ty");
+  REQUIRE(f_col >= 0);
+  const std::size_t window = std::size_t(std::lround(2.0 / s.lab()->dt()));
+  // Frame by frame as the window plays (1/60 s of 1 ms steps: 16 or 17 steps a frame).
+  int frames = 0;
+  while (!s.finished() && frames < 1000) {
+    s.advance(frames % 3 == 0 ? 16 : 17);
+    ++frames;
+    const Trace& tr = s.primary();
+    const std::size_t row = s.row(), first = row > window ? row - window : 0;
+    const std::vector<Series> plots = s.livePlots(f_col);
+    REQUIRE(plots.size() == 3);  // the lab's two, then the chosen column
+    for (const Series& p : {plots[0], plots[2]}) {
+      INFO("frame ", frames, ", row ", row, ", plot ", p.name);
+      REQUIRE(p.values.size() == row - first + 1);  // one value per step, none skipped
+      for (std::size_t i = 0; i < p.values.size(); i += 7) CHECK(p.values[i] == float(tr.at(first + i, f_col)));
+      CHECK(p.values.back() == float(tr.at(row, f_col)));
+    }
+    CHECK(plots[0].name == "f_Ty (N)");
+    CHECK(plots[2].name == "f_Ty (N)");
+  }
+  // The watchdog stopped it: the plot's last value is the f_Ty the sentence names and the overlay shows.
+  REQUIRE(s.finished());
+  CHECK(s.problem().find("(f_Ty = 537.8)") != std::string::npos);
+  const float last = s.livePlots()[0].values.back();
+  CHECK(last == doctest::Approx(537.8).epsilon(1e-4));
+  Overlay overlay;
+  s.lab()->overlay(s.primary(), s.row(), overlay);
+  char shown[32];
+  std::snprintf(shown, sizeof shown, "%.2f", double(last));
+  bool found = false;
+  for (const auto& [label, value] : overlay.lines) found = found || (label == "f_Ty / f_des" && value.rfind(shown, 0) == 0);
+  CHECK_MESSAGE(found, "the overlay's f_Ty line starts with ", shown);
+}
+
+TEST_CASE("the metrics the panel shows are the row on screen's: recomputed every frame, and after a restart") {
+  TuningSession s("slider_crank");
+  for (int frame = 0; frame < 40; ++frame) {
+    s.advance(17);
+    INFO("frame ", frame, ", row ", s.row());
+    CHECK(s.currentMetrics() == s.metrics());
+    CHECK(s.currentMetrics()["steps"] == s.primary().rows());
+  }
+  // A restart with other gains, advanced to the same row: the new run's metrics, never the cached ones.
+  const std::size_t row = s.row();
+  const json before = s.currentMetrics();
+  s.setGain("kp_x", 400);
+  s.restart();
+  s.advance(long(row));
+  REQUIRE(s.row() == row);
+  CHECK(s.currentMetrics() == s.metrics());
+  CHECK(s.currentMetrics() != before);
 }

@@ -93,14 +93,27 @@ Diff compare(const Png& shot, int x0, int y0, const Image& ref) {
   return d;
 }
 
-Image renderOsmesa(const Lab& lab, const Trace& trace, const Trace* ghost, std::size_t row, int w, int h) {
+// The first `rows` rows of a trace: what the window's session had when it drew a row.
+Trace upTo(const Trace& trace, std::size_t rows) {
+  Trace t = trace;
+  t.data.resize(std::min(rows, trace.rows()) * trace.columns.size());
+  return t;
+}
+
+// The OSMesa frame of a row, from the traces as the window had them then (the lab frames its
+// scene around the run so far); camera, when given, receives the camera the frame was drawn with.
+Image renderOsmesa(const Lab& lab, const Trace& full, const Trace* full_ghost, std::size_t row, int w, int h,
+                   Camera* camera = nullptr) {
+  const Trace trace = upTo(full, row + 1), ghost = full_ghost ? upTo(*full_ghost, row + 1) : Trace{};
   auto context = makeOffscreenContext(w, h);
   Renderer renderer(*context);
   Scene scene;
   Overlay overlay;
-  lab.scene(trace, row, ghost, scene);
+  lab.scene(trace, row, full_ghost ? &ghost : nullptr, scene);
   lab.overlay(trace, row, overlay);
-  return renderer.render(scene, &overlay);
+  Image image = renderer.render(scene, &overlay);
+  if (camera) *camera = renderer.camera();
+  return image;
 }
 
 // Grades a submission with the real dynlab; returns results.json.
@@ -180,7 +193,8 @@ TEST_CASE("the window's scene is the OSMesa render of the state it shows, with t
   REQUIRE(vw >= 320);
   REQUIRE(vx + vw <= shot.width);
   REQUIRE(vy + vh <= shot.height);
-  const Image same = renderOsmesa(*loaded.lab, hand.trace, &bullet.trace, row, vw, vh);
+  Camera camera;
+  const Image same = renderOsmesa(*loaded.lab, hand.trace, &bullet.trace, row, vw, vh, &camera);
   const Diff d = compare(shot, vx, vy, same);
   MESSAGE("window vs OSMesa: " << d.differing << " of " << vw * vh << " pixels differ, largest channel difference " << d.max);
   CHECK(d.differing <= long(vw) * vh / 1000);
@@ -189,20 +203,20 @@ TEST_CASE("the window's scene is the OSMesa render of the state it shows, with t
   CHECK(compare(shot, vx, vy, earlier).differing > 500);
 
   // The arm where the state says: every opaque link's midpoint is link-coloured in the window,
-  // and the slider sits at the state's x_c.
+  // and the slider sits at the state's x_c (seen through the camera the frame was drawn with).
   Scene scene;
   loaded.lab->scene(hand.trace, row, &bullet.trace, scene);
   int links = 0;
   for (const Capsule& c : scene.capsules) {
     if (c.color.a < 1.0f) continue;
-    const Eigen::Vector2d px = Renderer::project(scene.camera, vw, vh, 0.5 * (c.p0 + c.p1));
+    const Eigen::Vector2d px = Renderer::project(camera, vw, vh, 0.5 * (c.p0 + c.p1));
     const std::uint8_t* p = shot.pixel(vx + int(px.x()), vy + int(px.y()));
     INFO("link " << links << " at " << px.transpose() << ": " << int(p[0]) << "," << int(p[1]) << "," << int(p[2]));
     CHECK(int(p[2]) > int(p[0]) + 40);  // blue links (0.23, 0.42, 0.68) on a pale background
     ++links;
   }
   CHECK(links == 3);
-  const Eigen::Vector2d slider = Renderer::project(scene.camera, vw, vh, {state["values"]["x_c"].get<double>(), 0.011, 0.0});
+  const Eigen::Vector2d slider = Renderer::project(camera, vw, vh, {state["values"]["x_c"].get<double>(), 0.011, 0.0});
   const std::uint8_t* p = shot.pixel(vx + int(slider.x()), vy + int(slider.y()));
   INFO("slider pixel " << int(p[0]) << "," << int(p[1]) << "," << int(p[2]));
   CHECK(int(p[0]) > int(p[1]) + 30);  // orange (0.85, 0.55, 0.20)
