@@ -147,7 +147,7 @@ WatchedRun runWatched(const Lab& lab, Engine engine, const Watchdog& wd, Deadlin
   }
   if (out.failure.empty() && !sim->failure().empty()) {
     const double t = tr.rows() ? tr.at(tr.rows() - 1, t_col) : 0.0;
-    stop(t, "unstable: " + sim->failure() + " at t = " + fmtNumber(t) + " s");
+    stop(t, stoppedSentence(sim->failure(), t));
   }
   return out;
 }

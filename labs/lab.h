@@ -34,7 +34,9 @@ class Simulation {
   // Computes the control, fills the trace row for the current time, advances one step.
   // Returns false (and fills nothing) once the run's duration is reached.
   virtual bool step(std::vector<double>& row) = 0;
-  // Non-empty once the run has gone bad (non-finite state, failed projection): a plain sentence.
+  // Non-empty once the run has gone bad (non-finite state, failed projection): a plain sentence,
+  // which stoppedSentence() completes. A lab's own watchdog (a grasp that slipped) writes the whole
+  // sentence itself, starting "stopped: " and naming the time.
   virtual std::string failure() const { return {}; }
   // The engine alone, for `dynlab bench`: advance the state one more step with the control of the
   // last step() held (no controller, no trace row; it uses up one step of the run). False once the
@@ -70,9 +72,12 @@ class Lab {
 
   // The passive check: with passivePatch() applied, the hand engine keeps the "energy" column
   // within |E − E0| ≤ tolerance·|E0| (absolute when E0 = 0) over `duration` s (0: the whole run).
+  // `conservative`: a merge patch applied with passivePatch() for this check, taking out what
+  // dissipates by design (a lab's joint friction), so that E itself must stay put.
   struct PassiveEnergy {
     double tolerance = 1e-6;
     double duration = 0;
+    json conservative = json::object();
   };
   virtual PassiveEnergy passiveEnergy() const { return {}; }
 
@@ -85,6 +90,10 @@ class Lab {
   // a loop without feedback (open loop, zero gains) has a zero numerator and is reported as such.
   virtual std::vector<LinearLoop> linearise() const { return {}; }
 };
+
+// What a run's failure() says in reports: a lab's own "stopped: ..." sentence as it is, anything else
+// as "unstable: <failure> at t = <t> s".
+std::string stoppedSentence(const std::string& failure, double t);
 
 // Builds a lab from its config (already merged with gains); throws InputError on bad input.
 using LabFactory = std::function<std::unique_ptr<Lab>(const JsonView& config)>;

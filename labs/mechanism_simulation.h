@@ -3,9 +3,11 @@
 //   (q, v) at t_k → τ = controller(t_k, q, v) → E(q, v), |φ(q)| by the hand model (both engines alike)
 //   → the engine steps with τ held, giving the constraint forces of the step (hand: eq. (2) solved at the
 //     step's start, the solve its first RK4 stage reuses; Bullet: impulses over the step / dt)
-//   → the lab writes the trace row → work += τ·(θ'_k + θ'_k+1)/2 dt → the controller observes (sensors)
+//   → the lab writes the trace row → work += τ·(θ'_k + θ'_k+1)/2 dt (+ the joint friction's power, by
+//     the trapezoid: what friction dissipates is work done on the mechanism) → the controller observes
 //   → a non-finite state or row ends the run with a plain sentence.
 #pragma once
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -86,7 +88,7 @@ struct StepRecord {
   const VecN& v;                     // (θ', v_c) at t
   const VecN& tau;                   // the torque held over the step
   const std::vector<VecN>& forces;   // each constraint's force over the step
-  double energy, residual, work;     // E(q, v), |φ(q)|∞, ∫ τ·θ' dt up to t
+  double energy, residual, work;     // E(q, v), |φ(q)|∞, ∫ (τ + τ_friction)·θ' dt up to t
 };
 
 // The lab's part of a run: its control law, its trace row, its sensors.
@@ -96,6 +98,12 @@ class StepHooks {
   virtual VecN torque(double t, const VecN& q, const VecN& v) = 0;
   virtual void row(const StepRecord& r, std::vector<double>& out) = 0;
   virtual void observe(const StepRecord& r) { (void)r; }
+  // The lab's own watchdog, after each row: empty while the step is acceptable, else the whole
+  // sentence ("stopped: the grasp slipped at contact 2 at t = 1.24 s (...)"); the run ends there.
+  virtual std::string stop(const StepRecord& r) {
+    (void)r;
+    return {};
+  }
 };
 
 // A run of one engine: the bookkeeping every lab shares. M is the lab's hand mechanism type; it also
@@ -122,13 +130,15 @@ class MechanismSimulation final : public Simulation {
     VecN q1, v1;
     stepper_->state(q1, v1);
     const int n = int(tau_.size());
-    work_ += tau_.dot(0.5 * (v_.head(n) + v1.head(n))) * dt_;
+    work_ += (tau_.dot(0.5 * (v_.head(n) + v1.head(n))) + 0.5 * (frictionPower(v_) + frictionPower(v1))) * dt_;
     hooks_->observe(r);
+    if (failure_.empty())
+      if (std::string why = hooks_->stop(r); !why.empty()) failure_ = std::move(why);
     q_ = std::move(q1);
     v_ = std::move(v1);
-    if (!q_.allFinite() || !v_.allFinite())
+    if (failure_.empty() && (!q_.allFinite() || !v_.allFinite()))
       failure_ = engine_ == Engine::Hand ? "the state became non-finite" : "the Bullet state became non-finite";
-    for (std::size_t c = 0; c < row.size() && c < columns_.size(); ++c)
+    for (std::size_t c = 0; c < row.size() && c < columns_.size() && failure_.empty(); ++c)
       if (!std::isfinite(row[c])) {
         failure_ = columns_[c] + " became non-finite";
         break;
@@ -149,6 +159,17 @@ class MechanismSimulation final : public Simulation {
   M& model() { return *model_; }
 
  private:
+  // The power of the joints' viscous and Coulomb friction at rates v (≤ 0).
+  double frictionPower(const VecN& v) const {
+    double p = 0;
+    const auto& joints = model_->model().joints;
+    for (std::size_t i = 0; i < joints.size(); ++i) {
+      const JointProperties& j = joints[i];
+      const double w = j.coulomb_width > 0 ? j.coulomb_width : 1e-12, qd = v[Eigen::Index(i)];
+      p -= (j.viscous * qd + j.coulomb * std::clamp(qd / w, -1.0, 1.0)) * qd;
+    }
+    return p;
+  }
   void advance(bool with_forces) {
     if (!stepper_->step(tau_, with_forces) && failure_.empty()) failure_ = stepper_->failure();
   }

@@ -1,5 +1,6 @@
 // The lab registry: labs add themselves at static-initialisation time (DYNLAB_REGISTER_LAB).
 #include <algorithm>
+#include <cstdio>
 #include <cstdlib>
 
 #include "labs/lab.h"
@@ -40,6 +41,17 @@ const LabEntry* findLab(const std::string& name) {
 std::string defaultConfigPath(const std::string& name) {
   const char* home = std::getenv("DYNLAB_HOME");
   return std::string(home && *home ? home : DYNLAB_SOURCE_DIR) + "/labs/" + name + "/" + name + ".json";
+}
+
+}  // namespace dyn
+
+namespace dyn {
+
+std::string stoppedSentence(const std::string& failure, double t) {
+  if (failure.rfind("stopped: ", 0) == 0) return failure;
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", t);
+  return "unstable: " + failure + " at t = " + b + " s";
 }
 
 }  // namespace dyn

@@ -41,7 +41,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   void metric(const VecN& q, MatN& W) override;
   bool correction(const VecN& q, const VecN& e, VecN& dx) override;
 
-  // The full solve at a state (τ: n tree torques): α_c, η, f and θ''. Remembered: the integrator's
+  // The full solve at a state (τ: n tree torques, or n + k: then also generalised forces w on the
+  // payload coordinates, an external push: M_c α_c + b_c + G_c = Aᵀ f + w): α_c, η, f and θ''. Remembered: the integrator's
   // next first stage at the same (q, v, τ) reuses it.
   Solution solve(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab = nullptr);
 
@@ -92,6 +93,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
   ConstrainedFactorT<Nj, Nr, Nl> factor_;
   bool factored_ = false;
   VecN phi_;
+  VecN gravity_bc_;    // b_c + G_c of the payloads without external forces (b_c = 0: world axes at the centre of mass)
   VecN staged_q_;      // the configuration of the position stage
   bool have_position_ = false;
   std::vector<double> tree_angle_;  // planar: each placement's fixed rotation angle

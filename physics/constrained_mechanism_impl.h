@@ -49,6 +49,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
         ++col;
       }
   }
+  gravity_bc_ = problem_.bc_Gc;
   problem_.A.setZero(rows_, kk);
   phi_.setZero(rows_);
 }
@@ -135,7 +136,13 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
     const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
   positionStage(q);
   velocityStage(v);
-  problem_.tau = tau;
+  // τ: the tree torques, optionally followed by generalised forces on the payload coordinates
+  // (an external push w on the payload: M_c α_c + b_c + G_c = Aᵀ f + w).
+  if (tau.size() != n() && tau.size() != n() + k())
+    throw std::invalid_argument("ConstrainedMechanism: τ needs n tree torques, or n + k with payload forces");
+  problem_.tau = tau.head(n());
+  if (tau.size() == n() + k()) problem_.bc_Gc = gravity_bc_ - tau.tail(k());
+  else problem_.bc_Gc = gravity_bc_;
   if (stab) problem_.stab = *stab;
   else problem_.stab.resize(0);
   if (!factored_) return solveConstrainedBlockLU(problem_);
@@ -163,7 +170,7 @@ template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::accelerations(const VecN& q, const VecN& v, const VecN& tau,
                                                         const VecN* stab, VecN& a) {
   // The state solve() was last asked about: the same answer (a pure function of q, v, τ).
-  const bool known = !stab && have_last_ && q == last_q_ && v == last_v_ && tau == last_tau_;
+  const bool known = !stab && have_last_ && q == last_q_ && v == last_v_ && tau.size() == last_tau_.size() && tau == last_tau_;
   const Solution s = known ? last_ : evaluate(q, v, tau, stab);
   a.resize(n() + k());
   a.head(n()) = s.qdd;

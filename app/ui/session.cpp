@@ -230,7 +230,7 @@ bool TuningSession::stepRun(Run& run) {
       run.done = true;
       if (!run.sim->failure().empty()) {
         const double t = run.trace.rows() ? run.trace.at(run.trace.rows() - 1, run.trace.column("t")) : 0.0;
-        run.stopped = "unstable: " + run.sim->failure() + " at t = " + fmtNumber(t) + " s";
+        run.stopped = stoppedSentence(run.sim->failure(), t);
       }
       return false;
     }

@@ -24,7 +24,8 @@
 //   with the link accelerations of the step Bullet took: (q_n, v_n) and a = (v_{n+1} − v_n)/dt on
 //   Bullet's own tree (its step is M(q_n)(v_{n+1} − v_n)/dt + h(q_n, v_n) = τ + J_c(q_n)ᵀλ/dt, so
 //   these balances hold to rounding). F_ext, M_ext: constraint impulses / dt on links of S at their
-//   pivots and link torques applied to S (joint torques inside S are internal). f = ±F_PC (+ if C = b).
+//   pivots, link forces (payload pushes) and link torques applied to S (joint torques inside S are
+//   internal). f = ±F_PC (+ if C = b).
 #include "physics/bullet/bullet_mechanism.h"
 
 #include <btBulletDynamicsCommon.h>
@@ -75,6 +76,7 @@ struct BulletMechanism<Planar>::Impl {
   std::vector<LinkMotion> now;                    // link motion at the current state
   std::vector<double> cut_theta;                  // per tree joint: unwrapped angle if cut
   std::vector<double> link_torque;                // link torques applied over the last step
+  std::vector<Vec2> link_force;                   // link forces (at the centre of mass) over the last step
   std::vector<Planar::Vec> force;                 // per description constraint, last step
 
   std::unique_ptr<btDefaultCollisionConfiguration> config;
@@ -104,6 +106,7 @@ struct BulletMechanism<Planar>::Impl {
       if (plan.links[std::size_t(k)].tree_joint >= 0) joint_link[std::size_t(plan.links[std::size_t(k)].tree_joint)] = k;
     force.assign(m.constraints.size(), Planar::Vec::Zero());
     link_torque.assign(plan.links.size(), 0.0);
+    link_force.assign(plan.links.size(), Vec2::Zero());
 
     config = std::make_unique<btDefaultCollisionConfiguration>();
     dispatcher = std::make_unique<btCollisionDispatcher>(config.get());
@@ -272,10 +275,26 @@ struct BulletMechanism<Planar>::Impl {
 
   void step(const VecN& tau_in) {
     const int n = model.treeDof();
-    if (tau_in.size() != n) throw std::invalid_argument("BulletMechanism::step: τ needs one value per tree joint");
+    const int k = model.payloadDof();
+    if (tau_in.size() != n && tau_in.size() != n + k)
+      throw std::invalid_argument("BulletMechanism::step: τ needs one value per tree joint (and optionally per payload coordinate)");
     VecN q, v;
     state(q, v);
     std::fill(link_torque.begin(), link_torque.end(), 0.0);
+    std::fill(link_force.begin(), link_force.end(), Vec2::Zero());
+    // Payload forces w (ψ, x, y on the free coordinates): a torque and a force at the centre of mass.
+    if (tau_in.size() == n + k)
+      for (int p = 0, off = n; p < int(model.payloads.size()); ++p) {
+        const Payload& pl = model.payloads[std::size_t(p)];
+        double w[3] = {0.0, 0.0, 0.0};
+        for (std::size_t c = 0; c < 3; ++c)
+          if (pl.free[c]) w[c] = tau_in[off++];
+        const int l = plan.link_of_payload[std::size_t(p)];
+        body->addLinkTorque(l, btVector3(0, 0, w[0]));
+        body->addLinkForce(l, btVector3(w[1], w[2], 0));
+        link_torque[std::size_t(l)] += w[0];
+        link_force[std::size_t(l)] += Vec2(w[1], w[2]);
+      }
     for (int i = 0; i < n; ++i) {
       double tau = tau_in[i];
       if (!model.joints.empty()) {  // spring, viscous and Coulomb friction from the step's start
@@ -350,7 +369,7 @@ struct BulletMechanism<Planar>::Impl {
       if (!in[k]) continue;
       const PlanLink& l = plan.links[k];
       const LinkMotion& s = start[k];
-      const Vec2 D = l.mass * (s.a - plan.gravity);
+      const Vec2 D = l.mass * (s.a - plan.gravity) - link_force[k];
       F += D;
       M += cross(s.c - p, D) + l.inertia * s.alpha - link_torque[k];
     }

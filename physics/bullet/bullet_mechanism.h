@@ -24,7 +24,9 @@ class BulletMechanism {
   BulletMechanism& operator=(const BulletMechanism&) = delete;
 
   // One fixed step of dt with the tree-joint torques τ held (joint springs and friction of the
-  // description are added as joint torques from the state at the start of the step).
+  // description are added as joint torques from the state at the start of the step). τ may carry
+  // n + k values: then the last k are generalised forces on the payloads' free coordinates (ψ, x, y:
+  // a torque and a world-axes force at the centre of mass), as for ConstrainedMechanism::solve.
   void step(const VecN& tau);
   // The state in the description's coordinates.
   void state(VecN& q, VecN& v) const;

@@ -133,6 +133,7 @@ inline void checkPassive(const LabEntry& entry, const json& config) {
   INFO("lab ", entry.name, ": passive energy");
   json passive = mergePatch(config, passivePatch());
   const Lab::PassiveEnergy stated = buildLab(entry, passive, "passive.json")->passiveEnergy();
+  passive = mergePatch(passive, stated.conservative);
   if (stated.duration > 0) passive["simulation"]["duration"] = stated.duration;
   const auto lab = buildLab(entry, passive, "passive.json");
   const RunResult r = runEngine(*lab, Engine::Hand);

@@ -1,0 +1,75 @@
+// Object-level grasp control (lecture §3 "Multi-finger grasp" and "Closed-chain force control"):
+//   wrench     W = M_c (α_d) + K_p (x_d − x_o) + K_d (v_d − v_o) − M_c g        on (ψ, x, y), world axes
+//              K_p = diag(k_pψ, k_p, k_p), K_d = diag(k_dψ, k_d, k_d), M_c = diag(I_o, m_o, m_o)
+//   contacts   F = G⁺ W + s d                 (G⁺W moves the object; s d ∈ N(G) = N(Aᵀ) squeezes it)
+//   squeeze    s = f_sq + k_if ∫ (f_sq − f_int,meas) dt     (f_int,meas: delayed, noisy contact forces)
+//   torques    τ = G(θ) + Jᵀ F                (J: the fingertips' translational Jacobian)
+// The fingers' own inertia is not compensated: it is what the motion loops and the squeeze loop see as
+// a disturbance (the lecture's "motion-induced force" d of the force loop). Kinds `none` (τ = 0) and
+// `constant` (τ from the JSON) check the mechanism alone.
+#pragma once
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include "labs/grasp/mechanism.h"
+
+namespace dyn::grasp {
+
+enum class ControllerKind { None, Constant, Grasp };
+
+struct Gains {
+  double kp_pos = 0, kd_pos = 0;   // N/m, N·s/m
+  double kp_psi = 0, kd_psi = 0;   // N·m/rad, N·m·s/rad
+  double f_squeeze = 0;            // N, the internal-force set point f_sq
+  double ki_int = 0;               // 1/s, integral gain on the measured internal force
+};
+
+struct ControllerConfig {
+  ControllerKind kind = ControllerKind::None;
+  Gains gains;
+  std::vector<double> torques;     // constant kind: one per joint, N·m
+  double delay = 0;                // s, contact-force measurement delay (at least one step)
+  double noise_std = 0;            // N, per force component (seeded)
+  std::uint64_t seed = 1;
+};
+
+// The object's reference pose (ψ, x, y): lift by `lift` over `lift_time` (a quintic, at rest at both
+// ends), hold, then one period of a sideways swing ±`sideways` with a tilt ±`tilt` that starts and ends
+// at rest: g(u) = (sin u − sin 2u / 2) / (3√3/4), u = 2π (t − t_1) / period, |g| ≤ 1.
+struct Reference {
+  Eigen::Vector3d pose0 = Eigen::Vector3d::Zero();
+  double lift = 0.05, lift_time = 1.0, hold = 0.5;   // m, s, s
+  double sideways = 0.02, tilt = 0.0, period = 2.0;  // m, rad, s
+  // Pose, rate and acceleration at t.
+  void at(double t, Eigen::Vector3d& pose, Eigen::Vector3d& rate, Eigen::Vector3d& accel) const;
+};
+
+class Controller {
+ public:
+  Controller(const ControllerConfig& config, const Reference& reference, const Params& model, double dt);
+  // Joint torques at t from the measured state (q = (θ, ψ, x, y)).
+  VecN torque(double t, const VecN& q, const VecN& v);
+  // The contact forces of the step just taken (on the object, world axes, stacked): they reach the
+  // squeeze law `delay` later.
+  void measure(const VecN& q, const VecN& F);
+  // Before t = 0 the sensor has been measuring the squeeze the t = 0 torques produce at (q, v).
+  void primeMeasurement(const VecN& q, const VecN& v);
+  double measured() const;         // the internal force the squeeze law currently sees
+  double squeeze() const { return squeeze_; }  // s of the last torque
+  const Reference& reference() const { return reference_; }
+  const ControllerConfig& config() const { return config_; }
+
+ private:
+  ControllerConfig config_;
+  Reference reference_;
+  Mechanism model_;
+  double dt_;
+  std::vector<double> history_;    // ring buffer of f_int, newest at head_
+  std::size_t head_ = 0;
+  double integral_ = 0, squeeze_ = 0;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> noise_{0.0, 1.0};
+};
+
+}  // namespace dyn::grasp
