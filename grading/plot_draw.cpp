@@ -260,15 +260,25 @@ void drawSeries(const PlotSeries& s, bool faint, size_t budget, double scale) {
   pllsty(1);
 }
 
+// The first n UTF-8 characters of s, with "…" when it had more.
+std::string clip(const std::string& s, size_t n) {
+  if (glyphs(s) <= n) return s;
+  size_t kept = 0, i = 0;
+  for (; i < s.size(); ++i)
+    if ((static_cast<unsigned char>(s[i]) & 0xC0) != 0x80 && kept++ == n - 1) break;
+  return s.substr(0, i) + "\u2026";
+}
+
 // The legend: spans (hatched boxes), bands (filled boxes), series (line samples), then the
-// markers, in spec order.
+// markers, in spec order. Sizes are estimates in mm for character height ch (PLplot only measures
+// while it draws); texts too long for the page are clipped with "…".
 struct Legend {
   std::vector<std::string> texts;
   std::vector<PLINT> opts, text_colors, box_colors, box_patterns, line_colors, line_styles;
   std::vector<PLFLT> box_scales, box_widths, line_widths;
-  double scale;
+  double scale, ch;
 
-  Legend(const Prepared& p, double scale) : scale(scale) {
+  Legend(const Prepared& p, double scale, double ch, double page_w) : scale(scale), ch(ch) {
     for (const auto& s : p.spec.spans)
       if (!s.label.empty()) add(s.label, PL_LEGEND_COLOR_BOX, kSpan, 3, kInk, 1, scale);
     for (const auto& b : p.spec.bands)
@@ -281,9 +291,12 @@ struct Legend {
     }
     if (!p.spec.vlines.empty() && !p.spec.vline_label.empty())
       add(p.spec.vline_label, PL_LEGEND_LINE, kInk, 0, kMarker, 2, 2.0 * scale);
+    const double room = page_w - 2 * ch - (entryMm() - chars() * kGlyphWidth * ch);
+    const size_t most = static_cast<size_t>(std::max(4.0, room / (kGlyphWidth * ch)));
+    for (auto& t : texts) t = clip(t, most);
   }
   void add(const std::string& text, PLINT opt, PLINT box, PLINT pattern, PLINT line, PLINT style, double width) {
-    texts.push_back(plText(text));
+    texts.push_back(text);
     opts.push_back(opt);
     text_colors.push_back(kInk);
     box_colors.push_back(box);
@@ -295,23 +308,25 @@ struct Legend {
     line_widths.push_back(width);
   }
   bool empty() const { return texts.empty(); }
-  // Estimated sizes in mm for character height ch (PLplot only measures while it draws).
-  double sampleMm(double ch) const { return 4.5 * ch; }
-  double entryMm(double ch) const {
-    size_t chars = 0;
-    for (const auto& t : texts) chars = std::max(chars, glyphs(t));
-    return sampleMm(ch) + 2.5 * ch + chars * kGlyphWidth * ch + 1.5 * ch;
+  size_t chars() const {
+    size_t n = 0;
+    for (const auto& t : texts) n = std::max(n, glyphs(t));
+    return n;
   }
-  double heightMm(double ch, int rows) const { return (2.0 * rows + 0.6) * ch; }
+  double sampleMm() const { return 4.5 * ch; }
+  double entryMm() const { return sampleMm() + 2.5 * ch + chars() * kGlyphWidth * ch + 1.5 * ch; }
+  double heightMm(int rows) const { return (2.0 * rows + 0.6) * ch; }
 
-  // Draws with its top-left corner at (x, y) below/right of the viewport's top-left corner, in
+  // Draws with its top-left corner at (x, y) right of/below the viewport's top-left corner, in
   // fractions of the viewport; returns its size in the same fractions.
-  std::pair<double, double> draw(double x, double y, int rows, int columns, double ch, double viewport_w_mm) const {
+  std::pair<double, double> draw(double x, double y, int rows, int columns, double viewport_w_mm) const {
+    std::vector<std::string> escaped;
+    for (const auto& t : texts) escaped.push_back(plText(t));
     std::vector<const char*> ctext;
-    for (const auto& t : texts) ctext.push_back(t.c_str());
+    for (const auto& t : escaped) ctext.push_back(t.c_str());
     PLFLT w = 0, h = 0;
     pllegend(&w, &h, PL_LEGEND_BACKGROUND | (columns > 1 ? PL_LEGEND_ROW_MAJOR : 0),
-             PL_POSITION_LEFT | PL_POSITION_TOP | PL_POSITION_INSIDE, x, y, sampleMm(ch) / viewport_w_mm, kWhite,
+             PL_POSITION_LEFT | PL_POSITION_TOP | PL_POSITION_INSIDE, x, y, sampleMm() / viewport_w_mm, kWhite,
              kLegendEdge, 1, rows, columns, static_cast<PLINT>(texts.size()), opts.data(), 1.0, 1.0, 2.0, 0.0,
              text_colors.data(), ctext.data(), box_colors.data(), box_patterns.data(), box_scales.data(),
              box_widths.data(), line_colors.data(), line_styles.data(), line_widths.data(), nullptr, nullptr,
@@ -391,19 +406,19 @@ PlotLayout draw(const Prepared& p, int width_px, int height_px) {
 
   // Margins in mm: tick and axis labels left and below, the title on top, the legend right of
   // the frame (narrow) or below the x label (wide, in as many columns as fit).
-  const Legend legend(p, text_scale);
+  const Legend legend(p, text_scale, ch, page_w);
   const double cw = kGlyphWidth * ch, gap = 0.8 * ch;
-  const bool legend_right = !legend.empty() && legend.entryMm(ch) <= kMaxRightLegend * page_w;
+  const bool legend_right = !legend.empty() && legend.entryMm() <= kMaxRightLegend * page_w;
   const double left = 0.6 * ch + (spec.ylabel.empty() ? 0.0 : 2.5 * ch) + ytick_w * cw + 0.8 * ch;
   const double axis_below = (spec.xlabel.empty() ? 0.0 : 1.8 * ch) + 1.8 * ch;  // tick labels and x label
-  const double right = legend_right ? legend.entryMm(ch) + 1.2 * ch : std::max(1.8 * ch, 0.5 * xtick_w * cw + 0.5 * ch);
+  const double right = legend_right ? legend.entryMm() + 1.2 * ch : std::max(1.8 * ch, 0.5 * xtick_w * cw + 0.5 * ch);
   const double frame_w = page_w - right - left;
   int columns = 1, rows = static_cast<int>(legend.texts.size());
   if (!legend.empty() && !legend_right) {
-    columns = std::clamp(static_cast<int>(frame_w / legend.entryMm(ch)), 1, rows);
+    columns = std::clamp(static_cast<int>((page_w - 2 * gap) / legend.entryMm()), 1, rows);
     rows = (rows + columns - 1) / columns;
   }
-  const double legend_below = legend.empty() || legend_right ? 0.0 : gap + legend.heightMm(ch, rows);
+  const double legend_below = legend.empty() || legend_right ? 0.0 : gap + legend.heightMm(rows);
   const double bottom = 0.6 * ch + axis_below + legend_below;
   const double top = spec.title.empty() ? 1.2 * ch : 3.0 * ch;
   plsvpa(left, page_w - right, bottom, page_h - top);
@@ -453,14 +468,13 @@ PlotLayout draw(const Prepared& p, int width_px, int height_px) {
   layout.log_y = p.log_y;
   layout.frame = {left / kMmPerPx, top / kMmPerPx, (page_w - right) / kMmPerPx, (page_h - bottom) / kMmPerPx};
   if (legend.empty()) return layout;
-  // Legend: right of the frame, top-aligned; or below the x label, centred on the frame.
+  // Legend: right of the frame, top-aligned; or below the x label, centred on the page.
   double lx = 1.0 + gap / frame_w, ly = 0.0;
   if (!legend_right) {
-    const double width = std::min(frame_w, columns * legend.entryMm(ch));
-    lx = 0.5 * (1.0 - width / frame_w);
+    lx = (0.5 * (page_w - columns * legend.entryMm()) - left) / frame_w;
     ly = 1.0 + (axis_below + gap) / frame_h;
   }
-  const auto [w, h] = legend.draw(lx, ly, rows, columns, ch, frame_w);
+  const auto [w, h] = legend.draw(lx, ly, rows, columns, frame_w);
   const PlotBox& f = layout.frame;
   const double fw = f.x1 - f.x0, fh = f.y1 - f.y0;
   layout.legend = {f.x0 + lx * fw, f.y0 + ly * fh, f.x0 + (lx + w) * fw, f.y0 + (ly + h) * fh};
