@@ -158,7 +158,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     out.results["extra_data"]["status"] = out.status();
     out.report = terminalReport(rep);
     out.markdown = markdownReport(rep);
-    out.html = renderHtml(markdownReport(rep, true), "dynlab grade: " + lab_name);
+    out.html = reportHtml(rep, out.markdown, "dynlab grade: " + lab_name);
     out.results["execution_time"] =
         std::round(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() * 100) / 100;
     return out;

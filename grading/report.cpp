@@ -157,7 +157,7 @@ std::string terminalReport(const GradeReport& r) {
   return s;
 }
 
-std::string markdownReport(const GradeReport& r, bool inline_images) {
+std::string markdownReport(const GradeReport& r) {
   const std::string file = std::filesystem::path(r.submission).filename().string();
   std::string md = "# dynlab grade: " + mdText(r.lab) + "\n\n";
   md += "Submission " + mdText(file) + ": **" + points(r.score()) + " / " + points(r.maxScore()) + " points**.\n\n";
@@ -176,9 +176,7 @@ std::string markdownReport(const GradeReport& r, bool inline_images) {
     md += "\n### " + std::to_string(i + 1) + ". " + mdText(g.test.name) + " — " + points(g.score) + " / " + points(g.test.points) + "\n\n";
     md += testText(r, g) + "\n";
     // The image is all ours (plots/NN-slug.png, alt text by number): the heading above names it.
-    if (!g.plot.empty())
-      md += "\n![plot of test " + std::to_string(i + 1) + "](" +
-            (inline_images && !g.plot_png.empty() ? pngDataUri(g.plot_png) : g.plot) + ")\n";
+    if (!g.plot.empty()) md += "\n![plot of test " + std::to_string(i + 1) + "](" + g.plot + ")\n";
   }
   md += "\n## Scenarios and gain screening\n\n";
   for (const auto& s : r.scenarios) {
@@ -226,6 +224,19 @@ std::string renderHtml(const std::string& markdown, const std::string& title, co
       "img{max-width:100%}code{background:#f3f3f3;padding:0 .2em}" + extra_css + "</style></head><body>\n";
   html += renderHtmlFragment(markdown);
   html += "</body></html>\n";
+  return html;
+}
+
+std::string reportHtml(const GradeReport& r, const std::string& markdown, const std::string& title) {
+  // cmark renders the links (small), then each becomes its image's bytes: the grader's own file
+  // names (plots/NN-slug.png) need no escaping and appear nowhere else as a src.
+  std::string html = renderHtml(markdown, title);
+  for (const auto& g : r.tests) {
+    if (g.plot.empty() || g.plot_png.empty()) continue;
+    const std::string link = "src=\"" + g.plot + "\"";
+    if (const std::size_t at = html.find(link); at != std::string::npos)
+      html.replace(at, link.size(), "src=\"" + pngDataUri(g.plot_png) + "\"");
+  }
   return html;
 }
 

@@ -63,9 +63,10 @@ constexpr std::size_t kMaxInlinePlotBytes = 600 * 1024;
 
 json resultsJson(const GradeReport& r);
 std::string terminalReport(const GradeReport& r);
-// report.md links each plot (plots/NN-name.png); with inline_images, the plots are data: URIs
-// (the Markdown report.html is rendered from).
-std::string markdownReport(const GradeReport& r, bool inline_images = false);
+// report.md: each plot linked (plots/NN-name.png).
+std::string markdownReport(const GradeReport& r);
+// The HTML of report.md with each plot's link replaced by its bytes (a data: URI): one file.
+std::string reportHtml(const GradeReport& r, const std::string& markdown, const std::string& title);
 // A standalone page; markdown must already be escaped (grading/escape.h), title is plain text.
 std::string renderHtml(const std::string& markdown, const std::string& title = "dynlab grade", const std::string& extra_css = "");
 // The HTML of a Markdown fragment (cmark-gfm, safe mode, tables), without the page around it.
