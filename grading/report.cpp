@@ -71,8 +71,8 @@ std::string inlinePlot(const GradedTest& g, std::size_t i, std::size_t& budget) 
            std::to_string(kMaxInlinePlotBytes / 1024) + " KB of plots.)</em></p>\n";
   budget -= uri.size();
   const auto [w, h] = pngSize(g.plot_png);
-  return kPlotParagraph + "<img alt=\"plot of test " + std::to_string(i + 1) + "\" width=\"" + std::to_string(w) +
-         "\" height=\"" + std::to_string(h) + "\" src=\"" + uri + "\"></p>\n";
+  const std::string size = w && h ? " width=\"" + std::to_string(w) + "\" height=\"" + std::to_string(h) + "\"" : "";
+  return kPlotParagraph + "<img alt=\"plot of test " + std::to_string(i + 1) + "\"" + size + " src=\"" + uri + "\"></p>\n";
 }
 
 }  // namespace

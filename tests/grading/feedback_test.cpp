@@ -316,3 +316,30 @@ TEST_CASE("dynlab grade: the replay hints run as printed, from any folder, and r
   CHECK(changed.out.find("metric x_rms of test 1 (Slider tracks x_d(t)): was 0.02 → now 0.0111") != std::string::npos);
   CHECK(changed.out.find("score was 2.5 → now 2.09") != std::string::npos);
 }
+
+TEST_CASE("inline plots stop at their budget: later ones are named as left out, and replay strips both") {
+  GradeReport r;
+  r.lab = "slider_crank";
+  r.inline_plots = true;
+  ScenarioSummary s;
+  s.scenario.name = "nominal";
+  r.scenarios.push_back(s);
+  for (int i = 0; i < 3; ++i) {
+    GradedTest g;
+    g.test.name = "test " + std::to_string(i);
+    g.test.scenario = "nominal";
+    g.value = 1;
+    g.plot = "plots/0" + std::to_string(i + 1) + "-test.png";
+    g.plot_png = "\x89PNG\r\n\x1a\n" + std::string(kMaxInlinePlotBytes / 3, 'x');  // 4/9 of the budget as base64
+    r.tests.push_back(g);
+  }
+  const json results = resultsJson(r);
+  const auto output = [&](int i) { return results["tests"][i]["output"].get<std::string>(); };
+  CHECK(output(0).find("src=\"data:image/png;base64,iVBORw0KGg") != std::string::npos);
+  CHECK(output(1).find("src=\"data:image/png;base64,") != std::string::npos);
+  CHECK(output(2).find("data:") == std::string::npos);
+  CHECK(output(2).find("left out") != std::string::npos);
+  // Without them, each output is the test's text alone.
+  r.inline_plots = false;
+  CHECK(withoutInlinePlots(results) == resultsJson(r));
+}
