@@ -94,7 +94,7 @@ int dispatch(int argc, char** argv) {
   g->add_option("--time-budget", grade.time_budget, "Wall-time budget per submission (s)")->check(CLI::Range(1.0, 86400.0));
   g->add_flag("!--no-plots", grade.plots, "Skip the response plots (faster)");
   g->add_flag("--inline-plots", grade.inline_plots, "Put each test's plot in results.json as an inline PNG (Gradescope shows "
-                                                    "it to the student; about 30 KB a plot)");
+                                                    "it to the student; 30-100 KB a plot, at most 600 KB in all)");
   g->add_option("--replay", grade.replay, "Re-grade SUBMISSION and check it matches this results.json");
   g->add_option("--batch", grade.batch, "Grade every *.json in this directory, and each folder below it as one student (a Gradescope export); one process each");
   g->add_option("--jobs", grade.jobs, "Submissions graded in parallel with --batch")->check(CLI::Range(1, 256));
