@@ -16,6 +16,7 @@
 #include "app/output.h"
 #include "grading/escape.h"
 #include "grading/grade.h"
+#include "grading/report.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
 #include "labs/run.h"
@@ -152,12 +153,31 @@ static void injectFault(const std::string& submission) {
   if (s.find("throw:" + stem) != std::string::npos) throw std::logic_error("injected fault for " + stem);
 }
 
+// The word that runs this dynlab in a shell: "dynlab" when that is what PATH finds, else its
+// absolute path (a build tree's binary), so a printed command runs as printed.
+static std::string dynlabProgram() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return "dynlab";
+  if (const char* path = std::getenv("PATH")) {
+    const std::string dirs = path;
+    for (std::size_t at = 0; at <= dirs.size();) {
+      const std::size_t end = std::min(dirs.find(':', at), dirs.size());
+      const fs::path candidate = fs::path(dirs.substr(at, end - at)) / "dynlab";
+      if (end > at && fs::equivalent(candidate, self, ec)) return "dynlab";
+      at = end + 1;
+    }
+  }
+  return shellWord(self.string());
+}
+
 static GradeOptions gradeOptions(const GradeArgs& a, const std::string& out_dir) {
   GradeOptions o;
   o.expected_lab = a.lab;
   o.config_file = a.config;
   o.time_budget = a.time_budget;
   if (a.plots) o.out_dir = out_dir;
+  o.inline_plots = a.inline_plots && a.plots;
   return o;
 }
 
@@ -168,7 +188,10 @@ int gradeOne(const GradeArgs& a) {
     // Everything lands in OUT/.staging first; a failure never leaves a half-written results set.
     Staging staging(a.out);
     staging.owns({"results.json", "report.md", "report.html", "plots"});
-    g = gradeSubmission(a.submission, gradeOptions(a, staging.path("").string()));
+    GradeOptions o = gradeOptions(a, staging.path("").string());
+    o.replay_program = dynlabProgram();
+    o.results_file = (fs::path(a.out) / "results.json").string();
+    g = gradeSubmission(a.submission, o);
     // An internal error's plots may be partial: none are published (the old ones are removed).
     if (g.internal_error) fs::remove_all(staging.path("plots"));
     staging.write("results.json", dumpJson(g.results, 2) + "\n");
@@ -188,10 +211,35 @@ int gradeOne(const GradeArgs& a) {
   std::fputs(g.report.c_str(), stdout);
   std::printf("results: %s\nreport:  %s\n", termText((fs::path(a.out) / "results.json").string()).c_str(),
               termText((fs::path(a.out) / "report.html").string()).c_str());
+  if (!g.input_error && !g.internal_error)
+    std::printf("replay:  %s\n", termText(replayCommand(dynlabProgram(), (fs::path(a.out) / "results.json").string(),
+                                                         a.submission, gradeOptions(a, ""))).c_str());
   // A grade the time budget cut short is written (score 0 for what it stopped) but is not a grade.
   if (g.out_of_time) std::fprintf(stderr, "error: %s: the grading time budget of %g s ran out; the grade is incomplete\n",
                                   utf8Quotable(a.submission).c_str(), a.time_budget);
   return g.input_error ? 2 : g.internal_error ? 3 : g.out_of_time ? 4 : 0;
+}
+
+// "metric x_rms of test 1 (Slider tracks x_d(t)): was 0.01113 → now 0.012; score was 2.1 → now 2"
+// for every test whose metric value or score differs between two results.json.
+static std::vector<std::string> metricChanges(const json& expected, const json& actual) {
+  std::vector<std::string> out;
+  const auto tests = [](const json& r) { return r.contains("tests") && r["tests"].is_array() ? r["tests"] : json::array(); };
+  const json a = tests(expected), b = tests(actual);
+  const auto field = [](const json& t, const char* key) {
+    return t.is_object() && t.contains("extra_data") && t["extra_data"].is_object() ? t["extra_data"].value(key, json()) : json();
+  };
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    const json was = field(a[i], "value"), now = field(b[i], "value");
+    const json was_score = a[i].is_object() ? a[i].value("score", json()) : json(), now_score = b[i].value("score", json());
+    if (was == now && was_score == now_score) continue;
+    const json metric = field(b[i], "metric");
+    std::string line = "metric " + (metric.is_string() ? metric.get<std::string>() : "?") + " of test " + std::to_string(i + 1) + " (" +
+                       b[i].value("name", std::string()) + "): was " + dumpJson(was) + " → now " + dumpJson(now);
+    if (was_score != now_score) line += "; score was " + dumpJson(was_score) + " → now " + dumpJson(now_score);
+    out.push_back(line);
+  }
+  return out;
 }
 
 int gradeReplay(const GradeArgs& a) {
@@ -208,11 +256,12 @@ int gradeReplay(const GradeArgs& a) {
   quiet.plots = false;
   const GradeOutcome g = gradeSubmission(a.submission, gradeOptions(quiet, ""));
   json actual = g.results;
-  // Plot paths are only present when plots were written; they are not part of the grade.
+  // Plot paths and inline plots are only present when plots were drawn; they are not the grade.
+  expected = withoutInlinePlots(expected);
   for (json* r : {&expected, &actual})
-    if (r->contains("tests"))
+    if (r->contains("tests") && (*r)["tests"].is_array())
       for (auto& t : (*r)["tests"])
-        if (t.contains("extra_data")) t["extra_data"].erase("plot");
+        if (t.is_object() && t.contains("extra_data") && t["extra_data"].is_object()) t["extra_data"].erase("plot");
   const auto diff = compareResults(expected, actual);
   if (diff.empty()) {
     std::printf("replay: match (score %s, trajectory hash %s)\n", dumpJson(actual["score"]).c_str(),
@@ -220,7 +269,10 @@ int gradeReplay(const GradeArgs& a) {
     return 0;
   }
   std::printf("replay: MISMATCH, %zu difference(s):\n", diff.size());
+  // Each metric first (was → now, with its test), then the differences as JSON paths.
+  for (const auto& line : metricChanges(expected, actual)) std::printf("  %s\n", termText(line).c_str());
   for (std::size_t i = 0; i < diff.size() && i < 20; ++i) std::printf("  %s\n", termText(diff[i]).c_str());
+  if (diff.size() > 20) std::printf("  ... and %zu more\n", diff.size() - 20);
   return 1;
 }
 

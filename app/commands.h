@@ -22,6 +22,7 @@ struct GradeArgs {
   std::string submission, out = "out/grade", lab, config, replay, batch;
   double time_budget = 300;  // s of wall time per submission
   bool plots = true;
+  bool inline_plots = false;  // each test's plot inline in results.json (the Gradescope autograder)
   int jobs = 1;
 };
 
@@ -31,7 +32,10 @@ struct UiArgs {
 };
 
 struct FigureArgs {
-  std::string lab, config, gains, out, engine = "both", format = "pdf", size = "1920x1080", title;
+  std::string lab, config, gains, out, engine = "both", format = "pdf", title;
+  std::string size;              // WxH of stills and plots (empty: 1920x1080 stills, 800x450 plots)
+  std::string y_scale = "auto";  // plots: auto (log when the data span decades), linear or log
+  double font_scale = 1.0;       // plots' text size
   std::vector<std::string> plots;  // each "col,col,...": one plot
   std::vector<double> stills;      // simulated times (s)
   std::optional<double> duration;

@@ -134,9 +134,12 @@ std::string ylabelFor(const Lab& lab, const std::vector<std::string>& columns,
 
 // One plot of the runs: each column a colour, hand solid and Bullet dashed; a column the engines
 // share exactly (a reference, a setpoint) is drawn once, as both engines'.
-PlotSpec plotSpec(const FigurePlot& p, const std::string& title, const RunResult* hand, const RunResult* bullet) {
+PlotSpec plotSpec(const FigurePlot& p, const std::string& title, const RunResult* hand, const RunResult* bullet,
+                  const FigureArgs& a) {
   PlotSpec spec;
   spec.title = title;
+  spec.font_scale = a.font_scale;
+  spec.y_scale = a.y_scale == "log" ? YScale::Log : a.y_scale == "linear" ? YScale::Linear : YScale::Auto;
   spec.xlabel = "t (s)";
   spec.ylabel = p.ylabel.empty() ? join(p.columns, ", ") : p.ylabel;
   for (std::size_t k = 0; k < p.columns.size(); ++k) {
@@ -172,14 +175,20 @@ std::vector<std::string> ownedFigures(const fs::path& dir) {
 int figure(const FigureArgs& a) {
   // Check every input before simulating or writing anything.
   LoadedLab loaded;
-  std::pair<int, int> size;
+  std::pair<int, int> size{1920, 1080}, plot_size{800, 450};
   std::vector<std::vector<std::string>> requested;
   std::vector<double> stills = a.stills;
   std::vector<FigurePlot> lab_plots, plots;
   try {
     if (a.format != "pdf" && a.format != "svg" && a.format != "png")
       badOption("--format", a.format, "expected pdf, svg or png");
-    size = parseSize(a.size);
+    // One --size for stills and plots (a plot needs at least 100x100 for its labels).
+    if (!a.size.empty()) {
+      size = plot_size = parseSize(a.size);
+      const bool draws_plots = !a.plots.empty() || a.stills.empty();  // the lab's own set has plots
+      if (draws_plots && (size.first < 100 || size.second < 100))
+        badOption("--size", a.size, "expected at least 100x100 for a plot");
+    }
     loaded = loadLab(a.lab, a.config, a.gains, a.duration);
     const std::vector<std::string> columns = loaded.lab->columns();
     for (const auto& spec : a.plots) requested.push_back(parseColumns(spec, columns));
@@ -225,7 +234,8 @@ int figure(const FigureArgs& a) {
       bar.set(made++);
       if (!names.insert(name).second) continue;
       const std::string title = a.title.empty() ? a.lab + ": " + join(p.columns, ", ") : a.title;
-      writePlot(staging.path(name).string(), plotSpec(p, title, hand ? &*hand : nullptr, bullet ? &*bullet : nullptr));
+      writePlot(staging.path(name).string(), plotSpec(p, title, hand ? &*hand : nullptr, bullet ? &*bullet : nullptr, a),
+                plot_size.first, plot_size.second);
       written.push_back(name);
     }
     if (!stills.empty()) {

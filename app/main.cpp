@@ -75,7 +75,13 @@ int dispatch(int argc, char** argv) {
                                        "written as still_<t>.png")
       ->allow_extra_args(false);
   f->add_option("--format", fig.format, "Plot format: pdf, svg or png (default: pdf)");
-  f->add_option("--size", fig.size, "Still size WIDTHxHEIGHT in pixels (default: 1920x1080)");
+  f->add_option("--size", fig.size, "Size WIDTHxHEIGHT in pixels of the stills and the plots (a PDF or SVG page in "
+                                    "points; default: stills 1920x1080, plots 800x450)");
+  f->add_option("--font-scale", fig.font_scale, "Plot text size relative to the default for the plot's size (default: 1)")
+      ->check(CLI::Range(0.25, 8.0));
+  f->add_option("--y-scale", fig.y_scale, "Plot y axis: auto (log when the data are positive and span over 3 decades, "
+                                          "e.g. a constraint residual), linear or log (default: auto)")
+      ->check(CLI::IsMember({"auto", "linear", "log"}));
   f->add_flag("!--no-overlay", fig.overlay, "Stills without the overlay panel");
   f->add_option("--title", fig.title, "Title of every plot and of the stills' panel (default: the lab and columns)");
 
@@ -87,6 +93,8 @@ int dispatch(int argc, char** argv) {
   g->add_option("--config", grade.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
   g->add_option("--time-budget", grade.time_budget, "Wall-time budget per submission (s)")->check(CLI::Range(1.0, 86400.0));
   g->add_flag("!--no-plots", grade.plots, "Skip the response plots (faster)");
+  g->add_flag("--inline-plots", grade.inline_plots, "Put each test's plot in results.json as an inline PNG (Gradescope shows "
+                                                    "it to the student; 30-100 KB a plot, at most 600 KB in all)");
   g->add_option("--replay", grade.replay, "Re-grade SUBMISSION and check it matches this results.json");
   g->add_option("--batch", grade.batch, "Grade every *.json in this directory, and each folder below it as one student (a Gradescope export); one process each");
   g->add_option("--jobs", grade.jobs, "Submissions graded in parallel with --batch")->check(CLI::Range(1, 256));

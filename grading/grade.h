@@ -24,6 +24,11 @@ struct GradeOptions {
   std::string config_file;   // lab config (empty: the lab's default JSON)
   std::string out_dir;       // plots go to out_dir/plots/ (empty: no plots)
   double time_budget = 300;  // s of wall time for the whole submission
+  int plot_width = 640, plot_height = 360;  // px: small enough to inline, large enough to read
+  bool inline_plots = false;  // each test's plot inline in results.json (for Gradescope to show)
+  // The replay hint in report.md: the dynlab command (a shell word) and where results.json will be
+  // (empty: a generic hint). Paths in it are made absolute and shell-quoted.
+  std::string replay_program = "dynlab", results_file;
 };
 
 struct GradeOutcome {
@@ -40,8 +45,14 @@ struct GradeOutcome {
 
 GradeOutcome gradeSubmission(const std::string& submission_file, const GradeOptions& options);
 
-// What differs between two results.json, ignoring execution_time (empty: they match).
+// What differs between two results.json, ignoring execution_time (empty: they match): one line per
+// difference, "<JSON path>: was <old> → now <new>" (or "added, now ..." / "removed, was ...").
 std::vector<std::string> compareResults(const json& expected, const json& actual);
+
+// The command that re-grades `submission` and checks it against results_file: absolute,
+// shell-quoted paths, with the --lab and --config the grade used.
+std::string replayCommand(const std::string& program, const std::string& results_file, const std::string& submission,
+                          const GradeOptions& options);
 
 // FNV-1a 64 of a string, as 16 hex digits (fingerprints and seeds).
 std::string hashHex(const std::string& bytes);
