@@ -12,9 +12,11 @@
 // lets `dynlab grade --replay` check it.
 #pragma once
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
+#include "grading/report.h"
 #include "labs/config.h"
 
 namespace dyn {
@@ -24,6 +26,7 @@ struct GradeOptions {
   std::string config_file;   // lab config (empty: the lab's default JSON)
   std::string out_dir;       // plots go to out_dir/plots/ (empty: no plots)
   double time_budget = 300;  // s of wall time for the whole submission
+  bool keep_runs = false;    // keep what was graded in the outcome (tools that compare or draw it)
 };
 
 struct GradeOutcome {
@@ -35,6 +38,9 @@ struct GradeOutcome {
   bool input_error = false;     // the submission's fault (results say how to fix it)
   bool internal_error = false;  // the grader's or the machine's fault
   bool out_of_time = false;     // the time budget stopped a scenario: the grade is incomplete
+  // With GradeOptions::keep_runs, a graded submission's tests (values, units) and each scenario's run.
+  GradeReport graded;
+  std::map<std::string, ScenarioRun> runs;
   const char* status() const { return input_error ? "invalid_submission" : internal_error ? "internal_error" : "graded"; }
 };
 
@@ -46,5 +52,8 @@ std::vector<std::string> compareResults(const json& expected, const json& actual
 // FNV-1a 64 of a string, as 16 hex digits (fingerprints and seeds).
 std::string hashHex(const std::string& bytes);
 std::string hashHexOf(std::uint64_t h);
+// A submission's hash as the fingerprint records it and scenario seeds derive from it: of its
+// canonical dump (sorted keys), so whitespace and key order do not matter.
+std::string submissionHash(const json& submission);
 
 }  // namespace dyn
