@@ -99,7 +99,9 @@ void put(const fs::path& p, const std::string& text) {
 
 void copyExample(const std::string& example, const fs::path& to) {
   fs::create_directories(to.parent_path());
-  fs::copy_file(kExamples / (example + ".json"), to, fs::copy_options::overwrite_existing);
+  // "good" is the full-credit example, kept with the instructor's files (not the students').
+  const fs::path from = example == "good" ? kExamples.parent_path() / "instructor" / "good.json" : kExamples / (example + ".json");
+  fs::copy_file(from, to, fs::copy_options::overwrite_existing);
 }
 
 // Each grader's time budget: 1 s (a grade takes ~0.15 s); scripts/sanitize raises it, since grading
