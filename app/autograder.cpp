@@ -50,10 +50,11 @@ std::string replaceAll(std::string s, const std::string& from, const std::string
   return s;
 }
 
-// Build output, run output, VCS data, staging folders and temp files stay out of the bundle.
+// Build output, run output, VCS data, staging folders and temp files stay out of the bundle, and so
+// do the labs' instructor/ folders (full-credit examples: course staff only; grading never reads them).
 bool skipped(const fs::directory_entry& e) {
   const std::string name = e.path().filename().string();
-  if (e.is_directory()) return name.rfind("build", 0) == 0 || name == "out" || name[0] == '.';
+  if (e.is_directory()) return name.rfind("build", 0) == 0 || name == "out" || name[0] == '.' || name == "instructor";
   return name.size() > 4 && name.compare(name.size() - 4, 4, ".tmp") == 0;
 }
 
@@ -251,6 +252,13 @@ This zip is a Gradescope autograder for the dynlab lab `@LAB@`. It holds:
 3. Keep the autograder timeout at 10 minutes or more: `run_autograder` stops dynlab after 540 s
    so that it can still explain a timeout to the student.
 4. Press **Test Autograder** and upload the example below as `submission.json`.
+
+## What students work from
+
+The lab handout: `dynlab handout @LAB@` writes `handout.md` and `handout.html` (the mechanism, the
+exercise, every gain with its bounds, the submission format, each test and scenario with its
+metric, unit and window, how to tune and self-grade). Give it to the students; the feedback's
+"see the lab handout" means it. Full-credit examples (`labs/@LAB@/instructor/`) are not in this zip.
 
 ## What students submit
 

@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -47,6 +48,47 @@ std::string describeAgreement(const Lab& lab, const json& agreement) {
   return s;
 }
 
+json defaultsSubmission(const json& config, const std::string& lab) {
+  json sub = {{"lab", lab}, {"gains", json::object()}};
+  // Gains as numbers in double precision and options as the config sets them, as the tuning window saves them.
+  const json gains = config.value("gains", json::object()), options = config.value("submission_options", json::object());
+  for (const auto& [name, g] : gains.items())
+    if (g.is_object() && g.contains("value") && g["value"].is_number()) sub["gains"][name] = g["value"].get<double>();
+  for (const auto& [name, o] : options.items()) {
+    if (!o.is_object() || !o.contains("target") || !o["target"].is_string()) continue;
+    const json::json_pointer target(o["target"].get<std::string>());
+    if (config.contains(target)) sub[name] = config.at(target);
+  }
+  return sub;
+}
+
+void applyScenario(LoadedLab& loaded, const std::string& scenario, const std::string& gains_file,
+                   std::optional<double> duration) {
+  if (scenario.empty()) return;
+  if (!loaded.config.contains("rubric"))
+    throw InputError("<command line>", "--scenario", "expected a lab with a rubric; " + loaded.config_file + " has none");
+  const Rubric rubric = parseRubric(JsonView(loaded.config, loaded.config_file));
+  const Scenario& sc = findScenario(rubric, scenario);
+  // The grader's seed: from the submission's hash, so the noise is the one this file is graded with.
+  const json sub = gains_file.empty() ? defaultsSubmission(loaded.config, loaded.entry->name) : loadJsonFile(gains_file, 1u << 20);
+  json cfg = scenarioConfig(loaded.config, rubric, sc, submissionHash(sub), loaded.config_file);
+  if (duration) cfg["simulation"]["duration"] = *duration;
+  loaded.lab = buildLab(*loaded.entry, cfg, loaded.config_file + " (scenario " + sc.name + ")");
+  loaded.config = std::move(cfg);
+}
+
+fs::path defaultOut(const std::string& lab, const std::string& scenario, const std::string& sub) {
+  fs::path out = fs::path("out") / lab;
+  if (!scenario.empty()) {
+    // A scenario's name as one folder name: anything but [A-Za-z0-9_-] becomes '_'.
+    std::string folder = scenario;
+    for (char& c : folder)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-') c = '_';
+    out /= fs::path("scenarios") / folder;
+  }
+  return sub.empty() ? out : out / sub;
+}
+
 // The watchdog `dynlab run` uses: the rubric's limits (so a run stops where a grade would, with
 // the same sentence) without its step budget, since a run's length is its own --duration.
 static Watchdog runWatchdog(const LoadedLab& loaded) {
@@ -65,13 +107,14 @@ int runLab(const RunArgs& a) {
   Watchdog watchdog;
   try {
     loaded = loadLab(a.lab, a.config, a.gains, a.duration);
+    applyScenario(loaded, a.scenario, a.gains, a.duration);
     watchdog = runWatchdog(loaded);
   } catch (const InputError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
     return 2;
   }
   const Lab& lab = *loaded.lab;
-  const fs::path out = a.out.empty() ? fs::path("out") / a.lab : fs::path(a.out);
+  const fs::path out = a.out.empty() ? defaultOut(a.lab, a.scenario) : fs::path(a.out);
   try {
     // Simulate first, each engine under the grader's watchdog; nothing is written until every run is done.
     std::optional<WatchedRun> hand, bullet;
@@ -84,6 +127,7 @@ int runLab(const RunArgs& a) {
     json summary = {{"lab", a.lab},
                     {"config", loaded.config_file},
                     {"gains", a.gains.empty() ? json(nullptr) : json(a.gains)},
+                    {"scenario", a.scenario.empty() ? json(nullptr) : json(a.scenario)},
                     {"dt", lab.dt()},
                     {"duration", lab.duration()},
                     {"dynlab_version", DYNLAB_VERSION}};
@@ -120,7 +164,9 @@ int runLab(const RunArgs& a) {
     staging.commit();
 
     // Tell the user where things are, how each engine ended and the headline numbers.
-    std::printf("dynlab run %s: %.2f s at dt = %g s (%s)\n", a.lab.c_str(), lab.duration(), lab.dt(), status.c_str());
+    const std::string under = a.scenario.empty() ? "" : " under scenario " + termText(a.scenario);
+    std::printf("dynlab run %s%s: %.2f s at dt = %g s (%s)\n", a.lab.c_str(), under.c_str(), lab.duration(), lab.dt(),
+                status.c_str());
     for (auto* r : {&hand, &bullet}) {
       if (!*r) continue;
       const char* engine = r == &hand ? "hand" : "bullet";
@@ -315,6 +361,7 @@ int openUi(const UiArgs& a) {
   std::vector<std::string> args = {ui.string(), a.lab};
   if (!a.config.empty()) args.insert(args.end(), {"--config", a.config});
   if (!a.gains.empty()) args.insert(args.end(), {"--gains", a.gains});
+  if (!a.scenario.empty()) args.insert(args.end(), {"--scenario", a.scenario});
   args.insert(args.end(), a.extra.begin(), a.extra.end());
   std::vector<char*> argv;
   for (auto& s : args) argv.push_back(s.data());

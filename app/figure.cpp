@@ -3,7 +3,8 @@
 // (app/movie.h renderRow through OSMesa; the Bullet run as a ghost). Without --plot and --still the
 // lab chooses: the plots its rubric draws (else those of its overlay panel that are trace columns)
 // and stills at the start, middle and end. Everything is checked before anything is simulated or
-// written; output goes through Staging, and a figure run owns DIR/plot_* and DIR/still_*.
+// written; output goes through Staging, and a figure run owns DIR/plot_* and DIR/still_*. Under
+// --scenario NAME the run is the rubric scenario's, as the grader runs it (commands.h applyScenario).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -190,6 +191,7 @@ int figure(const FigureArgs& a) {
         badOption("--size", a.size, "expected at least 100x100 for a plot");
     }
     loaded = loadLab(a.lab, a.config, a.gains, a.duration);
+    applyScenario(loaded, a.scenario, a.gains, a.duration);
     const std::vector<std::string> columns = loaded.lab->columns();
     for (const auto& spec : a.plots) requested.push_back(parseColumns(spec, columns));
     const double duration = loaded.lab->duration();
@@ -207,7 +209,8 @@ int figure(const FigureArgs& a) {
     return 2;
   }
   const Lab& lab = *loaded.lab;
-  const fs::path out = a.out.empty() ? fs::path("out") / a.lab / "figures" : fs::path(a.out);
+  const fs::path out = a.out.empty() ? defaultOut(a.lab, a.scenario, "figures") : fs::path(a.out);
+  const std::string lab_title = a.scenario.empty() ? a.lab : a.lab + " (" + a.scenario + ")";
   try {
     // A bar on a terminal for each stage (nothing otherwise): the runs, then the figures.
     auto run = [&](Engine engine) {
@@ -233,7 +236,7 @@ int figure(const FigureArgs& a) {
       const std::string name = "plot_" + join(p.columns, "+") + "." + a.format;
       bar.set(made++);
       if (!names.insert(name).second) continue;
-      const std::string title = a.title.empty() ? a.lab + ": " + join(p.columns, ", ") : a.title;
+      const std::string title = a.title.empty() ? lab_title + ": " + join(p.columns, ", ") : a.title;
       writePlot(staging.path(name).string(), plotSpec(p, title, hand ? &*hand : nullptr, bullet ? &*bullet : nullptr, a),
                 plot_size.first, plot_size.second);
       written.push_back(name);
@@ -261,8 +264,8 @@ int figure(const FigureArgs& a) {
     std::string status = "ok";
     for (const auto* r : {&hand, &bullet})
       if (*r && !(*r)->failure.empty()) status = std::string(r == &hand ? "hand" : "bullet") + ": " + (*r)->failure;
-    std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n", a.lab.c_str(), lab.duration(), lab.dt(),
-                a.engine.c_str(), status.c_str());
+    std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n", termText(lab_title).c_str(), lab.duration(),
+                lab.dt(), a.engine.c_str(), status.c_str());
     for (const auto& name : written) std::printf("  %s\n", (out / name).c_str());
     // An earlier figure run's figures this one did not remake are gone: said, never silent.
     std::string removed;

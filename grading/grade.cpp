@@ -20,6 +20,8 @@ namespace dyn {
 
 std::string hashHex(const std::string& bytes) { return hashHexOf(fnv1a(bytes.data(), bytes.size())); }
 
+std::string submissionHash(const json& submission) { return hashHex(dumpJson(submission)); }
+
 std::string hashHexOf(std::uint64_t h) {
   char out[17];
   std::snprintf(out, sizeof out, "%016llx", static_cast<unsigned long long>(h));
@@ -56,11 +58,6 @@ GradeOutcome failedOutcome(const std::string& message, const InputError* e) {
   return out;
 }
 
-// The per-scenario seed: derived from the submission, so noise is fixed per student and scenario.
-std::uint64_t scenarioSeed(const std::string& submission_hash, const std::string& scenario) {
-  return std::stoull(hashHex(submission_hash + "/" + scenario), nullptr, 16) & ((1ull << 53) - 1);
-}
-
 }  // namespace
 
 GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
@@ -94,7 +91,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     rep.submission = utf8Quotable(file);  // a file name is not always UTF-8; results.json must be
     rep.fingerprint = {{"dynlab_version", DYNLAB_VERSION},
                        {"lab_config_hash", hashHex(dumpJson(base))},
-                       {"submission_hash", hashHex(dumpJson(sub))}};
+                       {"submission_hash", submissionHash(sub)}};
 
     // Run each scenario the tests use, once, in rubric order.
     std::map<std::string, ScenarioRun> runs;
@@ -104,8 +101,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
       for (const auto& t : rubric.tests) used = used || t.scenario == sc.name;
       for (const auto& l : rubric.leaderboard) used = used || l.scenario == sc.name;
       if (!used) continue;
-      json cfg = mergePatch(applied, sc.patch);
-      writeSeed(cfg, rubric, scenarioSeed(rep.fingerprint["submission_hash"], sc.name), config_file, sc.name);
+      const json cfg = scenarioConfig(applied, rubric, sc, rep.fingerprint["submission_hash"], config_file);
       const auto lab = buildLab(*entry, cfg, config_file + " (scenario " + sc.name + ")");
       ScenarioRun run = runScenario(*lab, rubric.watchdog, deadline, config_file);
       trajectories += hashHex(std::to_string(run.trace.hash()));
@@ -161,6 +157,10 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     out.html = reportHtml(rep, out.markdown, "dynlab grade: " + lab_name);
     out.results["execution_time"] =
         std::round(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() * 100) / 100;
+    if (opt.keep_runs) {
+      out.graded = std::move(rep);
+      out.runs = std::move(runs);
+    }
     return out;
   } catch (const InputError& e) {
     return failedOutcome(e.what(), &e);

@@ -12,9 +12,11 @@
 // lets `dynlab grade --replay` check it.
 #pragma once
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
+#include "grading/report.h"
 #include "labs/config.h"
 
 namespace dyn {
@@ -29,6 +31,7 @@ struct GradeOptions {
   // The replay hint in report.md: the dynlab command (a shell word) and where results.json will be
   // (empty: a generic hint). Paths in it are made absolute and shell-quoted.
   std::string replay_program = "dynlab", results_file;
+  bool keep_runs = false;    // keep what was graded in the outcome (tools that compare or draw it)
 };
 
 struct GradeOutcome {
@@ -40,6 +43,9 @@ struct GradeOutcome {
   bool input_error = false;     // the submission's fault (results say how to fix it)
   bool internal_error = false;  // the grader's or the machine's fault
   bool out_of_time = false;     // the time budget stopped a scenario: the grade is incomplete
+  // With GradeOptions::keep_runs, a graded submission's tests (values, units) and each scenario's run.
+  GradeReport graded;
+  std::map<std::string, ScenarioRun> runs;
   const char* status() const { return input_error ? "invalid_submission" : internal_error ? "internal_error" : "graded"; }
 };
 
@@ -57,5 +63,8 @@ std::string replayCommand(const std::string& program, const std::string& results
 // FNV-1a 64 of a string, as 16 hex digits (fingerprints and seeds).
 std::string hashHex(const std::string& bytes);
 std::string hashHexOf(std::uint64_t h);
+// A submission's hash as the fingerprint records it and scenario seeds derive from it: of its
+// canonical dump (sorted keys), so whitespace and key order do not matter.
+std::string submissionHash(const json& submission);
 
 }  // namespace dyn

@@ -1,7 +1,8 @@
 // The lab contract (labs/lab.h), checked on one lab: every_lab_test runs it on each registered lab,
 // and a test may register a scratch lab (registerLab / unregisterLab) and run it on that too.
 //   config     the default config builds; every lab has the shared simulation block
-//   examples   the submission schema covers labs/<name>/examples/*.json, each applies strictly
+//   examples   the submission schema covers labs/<name>/examples/*.json (and instructor/*.json),
+//              each applies strictly
 //   engines    hand and Bullet run 200 steps with finite values
 //   passive    with passivePatch() (τ = 0) the energy stays within the lab's stated tolerance
 //   columns    the rubric's plot and watchdog columns exist; metrics read only columns that exist
@@ -268,7 +269,10 @@ inline void checkLab(const LabEntry& entry, const json& config, const LabCheckOp
   const std::string examples_dir = options.examples_dir.empty()
                                        ? std::string(DYNLAB_SOURCE_DIR) + "/labs/" + entry.name + "/examples"
                                        : options.examples_dir;
-  const std::vector<std::string> examples = exampleFiles(examples_dir);
+  std::vector<std::string> examples = exampleFiles(examples_dir);
+  // The instructor's examples (full credit, never shipped to students) are held to the same schema.
+  if (options.examples_dir.empty())
+    for (const auto& f : exampleFiles(std::string(DYNLAB_SOURCE_DIR) + "/labs/" + entry.name + "/instructor")) examples.push_back(f);
   checkConfigAndExamples(entry, config, examples);
   checkEngines(entry, config);
   checkPassive(entry, config);
