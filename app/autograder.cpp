@@ -50,10 +50,11 @@ std::string replaceAll(std::string s, const std::string& from, const std::string
   return s;
 }
 
-// Build output, run output, VCS data, staging folders and temp files stay out of the bundle.
+// Build output, run output, VCS data, staging folders and temp files stay out of the bundle, and so
+// do the labs' instructor/ folders (full-credit examples: course staff only; grading never reads them).
 bool skipped(const fs::directory_entry& e) {
   const std::string name = e.path().filename().string();
-  if (e.is_directory()) return name.rfind("build", 0) == 0 || name == "out" || name[0] == '.';
+  if (e.is_directory()) return name.rfind("build", 0) == 0 || name == "out" || name[0] == '.' || name == "instructor";
   return name.size() > 4 && name.compare(name.size() - 4, 4, ".tmp") == 0;
 }
 
@@ -178,13 +179,14 @@ fi
 
 [ -x "$dynlab" ] || fail 'The autograder is broken: dynlab was not built when the image was set up. This is not your fault; please tell the course staff.'
 
-# Grade within the time limit; dynlab writes results.json (and report.md, plots/) itself. Its own
+# Grade within the time limit; dynlab writes results.json (each test's plot inline, for the student
+# to see on Gradescope), report.md and plots/ itself. Its own
 # time budget (3/4 of the limit, at most 300 s) lets it explain a slow run before it is stopped.
 budget=$((time_limit * 3 / 4))
 ((budget >= 1)) || budget=1
 ((budget <= 300)) || budget=300
 started=$SECONDS
-timeout --kill-after=10 "$time_limit" "$dynlab" grade "$file" --time-budget "$budget" --lab "$lab" --out "$results_dir"
+timeout --kill-after=10 "$time_limit" "$dynlab" grade "$file" --time-budget "$budget" --lab "$lab" --inline-plots --out "$results_dir"
 status=$?
 elapsed=$((SECONDS - started))
 # Its results.json stands only if Gradescope would accept it, checked by dynlab check-results.
@@ -233,8 +235,9 @@ This zip is a Gradescope autograder for the dynlab lab `@LAB@`. It holds:
   `source/scripts/setup`) and compiles dynlab (Release) into `source/build/`.
 * `run_autograder`: run for every submission: finds the student's JSON (a symbolic link out of the
   submission, a FIFO or a device is refused unread), runs
-  `dynlab grade FILE --time-budget B --lab @LAB@ --out /autograder/results` (B: 3/4 of the time
-  limit, at most 300 s, so dynlab explains a slow run itself), and always leaves a valid
+  `dynlab grade FILE --time-budget B --lab @LAB@ --inline-plots --out /autograder/results` (B: 3/4
+  of the time limit, at most 300 s, so dynlab explains a slow run itself; each test's feedback is
+  HTML with its response plot inline, which Gradescope shows the student), and always leaves a valid
   `results.json` (score 0 with an explanation when the file is missing, grading fails, or what
   dynlab wrote does not pass `dynlab check-results`). Set `DYNLAB_TIME_LIMIT` (whole seconds,
   1–86400; default 540) to change how long dynlab may grade.
@@ -249,6 +252,13 @@ This zip is a Gradescope autograder for the dynlab lab `@LAB@`. It holds:
 3. Keep the autograder timeout at 10 minutes or more: `run_autograder` stops dynlab after 540 s
    so that it can still explain a timeout to the student.
 4. Press **Test Autograder** and upload the example below as `submission.json`.
+
+## What students work from
+
+The lab handout: `dynlab handout @LAB@` writes `handout.md` and `handout.html` (the mechanism, the
+exercise, every gain with its bounds, the submission format, each test and scenario with its
+metric, unit and window, how to tune and self-grade). Give it to the students; the feedback's
+"see the lab handout" means it. Full-credit examples (`labs/@LAB@/instructor/`) are not in this zip.
 
 ## What students submit
 

@@ -1,7 +1,8 @@
 // dynlab grade --batch DIR --jobs N --out OUT: every submission in DIR graded in its own child
 // process (`dynlab grade FILE --out OUT/<folder>`), N at a time, under a lock on OUT. A grader
 // that exits with anything but 0 (graded) or 2 (invalid submission), crashes or hangs (killed after
-// its time budget) gets a results.json saying so; the batch goes on. Then OUT/gradebook.csv.
+// its time budget) gets a results.json saying so; the batch goes on. Then OUT/gradebook.csv and
+// its summary, OUT/gradebook.md.
 #include <fcntl.h>
 #include <signal.h>
 #include <sys/file.h>
@@ -20,6 +21,7 @@
 #include "app/batch.h"
 #include "app/commands.h"
 #include "app/output.h"
+#include "grading/escape.h"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -236,14 +238,19 @@ int gradeBatch(const GradeArgs& a) {
   }
   if (tty) std::fprintf(stderr, "\n");
 
-  const fs::path book = out / "gradebook.csv";
-  try {
-    writeFileAtomic(book, batch::gradebookCsv(rows, batch::labMaxScore(a.lab, a.config, rows)));
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: %s: cannot write the gradebook (%s)\n", book.c_str(), e.what());
-    return 1;
+  // The gradebook, and its summary beside it (score statistics, histogram, common failure reasons).
+  const fs::path book = out / "gradebook.csv", summary = out / "gradebook.md";
+  const double lab_max = batch::labMaxScore(a.lab, a.config, rows);
+  for (const auto& [path, text] : {std::pair{book, batch::gradebookCsv(rows, lab_max)}, std::pair{summary, batch::gradebookMarkdown(rows, lab_max)}}) {
+    try {
+      writeFileAtomic(path, text);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "error: %s: cannot write the gradebook (%s)\n", termText(path.string()).c_str(), termText(e.what()).c_str());
+      return 1;
+    }
   }
-  std::printf("graded %zu submission(s) into %s; gradebook: %s\n", total, out.c_str(), book.c_str());
+  std::printf("graded %zu submission(s) into %s; gradebook: %s (summary: %s)\n", total, out.c_str(), book.c_str(),
+              summary.c_str());
   if (problems) std::printf("%zu submission(s) need a look (see the status and reason columns)\n", problems);
   ::close(lock_fd);
   return 0;

@@ -1,18 +1,12 @@
 // dynlab grade --batch, in three parts: finding the submissions and giving each a safe output
 // folder (batch_inputs.cpp), running one grader process per submission under a lock on OUT
-// (batch.cpp), and turning each result into a gradebook row (batch_gradebook.cpp).
+// (batch.cpp), and turning each result into a gradebook row and the gradebook with its summary
+// (batch_gradebook.cpp).
 #pragma once
 #include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
-
-namespace dyn {
-// One CSV field: a leading = + - @ tab or CR gets a ' prefix, invalid UTF-8 becomes U+FFFD, and the
-// field is quoted when it holds , " CR or LF or starts/ends with a space.
-// TODO(merge): grading/escape.h (outputs branch) declares the same function; drop this one then.
-std::string csvField(const std::string& s);
-}  // namespace dyn
 
 namespace dyn::app::batch {
 
@@ -41,12 +35,18 @@ Found findSubmissions(const std::filesystem::path& dir, const std::filesystem::p
 // folder of that name that no batch wrote (no grade.log in it).
 void assignFolders(std::vector<Submission>& subs, const std::filesystem::path& out);
 
+// One test of a graded row.
+struct TestScore {
+  std::string name;
+  double score = 0, max_score = 0;
+};
+
 // One gradebook row.
 struct Row {
   std::string name, folder, status, reason;
   double score = 0, max_score = 0;
-  bool graded = false;                                  // max_score comes from its own tests
-  std::vector<std::pair<std::string, double>> tests;    // in rubric order
+  bool graded = false;           // max_score comes from its own tests
+  std::vector<TestScore> tests;  // in rubric order
 };
 
 // A row from OUT/<folder>/results.json after the grader exited with `exit_code` (0 graded, 2 invalid
@@ -65,5 +65,11 @@ double labMaxScore(const std::string& lab, const std::string& config, const std:
 
 // gradebook.csv: submission, score, max_score, status, reason, folder, then one column per test.
 std::string gradebookCsv(std::vector<Row> rows, double lab_max);
+
+// gradebook.md, the summary beside it: how many submissions and of what status, mean, median, min and
+// max score (ungraded ones count 0), a histogram of the scores in ten bins of the lab's total, the
+// most common failure reasons (numbers in them as #, so one kind of failure is one line) with counts,
+// each test's mean, and the submissions that need a look. Every name and reason escaped (mdText).
+std::string gradebookMarkdown(std::vector<Row> rows, double lab_max);
 
 }  // namespace dyn::app::batch

@@ -1,7 +1,10 @@
 // From each grader's results.json to a gradebook row, and the gradebook itself; see batch.h.
 #include <algorithm>
+#include <cctype>
+#include <cmath>
 #include <cstdio>
 #include <map>
+#include <set>
 
 #include "app/batch.h"
 #include "app/output.h"
@@ -46,8 +49,8 @@ Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, 
   Row row{s.name, s.folder, "graded", "", r.value("score", 0.0), 0, true, {}};
   try {
     for (const auto& t : r.value("tests", json::array())) {
-      row.tests.emplace_back(t.value("name", "?"), t.value("score", 0.0));
-      row.max_score += t.value("max_score", 0.0);
+      row.tests.push_back({t.value("name", "?"), t.value("score", 0.0), t.value("max_score", 0.0)});
+      row.max_score += row.tests.back().max_score;
     }
     // A scenario that did not complete: the watchdog's sentence, or the time budget running out.
     const json scenarios = extra.value("scenarios", json::object());
@@ -103,7 +106,7 @@ std::string gradebookCsv(std::vector<Row> rows, double lab_max) {
   std::vector<std::string> tests;
   for (const auto& r : rows)
     for (const auto& t : r.tests)
-      if (std::find(tests.begin(), tests.end(), t.first) == tests.end()) tests.push_back(t.first);
+      if (std::find(tests.begin(), tests.end(), t.name) == tests.end()) tests.push_back(t.name);
   const auto number = [](double x) {
     char buf[32];
     std::snprintf(buf, sizeof buf, "%.4g", x);
@@ -116,13 +119,183 @@ std::string gradebookCsv(std::vector<Row> rows, double lab_max) {
     csv += csvField(r.name) + "," + number(r.score) + "," + number(r.graded ? r.max_score : lab_max) + "," +
            csvField(r.status) + "," + csvField(r.reason) + "," + csvField(r.folder);
     for (const auto& t : tests) {
-      const auto it = std::find_if(r.tests.begin(), r.tests.end(), [&](const auto& p) { return p.first == t; });
+      const auto it = std::find_if(r.tests.begin(), r.tests.end(), [&](const TestScore& p) { return p.name == t; });
       csv += ',';
-      if (it != r.tests.end()) csv += number(it->second);
+      if (it != r.tests.end()) csv += number(it->score);
     }
     csv += "\n";
   }
   return csv;
+}
+
+namespace {
+
+std::string fmt(double x) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.4g", x);
+  return buf;
+}
+
+// A reason with every number as # ("t = 0.15 s" → "t = # s"; "f_Ty" and "q1" stay): the same kind
+// of failure, whatever the numbers, is one line of the summary.
+std::string reasonKind(const std::string& reason) {
+  std::string out;
+  for (std::size_t i = 0; i < reason.size();) {
+    const unsigned char c = static_cast<unsigned char>(reason[i]);
+    const bool word = !out.empty() && (std::isalnum(static_cast<unsigned char>(out.back())) || out.back() == '_');
+    const bool sign = (c == '-' || c == '+') && i + 1 < reason.size() && std::isdigit(static_cast<unsigned char>(reason[i + 1]));
+    if (word || !(std::isdigit(c) || sign)) {
+      out += reason[i++];
+      continue;
+    }
+    // A number: sign, digits, a fraction, an exponent.
+    std::size_t j = i + (sign ? 1 : 0);
+    const auto digits = [&] { while (j < reason.size() && std::isdigit(static_cast<unsigned char>(reason[j]))) ++j; };
+    digits();
+    if (j + 1 < reason.size() && reason[j] == '.' && std::isdigit(static_cast<unsigned char>(reason[j + 1]))) ++j, digits();
+    if (j + 1 < reason.size() && (reason[j] == 'e' || reason[j] == 'E')) {
+      std::size_t k = j + 1 + ((reason[j + 1] == '-' || reason[j + 1] == '+') ? 1 : 0);
+      if (k < reason.size() && std::isdigit(static_cast<unsigned char>(reason[k]))) j = k, digits();
+    }
+    out += '#';
+    i = j;
+  }
+  return out;
+}
+
+// The reasons of one row as (scenario, reason): a graded row lists one per scenario that did not
+// complete ("a: ...; b: ..."), any other row has one reason of no scenario.
+std::vector<std::pair<std::string, std::string>> reasonsOf(const Row& r) {
+  std::vector<std::pair<std::string, std::string>> out;
+  if (r.reason.empty()) return out;
+  if (r.status.rfind("graded", 0) != 0 && r.status != "timed out") return {{"", r.reason}};
+  for (std::size_t at = 0; at <= r.reason.size();) {
+    std::size_t end = r.reason.find("; ", at);
+    if (end == std::string::npos) end = r.reason.size();
+    const std::string item = r.reason.substr(at, end - at);
+    const std::size_t colon = item.find(": ");
+    if (colon != std::string::npos) out.emplace_back(item.substr(0, colon), item.substr(colon + 2));
+    else if (!item.empty()) out.emplace_back("", item);
+    at = end + 2;
+  }
+  return out;
+}
+
+// Sorted by count, most first, then by text: the same rows give the same summary.
+template <class Map>
+std::vector<std::pair<typename Map::key_type, int>> byCount(const Map& counts) {
+  std::vector<std::pair<typename Map::key_type, int>> v(counts.begin(), counts.end());
+  std::stable_sort(v.begin(), v.end(), [](const auto& a, const auto& b) { return a.second > b.second; });
+  return v;
+}
+
+}  // namespace
+
+std::string gradebookMarkdown(std::vector<Row> rows, double lab_max) {
+  std::sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) { return a.name < b.name; });
+  const std::size_t n = rows.size();
+  std::vector<double> scores;
+  for (const auto& r : rows) scores.push_back(r.score);
+  std::sort(scores.begin(), scores.end());
+  double total = lab_max > 0 ? lab_max : (scores.empty() ? 0.0 : scores.back());
+  std::string md = "# Gradebook summary\n\n" + std::to_string(n) + " submission" + (n == 1 ? "" : "s") +
+                   "; one row each in `gradebook.csv`, with its feedback in its folder.\n\n";
+
+  // How many of each status, and the score statistics over every submission.
+  std::map<std::string, int> status;
+  for (const auto& r : rows) ++status[r.status];
+  md += "| status | submissions |\n|---|---|\n";
+  for (const auto& [s, count] : byCount(status)) md += "| " + mdText(s) + " | " + std::to_string(count) + " |\n";
+  if (!scores.empty()) {
+    double sum = 0;
+    for (double x : scores) sum += x;
+    const double median = n % 2 ? scores[n / 2] : (scores[n / 2 - 1] + scores[n / 2]) / 2;
+    const auto of = [&](double x) { return fmt(x) + (total > 0 ? " (" + fmt(100 * x / total) + " %)" : ""); };
+    md += "\n| score (of " + fmt(total) + ") | |\n|---|---|\n| mean | " + of(sum / double(n)) + " |\n| median | " +
+          of(median) + " |\n| min | " + of(scores.front()) + " |\n| max | " + of(scores.back()) + " |\n\n" +
+          "Over every submission: one that was not graded counts as 0.\n";
+  }
+
+  // The histogram: ten bins of a tenth of the total each, the last one holding full marks.
+  if (!scores.empty()) {
+    constexpr int kBins = 10, kBarMax = 40;
+    std::vector<int> bins(kBins, 0);
+    for (double x : scores) {
+      const int b = total > 0 ? int(std::floor(x / total * kBins)) : 0;
+      ++bins[std::size_t(std::clamp(b, 0, kBins - 1))];
+    }
+    const int most = *std::max_element(bins.begin(), bins.end());
+    md += "\n## Scores\n\n| score | submissions | |\n|---|---|---|\n";
+    for (int b = 0; b < kBins; ++b) {
+      const double lo = total * b / kBins, hi = total * (b + 1) / kBins;
+      const int bar = most > kBarMax ? (bins[b] * kBarMax + most - 1) / most : bins[b];
+      std::string bars;
+      for (int k = 0; k < bar; ++k) bars += "█";
+      md += "| " + fmt(lo) + (b + 1 == kBins ? " – " : " – <") + fmt(hi) + " | " + std::to_string(bins[b]) + " | " + bars + " |\n";
+    }
+  }
+
+  // The most common failure reasons, numbers as #, with the scenarios they happened in.
+  struct Kind {
+    int submissions = 0;
+    std::set<std::string> scenarios;
+  };
+  std::map<std::pair<std::string, std::string>, Kind> reasons;  // (status, reason kind)
+  for (const auto& r : rows) {
+    std::set<std::string> seen;  // a row counts once per kind
+    for (const auto& [scenario, reason] : reasonsOf(r)) {
+      Kind& k = reasons[{r.status, reasonKind(reason)}];
+      if (!scenario.empty()) k.scenarios.insert(scenario);
+      if (seen.insert(reasonKind(reason)).second) ++k.submissions;
+    }
+  }
+  if (!reasons.empty()) {
+    std::map<std::pair<std::string, std::string>, int> counts;
+    for (const auto& [key, k] : reasons) counts[key] = k.submissions;
+    md += "\n## Most common failure reasons\n\nNumbers are shown as #, so one kind of failure is one line.\n\n"
+          "| reason | status | scenarios | submissions |\n|---|---|---|---|\n";
+    int shown = 0;
+    for (const auto& [key, count] : byCount(counts)) {
+      if (++shown > 10) break;
+      std::string scenarios;
+      for (const auto& s : reasons[key].scenarios) scenarios += (scenarios.empty() ? "" : ", ") + s;
+      md += "| " + mdText(key.second) + " | " + mdText(key.first) + " | " + (scenarios.empty() ? "—" : mdText(scenarios)) +
+            " | " + std::to_string(count) + " |\n";
+    }
+    if (reasons.size() > 10) md += "\nand " + std::to_string(reasons.size() - 10) + " more kinds (see the reason column).\n";
+  }
+
+  // Each test's mean score over the graded submissions, and how many got full marks or none.
+  std::vector<std::string> tests;
+  std::map<std::string, std::vector<TestScore>> by_test;
+  for (const auto& r : rows)
+    for (const auto& t : r.tests) {
+      if (!by_test.count(t.name)) tests.push_back(t.name);
+      by_test[t.name].push_back(t);
+    }
+  if (!tests.empty()) {
+    md += "\n## Tests\n\nOver the graded submissions.\n\n| test | mean | points | full marks | zero |\n|---|---|---|---|---|\n";
+    for (const auto& name : tests) {
+      const auto& ts = by_test[name];
+      double sum = 0, points = 0;
+      int full = 0, zero = 0;
+      for (const auto& t : ts) {
+        sum += t.score;
+        points = std::max(points, t.max_score);
+        full += t.score >= t.max_score - 1e-9;
+        zero += t.score <= 1e-9;
+      }
+      md += "| " + mdText(name) + " | " + fmt(sum / double(ts.size())) + " | " + fmt(points) + " | " + std::to_string(full) +
+            " | " + std::to_string(zero) + " |\n";
+    }
+  }
+
+  // Who needs a look: every submission that has no grade of the grader's.
+  std::string look;
+  for (const auto& r : rows)
+    if (!r.graded) look += "| " + mdText(r.name) + " | " + mdText(r.status) + " | " + mdText(r.folder) + " |\n";
+  if (!look.empty()) md += "\n## Not graded\n\n| submission | status | folder |\n|---|---|---|\n" + look;
+  return md;
 }
 
 }  // namespace dyn::app::batch

@@ -7,7 +7,7 @@
 //     against the reference (the lab's configured hand run) in the lab's measures of agreement;
 //     the reference engine described by the lab (Lab::referenceEngine);
 //   render, render+PNG, render+video: frames per second at 640×480 (MSAA 4, overlay on);
-//   grading: CPU seconds of a full rubric grade of the lab's examples/good.json.
+//   grading: CPU seconds of a full rubric grade of the lab's instructor/good.json.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>

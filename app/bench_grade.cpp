@@ -34,8 +34,8 @@ double gradeCpu(const std::string& file, const GradeOptions& o, int repeats) {
 }  // namespace
 
 json gradeThroughput(const std::string& lab, int repeats) {
-  // The lab's example of a well-tuned submission, if it ships one.
-  const std::string file = std::filesystem::path(defaultConfigPath(lab)).parent_path() / "examples" / "good.json";
+  // The lab's full-credit submission (its instructor folder), if it has one.
+  const std::string file = std::filesystem::path(defaultConfigPath(lab)).parent_path() / "instructor" / "good.json";
   if (!std::filesystem::exists(file)) return json::object();
   GradeOptions o;
   const double plain = gradeCpu(file, o, repeats);

@@ -3,6 +3,7 @@
 
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstdio>
 #include <cstdlib>
@@ -16,6 +17,7 @@
 #include "app/output.h"
 #include "grading/escape.h"
 #include "grading/grade.h"
+#include "grading/report.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
 #include "labs/run.h"
@@ -46,6 +48,47 @@ std::string describeAgreement(const Lab& lab, const json& agreement) {
   return s;
 }
 
+json defaultsSubmission(const json& config, const std::string& lab) {
+  json sub = {{"lab", lab}, {"gains", json::object()}};
+  // Gains as numbers in double precision and options as the config sets them, as the tuning window saves them.
+  const json gains = config.value("gains", json::object()), options = config.value("submission_options", json::object());
+  for (const auto& [name, g] : gains.items())
+    if (g.is_object() && g.contains("value") && g["value"].is_number()) sub["gains"][name] = g["value"].get<double>();
+  for (const auto& [name, o] : options.items()) {
+    if (!o.is_object() || !o.contains("target") || !o["target"].is_string()) continue;
+    const json::json_pointer target(o["target"].get<std::string>());
+    if (config.contains(target)) sub[name] = config.at(target);
+  }
+  return sub;
+}
+
+void applyScenario(LoadedLab& loaded, const std::string& scenario, const std::string& gains_file,
+                   std::optional<double> duration) {
+  if (scenario.empty()) return;
+  if (!loaded.config.contains("rubric"))
+    throw InputError("<command line>", "--scenario", "expected a lab with a rubric; " + loaded.config_file + " has none");
+  const Rubric rubric = parseRubric(JsonView(loaded.config, loaded.config_file));
+  const Scenario& sc = findScenario(rubric, scenario);
+  // The grader's seed: from the submission's hash, so the noise is the one this file is graded with.
+  const json sub = gains_file.empty() ? defaultsSubmission(loaded.config, loaded.entry->name) : loadJsonFile(gains_file, 1u << 20);
+  json cfg = scenarioConfig(loaded.config, rubric, sc, submissionHash(sub), loaded.config_file);
+  if (duration) cfg["simulation"]["duration"] = *duration;
+  loaded.lab = buildLab(*loaded.entry, cfg, loaded.config_file + " (scenario " + sc.name + ")");
+  loaded.config = std::move(cfg);
+}
+
+fs::path defaultOut(const std::string& lab, const std::string& scenario, const std::string& sub) {
+  fs::path out = fs::path("out") / lab;
+  if (!scenario.empty()) {
+    // A scenario's name as one folder name: anything but [A-Za-z0-9_-] becomes '_'.
+    std::string folder = scenario;
+    for (char& c : folder)
+      if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-') c = '_';
+    out /= fs::path("scenarios") / folder;
+  }
+  return sub.empty() ? out : out / sub;
+}
+
 // The watchdog `dynlab run` uses: the rubric's limits (so a run stops where a grade would, with
 // the same sentence) without its step budget, since a run's length is its own --duration.
 static Watchdog runWatchdog(const LoadedLab& loaded) {
@@ -64,13 +107,14 @@ int runLab(const RunArgs& a) {
   Watchdog watchdog;
   try {
     loaded = loadLab(a.lab, a.config, a.gains, a.duration);
+    applyScenario(loaded, a.scenario, a.gains, a.duration);
     watchdog = runWatchdog(loaded);
   } catch (const InputError& e) {
-    std::fprintf(stderr, "error: %s\n", e.what());
+    std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
     return 2;
   }
   const Lab& lab = *loaded.lab;
-  const fs::path out = a.out.empty() ? fs::path("out") / a.lab : fs::path(a.out);
+  const fs::path out = a.out.empty() ? defaultOut(a.lab, a.scenario) : fs::path(a.out);
   try {
     // Simulate first, each engine under the grader's watchdog; nothing is written until every run is done.
     std::optional<WatchedRun> hand, bullet;
@@ -83,6 +127,7 @@ int runLab(const RunArgs& a) {
     json summary = {{"lab", a.lab},
                     {"config", loaded.config_file},
                     {"gains", a.gains.empty() ? json(nullptr) : json(a.gains)},
+                    {"scenario", a.scenario.empty() ? json(nullptr) : json(a.scenario)},
                     {"dt", lab.dt()},
                     {"duration", lab.duration()},
                     {"dynlab_version", DYNLAB_VERSION}};
@@ -119,7 +164,9 @@ int runLab(const RunArgs& a) {
     staging.commit();
 
     // Tell the user where things are, how each engine ended and the headline numbers.
-    std::printf("dynlab run %s: %.2f s at dt = %g s (%s)\n", a.lab.c_str(), lab.duration(), lab.dt(), status.c_str());
+    const std::string under = a.scenario.empty() ? "" : " under scenario " + termText(a.scenario);
+    std::printf("dynlab run %s%s: %.2f s at dt = %g s (%s)\n", a.lab.c_str(), under.c_str(), lab.duration(), lab.dt(),
+                status.c_str());
     for (auto* r : {&hand, &bullet}) {
       if (!*r) continue;
       const char* engine = r == &hand ? "hand" : "bullet";
@@ -152,12 +199,31 @@ static void injectFault(const std::string& submission) {
   if (s.find("throw:" + stem) != std::string::npos) throw std::logic_error("injected fault for " + stem);
 }
 
+// The word that runs this dynlab in a shell: "dynlab" when that is what PATH finds, else its
+// absolute path (a build tree's binary), so a printed command runs as printed.
+static std::string dynlabProgram() {
+  std::error_code ec;
+  const fs::path self = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) return "dynlab";
+  if (const char* path = std::getenv("PATH")) {
+    const std::string dirs = path;
+    for (std::size_t at = 0; at <= dirs.size();) {
+      const std::size_t end = std::min(dirs.find(':', at), dirs.size());
+      const fs::path candidate = fs::path(dirs.substr(at, end - at)) / "dynlab";
+      if (end > at && fs::equivalent(candidate, self, ec)) return "dynlab";
+      at = end + 1;
+    }
+  }
+  return shellWord(self.string());
+}
+
 static GradeOptions gradeOptions(const GradeArgs& a, const std::string& out_dir) {
   GradeOptions o;
   o.expected_lab = a.lab;
   o.config_file = a.config;
   o.time_budget = a.time_budget;
   if (a.plots) o.out_dir = out_dir;
+  o.inline_plots = a.inline_plots && a.plots;
   return o;
 }
 
@@ -168,7 +234,10 @@ int gradeOne(const GradeArgs& a) {
     // Everything lands in OUT/.staging first; a failure never leaves a half-written results set.
     Staging staging(a.out);
     staging.owns({"results.json", "report.md", "report.html", "plots"});
-    g = gradeSubmission(a.submission, gradeOptions(a, staging.path("").string()));
+    GradeOptions o = gradeOptions(a, staging.path("").string());
+    o.replay_program = dynlabProgram();
+    o.results_file = (fs::path(a.out) / "results.json").string();
+    g = gradeSubmission(a.submission, o);
     // An internal error's plots may be partial: none are published (the old ones are removed).
     if (g.internal_error) fs::remove_all(staging.path("plots"));
     staging.write("results.json", dumpJson(g.results, 2) + "\n");
@@ -188,10 +257,35 @@ int gradeOne(const GradeArgs& a) {
   std::fputs(g.report.c_str(), stdout);
   std::printf("results: %s\nreport:  %s\n", termText((fs::path(a.out) / "results.json").string()).c_str(),
               termText((fs::path(a.out) / "report.html").string()).c_str());
+  if (!g.input_error && !g.internal_error)
+    std::printf("replay:  %s\n", termText(replayCommand(dynlabProgram(), (fs::path(a.out) / "results.json").string(),
+                                                         a.submission, gradeOptions(a, ""))).c_str());
   // A grade the time budget cut short is written (score 0 for what it stopped) but is not a grade.
   if (g.out_of_time) std::fprintf(stderr, "error: %s: the grading time budget of %g s ran out; the grade is incomplete\n",
                                   utf8Quotable(a.submission).c_str(), a.time_budget);
   return g.input_error ? 2 : g.internal_error ? 3 : g.out_of_time ? 4 : 0;
+}
+
+// "metric x_rms of test 1 (Slider tracks x_d(t)): was 0.01113 → now 0.012; score was 2.1 → now 2"
+// for every test whose metric value or score differs between two results.json.
+static std::vector<std::string> metricChanges(const json& expected, const json& actual) {
+  std::vector<std::string> out;
+  const auto tests = [](const json& r) { return r.contains("tests") && r["tests"].is_array() ? r["tests"] : json::array(); };
+  const json a = tests(expected), b = tests(actual);
+  const auto field = [](const json& t, const char* key) {
+    return t.is_object() && t.contains("extra_data") && t["extra_data"].is_object() ? t["extra_data"].value(key, json()) : json();
+  };
+  for (std::size_t i = 0; i < std::min(a.size(), b.size()); ++i) {
+    const json was = field(a[i], "value"), now = field(b[i], "value");
+    const json was_score = a[i].is_object() ? a[i].value("score", json()) : json(), now_score = b[i].value("score", json());
+    if (was == now && was_score == now_score) continue;
+    const json metric = field(b[i], "metric");
+    std::string line = "metric " + (metric.is_string() ? metric.get<std::string>() : "?") + " of test " + std::to_string(i + 1) + " (" +
+                       b[i].value("name", std::string()) + "): was " + dumpJson(was) + " → now " + dumpJson(now);
+    if (was_score != now_score) line += "; score was " + dumpJson(was_score) + " → now " + dumpJson(now_score);
+    out.push_back(line);
+  }
+  return out;
 }
 
 int gradeReplay(const GradeArgs& a) {
@@ -208,11 +302,12 @@ int gradeReplay(const GradeArgs& a) {
   quiet.plots = false;
   const GradeOutcome g = gradeSubmission(a.submission, gradeOptions(quiet, ""));
   json actual = g.results;
-  // Plot paths are only present when plots were written; they are not part of the grade.
+  // Plot paths and inline plots are only present when plots were drawn; they are not the grade.
+  expected = withoutInlinePlots(expected);
   for (json* r : {&expected, &actual})
-    if (r->contains("tests"))
+    if (r->contains("tests") && (*r)["tests"].is_array())
       for (auto& t : (*r)["tests"])
-        if (t.contains("extra_data")) t["extra_data"].erase("plot");
+        if (t.is_object() && t.contains("extra_data") && t["extra_data"].is_object()) t["extra_data"].erase("plot");
   const auto diff = compareResults(expected, actual);
   if (diff.empty()) {
     std::printf("replay: match (score %s, trajectory hash %s)\n", dumpJson(actual["score"]).c_str(),
@@ -220,7 +315,10 @@ int gradeReplay(const GradeArgs& a) {
     return 0;
   }
   std::printf("replay: MISMATCH, %zu difference(s):\n", diff.size());
+  // Each metric first (was → now, with its test), then the differences as JSON paths.
+  for (const auto& line : metricChanges(expected, actual)) std::printf("  %s\n", termText(line).c_str());
   for (std::size_t i = 0; i < diff.size() && i < 20; ++i) std::printf("  %s\n", termText(diff[i]).c_str());
+  if (diff.size() > 20) std::printf("  ... and %zu more\n", diff.size() - 20);
   return 1;
 }
 
@@ -263,6 +361,7 @@ int openUi(const UiArgs& a) {
   std::vector<std::string> args = {ui.string(), a.lab};
   if (!a.config.empty()) args.insert(args.end(), {"--config", a.config});
   if (!a.gains.empty()) args.insert(args.end(), {"--gains", a.gains});
+  if (!a.scenario.empty()) args.insert(args.end(), {"--scenario", a.scenario});
   args.insert(args.end(), a.extra.begin(), a.extra.end());
   std::vector<char*> argv;
   for (auto& s : args) argv.push_back(s.data());

@@ -4,16 +4,18 @@
 //   3 internal error (the grader or the machine; caught at the top of main, or reported in
 //     results.json when it could be written), 4 a grade cut short by its time budget.
 #pragma once
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "labs/lab.h"
+#include "labs/run.h"
 
 namespace dyn::app {
 
 struct RunArgs {
-  std::string lab, config, gains, out, engine = "both";
+  std::string lab, config, gains, out, engine = "both", scenario;
   bool video = false, frames = false;
   std::optional<double> duration;
 };
@@ -22,26 +24,49 @@ struct GradeArgs {
   std::string submission, out = "out/grade", lab, config, replay, batch;
   double time_budget = 300;  // s of wall time per submission
   bool plots = true;
+  bool inline_plots = false;  // each test's plot inline in results.json (the Gradescope autograder)
   int jobs = 1;
 };
 
 struct UiArgs {
-  std::string lab, config, gains;
+  std::string lab, config, gains, scenario;
   std::vector<std::string> extra;  // passed on to dynlab-ui as they are
 };
 
 struct FigureArgs {
-  std::string lab, config, gains, out, engine = "both", format = "pdf", size = "1920x1080", title;
+  std::string lab, config, gains, out, engine = "both", format = "pdf", title, scenario;
+  std::string size;              // WxH of stills and plots (empty: 1920x1080 stills, 800x450 plots)
+  std::string y_scale = "auto";  // plots: auto (log when the data span decades), linear or log
+  double font_scale = 1.0;       // plots' text size
   std::vector<std::string> plots;  // each "col,col,...": one plot
   std::vector<double> stills;      // simulated times (s)
   std::optional<double> duration;
   bool overlay = true;
 };
 
+// dynlab compare A B: two submissions of one lab graded by the same rubric, side by side.
+struct CompareArgs {
+  std::string a, b, out = "out/compare", lab, config;
+  double time_budget = 300;  // s of wall time per submission
+  bool plots = true;
+};
+
 struct BenchArgs {
   bool json = false;
   int steps = 4000, frames = 60;
 };
+
+// --scenario NAME (run, figure): rebuilds the loaded lab under the rubric scenario's patch and noise
+// seed exactly as the grader does (grading/scenario.h scenarioConfig). The seed is the one grading
+// gains_file as a submission gives; without one, the lab's defaults as a submission (what the tuning
+// window saves). --duration still wins. Nothing happens for an empty name; throws InputError (an
+// unknown name lists the rubric's).
+void applyScenario(LoadedLab& loaded, const std::string& scenario, const std::string& gains_file,
+                   std::optional<double> duration);
+// {"lab", <options as the config sets them>, "gains": {every gain's value}}: the lab's defaults as a submission.
+json defaultsSubmission(const json& config, const std::string& lab);
+// Where a command writes by default: out/LAB/SUB, or out/LAB/scenarios/NAME/SUB under a scenario.
+std::filesystem::path defaultOut(const std::string& lab, const std::string& scenario, const std::string& sub = "");
 
 // "key = value unit, ..." of every top-level number of a lab's agreement (run, bench).
 std::string describeAgreement(const Lab& lab, const json& agreement);
@@ -56,9 +81,11 @@ int writeAutograderZip(const std::string& lab, const std::string& out);
 int figure(const FigureArgs& args);
 int printSchema(const std::string& lab);
 int bench(const BenchArgs& args);
+// Grades both, prints a table per test, writes OUT/comparison.md and OUT/plots/ (app/compare.cpp).
+int compare(const CompareArgs& args);
 // Replaces this process with dynlab-ui (next to /proc/self/exe); returns only on failure (1).
 int openUi(const UiArgs& args);
-// CPU cost of grading the lab's examples/good.json (app/bench_grade.cpp); empty if none.
+// CPU cost of grading the lab's instructor/good.json (app/bench_grade.cpp); empty if none.
 json gradeThroughput(const std::string& lab, int repeats);
 
 }  // namespace dyn::app

@@ -3,7 +3,8 @@
 // (app/movie.h renderRow through OSMesa; the Bullet run as a ghost). Without --plot and --still the
 // lab chooses: the plots its rubric draws (else those of its overlay panel that are trace columns)
 // and stills at the start, middle and end. Everything is checked before anything is simulated or
-// written; output goes through Staging, and a figure run owns DIR/plot_* and DIR/still_*.
+// written; output goes through Staging, and a figure run owns DIR/plot_* and DIR/still_*. Under
+// --scenario NAME the run is the rubric scenario's, as the grader runs it (commands.h applyScenario).
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -134,9 +135,12 @@ std::string ylabelFor(const Lab& lab, const std::vector<std::string>& columns,
 
 // One plot of the runs: each column a colour, hand solid and Bullet dashed; a column the engines
 // share exactly (a reference, a setpoint) is drawn once, as both engines'.
-PlotSpec plotSpec(const FigurePlot& p, const std::string& title, const RunResult* hand, const RunResult* bullet) {
+PlotSpec plotSpec(const FigurePlot& p, const std::string& title, const RunResult* hand, const RunResult* bullet,
+                  const FigureArgs& a) {
   PlotSpec spec;
   spec.title = title;
+  spec.font_scale = a.font_scale;
+  spec.y_scale = a.y_scale == "log" ? YScale::Log : a.y_scale == "linear" ? YScale::Linear : YScale::Auto;
   spec.xlabel = "t (s)";
   spec.ylabel = p.ylabel.empty() ? join(p.columns, ", ") : p.ylabel;
   for (std::size_t k = 0; k < p.columns.size(); ++k) {
@@ -172,15 +176,22 @@ std::vector<std::string> ownedFigures(const fs::path& dir) {
 int figure(const FigureArgs& a) {
   // Check every input before simulating or writing anything.
   LoadedLab loaded;
-  std::pair<int, int> size;
+  std::pair<int, int> size{1920, 1080}, plot_size{800, 450};
   std::vector<std::vector<std::string>> requested;
   std::vector<double> stills = a.stills;
   std::vector<FigurePlot> lab_plots, plots;
   try {
     if (a.format != "pdf" && a.format != "svg" && a.format != "png")
       badOption("--format", a.format, "expected pdf, svg or png");
-    size = parseSize(a.size);
+    // One --size for stills and plots (a plot needs at least 100x100 for its labels).
+    if (!a.size.empty()) {
+      size = plot_size = parseSize(a.size);
+      const bool draws_plots = !a.plots.empty() || a.stills.empty();  // the lab's own set has plots
+      if (draws_plots && (size.first < 100 || size.second < 100))
+        badOption("--size", a.size, "expected at least 100x100 for a plot");
+    }
     loaded = loadLab(a.lab, a.config, a.gains, a.duration);
+    applyScenario(loaded, a.scenario, a.gains, a.duration);
     const std::vector<std::string> columns = loaded.lab->columns();
     for (const auto& spec : a.plots) requested.push_back(parseColumns(spec, columns));
     const double duration = loaded.lab->duration();
@@ -198,7 +209,8 @@ int figure(const FigureArgs& a) {
     return 2;
   }
   const Lab& lab = *loaded.lab;
-  const fs::path out = a.out.empty() ? fs::path("out") / a.lab / "figures" : fs::path(a.out);
+  const fs::path out = a.out.empty() ? defaultOut(a.lab, a.scenario, "figures") : fs::path(a.out);
+  const std::string lab_title = a.scenario.empty() ? a.lab : a.lab + " (" + a.scenario + ")";
   try {
     // A bar on a terminal for each stage (nothing otherwise): the runs, then the figures.
     auto run = [&](Engine engine) {
@@ -224,8 +236,9 @@ int figure(const FigureArgs& a) {
       const std::string name = "plot_" + join(p.columns, "+") + "." + a.format;
       bar.set(made++);
       if (!names.insert(name).second) continue;
-      const std::string title = a.title.empty() ? a.lab + ": " + join(p.columns, ", ") : a.title;
-      writePlot(staging.path(name).string(), plotSpec(p, title, hand ? &*hand : nullptr, bullet ? &*bullet : nullptr));
+      const std::string title = a.title.empty() ? lab_title + ": " + join(p.columns, ", ") : a.title;
+      writePlot(staging.path(name).string(), plotSpec(p, title, hand ? &*hand : nullptr, bullet ? &*bullet : nullptr, a),
+                plot_size.first, plot_size.second);
       written.push_back(name);
     }
     if (!stills.empty()) {
@@ -251,8 +264,8 @@ int figure(const FigureArgs& a) {
     std::string status = "ok";
     for (const auto* r : {&hand, &bullet})
       if (*r && !(*r)->failure.empty()) status = std::string(r == &hand ? "hand" : "bullet") + ": " + (*r)->failure;
-    std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n", a.lab.c_str(), lab.duration(), lab.dt(),
-                a.engine.c_str(), status.c_str());
+    std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n", termText(lab_title).c_str(), lab.duration(),
+                lab.dt(), a.engine.c_str(), status.c_str());
     for (const auto& name : written) std::printf("  %s\n", (out / name).c_str());
     // An earlier figure run's figures this one did not remake are gone: said, never silent.
     std::string removed;

@@ -56,6 +56,9 @@ int dispatch(int argc, char** argv) {
   r->add_flag("--video", run.video, "Write video.mp4 (H.264, 30 fps)");
   r->add_flag("--frames", run.frames, "Write frames/NNNNN.png (30 fps)");
   r->add_option("--duration", run.duration, "Override the simulated duration (s)");
+  r->add_option("--scenario", run.scenario, "Run under one rubric scenario (heavy_load, noisy_sensor, ...) exactly as the "
+                                          "grader does: its patch and the noise seed the gains file is graded with "
+                                          "(default out: out/LAB/scenarios/NAME)");
 
   FigureArgs fig;
   auto* f = cli.add_subcommand("figure", "Lecture figures from a lab's run: plots of trace columns (PDF/SVG/PNG) and "
@@ -75,9 +78,17 @@ int dispatch(int argc, char** argv) {
                                        "written as still_<t>.png")
       ->allow_extra_args(false);
   f->add_option("--format", fig.format, "Plot format: pdf, svg or png (default: pdf)");
-  f->add_option("--size", fig.size, "Still size WIDTHxHEIGHT in pixels (default: 1920x1080)");
+  f->add_option("--size", fig.size, "Size WIDTHxHEIGHT in pixels of the stills and the plots (a PDF or SVG page in "
+                                    "points; default: stills 1920x1080, plots 800x450)");
+  f->add_option("--font-scale", fig.font_scale, "Plot text size relative to the default for the plot's size (default: 1)")
+      ->check(CLI::Range(0.25, 8.0));
+  f->add_option("--y-scale", fig.y_scale, "Plot y axis: auto (log when the data are positive and span over 3 decades, "
+                                          "e.g. a constraint residual), linear or log (default: auto)")
+      ->check(CLI::IsMember({"auto", "linear", "log"}));
   f->add_flag("!--no-overlay", fig.overlay, "Stills without the overlay panel");
   f->add_option("--title", fig.title, "Title of every plot and of the stills' panel (default: the lab and columns)");
+  f->add_option("--scenario", fig.scenario, "Run under one rubric scenario exactly as the grader does "
+                                          "(default out: out/LAB/scenarios/NAME/figures)");
 
   GradeArgs grade;
   auto* g = cli.add_subcommand("grade", "Grade a submission (gains JSON) against its lab's rubric, or a whole directory");
@@ -87,6 +98,8 @@ int dispatch(int argc, char** argv) {
   g->add_option("--config", grade.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
   g->add_option("--time-budget", grade.time_budget, "Wall-time budget per submission (s)")->check(CLI::Range(1.0, 86400.0));
   g->add_flag("!--no-plots", grade.plots, "Skip the response plots (faster)");
+  g->add_flag("--inline-plots", grade.inline_plots, "Put each test's plot in results.json as an inline PNG (Gradescope shows "
+                                                    "it to the student; 30-100 KB a plot, at most 600 KB in all)");
   g->add_option("--replay", grade.replay, "Re-grade SUBMISSION and check it matches this results.json");
   g->add_option("--batch", grade.batch, "Grade every *.json in this directory, and each folder below it as one student (a Gradescope export); one process each");
   g->add_option("--jobs", grade.jobs, "Submissions graded in parallel with --batch")->check(CLI::Range(1, 256));
@@ -115,7 +128,19 @@ int dispatch(int argc, char** argv) {
   u->add_option("LAB", ui.lab, "Lab name (see `dynlab list`)")->required();
   u->add_option("--config", ui.config, "Lab config JSON (default: labs/LAB/LAB.json)");
   u->add_option("--gains", ui.gains, "Start from these gains: a submission or gains JSON");
+  u->add_option("--scenario", ui.scenario, "Tune under one rubric scenario (its patch and the grader's noise seed)");
   u->allow_extras();
+
+  CompareArgs cmp;
+  auto* k = cli.add_subcommand("compare", "Grade two submissions (gain sets) of one lab with the same rubric, side by side: "
+                                          "a table per test, OUT/comparison.md and one plot per simulated test with both responses");
+  k->add_option("A", cmp.a, "First submission JSON")->required();
+  k->add_option("B", cmp.b, "Second submission JSON")->required();
+  k->add_option("--out", cmp.out, "Output directory: comparison.md, plots/ (default: out/compare)");
+  k->add_option("--lab", cmp.lab, "The lab both must name (default: the lab A names)");
+  k->add_option("--config", cmp.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
+  k->add_option("--time-budget", cmp.time_budget, "Wall-time budget per submission (s)")->check(CLI::Range(1.0, 86400.0));
+  k->add_flag("!--no-plots", cmp.plots, "Skip the plots (faster)");
 
   BenchArgs bench_args;
   auto* b = cli.add_subcommand("bench", "Benchmark: hand-written vs Bullet step time, render/PNG/video frame rates");
@@ -138,6 +163,7 @@ int dispatch(int argc, char** argv) {
   if (*z) return writeAutograderZip(zip_lab, zip_out);
   if (*c) return checkResults(results_file);
   if (*s) return printSchema(schema_lab);
+  if (*k) return compare(cmp);
   if (*b) return bench(bench_args);
   if (course.chosen()) return course.run();
   if (*u) {

@@ -11,6 +11,7 @@
 #include "grading/report.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
+#include "grading/test_plot.h"
 #include "labs/run.h"
 #include "labs/submission.h"
 #include "labs/utf8.h"
@@ -18,6 +19,8 @@
 namespace dyn {
 
 std::string hashHex(const std::string& bytes) { return hashHexOf(fnv1a(bytes.data(), bytes.size())); }
+
+std::string submissionHash(const json& submission) { return hashHex(dumpJson(submission)); }
 
 std::string hashHexOf(std::uint64_t h) {
   char out[17];
@@ -55,11 +58,6 @@ GradeOutcome failedOutcome(const std::string& message, const InputError* e) {
   return out;
 }
 
-// The per-scenario seed: derived from the submission, so noise is fixed per student and scenario.
-std::uint64_t scenarioSeed(const std::string& submission_hash, const std::string& scenario) {
-  return std::stoull(hashHex(submission_hash + "/" + scenario), nullptr, 16) & ((1ull << 53) - 1);
-}
-
 }  // namespace
 
 GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
@@ -93,7 +91,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     rep.submission = utf8Quotable(file);  // a file name is not always UTF-8; results.json must be
     rep.fingerprint = {{"dynlab_version", DYNLAB_VERSION},
                        {"lab_config_hash", hashHex(dumpJson(base))},
-                       {"submission_hash", hashHex(dumpJson(sub))}};
+                       {"submission_hash", submissionHash(sub)}};
 
     // Run each scenario the tests use, once, in rubric order.
     std::map<std::string, ScenarioRun> runs;
@@ -103,8 +101,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
       for (const auto& t : rubric.tests) used = used || t.scenario == sc.name;
       for (const auto& l : rubric.leaderboard) used = used || l.scenario == sc.name;
       if (!used) continue;
-      json cfg = mergePatch(applied, sc.patch);
-      writeSeed(cfg, rubric, scenarioSeed(rep.fingerprint["submission_hash"], sc.name), config_file, sc.name);
+      const json cfg = scenarioConfig(applied, rubric, sc, rep.fingerprint["submission_hash"], config_file);
       const auto lab = buildLab(*entry, cfg, config_file + " (scenario " + sc.name + ")");
       ScenarioRun run = runScenario(*lab, rubric.watchdog, deadline, config_file);
       trajectories += hashHex(std::to_string(run.trace.hash()));
@@ -126,7 +123,9 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     for (std::size_t i = 0; i < rubric.tests.size(); ++i) {
       const RubricTest& t = rubric.tests[i];
       const ScenarioRun& run = runs.at(t.scenario);
-      GradedTest g{t, 0.0, NAN, "", "", unitOf(t.metric)};
+      GradedTest g{t, 0.0, NAN, "", "", unitOf(t.metric), std::nullopt, ""};
+      // A test of a simulated metric (not the screening's) gets a plot.
+      if (!run.screen.metrics.contains(t.metric)) g.plan = planTestPlot(rubric, i, docs, *base_lab);
       if (run.metrics.contains(t.metric)) {
         g.value = run.metrics[t.metric].get<double>();
         g.score = t.points * partialCredit(g.value, t.full, t.zero);
@@ -145,7 +144,9 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     }
 
     // Plots of each test's response against its reference and tolerance band.
-    if (!opt.out_dir.empty()) writeTestPlots(rep, runs, opt.out_dir);
+    if (!opt.out_dir.empty()) writeTestPlots(rep, runs, opt.out_dir, opt.plot_width, opt.plot_height);
+    rep.inline_plots = opt.inline_plots;
+    if (!opt.results_file.empty()) rep.replay = replayCommand(opt.replay_program, opt.results_file, file, opt);
 
     GradeOutcome out;
     for (const auto& s : rep.scenarios) out.out_of_time = out.out_of_time || s.out_of_time;
@@ -153,9 +154,13 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     out.results["extra_data"]["status"] = out.status();
     out.report = terminalReport(rep);
     out.markdown = markdownReport(rep);
-    out.html = renderHtml(out.markdown, "dynlab grade: " + lab_name);
+    out.html = reportHtml(rep, out.markdown, "dynlab grade: " + lab_name);
     out.results["execution_time"] =
         std::round(std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count() * 100) / 100;
+    if (opt.keep_runs) {
+      out.graded = std::move(rep);
+      out.runs = std::move(runs);
+    }
     return out;
   } catch (const InputError& e) {
     return failedOutcome(e.what(), &e);
@@ -170,17 +175,29 @@ std::vector<std::string> compareResults(const json& expected, const json& actual
   a.erase("execution_time");
   b.erase("execution_time");
   std::vector<std::string> out;
+  const auto shown = [](const json& v) {
+    std::string s = dumpJson(v);
+    return s.size() > 60 ? s.substr(0, 57) + "..." : s;  // may cut a character: shown through termText
+  };
   for (const auto& op : json::diff(a, b)) {
-    const std::string path = op.at("path");
-    std::string what = op.at("op").get<std::string>() + " " + path;
-    if (op.contains("value")) {
-      std::string v = dumpJson(op.at("value"));
-      if (v.size() > 60) v = v.substr(0, 57) + "...";  // may cut a character: shown through termText
-      what += ": now " + v;
-    }
-    out.push_back(what);
+    const std::string path = op.at("path"), kind = op.at("op");
+    const json::json_pointer ptr(path);
+    const std::string was = a.contains(ptr) ? shown(a.at(ptr)) : "", now = op.contains("value") ? shown(op.at("value")) : "";
+    if (kind == "replace") out.push_back(path + ": was " + was + " → now " + now);
+    else if (kind == "add") out.push_back(path + ": added, now " + now);
+    else if (kind == "remove") out.push_back(path + ": removed, was " + was);
+    else out.push_back(kind + " " + path);
   }
   return out;
+}
+
+std::string replayCommand(const std::string& program, const std::string& results_file, const std::string& submission,
+                          const GradeOptions& o) {
+  const auto path = [](const std::string& p) { return shellWord(std::filesystem::absolute(p).lexically_normal().string()); };
+  std::string cmd = program + " grade --replay " + path(results_file) + " " + path(submission);
+  if (!o.expected_lab.empty()) cmd += " --lab " + shellWord(o.expected_lab);
+  if (!o.config_file.empty()) cmd += " --config " + path(o.config_file);
+  return cmd;
 }
 
 }  // namespace dyn

@@ -12,9 +12,11 @@
 // lets `dynlab grade --replay` check it.
 #pragma once
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
+#include "grading/report.h"
 #include "labs/config.h"
 
 namespace dyn {
@@ -24,6 +26,12 @@ struct GradeOptions {
   std::string config_file;   // lab config (empty: the lab's default JSON)
   std::string out_dir;       // plots go to out_dir/plots/ (empty: no plots)
   double time_budget = 300;  // s of wall time for the whole submission
+  int plot_width = 640, plot_height = 360;  // px: small enough to inline, large enough to read
+  bool inline_plots = false;  // each test's plot inline in results.json (for Gradescope to show)
+  // The replay hint in report.md: the dynlab command (a shell word) and where results.json will be
+  // (empty: a generic hint). Paths in it are made absolute and shell-quoted.
+  std::string replay_program = "dynlab", results_file;
+  bool keep_runs = false;    // keep what was graded in the outcome (tools that compare or draw it)
 };
 
 struct GradeOutcome {
@@ -35,16 +43,28 @@ struct GradeOutcome {
   bool input_error = false;     // the submission's fault (results say how to fix it)
   bool internal_error = false;  // the grader's or the machine's fault
   bool out_of_time = false;     // the time budget stopped a scenario: the grade is incomplete
+  // With GradeOptions::keep_runs, a graded submission's tests (values, units) and each scenario's run.
+  GradeReport graded;
+  std::map<std::string, ScenarioRun> runs;
   const char* status() const { return input_error ? "invalid_submission" : internal_error ? "internal_error" : "graded"; }
 };
 
 GradeOutcome gradeSubmission(const std::string& submission_file, const GradeOptions& options);
 
-// What differs between two results.json, ignoring execution_time (empty: they match).
+// What differs between two results.json, ignoring execution_time (empty: they match): one line per
+// difference, "<JSON path>: was <old> → now <new>" (or "added, now ..." / "removed, was ...").
 std::vector<std::string> compareResults(const json& expected, const json& actual);
+
+// The command that re-grades `submission` and checks it against results_file: absolute,
+// shell-quoted paths, with the --lab and --config the grade used.
+std::string replayCommand(const std::string& program, const std::string& results_file, const std::string& submission,
+                          const GradeOptions& options);
 
 // FNV-1a 64 of a string, as 16 hex digits (fingerprints and seeds).
 std::string hashHex(const std::string& bytes);
 std::string hashHexOf(std::uint64_t h);
+// A submission's hash as the fingerprint records it and scenario seeds derive from it: of its
+// canonical dump (sorted keys), so whitespace and key order do not matter.
+std::string submissionHash(const json& submission);
 
 }  // namespace dyn

@@ -39,6 +39,25 @@ std::string fillFromConfig(const std::string& text, const JsonView& config, cons
   return out;
 }
 
+namespace {
+
+// A window bound: seconds, or "{/pointer}" naming a number of the config.
+double windowBound(const JsonView& v, const JsonView& config) {
+  if (v.raw().is_number()) return v.number();
+  const std::string expected = "expected a number of seconds or \"{/json/pointer}\" naming one";
+  if (!v.raw().is_string()) v.fail(expected);
+  const std::string text = v.string();
+  if (text.size() < 3 || text.front() != '{' || text.back() != '}') v.fail(expected);
+  try {
+    const json& value = config.raw().at(json::json_pointer(text.substr(1, text.size() - 2)));
+    if (value.is_number() && std::isfinite(value.get<double>())) return value.get<double>();
+  } catch (const json::exception&) {
+  }
+  v.fail(expected + ", got \"" + text + "\" (not a number of the config)");
+}
+
+}  // namespace
+
 std::map<std::string, MetricDoc> parseMetricDocs(const JsonView& config) {
   std::map<std::string, MetricDoc> docs;
   if (!config.has("metric_docs")) return docs;
@@ -46,9 +65,13 @@ std::map<std::string, MetricDoc> parseMetricDocs(const JsonView& config) {
   all.requireObject();
   for (const auto& [name, _] : all.raw().items()) {
     const JsonView d = all[name];
-    d.onlyKeys({"what", "unit", "window"});
-    docs[name] = {fillFromConfig(d["what"].string(), config, d["what"].path()), d["unit"].string(),
-                  fillFromConfig(d["window"].string(), config, d["window"].path())};
+    d.onlyKeys({"what", "unit", "window", "from", "to"});
+    MetricDoc& doc = docs[name];
+    doc = {fillFromConfig(d["what"].string(), config, d["what"].path()), d["unit"].string(),
+           fillFromConfig(d["window"].string(), config, d["window"].path())};
+    if (d.has("from")) doc.from = windowBound(d["from"], config);
+    if (d.has("to")) doc.to = windowBound(d["to"], config);
+    if (!(doc.from < doc.to)) (d.has("to") ? d["to"] : d["from"]).fail("expected the window's end after its start (" + fmtConfigNumber(doc.from) + " s)");
   }
   return docs;
 }

@@ -1,11 +1,15 @@
 // What a metric means, for people (the handout, feedback): its definition, unit and time window.
 // Lab metrics are documented by the lab's JSON,
-//   "metric_docs": {"x_rms": {"unit": "m", "window": "whole run", "what": "RMS of x_c − x_d"}, ...}
+//   "metric_docs": {"x_rms": {"unit": "m", "window": "whole run", "what": "RMS of x_c − x_d"},
+//                   "f_rms": {..., "window": "from t = {/metrics/settle_time} s on", "from": "{/metrics/settle_time}"}}
 // where "{/json/pointer}" in window or what stands for the config's value there (so a window such
-// as "from t = {/metrics/settle_time} s on" never disagrees with the grader); the screening
+// as "from t = {/metrics/settle_time} s on" never disagrees with the grader); "from" and "to"
+// (optional: a number of seconds or "{/pointer}" naming one) are the window for machines, which
+// the feedback plots shade; the screening
 // metrics (<loop>_delay_margin, <loop>_damping, ... from grading/scenario.h) are documented here,
 // once for every lab, from the loops the lab reports.
 #pragma once
+#include <cmath>
 #include <map>
 #include <optional>
 #include <string>
@@ -18,6 +22,7 @@ namespace dyn {
 
 struct MetricDoc {
   std::string what, unit, window;  // unit "1": dimensionless
+  double from = -INFINITY, to = INFINITY;  // the time window the metric reads (s)
 };
 
 // config["metric_docs"] (none: empty), placeholders filled from config; throws InputError naming the

@@ -4,11 +4,11 @@
 #include <cmark-gfm-core-extensions.h>
 #include <cmark-gfm.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include "grading/escape.h"
 #include "grading/grade.h"
-#include "grading/plot.h"
 
 namespace dyn {
 namespace {
@@ -20,16 +20,6 @@ const ScenarioSummary& scenarioOf(const GradeReport& r, const std::string& name)
 }
 
 std::string points(double x) { return fmtNumber(std::round(x * 100) / 100); }
-
-std::string slug(const std::string& s) {
-  std::string out;
-  for (char c : s) {
-    if (std::isalnum(static_cast<unsigned char>(c))) out += char(std::tolower(static_cast<unsigned char>(c)));
-    else if (!out.empty() && out.back() != '-') out += '-';
-  }
-  while (!out.empty() && out.back() == '-') out.pop_back();
-  return out.substr(0, 40);
-}
 
 // A metric's value with its unit, as feedback shows it ("0.01113 m"; dimensionless: the number). The
 // number is plain digits; the unit (from the lab's JSON) is escaped for where it lands.
@@ -58,6 +48,33 @@ bool blank(const std::string& s) { return s.find_first_not_of(" \t") == std::str
 
 std::string scenarioStatus(const ScenarioSummary& s) { return s.failure.empty() ? "completed" : s.failure; }
 
+// The paragraph of a test's output that holds its plot (or says why it does not): marked by its
+// class, which cmark never writes, so withoutInlinePlots finds exactly it.
+const std::string kPlotParagraph = "<p class=\"dynlab-plot\">";
+
+// A PNG's size from its IHDR chunk (0 × 0 if it is not a PNG).
+std::pair<unsigned, unsigned> pngSize(const std::string& png) {
+  if (png.size() < 24 || png.compare(12, 4, "IHDR") != 0) return {0, 0};
+  const auto u32 = [&](std::size_t at) {
+    unsigned v = 0;
+    for (std::size_t k = 0; k < 4; ++k) v = v << 8 | static_cast<unsigned char>(png[at + k]);
+    return v;
+  };
+  return {u32(16), u32(20)};
+}
+
+// The plot paragraph of test i: the image inline while the budget lasts, else a note.
+std::string inlinePlot(const GradedTest& g, std::size_t i, std::size_t& budget) {
+  const std::string uri = pngDataUri(g.plot_png);
+  if (uri.size() > budget)
+    return kPlotParagraph + "<em>(The plot of this test is left out: the feedback holds at most " +
+           std::to_string(kMaxInlinePlotBytes / 1024) + " KB of plots.)</em></p>\n";
+  budget -= uri.size();
+  const auto [w, h] = pngSize(g.plot_png);
+  const std::string size = w && h ? " width=\"" + std::to_string(w) + "\" height=\"" + std::to_string(h) + "\"" : "";
+  return kPlotParagraph + "<img alt=\"plot of test " + std::to_string(i + 1) + "\"" + size + " src=\"" + uri + "\"></p>\n";
+}
+
 }  // namespace
 
 double GradeReport::score() const {
@@ -74,6 +91,7 @@ double GradeReport::maxScore() const {
 
 json resultsJson(const GradeReport& r) {
   json tests = json::array();
+  std::size_t budget = kMaxInlinePlotBytes;
   for (std::size_t i = 0; i < r.tests.size(); ++i) {
     const GradedTest& g = r.tests[i];
     json extra = {{"scenario", g.test.scenario}, {"metric", g.test.metric}, {"full", g.test.full}, {"zero", g.test.zero}};
@@ -84,8 +102,9 @@ json resultsJson(const GradeReport& r) {
                      {"score", g.score},
                      {"max_score", g.test.points},
                      {"status", g.score >= g.test.points - 1e-9 ? "passed" : "failed"},
-                     {"output", testText(r, g)},
-                     {"output_format", "md"},
+                     {"output", renderHtmlFragment(testText(r, g)) +
+                                    (r.inline_plots && !g.plot_png.empty() ? inlinePlot(g, i, budget) : "")},
+                     {"output_format", "html"},
                      {"tags", {g.test.scenario}},
                      {"visibility", g.test.visibility},
                      {"extra_data", extra}});
@@ -111,7 +130,7 @@ json resultsJson(const GradeReport& r) {
   json results = {{"score", r.score()},
                   {"output", output},
                   {"output_format", "md"},
-                  {"test_output_format", "md"},
+                  {"test_output_format", "html"},
                   {"visibility", "visible"},
                   {"stdout_visibility", "hidden"},
                   {"tests", tests},
@@ -168,16 +187,21 @@ std::string markdownReport(const GradeReport& r) {
   md += "\n## Fingerprint\n\n";
   for (const auto& [k, v] : r.fingerprint.items())
     md += "- " + mdText(k) + ": " + mdCode(v.is_string() ? v.get<std::string>() : dumpJson(v)) + "\n";
-  // The command to copy, with the file name in it when that holds no markup.
-  const bool plain_name = file.find_first_of("<>&") == std::string::npos;
-  md += "\nRe-check with " + mdCode("dynlab grade --replay results.json " + (plain_name ? shellWord(file) : "SUBMISSION")) +
-        (plain_name ? "" : " (SUBMISSION: the file named above)") + ".\n";
+  // The command to copy: the grader's own (absolute, quoted paths) when it holds nothing a code
+  // span or the page could mangle, else a generic one.
+  const std::string command = r.replay.empty() ? "dynlab grade --replay results.json " + shellWord(file) : r.replay;
+  const bool plain = std::none_of(command.begin(), command.end(), [](unsigned char c) {
+    return c < 0x20 || c == 0x7f || c == '<' || c == '>' || c == '&' || c == '|' || c == '`';
+  });
+  md += "\nRe-check with " + mdCode(plain ? command : "dynlab grade --replay results.json SUBMISSION") +
+        (plain ? "" : " (SUBMISSION: the file named above)") + ".\n";
   return md;
 }
 
-std::string renderHtml(const std::string& markdown, const std::string& title, const std::string& extra_css) {
+std::string renderHtmlFragment(const std::string& markdown) {
   // GitHub-flavoured Markdown (tables) through cmark-gfm, safe mode (the default since 0.29; named
-  // for older versions): raw HTML and javascript: links are dropped, not passed through.
+  // for older versions): raw HTML and javascript: links are dropped, not passed through (data:
+  // URIs of PNG, GIF, JPEG and WebP images are kept).
   cmark_gfm_core_extensions_ensure_registered();
   const int options = CMARK_OPT_DEFAULT | CMARK_OPT_SAFE;
   cmark_parser* parser = cmark_parser_new(options);
@@ -185,60 +209,63 @@ std::string renderHtml(const std::string& markdown, const std::string& title, co
   cmark_parser_feed(parser, markdown.data(), markdown.size());
   cmark_node* doc = cmark_parser_finish(parser);
   char* body = cmark_render_html(doc, options, cmark_parser_get_syntax_extensions(parser));
-  std::string html =
-      "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>" + htmlText(title) + "</title>\n"
-      "<style>body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.45}"
-      "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:.25em .6em}"
-      "img{max-width:100%}code{background:#f3f3f3;padding:0 .2em}" + extra_css + "</style></head><body>\n";
-  html += body;
-  html += "</body></html>\n";
+  std::string html = body;
   free(body);
   cmark_node_free(doc);
   cmark_parser_free(parser);
   return html;
 }
 
-void writeTestPlots(GradeReport& r, const std::map<std::string, ScenarioRun>& runs, const std::string& out_dir) {
-  std::filesystem::create_directories(std::filesystem::path(out_dir) / "plots");
-  for (std::size_t i = 0; i < r.tests.size(); ++i) {
-    GradedTest& g = r.tests[i];
-    if (!g.test.plot) continue;
-    const PlotRequest& p = *g.test.plot;
-    const ScenarioRun& run = runs.at(g.test.scenario);
-    const Trace& tr = run.trace;
-    if (tr.rows() < 2) continue;
-    PlotSpec spec;
-    spec.title = g.test.name + " (" + g.test.scenario + ")";
-    spec.xlabel = "t (s)";
-    spec.ylabel = p.ylabel;
-    const std::vector<double> t = tr.series("t");
-    if (!p.reference.empty() && tr.column(p.reference) >= 0) {
-      const std::vector<double> ref = tr.series(p.reference);
-      if (p.band > 0) {
-        PlotBand band{"tolerance ±" + fmtNumber(p.band), t, ref, ref};
-        for (std::size_t k = 0; k < ref.size(); ++k) band.lo[k] -= p.band, band.hi[k] += p.band;
-        spec.bands.push_back(band);
-      }
-      spec.series.push_back({p.reference + " (reference)", t, ref, PlotSeries::Style::Dashed, 1});
-    } else if (p.band > 0) {
-      spec.bands.push_back({"limit ±" + fmtNumber(p.band), t, std::vector<double>(t.size(), -p.band),
-                            std::vector<double>(t.size(), p.band)});
-    }
-    int color = 0;
-    for (const auto& c : p.columns) {
-      if (tr.column(c) < 0) continue;
-      spec.series.push_back({c, t, tr.series(c), PlotSeries::Style::Solid, color == 1 ? 2 : color});
-      color = color == 0 ? 2 : color + 1;
-    }
-    if (run.failure_time >= 0) {
-      spec.vlines.push_back(run.failure_time);
-      spec.vline_label = "run stopped";
-    }
-    char name[96];
-    std::snprintf(name, sizeof name, "plots/%02zu-%s.png", i + 1, slug(g.test.name).c_str());
-    writePlot((std::filesystem::path(out_dir) / name).string(), spec);
-    g.plot = name;
+std::string renderHtml(const std::string& markdown, const std::string& title, const std::string& extra_css) {
+  std::string html =
+      "<!doctype html>\n<html><head><meta charset=\"utf-8\"><title>" + htmlText(title) + "</title>\n"
+      "<style>body{font-family:sans-serif;max-width:60em;margin:2em auto;line-height:1.45}"
+      "table{border-collapse:collapse}td,th{border:1px solid #ccc;padding:.25em .6em}"
+      "img{max-width:100%}code{background:#f3f3f3;padding:0 .2em}" + extra_css + "</style></head><body>\n";
+  html += renderHtmlFragment(markdown);
+  html += "</body></html>\n";
+  return html;
+}
+
+std::string reportHtml(const GradeReport& r, const std::string& markdown, const std::string& title) {
+  // cmark renders the links (small), then each becomes its image's bytes: the grader's own file
+  // names (plots/NN-slug.png) need no escaping and appear nowhere else as a src.
+  std::string html = renderHtml(markdown, title);
+  for (const auto& g : r.tests) {
+    if (g.plot.empty() || g.plot_png.empty()) continue;
+    const std::string link = "src=\"" + g.plot + "\"";
+    if (const std::size_t at = html.find(link); at != std::string::npos)
+      html.replace(at, link.size(), "src=\"" + pngDataUri(g.plot_png) + "\"");
   }
+  return html;
+}
+
+std::string pngDataUri(const std::string& png) {
+  static const char* kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out = "data:image/png;base64,";
+  out.reserve(out.size() + (png.size() + 2) / 3 * 4);
+  for (std::size_t i = 0; i < png.size(); i += 3) {
+    // Three bytes → four digits; a short last group is padded with '='.
+    const std::size_t n = std::min<std::size_t>(3, png.size() - i);
+    unsigned v = 0;
+    for (std::size_t k = 0; k < 3; ++k) v = v << 8 | (k < n ? static_cast<unsigned char>(png[i + k]) : 0u);
+    for (std::size_t k = 0; k < 4; ++k) out += k <= n ? kDigits[(v >> (18 - 6 * k)) & 63] : '=';
+  }
+  return out;
+}
+
+json withoutInlinePlots(json results) {
+  if (!results.contains("tests") || !results["tests"].is_array()) return results;
+  for (auto& t : results["tests"]) {
+    if (!t.is_object() || !t.contains("output") || !t["output"].is_string()) continue;
+    std::string out = t["output"];
+    for (std::size_t at; (at = out.find(kPlotParagraph)) != std::string::npos;) {
+      const std::size_t end = out.find("</p>\n", at);
+      out.erase(at, end == std::string::npos ? std::string::npos : end + 5 - at);
+    }
+    t["output"] = out;
+  }
+  return results;
 }
 
 }  // namespace dyn

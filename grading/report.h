@@ -1,8 +1,13 @@
 // What a grade says, in four forms: Gradescope's results.json, a terminal summary, a Markdown
-// report (report.md, plots linked) and the same as HTML (report.html, via cmark-gfm).
+// report (report.md, plots linked) and the same as HTML (report.html, via cmark-gfm, its plots
+// inlined as data: URIs so the one file is the whole report).
+// results.json's tests are HTML (Gradescope's "html" output format) so that each can carry its
+// plot inline, where Gradescope shows it to the student.
 // Everything here reads the GradeReport only; nothing is simulated.
 #pragma once
+#include <cmath>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -11,6 +16,13 @@
 
 namespace dyn {
 
+// What a simulated test's plot shows (grading/test_plot.h derives it for every lab).
+struct TestPlotPlan {
+  PlotRequest request;    // columns, reference, band and y label
+  std::string band_unit;  // the plotted columns' unit, for the band's label
+  double from = -INFINITY, to = INFINITY;  // the metric's time window: the rest is hatched
+};
+
 struct GradedTest {
   RubricTest test;
   double score = 0;
@@ -18,6 +30,8 @@ struct GradedTest {
   std::string note;    // why there is no value
   std::string plot;    // relative path of its plot (plots/NN-name.png), or empty
   std::string unit;    // the metric's unit (its metric_docs or the screening's: "m", "s"; "1" or empty: none)
+  std::optional<TestPlotPlan> plan;  // a simulated test's plot (a screening test has none)
+  std::string plot_png;              // the plot's bytes once written (inlined in report.html, results.json)
 };
 
 struct ScenarioSummary {
@@ -37,17 +51,31 @@ struct GradeReport {
   std::vector<GradedTest> tests;
   json leaderboard = json::array();
   json fingerprint;
+  std::string replay;         // the command that re-checks this grade (empty: a generic one)
+  bool inline_plots = false;  // results.json carries each test's plot (Gradescope shows it)
   double score() const;
   double maxScore() const;
 };
 
+// At most this many bytes of inline plots go into one results.json (base64); later plots are left
+// out with a note, so a results.json stays well under a megabyte.
+constexpr std::size_t kMaxInlinePlotBytes = 600 * 1024;
+
 json resultsJson(const GradeReport& r);
 std::string terminalReport(const GradeReport& r);
+// report.md: each plot linked (plots/NN-name.png).
 std::string markdownReport(const GradeReport& r);
+// The HTML of report.md with each plot's link replaced by its bytes (a data: URI): one file.
+std::string reportHtml(const GradeReport& r, const std::string& markdown, const std::string& title);
 // A standalone page; markdown must already be escaped (grading/escape.h), title is plain text.
 std::string renderHtml(const std::string& markdown, const std::string& title = "dynlab grade", const std::string& extra_css = "");
+// The HTML of a Markdown fragment (cmark-gfm, safe mode, tables), without the page around it.
+std::string renderHtmlFragment(const std::string& markdown);
 
-// Writes out_dir/plots/NN-<slug>.png for every test with a plot request and records the path.
-void writeTestPlots(GradeReport& r, const std::map<std::string, ScenarioRun>& runs, const std::string& out_dir);
+// "data:image/png;base64,..." of a PNG's bytes.
+std::string pngDataUri(const std::string& png);
+// results.json without the inline plots resultsJson put into its tests' output (for --replay,
+// which re-grades without plots).
+json withoutInlinePlots(json results);
 
 }  // namespace dyn

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "grading/grade.h"
+
 namespace dyn {
 
 std::string fmtNumber(double x) {
@@ -150,6 +152,23 @@ WatchedRun runWatched(const Lab& lab, Engine engine, const Watchdog& wd, Deadlin
     stop(t, stoppedSentence(sim->failure(), t));
   }
   return out;
+}
+
+json scenarioConfig(const json& applied, const Rubric& rubric, const Scenario& sc, const std::string& submission_hash,
+                    const std::string& config_file) {
+  json cfg = mergePatch(applied, sc.patch);
+  // The seed: fixed per submission and scenario, so noise is the same every time it is graded.
+  const std::uint64_t seed = std::stoull(hashHex(submission_hash + "/" + sc.name), nullptr, 16) & ((1ull << 53) - 1);
+  writeSeed(cfg, rubric, seed, config_file, sc.name);
+  return cfg;
+}
+
+const Scenario& findScenario(const Rubric& rubric, const std::string& name, const std::string& option) {
+  if (const Scenario* sc = rubric.scenario(name)) return *sc;
+  std::string known;
+  for (const Scenario& sc : rubric.scenarios) known += (known.empty() ? "" : ", ") + sc.name;
+  throw InputError("<command line>", option,
+                   "expected one of the rubric's scenarios (" + known + "), got \"" + name + "\"");
 }
 
 ScenarioRun runScenario(const Lab& lab, const Watchdog& wd, Deadline deadline, const std::string& config_file) {

@@ -66,6 +66,17 @@ WatchedRun runWatched(const Lab& lab, Engine engine, const Watchdog& watchdog, D
 ScenarioRun runScenario(const Lab& lab, const Watchdog& watchdog, Deadline deadline,
                         const std::string& config_file);
 
+// The config one rubric scenario runs on, exactly as the grader builds it: the submission's config
+// (its gains applied) merged with the scenario's patch (RFC 7386), and the scenario's noise seed,
+// derived from the submission's hash (grade.h submissionHash) and the scenario's name, written at
+// the rubric's seed_target. Used by the grader, `dynlab run/figure --scenario` and the tuning window,
+// so a scenario run locally is the graded one. Throws InputError (naming config_file) on a bad seed_target.
+json scenarioConfig(const json& applied, const Rubric& rubric, const Scenario& scenario,
+                    const std::string& submission_hash, const std::string& config_file);
+
+// The rubric's scenario NAME; else InputError("<command line>", option, the names it knows).
+const Scenario& findScenario(const Rubric& rubric, const std::string& name, const std::string& option = "--scenario");
+
 // Format a number for people: 4 significant digits.
 std::string fmtNumber(double x);
 

@@ -23,7 +23,7 @@ using namespace dyn;
 using namespace dyn::ui;
 
 struct Args {
-  std::string lab, config, gains, engine = "both", size = "1320x720", save, screenshot, state;
+  std::string lab, config, gains, scenario, engine = "both", size = "1320x720", save, screenshot, state;
   std::vector<std::string> set;
   double speed = 1.0;
   bool paused = false;
@@ -78,6 +78,7 @@ json frameState(const TuningSession& s, const WindowContext& ctx, const Layout& 
   if (s.hasRows())
     for (std::size_t c = 0; c < s.primary().columns.size(); ++c) values[s.primary().columns[c]] = s.primary().at(s.row(), int(c));
   return {{"lab", s.labName()},
+          {"scenario", s.scenario()},
           {"frame", frame},
           {"row", s.row()},
           {"t", s.time()},
@@ -106,7 +107,7 @@ bool writeText(const std::string& path, const std::string& text) {
 
 int run(const Args& a) {
   // Everything that can be wrong with the input is checked before a window opens.
-  TuningSession session(a.lab, a.config, a.gains);
+  TuningSession session(a.lab, a.config, a.gains, a.scenario);
   for (const auto& s : a.set) session.set(s);
   session.setEngine(parseEngineChoice(a.engine));
   session.restart();
@@ -222,6 +223,7 @@ int main(int argc, char** argv) {
   cli.add_option("LAB", a.lab, "Lab name (see `dynlab list`)")->required();
   cli.add_option("--config", a.config, "Lab config JSON (default: labs/LAB/LAB.json)");
   cli.add_option("--gains", a.gains, "Start from these gains: a submission or gains JSON");
+  cli.add_option("--scenario", a.scenario, "Tune under one rubric scenario (heavy_load, noisy_sensor, ...) exactly as the grader runs it");
   cli.add_option("--set", a.set, "NAME=VALUE: set a gain or an option (e.g. kp=500, law=integral: names the lab's JSON declares); repeatable");
   cli.add_option("--engine", a.engine, "hand, bullet, or both (Bullet drawn as a ghost)")->check(CLI::IsMember({"hand", "bullet", "both"}));
   cli.add_option("--speed", a.speed, "Simulated seconds per wall second")->check(CLI::Range(0.02, 20.0));

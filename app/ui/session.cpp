@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "grading/grade.h"
 #include "grading/rubric.h"
 #include "labs/run.h"
 #include "labs/submission.h"
@@ -30,7 +31,8 @@ EngineChoice parseEngineChoice(const std::string& s) {
   throw InputError("<command line>", "--engine", "expected one of hand, bullet, both, got \"" + s + "\"");
 }
 
-TuningSession::TuningSession(const std::string& lab, const std::string& config_file, const std::string& gains_file) {
+TuningSession::TuningSession(const std::string& lab, const std::string& config_file, const std::string& gains_file,
+                             const std::string& scenario) {
   LoadedLab loaded = loadLab(lab, config_file, gains_file);
   lab_name_ = lab;
   entry_ = loaded.entry;
@@ -70,13 +72,22 @@ TuningSession::TuningSession(const std::string& lab, const std::string& config_f
     options_[oname] = current(file_config_);
     option_specs_.push_back(o);
   }
-  if (file_config_.contains("rubric")) watchdog_ = parseRubric(JsonView(file_config_, config_file_)).watchdog;
+  if (file_config_.contains("rubric")) {
+    rubric_ = parseRubric(JsonView(file_config_, config_file_));
+    watchdog_ = rubric_.watchdog;
+  }
+  if (!scenario.empty()) {
+    if (!file_config_.contains("rubric"))
+      throw InputError("<command line>", "--scenario", "expected a lab with a rubric; " + config_file_ + " has none");
+    scenario_ = findScenario(rubric_, scenario).name;
+  }
   restart();
 }
 
 std::string TuningSession::title() const {
   const auto it = file_config_.find("title");
-  return it != file_config_.end() && it->is_string() ? it->get<std::string>() : lab_name_;
+  const std::string t = it != file_config_.end() && it->is_string() ? it->get<std::string>() : lab_name_;
+  return scenario_.empty() ? t : t + " — scenario " + scenario_;
 }
 
 double TuningSession::gain(const std::string& gname) const { return gains_.at(gname).get<double>(); }
@@ -195,7 +206,11 @@ void TuningSession::restart() {
   runs_.clear();
   lab_.reset();
   try {
-    effective_config_ = applySubmission(file_config_, JsonView(submission(), source_), lab_name_, true);
+    const json sub = submission();
+    effective_config_ = applySubmission(file_config_, JsonView(sub, source_), lab_name_, true);
+    // Under a scenario: its patch and the seed grading this submission (once saved) would use.
+    if (!scenario_.empty())
+      effective_config_ = scenarioConfig(effective_config_, rubric_, *rubric_.scenario(scenario_), submissionHash(sub), config_file_);
     lab_ = buildLab(*entry_, effective_config_, source_);
     watch_ = std::make_unique<RowWatch>(watchdog_, lab_->columns(), config_file_);
     const ScreenResult screen = screenLoops(*lab_);

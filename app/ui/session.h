@@ -34,12 +34,16 @@ EngineChoice parseEngineChoice(const std::string& s);  // "hand" | "bullet" | "b
 class TuningSession {
  public:
   // Loads LAB's config (default path unless config_file), applies an optional gains file, builds
-  // the lab and starts a run. Throws InputError on bad input (nothing is opened).
-  TuningSession(const std::string& lab, const std::string& config_file = "", const std::string& gains_file = "");
+  // the lab and starts a run. Throws InputError on bad input (nothing is opened). With a scenario,
+  // every run is under that rubric scenario exactly as the grader runs it (grading/scenario.h
+  // scenarioConfig), its noise seeded as grading submission() would seed it.
+  TuningSession(const std::string& lab, const std::string& config_file = "", const std::string& gains_file = "",
+                const std::string& scenario = "");
 
   // ---- what can be tuned --------------------------------------------------------------------
   const std::string& labName() const { return lab_name_; }
-  std::string title() const;  // the config's "title", else the lab name
+  std::string title() const;  // the config's "title", else the lab name; + " — scenario NAME" under one
+  const std::string& scenario() const { return scenario_; }  // the rubric scenario, or ""
   const std::vector<GainSpec>& gainSpecs() const { return gain_specs_; }
   const std::vector<OptionSpec>& optionSpecs() const { return option_specs_; }
   double gain(const std::string& name) const;
@@ -112,6 +116,8 @@ class TuningSession {
   json options_ = json::object();  // name -> choice
   EngineChoice engine_ = EngineChoice::Hand;
   Watchdog watchdog_;
+  Rubric rubric_;          // the lab's rubric (when it has one): scenarios and seed target
+  std::string scenario_;   // the rubric scenario every run is under, or ""
   std::unique_ptr<Lab> lab_;
   std::unique_ptr<RowWatch> watch_;
   std::vector<Run> runs_;  // [0] primary, [1] ghost

@@ -1,6 +1,7 @@
 // What the grasp lab shows: the finger bases, the fingers, the object and its reference outline, each
 // contact's friction cone (green inside, turning red as |f_t| nears μ f_n) with the force the finger
 // applies, the Bullet run as a translucent ghost, and the live overlay with the cone margins.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -13,6 +14,7 @@ const Color kLink{0.23f, 0.42f, 0.68f, 1.0f}, kJoint{0.15f, 0.15f, 0.18f, 1.0f},
 const Color kObject{0.85f, 0.55f, 0.20f, 1.0f}, kRef{0.20f, 0.65f, 0.30f, 1.0f}, kForce{0.85f, 0.15f, 0.15f, 1.0f};
 const Color kInside{0.20f, 0.70f, 0.30f, 0.35f}, kEdge{0.90f, 0.15f, 0.10f, 0.45f};
 const Color kGhost{0.55f, 0.35f, 0.75f, 0.35f};
+constexpr double kConeLength = 0.035;  // m, the drawn friction cones
 
 Eigen::Vector3d at(const Eigen::Vector2d& p, double z = 0) { return {p.x(), p.y(), z}; }
 
@@ -43,26 +45,48 @@ void drawObject(const Object& o, const Eigen::Vector3d& pose, Color c, double z,
   s.boxes.push_back({at(pose.tail<2>(), z), {0.5 * o.size.x(), 0.5 * o.size.y(), 0.012}, rotZ(pose[0]), c});
 }
 
+// The space the mechanism moves through over the run (the rows so far, both engines), as drawn: the
+// bases, every finger point (with its joint's radius), the object's corners and its contacts' cones.
+Eigen::AlignedBox3d runBounds(const Mechanism& mech, const Trace& tr, const Trace* ghost, const Params& p) {
+  Eigen::AlignedBox3d box;
+  const Eigen::Vector3d pad(0.009, 0.009, 0.0);
+  for (const Finger& f : p.fingers) box.extend(at(f.base) - Eigen::Vector3d(0.014, 0.022, 0)), box.extend(at(f.base) + Eigen::Vector3d(0.014, 0, 0));
+  const Eigen::Vector2d h = 0.5 * p.object.size;
+  for (const Trace* t : {&tr, ghost}) {
+    if (!t || t->rows() == 0) continue;
+    const std::size_t stride = std::max<std::size_t>(1, t->rows() / 400);
+    auto add = [&](std::size_t r) {
+      const VecN q = stateAt(*t, r, mech.fingers());
+      const Eigen::Vector3d pose = q.tail(3);
+      const Eigen::Matrix2d R = rotZ(pose[0]).topLeftCorner<2, 2>();
+      for (int i = 0; i < mech.fingers(); ++i) {
+        for (const auto& pt : mech.fingerPoints(i, q)) box.extend(at(pt) - pad), box.extend(at(pt) + pad);
+        // The cone's far rim: L (n ± μ t) from the contact.
+        const Eigen::Vector2d c = mech.contactPoint(i, pose), n = R * p.fingers[std::size_t(i)].normal.normalized();
+        const Eigen::Vector2d t(-n.y(), n.x());
+        for (const double sgn : {-1.0, 1.0}) box.extend(at(c + kConeLength * (n + sgn * p.mu * t)));
+      }
+      for (const double sx : {-1.0, 1.0})
+        for (const double sy : {-1.0, 1.0}) box.extend(at(pose.tail<2>() + R * Eigen::Vector2d(sx * h.x(), sy * h.y())));
+    };
+    for (std::size_t r = 0; r < t->rows(); r += stride) add(r);
+    add(t->rows() - 1);
+  }
+  return box;
+}
+
 }  // namespace
 
 void GraspLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene& s) const {
   const Mechanism mech(s_.params);
   const int m = fingers();
-  // Camera: every base and the object's whole path in the right 60 % of the frame, clear of the panel.
-  double x_lo = 1e9, x_hi = -1e9, y_lo = 1e9, y_hi = -1e9;
-  const double reach = s_.params.fingers[0].links[0].length + s_.params.fingers[0].links[1].length;
-  for (const Finger& f : s_.params.fingers) {
-    x_lo = std::min(x_lo, f.base.x() - 0.5 * reach), x_hi = std::max(x_hi, f.base.x() + 0.5 * reach);
-    y_lo = std::min(y_lo, f.base.y() - 0.03);
-  }
-  const Reference& ref = s_.reference;
-  y_hi = std::max(s_.pose0[2], s_.pose0[2] + ref.lift) + s_.params.object.size.norm() + 0.02;
-  const double visible_w = (x_hi - x_lo) / 0.6;
+  // Side-on, orthographic; the renderer fits the run's space (bases, fingers, object, cones) into the
+  // frame beside the panel (Scene::framing), so the camera holds still from frame to frame.
   s.camera.ortho = true;
-  s.camera.half_width = 0.5 * visible_w;
-  s.camera.half_height = 0.5 * (y_hi - y_lo) + 0.02;
-  s.camera.target = {x_hi + 0.01 - 0.5 * visible_w, 0.5 * (y_lo + y_hi), 0};
-  s.camera.eye = s.camera.target + Eigen::Vector3d(0, 0, 5);
+  s.camera.eye = {0, 0, 5};
+  s.camera.target = {0, 0, 0};
+  s.framing.fit = true;
+  s.framing.bounds = runBounds(mech, tr, ghost && row < ghost->rows() ? ghost : nullptr, s_.params);
 
   // Bases on the ground.
   for (const Finger& f : s_.params.fingers) s.boxes.push_back({at(f.base - Eigen::Vector2d(0, 0.012), -0.01), {0.014, 0.01, 0.012}, Eigen::Matrix3d::Identity(), kBase});
@@ -94,7 +118,7 @@ void GraspLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene
     const Eigen::Vector2d n = rotZ(pose[0]).topLeftCorner<2, 2>() * s_.params.fingers[std::size_t(i)].normal.normalized();
     const double f_n = tr.at(row, f + "_n"), f_t = tr.at(row, f + "_t");
     const double used = f_n > 0 ? std::abs(f_t) / (mu * f_n) : 1.0;
-    s.cones.push_back({at(p, 0.02), at(n), std::atan(mu), 0.035, mix(kInside, kEdge, (used - 0.5) / 0.5)});
+    s.cones.push_back({at(p, 0.02), at(n), std::atan(mu), kConeLength, mix(kInside, kEdge, (used - 0.5) / 0.5)});
     const Eigen::Vector2d force(tr.at(row, f + "_x"), tr.at(row, f + "_y"));
     if (force.norm() > 1e-9) {
       const Eigen::Vector2d v = force * s_.arrow_scale;
@@ -115,12 +139,11 @@ void GraspLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
                                 fmt("%.1f mm", 1e3 * (tr.at(row, "y_o") - tr.at(row, "y_d")))},
              {"f_int", fmt("%.2f N", tr.at(row, "f_int"))},
              {"cone margin", fmt("%.2f N", tr.at(row, "cone_margin")) + fmt(" (mu = %.2f)", s_.params.mu)}};
-  // Live plots over the last two seconds.
+  // Live plots over the last two seconds: every step, up to and including this row.
   Series margin{"cone margin (N)", {}, kRef}, squeeze{"f_int (N)", {}, kForce};
-  const std::size_t window = std::size_t(2.0 / s_.step.dt);
+  const std::size_t window = std::size_t(std::lround(2.0 / s_.step.dt));
   const std::size_t first = row > window ? row - window : 0;
-  const std::size_t stride = std::max<std::size_t>(1, window / 200);
-  for (std::size_t r = first; r <= row; r += stride) {
+  for (std::size_t r = first; r <= row; ++r) {
     margin.values.push_back(float(tr.at(r, "cone_margin")));
     squeeze.values.push_back(float(tr.at(r, "f_int")));
   }

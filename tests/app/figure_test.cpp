@@ -112,6 +112,45 @@ TEST_CASE("dynlab figure --plot: valid PDF, SVG and PNG files, legend per column
   CHECK(hand != svg);
 }
 
+// The largest font-size="N" of an SVG (PLplot writes one per text).
+int largestFont(const std::string& svg) {
+  int most = 0;
+  for (std::size_t at = svg.find("font-size=\""); at != std::string::npos; at = svg.find("font-size=\"", at + 1))
+    most = std::max(most, std::atoi(svg.c_str() + at + 11));
+  return most;
+}
+
+TEST_CASE("dynlab figure: plots are --size big (PNG pixels, PDF and SVG page), text --font-scale, y --y-scale") {
+  TempDir dir("figure_plot_size");
+  const std::string fig = "figure slider_crank --duration 0.3 --plot x_c ";
+  REQUIRE(dynlab(dir, fig + "--out a --format png --size 1280x720").code == 0);
+  CHECK(pngSize(readFile(dir / "a/plot_x_c.png")) == std::pair<int, int>(1280, 720));
+  REQUIRE(dynlab(dir, fig + "--out b --format pdf --size 1024x768").code == 0);
+  CHECK(readFile(dir / "b/plot_x_c.pdf").find("/MediaBox [ 0 0 1024 768 ]") != std::string::npos);
+  REQUIRE(dynlab(dir, fig + "--out c --format svg --size 640x360").code == 0);
+  const std::string small = readFile(dir / "c/plot_x_c.svg");
+  CHECK(small.find("width=\"640px\"") != std::string::npos);
+  CHECK(small.find("height=\"360px\"") != std::string::npos);
+  // Without --size a plot is 800x450 (a still 1920x1080).
+  REQUIRE(dynlab(dir, fig + "--out d --format pdf").code == 0);
+  CHECK(readFile(dir / "d/plot_x_c.pdf").find("/MediaBox [ 0 0 800 450 ]") != std::string::npos);
+  // --font-scale: the same page, bigger text.
+  REQUIRE(dynlab(dir, fig + "--out e --format svg --size 640x360 --font-scale 2").code == 0);
+  const std::string big = readFile(dir / "e/plot_x_c.svg");
+  CHECK(largestFont(big) >= 1.8 * largestFont(small));
+  CHECK(big.find("width=\"640px\"") != std::string::npos);
+  // --y-scale log: tick labels are powers of ten ("10" with a superscript exponent); linear: none.
+  const std::string residual = "figure slider_crank --duration 0.3 --plot constraint_residual --engine bullet --format svg ";
+  REQUIRE(dynlab(dir, residual + "--out f --y-scale log").code == 0);
+  CHECK(test::svgText(readFile(dir / "f/plot_constraint_residual.svg")).find(">10<tspan") != std::string::npos);
+  REQUIRE(dynlab(dir, residual + "--out h --y-scale linear").code == 0);
+  CHECK(test::svgText(readFile(dir / "h/plot_constraint_residual.svg")).find(">10<tspan") == std::string::npos);
+  // A plot needs room for its labels; a bad scale is named.
+  checkBadInput(dir, fig + "--out g --size 80x60", {"--size 80x60", "at least 100x100"}, dir / "g");
+  CHECK(dynlab(dir, fig + "--out g --y-scale cubic").code == 2);
+  CHECK(dynlab(dir, fig + "--out g --font-scale 0").code == 2);
+}
+
 TEST_CASE("dynlab figure --still: the requested size, the arm and slider where the trace puts them at t") {
   TempDir dir("figure_still");
   const double t = 1.0;  // half the reference period: the slider has moved its full stroke

@@ -296,7 +296,7 @@ TEST_CASE("run_autograder: dynlab's own results.json is kept, and it gets the la
   const auto r = box.run();
   CHECK(r.at("score").get<double>() == 7.5);
   const std::string args = readBytes(box.dir / "args.txt");
-  CHECK(args == "grade\n" + (box.submission / "my gains.json").string() + "\n--time-budget\n300\n--lab\nslider_crank\n--out\n" +
+  CHECK(args == "grade\n" + (box.submission / "my gains.json").string() + "\n--time-budget\n300\n--lab\nslider_crank\n--inline-plots\n--out\n" +
                     box.results.string() + "\n");
 }
 
@@ -570,6 +570,13 @@ TEST_CASE("run_autograder with the real dynlab: an example is graded and its res
   CHECK(r.at("score").get<double>() > 0.0);
   CHECK(r.at("tests").size() > 3);
   CHECK(box.log().find("no grade from dynlab") == std::string::npos);
+  // The student sees each simulated test's plot: HTML output with the PNG inline.
+  int inline_plots = 0;
+  for (const auto& t : r.at("tests")) {
+    CHECK(t.at("output_format") == "html");
+    inline_plots += t.at("output").get<std::string>().find("src=\"data:image/png;base64,iVBORw0KGgo") != std::string::npos;
+  }
+  CHECK(inline_plots == 8);
 }
 
 TEST_CASE("run_autograder: a link out of the submission, a FIFO or a device is refused unread") {

@@ -99,7 +99,9 @@ void put(const fs::path& p, const std::string& text) {
 
 void copyExample(const std::string& example, const fs::path& to) {
   fs::create_directories(to.parent_path());
-  fs::copy_file(kExamples / (example + ".json"), to, fs::copy_options::overwrite_existing);
+  // "good" is the full-credit example, kept with the instructor's files (not the students').
+  const fs::path from = example == "good" ? kExamples.parent_path() / "instructor" / "good.json" : kExamples / (example + ".json");
+  fs::copy_file(from, to, fs::copy_options::overwrite_existing);
 }
 
 // Each grader's time budget: 1 s (a grade takes ~0.15 s); scripts/sanitize raises it, since grading
@@ -191,7 +193,7 @@ TEST_CASE("hostile submission names: each its own safe folder inside OUT, nothin
     INFO("row " << name);
     const std::string folder = row.at("folder");
     CHECK(std::regex_match(folder, safe));
-    for (const char* own : {"gradebook.csv", "gradebook.csv.tmp", ".dynlab-batch.lock"}) CHECK(folder != own);
+    for (const char* own : {"gradebook.csv", "gradebook.csv.tmp", "gradebook.md", ".dynlab-batch.lock"}) CHECK(folder != own);
     CHECK(folder != "x");  // the TA's folder is not reused
     CHECK(folders.insert(folder).second);  // one folder each
     const json results = json::parse(readFile(out / folder / "results.json"));
@@ -209,14 +211,26 @@ TEST_CASE("hostile submission names: each its own safe folder inside OUT, nothin
   CHECK(book.at("...json").at("status") == "graded");
   CHECK(book.at("...json").at("score") == "15");
   CHECK(book.at("a_b.json").at("reason") == "/gains/kp_x: expected a number, got \"high\"");
-  // OUT holds the gradebook, the lock and one folder per submission (plus the TA's), nothing else.
+  // The summary lists every name that was not graded, as one line of text each: no tag, no control
+  // character.
+  const std::string md = readFile(out / "gradebook.md");
+  CHECK(md.find("<img") == std::string::npos);
+  CHECK(md.find("&lt;img src=x onerror=alert(1)&gt;.json") != std::string::npos);
+  CHECK(md.find("tab.json") != std::string::npos);  // listed, its tab shown as \t
+  CHECK(md.find('\t') == std::string::npos);
+  std::size_t listed = 0;
+  for (const auto& [name, row] : book) listed += row.at("status") == "invalid submission";
+  const std::size_t section = md.find("## Not graded");
+  REQUIRE(section != std::string::npos);
+  CHECK(std::size_t(std::count(md.begin() + std::ptrdiff_t(section), md.end(), '\n')) == listed + 4);  // heading, blank, header, rule
+  // OUT holds the gradebook and its summary, the lock and one folder per submission (plus the TA's), nothing else.
   std::size_t entries = 0;
   for (const auto& e : fs::directory_iterator(out)) {
     ++entries;
     const std::string n = e.path().filename().string();
-    CHECK_MESSAGE((n == "gradebook.csv" || n == ".dynlab-batch.lock" || n == "x" || folders.count(n)), n);
+    CHECK_MESSAGE((n == "gradebook.csv" || n == "gradebook.md" || n == ".dynlab-batch.lock" || n == "x" || folders.count(n)), n);
   }
-  CHECK(entries == names.size() + 3);
+  CHECK(entries == names.size() + 4);
 }
 
 TEST_CASE("a rerun grades afresh: a stale results.json never counts, a failing grader is a failure" * doctest::timeout(300)) {

@@ -18,6 +18,8 @@ using nlohmann::json;
 namespace {
 
 const std::string kExamples = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/examples/";
+// The full-credit example: course staff only, never in what students receive.
+const std::string kInstructor = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/instructor/";
 
 using dyn::test::readBytes;
 
@@ -31,10 +33,11 @@ fs::path makeBatch() {
   const fs::path dir = fs::temp_directory_path() / ("dynlab-batch-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "in");
-  for (const char* n : {"good", "mediocre", "unstable_integral"}) fs::copy_file(kExamples + n + ".json", dir / "in" / (std::string(n) + ".json"));
+  for (const char* n : {"mediocre", "unstable_integral"}) fs::copy_file(kExamples + n + ".json", dir / "in" / (std::string(n) + ".json"));
+  fs::copy_file(kInstructor + "good.json", dir / "in" / "good.json");
   std::ofstream(dir / "in" / "malformed.json") << "{\"lab\": \"slider_crank\", \"gains\": {\"kp_x\": }";
-  fs::copy_file(kExamples + "good.json", dir / "in" / "hangs.json");
-  fs::copy_file(kExamples + "good.json", dir / "in" / "crashes.json");
+  fs::copy_file(kInstructor + "good.json", dir / "in" / "hangs.json");
+  fs::copy_file(kInstructor + "good.json", dir / "in" / "crashes.json");
   return dir;
 }
 

@@ -15,6 +15,8 @@ using namespace dyn;
 namespace {
 
 const std::string kExamples = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/examples/";
+// The full-credit example: course staff only, never in what students receive.
+const std::string kInstructor = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/instructor/";
 
 fs::path tempDir() {
   const fs::path d = fs::temp_directory_path() / ("dynlab-grade-test-" + std::to_string(::getpid()));
@@ -47,7 +49,7 @@ bool anyTestSays(const GradeOutcome& g, const std::string& text) {
 }  // namespace
 
 TEST_CASE("submissions score in their expected ranges, with messages that explain") {
-  const GradeOutcome good = grade(kExamples + "good.json");
+  const GradeOutcome good = grade(kInstructor + "good.json");
   const GradeOutcome mediocre = grade(kExamples + "mediocre.json");
   const GradeOutcome unstable = grade(kExamples + "unstable_integral.json");
   REQUIRE(maxScore(good) == doctest::Approx(15));
@@ -109,7 +111,7 @@ TEST_CASE("malformed submissions score 0 with a message naming file, JSON path a
   // A submission for another lab than the assignment's.
   GradeOptions o;
   o.expected_lab = "unicycle";
-  CHECK(grade(kExamples + "good.json", o).results.at("output").get<std::string>().find("this assignment's lab") != std::string::npos);
+  CHECK(grade(kInstructor + "good.json", o).results.at("output").get<std::string>().find("this assignment's lab") != std::string::npos);
 }
 
 TEST_CASE("grading twice gives the same results apart from execution_time; replay detects a change") {
@@ -121,7 +123,7 @@ TEST_CASE("grading twice gives the same results apart from execution_time; repla
   CHECK(compareResults(a.results, b.results).empty());
   // The noisy scenario's seed comes from the submission: other gains, other trajectories.
   const auto fp = a.results["extra_data"]["fingerprint"];
-  CHECK(fp["trajectory_hash"] != grade(kExamples + "good.json").results["extra_data"]["fingerprint"]["trajectory_hash"]);
+  CHECK(fp["trajectory_hash"] != grade(kInstructor + "good.json").results["extra_data"]["fingerprint"]["trajectory_hash"]);
   // A tampered score is reported.
   json tampered = a.results;
   tampered["tests"][0]["score"] = 3.0;
@@ -131,7 +133,7 @@ TEST_CASE("grading twice gives the same results apart from execution_time; repla
 }
 
 TEST_CASE("results.json has Gradescope's field names and types") {
-  for (const std::string& f : {kExamples + "good.json", kExamples + "unstable_integral.json", writeFile("bad.json", "{")}) {
+  for (const std::string& f : {kInstructor + "good.json", kExamples + "unstable_integral.json", writeFile("bad.json", "{")}) {
     CAPTURE(f);
     const json r = grade(f).results;
     CHECK(r.at("score").is_number());
@@ -164,7 +166,7 @@ TEST_CASE("results.json has Gradescope's field names and types") {
 TEST_CASE("the time budget and the step budget stop runs without losing the grade") {
   GradeOptions o;
   o.time_budget = 1e-6;  // already over when the first run starts
-  const GradeOutcome late = grade(kExamples + "good.json", o);
+  const GradeOutcome late = grade(kInstructor + "good.json", o);
   CHECK_FALSE(late.input_error);
   CHECK(anyTestSays(late, "not graded: the grading time budget ran out"));
   CHECK(late.results["tests"].size() == 10);
@@ -176,7 +178,7 @@ TEST_CASE("the time budget and the step budget stop runs without losing the grad
   config["rubric"]["watchdog"]["max_steps"] = 100;
   GradeOptions s;
   s.config_file = writeFile("short_budget.json", config.dump());
-  const GradeOutcome g = grade(kExamples + "good.json", s);
+  const GradeOutcome g = grade(kInstructor + "good.json", s);
   CHECK(anyTestSays(g, "exceeded its step budget of 100 steps"));
 }
 
@@ -185,7 +187,7 @@ TEST_CASE("a rubric naming a metric the lab does not report is the config's erro
   config["rubric"]["tests"][0]["metric"] = "x_rsm";
   GradeOptions o;
   o.config_file = writeFile("typo_rubric.json", config.dump());
-  const GradeOutcome g = grade(kExamples + "good.json", o);
+  const GradeOutcome g = grade(kInstructor + "good.json", o);
   const std::string out = g.results["output"];
   CHECK(out.find("typo_rubric.json") != std::string::npos);
   CHECK(out.find("/rubric/tests/0/metric") != std::string::npos);
@@ -243,7 +245,7 @@ TEST_CASE("a scenario patch that removes the seed's object is the config's error
   config["rubric"]["scenarios"]["long_delay"]["patch"] = {{"controller", 5}};
   GradeOptions o;
   o.config_file = writeFile("seedless_rubric.json", config.dump());
-  const GradeOutcome g = grade(kExamples + "good.json", o);
+  const GradeOutcome g = grade(kInstructor + "good.json", o);
   CHECK(g.input_error);
   REQUIRE(g.results["extra_data"].contains("error"));
   CHECK(g.results["extra_data"]["error"]["path"] == "/rubric/seed_target");
@@ -258,7 +260,7 @@ TEST_CASE("a rubric plot of a column the lab lacks is the config's error, found 
   GradeOptions o;
   o.config_file = writeFile("plot_column_rubric.json", config.dump());
   o.out_dir = (tempDir() / "plot_column_out").string();
-  const GradeOutcome g = grade(kExamples + "good.json", o);
+  const GradeOutcome g = grade(kInstructor + "good.json", o);
   CHECK(g.input_error);
   REQUIRE(g.results["extra_data"].contains("error"));
   CHECK(g.results["extra_data"]["error"]["path"] == "/rubric/tests/1/plot/columns/0");
@@ -272,10 +274,10 @@ TEST_CASE("feedback gives every metric its unit: the lab's metric_docs, and the 
   CHECK(g.report.find("f_rms = 0.1483 N (full 0.05 N, zero 0.5 N)") != std::string::npos);
   CHECK(g.report.find("force_delay_margin = 0.1963 s (full 0.03 s, zero 0.01 s)") != std::string::npos);
   CHECK(g.report.find("motion_damping = 0.2019 (full 0.7, zero 0.2)") != std::string::npos);  // dimensionless
-  // The student's view (results.json, Markdown) and report.md's table say the same.
+  // The student's view (results.json, HTML) and report.md's table say the same.
   bool found = false;
   for (const auto& t : g.results.at("tests"))
-    if (t.at("name") == "Slider tracks x_d(t)") found = t.at("output").get<std::string>().find("= **0.01113 m**; full credit at 0.003 m") != std::string::npos;
+    if (t.at("name") == "Slider tracks x_d(t)") found = t.at("output").get<std::string>().find("= <strong>0.01113 m</strong>; full credit at 0.003 m") != std::string::npos;
   CHECK(found);
   CHECK(g.markdown.find("| 0.01113 m | 0.003 m | 0.03 m |") != std::string::npos);
 }

@@ -8,6 +8,7 @@
 #include "tests/test_files.h"
 #include <stb/stb_image.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -252,4 +253,150 @@ TEST_CASE("bad input throws naming the path") {
   // A failure leaves neither the file nor its .tmp behind.
   CHECK(!fs::exists(dir / "m.png"));
   CHECK(noTmpLeft(dir));
+}
+
+namespace {
+
+// Pixels near colour c inside a box given in pixels.
+int countIn(const Image& img, const PlotBox& box, const int* c, int tol = 40) {
+  int n = 0;
+  for (int y = std::max(0, int(box.y0) + 2); y < std::min(img.h, int(box.y1) - 2); ++y)
+    for (int x = std::max(0, int(box.x0) + 2); x < std::min(img.w, int(box.x1) - 2); ++x) n += img.near(x, y, c[0], c[1], c[2], tol);
+  return n;
+}
+
+// Hatching pixels: a light bluish grey (the span colour, or its anti-aliased blend with white).
+int hatchIn(const Image& img, const PlotBox& box) {
+  int n = 0;
+  for (int y = int(box.y0); y < int(box.y1); ++y)
+    for (int x = int(box.x0); x < int(box.x1); ++x) {
+      const unsigned char* p = &img.rgb[(static_cast<size_t>(y) * img.w + x) * 3];
+      n += p[0] >= 150 && p[0] < 245 && std::abs(p[0] - p[1]) <= 3 && p[2] - p[0] >= 5;
+    }
+  return n;
+}
+
+// A fraction [a, b] of a box's width (all of its height).
+PlotBox part(const PlotBox& f, double a, double b) { return {f.x0 + a * (f.x1 - f.x0), f.y0, f.x0 + b * (f.x1 - f.x0), f.y1}; }
+
+constexpr int kGreen[3] = {0, 158, 115};
+
+}  // namespace
+
+TEST_CASE("a noisy series is drawn faint, under the smooth response, its reference and band") {
+  const fs::path dir = scratch("faint");
+  const auto x = linspace(4000, 0.0, 4.0);
+  PlotSeries response{"f_Ty", x, {}, PlotSeries::Style::Solid, 0}, reference{"f_des (reference)", x, {}, PlotSeries::Style::Dashed, 1};
+  for (double t : x) response.y.push_back(-5 + 0.2 * std::sin(3 * t)), reference.y.push_back(-5);
+  // A measurement of the response with noise, listed last (drawn last, over everything, before).
+  PlotSeries meas{"f_meas", x, response.y, PlotSeries::Style::Solid, 2};
+  std::srand(7);
+  for (double& v : meas.y) v += 1.5 * (std::rand() / double(RAND_MAX) - 0.5);
+  // The same plot without it, on the same axes (two isolated samples hold the range).
+  PlotSeries range{"", x, std::vector<double>(x.size(), NAN), PlotSeries::Style::Solid, 2};
+  range.y[0] = *std::min_element(meas.y.begin(), meas.y.end());
+  range.y[2] = *std::max_element(meas.y.begin(), meas.y.end());
+  PlotSpec s;
+  s.bands.push_back({"tolerance", x, std::vector<double>(x.size(), -5.25), std::vector<double>(x.size(), -4.75)});
+  s.series = {reference, response, meas};
+  const PlotLayout b = writePlot((dir / "noisy.png").string(), s, 640, 360);
+  s.series.back() = range;
+  const PlotLayout a = writePlot((dir / "clean.png").string(), s, 640, 360);
+  const Image clean(dir / "clean.png"), with_noise(dir / "noisy.png");
+  // The response and the reference keep most of their pixels (the noise under them is thin and
+  // translucent), and the noise is there.
+  const int blue_clean = countIn(clean, a.frame, kBlue), blue_noisy = countIn(with_noise, b.frame, kBlue);
+  const int ref_clean = countIn(clean, a.frame, kVermillion), ref_noisy = countIn(with_noise, b.frame, kVermillion);
+  INFO("response pixels " << blue_clean << " → " << blue_noisy << ", reference " << ref_clean << " → " << ref_noisy);
+  CHECK(blue_noisy > 0.8 * blue_clean);
+  CHECK(ref_noisy > 0.8 * ref_clean);
+  CHECK(countIn(with_noise, b.frame, kGreen, 120) > 1000);
+  // The noise is not drawn at full strength: no pixel of the frame is the pure palette green.
+  CHECK(countIn(with_noise, b.frame, kGreen, 6) == 0);
+}
+
+TEST_CASE("the legend never covers the data: right of the frame, or below it when wide") {
+  const fs::path dir = scratch("legend");
+  const auto x = linspace(400, 0.0, 1.0);
+  for (const std::string label : {"x", "a rather long legend entry that cannot fit beside the frame of the plot"})
+    for (auto [w, h] : {std::pair{800, 450}, std::pair{640, 360}, std::pair{1920, 1080}, std::pair{300, 300}}) {
+      CAPTURE(label);
+      CAPTURE(w);
+      PlotSpec s;
+      // Data filling the whole frame: any legend inside it would cover some.
+      PlotSeries fill{label, x, {}, PlotSeries::Style::Solid, 0};
+      for (double t : x) fill.y.push_back(std::sin(200 * t));
+      s.series = {fill, {label + " 2", x, std::vector<double>(x.size(), 0.0), PlotSeries::Style::Dashed, 1}};
+      s.spans.push_back({"not scored", 0.0, 0.1});
+      s.bands.push_back({"band", x, std::vector<double>(x.size(), -0.1), std::vector<double>(x.size(), 0.1)});
+      s.title = "legend";
+      s.xlabel = "t (s)";
+      const PlotLayout l = writePlot((dir / "p.png").string(), s, w, h);
+      REQUIRE_FALSE(l.legend.empty());
+      CHECK_FALSE(l.legend.overlaps(l.frame));
+      CHECK(l.legend.x1 <= w + 1);
+      CHECK(l.legend.y1 <= h + 1);
+      CHECK(l.legend.x0 >= -1);
+      // Short labels sit right of a frame of a usual size, long ones below it.
+      if (label == "x" && w >= 640) CHECK(l.legend.x0 >= l.frame.x1);
+      else CHECK(l.legend.y0 >= l.frame.y1);
+    }
+}
+
+TEST_CASE("log y: automatic for positive data over decades, so a 1e-14 residual beside 1e-7 is visible") {
+  const fs::path dir = scratch("log");
+  const auto x = linspace(1000, 0.0, 4.0);
+  PlotSpec s;
+  PlotSeries hand{"hand", x, {}, PlotSeries::Style::Solid, 0}, bullet{"Bullet", x, {}, PlotSeries::Style::Dashed, 1};
+  for (double t : x) hand.y.push_back(1e-14 * (1.5 + std::sin(5 * t))), bullet.y.push_back(1e-7 * (1.5 + std::sin(3 * t)));
+  hand.y[0] = 0.0;  // a zero is left out of a log plot, not an error
+  s.series = {hand, bullet};
+  s.y_scale = YScale::Auto;
+  const PlotLayout log = writePlot((dir / "auto.png").string(), s);
+  s.y_scale = YScale::Linear;
+  const PlotLayout lin = writePlot((dir / "linear.png").string(), s);
+  CHECK(log.log_y);
+  CHECK_FALSE(lin.log_y);
+  // Where the hand residual's pixels are: well above the frame's bottom on the log axis, on it
+  // (indistinguishable from zero) on the linear one.
+  const auto lowest = [](const Image& img, const PlotBox& f) {
+    double sum = 0;
+    int n = 0;
+    for (int y = int(f.y0) + 2; y < int(f.y1) - 1; ++y)
+      for (int x = int(f.x0) + 2; x < int(f.x1) - 2; ++x)
+        if (img.near(x, y, kBlue[0], kBlue[1], kBlue[2])) sum += y, ++n;
+    return n ? (f.y1 - sum / n) / (f.y1 - f.y0) : -1.0;  // mean height above the bottom, in frames
+  };
+  CHECK(lowest(Image(dir / "auto.png"), log.frame) > 0.08);
+  CHECK(lowest(Image(dir / "linear.png"), lin.frame) < 0.06);
+  // Data below zero stay linear under Auto; Log is there when asked.
+  s.series[0].y[5] = -1e-14;
+  s.y_scale = YScale::Auto;
+  CHECK_FALSE(writePlot((dir / "neg.png").string(), s).log_y);
+  s.y_scale = YScale::Log;
+  CHECK(writePlot((dir / "forced.png").string(), s).log_y);
+}
+
+TEST_CASE("a span is hatched over its stretch of x, and nowhere else") {
+  const fs::path dir = scratch("span");
+  PlotSpec s = crossingSpec();
+  s.spans.push_back({"not scored", 0.0, 0.25});
+  const PlotLayout l = writePlot((dir / "span.png").string(), s);
+  s.spans.clear();
+  writePlot((dir / "plain.png").string(), s);
+  const Image span(dir / "span.png"), plain(dir / "plain.png");
+  CHECK(hatchIn(span, part(l.frame, 0.02, 0.23)) > 200);
+  CHECK(hatchIn(span, part(l.frame, 0.3, 0.98)) == 0);
+  CHECK(hatchIn(plain, part(l.frame, 0.02, 0.23)) == 0);
+}
+
+TEST_CASE("a PDF's page and a PNG's picture are the size asked for") {
+  const fs::path dir = scratch("page");
+  writePlot((dir / "p.pdf").string(), crossingSpec(), 1280, 720);
+  const std::string pdf = readBytes(dir / "p.pdf");
+  CHECK(pdf.find("/MediaBox [ 0 0 1280 720 ]") != std::string::npos);
+  writePlot((dir / "p.png").string(), crossingSpec(), 1280, 720);
+  const Image png(dir / "p.png");
+  CHECK(png.w == 1280);
+  CHECK(png.h == 720);
 }

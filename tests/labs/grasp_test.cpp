@@ -174,7 +174,7 @@ TEST_CASE("grasp: hand and Bullet agree within tolerances stated per dt") {
   // determined by the object's motion and agrees to ~3e-3 N; the squeeze is determined by the fingers'
   // dynamics here (not by the solver: the grip is not statically indeterminate once the fingers have
   // inertia) and agrees to ~5e-4 N with Bullet's PGS at 50 iterations. Limits: 3× what was measured.
-  json good = loadJsonFile(std::string(DYNLAB_SOURCE_DIR) + "/labs/grasp/examples/good.json");
+  json good = loadJsonFile(std::string(DYNLAB_SOURCE_DIR) + "/labs/grasp/instructor/good.json");
   double previous = 0;
   for (const double dt : {1e-3, 5e-4}) {
     json patch = {{"gains", good["gains"]}, {"simulation", {{"dt", dt}}}};
@@ -240,7 +240,7 @@ TEST_CASE("grasp: three fingers hold the object too (the finger count comes from
   // A third finger from above, pressing on the top mid-point.
   fingers.push_back({{"base", {0.0, 0.30}}, {"links", fingers[0]["links"]}, {"elbow", "positive"},
                      {"contact", {0.0, 0.02}}, {"normal", {0.0, 1.0}}});
-  json gains = loadJsonFile(std::string(DYNLAB_SOURCE_DIR) + "/labs/grasp/examples/good.json")["gains"];
+  json gains = loadJsonFile(std::string(DYNLAB_SOURCE_DIR) + "/labs/grasp/instructor/good.json")["gains"];
   for (auto& [k, g] : gains.items()) g = json{{"value", g}};
   const auto lab = makeLab({{"mechanism", {{"fingers", fingers}}}, {"simulation", {{"duration", 1.0}}}, {"gains", gains}});
   CHECK(lab->columns().size() == makeLab(json::object())->columns().size() + 2 + 2 + 2 + 2);  // q, τ, f_xy, f_nt of finger 3

@@ -1,13 +1,14 @@
 // The lab contract (labs/lab.h), checked on one lab: every_lab_test runs it on each registered lab,
 // and a test may register a scratch lab (registerLab / unregisterLab) and run it on that too.
 //   config     the default config builds; every lab has the shared simulation block
-//   examples   the submission schema covers labs/<name>/examples/*.json, each applies strictly
+//   examples   the submission schema covers labs/<name>/examples/*.json (and instructor/*.json),
+//              each applies strictly
 //   engines    hand and Bullet run 200 steps with finite values
 //   passive    with passivePatch() (τ = 0) the energy stays within the lab's stated tolerance
 //   columns    the rubric's plot and watchdog columns exist; metrics read only columns that exist
 //   options    every rubric metric exists for every submission option choice (metrics + screening)
 //   grading    every example and every option choice grades to a valid results.json; the default
-//              gains score 20–50 % of the points (a weak, stable start)
+//              gains score 20–50 % of the points (a weak, stable start); every simulated test has a plot
 //   render     a frame of the scene renders non-blank (OSMesa)
 //   cli        `dynlab run` (the demo: both engines, whole run), `dynlab figure`, `dynlab grade` (and
 //              `dynlab ui` under xvfb-run): exit 0
@@ -22,6 +23,7 @@
 #include <vector>
 
 #include "grading/grade.h"
+#include "grading/metric_doc.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
 #include "labs/run.h"
@@ -188,8 +190,19 @@ inline void checkGrading(const LabEntry& entry, const std::string& config_file, 
   {
     const std::string file = (dir / "defaults.json").string();
     cli::writeFile(file, defaultSubmission(entry.name, config).dump());
-    const GradeOutcome g = gradeSubmission(file, o);
+    GradeOptions with_plots = o;
+    with_plots.out_dir = (dir / "defaults_out").string();
+    const GradeOutcome g = gradeSubmission(file, with_plots);
     checkResults(g);
+    // Every test of a simulated metric (not the screening's) has its plot on disk.
+    const auto loops = buildLab(entry, config, config_file)->linearise();
+    for (const auto& t : g.results.at("tests")) {
+      INFO("test ", t.at("name"));
+      const std::string metric = t.at("extra_data").at("metric");
+      if (screeningMetricDoc(metric, loops)) continue;
+      REQUIRE(t.at("extra_data").contains("plot"));
+      CHECK(std::filesystem::is_regular_file(std::filesystem::path(with_plots.out_dir) / t["extra_data"]["plot"].get<std::string>()));
+    }
     double max = 0;
     for (const auto& t : g.results.at("tests")) max += t.at("max_score").get<double>();
     const double share = g.results.at("score").get<double>() / max;
@@ -256,7 +269,10 @@ inline void checkLab(const LabEntry& entry, const json& config, const LabCheckOp
   const std::string examples_dir = options.examples_dir.empty()
                                        ? std::string(DYNLAB_SOURCE_DIR) + "/labs/" + entry.name + "/examples"
                                        : options.examples_dir;
-  const std::vector<std::string> examples = exampleFiles(examples_dir);
+  std::vector<std::string> examples = exampleFiles(examples_dir);
+  // The instructor's examples (full credit, never shipped to students) are held to the same schema.
+  if (options.examples_dir.empty())
+    for (const auto& f : exampleFiles(std::string(DYNLAB_SOURCE_DIR) + "/labs/" + entry.name + "/instructor")) examples.push_back(f);
   checkConfigAndExamples(entry, config, examples);
   checkEngines(entry, config);
   checkPassive(entry, config);

@@ -11,6 +11,7 @@
 #include <fstream>
 
 #include "app/ui/session.h"
+#include "grading/grade.h"
 #include "labs/run.h"
 #include "labs/submission.h"
 #include "tests/test_files.h"
@@ -229,4 +230,31 @@ TEST_CASE("the metrics the panel shows are the row on screen's: recomputed every
   REQUIRE(s.row() == row);
   CHECK(s.currentMetrics() == s.metrics());
   CHECK(s.currentMetrics() != before);
+}
+
+TEST_CASE("--scenario: the session runs the grader's scenario, and its saved gains grade to what it showed") {
+  const fs::path dir = test::scratchDir("dynlab_ui_session", "scenario");
+  const json config = loadJsonFile(defaultConfigPath("slider_crank"));
+  const json& scenarios = config["rubric"]["scenarios"];
+  // The patch is applied: the heavier payload, named in the title.
+  TuningSession heavy("slider_crank", "", kExamples + "mediocre.json", "heavy_load");
+  CHECK(heavy.scenario() == "heavy_load");
+  CHECK(heavy.title().find("heavy_load") != std::string::npos);
+  CHECK(heavy.config()["mechanism"]["load_mass"] == scenarios["heavy_load"]["patch"]["mechanism"]["load_mass"]);
+  CHECK(TuningSession("slider_crank", "", kExamples + "mediocre.json").config()["mechanism"]["load_mass"] ==
+        config["mechanism"]["load_mass"]);
+  // Sensor noise seeded as the grader seeds this submission: the whole run's metrics are the grade's.
+  TuningSession noisy("slider_crank", "", kExamples + "mediocre.json", "noisy_sensor");
+  runToEnd(noisy);
+  REQUIRE(noisy.problem().empty());
+  const fs::path saved = dir / "saved.json";
+  noisy.saveSubmission(saved.string());
+  const GradeOutcome g = gradeSubmission(saved.string(), GradeOptions{});
+  const json& graded = g.results["extra_data"]["scenarios"]["noisy_sensor"]["metrics"];
+  const json shown = noisy.metrics();
+  REQUIRE(shown.contains("f_rms"));
+  for (const auto& [metric, value] : shown.items())
+    if (graded.contains(metric)) CHECK_MESSAGE(graded[metric] == value, metric);
+  // An unknown scenario is bad input, listing the rubric's.
+  CHECK_THROWS_WITH_AS(TuningSession("slider_crank", "", "", "nope"), doctest::Contains("noisy_sensor"), InputError);
 }

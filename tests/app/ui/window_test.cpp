@@ -125,6 +125,8 @@ json grade(const fs::path& dir, const std::string& file, const std::string& out)
 }
 
 const std::string kExamples = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/examples/";
+// The full-credit example: course staff only, never in what students receive.
+const std::string kInstructor = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/instructor/";
 
 }  // namespace
 
@@ -238,7 +240,7 @@ TEST_CASE("gains saved by the window grade exactly like the same gains written b
   CHECK(saved == by_hand);
   std::ofstream(dir / "by_hand.json") << by_hand.dump();
   const json a = grade(dir, "mine.json", "graded_mine"), b = grade(dir, "by_hand.json", "graded_by_hand");
-  CHECK(a["score"].get<double>() > 10.0);  // good gains (the lab's examples/good.json)
+  CHECK(a["score"].get<double>() > 10.0);  // good gains (the lab's instructor/good.json)
   CHECK(a["score"] == b["score"]);
   CHECK(a["tests"] == b["tests"]);
   CHECK(a["extra_data"]["fingerprint"]["submission_hash"] == b["extra_data"]["fingerprint"]["submission_hash"]);
@@ -266,7 +268,7 @@ TEST_CASE("unstable gains: the window says why in the grader's words, and does n
 TEST_CASE("dynlab ui LAB runs the window (one entry point)") {
   if (!haveXvfb()) return;
   const fs::path dir = test::scratchDir("dynlab_ui_window", "entry");
-  const Result r = inXvfb(dir, DYNLAB_BIN, "ui slider_crank --gains " + quote(kExamples + "good.json") +
+  const Result r = inXvfb(dir, DYNLAB_BIN, "ui slider_crank --gains " + quote(kInstructor + "good.json") +
                                                " --set kp_f=0.25 --frames 2 --state state.json");
   INFO(r.out << r.err);
   REQUIRE(r.code == 0);
