@@ -3,6 +3,8 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
 
 namespace dyn {
 
@@ -56,6 +58,20 @@ double windowBound(const JsonView& v, const JsonView& config) {
   v.fail(expected + ", got \"" + text + "\" (not a number of the config)");
 }
 
+// A bound the window's own words give (placeholders filled): the number after one of the leads
+// ("from t = 0.5 s on" → 0.5).
+double boundIn(const std::string& window, std::initializer_list<const char*> leads, double none) {
+  for (const char* lead : leads) {
+    const std::size_t at = window.find(lead);
+    if (at == std::string::npos) continue;
+    const char* start = window.c_str() + at + std::strlen(lead);
+    char* end = nullptr;
+    const double v = std::strtod(start, &end);
+    if (end != start && std::isfinite(v)) return v;
+  }
+  return none;
+}
+
 }  // namespace
 
 std::map<std::string, MetricDoc> parseMetricDocs(const JsonView& config) {
@@ -69,9 +85,12 @@ std::map<std::string, MetricDoc> parseMetricDocs(const JsonView& config) {
     MetricDoc& doc = docs[name];
     doc = {fillFromConfig(d["what"].string(), config, d["what"].path()), d["unit"].string(),
            fillFromConfig(d["window"].string(), config, d["window"].path())};
-    if (d.has("from")) doc.from = windowBound(d["from"], config);
-    if (d.has("to")) doc.to = windowBound(d["to"], config);
-    if (!(doc.from < doc.to)) (d.has("to") ? d["to"] : d["from"]).fail("expected the window's end after its start (" + fmtConfigNumber(doc.from) + " s)");
+    // The window in numbers: "from"/"to" when given, else what its words say ("from t = {/..} s on").
+    doc.from = d.has("from") ? windowBound(d["from"], config) : boundIn(doc.window, {"from t = "}, -INFINITY);
+    doc.to = d.has("to") ? windowBound(d["to"], config) : boundIn(doc.window, {"until t = ", " to t = "}, INFINITY);
+    if (!(doc.from < doc.to))
+      (d.has("to") ? d["to"] : d.has("from") ? d["from"] : d["window"])
+          .fail("expected the window's end after its start (" + fmtConfigNumber(doc.from) + " s)");
   }
   return docs;
 }

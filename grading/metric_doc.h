@@ -1,11 +1,12 @@
 // What a metric means, for people (the handout, feedback): its definition, unit and time window.
 // Lab metrics are documented by the lab's JSON,
 //   "metric_docs": {"x_rms": {"unit": "m", "window": "whole run", "what": "RMS of x_c − x_d"},
-//                   "f_rms": {..., "window": "from t = {/metrics/settle_time} s on", "from": "{/metrics/settle_time}"}}
+//                   "f_rms": {..., "window": "from t = {/metrics/settle_time} s on"}}
 // where "{/json/pointer}" in window or what stands for the config's value there (so a window such
-// as "from t = {/metrics/settle_time} s on" never disagrees with the grader); "from" and "to"
-// (optional: a number of seconds or "{/pointer}" naming one) are the window for machines, which
-// the feedback plots shade; the screening
+// as "from t = {/metrics/settle_time} s on" never disagrees with the grader). The window in
+// numbers (the feedback plots hatch the rest of the run) is what its words say — the number after
+// "from t = ", "until t = " or " to t = " — or "from"/"to" when given (seconds, or "{/pointer}"
+// naming a number); the screening
 // metrics (<loop>_delay_margin, <loop>_damping, ... from grading/scenario.h) are documented here,
 // once for every lab, from the loops the lab reports.
 #pragma once

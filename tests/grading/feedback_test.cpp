@@ -190,7 +190,7 @@ TEST_CASE("what a test without a plot of its own plots, derived in order") {
   CHECK(plan(config, 1).from == doctest::Approx(0.8));
 }
 
-TEST_CASE("a metric's window: hatched where it does not count, read from metric_docs' from/to") {
+TEST_CASE("a metric's window: hatched where it does not count, read from its metric_docs window") {
   const fs::path dir = scratch("window");
   const GradeOutcome g = gradeInto(dir, kMediocre);
   REQUIRE_FALSE(g.input_error);
@@ -210,7 +210,23 @@ TEST_CASE("a metric's window: hatched where it does not count, read from metric_
     }
     return std::string("(no error)");
   };
+  // The window in numbers is what its words say (placeholders filled), or from/to when given.
+  const auto docs = [](const json& c) { return parseMetricDocs(JsonView(c, "cfg.json")); };
   json c = defaultConfig();
+  c["metric_docs"]["f_rms"]["window"] = "from t = {/metrics/settle_time} s to t = 3 s";
+  CHECK(docs(c).at("f_rms").from == doctest::Approx(0.5));
+  CHECK(docs(c).at("f_rms").to == doctest::Approx(3));
+  c["metric_docs"]["f_rms"]["window"] = "until t = 2.5 s";
+  CHECK(std::isinf(docs(c).at("f_rms").from));
+  CHECK(docs(c).at("f_rms").to == doctest::Approx(2.5));
+  c["metric_docs"]["f_rms"]["from"] = 1;
+  CHECK(docs(c).at("f_rms").from == doctest::Approx(1));
+  CHECK(std::isinf(docs(c).at("x_rms").from));  // "the whole run"
+  CHECK(std::isinf(docs(c).at("x_rms").to));
+  c["metric_docs"]["f_rms"]["window"] = "from t = 3 s until t = 1 s";
+  c["metric_docs"]["f_rms"].erase("from");
+  CHECK(error(c).find("/metric_docs/f_rms/window: expected the window's end after its start") != std::string::npos);
+  c = defaultConfig();
   c["metric_docs"]["f_rms"]["from"] = "{/metrics/nope}";
   CHECK(error(c).find("cfg.json: /metric_docs/f_rms/from: expected a number of seconds") != std::string::npos);
   c["metric_docs"]["f_rms"]["from"] = true;
