@@ -18,6 +18,7 @@
 #include "grading/escape.h"
 #include "grading/plot.h"
 #include "grading/rubric.h"
+#include "labs/numbers.h"
 #include "labs/run.h"
 #include "render/renderer.h"
 
@@ -41,12 +42,6 @@ std::string join(const std::vector<std::string>& parts, const std::string& sep) 
   std::string s;
   for (const auto& p : parts) s += (s.empty() ? "" : sep) + p;
   return s;
-}
-
-std::string fmt(const char* f, double x) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, x);
-  return b;
 }
 
 // "1920x1080" → {1920, 1080}.

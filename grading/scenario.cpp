@@ -6,14 +6,11 @@
 #include <cstdio>
 
 #include "grading/grade.h"
+#include "labs/numbers.h"
 
 namespace dyn {
 
-std::string fmtNumber(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", x);
-  return b;
-}
+std::string fmtNumber(double x) { return fmt("%.4g", x); }
 
 namespace {
 

@@ -4,6 +4,7 @@
 #include <cstdlib>
 
 #include "labs/lab.h"
+#include "labs/numbers.h"
 
 #ifndef DYNLAB_SOURCE_DIR
 #define DYNLAB_SOURCE_DIR "."
@@ -49,9 +50,7 @@ namespace dyn {
 
 std::string stoppedSentence(const std::string& failure, double t) {
   if (failure.rfind("stopped: ", 0) == 0) return failure;
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", t);
-  return "unstable: " + failure + " at t = " + b + " s";
+  return "unstable: " + failure + " at t = " + fmt("%.4g", t) + " s";
 }
 
 }  // namespace dyn

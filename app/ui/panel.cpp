@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "labs/numbers.h"
 #include "render/plot_widget.h"
 
 namespace dyn::ui {
@@ -15,12 +16,6 @@ namespace {
 
 const ImVec4 kError(0.78f, 0.12f, 0.10f, 1.0f), kWarn(0.70f, 0.40f, 0.00f, 1.0f);
 const ImVec4 kOk(0.10f, 0.50f, 0.20f, 1.0f), kMuted(0.40f, 0.43f, 0.48f, 1.0f);
-
-std::string fmt(const char* f, double x) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, x);
-  return b;
-}
 
 // A shell word: quoted only when it needs to be.
 std::string shellWord(const std::string& s) {

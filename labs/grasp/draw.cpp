@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "labs/grasp/lab.h"
+#include "labs/numbers.h"
 
 namespace dyn::grasp {
 namespace {
@@ -19,12 +20,6 @@ constexpr double kConeLength = 0.035;  // m, the drawn friction cones
 Eigen::Vector3d at(const Eigen::Vector2d& p, double z = 0) { return {p.x(), p.y(), z}; }
 
 Eigen::Matrix3d rotZ(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
-
-std::string fmt(const char* f, double x) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, x);
-  return b;
-}
 
 VecN stateAt(const Trace& tr, std::size_t r, int m) {
   VecN q(2 * m + 3);

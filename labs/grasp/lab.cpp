@@ -8,6 +8,7 @@
 #include <map>
 
 #include "labs/mechanism_simulation.h"
+#include "labs/numbers.h"
 #include "labs/settings.h"
 
 namespace dyn::grasp {
@@ -53,12 +54,6 @@ std::vector<std::string> makeColumns(int m) {
     for (const char* s : {"_n", "_t"}) c.push_back("f" + std::to_string(i) + s);
   for (const char* s : {"cone_margin", "f_int", "f_int_meas", "squeeze", "energy", "work", "constraint_residual"}) c.push_back(s);
   return c;
-}
-
-std::string fmt(const char* f, double x) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, x);
-  return b;
 }
 
 // The lab's part of a run on either engine (labs/mechanism_simulation.h): the controller, the push,
@@ -128,12 +123,6 @@ class Hooks final : public StepHooks {
   double margin_ = INFINITY, worst_fn_ = 0, worst_ft_ = 0;
   int worst_ = 0;
 };
-
-double rms(const std::vector<double>& x) {
-  double s = 0;
-  for (double v : x) s += v * v;
-  return x.empty() ? 0 : std::sqrt(s / double(x.size()));
-}
 
 }  // namespace
 

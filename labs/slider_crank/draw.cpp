@@ -6,6 +6,7 @@
 #include <cstdio>
 
 #include "labs/slider_crank/lab.h"
+#include "labs/numbers.h"
 
 namespace dyn::slider_crank {
 namespace {
@@ -24,12 +25,6 @@ void drawArm(const Mechanism& mech, const Eigen::Vector3d& th, Color link, Color
 }
 
 Eigen::Vector3d thetaAt(const Trace& tr, std::size_t r) { return {tr.at(r, "q1"), tr.at(r, "q2"), tr.at(r, "q3")}; }
-
-std::string fmt(const char* f, double x) {
-  char b[64];
-  std::snprintf(b, sizeof b, f, x);
-  return b;
-}
 
 // The space the mechanism moves through over the run (the rows so far, both engines), with the
 // mount, the rail and the force arrow (at most 0.25 m of it: a blow-up's arrow may leave the frame).

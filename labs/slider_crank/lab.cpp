@@ -6,6 +6,7 @@
 #include <map>
 
 #include "labs/mechanism_simulation.h"
+#include "labs/numbers.h"
 #include "labs/settings.h"
 
 namespace dyn::slider_crank {
@@ -60,12 +61,6 @@ class Hooks final : public StepHooks {
   const Settings& s_;
   Controller ctrl_;
 };
-
-double rms(const std::vector<double>& x) {
-  double s = 0;
-  for (double v : x) s += v * v;
-  return x.empty() ? 0 : std::sqrt(s / double(x.size()));
-}
 
 }  // namespace
 
