@@ -35,20 +35,15 @@ void Reference::at(double t, Eigen::Vector3d& pose, Eigen::Vector3d& rate, Eigen
 }
 
 Controller::Controller(const ControllerConfig& c, const Reference& r, const Params& model, double dt)
-    : config_(c), reference_(r), model_(model), dt_(dt), rng_(c.seed) {
-  // The measurement is at least one step old: the contact forces depend on τ, which depends on it.
-  const auto steps = std::max<long>(1, std::lround(c.delay / dt));
-  history_.assign(std::size_t(steps), c.gains.f_squeeze);
-  squeeze_ = c.gains.f_squeeze;
-}
+    : config_(c), reference_(r), model_(model), dt_(dt), sensor_(c.delay, dt, c.gains.f_squeeze), squeeze_(c.gains.f_squeeze), rng_(c.seed) {}
 
 void Controller::primeMeasurement(const VecN& q, const VecN& v) {
-  std::fill(history_.begin(), history_.end(), config_.gains.f_squeeze);
+  sensor_.fill(config_.gains.f_squeeze);
   const VecN tau = torque(0.0, q, v);
   const auto sol = model_.solve(q, v, tau);
   VecN F(2 * model_.fingers());
   for (int i = 0; i < model_.fingers(); ++i) F.segment<2>(2 * i) = model_.constraintForce(i, sol).tail<2>();
-  std::fill(history_.begin(), history_.end(), model_.internalForce(q.tail(3), F));
+  sensor_.fill(model_.internalForce(q.tail(3), F));
   integral_ = 0;
 }
 
@@ -56,13 +51,12 @@ void Controller::measure(const VecN& q, const VecN& F) {
   VecN Fm = F;
   if (config_.noise_std > 0)
     for (Eigen::Index i = 0; i < Fm.size(); ++i) Fm[i] += config_.noise_std * noise_(rng_);
-  head_ = (head_ + 1) % history_.size();
-  history_[head_] = model_.internalForce(q.tail(3), Fm);
+  sensor_.push(model_.internalForce(q.tail(3), Fm));
   // The squeeze law integrates what it sees.
   integral_ += (config_.gains.f_squeeze - measured()) * dt_;
 }
 
-double Controller::measured() const { return history_[(head_ + 1) % history_.size()]; }
+double Controller::measured() const { return sensor_.value(); }
 
 VecN Controller::torque(double t, const VecN& q, const VecN& v) {
   const int n = model_.n();

@@ -12,6 +12,7 @@
 #include <random>
 #include <vector>
 
+#include "labs/delay_line.h"
 #include "labs/grasp/mechanism.h"
 
 namespace dyn::grasp {
@@ -65,8 +66,7 @@ class Controller {
   Reference reference_;
   Mechanism model_;
   double dt_;
-  std::vector<double> history_;    // ring buffer of f_int, newest at head_
-  std::size_t head_ = 0;
+  DelayLine sensor_;               // f_int as measured (from noisy contact forces), `delay` late
   double integral_ = 0, squeeze_ = 0;
   std::mt19937_64 rng_;
   std::normal_distribution<double> noise_{0.0, 1.0};

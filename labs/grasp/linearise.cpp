@@ -8,6 +8,7 @@
 // Every loop is reported with the controller off too (no feedback), so the screening metrics always exist.
 #include <cmath>
 
+#include "labs/delay_line.h"
 #include "labs/grasp/lab.h"
 
 namespace dyn::grasp {
@@ -34,7 +35,7 @@ std::vector<LinearLoop> GraspLab::linearise() const {
   loops.push_back({"x", on ? "object x loop (PD, k_p and k_d)" : "object x loop" + off, {g.kp_pos, g.kd_pos}, {0, 0, inertia[1]}, 0.5 * dt});
   loops.push_back({"y", on ? "object y loop (PD, k_p and k_d)" : "object y loop" + off, {g.kp_pos, g.kd_pos}, {0, 0, inertia[2]}, 0.5 * dt});
   loops.push_back({"psi", on ? "object tilt loop (PD, k_pψ and k_dψ)" : "object tilt loop" + off, {g.kp_psi, g.kd_psi}, {0, 0, inertia[0]}, 0.5 * dt});
-  const double delay = std::max(1.0, std::round(c.delay / dt)) * dt;
+  const double delay = DelayLine::realised(c.delay, dt);
   if (on && g.ki_int != 0)
     loops.push_back({"squeeze", "internal-force loop (integral law, k_i)", {g.ki_int}, {0, 1}, delay});
   else

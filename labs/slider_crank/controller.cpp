@@ -14,26 +14,21 @@ double Reference::velocity(double t) const {
 }
 
 Controller::Controller(const ControllerConfig& c, const Reference& r, const Params& model, double dt)
-    : config_(c), reference_(r), model_(model), dt_(dt), rng_(c.seed) {
-  // The measurement is at least one step old: f depends on τ, which depends on the measurement.
-  const auto steps = std::max<long>(1, std::lround(c.delay / dt));
-  history_.assign(std::size_t(steps), 0.0);
-}
+    : config_(c), reference_(r), model_(model), dt_(dt), sensor_(c.delay, dt), rng_(c.seed) {}
 
 void Controller::primeMeasurement(const VecN& q, const VecN& v) {
-  std::fill(history_.begin(), history_.end(), config_.f_des);
+  sensor_.fill(config_.f_des);
   const Eigen::Vector3d tau = torque(0.0, q.head(3), v.head(3), q[3], v[3]);
-  std::fill(history_.begin(), history_.end(), model_.solve(q, v, VecN(tau)).f[2]);
+  sensor_.fill(model_.solve(q, v, VecN(tau)).f[2]);
 }
 
 void Controller::measure(double f_Ty) {
-  head_ = (head_ + 1) % history_.size();
-  history_[head_] = f_Ty + (config_.noise_std > 0 ? config_.noise_std * noise_(rng_) : 0.0);
+  sensor_.push(f_Ty + (config_.noise_std > 0 ? config_.noise_std * noise_(rng_) : 0.0));
   // The force loop integrates what it sees.
   integral_ += (measured() - config_.f_des) * dt_;
 }
 
-double Controller::measured() const { return history_[(head_ + 1) % history_.size()]; }
+double Controller::measured() const { return sensor_.value(); }
 
 Eigen::Vector3d Controller::torque(double t, const Eigen::Vector3d& th, const Eigen::Vector3d& thd,
                                    double x_c, double v_c) {

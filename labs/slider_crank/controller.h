@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "labs/delay_line.h"
 #include "labs/slider_crank/mechanism.h"
 
 namespace dyn::slider_crank {
@@ -61,8 +62,7 @@ class Controller {
   Reference reference_;
   Mechanism model_;
   double dt_;
-  std::vector<double> history_;  // ring buffer of f_Ty, newest at head_
-  std::size_t head_ = 0;
+  DelayLine sensor_;  // f_Ty as measured (noise included), `delay` late
   double integral_ = 0;
   std::mt19937_64 rng_;
   std::normal_distribution<double> noise_{0.0, 1.0};

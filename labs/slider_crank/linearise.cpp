@@ -9,6 +9,7 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "labs/delay_line.h"
 #include "labs/slider_crank/lab.h"
 
 namespace dyn::slider_crank {
@@ -33,7 +34,7 @@ std::vector<LinearLoop> SliderCrankLab::linearise() const {
   std::vector<LinearLoop> loops;
   loops.push_back({"motion", on ? "slider position loop (PD, k_px and k_dx)" : "slider position loop (controller off)",
                    {g.kp_x, g.kd_x}, {0, 0, m_eff}, 0.5 * dt});
-  const double delay = std::max(1.0, std::round(c.delay / dt)) * dt;
+  const double delay = DelayLine::realised(c.delay, dt);
   if (on && c.law == ForceLaw::Integral)
     loops.push_back({"force", "rail-force loop (integral law, k_if)", {g.ki_f}, {0, 1}, delay});
   else if (on && c.law == ForceLaw::Proportional)
