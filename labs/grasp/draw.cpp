@@ -57,7 +57,7 @@ Eigen::AlignedBox3d runBounds(const Mechanism& mech, const Trace& tr, const Trac
       for (int i = 0; i < mech.fingers(); ++i) {
         for (const auto& pt : mech.fingerPoints(i, q)) box.extend(at(pt) - pad), box.extend(at(pt) + pad);
         // The cone's far rim: L (n ± μ t) from the contact.
-        const Eigen::Vector2d c = mech.contactPoint(i, pose), n = R * p.fingers[std::size_t(i)].normal.normalized();
+        const Eigen::Vector2d c = mech.contactPoint(i, pose), n = mech.contactNormal(i, pose[0]);
         const Eigen::Vector2d t(-n.y(), n.x());
         for (const double sgn : {-1.0, 1.0}) box.extend(at(c + kConeLength * (n + sgn * p.mu * t)));
       }
@@ -110,7 +110,7 @@ void GraspLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene
   for (int i = 0; i < m; ++i) {
     const std::string f = "f" + std::to_string(i + 1);
     const Eigen::Vector2d p = mech.contactPoint(i, pose);
-    const Eigen::Vector2d n = rotZ(pose[0]).topLeftCorner<2, 2>() * s_.params.fingers[std::size_t(i)].normal.normalized();
+    const Eigen::Vector2d n = mech.contactNormal(i, pose[0]);
     const double f_n = tr.at(row, f + "_n"), f_t = tr.at(row, f + "_t");
     const double used = f_n > 0 ? std::abs(f_t) / (mu * f_n) : 1.0;
     s.cones.push_back({at(p, 0.02), at(n), std::atan(mu), kConeLength, mix(kInside, kEdge, (used - 0.5) / 0.5)});

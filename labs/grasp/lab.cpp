@@ -10,6 +10,7 @@
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
 #include "labs/settings.h"
+#include "physics/constraints/point_contact.h"
 
 namespace dyn::grasp {
 namespace {
@@ -85,12 +86,11 @@ class Hooks final : public StepHooks {
     for (int j = 0; j < n; ++j) out.push_back(F_[j]);
     margin_ = INFINITY;
     for (int i = 0; i < m; ++i) {
-      const Eigen::Vector2d nrm = normal(i, r.q[n]), f = F_.segment<2>(2 * i);
-      const double f_n = -f.dot(nrm), f_t = f.dot(Eigen::Vector2d(-nrm.y(), nrm.x()));
-      out.push_back(f_n);
-      out.push_back(f_t);
-      const double margin = s_.params.mu * f_n - std::abs(f_t);
-      if (margin < margin_) margin_ = margin, worst_ = i, worst_fn_ = f_n, worst_ft_ = f_t;
+      double c[3];  // f_n, f_t, margin: the point contact's own definitions
+      PointContact<Planar>::contactAxes(F_.segment<2>(2 * i), model_.contactNormal(i, r.q[n]), s_.params.mu, c);
+      out.push_back(c[0]);
+      out.push_back(c[1]);
+      if (c[2] < margin_) margin_ = c[2], worst_ = i, worst_fn_ = c[0], worst_ft_ = c[1];
     }
     for (const double x : {margin_, model_.internalForce(r.q.tail(3), F_), ctrl_.measured(), ctrl_.squeeze(), r.energy, r.work, r.residual})
       out.push_back(x);
@@ -107,10 +107,6 @@ class Hooks final : public StepHooks {
   }
 
  private:
-  Eigen::Vector2d normal(int i, double psi) const {
-    const Eigen::Vector2d n = s_.params.fingers[std::size_t(i)].normal.normalized();
-    return {std::cos(psi) * n.x() - std::sin(psi) * n.y(), std::sin(psi) * n.x() + std::cos(psi) * n.y()};
-  }
   // Each contact's force on the object (its constraint's force: the fingertip, body a, on the object).
   void contactForces(const StepRecord& r, VecN& F) const {
     F.resize(2 * model_.fingers());
@@ -150,7 +146,7 @@ Settings parseSettings(const JsonView& c) {
     s.params.joint.coulomb = jf["coulomb"].inRange(0, kMaxForce);
     if (jf.has("coulomb_width")) s.params.joint.coulomb_width = jf["coulomb_width"].positive(1e3);
   }
-  if (!m["mu"].raw().is_number() || !(m["mu"].raw().get<double>() > 0))
+  if (!(m["mu"].number() > 0))
     m["mu"].fail("expected a friction coefficient μ > 0 (a contact without friction cannot hold the object up)");
   s.params.mu = m["mu"].positive(100);
   s.params.gravity = vec2(m["gravity"], -kMaxGravity, kMaxGravity);

@@ -53,6 +53,10 @@ Eigen::Vector2d Mechanism::contactPoint(int i, const Eigen::Vector3d& pose) cons
   return pose.tail<2>() + rotate(pose[0], params_.fingers[std::size_t(i)].contact);
 }
 
+Eigen::Vector2d Mechanism::contactNormal(int i, double psi) const {
+  return rotate(psi, params_.fingers[std::size_t(i)].normal.normalized());
+}
+
 bool Mechanism::assemble(const Eigen::Vector3d& pose, const Eigen::Vector3d& rate, VecN& q, VecN& v, std::string* why) const {
   const int m = fingers(), nn = 2 * m;
   q.setZero(nn + 3);
@@ -118,7 +122,7 @@ void Mechanism::graspMap(const Eigen::Vector3d& pose, MatN& G, VecN& d) const {
     G(0, 2 * i + 1) = r.x();
     G(1, 2 * i) = 1.0;
     G(2, 2 * i + 1) = 1.0;
-    e.segment<2>(2 * i) = -rotate(pose[0], params_.fingers[std::size_t(i)].normal.normalized());
+    e.segment<2>(2 * i) = -contactNormal(i, pose[0]);
   }
   // d = e − G⁺ G e, G⁺ = Gᵀ (G Gᵀ)⁻¹ (G has full row rank for two or more distinct contacts).
   const Eigen::Matrix3d GGt = G * G.transpose();

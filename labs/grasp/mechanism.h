@@ -65,6 +65,8 @@ class Mechanism final : public ConstrainedMechanism<Planar> {
 
   // World positions of contact i on the object at pose (ψ, x, y), and of finger i's joints and tip at q.
   Eigen::Vector2d contactPoint(int i, const Eigen::Vector3d& pose) const;
+  // The object's outward unit normal at contact i, world axes, at tilt ψ.
+  Eigen::Vector2d contactNormal(int i, double psi) const;
   std::vector<Eigen::Vector2d> fingerPoints(int i, const VecN& q) const;  // base, elbow, tip
   // The grasp map G (3 × 2m) and the squeeze direction d (2m) at object pose (ψ, x, y).
   void graspMap(const Eigen::Vector3d& pose, MatN& G, VecN& d) const;

@@ -15,19 +15,22 @@ typename S::Pos PointContact<S>::normal(const MechanismKinematics<S>& k) const {
 }
 
 template <class S>
-void PointContact<S>::report(const MechanismKinematics<S>& k, const double* eta, double* out) const {
-  const Vec f = force(k, eta);
-  const Pos f_lin = S::linear(f), n = normal(k);
-  const double f_n = -f_lin.dot(n);
+void PointContact<S>::contactAxes(const Pos& f, const Pos& n, double mu, double* out) {
+  const double f_n = -f.dot(n);
   double f_t;
   if constexpr (S::kDim == 3) {
-    f_t = f_lin.dot(Pos(-n.y(), n.x()));  // t = ẑ × n
+    f_t = f.dot(Pos(-n.y(), n.x()));  // t = ẑ × n
   } else {
-    f_t = (f_lin - f_lin.dot(n) * n).norm();
+    f_t = (f - f.dot(n) * n).norm();
   }
   out[0] = f_n;
   out[1] = f_t;
-  out[2] = mu_ * f_n - std::abs(f_t);
+  out[2] = mu * f_n - std::abs(f_t);
+}
+
+template <class S>
+void PointContact<S>::report(const MechanismKinematics<S>& k, const double* eta, double* out) const {
+  contactAxes(S::linear(force(k, eta)), normal(k), mu_, out);
 }
 
 template class PointContact<Planar>;

@@ -37,6 +37,9 @@ class PointContact final : public Constraint<S> {
   void report(const MechanismKinematics<S>& k, const double* eta, double* out) const override;
 
   double mu() const { return mu_; }
+  // f_n, f_t and the cone margin μ f_n − |f_t| of a force f (a on b, world axes) at a contact whose
+  // outward normal (b's, world axes) is n: what report() writes, for forces from elsewhere (Bullet's).
+  static void contactAxes(const Pos& f, const Pos& n, double mu, double* out);
   // The world outward normal of b at the contact.
   Pos normal(const MechanismKinematics<S>& k) const;
 
