@@ -12,24 +12,12 @@
 #include "tests/render/test_scene.h"
 
 using namespace dyn;
+using dyn::test::inkBox;
 
 namespace {
 
 Eigen::AlignedBox3d box(Eigen::Vector3d lo, Eigen::Vector3d hi) { return Eigen::AlignedBox3d(lo, hi); }
 
-// The pixel box of every pixel that is not the background colour (rows and columns inclusive).
-PixelRect inkBox(const Image& image, const Color& bg) {
-  int x0 = image.width, y0 = image.height, x1 = -1, y1 = -1;
-  const int r = int(std::lround(bg.r * 255)), g = int(std::lround(bg.g * 255)), b = int(std::lround(bg.b * 255));
-  for (int y = 0; y < image.height; ++y)
-    for (int x = 0; x < image.width; ++x) {
-      const std::uint8_t* p = image.pixel(x, y);
-      if (std::abs(p[0] - r) + std::abs(p[1] - g) + std::abs(p[2] - b) > 6)
-        x0 = std::min(x0, x), x1 = std::max(x1, x), y0 = std::min(y0, y), y1 = std::max(y1, y);
-    }
-  if (x1 < 0) return {};
-  return {double(x0), double(y0), double(x1 - x0 + 1), double(y1 - y0 + 1)};
-}
 
 }  // namespace
 
