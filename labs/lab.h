@@ -12,6 +12,7 @@
 //     not close is reported with no feedback), so every rubric metric exists for every option.
 #pragma once
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -90,6 +91,21 @@ class Lab {
   // a loop without feedback (open loop, zero gains) has a zero numerator and is reported as such.
   virtual std::vector<LinearLoop> linearise() const { return {}; }
 };
+
+// The part of every lab's agreement() that says how well each engine kept its own books: the energy
+// drift and constraint residual of each run's metrics (keys "energy_drift", "max_constraint_residual").
+inline json engineHealth(const json& hand_metrics, const json& bullet_metrics) {
+  auto health = [](const json& m) {
+    return json{{"energy_drift", m["energy_drift"]}, {"max_constraint_residual", m["max_constraint_residual"]}};
+  };
+  return {{"hand", health(hand_metrics)}, {"bullet", health(bullet_metrics)}};
+}
+
+// A unit from a lab's table (unit(), agreementUnit()): empty when the key is not in it.
+inline std::string unitIn(const std::map<std::string, std::string>& units, const std::string& key) {
+  const auto it = units.find(key);
+  return it == units.end() ? std::string() : it->second;
+}
 
 // What a run's failure() says in reports: a lab's own "stopped: ..." sentence as it is, anything else
 // as "unstable: <failure> at t = <t> s".

@@ -223,7 +223,7 @@ std::string GraspLab::unit(const std::string& c) const {
       {"w_o", "rad/s"}, {"x_d", "m"},      {"y_d", "m"},         {"psi_d", "rad"},   {"cone_margin", "N"},
       {"f_int", "N"},  {"f_int_meas", "N"}, {"squeeze", "N"},    {"energy", "J"},    {"work", "J"},
       {"constraint_residual", "m"}};
-  if (const auto it = units.find(c); it != units.end()) return it->second;
+  if (std::string u = unitIn(units, c); !u.empty()) return u;
   if (c.size() > 1 && c[0] == 'q' && std::isdigit(static_cast<unsigned char>(c[1]))) return "rad";
   if (c.rfind("tau", 0) == 0) return "N·m";
   if (c.size() > 2 && c[0] == 'f' && std::isdigit(static_cast<unsigned char>(c[1]))) return "N";
@@ -285,22 +285,20 @@ json GraspLab::agreement(const Trace& a, const Trace& b) const {
     dnet = std::max(dnet, net.norm());
     dint = std::max(dint, std::abs(a.at(r, "f_int") - b.at(r, "f_int")));
   }
-  const json ma = metrics(a), mb = metrics(b);
-  return {{"rows_compared", n},
+  json out = {{"rows_compared", n},
           {"max_dq", dq},
           {"max_dpos", dpos},
           {"max_dpsi", dpsi},
           {"max_dnet_force", dnet},
-          {"max_df_int", dint},
-          {"hand", {{"energy_drift", ma["energy_drift"]}, {"max_constraint_residual", ma["max_constraint_residual"]}}},
-          {"bullet", {{"energy_drift", mb["energy_drift"]}, {"max_constraint_residual", mb["max_constraint_residual"]}}}};
+          {"max_df_int", dint}};
+  out.update(engineHealth(metrics(a), metrics(b)));
+  return out;
 }
 
 std::string GraspLab::agreementUnit(const std::string& key) const {
   static const std::map<std::string, std::string> units = {
       {"max_dq", "rad"}, {"max_dpos", "m"}, {"max_dpsi", "rad"}, {"max_dnet_force", "N"}, {"max_df_int", "N"}};
-  const auto it = units.find(key);
-  return it == units.end() ? std::string() : it->second;
+  return unitIn(units, key);
 }
 
 std::string GraspLab::referenceEngine() const {

@@ -140,8 +140,7 @@ std::string SliderCrankLab::unit(const std::string& c) const {
       {"tau2", "N·m"},  {"tau3", "N·m"}, {"energy", "J"}, {"x_d", "m"},     {"f_des", "N"},
       {"f_meas", "N"},  {"work", "J"},
       {"constraint_residual", "m, rad"}};  // |φ|∞ over (θ1+θ2+θ3, x_T − x_c, y_T)
-  const auto it = units.find(c);
-  return it == units.end() ? std::string() : it->second;
+  return unitIn(units, c);
 }
 
 std::unique_ptr<Simulation> SliderCrankLab::simulate(Engine engine) const {
@@ -189,21 +188,19 @@ json SliderCrankLab::agreement(const Trace& a, const Trace& b) const {
     for (const char* c : {"f_Tx", "f_Ty"}) df = std::max(df, std::abs(a.at(r, c) - b.at(r, c)));
     dtau_T = std::max(dtau_T, std::abs(a.at(r, "tau_T") - b.at(r, "tau_T")));
   }
-  const json ma = metrics(a), mb = metrics(b);
-  return {{"rows_compared", n},
+  json out = {{"rows_compared", n},
           {"max_dq", dq},
           {"max_dx_c", dx},
           {"max_df", df},
-          {"max_dtau_T", dtau_T},
-          {"hand", {{"energy_drift", ma["energy_drift"]}, {"max_constraint_residual", ma["max_constraint_residual"]}}},
-          {"bullet", {{"energy_drift", mb["energy_drift"]}, {"max_constraint_residual", mb["max_constraint_residual"]}}}};
+          {"max_dtau_T", dtau_T}};
+  out.update(engineHealth(metrics(a), metrics(b)));
+  return out;
 }
 
 std::string SliderCrankLab::agreementUnit(const std::string& key) const {
   static const std::map<std::string, std::string> units = {
       {"max_dq", "rad"}, {"max_dx_c", "m"}, {"max_df", "N"}, {"max_dtau_T", "N·m"}};
-  const auto it = units.find(key);
-  return it == units.end() ? std::string() : it->second;
+  return unitIn(units, key);
 }
 
 std::string SliderCrankLab::referenceEngine() const {
