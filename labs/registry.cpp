@@ -1,6 +1,5 @@
 // The lab registry: labs add themselves at static-initialisation time (DYNLAB_REGISTER_LAB).
 #include <algorithm>
-#include <cstdio>
 #include <cstdlib>
 
 #include "labs/lab.h"
@@ -43,10 +42,6 @@ std::string defaultConfigPath(const std::string& name) {
   const char* home = std::getenv("DYNLAB_HOME");
   return std::string(home && *home ? home : DYNLAB_SOURCE_DIR) + "/labs/" + name + "/" + name + ".json";
 }
-
-}  // namespace dyn
-
-namespace dyn {
 
 std::string stoppedSentence(const std::string& failure, double t) {
   if (failure.rfind("stopped: ", 0) == 0) return failure;
