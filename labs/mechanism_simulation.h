@@ -88,7 +88,7 @@ struct StepRecord {
   const VecN& v;                     // (θ', v_c) at t
   const VecN& tau;                   // the torque held over the step
   const std::vector<VecN>& forces;   // each constraint's force over the step
-  double energy, residual, work;     // E(q, v), |φ(q)|∞, ∫ (τ + τ_friction)·θ' dt up to t
+  double energy, residual, work;     // E(q, v), |φ(q)|∞ (velocity-level kinds: also |Jθ' − Av_c|∞), ∫ (τ + τ_friction)·θ' dt up to t
 };
 
 // The lab's part of a run: its control law, its trace row, its sensors.
@@ -122,7 +122,9 @@ class MechanismSimulation final : public Simulation {
     if (k_ >= steps_ || !failure_.empty()) return false;
     const double t = double(k_) * dt_;
     tau_ = hooks_->torque(t, q_, v_);
-    const double energy = model_->energy(q_, v_), residual = model_->residual(q_);
+    // |φ(q)|, and for velocity-level kinds (rolling) |J θ' − A v_c| as well: they have no φ.
+    const double energy = model_->energy(q_, v_);
+    const double residual = model_->holonomic() ? model_->residual(q_) : model_->residual(q_, v_);
     advance(true);
     const StepRecord r{engine_, t, q_, v_, tau_, stepper_->forces(), energy, residual, work_};
     hooks_->row(r, row);

@@ -33,6 +33,12 @@ class ConstrainedMechanism : public ConstrainedSystem {
   int n() const { return model_.treeDof(); }
   int k() const { return model_.payloadDof(); }
   int rows() const { return rows_; }
+  // True when every constraint has a position form (no velocity-level kind such as rolling).
+  bool holonomic() const {
+    for (const auto& c : model_.constraints)
+      if (!c->holonomic()) return false;
+    return true;
+  }
 
   // ConstrainedSystem
   int nq() const override { return n() + k(); }
