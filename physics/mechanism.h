@@ -68,10 +68,15 @@ struct Attachment {
 
 // Choices for the Bullet reference model that the physics does not decide: where to cut loops
 // (a tree joint listed here becomes a Bullet constraint, and Bullet's trees are re-grown from the
-// world through the rest; the slider crank is 20× more accurate cut at joint 1) and solver effort.
+// world through the rest; the slider crank is 20× more accurate cut at joint 1), solver effort, and
+// how a rolling constraint is modelled: NoSlip, the description's own rows as a custom Bullet
+// constraint (never slips), or Friction, a sphere collider on a static ground plane with Coulomb
+// friction μ (skids when the no-slip force would leave the friction cone).
+enum class RollingModel { NoSlip, Friction };
 struct BulletHints {
   std::vector<int> cut_joints;
   int solver_iterations = 30;
+  RollingModel rolling = RollingModel::NoSlip;
 };
 
 template <class S>

@@ -391,22 +391,9 @@ struct BulletMechanism<Planar>::Impl {
   }
 };
 
-// Spatial mechanisms are not built yet: the constructor says so.
-template <>
-struct BulletMechanism<Spatial>::Impl {
-  void step(const VecN&) {}
-  void state(VecN&, VecN&) const {}
-  Spatial::Vec force(int) const { return Spatial::Vec::Zero(); }
-  std::string describe() const { return {}; }
-};
-
 template <>
 BulletMechanism<Planar>::BulletMechanism(const MechanismModel<Planar>& model, double dt, const VecN& q0, const VecN& v0)
     : impl_(std::make_unique<Impl>(model, dt, q0, v0)) {}
-template <>
-BulletMechanism<Spatial>::BulletMechanism(const MechanismModel<Spatial>&, double, const VecN&, const VecN&) {
-  throw std::invalid_argument("BulletMechanism: spatial mechanisms: not yet");
-}
 
 template <class S>
 BulletMechanism<S>::~BulletMechanism() = default;
@@ -414,24 +401,16 @@ BulletMechanism<S>::~BulletMechanism() = default;
 template <>
 void BulletMechanism<Planar>::step(const VecN& tau) { impl_->step(tau); }
 template <>
-void BulletMechanism<Spatial>::step(const VecN& tau) { impl_->step(tau); }
-template <>
 void BulletMechanism<Planar>::state(VecN& q, VecN& v) const { impl_->state(q, v); }
-template <>
-void BulletMechanism<Spatial>::state(VecN& q, VecN& v) const { impl_->state(q, v); }
 template <>
 Planar::Vec BulletMechanism<Planar>::constraintForce(int i) const {
   if (i < 0 || i >= int(impl_->force.size())) throw std::out_of_range("BulletMechanism::constraintForce: no such constraint");
   return impl_->force[std::size_t(i)];
 }
 template <>
-Spatial::Vec BulletMechanism<Spatial>::constraintForce(int i) const { return impl_->force(i); }
-template <>
 std::string BulletMechanism<Planar>::describe() const { return impl_->plan.summary; }
-template <>
-std::string BulletMechanism<Spatial>::describe() const { return impl_->describe(); }
 
+// Spatial mechanisms: spatial_mechanism.cpp.
 template class BulletMechanism<Planar>;
-template class BulletMechanism<Spatial>;
 
 }  // namespace dyn::bullet

@@ -1,0 +1,436 @@
+// Bullet 3.24 (double precision) reference model of a spatial mechanism description: the trees as one
+// fixed-base btMultiBody (every body whose parent is −1 hangs from the base, which is the world),
+// revolute and prismatic joints about their axes at the X_tree placements, and the rolling kind in
+// one of two models (BulletHints::rolling):
+//   NoSlip    RollingNoSlipConstraint (rolling_constraint.h): the description's three rows, bilateral;
+//   Friction  a sphere of the wheel's radius on the wheel link (under the centre it touches the
+//             ground where an upright disk does) against a static plane z = h, friction μ from the
+//             description (the plane's own friction is 1: Bullet multiplies the two), restitution 0,
+//             two friction directions with Bullet's implicit cone |f_t| ≤ μ f_n.
+// Other constraint kinds, cut joints and payloads are refused (std::invalid_argument: "not yet").
+//
+// Links. Bullet puts a link's frame at its centre of mass with its inertia diagonal; the description
+// puts it at the joint with a full 6×6 inertia. Each Bullet link is the description's body frame
+// turned onto its principal axes (E_p: body → link coordinates, identity when the inertia is already
+// diagonal) and moved to its centre of mass c. With X_tree = {E_t, r_t} (parent body → joint frame):
+//   rotParentToThis = E_p E_t E_p,parentᵀ,  pivot offset e = E_p,parent (r_t − c_parent),
+//   pivot → centre of mass d = E_p c,        joint axis E_p axis (this link's frame)
+// and Bullet's joint coordinates are the description's θ, θ' one to one (self-checked at start).
+// Massless bodies (the unicycle's x, y, z and heading carriers) get mass and principal inertias of
+// 1e-9 × the model's largest: Bullet needs them positive, and their effect is linear in them (the
+// tests show 1e-6 × changes nothing at their tolerances).
+//
+// Settings (shared/notes/bullet-reference.md): gravity from the description, PGS with
+// BulletHints::solver_iterations, no damping, no joint-speed cap, never sleep, impulse caps 1e12, a
+// collider on every link (mask 0 but the friction wheel's: pitfall 1), and exactly one
+// stepSimulation(dt, 0, dt) per step. Joint springs and friction are joint torques from the state at
+// the step's start, as in the planar builder.
+#include <btBulletDynamicsCommon.h>
+#include <BulletDynamics/Featherstone/btMultiBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
+#include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
+#include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+#include <stdexcept>
+
+#include "physics/bullet/bullet_mechanism.h"
+#include "physics/bullet/rolling_constraint.h"
+#include "physics/constraints/rolling.h"
+
+#ifndef BT_USE_DOUBLE_PRECISION
+#error "spatial_mechanism.cpp must be built against bullet-float64 (BT_USE_DOUBLE_PRECISION)"
+#endif
+
+namespace dyn::bullet {
+namespace {
+
+using Pos = Spatial::Pos;
+using Mat3 = Eigen::Matrix3d;
+
+constexpr double kTiny = 1e-9;          // massless bodies: this × the model's largest mass / inertia
+constexpr double kImpulseCap = 1e12;    // pitfall 2: Bullet's default caps are 100 and 1000 N·s
+
+btVector3 bt(const Pos& p) { return {p.x(), p.y(), p.z()}; }
+Pos eig(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
+btQuaternion quaternion(const Mat3& R) {  // the rotation taking v to R v
+  btQuaternion q;
+  btMatrix3x3(R(0, 0), R(0, 1), R(0, 2), R(1, 0), R(1, 1), R(1, 2), R(2, 0), R(2, 1), R(2, 2)).getRotation(q);
+  return q;
+}
+
+// One description body as a Bullet link: principal frame E_p (body → link), centre of mass c (body
+// frame), mass and principal inertias (tiny ones for massless bodies).
+struct LinkFrame {
+  Mat3 E_p = Mat3::Identity();
+  Pos com = Pos::Zero();
+  double mass = 0;
+  Pos inertia = Pos::Zero();
+};
+
+std::vector<LinkFrame> linkFrames(const TreeModel<Spatial>& tree) {
+  std::vector<LinkFrame> out(tree.bodies.size());
+  double max_mass = 0, max_inertia = 0;
+  std::vector<Mat3> Ic(tree.bodies.size());
+  for (std::size_t i = 0; i < tree.bodies.size(); ++i) {
+    const Spatial::Mat& I = tree.bodies[i].inertia;
+    Spatial::massAndCom(I, out[i].mass, out[i].com);
+    const Mat3 C = Spatial::skew(out[i].com);
+    Ic[i] = I.block<3, 3>(0, 0) - out[i].mass * C * C.transpose();  // about the centre of mass
+    max_mass = std::max(max_mass, out[i].mass);
+    max_inertia = std::max(max_inertia, Ic[i].diagonal().maxCoeff());
+  }
+  const double tiny_mass = kTiny * (max_mass > 0 ? max_mass : 1.0);
+  const double tiny_inertia = kTiny * (max_inertia > 0 ? max_inertia : 1.0);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    LinkFrame& l = out[i];
+    if (!(l.mass > 0)) l.mass = tiny_mass;
+    const Mat3 off = Ic[i] - Mat3(Ic[i].diagonal().asDiagonal());
+    if (off.cwiseAbs().maxCoeff() <= 1e-15 * std::max(1e-300, Ic[i].cwiseAbs().maxCoeff())) {
+      l.inertia = Ic[i].diagonal();
+    } else {
+      // Principal axes: link coordinates = Vᵀ body coordinates, V a proper rotation.
+      Eigen::SelfAdjointEigenSolver<Mat3> eig(Ic[i]);
+      Mat3 V = eig.eigenvectors();
+      if (V.determinant() < 0) V.col(2) = -V.col(2);
+      l.E_p = V.transpose();
+      l.inertia = eig.eigenvalues();
+    }
+    for (int k = 0; k < 3; ++k) l.inertia[k] = std::max(l.inertia[k], tiny_inertia);
+  }
+  return out;
+}
+
+}  // namespace
+
+template <>
+struct BulletMechanism<Spatial>::Impl {
+  // A rolling constraint of the description and its Bullet model.
+  struct Wheel {
+    int constraint = -1, link = -1;
+    const Rolling* rolling = nullptr;
+    btVector3 centre, axle;                       // Bullet link frame
+    RollingNoSlipConstraint* noslip = nullptr;    // NoSlip
+    btMultiBodyLinkCollider* collider = nullptr;  // the wheel link's collider
+    btRigidBody* ground = nullptr;                // Friction
+    btVector3 start_point{0, 0, 0};               // the no-slip contact point at the last step's start
+  };
+
+  MechanismModel<Spatial> model;
+  double dt;
+  std::vector<LinkFrame> frames;
+  std::vector<Wheel> wheels;
+  std::vector<Spatial::Vec> force;  // per description constraint, over the last step
+  std::string summary;
+
+  std::unique_ptr<btDefaultCollisionConfiguration> config;
+  std::unique_ptr<btCollisionDispatcher> dispatcher;
+  std::unique_ptr<btDbvtBroadphase> broadphase;
+  std::unique_ptr<btMultiBodyConstraintSolver> solver;
+  std::unique_ptr<btMultiBodyDynamicsWorld> world;
+  std::unique_ptr<btMultiBody> body;
+  std::vector<std::unique_ptr<btCollisionShape>> shapes;
+  std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders;
+  std::vector<std::unique_ptr<btMultiBodyConstraint>> closures;
+  std::vector<std::unique_ptr<btRigidBody>> grounds;
+
+  Impl(const MechanismModel<Spatial>& m, double step, const VecN& q0, const VecN& v0) : model(m), dt(step) {
+    check(q0, v0);
+    frames = linkFrames(m.tree);
+    force.assign(m.constraints.size(), Spatial::Vec::Zero());
+    config = std::make_unique<btDefaultCollisionConfiguration>();
+    dispatcher = std::make_unique<btCollisionDispatcher>(config.get());
+    broadphase = std::make_unique<btDbvtBroadphase>();
+    solver = std::make_unique<btMultiBodyConstraintSolver>();
+    world = std::make_unique<btMultiBodyDynamicsWorld>(dispatcher.get(), broadphase.get(), solver.get(), config.get());
+    world->setGravity(bt(Spatial::linear(m.tree.gravity)));  // pitfall 2: Bullet's default is (0, −10, 0)
+    btContactSolverInfo& info = world->getSolverInfo();
+    info.m_numIterations = m.bullet.solver_iterations;
+    // Two friction directions, clipped together to the cone (without the flag Bullet keeps one).
+    info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+    info.m_solverMode &= ~SOLVER_DISABLE_IMPLICIT_CONE_FRICTION;
+    buildTree();
+    buildColliders();
+    buildWheels();
+    setState(q0, v0);
+    summarise();
+  }
+
+  ~Impl() {
+    if (world) {
+      for (auto& c : closures) world->removeMultiBodyConstraint(c.get());
+      for (auto& g : grounds) world->removeRigidBody(g.get());
+      for (auto& c : colliders) world->removeCollisionObject(c.get());
+      if (body) world->removeMultiBody(body.get());
+    }
+    closures.clear();
+    grounds.clear();
+    colliders.clear();
+    body.reset();
+    world.reset();
+  }
+
+  // What this model cannot build, said before anything is built.
+  void check(const VecN& q0, const VecN& v0) const {
+    const std::string who = "BulletMechanism (spatial): ";
+    if (!(dt > 0.0) || !std::isfinite(dt)) throw std::invalid_argument(who + "dt must be a positive number");
+    if (!model.payloads.empty()) throw std::invalid_argument(who + "spatial payloads: not yet");
+    if (!model.bullet.cut_joints.empty()) throw std::invalid_argument(who + "cut joints: not yet");
+    if (const std::string why = model.validate(); !why.empty()) throw std::invalid_argument(who + why);
+    if (model.tree.bodies.empty()) throw std::invalid_argument(who + "the mechanism has no tree bodies");
+    if (model.bullet.solver_iterations < 1) throw std::invalid_argument(who + "solver_iterations must be ≥ 1");
+    const int n = model.treeDof();
+    if (q0.size() != n || v0.size() != n)
+      throw std::invalid_argument(who + "q0 and v0 need " + std::to_string(n) + " coordinates (one per tree joint)");
+    for (int i = 0; i < n; ++i) {
+      const auto& b = model.tree.bodies[std::size_t(i)];
+      if (b.parent >= i) throw std::invalid_argument(who + "body " + std::to_string(i) + " comes before its parent");
+      if (!(b.axis.norm() > 0) || !b.axis.allFinite())
+        throw std::invalid_argument(who + "body " + std::to_string(i) + " has no joint axis");
+    }
+    for (std::size_t c = 0; c < model.constraints.size(); ++c)
+      if (!dynamic_cast<const Rolling*>(model.constraints[c].get()))
+        throw std::invalid_argument(who + "constraint " + std::to_string(c) + " (" + model.constraints[c]->kind() +
+                                    "): not yet (only rolling)");
+  }
+
+  void buildTree() {
+    const int n = model.treeDof();
+    body = std::make_unique<btMultiBody>(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true, /*canSleep=*/false);
+    body->setBaseWorldTransform(btTransform::getIdentity());
+    static const LinkFrame world_frame;  // the base is the world: identity, centre at the origin
+    for (int i = 0; i < n; ++i) {
+      const auto& b = model.tree.bodies[std::size_t(i)];
+      const LinkFrame& l = frames[std::size_t(i)];
+      const LinkFrame& p = b.parent < 0 ? world_frame : frames[std::size_t(b.parent)];
+      const btQuaternion rot = quaternion(l.E_p * b.X_tree.E * p.E_p.transpose());
+      const btVector3 axis = bt(l.E_p * b.axis.normalized());
+      const btVector3 e = bt(p.E_p * (b.X_tree.r - p.com)), d = bt(l.E_p * l.com);
+      if (b.joint == JointType::Revolute)
+        body->setupRevolute(i, l.mass, bt(l.inertia), b.parent, rot, axis, e, d, true);
+      else
+        body->setupPrismatic(i, l.mass, bt(l.inertia), b.parent, rot, axis, e, d, true);
+    }
+    body->finalizeMultiDof();
+    // Pitfall 2: no damping, no velocity cap, never sleep.
+    body->setLinearDamping(0.0);
+    body->setAngularDamping(0.0);
+    body->setMaxCoordinateVelocity(1e6);
+    body->setMaxAppliedImpulse(kImpulseCap);
+    body->setCanSleep(false);
+    body->setHasSelfCollision(false);
+    body->setUseGyroTerm(true);
+    world->addMultiBody(body.get());
+  }
+
+  // Pitfall 1: every link gets a collider, with mask 0 (no contacts) unless a friction wheel's.
+  void buildColliders() {
+    shapes.push_back(std::make_unique<btSphereShape>(0.01));
+    for (int i = -1; i < model.treeDof(); ++i) {
+      auto c = std::make_unique<btMultiBodyLinkCollider>(body.get(), i);
+      c->setCollisionShape(shapes.front().get());
+      c->setActivationState(DISABLE_DEACTIVATION);
+      world->addCollisionObject(c.get(), btBroadphaseProxy::DefaultFilter, 0);
+      if (i < 0)
+        body->setBaseCollider(c.get());
+      else
+        body->getLink(i).m_collider = c.get();
+      colliders.push_back(std::move(c));
+    }
+  }
+
+  void buildWheels() {
+    const bool friction = model.bullet.rolling == RollingModel::Friction;
+    for (std::size_t c = 0; c < model.constraints.size(); ++c) {
+      Wheel w;
+      w.constraint = int(c);
+      w.rolling = dynamic_cast<const Rolling*>(model.constraints[c].get());
+      w.link = w.rolling->wheel().index;
+      const LinkFrame& l = frames[std::size_t(w.link)];
+      w.centre = bt(l.E_p * (w.rolling->centre() - l.com));
+      w.axle = bt(l.E_p * w.rolling->axle());
+      w.collider = colliders[std::size_t(w.link) + 1].get();
+      if (friction) {
+        addGround(w, int(wheels.size()));
+      } else {
+        auto r = std::make_unique<RollingNoSlipConstraint>(body.get(), w.link, w.centre, w.axle, w.rolling->radius(),
+                                                           w.rolling->groundHeight());
+        r->setMaxAppliedImpulse(kImpulseCap);
+        world->addMultiBodyConstraint(r.get());
+        w.noslip = r.get();
+        closures.push_back(std::move(r));
+      }
+      wheels.push_back(w);
+    }
+  }
+
+  // Friction: the wheel's sphere and its own ground plane collide with each other and nothing else
+  // (a collision group pair per wheel: wheels at other heights never touch this plane).
+  void addGround(Wheel& w, int k) {
+    if (k >= 12) throw std::invalid_argument("BulletMechanism (spatial): at most 12 friction wheels");
+    const int wheel_group = 1 << (2 * k + 6), ground_group = 1 << (2 * k + 7);
+    const double r = w.rolling->radius();
+    btCollisionShape* wheel_shape;
+    if (w.centre.length() == 0.0) {
+      shapes.push_back(std::make_unique<btSphereShape>(r));
+      wheel_shape = shapes.back().get();
+    } else {  // the disk's centre is off the link's centre of mass: a sphere placed in a compound
+      shapes.push_back(std::make_unique<btSphereShape>(r));
+      btCollisionShape* sphere = shapes.back().get();
+      auto compound = std::make_unique<btCompoundShape>();
+      compound->addChildShape(btTransform(btQuaternion::getIdentity(), w.centre), sphere);
+      shapes.push_back(std::move(compound));
+      wheel_shape = shapes.back().get();
+    }
+    btMultiBodyLinkCollider* c = w.collider;
+    world->removeCollisionObject(c);
+    c->setCollisionShape(wheel_shape);
+    c->setFriction(w.rolling->mu());
+    c->setRestitution(0.0);
+    c->setRollingFriction(0.0);
+    c->setSpinningFriction(0.0);
+    world->addCollisionObject(c, wheel_group, ground_group);
+
+    shapes.push_back(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), w.rolling->groundHeight()));
+    btRigidBody::btRigidBodyConstructionInfo info(0.0, nullptr, shapes.back().get());
+    info.m_friction = 1.0;  // combined friction = μ_wheel × μ_ground = μ
+    info.m_restitution = 0.0;
+    auto g = std::make_unique<btRigidBody>(info);
+    world->addRigidBody(g.get(), ground_group, wheel_group);
+    w.ground = g.get();
+    grounds.push_back(std::move(g));
+  }
+
+  void summarise() {
+    std::ostringstream s;
+    s << "Bullet 3.24 btMultiBody (" << model.treeDof() << " links) hung from the world";
+    if (!wheels.empty()) {
+      if (model.bullet.rolling == RollingModel::NoSlip)
+        s << ", " << wheels.size() << " rolling wheel(s) as a no-slip constraint (rows x, y velocity-level, z at the rim; bilateral)";
+      else
+        s << ", " << wheels.size() << " rolling wheel(s) as a sphere on a friction plane (μ = " << wheels.front().rolling->mu()
+          << ", cone)";
+    }
+    s << ", PGS " << model.bullet.solver_iterations << " iterations";
+    summary = s.str();
+  }
+
+  void setState(const VecN& q, const VecN& v) {
+    for (int i = 0; i < model.treeDof(); ++i) {
+      body->setJointPos(i, q[i]);
+      body->setJointVel(i, v[i]);
+    }
+    btAlignedObjectArray<btQuaternion> w2l;
+    btAlignedObjectArray<btVector3> origin;
+    body->forwardKinematics(w2l, origin);
+    body->updateCollisionObjectWorldTransforms(w2l, origin);
+    checkKinematics(q);
+  }
+
+  // Self-check of the link frames against the description's own kinematics (a convention slip shows here).
+  void checkKinematics(const VecN& q) const {
+    TreeData<Spatial> data(model.tree);
+    positionKinematics(model.tree, q, data);
+    for (int i = 0; i < model.treeDof(); ++i) {
+      const LinkFrame& l = frames[std::size_t(i)];
+      const Pos c = pointPosition(data, i, l.com);
+      const Mat3 R = data.X_world[std::size_t(i)].E.transpose() * l.E_p.transpose();  // link → world
+      double err = (eig(body->localPosToWorld(i, btVector3(0, 0, 0))) - c).norm();
+      for (int k = 0; k < 3; ++k) {
+        btVector3 e(0, 0, 0);
+        e[k] = 1;
+        err = std::max(err, (eig(body->localDirToWorld(i, e)) - R.col(k)).norm());
+      }
+      if (err > 1e-9 * (1 + c.norm()))
+        throw std::logic_error("BulletMechanism (spatial): link " + std::to_string(i) + " disagrees with the description's kinematics");
+    }
+  }
+
+  void state(VecN& q, VecN& v) const {
+    const int n = model.treeDof();
+    q.resize(n);
+    v.resize(n);
+    for (int i = 0; i < n; ++i) {
+      q[i] = body->getJointPos(i);
+      v[i] = body->getJointVel(i);
+    }
+  }
+
+  void step(const VecN& tau_in) {
+    const int n = model.treeDof();
+    if (tau_in.size() != n) throw std::invalid_argument("BulletMechanism::step: τ needs one value per tree joint (" + std::to_string(n) + ")");
+    VecN q, v;
+    state(q, v);
+    for (int i = 0; i < n; ++i) {
+      double tau = tau_in[i];
+      if (!model.joints.empty()) {  // spring, viscous and Coulomb friction from the step's start
+        const JointProperties& jp = model.joints[std::size_t(i)];
+        tau -= jp.stiffness * (q[i] - jp.rest) + jp.viscous * v[i] + jp.coulomb * std::clamp(v[i] / jp.coulomb_width, -1.0, 1.0);
+      }
+      body->addJointTorque(i, tau);  // pitfall 3: cleared after every step
+    }
+    for (Wheel& w : wheels)
+      w.start_point = rimContact(*body, w.link, w.centre, w.axle, w.rolling->radius()).point;
+    world->stepSimulation(dt, 0, dt);  // exactly one step of dt
+    for (Wheel& w : wheels) force[std::size_t(w.constraint)] = w.noslip ? noSlipForce(w) : contactForce(w);
+  }
+
+  // The constraint's impulses over the step, at the point it was written at: no moment there.
+  Spatial::Vec noSlipForce(const Wheel& w) const {
+    Spatial::Vec f = Spatial::Vec::Zero();
+    f.tail<3>() = eig(w.noslip->impulse()) / dt;
+    return f;
+  }
+
+  // The ground's force on the wheel from the contact manifold: normal and both friction impulses over
+  // the step, with its moment about the no-slip contact point at the step's start (zero for an upright
+  // disk up to the contact's penetration); zero when the wheel does not touch.
+  Spatial::Vec contactForce(const Wheel& w) const {
+    Pos f = Pos::Zero(), m = Pos::Zero();
+    const Pos P = eig(w.start_point);
+    for (int i = 0; i < dispatcher->getNumManifolds(); ++i) {
+      const btPersistentManifold* man = dispatcher->getManifoldByIndexInternal(i);
+      double sign;
+      if (man->getBody0() == w.collider && man->getBody1() == w.ground)
+        sign = 1.0;  // Bullet's impulses act on body 0 along +normal, +friction directions
+      else if (man->getBody1() == w.collider && man->getBody0() == w.ground)
+        sign = -1.0;
+      else
+        continue;
+      for (int j = 0; j < man->getNumContacts(); ++j) {
+        const btManifoldPoint& cp = man->getContactPoint(j);
+        const btVector3 impulse = cp.m_normalWorldOnB * cp.m_appliedImpulse + cp.m_lateralFrictionDir1 * cp.m_appliedImpulseLateral1 +
+                                  cp.m_lateralFrictionDir2 * cp.m_appliedImpulseLateral2;
+        const Pos fj = sign * eig(impulse) / dt;
+        const Pos x = eig(sign > 0 ? cp.getPositionWorldOnA() : cp.getPositionWorldOnB());
+        f += fj;
+        m += (x - P).cross(fj);
+      }
+    }
+    Spatial::Vec out;
+    out << m, f;
+    return out;
+  }
+};
+
+template <>
+BulletMechanism<Spatial>::BulletMechanism(const MechanismModel<Spatial>& model, double dt, const VecN& q0, const VecN& v0)
+    : impl_(std::make_unique<Impl>(model, dt, q0, v0)) {}
+template <>
+BulletMechanism<Spatial>::~BulletMechanism() {}
+template <>
+void BulletMechanism<Spatial>::step(const VecN& tau) { impl_->step(tau); }
+template <>
+void BulletMechanism<Spatial>::state(VecN& q, VecN& v) const { impl_->state(q, v); }
+template <>
+Spatial::Vec BulletMechanism<Spatial>::constraintForce(int i) const {
+  if (i < 0 || i >= int(impl_->force.size())) throw std::out_of_range("BulletMechanism::constraintForce: no such constraint");
+  return impl_->force[std::size_t(i)];
+}
+template <>
+std::string BulletMechanism<Spatial>::describe() const { return impl_->summary; }
+
+}  // namespace dyn::bullet
