@@ -8,6 +8,11 @@
 //             description (the plane's own friction is 1: Bullet multiplies the two), restitution 0,
 //             two friction directions with Bullet's implicit cone |f_t| ≤ μ f_n.
 // Other constraint kinds, cut joints and payloads are refused (std::invalid_argument: "not yet").
+// The rolling force reported is the ground's on the wheel over the step (impulses / dt), a pure force
+// at the contact point the step used (moment ~0): NoSlip's predicted end-of-step point, the friction
+// contact's start-of-step point. Bullet's contact friction holds at the step's start geometry, so a
+// friction wheel's state reads a slip of v φ' dt while it grips (the NoSlip rows avoid this; see
+// rolling_constraint.h); its contact's own slip (start heading, new velocities) is ~1e-12 m/s.
 //
 // Links. Bullet puts a link's frame at its centre of mass with its inertia diagonal; the description
 // puts it at the joint with a full 6×6 inertia. Each Bullet link is the description's body frame
