@@ -13,6 +13,8 @@ namespace dyn::bullet::test {
 struct Unicycle {
   double r = 0.1, m = 2.0, g = 9.81, mu = 0.8;
   double carrier_mass = 0.0;  // > 0: every carrier gets this mass (and m r² × it / m inertia)
+  double com_y = 0.0;         // a lopsided wheel: centre of mass this far along the axle from the disk's centre
+  double product = 0.0;       // and these products of inertia (xy, xz, yz = product, −product/2, product/3)
   double Ia() const { return m * r * r / 2; }
   double Id() const { return m * r * r / 4; }
 
@@ -27,8 +29,11 @@ struct Unicycle {
     b = t.addBody(b, JointType::Prismatic, Pos::UnitY(), Spatial::Transform(), carrier);
     b = t.addBody(b, JointType::Prismatic, Pos::UnitZ(), Spatial::Transform(), carrier);
     b = t.addBody(b, JointType::Revolute, Pos::UnitZ(), Spatial::Transform(), carrier);
-    b = t.addBody(b, JointType::Revolute, Pos::UnitY(), Spatial::Transform(),
-                  Spatial::inertia(m, Pos::Zero(), Eigen::Vector3d(Id(), Ia(), Id()).asDiagonal()));
+    Eigen::Matrix3d Ic = Eigen::Vector3d(Id(), Ia(), Id()).asDiagonal();
+    Ic(0, 1) = Ic(1, 0) = product;
+    Ic(0, 2) = Ic(2, 0) = -product / 2;
+    Ic(1, 2) = Ic(2, 1) = product / 3;
+    b = t.addBody(b, JointType::Revolute, Pos::UnitY(), Spatial::Transform(), Spatial::inertia(m, Pos(0, com_y, 0), Ic));
     d.constraints.push_back(std::make_shared<Rolling>(BodyRef::link(b), Pos::Zero(), Pos::UnitY(), r, 0.0, mu));
     d.bullet.rolling = rolling;
     return d;
