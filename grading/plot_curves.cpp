@@ -112,9 +112,15 @@ std::vector<LabFigure> parseLabFigures(const JsonView& config, const std::vector
     f.onlyKeys({"plot", "title", "xlabel", "ylabel"});
     const JsonView plot = f["plot"];
     LabFigure fig{parsePlotCurves(plot.string(), columns, plot.file(), plot.path()), "", "", ""};
-    if (f.has("title")) fig.title = f["title"].string();
-    if (f.has("xlabel")) fig.xlabel = f["xlabel"].string();
-    if (f.has("ylabel")) fig.ylabel = f["ylabel"].string();
+    // Titles and labels are drawn on one line: short, and no control characters.
+    const auto text = [&](const char* key) {
+      if (!f.has(key)) return std::string();
+      const std::string s = f[key].string();
+      if (s.size() > 200 || std::any_of(s.begin(), s.end(), [](unsigned char c) { return c < 0x20 || c == 0x7F; }))
+        f[key].fail("expected one line of at most 200 bytes, without control characters");
+      return s;
+    };
+    fig.title = text("title"), fig.xlabel = text("xlabel"), fig.ylabel = text("ylabel");
     out.push_back(fig);
   }
   return out;

@@ -50,8 +50,8 @@ struct LabFigure {
 };
 
 // Reads config["figures"] (absent: none): an array of at most 20 objects with "plot" (the --plot
-// grammar above) and optional "title", "xlabel", "ylabel" strings. Throws InputError naming the
-// file and the JSON path ("/figures/0/plot").
+// grammar above) and optional "title", "xlabel", "ylabel" strings (one line, at most 200 bytes).
+// Throws InputError naming the file and the JSON path ("/figures/0/plot").
 std::vector<LabFigure> parseLabFigures(const JsonView& config, const std::vector<std::string>& columns);
 
 }  // namespace dyn

@@ -110,6 +110,10 @@ TEST_CASE("a lab's \"figures\": its default x–y plots, validated with file and
             "lab.json: /figures/1/plot: unknown column \"y\""));
   CHECK(has(bad(R"j({"figures": [{"plot": "x_c, f_Ty:f_Tx"}]})j"), "lab.json: /figures/0/plot: expected every curve"));
   CHECK(has(bad(R"j({"figures": [{"plot": "x_c", "title": 3}]})j"), "lab.json: /figures/0/title: expected a string"));
+  CHECK(has(bad(R"j({"figures": [{"plot": "x_c", "ylabel": "two\nlines"}]})j"),
+            "lab.json: /figures/0/ylabel: expected one line of at most 200 bytes"));
+  const json long_title = {{"figures", {{{"plot", "x_c"}, {"title", std::string(201, 'a')}}}}};
+  CHECK(has(error([&] { parse(long_title); }), "lab.json: /figures/0/title: expected one line"));
   json many = {{"figures", json::array()}};
   for (int i = 0; i < 21; ++i) many["figures"].push_back({{"plot", "x_c"}});
   CHECK(has(error([&] { parse(many); }), "/figures: expected an array of 1 to 20 elements, got 21"));
