@@ -113,8 +113,8 @@ std::vector<FigurePlot> overlayPlots(const Lab& lab, const Trace& trace) {
   return plots;
 }
 
-// A requested plot's labels: the lab's own for exactly these curves (from its rubric or its
-// "figures"), else the column names with the lab's units ("theta, theta_d (rad)"; "x (m), theta (rad)").
+// A requested plot with the lab's own labels for exactly these curves (from its "figures", else its
+// rubric); without any, fillLabels derives them from the columns.
 FigurePlot labelled(const std::vector<PlotCurve>& curves, const std::vector<FigurePlot>& lab_plots) {
   const auto key = [](const std::vector<PlotCurve>& cs) {
     std::set<std::pair<std::string, std::string>> k;
