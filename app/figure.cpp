@@ -1,7 +1,9 @@
-// dynlab figure: lecture figures from a lab's run. Plots of trace columns against t (grading/plot.h:
-// PDF, SVG or PNG; hand solid, Bullet dashed) and rendered stills of the scene at chosen times
-// (app/movie.h renderRow through OSMesa; the Bullet run as a ghost). Without --plot and --still the
-// lab chooses: the plots its rubric draws (else those of its overlay panel that are trace columns)
+// dynlab figure: lecture figures from a lab's run. Plots of trace columns against t, or of one
+// column against another (x–y: the path in the plane, equal scales when both axes have one unit;
+// grading/plot_curves.h names them), as PDF, SVG or PNG (grading/plot.h; hand solid, Bullet dashed),
+// and rendered stills of the scene at chosen times (app/movie.h renderRow through OSMesa; the Bullet
+// run as a ghost). Without --plot and --still the lab chooses: the plots its rubric draws (else
+// those of its overlay panel that are trace columns), the figures its JSON declares ("figures"),
 // and stills at the start, middle and end. Everything is checked before anything is simulated or
 // written; output goes through Staging, and a figure run owns DIR/plot_* and DIR/still_*. Under
 // --scenario NAME the run is the rubric scenario's, as the grader runs it (commands.h applyScenario).
@@ -17,6 +19,7 @@
 #include "app/progress.h"
 #include "grading/escape.h"
 #include "grading/plot.h"
+#include "grading/plot_curves.h"
 #include "grading/rubric.h"
 #include "labs/numbers.h"
 #include "labs/run.h"
@@ -27,10 +30,10 @@ namespace fs = std::filesystem;
 namespace dyn::app {
 namespace {
 
-// One plot to draw: trace columns against t, and its y label (empty: the column names).
+// One plot to draw: its curves (columns against t, or x–y), its title and labels (empty: derived).
 struct FigurePlot {
-  std::vector<std::string> columns;
-  std::string ylabel;
+  std::vector<PlotCurve> curves;
+  std::string ylabel, xlabel, title;
 };
 
 // Bad command-line input: "<command line>: OPTION VALUE: expected ...", exit code 2.
@@ -52,30 +55,21 @@ std::pair<int, int> parseSize(const std::string& s) {
   return {w, h};
 }
 
-// "theta, theta_d" → {"theta", "theta_d"}, every name a column of the lab.
-std::vector<std::string> parseColumns(const std::string& spec, const std::vector<std::string>& columns) {
-  std::vector<std::string> out;
-  std::size_t start = 0;
-  while (start <= spec.size()) {
-    std::size_t end = spec.find(',', start);
-    if (end == std::string::npos) end = spec.size();
-    std::string name = spec.substr(start, end - start);
-    name.erase(0, name.find_first_not_of(' '));
-    name.erase(name.find_last_not_of(' ') + 1);
-    if (std::find(columns.begin(), columns.end(), name) == columns.end())
-      badOption("--plot", spec,
-                (name.empty() ? std::string("empty column name") : "unknown column \"" + name + "\"") +
-                    "; expected trace columns separated by commas, one of: " + join(columns, ", "));
-    if (std::find(out.begin(), out.end(), name) == out.end()) out.push_back(name);
-    start = end + 1;
-  }
-  return out;
+// Adds p unless a plot of the same curves is there already (which `replace` overwrites instead).
+void addPlot(std::vector<FigurePlot>& plots, FigurePlot p, bool replace = false) {
+  for (auto& q : plots)
+    if (q.curves == p.curves) {
+      if (replace) q = std::move(p);
+      return;
+    }
+  if (!p.curves.empty()) plots.push_back(std::move(p));
 }
 
-void addPlot(std::vector<FigurePlot>& plots, FigurePlot p) {
-  for (const auto& q : plots)
-    if (q.columns == p.columns) return;
-  if (!p.columns.empty()) plots.push_back(std::move(p));
+// "plot_f_Ty+f_des" against t; "plot_y-vs-x+y_d-vs-x_d" for an x–y plot.
+std::string fileStem(const std::vector<PlotCurve>& curves) {
+  std::vector<std::string> parts;
+  for (const auto& c : curves) parts.push_back(c.x == "t" ? c.y : c.y + "-vs-" + c.x);
+  return "plot_" + join(parts, "+");
 }
 
 // The plots the lab's rubric draws (each response with its reference), with the rubric's y label
@@ -87,12 +81,22 @@ std::vector<FigurePlot> rubricPlots(const LoadedLab& loaded) {
   auto known = [&](const std::string& c) { return std::find(columns.begin(), columns.end(), c) != columns.end(); };
   for (const RubricTest& test : parseRubric(JsonView(loaded.config, loaded.config_file)).tests) {
     if (!test.plot) continue;
-    FigurePlot p{{}, test.plot->ylabel};
-    for (const auto& c : test.plot->columns)
-      if (known(c)) p.columns.push_back(c);
-    if (!test.plot->reference.empty() && known(test.plot->reference)) p.columns.push_back(test.plot->reference);
+    const PlotRequest& r = *test.plot;
+    const std::string x = r.x.empty() ? "t" : r.x, ref_x = r.reference_x.empty() ? x : r.reference_x;
+    FigurePlot p{{}, r.ylabel, r.xlabel, ""};
+    for (const auto& c : r.columns)
+      if (known(c) && (x == "t" || known(x))) p.curves.push_back({c, x});
+    if (!r.reference.empty() && known(r.reference) && (ref_x == "t" || known(ref_x))) p.curves.push_back({r.reference, ref_x});
     addPlot(plots, p);
   }
+  return plots;
+}
+
+// The figures the lab's JSON asks for ("figures"), with their own titles and labels.
+std::vector<FigurePlot> declaredPlots(const LoadedLab& loaded) {
+  std::vector<FigurePlot> plots;
+  for (const LabFigure& f : parseLabFigures(JsonView(loaded.config, loaded.config_file), loaded.lab->columns()))
+    addPlot(plots, {f.curves, f.ylabel, f.xlabel, f.title});
   return plots;
 }
 
@@ -104,50 +108,61 @@ std::vector<FigurePlot> overlayPlots(const Lab& lab, const Trace& trace) {
   lab.overlay(trace, 0, overlay);
   for (const Series& s : overlay.plots) {
     const std::string name = s.name.substr(0, s.name.find(" ("));
-    if (trace.column(name) >= 0) addPlot(plots, {{name}, s.name});
+    if (trace.column(name) >= 0) addPlot(plots, {{{name, "t"}}, s.name, "", ""});
   }
   return plots;
 }
 
-// The y label of a requested plot: the lab's own label for exactly these columns (from its
-// rubric), else the column names with the lab's units ("theta, theta_d (rad)"; "x (m), theta (rad)").
-std::string ylabelFor(const Lab& lab, const std::vector<std::string>& columns,
-                      const std::vector<FigurePlot>& lab_plots) {
-  for (const auto& p : lab_plots)
-    if (std::set<std::string>(p.columns.begin(), p.columns.end()) ==
-        std::set<std::string>(columns.begin(), columns.end()))
-      return p.ylabel;
-  std::set<std::string> units;
-  for (const auto& c : columns) units.insert(lab.unit(c));
-  if (units.size() == 1) {
-    const std::string& u = *units.begin();
-    return join(columns, ", ") + (u.empty() ? "" : " (" + u + ")");
-  }
-  std::vector<std::string> labelled;
-  for (const auto& c : columns) labelled.push_back(lab.unit(c).empty() ? c : c + " (" + lab.unit(c) + ")");
-  return join(labelled, ", ");
+// A requested plot with the lab's own labels for exactly these curves (from its "figures", else its
+// rubric); without any, fillLabels derives them from the columns.
+FigurePlot labelled(const std::vector<PlotCurve>& curves, const std::vector<FigurePlot>& lab_plots) {
+  const auto key = [](const std::vector<PlotCurve>& cs) {
+    std::set<std::pair<std::string, std::string>> k;
+    for (const auto& c : cs) k.insert({c.y, c.x});
+    return k;
+  };
+  FigurePlot p{curves, "", "", ""};
+  for (const auto& q : lab_plots)
+    if (key(q.curves) == key(curves)) {
+      p.ylabel = q.ylabel, p.xlabel = q.xlabel;
+      break;
+    }
+  return p;
 }
 
-// One plot of the runs: each column a colour, hand solid and Bullet dashed; a column the engines
-// share exactly (a reference, a setpoint) is drawn once, as both engines'.
-PlotSpec plotSpec(const FigurePlot& p, const std::string& title, const RunResult* hand, const RunResult* bullet,
-                  const FigureArgs& a) {
+// The labels a plot is drawn with: its own, else its columns with their units (x: t in seconds).
+void fillLabels(const Lab& lab, FigurePlot& p) {
+  if (p.ylabel.empty()) p.ylabel = axisLabel(lab, yColumns(p.curves));
+  if (p.xlabel.empty()) p.xlabel = parametric(p.curves) ? axisLabel(lab, xColumns(p.curves)) : "t (s)";
+}
+
+// One plot of the runs: each curve a colour, hand solid and Bullet dashed; a curve the engines
+// share exactly (a reference, a setpoint) is drawn once, as both engines'. An x–y plot is linear,
+// with equal scales when its axes have one unit (metres against metres).
+PlotSpec plotSpec(const Lab& lab, const FigurePlot& p, const std::string& title, const RunResult* hand,
+                  const RunResult* bullet, const FigureArgs& a) {
   PlotSpec spec;
   spec.title = title;
   spec.font_scale = a.font_scale;
   spec.y_scale = a.y_scale == "log" ? YScale::Log : a.y_scale == "linear" ? YScale::Linear : YScale::Auto;
-  spec.xlabel = "t (s)";
-  spec.ylabel = p.ylabel.empty() ? join(p.columns, ", ") : p.ylabel;
-  for (std::size_t k = 0; k < p.columns.size(); ++k) {
-    const std::string& c = p.columns[k];
-    const std::vector<double> h = hand ? hand->trace.series(c) : std::vector<double>{};
-    const std::vector<double> b = bullet ? bullet->trace.series(c) : std::vector<double>{};
-    if (hand && bullet && h == b) {
-      spec.series.push_back({c + " (hand, Bullet)", hand->trace.series("t"), h, PlotSeries::Style::Solid, int(k)});
+  spec.xlabel = p.xlabel;
+  spec.ylabel = p.ylabel;
+  spec.parametric = parametric(p.curves);
+  spec.equal_aspect = spec.parametric && sameUnit(lab, xColumns(p.curves), yColumns(p.curves));
+  for (std::size_t k = 0; k < p.curves.size(); ++k) {
+    const PlotCurve& c = p.curves[k];
+    const std::string name = curvesText({c});
+    const auto series = [&](const RunResult* r, const std::string& col) {
+      return r ? r->trace.series(col) : std::vector<double>{};
+    };
+    const std::vector<double> hy = series(hand, c.y), by = series(bullet, c.y);
+    const std::vector<double> hx = series(hand, c.x), bx = series(bullet, c.x);
+    if (hand && bullet && hy == by && (c.x == "t" || hx == bx)) {
+      spec.series.push_back({name + " (hand, Bullet)", hx, hy, PlotSeries::Style::Solid, int(k)});
       continue;
     }
-    if (hand) spec.series.push_back({c + " (hand)", hand->trace.series("t"), h, PlotSeries::Style::Solid, int(k)});
-    if (bullet) spec.series.push_back({c + " (Bullet)", bullet->trace.series("t"), b, PlotSeries::Style::Dashed, int(k)});
+    if (hand) spec.series.push_back({name + " (hand)", hx, hy, PlotSeries::Style::Solid, int(k)});
+    if (bullet) spec.series.push_back({name + " (Bullet)", bx, by, PlotSeries::Style::Dashed, int(k)});
   }
   return spec;
 }
@@ -172,9 +187,10 @@ int figure(const FigureArgs& a) {
   // Check every input before simulating or writing anything.
   LoadedLab loaded;
   std::pair<int, int> size{1920, 1080}, plot_size{800, 450};
-  std::vector<std::vector<std::string>> requested;
+  std::vector<std::vector<PlotCurve>> requested;
   std::vector<double> stills = a.stills;
-  std::vector<FigurePlot> lab_plots, plots;
+  std::vector<FigurePlot> rubric_plots, declared, plots;
+  bool own_set = false;  // neither --plot nor --still: the lab's plots and stills
   try {
     if (a.format != "pdf" && a.format != "svg" && a.format != "png")
       badOption("--format", a.format, "expected pdf, svg or png");
@@ -188,16 +204,20 @@ int figure(const FigureArgs& a) {
     loaded = loadLab(a.lab, a.config, a.gains, a.duration);
     applyScenario(loaded, a.scenario, a.gains, a.duration);
     const std::vector<std::string> columns = loaded.lab->columns();
-    for (const auto& spec : a.plots) requested.push_back(parseColumns(spec, columns));
+    for (const auto& spec : a.plots) requested.push_back(parsePlotCurves(spec, columns, "<command line>", "--plot " + spec));
     const double duration = loaded.lab->duration();
     for (double t : stills)
       if (!(t >= 0 && t <= duration))
         badOption("--still", fmt("%g", t), "expected a time in [0, " + fmt("%g", duration) + "] s (the run's duration)");
-    lab_plots = rubricPlots(loaded);
-    for (const auto& cols : requested) plots.push_back({cols, ylabelFor(*loaded.lab, cols, lab_plots)});
-    if (a.plots.empty() && stills.empty()) {
+    rubric_plots = rubricPlots(loaded);
+    declared = declaredPlots(loaded);
+    std::vector<FigurePlot> known = declared;  // a declared figure's labels first: they are for figures
+    known.insert(known.end(), rubric_plots.begin(), rubric_plots.end());
+    for (const auto& curves : requested) plots.push_back(labelled(curves, known));
+    own_set = a.plots.empty() && stills.empty();
+    if (own_set) {
       stills = {0.0, 0.5 * duration, duration};
-      plots = lab_plots;
+      plots = rubric_plots;
     }
   } catch (const InputError& e) {
     std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
@@ -218,7 +238,13 @@ int figure(const FigureArgs& a) {
     if (a.engine != "hand") bullet = run(Engine::Bullet);
     const RunResult& shown = hand ? *hand : *bullet;
 
-    if (a.plots.empty() && a.stills.empty() && plots.empty()) plots = overlayPlots(lab, shown.trace);
+    // The lab's own set: its rubric's plots (else its overlay's), then the figures it declares
+    // (one of the same curves as a rubric plot takes its place, with its title and labels).
+    if (own_set) {
+      if (plots.empty()) plots = overlayPlots(lab, shown.trace);
+      for (const auto& p : declared) addPlot(plots, p, true);
+    }
+    for (auto& p : plots) fillLabels(lab, p);
 
     Staging staging(out);
     const std::vector<std::string> earlier = ownedFigures(out);
@@ -228,12 +254,14 @@ int figure(const FigureArgs& a) {
     Progress bar("figures", plots.size() + stills.size());
     std::size_t made = 0;
     for (const FigurePlot& p : plots) {
-      const std::string name = "plot_" + join(p.columns, "+") + "." + a.format;
+      const std::string name = fileStem(p.curves) + "." + a.format;
       bar.set(made++);
       if (!names.insert(name).second) continue;
-      const std::string title = a.title.empty() ? lab_title + ": " + join(p.columns, ", ") : a.title;
-      writePlot(staging.path(name).string(), plotSpec(p, title, hand ? &*hand : nullptr, bullet ? &*bullet : nullptr, a),
-                plot_size.first, plot_size.second);
+      const std::string title =
+          !a.title.empty() ? a.title : lab_title + ": " + (p.title.empty() ? curvesText(p.curves) : p.title);
+      writePlot(staging.path(name).string(),
+                plotSpec(lab, p, title, hand ? &*hand : nullptr, bullet ? &*bullet : nullptr, a), plot_size.first,
+                plot_size.second);
       written.push_back(name);
     }
     if (!stills.empty()) {

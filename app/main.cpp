@@ -62,8 +62,9 @@ int dispatch(int argc, char** argv) {
 
   FigureArgs fig;
   auto* f = cli.add_subcommand("figure", "Lecture figures from a lab's run: plots of trace columns (PDF/SVG/PNG) and "
-                                         "rendered stills (PNG); without --plot/--still, the lab's own plots and "
-                                         "stills at the start, middle and end");
+                                         "rendered stills (PNG); without --plot/--still, the lab's own plots (its "
+                                         "rubric's and its JSON's \"figures\") and stills at the start, middle "
+                                         "and end");
   f->add_option("LAB", fig.lab, "Lab name (see `dynlab list`)")->required();
   f->add_option("--config", fig.config, "Lab config JSON (default: labs/LAB/LAB.json)");
   f->add_option("--gains", fig.gains, "Gains JSON: {\"gains\": {...}} as in a submission");
@@ -71,8 +72,10 @@ int dispatch(int argc, char** argv) {
   f->add_option("--engine", fig.engine, "Which engine(s) to run: hand solid, Bullet dashed (plots) or as a ghost (stills)")
       ->check(CLI::IsMember({"hand", "bullet", "both"}));
   f->add_option("--out", fig.out, "Output directory (default: out/LAB/figures)");
-  f->add_option("--plot", fig.plots, "Trace columns to plot against t, e.g. theta,theta_d (repeatable: one plot each); "
-                                     "written as plot_<cols joined by +>.<format>")
+  f->add_option("--plot", fig.plots, "Trace columns to plot against t, e.g. theta,theta_d, or Y:X for column Y "
+                                     "against column X, e.g. \"y:x, y_d:x_d\" (the path in the plane; equal scales "
+                                     "when both axes have one unit) (repeatable: one plot each); written as "
+                                     "plot_<cols joined by +>.<format> (Y:X as Y-vs-X)")
       ->allow_extra_args(false);
   f->add_option("--still", fig.stills, "Render the scene at this time (s), nearest trace row (repeatable); "
                                        "written as still_<t>.png")

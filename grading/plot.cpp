@@ -113,6 +113,19 @@ bool completeFile(const std::string& text, const std::string& device) {
 
 }  // namespace
 
+PlotWindow equalAspect(const PlotWindow& w, double frame_width, double frame_height) {
+  PlotWindow out = w;
+  const double per_x = (w.x1 - w.x0) / frame_width, per_y = (w.y1 - w.y0) / frame_height;  // data per length
+  if (per_x < per_y) {  // x is stretched: show more of it
+    const double half = 0.5 * per_y * frame_width, mid = 0.5 * (w.x0 + w.x1);
+    out.x0 = mid - half, out.x1 = mid + half;
+  } else if (per_y < per_x) {
+    const double half = 0.5 * per_x * frame_height, mid = 0.5 * (w.y0 + w.y1);
+    out.y0 = mid - half, out.y1 = mid + half;
+  }
+  return out;
+}
+
 PlotLayout writePlot(const std::string& path, const PlotSpec& spec, int width_px, int height_px) {
   const std::string device = deviceFor(path);
   validate(path, spec);

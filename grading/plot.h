@@ -37,6 +37,10 @@ struct PlotSpec {
   std::string vline_label;           // legend text for the markers (optional)
   YScale y_scale = YScale::Linear;
   double font_scale = 1.0;           // text size relative to the picture's default
+  // x–y (parametric) plots: x is data like y (both axes get headroom, y is linear), and with
+  // equal_aspect one unit is as long on both axes (a circle looks round): see equalAspect.
+  bool parametric = false;
+  bool equal_aspect = false;
 };
 
 // Where things landed, in pixels from the top-left corner (x0 < x1, y0 < y1).
@@ -49,7 +53,17 @@ struct PlotLayout {
   PlotBox frame;   // the data area
   PlotBox legend;  // empty when there is no legend; never overlaps the frame
   bool log_y = false;
+  double x_lo = 0, x_hi = 0, y_lo = 0, y_hi = 0;  // the data the frame spans (log y: exponents)
 };
+
+// World ranges [x0, x1] × [y0, y1] shown in a frame of width × height (any length unit).
+struct PlotWindow {
+  double x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+};
+// Equal scales: the narrower range (in data per length) is widened about its middle until one
+// data unit spans as much of the frame along x as along y; the other is kept. Ranges must be
+// non-empty and the frame positive.
+PlotWindow equalAspect(const PlotWindow& w, double frame_width, double frame_height);
 
 // Writes the plot as PNG (pngcairo) or SVG (svg) or PDF (pdf), chosen by the file extension, at
 // width × height pixels (1 px = 1 pt: a PDF's page is that many points).
@@ -65,6 +79,9 @@ struct PlotLayout {
 // smooth solid series, then dashed ones (references) on top.
 // The legend sits outside the frame — right of it when narrow, else below it — so it never
 // covers data. Log y: values ≤ 0 are left out; ticks at powers of ten.
+// Parametric plots: spans and vertical markers are not drawn (x is not time); with equal_aspect
+// the ranges are widened to the frame's shape, then the frame is trimmed (centred) to make the
+// scales exactly equal once the tick labels have taken their room.
 PlotLayout writePlot(const std::string& path, const PlotSpec& spec, int width_px = 800, int height_px = 450);
 
 }  // namespace dyn

@@ -3,6 +3,8 @@
 // top: hatched spans, faint (noisy) series, bands, solid series, dashed series, markers, frame.
 // The legend goes right of the frame when it is narrow, else below it: never over the data.
 // Every number PLplot sees is finite: the data are split into finite runs before drawing.
+// An x–y plot has no spans or markers (x is not time); equal aspect widens one range to the
+// frame's shape, then trims the frame so a unit is as long along x as along y.
 #include "grading/plot_draw.h"
 
 #include <plplot/plplot.h>
@@ -190,10 +192,19 @@ void setRanges(const std::string& path, Prepared& p) {
   for (const auto& b : spec.bands)
     for (size_t i = 0; i < b.x.size(); ++i)
       if (std::isfinite(b.x[i])) xr.add(b.x[i]), yr.add(b.lo[i]), yr.add(b.hi[i]);
-  for (double v : spec.vlines) xr.add(v);
+  if (!spec.parametric)
+    for (double v : spec.vlines) xr.add(v);
   if (xr.empty()) throw std::runtime_error("writePlot " + path + ": no finite x values to plot");
   if (yr.empty()) yr = {0.0, 0.0};
   xr.widenIfFlat();
+  // A parametric plot's x is data: 5% headroom each side like y, and it is drawn as it is.
+  if (spec.parametric) {
+    yr.widenIfFlat();
+    const double px = 0.05 * (xr.hi - xr.lo), py = 0.05 * (yr.hi - yr.lo);
+    p.xr = {xr.lo - px, xr.hi + px};
+    p.yr = {yr.lo - py, yr.hi + py};
+    return;
+  }
   // A marker on the last sample (a run that stopped) would hide in the frame: leave it some room.
   for (double v : spec.vlines)
     if (std::isfinite(v) && xr.hi - v < 0.01 * (xr.hi - xr.lo)) xr.hi = v + 0.03 * (xr.hi - xr.lo);
@@ -280,7 +291,7 @@ struct Legend {
 
   Legend(const Prepared& p, double scale, double ch, double page_w) : scale(scale), ch(ch) {
     for (const auto& s : p.spec.spans)
-      if (!s.label.empty()) add(s.label, PL_LEGEND_COLOR_BOX, kSpan, 3, kInk, 1, scale);
+      if (!s.label.empty() && !p.spec.parametric) add(s.label, PL_LEGEND_COLOR_BOX, kSpan, 3, kInk, 1, scale);
     for (const auto& b : p.spec.bands)
       if (!b.label.empty()) add(b.label, PL_LEGEND_COLOR_BOX, kBand, 0, kInk, 1, scale);
     for (size_t i = 0; i < p.spec.series.size(); ++i) {
@@ -289,7 +300,7 @@ struct Legend {
         add(s.label, PL_LEGEND_LINE, kInk, 0, seriesColour(s.color, p.faint[i]), seriesStyle(s.style),
             (p.faint[i] ? 1.2 : 2.0) * scale);
     }
-    if (!p.spec.vlines.empty() && !p.spec.vline_label.empty())
+    if (!p.spec.parametric && !p.spec.vlines.empty() && !p.spec.vline_label.empty())
       add(p.spec.vline_label, PL_LEGEND_LINE, kInk, 0, kMarker, 2, 2.0 * scale);
     const double room = page_w - 2 * ch - (entryMm() - chars() * kGlyphWidth * ch);
     const size_t most = static_cast<size_t>(std::max(4.0, room / (kGlyphWidth * ch)));
@@ -353,7 +364,7 @@ void Range::widenIfFlat() {
 
 Prepared prepare(const std::string& path, const PlotSpec& spec) {
   Prepared p{spec, {}, {}, false, {}};
-  p.log_y = spec.y_scale == YScale::Log || (spec.y_scale == YScale::Auto && wantsLog(spec));
+  p.log_y = !spec.parametric && (spec.y_scale == YScale::Log || (spec.y_scale == YScale::Auto && wantsLog(spec)));
   if (p.log_y) toLog(p.spec);
   // Faint: a noise-like series beside one much smoother (its roughness a tenth or less).
   std::vector<double> rough;
@@ -385,7 +396,7 @@ void setColours() {
 
 PlotLayout draw(const Prepared& p, int width_px, int height_px) {
   const PlotSpec& spec = p.spec;
-  const Range &xr = p.xr, &yr = p.yr;
+  Range xr = p.xr, yr = p.yr;  // equal_aspect widens one of them to the frame's shape
   // Lines scale with the picture; text also with the spec's font scale.
   const double scale = std::clamp(std::min(width_px / 800.0, height_px / 450.0), 0.8, 4.0);
   const double text_scale = scale * std::clamp(spec.font_scale, 0.25, 8.0);
@@ -396,34 +407,58 @@ PlotLayout draw(const Prepared& p, int width_px, int height_px) {
   plgspa(&page_x0, &page_x1, &page_y0, &page_y1);
   const double page_w = page_x1 - page_x0, page_h = page_y1 - page_y0;
 
-  // Ticks at nice steps (whole decades on a log axis), labelled by our own formatter so their
-  // widths are known.
-  tick_x = {niceStep(xr.hi - xr.lo, kXTicks), std::max(std::abs(xr.lo), std::abs(xr.hi)), false};
-  tick_y = {niceStep(yr.hi - yr.lo, kYTicks), std::max(std::abs(yr.lo), std::abs(yr.hi)), p.log_y};
-  if (p.log_y) tick_y.step = std::max(1.0, std::round(tick_y.step));
+  // Ticks at nice steps (whole decades on a log axis; one step on both axes of an equal-aspect
+  // plot, so the grid is square), labelled by our own formatter so their widths are known.
+  size_t ytick_w = 1, xtick_w = 1;
+  const auto setTicks = [&] {
+    tick_x = {niceStep(xr.hi - xr.lo, kXTicks), std::max(std::abs(xr.lo), std::abs(xr.hi)), false};
+    tick_y = {niceStep(yr.hi - yr.lo, kYTicks), std::max(std::abs(yr.lo), std::abs(yr.hi)), p.log_y};
+    if (p.log_y) tick_y.step = std::max(1.0, std::round(tick_y.step));
+    if (spec.equal_aspect) tick_x.step = tick_y.step = std::max(tick_x.step, tick_y.step);
+    ytick_w = widestTick(tick_y, yr.lo, yr.hi), xtick_w = widestTick(tick_x, xr.lo, xr.hi);
+  };
+  setTicks();
   plslabelfunc(tickLabel, nullptr);
-  const size_t ytick_w = widestTick(tick_y, yr.lo, yr.hi), xtick_w = widestTick(tick_x, xr.lo, xr.hi);
 
   // Margins in mm: tick and axis labels left and below, the title on top, the legend right of
   // the frame (narrow) or below the x label (wide, in as many columns as fit).
   const Legend legend(p, text_scale, ch, page_w);
   const double cw = kGlyphWidth * ch, gap = 0.8 * ch;
   const bool legend_right = !legend.empty() && legend.entryMm() <= kMaxRightLegend * page_w;
-  const double left = 0.6 * ch + (spec.ylabel.empty() ? 0.0 : 2.5 * ch) + ytick_w * cw + 0.8 * ch;
+  const auto leftMargin = [&] { return 0.6 * ch + (spec.ylabel.empty() ? 0.0 : 2.5 * ch) + ytick_w * cw + 0.8 * ch; };
+  const auto rightMargin = [&] {
+    return legend_right ? legend.entryMm() + 1.2 * ch : std::max(1.8 * ch, 0.5 * xtick_w * cw + 0.5 * ch);
+  };
+  double left = leftMargin(), right = rightMargin();
   const double axis_below = (spec.xlabel.empty() ? 0.0 : 1.8 * ch) + 1.8 * ch;  // tick labels and x label
-  const double right = legend_right ? legend.entryMm() + 1.2 * ch : std::max(1.8 * ch, 0.5 * xtick_w * cw + 0.5 * ch);
-  const double frame_w = page_w - right - left;
   int columns = 1, rows = static_cast<int>(legend.texts.size());
   if (!legend.empty() && !legend_right) {
     columns = std::clamp(static_cast<int>((page_w - 2 * gap) / legend.entryMm()), 1, rows);
     rows = (rows + columns - 1) / columns;
   }
   const double legend_below = legend.empty() || legend_right ? 0.0 : gap + legend.heightMm(rows);
-  const double bottom = 0.6 * ch + axis_below + legend_below;
-  const double top = spec.title.empty() ? 1.2 * ch : 3.0 * ch;
+  double bottom = 0.6 * ch + axis_below + legend_below;
+  double top = spec.title.empty() ? 1.2 * ch : 3.0 * ch;
+  // Equal aspect: widen the data to the frame's shape, re-tick (labels may change width), then
+  // trim the frame about its middle so a unit is exactly as long along x as along y.
+  if (spec.equal_aspect && page_w - right - left > 0 && page_h - top - bottom > 0) {
+    const PlotWindow w = equalAspect({xr.lo, xr.hi, yr.lo, yr.hi}, page_w - right - left, page_h - top - bottom);
+    xr = {w.x0, w.x1}, yr = {w.y0, w.y1};
+    setTicks();
+    left = leftMargin(), right = rightMargin();
+    const double fw = page_w - right - left, fh = page_h - top - bottom;
+    const double per_x = (xr.hi - xr.lo) / fw, per_y = (yr.hi - yr.lo) / fh;  // data per mm
+    if (per_x < per_y) {
+      const double cut = 0.5 * (fw - (xr.hi - xr.lo) / per_y);
+      left += cut, right += cut;
+    } else {
+      const double cut = 0.5 * (fh - (yr.hi - yr.lo) / per_x);
+      bottom += cut, top += cut;
+    }
+  }
+  const double frame_w = page_w - right - left, frame_h = page_h - top - bottom;
   plsvpa(left, page_w - right, bottom, page_h - top);
   plwind(xr.lo, xr.hi, yr.lo, yr.hi);
-  const double frame_h = page_h - top - bottom;
 
   // Grid underneath everything.
   plcol0(kGrid);
@@ -432,7 +467,8 @@ PlotLayout draw(const Prepared& p, int width_px, int height_px) {
 
   // Layers: spans, faint series, bands, solid series, dashed ones (a reference stays visible over
   // a response that tracks it), then the markers on top.
-  for (const auto& s : spec.spans) drawSpan(s, xr, yr, scale);
+  if (!spec.parametric)
+    for (const auto& s : spec.spans) drawSpan(s, xr, yr, scale);
   const size_t budget = std::max<size_t>(400, static_cast<size_t>(2 * frame_w / kMmPerPx));
   for (size_t i = 0; i < spec.series.size(); ++i)
     if (p.faint[i]) drawSeries(spec.series[i], true, budget, scale);
@@ -444,7 +480,7 @@ PlotLayout draw(const Prepared& p, int width_px, int height_px) {
   pllsty(2);
   plwidth(1.5 * scale);
   for (double v : spec.vlines) {
-    if (!std::isfinite(v)) continue;
+    if (!std::isfinite(v) || spec.parametric) continue;
     PLFLT mx[2] = {clampHuge(v), clampHuge(v)}, my[2] = {yr.lo, yr.hi};
     plline(2, mx, my);
   }
@@ -466,6 +502,7 @@ PlotLayout draw(const Prepared& p, int width_px, int height_px) {
   // Where things are, in pixels from the top-left corner.
   PlotLayout layout;
   layout.log_y = p.log_y;
+  layout.x_lo = xr.lo, layout.x_hi = xr.hi, layout.y_lo = yr.lo, layout.y_hi = yr.hi;
   layout.frame = {left / kMmPerPx, top / kMmPerPx, (page_w - right) / kMmPerPx, (page_h - bottom) / kMmPerPx};
   if (legend.empty()) return layout;
   // Legend: right of the frame, top-aligned; or below the x label, centred on the page.

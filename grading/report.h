@@ -21,6 +21,7 @@ struct TestPlotPlan {
   PlotRequest request;    // columns, reference, band and y label
   std::string band_unit;  // the plotted columns' unit, for the band's label
   double from = -INFINITY, to = INFINITY;  // the metric's time window: the rest is hatched
+  bool equal_aspect = false;  // an x–y plot with one unit on both axes: a circle looks round
 };
 
 struct GradedTest {

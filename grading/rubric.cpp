@@ -40,6 +40,8 @@ void checkColumns(const Rubric& r, const std::vector<std::string>& columns, cons
     const PlotRequest& p = *r.tests[i].plot;
     for (std::size_t k = 0; k < p.columns.size(); ++k) check(p.columns[k], at + "columns/" + std::to_string(k));
     if (!p.reference.empty()) check(p.reference, at + "reference");
+    if (!p.x.empty()) check(p.x, at + "x");
+    if (!p.reference_x.empty()) check(p.reference_x, at + "reference_x");
   }
 }
 
@@ -125,12 +127,25 @@ Rubric parseRubric(const JsonView& config) {
     if (t.has("visibility")) rt.visibility = t["visibility"].oneOf({"visible", "hidden", "after_due_date", "after_published"});
     if (t.has("plot")) {
       const JsonView p = t["plot"];
-      p.onlyKeys({"columns", "reference", "band", "ylabel"});
+      p.onlyKeys({"columns", "reference", "band", "ylabel", "x", "reference_x", "xlabel"});
       PlotRequest pr;
       for (std::size_t k = 0, m = p["columns"].size(1, 8); k < m; ++k) pr.columns.push_back(p["columns"].at(k).string());
       if (p.has("reference")) pr.reference = p["reference"].string();
       if (p.has("band")) pr.band = p["band"].nonNegative();
-      pr.ylabel = p.has("ylabel") ? p["ylabel"].string() : pr.columns[0];
+      // An x–y plot: the columns against "x", the reference against "reference_x" (else "x"); a
+      // band around a path is not a band in y, so none; its labels default to the columns' units.
+      if (p.has("x")) {
+        pr.x = p["x"].string();
+        if (p.has("band")) p["band"].fail("expected no band on an x–y plot (\"x\" is given)");
+        pr.reference_x = p.has("reference_x") ? p["reference_x"].string() : pr.reference.empty() ? "" : pr.x;
+        if (!pr.reference_x.empty() && pr.reference.empty())
+          p["reference_x"].fail("expected a \"reference\" to plot against it");
+        if (p.has("xlabel")) pr.xlabel = p["xlabel"].string();
+      } else {
+        for (const char* key : {"reference_x", "xlabel"})
+          if (p.has(key)) p[key].fail("expected \"x\" too (" + std::string(key) + " is for an x–y plot)");
+      }
+      pr.ylabel = p.has("ylabel") ? p["ylabel"].string() : pr.x.empty() ? pr.columns[0] : "";
       rt.plot = pr;
     }
     r.tests.push_back(rt);

@@ -10,6 +10,8 @@
 //     "tests": [{"name": "...", "scenario": "nominal", "metric": "theta_rms", "full": 0.003,
 //                "zero": 0.03, "points": 4, "visibility": "visible",
 //                "plot": {"columns": ["theta"], "reference": "theta_d", "band": 0.003, "ylabel": "theta (rad)"}}],
+//     (an x–y plot, the path in the plane: "plot": {"x": "x", "columns": ["y"], "reference": "y_d",
+//      "reference_x": "x_d"}; no band, no hatched window)
 //     "leaderboard": [{"name": "tracking RMS (mrad)", "scenario": "nominal", "metric": "theta_rms",
 //                      "scale": 1000, "order": "asc"}]
 //   }
@@ -41,6 +43,9 @@ struct PlotRequest {
   std::string reference;  // optional column the response should follow
   double band = 0;        // half-width of the tolerance band around the reference (or zero)
   std::string ylabel;
+  std::string x;            // x–y plot: the columns against this column (empty: against t)
+  std::string reference_x;  // x–y plot: the reference against this column (default: x)
+  std::string xlabel;       // x–y plot: its x label (empty: the x columns with their unit)
 };
 
 struct RubricTest {

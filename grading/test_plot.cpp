@@ -8,6 +8,7 @@
 #include <iterator>
 
 #include "grading/plot.h"
+#include "grading/plot_curves.h"
 
 namespace dyn {
 namespace {
@@ -49,20 +50,6 @@ PlotRequest columnsNamed(const std::string& what, const std::vector<std::string>
   return out;
 }
 
-// "x_c, x_d (m)"; columns of different units each with its own ("x_c (m), q1 (rad)").
-std::string ylabelFor(const Lab& lab, std::vector<std::string> columns) {
-  const auto join = [](const std::vector<std::string>& parts) {
-    std::string s;
-    for (const auto& p : parts) s += (s.empty() ? "" : ", ") + p;
-    return s;
-  };
-  bool one_unit = true;
-  for (const auto& c : columns) one_unit = one_unit && lab.unit(c) == lab.unit(columns.front());
-  if (one_unit) return join(columns) + (lab.unit(columns.front()).empty() ? "" : " (" + lab.unit(columns.front()) + ")");
-  for (auto& c : columns) c += lab.unit(c).empty() ? "" : " (" + lab.unit(c) + ")";
-  return join(columns);
-}
-
 std::string seconds(double t) { return fmtNumber(t) + " s"; }
 
 // "not scored: f_rms counts from t = 0.5 s" (or "until", or "from ... to ...").
@@ -84,9 +71,35 @@ std::string slug(const std::string& s) {
 
 std::string withUnit(double x, const std::string& unit) { return fmtNumber(x) + (unit.empty() || unit == "1" ? "" : " " + unit); }
 
+// An x–y plot of one test's run (the path in the plane): each column against x (solid), the
+// reference against its x (dashed), equal scales when both axes have one unit; no hatching (x is
+// not time), and a stopped run says when in its legend.
+PlotSpec pathPlotSpec(const GradedTest& g, const TestPlotPlan& plan, const ScenarioRun& run) {
+  const Trace& tr = run.trace;
+  const PlotRequest& p = plan.request;
+  PlotSpec spec;
+  spec.title = g.test.name + " (" + g.test.scenario + ")";
+  spec.parametric = true;
+  spec.equal_aspect = plan.equal_aspect;
+  spec.xlabel = p.xlabel;
+  spec.ylabel = p.ylabel;
+  const std::string stopped = run.failure_time >= 0 ? " (stopped at t = " + seconds(run.failure_time) + ")" : "";
+  if (!p.reference.empty() && tr.column(p.reference) >= 0 && tr.column(p.reference_x) >= 0)
+    spec.series.push_back({p.reference + " vs " + p.reference_x + " (reference)", tr.series(p.reference_x),
+                           tr.series(p.reference), PlotSeries::Style::Dashed, 1});
+  int color = 0;
+  for (const auto& c : p.columns) {
+    if (tr.column(c) < 0 || tr.column(p.x) < 0) continue;
+    spec.series.push_back({c + " vs " + p.x + stopped, tr.series(p.x), tr.series(c), PlotSeries::Style::Solid, color});
+    color = color == 0 ? 2 : color + 1;  // colour 1 is the reference's
+  }
+  return spec;
+}
+
 // The plot of one test's run: hatched outside the metric's window, the band, the response
 // columns (solid) and the reference (dashed), and where the run was stopped.
 PlotSpec testPlotSpec(const GradedTest& g, const TestPlotPlan& plan, const ScenarioRun& run) {
+  if (!plan.request.x.empty()) return pathPlotSpec(g, plan, run);
   const Trace& tr = run.trace;
   const PlotRequest& p = plan.request;
   PlotSpec spec;
@@ -150,10 +163,16 @@ TestPlotPlan planTestPlot(const Rubric& rubric, std::size_t i, const std::map<st
         plan.request.columns.push_back(l.column);
     if (plan.request.columns.empty()) plan.request.columns = {"energy"};
   }
-  if (plan.request.ylabel.empty()) {
-    std::vector<std::string> shown = plan.request.columns;
-    if (!plan.request.reference.empty()) shown.push_back(plan.request.reference);
-    plan.request.ylabel = ylabelFor(lab, shown);
+  PlotRequest& r = plan.request;
+  std::vector<std::string> ys = r.columns;
+  if (!r.reference.empty()) ys.push_back(r.reference);
+  if (r.ylabel.empty()) r.ylabel = axisLabel(lab, ys);
+  // An x–y plot: the x label from its x columns, equal scales when every axis column has one unit.
+  if (!r.x.empty()) {
+    std::vector<std::string> xs = {r.x};
+    if (!r.reference_x.empty() && r.reference_x != r.x) xs.push_back(r.reference_x);
+    if (r.xlabel.empty()) r.xlabel = axisLabel(lab, xs);
+    plan.equal_aspect = sameUnit(lab, xs, ys);
   }
   plan.band_unit = plan.request.columns.empty() ? "" : lab.unit(plan.request.columns.front());
   return plan;

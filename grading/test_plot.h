@@ -22,7 +22,8 @@ namespace dyn {
 //      has the columns' unit;
 //   4. the columns the watchdog watches; 5. "energy" (every lab has it).
 // The y label is the rubric's, else the columns with their units ("x_c, x_d (m)"); the window is
-// the metric's "from"/"to".
+// the metric's "from"/"to". A plot with an "x" column is an x–y plot (the path in the plane): its
+// x label likewise, equal scales when both axes have one unit, and no window hatched.
 TestPlotPlan planTestPlot(const Rubric& rubric, std::size_t i, const std::map<std::string, MetricDoc>& docs,
                           const Lab& lab);
 

@@ -1,0 +1,129 @@
+// Figure curves and a lab's own figures; see plot_curves.h.
+#include "grading/plot_curves.h"
+
+#include <algorithm>
+
+namespace dyn {
+namespace {
+
+std::string join(const std::vector<std::string>& parts, const std::string& sep) {
+  std::string s;
+  for (const auto& p : parts) s += (s.empty() ? "" : sep) + p;
+  return s;
+}
+
+std::string trim(std::string s) {
+  s.erase(0, s.find_first_not_of(' '));
+  s.erase(s.find_last_not_of(' ') + 1);
+  return s;
+}
+
+// Splits s at every sep (an empty s is one empty part).
+std::vector<std::string> split(const std::string& s, char sep) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  for (std::size_t end; (end = s.find(sep, start)) != std::string::npos; start = end + 1)
+    parts.push_back(s.substr(start, end - start));
+  parts.push_back(s.substr(start));
+  return parts;
+}
+
+void addOnce(std::vector<std::string>& v, const std::string& s) {
+  if (std::find(v.begin(), v.end(), s) == v.end()) v.push_back(s);
+}
+
+}  // namespace
+
+std::vector<PlotCurve> parsePlotCurves(const std::string& spec, const std::vector<std::string>& columns,
+                                       const std::string& file, const std::string& path) {
+  const std::string grammar =
+      "expected trace columns separated by commas, each against t or as Y:X for column Y against column X "
+      "(\"y:x, y_d:x_d\")";
+  // Each name is a column of the lab; the error lists them.
+  const auto column = [&](const std::string& raw) {
+    const std::string name = trim(raw);
+    if (std::find(columns.begin(), columns.end(), name) == columns.end())
+      throw InputError(file, path,
+                       (name.empty() ? std::string("empty column name") : "unknown column \"" + name + "\"") + "; " +
+                           grammar + ", one of: " + join(columns, ", "));
+    return name;
+  };
+  std::vector<PlotCurve> curves;
+  std::string against_t, against_column;  // one curve of each kind, for the error that mixes them
+  for (const std::string& item : split(spec, ',')) {
+    const std::vector<std::string> sides = split(item, ':');
+    if (sides.size() > 2) throw InputError(file, path, "\"" + trim(item) + "\" has two ':'; " + grammar);
+    PlotCurve c{column(sides[0]), sides.size() == 2 ? column(sides[1]) : "t"};
+    (c.x == "t" ? against_t : against_column) = trim(item);
+    if (std::find(curves.begin(), curves.end(), c) == curves.end()) curves.push_back(c);
+  }
+  if (!against_t.empty() && !against_column.empty())
+    throw InputError(file, path,
+                     "expected every curve of one plot against t or every one against a column (\"" + against_t +
+                         "\" is against t, \"" + against_column + "\" is not): one plot each");
+  return curves;
+}
+
+bool parametric(const std::vector<PlotCurve>& curves) {
+  return std::any_of(curves.begin(), curves.end(), [](const PlotCurve& c) { return c.x != "t"; });
+}
+
+std::vector<std::string> yColumns(const std::vector<PlotCurve>& curves) {
+  std::vector<std::string> out;
+  for (const auto& c : curves) addOnce(out, c.y);
+  return out;
+}
+
+std::vector<std::string> xColumns(const std::vector<PlotCurve>& curves) {
+  std::vector<std::string> out;
+  for (const auto& c : curves) addOnce(out, c.x);
+  return out;
+}
+
+std::string curvesText(const std::vector<PlotCurve>& curves) {
+  std::vector<std::string> parts;
+  for (const auto& c : curves) parts.push_back(c.x == "t" ? c.y : c.y + " vs " + c.x);
+  return join(parts, ", ");
+}
+
+std::string axisLabel(const Lab& lab, const std::vector<std::string>& columns) {
+  if (columns.empty()) return "";
+  const std::string unit = lab.unit(columns.front());
+  if (std::all_of(columns.begin(), columns.end(), [&](const std::string& c) { return lab.unit(c) == unit; }))
+    return join(columns, ", ") + (unit.empty() ? "" : " (" + unit + ")");
+  std::vector<std::string> labelled;
+  for (const auto& c : columns) labelled.push_back(lab.unit(c).empty() ? c : c + " (" + lab.unit(c) + ")");
+  return join(labelled, ", ");
+}
+
+bool sameUnit(const Lab& lab, const std::vector<std::string>& xs, const std::vector<std::string>& ys) {
+  if (xs.empty() || ys.empty()) return false;
+  const std::string unit = lab.unit(xs.front());
+  const auto same = [&](const std::string& c) { return lab.unit(c) == unit; };
+  return !unit.empty() && unit != "1" && std::all_of(xs.begin(), xs.end(), same) && std::all_of(ys.begin(), ys.end(), same);
+}
+
+std::vector<LabFigure> parseLabFigures(const JsonView& config, const std::vector<std::string>& columns) {
+  std::vector<LabFigure> out;
+  if (!config.has("figures")) return out;
+  const JsonView figures = config["figures"];
+  for (std::size_t i = 0, n = figures.size(1, 20); i < n; ++i) {
+    const JsonView f = figures.at(i);
+    f.onlyKeys({"plot", "title", "xlabel", "ylabel"});
+    const JsonView plot = f["plot"];
+    LabFigure fig{parsePlotCurves(plot.string(), columns, plot.file(), plot.path()), "", "", ""};
+    // Titles and labels are drawn on one line: short, and no control characters.
+    const auto text = [&](const char* key) {
+      if (!f.has(key)) return std::string();
+      const std::string s = f[key].string();
+      if (s.size() > 200 || std::any_of(s.begin(), s.end(), [](unsigned char c) { return c < 0x20 || c == 0x7F; }))
+        f[key].fail("expected one line of at most 200 bytes, without control characters");
+      return s;
+    };
+    fig.title = text("title"), fig.xlabel = text("xlabel"), fig.ylabel = text("ylabel");
+    out.push_back(fig);
+  }
+  return out;
+}
+
+}  // namespace dyn

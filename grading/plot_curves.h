@@ -1,0 +1,57 @@
+// What a figure plots, named the way `dynlab figure --plot` and a lab's JSON write it: curves of
+// one trace column against another, several to a plot,
+//   "f_Ty, f_des"      f_Ty and f_des against t
+//   "y:x, y_d:x_d"     y against x and y_d against x_d: an x–y (parametric) plot, the path in the plane
+// and the figures a lab asks `dynlab figure` to draw by default, beside its rubric's plots:
+//   "figures": [{"plot": "y:x, y_d:x_d", "title": "path in the plane"}]   ("xlabel", "ylabel" optional)
+#pragma once
+#include <string>
+#include <vector>
+
+#include "labs/config.h"
+#include "labs/lab.h"
+
+namespace dyn {
+
+// Column y against column x ("t": a time plot).
+struct PlotCurve {
+  std::string y, x = "t";
+  bool operator==(const PlotCurve& o) const { return y == o.y && x == o.x; }
+};
+
+// "a, b" or "y:x, y_d:x_d" → its curves in order, repeats dropped. Every name is one of columns,
+// and a plot is against t or against columns, not both (one x axis). Throws InputError(file,
+// path, what was expected, listing the columns for an unknown one).
+std::vector<PlotCurve> parsePlotCurves(const std::string& spec, const std::vector<std::string>& columns,
+                                       const std::string& file, const std::string& path);
+
+// Whether the curves are an x–y plot (some x is not t).
+bool parametric(const std::vector<PlotCurve>& curves);
+
+// The y columns, and the x columns, each once, in order.
+std::vector<std::string> yColumns(const std::vector<PlotCurve>& curves);
+std::vector<std::string> xColumns(const std::vector<PlotCurve>& curves);
+
+// "y vs x" for an x–y curve, "y" for a time curve; curves joined by ", ".
+std::string curvesText(const std::vector<PlotCurve>& curves);
+
+// An axis label of columns with the lab's units: "x, x_d (m)" when they share one, else each its
+// own ("x_c (m), q1 (rad)").
+std::string axisLabel(const Lab& lab, const std::vector<std::string>& columns);
+
+// Equal aspect is right when every column on both axes has one and the same unit (metres against
+// metres), not for a phase plot (m/s against m) or unitless columns.
+bool sameUnit(const Lab& lab, const std::vector<std::string>& xs, const std::vector<std::string>& ys);
+
+// One of a lab's own figures.
+struct LabFigure {
+  std::vector<PlotCurve> curves;
+  std::string title, xlabel, ylabel;  // empty: derived (the lab and columns; columns with units)
+};
+
+// Reads config["figures"] (absent: none): an array of at most 20 objects with "plot" (the --plot
+// grammar above) and optional "title", "xlabel", "ylabel" strings (one line, at most 200 bytes).
+// Throws InputError naming the file and the JSON path ("/figures/0/plot").
+std::vector<LabFigure> parseLabFigures(const JsonView& config, const std::vector<std::string>& columns);
+
+}  // namespace dyn
