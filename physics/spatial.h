@@ -194,10 +194,15 @@ struct Spatial {
     return out;
   }
   static Vec inertiaTimes(const Mat& I, const Vec& v) { return I * v; }
-  // Xᵀ I X: a rigid-body inertia given in frame B, in frame A.
+  // Xᵀ I X: a rigid-body inertia given in frame B, in frame A. Not as two 6×6 products: the body's
+  // mass, centre c and inertia about it, moved (c → r + Eᵀc) and turned (I_c → Eᵀ I_c E).
   static Mat inertiaInParent(const Transform& X, const Mat& I) {
-    const Mat m = motionMatrix(X);
-    return m.transpose() * I * m;
+    double m;
+    Pos c;
+    massAndCom(I, m, c);
+    const Eigen::Matrix3d C = skew(c);
+    const Eigen::Matrix3d Ic = I.block<3, 3>(0, 0) - m * C * C.transpose();
+    return inertia(m, X.r + X.E.transpose() * c, X.E.transpose() * Ic * X.E);
   }
   static Mat inertia(double m, const Pos& c, const Eigen::Matrix3d& Ic) {
     const Eigen::Matrix3d C = skew(c);

@@ -41,8 +41,14 @@ class FrictionWheel {
     world_.step(tau);
     double f[4];
     wheelForces(Spatial::linear(world_.constraintForce(0)), q_[Phi], s_.params.mu, f);
-    out[0] = q_[X], out[1] = q_[Y], out[2] = q_[Phi], out[3] = mech_.slipSpeed(q_, v_), out[4] = f[1];
+    out[0] = q_[X], out[1] = q_[Y], out[2] = q_[Phi], out[3] = slip_, out[4] = f[1];
+    // The contact's slip over the step: Bullet's contact held at the step's start heading, so the new
+    // velocities are measured against it (at the new heading a gripping wheel would read v φ' dt).
+    const double phi_start = q_[Phi];
     world_.state(q_, v_);
+    VecN q_start = q_;
+    q_start[Phi] = phi_start;
+    slip_ = mech_.slipSpeed(q_start, v_);
   }
 
  private:
@@ -55,6 +61,7 @@ class FrictionWheel {
   const Mechanism& mech_;
   Controller ctrl_;
   VecN q_, v_;
+  double slip_ = 0;
   bullet::BulletMechanism<Spatial> world_;
 };
 
