@@ -17,6 +17,9 @@
 namespace dyn::app {
 namespace {
 
+// The width of a legend's colour box or line sample, and of the colour bar, as fractions of the page.
+constexpr double kSymbolWidth = 0.04, kBarWidth = 0.035;
+
 // cmap0 slots of the map.
 enum : PLINT { kPaper = 0, kInk = 1, kStable = 2, kUnstable = 3, kNoValue = 4, kWhiteLine = 5, kFrame = 6 };
 
@@ -56,6 +59,133 @@ void fillCell(double x0, double x1, double y0, double y1) {
   plfill(4, px, py);
 }
 
+// The colour bar of a value map at (x, y) from the viewport's top left (its labelled box's corner),
+// bar_width wide, 55 % of the viewport high, labelled below; returns the labelled box's width.
+double colourBar(const std::string& label, double vmin, double vmax, double x, double y, double bar_width) {
+  const char* label_text[] = {label.c_str()};
+  PLINT label_opts[] = {PL_COLORBAR_LABEL_BOTTOM};
+  const char* axis_opts[] = {"bcvtm"};
+  PLFLT ticks[] = {0.0};
+  PLINT sub_ticks[] = {0}, n_values[] = {2};
+  PLFLT range[] = {vmin, vmax};
+  const PLFLT* values_ptr[] = {range};
+  PLFLT width = 0, height = 0;
+  plcolorbar(&width, &height, PL_COLORBAR_GRADIENT, PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE, x, y,
+             bar_width, 0.55, kPaper, kFrame, 1, 0, 0, kInk, 0, 1, label_opts, label_text, 1, axis_opts, ticks,
+             sub_ticks, n_values, values_ptr);
+  return width;
+}
+
+// Text as the page will draw it, measured on a throwaway pdfcairo stream of the same size (PLplot
+// does not export plstrl; pllegend reports the width it laid out, its text at text_scale × the
+// default height whatever plschr says). Widths are fractions of the page's width, heights of its
+// height. The driver measures only text it draws: an empty string reports the previous length.
+class TextMeter {
+ public:
+  TextMeter(int width_px, int height_px) : aspect_(double(width_px) / height_px) {
+    plgstrm(&page_);
+    plmkstrm(&mine_);
+    plsdev("pdfcairo");
+    plsfnam("/dev/null");
+    plspage(72, 72, width_px, height_px, 0, 0);
+    plinit();
+    pladv(0);
+    plvpor(0, 1, 0, 1);
+    plwind(0, 1, 0, 1);
+    plsstrm(page_);
+  }
+  ~TextMeter() {
+    plsstrm(mine_);
+    plend1();
+    plsstrm(page_);
+  }
+  TextMeter(const TextMeter&) = delete;
+  TextMeter& operator=(const TextMeter&) = delete;
+
+  // The width of one line of text at character scale `scale`.
+  double width(const std::string& text, double scale) {
+    return legend({"X" + text}, scale, PL_LEGEND_NONE) - legend({"X"}, scale, PL_LEGEND_NONE);
+  }
+  // The width of the labelled colour bar at `scale`.
+  double colourBar(const std::string& label, double vmin, double vmax, double scale) {
+    plsstrm(mine_);
+    plschr(0, scale);
+    const double w = dyn::app::colourBar(label, vmin, vmax, 0, 0, kBarWidth);
+    plsstrm(page_);
+    return w;
+  }
+  // The character height at `scale`, as a fraction of the page's height (X: of its width).
+  double charHeight(double scale) { return charMm(scale) / pageMm(false); }
+  double charHeightX(double scale) { return charMm(scale) / pageMm(true); }
+  // A length measured as a fraction of the page's width, as a fraction of its height.
+  double widthToHeight(double w) const { return w * aspect_; }
+
+  // The width pllegend lays out for these entries (all of one kind, none empty) at scale `scale`,
+  // drawn as draw() draws the legend.
+  double legend(const std::vector<std::string>& texts, double scale, PLINT kind) {
+    plsstrm(mine_);
+    plschr(0, scale);
+    const std::size_t n = texts.size();
+    std::vector<const char*> ctexts;
+    for (const auto& t : texts) ctexts.push_back(t.c_str());
+    std::vector<PLINT> opts(n, kind), colours(n, 1), patterns(n, 0), styles(n, 1);
+    std::vector<PLFLT> box_scales(n, 1.1), box_widths(n, 0), line_widths(n, 1);
+    PLFLT lw = 0, lh = 0;
+    pllegend(&lw, &lh, 0, PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE, 0, 0, kSymbolWidth, 0, 1, 1, 0, 0,
+             PLINT(n), opts.data(), 0.6, scale, 1.6, 0.0, colours.data(), ctexts.data(), colours.data(),
+             patterns.data(), box_scales.data(), box_widths.data(), colours.data(), styles.data(), line_widths.data(),
+             nullptr, nullptr, nullptr, nullptr);
+    plsstrm(page_);
+    return lw;
+  }
+
+ private:
+  double charMm(double scale) {
+    plsstrm(mine_);
+    plschr(0, scale);
+    PLFLT def = 0, ht = 0;
+    plgchr(&def, &ht);
+    plsstrm(page_);
+    return ht;
+  }
+  double pageMm(bool x) {
+    plsstrm(mine_);
+    PLFLT x0 = 0, x1 = 0, y0 = 0, y1 = 0;
+    plgspa(&x0, &x1, &y0, &y1);
+    plsstrm(page_);
+    return x ? x1 - x0 : y1 - y0;
+  }
+
+  double aspect_;
+  PLINT page_ = 0, mine_ = 0;
+};
+
+// A tick step of 1, 2 or 5 × 10^k giving about five intervals over `range`, and the tick labels
+// PLplot writes with it (as many decimals as the step needs).
+struct Ticks {
+  double step = 1;
+  std::vector<std::string> labels;
+};
+Ticks ticksFor(double lo, double hi) {
+  Ticks t;
+  const double rough = (hi - lo) / 6, decade = std::pow(10.0, std::floor(std::log10(rough)));
+  for (double f : {1.0, 2.0, 5.0, 10.0})
+    if (f * decade >= rough * (1 - 1e-9)) {
+      t.step = f * decade;
+      break;
+    }
+  const int decimals = std::max(0, int(std::ceil(-std::log10(t.step) - 1e-9)));
+  for (double k = std::ceil(lo / t.step - 1e-9); k * t.step <= hi + 1e-9 * t.step; k += 1) {
+    char b[64];
+    std::snprintf(b, sizeof b, "%.*f", decimals, std::abs(k) < 0.5 ? 0.0 : k * t.step);
+    t.labels.push_back(b);
+  }
+  return t;
+}
+
+// The character scale at which `text` (width w at scale s) fits in `room`: s, or smaller.
+double fitScale(double s, double w, double room) { return w <= room ? s : s * room / w; }
+
 void draw(const MapPicture& m, int width_px, int height_px) {
   const std::size_t nx = m.xs.size(), ny = m.ys.size();
   const auto ex = edges(m.xs), ey = edges(m.ys);
@@ -65,18 +195,60 @@ void draw(const MapPicture& m, int width_px, int height_px) {
     if (m.stable[k] && std::isfinite(m.value[k])) vmin = std::min(vmin, m.value[k]), vmax = std::max(vmax, m.value[k]);
   if (!(vmin <= vmax)) vmin = 0, vmax = 1;
   if (vmax - vmin < 1e-12 * std::max(1.0, std::abs(vmin))) vmin -= 0.5, vmax += 0.5;
+  const double wx0 = std::min(ex.front(), ex.back()), wx1 = std::max(ex.front(), ex.back());
+  const double wy0 = std::min(ey.front(), ey.back()), wy1 = std::max(ey.front(), ey.back());
 
   pladv(0);
+  TextMeter meter(width_px, height_px);
+  // Lines grow with the page; text does already (PLplot's default height follows the page size).
   const double scale = std::clamp(std::min(width_px / 900.0, height_px / 600.0), 0.6, 4.0);
-  plschr(0, 1.05 * scale);
-  // The frame on the left, the legend (and colour bar) in a column on the right.
-  plvpor(0.10, 0.64, 0.12, 0.90);
-  plwind(std::min(ex.front(), ex.back()), std::max(ex.front(), ex.back()), std::min(ey.front(), ey.back()),
-         std::max(ey.front(), ey.back()));
+  const double text = 1.05, legend_text = 0.9;
+  // A margin of 1.2 % of the page (at least 6 px) that no ink enters.
+  const double mx = std::max(6.0 / width_px, 0.012), my = std::max(6.0 / height_px, 0.012);
+  const double ch = meter.charHeight(text), chx = meter.charHeightX(text);
+
+  // Legend: the cell kinds shown, then the boundary line.
+  std::vector<std::string> texts;
+  std::vector<PLINT> opts, boxes, lines, styles;
+  auto add = [&](const std::string& t, PLINT opt, PLINT box, PLINT line) {
+    texts.push_back(t), opts.push_back(opt), boxes.push_back(box), lines.push_back(line), styles.push_back(1);
+  };
+  if (!values) add(m.stable_label, PL_LEGEND_COLOR_BOX, kStable, kInk);
+  add(values ? m.unstable_label + " (no value)" : m.unstable_label, PL_LEGEND_COLOR_BOX, values ? kNoValue : kUnstable, kInk);
+  if (!m.boundary.empty()) add(m.boundary_label, PL_LEGEND_LINE, kInk, kInk);
+
+  // The right-hand column holds the legend and the labelled colour bar at their measured widths:
+  // each at most 40 % of the page (longer texts are drawn smaller), the frame takes the rest.
+  const double max_column = 0.40 - mx;
+  auto fitted = [&](auto&& width_at, double& s) {
+    double w = width_at(s);
+    for (int k = 0; k < 4 && w > max_column; ++k) s *= 0.98 * max_column / w, w = width_at(s);
+    return w;
+  };
+  double legend_scale = legend_text, bar_scale = legend_text;
+  double column = fitted([&](double s) {
+    double w = 0;
+    for (const auto& t : texts) w = std::max(w, meter.legend({t}, s, PL_LEGEND_COLOR_BOX));
+    return w;
+  }, legend_scale);
+  if (values) column = std::max(column, fitted([&](double s) { return meter.colourBar(m.value_label, vmin, vmax, s); }, bar_scale));
+
+  // Ticks and how much room their labels take; then the frame: the title above it, tick labels
+  // and axis labels left of and below it, the column right of it.
+  const Ticks xt = ticksFor(wx0, wx1), yt = ticksFor(wy0, wy1);
+  double ytick_w = 0, xtick_w = 0;
+  for (const auto& l : yt.labels) ytick_w = std::max(ytick_w, meter.width(l, text));
+  for (const auto& l : xt.labels) xtick_w = std::max(xtick_w, meter.width(l, text));
+  const double title_scale = fitScale(1.15, meter.width(m.title, 1.15), 1 - 2 * mx);
+  const double fl = mx + ytick_w + 2.9 * chx, fr = 1 - mx - column - 0.5 * xtick_w - 1.5 * chx;
+  const double fb = my + 4.6 * ch, ft = 1 - my - 2.6 * meter.charHeight(title_scale);
+  plvpor(fl, fr, fb, ft);
+  plwind(wx0, wx1, wy0, wy1);
 
   // Plain tick labels (no "×10⁻²" factor that a reader has to find).
   plsxax(8, 0);
   plsyax(8, 0);
+  plschr(0, text);
 
   // The cells.
   for (std::size_t j = 0; j < ny; ++j)
@@ -105,52 +277,48 @@ void draw(const MapPicture& m, int width_px, int height_px) {
     }
   }
 
-  // Frame, ticks, labels.
+  // Frame, ticks at the measured steps, labels.
   plwidth(1.0 * scale);
   plcol0(kFrame);
-  plbox("bcnts", 0, 0, "bcntsv", 0, 0);
+  plbox("bcnts", xt.step, 0, "bcntsv", yt.step, 0);
   plcol0(kInk);
-  pllab(m.xlabel.c_str(), m.ylabel.c_str(), "");
+  // Each axis label centred on its side of the frame, moved (and if need be shrunk) to stay on the page.
+  {
+    const double room = 1 - 2 * mx, s = fitScale(text, meter.width(m.xlabel, text), room);
+    const double w = meter.width(m.xlabel, s), centre = std::clamp((fl + fr) / 2, mx + w / 2, 1 - mx - w / 2);
+    plschr(0, s);
+    plmtex("b", 3.3 * text / s, (centre - fl) / (fr - fl), 0.5, m.xlabel.c_str());
+  }
+  {
+    const double room = 1 - 2 * my, s = fitScale(text, meter.widthToHeight(meter.width(m.ylabel, text)), room);
+    const double h = meter.widthToHeight(meter.width(m.ylabel, s));
+    const double centre = std::clamp((fb + ft) / 2, my + h / 2, 1 - my - h / 2);
+    plschr(0, s);
+    plmtex("l", (fl - mx) / meter.charHeightX(s) - 1.0, (centre - fb) / (ft - fb), 0.5, m.ylabel.c_str());
+  }
   // The title across the whole page (it may be wider than the frame).
-  plvpor(0.0, 1.0, 0.0, 0.96);
-  plschr(0, 1.15 * scale);
-  plmtex("t", 0.0, 0.5, 0.5, m.title.c_str());
-  plschr(0, 1.05 * scale);
+  plvpor(0.0, 1.0, 0.0, 1 - my);
+  plschr(0, title_scale);
+  plmtex("t", -1.3, 0.5, 0.5, m.title.c_str());
 
-  // Legend: the cell kinds shown, then the boundary line.
-  std::vector<std::string> texts;
-  std::vector<PLINT> opts, boxes, lines, styles;
-  auto add = [&](const std::string& t, PLINT opt, PLINT box, PLINT line) {
-    texts.push_back(t), opts.push_back(opt), boxes.push_back(box), lines.push_back(line), styles.push_back(1);
-  };
-  if (!values) add(m.stable_label, PL_LEGEND_COLOR_BOX, kStable, kInk);
-  add(values ? m.unstable_label + " (no value)" : m.unstable_label, PL_LEGEND_COLOR_BOX, values ? kNoValue : kUnstable, kInk);
-  if (!m.boundary.empty()) add(m.boundary_label, PL_LEGEND_LINE, kInk, kInk);
+  // The legend at the top of the right-hand column.
   std::vector<const char*> ctexts;
   for (const auto& t : texts) ctexts.push_back(t.c_str());
   std::vector<PLINT> text_colours(texts.size(), kInk), patterns(texts.size(), 0);
   std::vector<PLFLT> box_scales(texts.size(), 1.1), box_widths(texts.size(), 0), line_widths(texts.size(), 2.5 * scale);
   PLFLT lw, lh;
-  plvpor(0.655, 0.995, 0.12, 0.90);
+  plvpor(1 - mx - column, 1 - mx, fb, ft);
   plwind(0, 1, 0, 1);
-  plschr(0, 0.9 * scale);
-  pllegend(&lw, &lh, PL_LEGEND_BACKGROUND, PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE, 0.02, 0.0, 0.12,
-           kPaper, kFrame, 1, 0, 0, PLINT(texts.size()), opts.data(), 0.6, 1.0, 1.6, 0.0, text_colours.data(),
+  plschr(0, legend_scale);
+  pllegend(&lw, &lh, PL_LEGEND_BACKGROUND, PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE, 0.0, 0.0, kSymbolWidth / column,
+           kPaper, kFrame, 1, 0, 0, PLINT(texts.size()), opts.data(), 0.6, legend_scale, 1.6, 0.0, text_colours.data(),
            ctexts.data(), boxes.data(), patterns.data(), box_scales.data(), box_widths.data(), lines.data(),
            styles.data(), line_widths.data(), nullptr, nullptr, nullptr, nullptr);
   if (values) {
-    // The colour bar under the legend, labelled with the metric and its unit.
-    const char* label_text[] = {m.value_label.c_str()};
-    PLINT label_opts[] = {PL_COLORBAR_LABEL_BOTTOM};
-    const char* axis_opts[] = {"bcvtm"};
-    PLFLT ticks[] = {0.0};
-    PLINT sub_ticks[] = {0}, n_values[] = {2};
-    PLFLT range[] = {vmin, vmax};
-    const PLFLT* values_ptr[] = {range};
-    PLFLT cw, chh;
-    plcolorbar(&cw, &chh, PL_COLORBAR_GRADIENT, PL_POSITION_TOP | PL_POSITION_LEFT | PL_POSITION_INSIDE, 0.08,
-               lh + 0.08, 0.12, 0.55, kPaper, kFrame, 1, 0, 0, kInk, 0, 1, label_opts, label_text, 1, axis_opts, ticks,
-               sub_ticks, n_values, values_ptr);
+    // The colour bar under the legend, labelled with the metric and its unit, centred in the column.
+    plschr(0, bar_scale);
+    const double box = meter.colourBar(m.value_label, vmin, vmax, bar_scale);
+    colourBar(m.value_label, vmin, vmax, (1 - box / column) / 2, lh + 0.08, kBarWidth / column);
   }
 }
 

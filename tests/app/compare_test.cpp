@@ -42,7 +42,8 @@ std::size_t plotCount(const fs::path& dir) {
 
 TEST_CASE("compare: both graded as dynlab grade grades them, side by side, one plot per simulated test") {
   const TempDir dir("compare");
-  const std::string a = kLab + "examples/mediocre.json", b = kLab + "instructor/good.json";
+  // Two of the students' examples (the integral and the proportional law); no instructor file needed.
+  const std::string a = kLab + "examples/mediocre.json", b = kLab + "examples/proportional.json";
   REQUIRE(dynlab(dir, "grade " + quote(a) + " --no-plots --out ga").code == 0);
   REQUIRE(dynlab(dir, "grade " + quote(b) + " --no-plots --out gb").code == 0);
   const json ra = json::parse(readFile(dir / "ga/results.json")), rb = json::parse(readFile(dir / "gb/results.json"));

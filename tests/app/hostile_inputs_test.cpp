@@ -21,8 +21,8 @@ using namespace dyn::test::cli;
 namespace {
 
 const std::string kExamples = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/examples/";
-// The full-credit example: course staff only, never in what students receive.
-const std::string kInstructor = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/instructor/";
+// A valid, stable submission that students have too (the full-credit one stays in instructor/).
+const std::string kStable = kExamples + "mediocre.json";
 
 // dynlab ARGS in dir, killed after 20 s: a blocking open() shows up as exit 124.
 Result timedDynlab(const TempDir& dir, const std::string& args) {
@@ -50,7 +50,7 @@ std::string offsetOf(const std::string& text, const std::string& bytes) {
 
 // Writes the corpus into dir.
 std::vector<Hostile> buildCorpus(const TempDir& dir) {
-  const std::string good = readFile(kInstructor + "good.json");
+  const std::string good = readFile(kStable);
   const std::string dup_gains = R"({"lab": "slider_crank", "gains": {"kp_x": 1, "kd_x": 2, "kp_x": 3}})";
   std::vector<Hostile> c;
   auto add = [&](const std::string& name, const std::string& text, std::vector<std::string> says) {
@@ -149,14 +149,14 @@ TEST_CASE("hostile submissions graded: exit 2, a valid results.json with score 0
     fs::remove_all(dir / "out");
 
     // The same file as the results to replay against: an input error about it.
-    const Result as_results = timedDynlab(dir, "grade " + quote(kInstructor + "good.json") + " --replay=" + quote(h.name));
+    const Result as_results = timedDynlab(dir, "grade " + quote(kStable) + " --replay=" + quote(h.name));
     checkMessage(as_results, h, h.shown);
   }
 }
 
 TEST_CASE("a UTF-8 byte order mark is accepted everywhere; a lone surrogate or overlong form is not UTF-8") {
   TempDir dir("hostile_bom");
-  writeFile(dir / "bom.json", "\xEF\xBB\xBF" + readFile(kInstructor + "good.json"));
+  writeFile(dir / "bom.json", "\xEF\xBB\xBF" + readFile(kStable));
   const Result g = timedDynlab(dir, "grade bom.json --out out --no-plots");
   INFO(g.err);
   CHECK(g.code == 0);
@@ -203,7 +203,7 @@ TEST_CASE("dynlab run with diverging gains: the grader's watchdog sentence, trut
   CHECK(summary["engines"]["hand"]["status"] == results["extra_data"]["scenarios"]["nominal"]["status"]);
 
   // Stable gains: both engines complete, with metrics and their agreement.
-  const Result ok = timedDynlab(dir, "run slider_crank --duration 0.5 --gains " + quote(kInstructor + "good.json") + " --out good");
+  const Result ok = timedDynlab(dir, "run slider_crank --duration 0.5 --gains " + quote(kStable) + " --out good");
   CHECK(ok.code == 0);
   const json fine = json::parse(readFile(dir / "good/summary.json"));
   CHECK(fine.at("status") == "ok");
@@ -222,7 +222,7 @@ TEST_CASE("a grade cut short by the time budget exits 4 with a valid results.jso
   config["simulation"]["duration"] = 15.0;
   config["rubric"]["watchdog"]["max_steps"] = 3000000;
   writeFile(dir / "slow.json", config.dump());
-  const Result r = timedDynlab(dir, "grade " + quote(kInstructor + "good.json") + " --config slow.json --time-budget 1 --no-plots --out out");
+  const Result r = timedDynlab(dir, "grade " + quote(kStable) + " --config slow.json --time-budget 1 --no-plots --out out");
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   CHECK(r.code == 4);
   CHECK(r.err.find("time budget of 1 s ran out") != std::string::npos);
@@ -233,7 +233,7 @@ TEST_CASE("a grade cut short by the time budget exits 4 with a valid results.jso
 
 TEST_CASE("an exception that escapes a command: one line 'error: internal: ...', exit 3, no abort") {
   TempDir dir("hostile_internal");
-  writeFile(dir / "boom.json", readFile(kInstructor + "good.json"));
+  writeFile(dir / "boom.json", readFile(kStable));
   const Result r = shell(dir, "DYNLAB_FAULT_INJECTION=throw:boom timeout 20 " + quote(DYNLAB_BIN) + " grade boom.json --out out");
   INFO("stderr: ", r.err);
   CHECK(r.code == 3);

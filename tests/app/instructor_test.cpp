@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/app/cli_run.h"
+#include "tests/instructor.h"
 
 using namespace dyn::test::cli;
 using json = nlohmann::json;
@@ -77,6 +78,10 @@ TEST_CASE("students' examples score well below full marks; the instructor's scor
     }
   }
   CHECK(labs >= 1);
+}
+
+TEST_CASE("the slider crank's instructor/good.json scores full marks" * doctest::skip(!dyn::test::instructorFilesPresent())) {
+  const TempDir dir("instructor_full");
   const auto [score, max] = grade(dir, kLabs / "slider_crank/instructor/good.json");
   CHECK(max > 0);
   CHECK(score == doctest::Approx(max));
@@ -106,4 +111,18 @@ TEST_CASE("a student copy made with git archive leaves instructor/ out (export-i
   REQUIRE(r.code == 0);
   CHECK(r.out.find("instructor/good.json: export-ignore: set") != std::string::npos);
   CHECK(r.out.find("mediocre.json: export-ignore: unspecified") != std::string::npos);
+}
+
+TEST_CASE("the instructor cases are skipped only in a student copy: files git tracks are on disk") {
+  // A staff checkout that lost its instructor folders would skip those cases silently: not here.
+  const TempDir dir("instructor_present");
+  const Result r = shell(dir, "git -C " + quote(DYNLAB_SOURCE_DIR) + " ls-files -- 'labs/*/instructor/*'");
+  if (r.code != 0) {
+    MESSAGE("not a git checkout (a student copy): nothing to check");
+    return;
+  }
+  if (r.out.empty()) return;  // a repository of the student copy's files (git init): nothing tracked there
+  CHECK(dyn::test::instructorFilesPresent());
+  std::istringstream files(r.out);
+  for (std::string file; std::getline(files, file);) CHECK_MESSAGE(fs::exists(fs::path(DYNLAB_SOURCE_DIR) / file), file);
 }

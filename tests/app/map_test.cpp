@@ -1,11 +1,14 @@
 // dynlab map end to end: a small grid through the real binary writes a valid picture (PNG, SVG,
 // PDF; byte-identical on a rerun and whatever the thread count); the screening reproduces the
 // lecture — the proportional force law is unstable under delay once k_pf ≥ 1, the integral law
-// beyond its delay margin π/(2 k_if) —; bad axis specs are one line and exit 2.
+// beyond its delay margin π/(2 k_if) —; bad axis specs are one line and exit 2; nothing of the
+// picture (labels, legend, colour bar) reaches the page's edge, at any page size.
 #include <doctest/doctest.h>
+#include <stb_image.h>
 
 #include <cmath>
 
+#include "app/map_plot.h"
 #include "tests/app/cli_run.h"
 
 using namespace dyn::test::cli;
@@ -13,6 +16,50 @@ using namespace dyn::test::cli;
 namespace {
 
 std::string magicOf(const fs::path& p) { return readFile(p).substr(0, 8); }
+
+// Where a PNG has ink (any pixel not white): its box, and whether any lies within `strip` pixels of
+// an edge (a label or legend cut off by the page).
+struct Ink {
+  int width = 0, height = 0, x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+  bool at_edge = false;
+};
+Ink inkOf(const fs::path& png, int strip = 2) {
+  Ink ink;
+  int n = 0;
+  unsigned char* data = stbi_load(png.string().c_str(), &ink.width, &ink.height, &n, 3);
+  REQUIRE(data != nullptr);
+  ink.x0 = ink.width, ink.y0 = ink.height;
+  for (int y = 0; y < ink.height; ++y)
+    for (int x = 0; x < ink.width; ++x) {
+      const unsigned char* p = data + (std::size_t(y) * ink.width + x) * 3;
+      if (p[0] > 250 && p[1] > 250 && p[2] > 250) continue;
+      ink.x0 = std::min(ink.x0, x), ink.x1 = std::max(ink.x1, x), ink.y0 = std::min(ink.y0, y), ink.y1 = std::max(ink.y1, y);
+      ink.at_edge = ink.at_edge || x < strip || y < strip || x >= ink.width - strip || y >= ink.height - strip;
+    }
+  stbi_image_free(data);
+  return ink;
+}
+
+// A 9 × 7 map with the grasp's long axis label, stable on the left and unstable on the right.
+dyn::app::MapPicture longLabelMap(bool values) {
+  dyn::app::MapPicture m;
+  m.title = "grasp: simulated, 4 s per point";
+  m.xlabel = "f_squeeze: internal-force set point: how hard each finger squeezes (N)";
+  m.ylabel = "mu: friction coefficient at the contacts";
+  for (int i = 0; i < 9; ++i) m.xs.push_back(1 + 0.625 * i);
+  for (int j = 0; j < 7; ++j) m.ys.push_back(0.2 + j * 0.8 / 6);
+  for (int j = 0; j < 7; ++j)
+    for (int i = 0; i < 9; ++i) {
+      m.stable.push_back(i < 2 + j / 2);
+      m.boundary.push_back(2.5 + j / 2.0 - i);
+      if (values) m.value.push_back(0.1 * (i + j));
+    }
+  m.value_label = values ? "cone_margin_min: the worst friction-cone margin over the run (N)" : "";
+  m.stable_label = "stable (run completes)";
+  m.unstable_label = "unstable (watchdog)";
+  m.boundary_label = "screening boundary";
+  return m;
+}
 
 }  // namespace
 
@@ -98,4 +145,28 @@ TEST_CASE("bad axis specs and metrics: one line, exit 2, nothing written") {
   checkBadInput(dir, "map slider_crank --x kp_f=0:2:5 --metric nope" + y, {"--metric", "nope"}, out);
   checkBadInput(dir, "map no_lab --x kp_f=0:2:5" + y, {"no_lab"}, out);
   checkBadInput(dir, "map slider_crank --x kp_f=0:2:5 --y delay=0:0.05:4 --out m.gif", {"--out", "m.gif"}, dir / "m.gif");
+}
+
+TEST_CASE("nothing of a map reaches the page's edge: long labels, legend and colour bar, at every size") {
+  TempDir dir("map_edges");
+  for (const bool values : {false, true})
+    for (const auto& [w, h] : {std::pair{640, 480}, std::pair{900, 600}, std::pair{1920, 1080}}) {
+      const fs::path png = dir / ("map_" + std::to_string(values) + "_" + std::to_string(w) + ".png");
+      dyn::app::writeMapPicture(png.string(), longLabelMap(values), w, h);
+      const Ink ink = inkOf(png);
+      INFO(png.filename().string(), ": ink from (", ink.x0, ", ", ink.y0, ") to (", ink.x1, ", ", ink.y1, ")");
+      CHECK(ink.width == w);
+      CHECK(ink.height == h);
+      CHECK_FALSE(ink.at_edge);
+      // ... and the picture still fills the page (nothing shrunk away to stay clear of the edges).
+      CHECK(ink.x1 - ink.x0 > 0.9 * w);
+      CHECK(ink.y1 - ink.y0 > 0.85 * h);
+    }
+}
+
+TEST_CASE("dynlab map: the grasp's long axis label stays on the page") {
+  TempDir dir("map_cli_edges");
+  const Result r = dynlab(dir, "map grasp --x f_squeeze=1:6:6 --y mu=0.2:1:5 --out m.png");
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK_FALSE(inkOf(dir / "m.png").at_edge);
 }

@@ -12,7 +12,8 @@ using namespace dyn::test::cli;
 
 namespace {
 
-const std::string kGood = R"({"lab": "slider_crank", "gains": {"kp_x": 6000, "kd_x": 190, "kp_f": 0.5, "ki_f": 25}})";
+// Stable gains that grade normally (the students' mediocre example, not the instructor's answer).
+const std::string kGood = readFile(fs::path(DYNLAB_SOURCE_DIR) / "labs/slider_crank/examples/mediocre.json");
 // A file name with markup, a line break, backticks and a heading (no ' : the tests quote with it).
 const std::string kHostileName = "x`` <img src=x onerror=alert(1)> <script>s\n# injected heading.json";
 
@@ -60,7 +61,7 @@ TEST_CASE("a hostile file name and string values stay escaped in every report") 
   }
   SUBCASE("invalid: a gain given as a string is quoted by the error message") {
     writeFile(dir / kHostileName,
-              R"({"lab": "slider_crank", "gains": {"kp_x": "<img src=x onerror=alert(1)>`` \n# injected <script>", "kd_x": 190}})");
+              R"({"lab": "slider_crank", "gains": {"kp_x": "<img src=x onerror=alert(1)>`` \n# injected <script>", "kd_x": 8}})");
     const Result r = dynlab(dir, "grade " + quote(kHostileName) + " --no-plots --out out");
     INFO(r.out, r.err);
     CHECK(r.code == 2);

@@ -3,6 +3,7 @@
 // every command under `timeout` so a hang fails the test instead of blocking the suite.
 #include <doctest/doctest.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <signal.h>
 #include <sys/stat.h>
@@ -97,11 +98,24 @@ void put(const fs::path& p, const std::string& text) {
   writeFile(p, text);
 }
 
+// One of the students' examples (never the instructor's: these tests run in a student copy too).
 void copyExample(const std::string& example, const fs::path& to) {
   fs::create_directories(to.parent_path());
-  // "good" is the full-credit example, kept with the instructor's files (not the students').
-  const fs::path from = example == "good" ? kExamples.parent_path() / "instructor" / "good.json" : kExamples / (example + ".json");
-  fs::copy_file(from, to, fs::copy_options::overwrite_existing);
+  fs::copy_file(kExamples / (example + ".json"), to, fs::copy_options::overwrite_existing);
+}
+
+// The gradebook's score cell (%.4g) of an example graded alone by `dynlab grade`: what the batch
+// must give it too.
+std::string aloneScore(const std::string& example) {
+  static std::map<std::string, std::string> cells;
+  if (const auto it = cells.find(example); it != cells.end()) return it->second;
+  const TempDir dir("batch_alone_" + example);
+  const Result r = shell(dir, "timeout 60 " + quote(DYNLAB_BIN) + " grade " + quote((kExamples / (example + ".json")).string()) +
+                                  " --no-plots --out out");
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  char cell[32];
+  std::snprintf(cell, sizeof cell, "%.4g", json::parse(readFile(dir / "out/results.json")).at("score").get<double>());
+  return cells[example] = cell;
 }
 
 // Each grader's time budget: 1 s (a grade takes ~0.15 s); scripts/sanitize raises it, since grading
@@ -150,9 +164,10 @@ bool processMentions(const std::string& text) {
 
 // The submissions of the kill and lock tests: graded, invalid, crashing, one that hangs (3 s).
 void standardBatch(const TempDir& dir) {
-  for (const char* n : {"good", "mediocre", "unstable_integral"}) copyExample(n, dir / "in" / (std::string(n) + ".json"));
-  copyExample("good", dir / "in" / "crashes.json");
-  copyExample("good", dir / "in" / "hangs.json");
+  copyExample("proportional", dir / "in" / "fine.json");  // graded before "hangs" (name order)
+  for (const char* n : {"mediocre", "unstable_integral"}) copyExample(n, dir / "in" / (std::string(n) + ".json"));
+  copyExample("proportional", dir / "in" / "crashes.json");
+  copyExample("proportional", dir / "in" / "hangs.json");
   put(dir / "in" / "malformed.json", "{\"lab\": \"slider_crank\", \"gains\": {\"kp_x\": }");
 }
 const char* kFaults = "crash:crashes,hang:hangs";
@@ -168,7 +183,7 @@ TEST_CASE("hostile submission names: each its own safe folder inside OUT, nothin
       "caf\xe9\xff.json", "a b.json", "a_b.json", "Same.json", "same.json", ".staging.json", "x.json",
       std::string(200, 'L') + ".json", "\xe2\x80\xae" "gnp.json"};
   for (std::size_t i = 0; i < names.size(); ++i) {
-    if (i % 4 == 0) copyExample("good", in / names[i]);
+    if (i % 4 == 0) copyExample("proportional", in / names[i]);
     else put(in / names[i], R"({"lab": "slider_crank", "gains": {"kp_x": "high"}})");
   }
   // Around OUT: a plots/ folder `...json` used to remove, and a folder in OUT that no batch wrote.
@@ -209,7 +224,7 @@ TEST_CASE("hostile submission names: each its own safe folder inside OUT, nothin
   CHECK(book.count("a\nb.json"));
   CHECK(book.count("caf\xef\xbf\xbd\xef\xbf\xbd.json"));
   CHECK(book.at("...json").at("status") == "graded");
-  CHECK(book.at("...json").at("score") == "15");
+  CHECK(book.at("...json").at("score") == aloneScore("proportional"));
   CHECK(book.at("a_b.json").at("reason") == "/gains/kp_x: expected a number, got \"high\"");
   // The summary lists every name that was not graded, as one line of text each: no tag, no control
   // character.
@@ -235,46 +250,46 @@ TEST_CASE("hostile submission names: each its own safe folder inside OUT, nothin
 
 TEST_CASE("a rerun grades afresh: a stale results.json never counts, a failing grader is a failure" * doctest::timeout(300)) {
   TempDir dir("batch_stale");
-  copyExample("good", dir / "in" / "good.json");
+  copyExample("proportional", dir / "in" / "fine.json");
   copyExample("mediocre", dir / "in" / "mediocre.json");
   REQUIRE(batch(dir, "in", "out").code == 0);
-  CHECK(readBook(dir / "out" / "gradebook.csv").at("good.json").at("score") == "15");
-  REQUIRE(fs::exists(dir / "out" / "good" / "report.md"));
+  CHECK(readBook(dir / "out" / "gradebook.csv").at("fine.json").at("score") == aloneScore("proportional"));
+  REQUIRE(fs::exists(dir / "out" / "fine" / "report.md"));
 
   SUBCASE("the grader exits 1 without writing anything") {
-    const Result r = batch(dir, "in", "out", "fail:good");
+    const Result r = batch(dir, "in", "out", "fail:fine");
     REQUIRE(r.code == 0);
-    const auto row = readBook(dir / "out" / "gradebook.csv").at("good.json");
+    const auto row = readBook(dir / "out" / "gradebook.csv").at("fine.json");
     CHECK(row.at("score") == "0");
     CHECK(row.at("max_score") == "15");
     CHECK(row.at("status") == "internal error");
     CHECK(row.at("reason").find("internal error: the grader exited with status 1") == 0);
-    const json results = json::parse(readFile(dir / "out" / "good" / "results.json"));
+    const json results = json::parse(readFile(dir / "out" / "fine" / "results.json"));
     CHECK(results.at("score") == 0.0);
     CHECK(results.at("output").get<std::string>().find("exited with status 1") != std::string::npos);
-    // Last run's report (15/15) is not left beside it.
-    CHECK(!fs::exists(dir / "out" / "good" / "report.md"));
-    CHECK(!fs::exists(dir / "out" / "good" / "report.html"));
+    // Last run's report is not left beside it.
+    CHECK(!fs::exists(dir / "out" / "fine" / "report.md"));
+    CHECK(!fs::exists(dir / "out" / "fine" / "report.html"));
   }
   SUBCASE("the submission became unreadable bytes") {
-    put(dir / "in" / "good.json", "\xff\xfe{\0\"");
+    put(dir / "in" / "fine.json", "\xff\xfe{\0\"");
     REQUIRE(batch(dir, "in", "out").code == 0);
-    const auto row = readBook(dir / "out" / "gradebook.csv").at("good.json");
+    const auto row = readBook(dir / "out" / "gradebook.csv").at("fine.json");
     CHECK(row.at("score") == "0");
     // Invalid once the grader reports bad UTF-8 as such (inputs branch); until then its exit 1 is an internal error.
     CHECK((row.at("status") == "invalid submission" || row.at("status") == "internal error"));
     CHECK(!row.at("reason").empty());
   }
   SUBCASE("the submission became a FIFO: refused, not waited on") {
-    fs::remove(dir / "in" / "good.json");
-    REQUIRE(::mkfifo((dir / "in" / "good.json").c_str(), 0644) == 0);
+    fs::remove(dir / "in" / "fine.json");
+    REQUIRE(::mkfifo((dir / "in" / "fine.json").c_str(), 0644) == 0);
     const auto started = std::chrono::steady_clock::now();
     REQUIRE(batch(dir, "in", "out").code == 0);
     CHECK(std::chrono::steady_clock::now() - started < std::chrono::seconds(60));
-    const auto row = readBook(dir / "out" / "gradebook.csv").at("good.json");
+    const auto row = readBook(dir / "out" / "gradebook.csv").at("fine.json");
     CHECK(row.at("score") == "0");
     CHECK(row.at("reason") == "expected a regular file, got a FIFO");
-    CHECK(json::parse(readFile(dir / "out" / "good" / "results.json")).at("score") == 0.0);
+    CHECK(json::parse(readFile(dir / "out" / "fine" / "results.json")).at("score") == 0.0);
   }
   // The other submission is graded as before.
   CHECK(readBook(dir / "out" / "gradebook.csv").at("mediocre.json").at("status") == "graded");
@@ -286,7 +301,7 @@ TEST_CASE("a batch killed with SIGKILL and rerun gives the gradebook of an unint
   REQUIRE(batch(dir, "in", "clean", kFaults, "--jobs 1").code == 0);
   const std::string clean = readFile(dir / "clean" / "gradebook.csv");
 
-  // Killed while the hanging submission is being graded (crashes and good are done by then).
+  // Killed while the hanging submission is being graded (crashes and fine are done by then).
   const pid_t pid = batchInBackground(dir, "in", "out", kFaults);
   REQUIRE(pid > 0);
   REQUIRE(waitFor(dir / "out" / "hangs" / "grade.log"));
@@ -296,7 +311,7 @@ TEST_CASE("a batch killed with SIGKILL and rerun gives the gradebook of an unint
   REQUIRE(::waitpid(pid, &status, 0) == pid);
   CHECK(WIFSIGNALED(status));
   CHECK(!fs::exists(dir / "out" / "gradebook.csv"));
-  CHECK(fs::exists(dir / "out" / "good" / "results.json"));
+  CHECK(fs::exists(dir / "out" / "fine" / "results.json"));
   // Its graders died with it: none is left writing into OUT.
   bool gone = false;
   for (int i = 0; i < 200 && !(gone = !processMentions((dir / "in" / "hangs.json").string())); ++i)
@@ -305,7 +320,7 @@ TEST_CASE("a batch killed with SIGKILL and rerun gives the gradebook of an unint
 
   REQUIRE(batch(dir, "in", "out", kFaults, "--jobs 1").code == 0);
   CHECK(readFile(dir / "out" / "gradebook.csv") == clean);
-  for (const char* n : {"good", "mediocre", "malformed", "crashes", "hangs"}) {
+  for (const char* n : {"fine", "mediocre", "malformed", "crashes", "hangs"}) {
     CAPTURE(n);
     json a = json::parse(readFile(dir / "clean" / n / "results.json")), b = json::parse(readFile(dir / "out" / n / "results.json"));
     a.erase("execution_time");
@@ -335,7 +350,7 @@ TEST_CASE("a second batch into the same OUT refuses at once; the first finishes 
   CHECK((WIFEXITED(status) && WEXITSTATUS(status) == 0));
   const auto book = readBook(dir / "out" / "gradebook.csv");
   CHECK(book.size() == 6);
-  CHECK(book.at("good.json").at("score") == "15");
+  CHECK(book.at("fine.json").at("score") == aloneScore("proportional"));
   CHECK(book.at("hangs.json").at("status") == "timed out");
   CHECK(book.at("crashes.json").at("status") == "crashed");
   CHECK(book.at("malformed.json").at("status") == "invalid submission");
@@ -349,22 +364,22 @@ TEST_CASE("a Gradescope export: one folder per student, macOS leftovers ignored"
   put(dir / "submission_metadata.yml", "");
   fs::create_directories(in);
   put(in / "submission_metadata.yml", "submission_1: {}\n");
-  copyExample("good", in / "submission_1" / "submission.json");
+  copyExample("proportional", in / "submission_1" / "submission.json");
   copyExample("mediocre", in / "submission_1" / "scratch.json");          // submission.json wins
-  copyExample("good", in / "submission_2" / "my gains.json");             // the only JSON
+  copyExample("proportional", in / "submission_2" / "my gains.json");     // the only JSON
   put(in / "submission_2" / "._my gains.json", "\x00\x05\x16\x07");  // AppleDouble beside it
   put(in / "__MACOSX" / "submission_2" / "._my gains.json", "\x00\x05\x16\x07");
-  copyExample("good", in / "submission_3" / "a.json");
-  copyExample("good", in / "submission_3" / "b.json");
+  copyExample("proportional", in / "submission_3" / "a.json");
+  copyExample("proportional", in / "submission_3" / "b.json");
   put(in / "submission_4" / "answer.pdf", "%PDF");
-  copyExample("good", in / "top.json");  // a file at the top is a submission too
+  copyExample("proportional", in / "top.json");  // a file at the top is a submission too
 
   const Result r = batch(dir, "export", "out");
   INFO("stderr: " << r.err);
   REQUIRE(r.code == 0);
   const auto book = readBook(dir / "out" / "gradebook.csv");
   CHECK(book.size() == 5);
-  CHECK(book.at("submission_1/submission.json").at("score") == "15");
+  CHECK(book.at("submission_1/submission.json").at("score") == aloneScore("proportional"));
   CHECK(book.at("submission_1/submission.json").at("folder") == "submission_1");
   CHECK(book.at("submission_2/my gains.json").at("status") == "graded");
   CHECK(book.at("submission_3/").at("reason") == "several JSON files in this folder and none is named submission.json");
@@ -388,18 +403,18 @@ TEST_CASE("a Gradescope export: one folder per student, macOS leftovers ignored"
 
 TEST_CASE("OUT inside the submissions folder is not taken for a student" * doctest::timeout(300)) {
   TempDir dir("batch_inside");
-  copyExample("good", dir / "in" / "good.json");
+  copyExample("proportional", dir / "in" / "fine.json");
   REQUIRE(batch(dir, "in", "in/graded").code == 0);
   REQUIRE(batch(dir, "in", "in/graded").code == 0);  // the rerun sees the graded folder again
   const auto book = readBook(dir / "in" / "graded" / "gradebook.csv");
   CHECK(book.size() == 1);
-  CHECK(book.at("good.json").at("score") == "15");
+  CHECK(book.at("fine.json").at("score") == aloneScore("proportional"));
 
   // --out . around the submissions: folders dynlab did not write (plots/, the submissions) are left alone.
   TempDir here("batch_here");
   put(here / "plots" / "figure.png", "not dynlab's");
-  copyExample("good", here / "in" / "plots.json");
-  copyExample("good", here / "in" / "in.json");
+  copyExample("proportional", here / "in" / "plots.json");
+  copyExample("proportional", here / "in" / "in.json");
   const auto before = tree(here.path, here / "nothing");
   REQUIRE(batch(here, "in", ".").code == 0);
   CHECK(readFile(here / "plots" / "figure.png") == "not dynlab's");
@@ -414,13 +429,13 @@ TEST_CASE("OUT inside the submissions folder is not taken for a student" * docte
 
 TEST_CASE("a broken lab config is an internal error in every row, not the students' mistake" * doctest::timeout(120)) {
   TempDir dir("batch_config");
-  copyExample("good", dir / "in" / "good.json");
+  copyExample("proportional", dir / "in" / "fine.json");
   json config = json::parse(defaultConfigText());
   config["rubric"]["tests"][0]["points"] = "lots";
   put(dir / "broken.json", config.dump());
   const Result r = shell(dir, "timeout 120 " + quote(DYNLAB_BIN) + " grade --batch in --out out --config broken.json --no-plots");
   REQUIRE(r.code == 0);
-  const auto row = readBook(dir / "out" / "gradebook.csv").at("good.json");
+  const auto row = readBook(dir / "out" / "gradebook.csv").at("fine.json");
   CHECK(row.at("status") == "internal error");
   CHECK(row.at("reason").find("internal error: ") == 0);
   CHECK(row.at("reason").find("broken.json: /rubric/tests/0/points: expected") != std::string::npos);

@@ -5,6 +5,7 @@
 
 #include "tests/test_files.h"
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -17,9 +18,8 @@ using nlohmann::json;
 
 namespace {
 
+// The students' examples (the full-credit one stays in instructor/, out of a student copy).
 const std::string kExamples = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/examples/";
-// The full-credit example: course staff only, never in what students receive.
-const std::string kInstructor = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/instructor/";
 
 using dyn::test::readBytes;
 
@@ -28,16 +28,16 @@ json withoutTime(json r) {
   return r;
 }
 
-// A submissions folder: good, mediocre, unstable, malformed, plus two that hang and crash the grader.
+// A submissions folder: two graded, an unstable, a malformed one, plus two that hang and crash the grader.
 fs::path makeBatch() {
   const fs::path dir = fs::temp_directory_path() / ("dynlab-batch-" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir / "in");
-  for (const char* n : {"mediocre", "unstable_integral"}) fs::copy_file(kExamples + n + ".json", dir / "in" / (std::string(n) + ".json"));
-  fs::copy_file(kInstructor + "good.json", dir / "in" / "good.json");
+  for (const char* n : {"mediocre", "proportional", "unstable_integral"})
+    fs::copy_file(kExamples + n + ".json", dir / "in" / (std::string(n) + ".json"));
   std::ofstream(dir / "in" / "malformed.json") << "{\"lab\": \"slider_crank\", \"gains\": {\"kp_x\": }";
-  fs::copy_file(kInstructor + "good.json", dir / "in" / "hangs.json");
-  fs::copy_file(kInstructor + "good.json", dir / "in" / "crashes.json");
+  fs::copy_file(kExamples + "mediocre.json", dir / "in" / "hangs.json");
+  fs::copy_file(kExamples + "mediocre.json", dir / "in" / "crashes.json");
   return dir;
 }
 
@@ -55,7 +55,7 @@ TEST_CASE("a batch survives a hanging and a crashing grader, and --jobs does not
   REQUIRE(runBatch(dir, "one", 1) == 0);
   REQUIRE(runBatch(dir, "two", 2) == 0);
 
-  for (const char* n : {"good", "mediocre", "unstable_integral", "malformed", "hangs", "crashes"}) {
+  for (const char* n : {"mediocre", "proportional", "unstable_integral", "malformed", "hangs", "crashes"}) {
     CAPTURE(n);
     const json a = json::parse(readBytes(dir / "one" / n / "results.json"));
     const json b = json::parse(readBytes(dir / "two" / n / "results.json"));
@@ -71,7 +71,11 @@ TEST_CASE("a batch survives a hanging and a crashing grader, and --jobs does not
   CHECK(book.find("crashes.json,0,15,crashed,internal error: the grader stopped with signal 6 (Aborted),crashes,,") !=
         std::string::npos);
   CHECK(book.find("malformed.json,0,15,invalid submission,") != std::string::npos);
-  CHECK(book.find("good.json,15,15,graded,,good,") != std::string::npos);
+  // A graded row: its score as its results.json has it (%.4g), of 15.
+  char row[96];
+  std::snprintf(row, sizeof row, "proportional.json,%.4g,15,graded,,proportional,",
+                json::parse(readBytes(dir / "one" / "proportional" / "results.json")).at("score").get<double>());
+  CHECK(book.find(row) != std::string::npos);
   CHECK(book.find("unstable_integral.json") != std::string::npos);
   // The crashed and timed-out submissions say what happened.
   CHECK(readBytes(dir / "one" / "crashes" / "results.json").find("signal 6") != std::string::npos);

@@ -1,5 +1,6 @@
-// grading/grade: good, mediocre, unstable and malformed submissions; reproducibility; the
-// Gradescope results.json contract; the watchdog and the time budget.
+// grading/grade: mediocre, unstable and malformed submissions (and the full-credit one where the
+// instructor files are); reproducibility; the Gradescope results.json contract; the watchdog and
+// the time budget.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -8,6 +9,7 @@
 
 #include "grading/grade.h"
 #include "grading/rubric.h"
+#include "tests/instructor.h"
 
 namespace fs = std::filesystem;
 using namespace dyn;
@@ -15,8 +17,8 @@ using namespace dyn;
 namespace {
 
 const std::string kExamples = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/examples/";
-// The full-credit example: course staff only, never in what students receive.
-const std::string kInstructor = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/instructor/";
+// A stable submission students have (not full credit: the answer stays in instructor/).
+const std::string kMediocre = kExamples + "mediocre.json";
 
 fs::path tempDir() {
   const fs::path d = fs::temp_directory_path() / ("dynlab-grade-test-" + std::to_string(::getpid()));
@@ -49,24 +51,29 @@ bool anyTestSays(const GradeOutcome& g, const std::string& text) {
 }  // namespace
 
 TEST_CASE("submissions score in their expected ranges, with messages that explain") {
-  const GradeOutcome good = grade(kInstructor + "good.json");
-  const GradeOutcome mediocre = grade(kExamples + "mediocre.json");
+  const GradeOutcome mediocre = grade(kMediocre);
   const GradeOutcome unstable = grade(kExamples + "unstable_integral.json");
-  REQUIRE(maxScore(good) == doctest::Approx(15));
-  CHECK(score(good) >= 14.5);
+  REQUIRE(maxScore(mediocre) == doctest::Approx(15));
   CHECK(score(mediocre) > 6);
   CHECK(score(mediocre) < 13);
   CHECK(score(unstable) < 2);
-  CHECK_FALSE(good.input_error);
+  CHECK_FALSE(mediocre.input_error);
   // The unstable gains: stopped by the watchdog with a time, and explained by the screening.
   CHECK(anyTestSays(unstable, "unstable: the rail force left its safe range"));
   CHECK(anyTestSays(unstable, "at t = "));
   CHECK(unstable.results["output"].get<std::string>().find("unstable, closed-loop pole") != std::string::npos);
   CHECK(unstable.results["output"].get<std::string>().find("the delay alone destabilises it") != std::string::npos);
   // Leaderboard from the nominal run: tracking RMS in mm.
-  REQUIRE(good.results.contains("leaderboard"));
-  CHECK(good.results["leaderboard"][0]["value"].get<double>() ==
-        doctest::Approx(good.results["extra_data"]["scenarios"]["nominal"]["metrics"]["x_rms"].get<double>() * 1000));
+  REQUIRE(mediocre.results.contains("leaderboard"));
+  CHECK(mediocre.results["leaderboard"][0]["value"].get<double>() ==
+        doctest::Approx(mediocre.results["extra_data"]["scenarios"]["nominal"]["metrics"]["x_rms"].get<double>() * 1000));
+}
+
+TEST_CASE("the instructor's full-credit submission scores (close to) full marks" * doctest::skip(!test::instructorFilesPresent())) {
+  const GradeOutcome good = grade(test::instructorDir("slider_crank") + "good.json");
+  REQUIRE(maxScore(good) == doctest::Approx(15));
+  CHECK(score(good) >= 14.5);
+  CHECK_FALSE(good.input_error);
 }
 
 TEST_CASE("malformed submissions score 0 with a message naming file, JSON path and expectation") {
@@ -111,11 +118,11 @@ TEST_CASE("malformed submissions score 0 with a message naming file, JSON path a
   // A submission for another lab than the assignment's.
   GradeOptions o;
   o.expected_lab = "unicycle";
-  CHECK(grade(kInstructor + "good.json", o).results.at("output").get<std::string>().find("this assignment's lab") != std::string::npos);
+  CHECK(grade(kMediocre, o).results.at("output").get<std::string>().find("this assignment's lab") != std::string::npos);
 }
 
 TEST_CASE("grading twice gives the same results apart from execution_time; replay detects a change") {
-  const GradeOutcome a = grade(kExamples + "mediocre.json"), b = grade(kExamples + "mediocre.json");
+  const GradeOutcome a = grade(kMediocre), b = grade(kMediocre);
   json ja = a.results, jb = b.results;
   ja.erase("execution_time");
   jb.erase("execution_time");
@@ -123,7 +130,7 @@ TEST_CASE("grading twice gives the same results apart from execution_time; repla
   CHECK(compareResults(a.results, b.results).empty());
   // The noisy scenario's seed comes from the submission: other gains, other trajectories.
   const auto fp = a.results["extra_data"]["fingerprint"];
-  CHECK(fp["trajectory_hash"] != grade(kInstructor + "good.json").results["extra_data"]["fingerprint"]["trajectory_hash"]);
+  CHECK(fp["trajectory_hash"] != grade(kExamples + "proportional.json").results["extra_data"]["fingerprint"]["trajectory_hash"]);
   // A tampered score is reported.
   json tampered = a.results;
   tampered["tests"][0]["score"] = 3.0;
@@ -133,7 +140,7 @@ TEST_CASE("grading twice gives the same results apart from execution_time; repla
 }
 
 TEST_CASE("results.json has Gradescope's field names and types") {
-  for (const std::string& f : {kInstructor + "good.json", kExamples + "unstable_integral.json", writeFile("bad.json", "{")}) {
+  for (const std::string& f : {kMediocre, kExamples + "unstable_integral.json", writeFile("bad.json", "{")}) {
     CAPTURE(f);
     const json r = grade(f).results;
     CHECK(r.at("score").is_number());
@@ -166,19 +173,28 @@ TEST_CASE("results.json has Gradescope's field names and types") {
 TEST_CASE("the time budget and the step budget stop runs without losing the grade") {
   GradeOptions o;
   o.time_budget = 1e-6;  // already over when the first run starts
-  const GradeOutcome late = grade(kInstructor + "good.json", o);
+  const GradeOutcome late = grade(kMediocre, o);
   CHECK_FALSE(late.input_error);
   CHECK(anyTestSays(late, "not graded: the grading time budget ran out"));
   CHECK(late.results["tests"].size() == 10);
-  // Screening needs no simulation: its tests are still scored.
-  CHECK(score(late) == doctest::Approx(2.0));
+  // Screening needs no simulation: its two tests are still scored, as a full grade scores them.
+  const GradeOutcome whole = grade(kMediocre);
+  double screened = 0;
+  int graded = 0;
+  for (std::size_t i = 0; i < late.results["tests"].size(); ++i) {
+    if (!late.results["tests"][i]["extra_data"].value("value", json()).is_number()) continue;  // not measured
+    screened += whole.results["tests"][i]["score"].get<double>();
+    ++graded;
+  }
+  CHECK(graded == 2);
+  CHECK(score(late) == doctest::Approx(screened));
 
   // A lab config whose watchdog allows 100 steps: every run exceeds it.
   json config = json::parse(std::ifstream(std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/slider_crank.json"));
   config["rubric"]["watchdog"]["max_steps"] = 100;
   GradeOptions s;
   s.config_file = writeFile("short_budget.json", config.dump());
-  const GradeOutcome g = grade(kInstructor + "good.json", s);
+  const GradeOutcome g = grade(kMediocre, s);
   CHECK(anyTestSays(g, "exceeded its step budget of 100 steps"));
 }
 
@@ -187,7 +203,7 @@ TEST_CASE("a rubric naming a metric the lab does not report is the config's erro
   config["rubric"]["tests"][0]["metric"] = "x_rsm";
   GradeOptions o;
   o.config_file = writeFile("typo_rubric.json", config.dump());
-  const GradeOutcome g = grade(kInstructor + "good.json", o);
+  const GradeOutcome g = grade(kMediocre, o);
   const std::string out = g.results["output"];
   CHECK(out.find("typo_rubric.json") != std::string::npos);
   CHECK(out.find("/rubric/tests/0/metric") != std::string::npos);
@@ -245,7 +261,7 @@ TEST_CASE("a scenario patch that removes the seed's object is the config's error
   config["rubric"]["scenarios"]["long_delay"]["patch"] = {{"controller", 5}};
   GradeOptions o;
   o.config_file = writeFile("seedless_rubric.json", config.dump());
-  const GradeOutcome g = grade(kInstructor + "good.json", o);
+  const GradeOutcome g = grade(kMediocre, o);
   CHECK(g.input_error);
   REQUIRE(g.results["extra_data"].contains("error"));
   CHECK(g.results["extra_data"]["error"]["path"] == "/rubric/seed_target");
@@ -260,7 +276,7 @@ TEST_CASE("a rubric plot of a column the lab lacks is the config's error, found 
   GradeOptions o;
   o.config_file = writeFile("plot_column_rubric.json", config.dump());
   o.out_dir = (tempDir() / "plot_column_out").string();
-  const GradeOutcome g = grade(kInstructor + "good.json", o);
+  const GradeOutcome g = grade(kMediocre, o);
   CHECK(g.input_error);
   REQUIRE(g.results["extra_data"].contains("error"));
   CHECK(g.results["extra_data"]["error"]["path"] == "/rubric/tests/1/plot/columns/0");
@@ -268,7 +284,7 @@ TEST_CASE("a rubric plot of a column the lab lacks is the config's error, found 
 }
 
 TEST_CASE("feedback gives every metric its unit: the lab's metric_docs, and the screening's own") {
-  const GradeOutcome g = grade(kExamples + "mediocre.json");
+  const GradeOutcome g = grade(kMediocre);
   REQUIRE_FALSE(g.input_error);
   CHECK(g.report.find("x_rms = 0.01113 m (full 0.003 m, zero 0.03 m)") != std::string::npos);
   CHECK(g.report.find("f_rms = 0.1483 N (full 0.05 N, zero 0.5 N)") != std::string::npos);

@@ -88,7 +88,7 @@ TEST_CASE("a stable loop keeps its damping and margins") {
 }
 
 TEST_CASE("the slider crank reports both loops for every force law, and with zero motion gains") {
-  const json gains = {{"kp_x", 6000}, {"kd_x", 190}, {"kp_f", 0.5}, {"ki_f", 25}};
+  const json gains = {{"kp_x", 300}, {"kd_x", 12}, {"kp_f", 0.5}, {"ki_f", 10}};
   for (const char* law : {"open_loop", "proportional", "integral"}) {
     CAPTURE(law);
     const ScreenResult r = screenLoops(*sliderCrank({{"force_law", law}, {"gains", gains}}));
@@ -109,7 +109,7 @@ TEST_CASE("the slider crank reports both loops for every force law, and with zer
   CHECK(r.metrics["motion_damping"].get<double>() == 0.0);
   CHECK(r.notes.front().find("no feedback") != std::string::npos);
   // k_px = 0 alone: a pole at 0, not stable.
-  zero["kd_x"] = 190;
+  zero["kd_x"] = 12;
   const ScreenResult d = screenLoops(*sliderCrank({{"gains", zero}}));
   CHECK(d.metrics["motion_damping"].get<double>() == 0.0);
   CHECK(d.notes.front().find("not stable") != std::string::npos);
@@ -120,7 +120,7 @@ TEST_CASE("an open-loop submission grades: its screening test is present and sco
   std::filesystem::create_directories(dir);
   const std::string file = (dir / "open_loop.json").string();
   std::ofstream(file) << R"({"lab": "slider_crank", "force_law": "open_loop",
-                            "gains": {"kp_x": 6000, "kd_x": 190, "kp_f": 0.5, "ki_f": 25}})";
+                            "gains": {"kp_x": 300, "kd_x": 12, "kp_f": 0.5, "ki_f": 10}})";
   const GradeOutcome g = gradeSubmission(file, {});
   std::filesystem::remove_all(dir);
   CHECK_FALSE(g.input_error);
