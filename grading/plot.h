@@ -67,4 +67,8 @@ struct PlotLayout {
 // covers data. Log y: values ≤ 0 are left out; ticks at powers of ten.
 PlotLayout writePlot(const std::string& path, const PlotSpec& spec, int width_px = 800, int height_px = 450);
 
+// Loads what the first plot of a process needs (fonts, the text shaper) by drawing a few glyphs
+// into memory: a batch calls it once before forking its graders, which then inherit it.
+void warmUpPlotting();
+
 }  // namespace dyn
