@@ -199,7 +199,7 @@ int bench(const BenchArgs& a) {
                   describeAgreement(lab, bullet_error).c_str());
       std::printf("  640x480 fps     render %.0f   +PNG %.0f   +video %.0f\n", fps.render, fps.png, fps.video);
       if (!grading.empty())
-        std::printf("  grading         %.3f s CPU per full rubric (%.3f s with plots): %.0f per s per core, 1000 on 2 cores in %.0f s\n",
+        std::printf("  grading         %.3f s CPU per full rubric (%.3f s with plots): %.0f per s per core, 1000 with plots on 2 cores in %.0f s\n",
                     grading["grade_cpu_s"].get<double>(), grading["grade_cpu_s_with_plots"].get<double>(),
                     grading["grade_per_s_per_core"].get<double>(), grading["class_of_1000_on_2_cores_s"].get<double>());
     }

@@ -45,7 +45,7 @@ json gradeThroughput(const std::string& lab, int repeats) {
   return {{"grade_cpu_s", plain},
           {"grade_cpu_s_with_plots", plots},
           {"grade_per_s_per_core", plain > 0 ? 1.0 / plain : 0.0},
-          {"class_of_1000_on_2_cores_s", 1000 * plain / 2}};
+          {"class_of_1000_on_2_cores_s", 1000 * plots / 2}};  // the measure: graded with plots
 }
 
 }  // namespace dyn::app

@@ -11,7 +11,7 @@ CourseCommands::CourseCommands(CLI::App& cli) {
   handout_->add_option("LAB", h.lab, "Lab name (see `dynlab list`)")->required();
   handout_->add_option("--out", h.out, "Output directory (default: out/LAB/handout)");
   handout_->add_option("--config", h.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
-  handout_->add_option("--format", h.format, "Comma-separated formats: md, html, pdf (default: md,html)");
+  handout_->add_option("--format", h.format, "Comma-separated formats: md, html (default: md,html); for a PDF, open the HTML in a browser and print it (Save as PDF)");
 
   MapArgs& m = map_args_;
   map_ = cli.add_subcommand("map", "Stability/score map over two gains or parameters, from the screening (fast) or "

@@ -84,4 +84,8 @@ PlotWindow equalAspect(const PlotWindow& w, double frame_width, double frame_hei
 // scales exactly equal once the tick labels have taken their room.
 PlotLayout writePlot(const std::string& path, const PlotSpec& spec, int width_px = 800, int height_px = 450);
 
+// Loads what the first plot of a process needs (fonts, the text shaper) by drawing a few glyphs
+// into memory: a batch calls it once before forking its graders, which then inherit it.
+void warmUpPlotting();
+
 }  // namespace dyn

@@ -43,6 +43,7 @@ TEST_CASE("every lab's handout names every gain, test, scenario and metric with 
     REQUIRE_MESSAGE(r.code == 0, r.err);
     const std::string md = readFile(dir / ("h_" + lab + "/handout.md"));
     const std::string html = readFile(dir / ("h_" + lab + "/handout.html"));
+    CHECK(has(md, "For a PDF, open `handout.html` in a browser and print it (Save as PDF)."));  // dynlab writes none
     const json config = json::parse(readFile(fs::path(DYNLAB_SOURCE_DIR) / "labs" / lab / (lab + ".json")));
     for (const auto& [gain, g] : config.at("gains").items()) {
       INFO("gain ", gain);
@@ -112,7 +113,7 @@ TEST_CASE("bad LAB, --out or --format: one line, exit 2, nothing written") {
   checkBadInput(dir, "handout no_such_lab --out h", {"no_such_lab"}, dir / "h");
   writeFile(dir / "a_file", "x");
   checkBadInput(dir, "handout slider_crank --out a_file/h", {"a_file"}, dir / "a_file/h");
-  checkBadInput(dir, "handout slider_crank --out h --format pdf", {"pdf"}, dir / "h");
+  checkBadInput(dir, "handout slider_crank --out h --format pdf", {"pdf", "print it to PDF from a browser"}, dir / "h");
   checkBadInput(dir, "handout slider_crank --out h --format docx", {"docx"}, dir / "h");
   json config = json::parse(defaultConfigText());
   config["metric_docs"]["f_rms"]["window"] = "from t = {/metrics/no_such} s on";

@@ -153,11 +153,14 @@ bool waitFor(const fs::path& p) {
   return false;
 }
 
-// Any process whose command line mentions text (a grader left running).
-bool processMentions(const std::string& text) {
-  for (const auto& e : fs::directory_iterator("/proc")) {
-    const std::string cmdline = readFile(e.path() / "cmdline");
-    if (cmdline.find(text) != std::string::npos && e.path().filename() != std::to_string(::getpid())) return true;
+// Any process other than this one working in `dir` (a grader left running: the graders are forks
+// of the batch, so their command line is the batch's; their working folder is the test's).
+bool processIn(const fs::path& dir) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator("/proc", ec)) {
+    if (e.path().filename() == std::to_string(::getpid())) continue;
+    const fs::path cwd = fs::read_symlink(e.path() / "cwd", ec);
+    if (!ec && cwd == dir) return true;
   }
   return false;
 }
@@ -306,6 +309,7 @@ TEST_CASE("a batch killed with SIGKILL and rerun gives the gradebook of an unint
   REQUIRE(pid > 0);
   REQUIRE(waitFor(dir / "out" / "hangs" / "grade.log"));
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
+  REQUIRE(processIn(dir.path));  // the batch and its graders are seen working there
   REQUIRE(::kill(pid, SIGKILL) == 0);
   int status = 0;
   REQUIRE(::waitpid(pid, &status, 0) == pid);
@@ -314,7 +318,7 @@ TEST_CASE("a batch killed with SIGKILL and rerun gives the gradebook of an unint
   CHECK(fs::exists(dir / "out" / "fine" / "results.json"));
   // Its graders died with it: none is left writing into OUT.
   bool gone = false;
-  for (int i = 0; i < 200 && !(gone = !processMentions((dir / "in" / "hangs.json").string())); ++i)
+  for (int i = 0; i < 200 && !(gone = !processIn(dir.path)); ++i)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   CHECK(gone);
 
