@@ -271,6 +271,13 @@ struct Series {
   Color color;
 };
 
+// The first trace row of a live plot that shows the last `seconds` up to and including `row`
+// (steps of dt): the plot then runs over rows [liveWindowStart(...), row].
+inline std::size_t liveWindowStart(std::size_t row, double seconds, double dt) {
+  const std::size_t window = std::size_t(std::lround(seconds / dt));
+  return row > window ? row - window : 0;
+}
+
 // The overlay panel (Dear ImGui): a title, label/value lines and live plots.
 struct Overlay {
   std::string title;

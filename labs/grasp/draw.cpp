@@ -136,9 +136,7 @@ void GraspLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
              {"cone margin", fmt("%.2f N", tr.at(row, "cone_margin")) + fmt(" (mu = %.2f)", s_.params.mu)}};
   // Live plots over the last two seconds: every step, up to and including this row.
   Series margin{"cone margin (N)", {}, kRef}, squeeze{"f_int (N)", {}, kForce};
-  const std::size_t window = std::size_t(std::lround(2.0 / s_.step.dt));
-  const std::size_t first = row > window ? row - window : 0;
-  for (std::size_t r = first; r <= row; ++r) {
+  for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) {
     margin.values.push_back(float(tr.at(r, "cone_margin")));
     squeeze.values.push_back(float(tr.at(r, "f_int")));
   }

@@ -110,9 +110,7 @@ void SliderCrankLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const
   // Live plots over the last two seconds: every step, up to and including this row (a plot never
   // ends on an older value than the lines above show).
   Series force{"f_Ty (N)", {}, kForce}, err{"x error (mm)", {}, kRef};
-  const std::size_t window = std::size_t(std::lround(2.0 / s_.step.dt));
-  const std::size_t first = row > window ? row - window : 0;
-  for (std::size_t r = first; r <= row; ++r) {
+  for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) {
     force.values.push_back(float(tr.at(r, "f_Ty")));
     err.values.push_back(float(1e3 * (tr.at(r, "x_c") - tr.at(r, "x_d"))));
   }

@@ -6,7 +6,7 @@
 namespace dyn::unicycle {
 
 Controller::Controller(const ControllerConfig& config, const Path& path, const ReferenceSettings& reference, double radius, double dt)
-    : config_(config), path_(&path), leader_(path, reference, config.gains.a_lat), radius_(radius), dt_(dt),
+    : config_(config), leader_(path, reference, config.gains.a_lat), radius_(radius), dt_(dt),
       drive_(config.delay, dt), steer_(config.delay, dt), rng_(config.seed) {}
 
 VecN Controller::torque(double t, const VecN& q, const VecN& v) {

@@ -54,7 +54,6 @@ class Controller {
 
  private:
   ControllerConfig config_;
-  const Path* path_;
   Leader leader_;
   double radius_, dt_;
   DelayLine drive_, steer_;

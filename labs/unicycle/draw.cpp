@@ -95,9 +95,7 @@ void UnicycleLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
              {"skid margin", fmt("%.2f N", tr.at(row, "skid_margin"))}};
   // Live plots over the last four seconds: every step, up to and including this row.
   Series speed{"speed (m/s)", {}, kWheel}, lateral{"f_lat (N)", {}, kForce};
-  const std::size_t window = std::size_t(std::lround(4.0 / s_.step.dt));
-  const std::size_t first = row > window ? row - window : 0;
-  for (std::size_t r = first; r <= row; ++r) {
+  for (std::size_t r = liveWindowStart(row, 4.0, s_.step.dt); r <= row; ++r) {
     speed.values.push_back(float(tr.at(r, "speed")));
     lateral.values.push_back(float(tr.at(r, "f_lat")));
   }
