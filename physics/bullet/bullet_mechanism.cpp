@@ -42,6 +42,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "physics/bullet/bullet_world.h"
 #include "physics/bullet/planar_plan.h"
 
 #ifndef BT_USE_DOUBLE_PRECISION
@@ -79,18 +80,14 @@ struct BulletMechanism<Planar>::Impl {
   std::vector<Vec2> link_force;                   // link forces (at the centre of mass) over the last step
   std::vector<Planar::Vec> force;                 // per description constraint, last step
 
-  std::unique_ptr<btDefaultCollisionConfiguration> config;
-  std::unique_ptr<btCollisionDispatcher> dispatcher;
-  std::unique_ptr<btDbvtBroadphase> broadphase;
-  std::unique_ptr<btMultiBodyConstraintSolver> solver;
-  std::unique_ptr<btMultiBodyDynamicsWorld> world;
+  BulletWorld world;  // before what it holds: destroyed after it
   std::unique_ptr<btMultiBody> body;
   std::unique_ptr<btSphereShape> shape;
   std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders;
   std::vector<std::unique_ptr<btMultiBodyConstraint>> closures;
 
   Impl(const MechanismModel<Planar>& m, double step, const VecN& q0, const VecN& v0)
-      : model(m), plan(makePlan(m)), dt(step) {
+      : model(m), plan(makePlan(m)), dt(step), world(bt(plan.gravity), m.bullet.solver_iterations) {
     if (!(dt > 0.0)) throw std::invalid_argument("BulletMechanism: dt must be > 0");
     if (q0.size() != plan.coordinates || v0.size() != plan.coordinates)
       throw std::invalid_argument("BulletMechanism: q0 and v0 need " + std::to_string(plan.coordinates) +
@@ -108,27 +105,17 @@ struct BulletMechanism<Planar>::Impl {
     link_torque.assign(plan.links.size(), 0.0);
     link_force.assign(plan.links.size(), Vec2::Zero());
 
-    config = std::make_unique<btDefaultCollisionConfiguration>();
-    dispatcher = std::make_unique<btCollisionDispatcher>(config.get());
-    broadphase = std::make_unique<btDbvtBroadphase>();
-    solver = std::make_unique<btMultiBodyConstraintSolver>();
-    world = std::make_unique<btMultiBodyDynamicsWorld>(dispatcher.get(), broadphase.get(), solver.get(), config.get());
-    world->setGravity(bt(plan.gravity));  // pitfall 2: Bullet's default is (0, −10, 0)
-    world->getSolverInfo().m_numIterations = m.bullet.solver_iterations;
     build();
     setState(q0, v0);
   }
 
   ~Impl() {
-    if (world) {
-      for (auto& c : closures) world->removeMultiBodyConstraint(c.get());
-      for (auto& c : colliders) world->removeCollisionObject(c.get());
-      if (body) world->removeMultiBody(body.get());
-    }
+    for (auto& c : closures) world->removeMultiBodyConstraint(c.get());
+    for (auto& c : colliders) world->removeCollisionObject(c.get());
+    if (body) world->removeMultiBody(body.get());
     closures.clear();
     colliders.clear();
     body.reset();
-    world.reset();
   }
 
   void build() {

@@ -43,6 +43,7 @@
 #include <stdexcept>
 
 #include "physics/bullet/bullet_mechanism.h"
+#include "physics/bullet/bullet_world.h"
 #include "physics/bullet/rolling_constraint.h"
 #include "physics/constraints/rolling.h"
 
@@ -131,29 +132,18 @@ struct BulletMechanism<Spatial>::Impl {
   std::vector<Spatial::Vec> force;  // per description constraint, over the last step
   std::string summary;
 
-  std::unique_ptr<btDefaultCollisionConfiguration> config;
-  std::unique_ptr<btCollisionDispatcher> dispatcher;
-  std::unique_ptr<btDbvtBroadphase> broadphase;
-  std::unique_ptr<btMultiBodyConstraintSolver> solver;
-  std::unique_ptr<btMultiBodyDynamicsWorld> world;
+  BulletWorld world;  // before what it holds: destroyed after it
   std::unique_ptr<btMultiBody> body;
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
   std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders;
   std::vector<std::unique_ptr<btMultiBodyConstraint>> closures;
   std::vector<std::unique_ptr<btRigidBody>> grounds;
 
-  Impl(const MechanismModel<Spatial>& m, double step, const VecN& q0, const VecN& v0) : model(m), dt(step) {
+  Impl(const MechanismModel<Spatial>& m, double step, const VecN& q0, const VecN& v0) : model(m), dt(step), world(bt(Spatial::linear(m.tree.gravity)), m.bullet.solver_iterations) {
     check(q0, v0);
     frames = linkFrames(m.tree);
     force.assign(m.constraints.size(), Spatial::Vec::Zero());
-    config = std::make_unique<btDefaultCollisionConfiguration>();
-    dispatcher = std::make_unique<btCollisionDispatcher>(config.get());
-    broadphase = std::make_unique<btDbvtBroadphase>();
-    solver = std::make_unique<btMultiBodyConstraintSolver>();
-    world = std::make_unique<btMultiBodyDynamicsWorld>(dispatcher.get(), broadphase.get(), solver.get(), config.get());
-    world->setGravity(bt(Spatial::linear(m.tree.gravity)));  // pitfall 2: Bullet's default is (0, −10, 0)
     btContactSolverInfo& info = world->getSolverInfo();
-    info.m_numIterations = m.bullet.solver_iterations;
     // Two friction directions, clipped together to the cone (without the flag Bullet keeps one).
     info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
     info.m_solverMode &= ~SOLVER_DISABLE_IMPLICIT_CONE_FRICTION;
@@ -165,17 +155,14 @@ struct BulletMechanism<Spatial>::Impl {
   }
 
   ~Impl() {
-    if (world) {
-      for (auto& c : closures) world->removeMultiBodyConstraint(c.get());
-      for (auto& g : grounds) world->removeRigidBody(g.get());
-      for (auto& c : colliders) world->removeCollisionObject(c.get());
-      if (body) world->removeMultiBody(body.get());
-    }
+    for (auto& c : closures) world->removeMultiBodyConstraint(c.get());
+    for (auto& g : grounds) world->removeRigidBody(g.get());
+    for (auto& c : colliders) world->removeCollisionObject(c.get());
+    if (body) world->removeMultiBody(body.get());
     closures.clear();
     grounds.clear();
     colliders.clear();
     body.reset();
-    world.reset();
   }
 
   // What this model cannot build, said before anything is built.
@@ -396,8 +383,8 @@ struct BulletMechanism<Spatial>::Impl {
   Spatial::Vec contactForce(const Wheel& w) const {
     Pos f = Pos::Zero(), m = Pos::Zero();
     const Pos P = eig(w.start_point);
-    for (int i = 0; i < dispatcher->getNumManifolds(); ++i) {
-      const btPersistentManifold* man = dispatcher->getManifoldByIndexInternal(i);
+    for (int i = 0; i < world.dispatcher->getNumManifolds(); ++i) {
+      const btPersistentManifold* man = world.dispatcher->getManifoldByIndexInternal(i);
       double sign;
       if (man->getBody0() == w.collider && man->getBody1() == w.ground)
         sign = 1.0;  // Bullet's impulses act on body 0 along +normal, +friction directions
