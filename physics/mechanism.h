@@ -97,6 +97,16 @@ class Constraint {
   virtual int rows() const = 0;
   // False for velocity-level kinds (rolling): no φ, no position projection, Baumgarte without ω²φ.
   virtual bool holonomic() const { return true; }
+  // True for one-sided kinds (plane_contact): φ = −gap, J θ' − A v_c = −gap', η ≥ 0 presses. The
+  // mechanism closes and opens their rows (a released row carries η = 0 and writes nothing).
+  virtual bool unilateral() const { return false; }
+  // True when the kind is a force element instead of rows (a compliant contact): its rows stay
+  // released and the mechanism applies compliantForce() as η through its J.
+  virtual bool compliant() const { return false; }
+  virtual double compliantForce(const MechanismKinematics<S>& k) const {
+    (void)k;
+    return 0.0;
+  }
   // Position stage: φ (rows), J (rows × n) and A (rows × k), written at row offset `row` of the
   // mechanism's stacked matrices (which arrive zeroed in those rows).
   virtual void position(const MechanismKinematics<S>& k, int row, VecN& phi, MatN& J, MatN& A) const = 0;
