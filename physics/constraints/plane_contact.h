@@ -2,8 +2,9 @@
 // radius ρ centred at c_b on body b (a pen tip, a hand) against the half-space n·x ≥ h of the world
 // (a table's top or a wall; n its outward unit normal, world axes). With c the ball's centre (world):
 //   gap      g(q) = n·c − ρ − h                  contact point P = c − ρ n (on the plane when g = 0)
-//   row      φ = −g,   J θ' − A v_c = −n·V_b(P) = −g'        (positive when the ball approaches)
-//   bias     J'θ' − A'v_c = −n·a_b(P)             (a_b: P's classical acceleration at θ'' = 0)
+//   row      φ = −g,   J θ' − A v_c = −n·v_b(c) = −g'       (positive when the ball approaches; the
+//            material point under P has the same normal velocity: n·(ω × ρn) = 0)
+//   bias     J'θ' − A'v_c = −n·a_b(c)             (a_b: c's classical acceleration at θ'' = 0)
 //   force    f = η n, a pure force on b at P (body a, the world, on b): η ≥ 0 presses
 // The tangential motions are free (frictionless: H spans them, H̃ = nᵀ). The rigid contact holds
 // g ≥ 0, η ≥ 0, g η = 0: the mechanism keeps it closed (this row of eq. (3)) while its η presses, opens
