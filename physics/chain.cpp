@@ -24,6 +24,7 @@ void TreeData<S>::resize(int n) {
   a.resize(n);
   f.resize(n);
   Ic.resize(n);
+  Ic_rb.resize(n);
   U.resize(n);
   pA.resize(n);
   D.resize(n);
@@ -71,7 +72,9 @@ VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const Ve
     const auto& b = model.bodies[i];
     const typename S::Vec a_parent = b.parent < 0 ? a0 : data.a[b.parent];
     data.a[i] = S::motion(data.X_up[i], a_parent) + data.S_i[i] * qdd[i] + data.c[i];
-    data.f[i] = S::inertiaTimes(b.inertia, data.a[i]) + S::crossForce(data.v[i], S::inertiaTimes(b.inertia, data.v[i]));
+    // A massless body (a carrier: zero mass and rotational inertia) needs no force of its own.
+    if (S::massless(b.inertia)) data.f[i].setZero();
+    else data.f[i] = S::inertiaTimes(b.inertia, data.a[i]) + S::crossForce(data.v[i], S::inertiaTimes(b.inertia, data.v[i]));
   }
   // Inward: project onto the joint axis, pass the rest to the parent.
   VecN tau(n);
@@ -83,18 +86,43 @@ VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const Ve
   return tau;
 }
 
+// M = Σ_b J_bᵀ I_b J_b over the bodies with mass (T = ½ Σ V_bᵀ I_b V_b), in world coordinates: the
+// axes S_j^w of the joints on b's path and b's inertia I_b^w. Cheaper than composites when most
+// bodies are massless carriers (the unicycle's x, y, z and heading).
 template <class S>
-MatN crba(const TreeModel<S>& model, TreeData<S>& data) {
+void crbaSparseMass(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M) {
+  using Vec = typename S::Vec;
   const int n = model.dof();
-  for (int i = 0; i < n; ++i) data.Ic[i] = model.bodies[i].inertia;
+  Vec Sw[kMaxDof], F[kMaxDof];
+  for (int j = 0; j < n; ++j) Sw[j] = S::motionInverse(data.X_world[j], data.S_i[j]);
+  M.setZero();
+  for (int b = 0; b < n; ++b) {
+    if (S::massless(model.bodies[b].inertia)) continue;
+    const typename S::Inertia Iw = S::inertiaInParent(data.X_world[b], S::compact(model.bodies[b].inertia));
+    for (int i = b; i >= 0; i = model.bodies[i].parent) {
+      F[i] = S::inertiaTimes(Iw, Sw[i]);
+      for (int j = b; j >= i; j = model.bodies[j].parent) M(j, i) += S::dot(Sw[j], F[i]);
+    }
+  }
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) M(i, j) = M(j, i);
+}
+
+template <class S>
+void crba(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M) {
+  const int n = model.dof();
+  int massive = 0;
+  for (int i = 0; i < n; ++i) massive += !S::massless(model.bodies[i].inertia);
+  if (2 * massive <= n) return crbaSparseMass(model, data, M);
+  for (int i = 0; i < n; ++i) data.Ic_rb[i] = S::compact(model.bodies[i].inertia);
   // Composite inertias, leaves to root: Ic_p += X^T Ic_i X.
   for (int i = n - 1; i >= 0; --i) {
     const int p = model.bodies[i].parent;
-    if (p >= 0) data.Ic[p] += S::inertiaInParent(data.X_up[i], data.Ic[i]);
+    if (p >= 0) data.Ic_rb[p] += S::inertiaInParent(data.X_up[i], data.Ic_rb[i]);
   }
-  MatN M = MatN::Zero(n, n);
+  M.setZero();
   for (int i = 0; i < n; ++i) {
-    typename S::Vec F = S::inertiaTimes(data.Ic[i], data.S_i[i]);
+    typename S::Vec F = S::inertiaTimes(data.Ic_rb[i], data.S_i[i]);
     M(i, i) = S::dot(data.S_i[i], F);
     // Carry the composite force up the ancestors: M_ij = S_j · F.
     for (int j = i; model.bodies[j].parent >= 0;) {
@@ -103,6 +131,12 @@ MatN crba(const TreeModel<S>& model, TreeData<S>& data) {
       M(i, j) = M(j, i) = S::dot(data.S_i[j], F);
     }
   }
+}
+
+template <class S>
+MatN crba(const TreeModel<S>& model, TreeData<S>& data) {
+  MatN M(model.dof(), model.dof());
+  crba(model, data, M);
   return M;
 }
 
@@ -233,6 +267,7 @@ double springEnergy(const VecN& k, const VecN& q) {
   template void velocityKinematics<S>(const TreeModel<S>&, const VecN&, TreeData<S>&);            \
   template VecN rnea<S>(const TreeModel<S>&, TreeData<S>&, const VecN&, const VecN&, bool);       \
   template MatN crba<S>(const TreeModel<S>&, TreeData<S>&);                                       \
+  template void crba<S>(const TreeModel<S>&, TreeData<S>&, Eigen::Ref<Eigen::MatrixXd>);          \
   template VecN aba<S>(const TreeModel<S>&, TreeData<S>&, const VecN&, const VecN&);              \
   template void pointJacobian<S>(const TreeModel<S>&, const TreeData<S>&, int, const S::Pos&,     \
                                  MatN&, VecN&);                                                   \

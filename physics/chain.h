@@ -37,7 +37,9 @@ struct TreeModel {
   int dof() const { return int(bodies.size()); }
   int addBody(int parent, JointType joint, const typename S::Axis& axis,
               const typename S::Transform& X_tree, const Mat& inertia) {
-    bodies.push_back({parent, joint, axis, X_tree, inertia});
+    // Spatial: a unit axis, and placements that do not turn marked so (spatial.h: E is skipped there).
+    if constexpr (S::kDim == 6) bodies.push_back({parent, joint, axis.normalized(), S::marked(X_tree), inertia});
+    else bodies.push_back({parent, joint, axis, X_tree, inertia});
     return int(bodies.size()) - 1;
   }
   Vec motionSubspace(int i) const;
@@ -50,7 +52,8 @@ struct TreeData {
   std::vector<typename S::Transform> X_world;  // world → body i
   std::vector<Vec> S_i, v, c;                  // joint axis, body velocity, velocity-product accel
   std::vector<Vec> a, f;                       // scratch for rnea
-  std::vector<typename S::Mat> Ic;             // scratch for crba / aba
+  std::vector<typename S::Mat> Ic;             // scratch for aba
+  std::vector<typename S::Inertia> Ic_rb;      // scratch for crba (composite rigid-body inertias)
   std::vector<Vec> U, pA;                      // scratch for aba
   std::vector<double> D, u;
   explicit TreeData(const TreeModel<S>& model) { resize(model.dof()); }
@@ -73,7 +76,9 @@ template <class S>
 VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const VecN& qdd,
           bool with_gravity = true);
 
-// Joint-space inertia M(θ), symmetric positive definite.
+// Joint-space inertia M(θ), symmetric positive definite (into M, sized n × n by the caller, or returned).
+template <class S>
+void crba(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M);
 template <class S>
 MatN crba(const TreeModel<S>& model, TreeData<S>& data);
 

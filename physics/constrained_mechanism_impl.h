@@ -63,7 +63,8 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::positionStage(const VecN& q) {
   positionKinematics(model_.tree, q.head(nn), data_);
   tree_q_ = q.head(nn);
   have_tree_ = true;
-  problem_.M = crba(model_.tree, data_);
+  problem_.M.resize(nn, nn);
+  crba(model_.tree, data_, problem_.M);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
   if constexpr (S::kDim == 3)
     for (int i = 0; i < nn; ++i) {

@@ -9,6 +9,11 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+// The spatial operations the tree algorithms call in their inner loops: inlined always, so their
+// 6-vectors stay in registers (a call returns them through memory, stored 8 bytes at a time and
+// reloaded 16 at a time: a store-forwarding stall that was a third of CRBA).
+#define DYN_INLINE __attribute__((always_inline)) inline
+
 namespace dyn {
 
 // ---------------------------------------------------------------- planar: 3-vectors
@@ -100,6 +105,9 @@ struct Planar {
         gy, 0, m;
     return out;
   }
+  // CRBA's composite inertias: planar ones are already compact.
+  using Inertia = Mat;
+  static const Mat& compact(const Mat& I) { return I; }
   // Rigid-body inertia at the body origin: mass m, centre of mass c, inertia Ic about c.
   static Mat inertia(double m, const Pos& c, double Ic) {
     Mat I;
@@ -124,6 +132,8 @@ struct Planar {
     return {X0.r.x() + w.x(), X0.r.y() + w.y()};
   }
   // Mass and centre of mass back out of a body inertia.
+  // Zero inertia (a rigid-body inertia is positive semi-definite: zero mass and diagonal make it zero).
+  static bool massless(const Mat& I) { return I(1, 1) == 0 && I(0, 0) == 0; }
   static void massAndCom(const Mat& I, double& m, Pos& c) {
     m = I(1, 1);
     c = m > 0 ? Pos(I(0, 2) / m, -I(0, 1) / m) : Pos::Zero();
@@ -140,10 +150,15 @@ struct Spatial {
   using Pos = Eigen::Vector3d;
   using Axis = Eigen::Vector3d;
 
+  // `turned` is false when E is exactly the identity (a pure translation: prismatic joints, most
+  // placements), so the operations below skip their rotations; {E, r} leaves it true, always safe.
   struct Transform {
     Rot E = Rot::Identity();
     Pos r = Pos::Zero();
+    bool turned = true;
   };
+  // The same transform, marked unturned when E is exactly the identity.
+  static Transform marked(const Transform& X) { return {X.E, X.r, X.E != Rot::Identity()}; }
 
   static double dot(const Vec& a, const Vec& b) { return a.dot(b); }
   static Eigen::Matrix3d skew(const Pos& p) {
@@ -151,21 +166,24 @@ struct Spatial {
     s << 0, -p.z(), p.y(), p.z(), 0, -p.x(), -p.y(), p.x(), 0;
     return s;
   }
-  static Vec motion(const Transform& X, const Vec& v) {
+  DYN_INLINE static Vec motion(const Transform& X, const Vec& v) {
     Vec out;
-    out << X.E * v.head<3>(), X.E * (v.tail<3>() - X.r.cross(v.head<3>()));
+    if (!X.turned) out << v.head<3>(), v.tail<3>() - X.r.cross(v.head<3>());
+    else out << X.E * v.head<3>(), X.E * (v.tail<3>() - X.r.cross(v.head<3>()));
     return out;
   }
-  static Vec motionInverse(const Transform& X, const Vec& v) {
-    const Pos w = X.E.transpose() * v.head<3>();
+  DYN_INLINE static Vec motionInverse(const Transform& X, const Vec& v) {
+    const Pos w = X.turned ? Pos(X.E.transpose() * v.head<3>()) : Pos(v.head<3>());
     Vec out;
-    out << w, X.E.transpose() * v.tail<3>() + X.r.cross(w);
+    if (!X.turned) out << w, v.tail<3>() + X.r.cross(w);
+    else out << w, X.E.transpose() * v.tail<3>() + X.r.cross(w);
     return out;
   }
-  static Vec forceTranspose(const Transform& X, const Vec& f) {
-    const Pos fa = X.E.transpose() * f.tail<3>();
+  DYN_INLINE static Vec forceTranspose(const Transform& X, const Vec& f) {
+    const Pos fa = X.turned ? Pos(X.E.transpose() * f.tail<3>()) : Pos(f.tail<3>());
     Vec out;
-    out << X.E.transpose() * f.head<3>() + X.r.cross(fa), fa;
+    if (!X.turned) out << f.head<3>() + X.r.cross(fa), fa;
+    else out << X.E.transpose() * f.head<3>() + X.r.cross(fa), fa;
     return out;
   }
   static Mat motionMatrix(const Transform& X) {
@@ -175,34 +193,65 @@ struct Spatial {
     m.block<3, 3>(3, 3) = X.E;
     return m;
   }
-  static Transform compose(const Transform& bc, const Transform& ab) {
-    return {bc.E * ab.E, ab.r + ab.E.transpose() * bc.r};
+  DYN_INLINE static Transform compose(const Transform& bc, const Transform& ab) {
+    if (!ab.turned) return {bc.E, ab.r + bc.r, bc.turned};
+    if (!bc.turned) return {ab.E, ab.r + ab.E.transpose() * bc.r, true};
+    return {bc.E * ab.E, ab.r + ab.E.transpose() * bc.r, true};
   }
-  static Transform inverse(const Transform& X) { return {X.E.transpose(), -X.E * X.r}; }
-  static Transform translation(const Pos& p) { return {Rot::Identity(), p}; }
+  static Transform inverse(const Transform& X) { return {X.E.transpose(), -X.E * X.r, X.turned}; }
+  static Transform translation(const Pos& p) { return {Rot::Identity(), p, false}; }
 
-  static Vec crossMotion(const Vec& v, const Vec& m) {
+  DYN_INLINE static Vec crossMotion(const Vec& v, const Vec& m) {
     Vec out;
     out << v.head<3>().cross(m.head<3>()),
         v.head<3>().cross(m.tail<3>()) + v.tail<3>().cross(m.head<3>());
     return out;
   }
-  static Vec crossForce(const Vec& v, const Vec& f) {
+  DYN_INLINE static Vec crossForce(const Vec& v, const Vec& f) {
     Vec out;
     out << v.head<3>().cross(f.head<3>()) + v.tail<3>().cross(f.tail<3>()),
         v.head<3>().cross(f.tail<3>());
     return out;
   }
-  static Vec inertiaTimes(const Mat& I, const Vec& v) { return I * v; }
+  DYN_INLINE static Vec inertiaTimes(const Mat& I, const Vec& v) { return I * v; }
   // Xᵀ I X: a rigid-body inertia given in frame B, in frame A. Not as two 6×6 products: the body's
   // mass, centre c and inertia about it, moved (c → r + Eᵀc) and turned (I_c → Eᵀ I_c E).
-  static Mat inertiaInParent(const Transform& X, const Mat& I) {
-    double m;
-    Pos c;
-    massAndCom(I, m, c);
-    const Eigen::Matrix3d C = skew(c);
-    const Eigen::Matrix3d Ic = I.block<3, 3>(0, 0) - m * C * C.transpose();
-    return inertia(m, X.r + X.E.transpose() * c, X.E.transpose() * Ic * X.E);
+  // A rigid-body inertia in its 13 numbers, for the composite inertias of CRBA: the blocks of
+  // I = [[I_O, [h]×], [[h]×ᵀ, m 1]] (I_O about the frame's origin, h = m c).
+  struct Inertia {
+    double m = 0;
+    Pos h = Pos::Zero();
+    Eigen::Matrix3d Io = Eigen::Matrix3d::Zero();
+    Inertia& operator+=(const Inertia& o) {
+      m += o.m;
+      h += o.h;
+      Io += o.Io;
+      return *this;
+    }
+  };
+  static Inertia compact(const Mat& I) { return {I(5, 5), Pos(I(2, 4), I(0, 5), I(1, 3)), I.block<3, 3>(0, 0)}; }
+  // I v = (I_O ω + h × v, m v − h × ω).
+  DYN_INLINE static Vec inertiaTimes(const Inertia& I, const Vec& v) {
+    const Pos w = v.head<3>(), u = v.tail<3>();
+    Vec out;
+    out << I.Io * w + I.h.cross(u), I.m * u - I.h.cross(w);
+    return out;
+  }
+  // Xᵀ I X: turn about the origin (I_O → Eᵀ I_O E, h → Eᵀ h), then move the origin by −r (parallel
+  // axes, no division, so massless bodies pass):
+  //   I_O → I_O + m(|r|² 1 − r rᵀ) + 2 (r·h) 1 − r hᵀ − h rᵀ,   h → h + m r.
+  DYN_INLINE static Inertia inertiaInParent(const Transform& X, const Inertia& I) {
+    Inertia out = I;
+    if (X.turned) {
+      out.Io = X.E.transpose() * I.Io * X.E;
+      out.h = X.E.transpose() * I.h;
+    }
+    const Pos& r = X.r;
+    const double rh = r.dot(out.h), rr = r.dot(r);
+    out.Io.noalias() -= out.m * r * r.transpose() + r * out.h.transpose() + out.h * r.transpose();
+    out.Io.diagonal().array() += out.m * rr + 2.0 * rh;
+    out.h += out.m * r;
+    return out;
   }
   static Mat inertia(double m, const Pos& c, const Eigen::Matrix3d& Ic) {
     const Eigen::Matrix3d C = skew(c);
@@ -210,26 +259,32 @@ struct Spatial {
     I << Ic + m * C * C.transpose(), m * C, m * C.transpose(), m * Eigen::Matrix3d::Identity();
     return I;
   }
+  // Joints: the axis a is a unit vector (TreeModel::addBody normalises it).
   static Vec revoluteAxis(const Axis& a) {
     Vec s;
-    s << a.normalized(), Pos::Zero();
+    s << a, Pos::Zero();
     return s;
   }
   static Vec prismaticAxis(const Axis& a) {
     Vec s;
-    s << Pos::Zero(), a.normalized();
+    s << Pos::Zero(), a;
     return s;
   }
-  static Transform jointTransform(bool revolute, const Axis& axis, double q) {
-    if (revolute) return {Eigen::AngleAxisd(q, axis.normalized()).toRotationMatrix().transpose(), Pos::Zero()};
-    return {Rot::Identity(), axis.normalized() * q};
+  // Revolute: E = R(a, q)ᵀ = c 1 + (1 − c) a aᵀ − s [a]× (Rodrigues, transposed); prismatic: r = a q.
+  static Transform jointTransform(bool revolute, const Axis& a, double q) {
+    if (!revolute) return {Rot::Identity(), a * q, false};
+    const double c = std::cos(q), s = std::sin(q);
+    Rot E = (1.0 - c) * a * a.transpose() - s * skew(a);
+    E.diagonal().array() += c;
+    return {E, Pos::Zero(), true};
   }
-  static Vec classicalAcceleration(const Vec& a, const Vec& v) {
+  DYN_INLINE static Vec classicalAcceleration(const Vec& a, const Vec& v) {
     Vec out;
     out << a.head<3>(), a.tail<3>() + v.head<3>().cross(v.tail<3>());
     return out;
   }
-  static Pos worldPoint(const Transform& X0, const Pos& p) { return X0.r + X0.E.transpose() * p; }
+  DYN_INLINE static Pos worldPoint(const Transform& X0, const Pos& p) { return X0.r + X0.E.transpose() * p; }
+  static bool massless(const Mat& I) { return I(5, 5) == 0 && I(0, 0) == 0 && I(1, 1) == 0 && I(2, 2) == 0; }
   static void massAndCom(const Mat& I, double& m, Pos& c) {
     m = I(5, 5);
     const Eigen::Matrix3d mC = I.block<3, 3>(0, 3);

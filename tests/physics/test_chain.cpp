@@ -150,3 +150,34 @@ TEST_CASE("joint springs: K is tridiagonal and K θ is the gradient of P_K") {
     CHECK(springTorque(k, q)[i] == doctest::Approx(grad).epsilon(1e-8));
   }
 }
+
+TEST_CASE("CRBA with massless carriers (the Σ Jᵀ I J form) equals RNEA columns") {
+  // Three prismatic carriers (one placement turned), a heading joint, and two massive leaves on a
+  // branch: 2 of 6 bodies carry mass, so crba takes its sparse-mass route.
+  using Pos = Spatial::Pos;
+  TreeModel<Spatial> t;
+  t.gravity << 0, 0, 0, 0, 0, -9.81;
+  const Spatial::Mat none = Spatial::Mat::Zero();
+  const Spatial::Transform turned{Eigen::AngleAxisd(0.4, Pos(1, 2, 3).normalized()).toRotationMatrix(), Pos(0.1, -0.2, 0.3)};
+  int b = t.addBody(-1, JointType::Prismatic, Pos::UnitX(), Spatial::Transform(), none);
+  b = t.addBody(b, JointType::Prismatic, Pos(0, 1, 1), turned, none);
+  b = t.addBody(b, JointType::Prismatic, Pos::UnitZ(), Spatial::Transform(), none);
+  const int hub = t.addBody(b, JointType::Revolute, Pos::UnitZ(), Spatial::Transform(), none);
+  const Eigen::Matrix3d Ic = (Eigen::Matrix3d() << 0.02, 0.003, -0.001, 0.003, 0.01, 0.002, -0.001, 0.002, 0.015).finished();
+  t.addBody(hub, JointType::Revolute, Pos::UnitY(), turned, Spatial::inertia(2.0, Pos(0.05, 0.01, -0.02), Ic));
+  t.addBody(hub, JointType::Revolute, Pos(1, 0, 1), Spatial::Transform(), Spatial::inertia(0.7, Pos(0.2, 0, 0.1), 0.5 * Ic));
+  TreeData<Spatial> data(t);
+  const int n = t.dof();
+  VecN q(n);
+  q << 0.3, -0.7, 1.1, 0.5, -1.2, 2.0;
+  forwardKinematics(t, q, VecN::Zero(n), data);
+  const MatN M = crba(t, data);
+  const VecN g = rnea(t, data, VecN::Zero(n), VecN::Zero(n));
+  for (int j = 0; j < n; ++j) {
+    const VecN col = rnea(t, data, VecN::Zero(n), VecN::Unit(n, j)) - g;
+    CHECK((col - M.col(j)).norm() < 1e-12);
+  }
+  CHECK((M - M.transpose()).norm() == 0.0);
+  // The two leaves are on separate branches: no inertia couples them.
+  CHECK(M(4, 5) == 0.0);
+}
