@@ -40,6 +40,8 @@ class HandEngine final : public MechanismEngine {
       : mech_(mech), options_(options), q_(std::move(q0)), v_(std::move(v0)), forces_(mech.model().constraints.size()) {}
   void state(VecN& q, VecN& v) const override { q = q_, v = v_; }
   bool step(const VecN& tau, bool with_forces) override {
+    // Unilateral contacts close (with an impact on v) or open between steps.
+    mech_.updateContacts(q_, v_, tau);
     // The constraint forces at the step's start: the solve the first RK4 stage reuses.
     if (with_forces) {
       const auto sol = mech_.solve(q_, v_, tau);

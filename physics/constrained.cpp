@@ -48,6 +48,7 @@ ConstrainedSolution solveConstrainedBlockLU(const ConstrainedProblem& p) {
   K.topRightCorner(k, r) = -HA.transpose();
   K.bottomLeftCorner(r, k) = HA;
   K.bottomRightCorner(r, r) = Lambda;
+  if (p.compliance.size()) K.bottomRightCorner(r, r).diagonal() += p.compliance;
   b.head(k) = p.bc_Gc.size() ? VecN(-p.bc_Gc) : VecN(VecN::Zero(k));
   b.tail(r) = rhs_eta;
   const Eigen::FullPivLU<MatN> lu(K);

@@ -42,6 +42,9 @@ struct ConstrainedProblemT {
   VecN Hdot_w;
   // Drift stabilisation s (m), e.g. Baumgarte −2ζω ψ' − ω² φ; empty: none.
   VecN stab;
+  // Compliance C (r, per η row) added to Λ's diagonal: Λ η + Ã α_c = r becomes (Λ + C) η + ...; empty:
+  // none. A released row (an open unilateral contact: its J, A and bias rows zero) has C = 1, so η = 0.
+  VecN compliance;
 };
 
 template <int Nj, int Nr, int Nl>

@@ -63,6 +63,16 @@ class ConstrainedMechanism : public ConstrainedSystem {
   double energy(const VecN& q, const VecN& v);
   double kineticEnergy(const VecN& q, const VecN& v);
   double potentialEnergy(const VecN& q);
+  // Unilateral contacts (Constraint::unilateral), between steps: closes every open rigid contact that
+  // has reached its plane moving into it, with a plastic impact (v projected onto the closed rows: eq.
+  // (2) for impulses), then opens closed ones whose solved η would pull, one at a time (most negative
+  // first), until every closed one presses. Returns how many changed; v changes only on impact.
+  int updateContacts(const VecN& q, VecN& v, const VecN& tau);
+  // False while constraint i's rows are released (an open unilateral or a compliant contact).
+  bool closed(int i) const { return !released_[std::size_t(i)]; }
+  // Close or open a unilateral constraint by hand (initial conditions, tests).
+  void setClosed(int i, bool closed);
+
   // |φ|∞ over every holonomic constraint (velocity-level kinds: |J θ' − A v_c|∞ needs v: residual(q, v)).
   double residual(const VecN& q);
   double residual(const VecN& q, const VecN& v);
@@ -89,6 +99,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // The tree's transforms alone at θ (controller queries), cached like the position stage.
   void treeStage(const VecN& q);
   Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab);
+  // Forget every cached stage (the released rows changed).
+  void invalidate() { have_position_ = have_last_ = false; }
 
   MechanismModel<S> model_;
   int rows_ = 0;
@@ -108,6 +120,14 @@ class ConstrainedMechanism : public ConstrainedSystem {
   VecN last_q_, last_v_, last_tau_;
   Solution last_;
   bool have_last_ = false;
+  // Unilateral and compliant kinds: which constraints are released, their rows before the release
+  // (φ, J, A: gaps and compliant forces read them), and the compliant forces of the velocity stage.
+  std::vector<char> released_;
+  bool any_released_kind_ = false;
+  VecN phi_full_;
+  MatN J_full_, A_full_;
+  VecN compliant_eta_;   // per row: the compliant force η (0 elsewhere)
+  VecN compliant_bc_;    // payload side: −Aᵀ η of the compliant rows
 };
 
 }  // namespace dyn

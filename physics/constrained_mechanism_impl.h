@@ -18,6 +18,10 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
   for (const auto& c : model_.constraints) {
     offsets_.push_back(rows_);
     rows_ += c->rows();
+    // Rigid unilateral contacts start open (updateContacts closes them); compliant ones never close.
+    const bool released = c->unilateral() || c->compliant();
+    released_.push_back(char(released));
+    any_released_kind_ = any_released_kind_ || released;
   }
   auto fits = [](int fixed, int actual) { return fixed == Eigen::Dynamic || fixed == actual; };
   if (!fits(Nj, n()) || !fits(Nr, rows_) || !fits(Nl, k()))
@@ -82,6 +86,21 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::positionStage(const VecN& q) {
   // Every constraint's φ, J and A rows, then eq. (2) factored at this configuration.
   MatN J = MatN::Zero(rows_, nn), A = MatN::Zero(rows_, kk);
   for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->position(kin_, offsets_[i], phi_, J, A);
+  // Released rows (open or compliant contacts) are kept aside and zeroed: with compliance 1, η = 0.
+  if (any_released_kind_) {
+    phi_full_ = phi_;
+    J_full_ = J;
+    A_full_ = A;
+    problem_.compliance.setZero(rows_);
+    for (std::size_t i = 0; i < model_.constraints.size(); ++i)
+      if (released_[i])
+        for (int r = offsets_[i]; r < offsets_[i] + model_.constraints[i]->rows(); ++r) {
+          phi_[r] = 0.0;
+          J.row(r).setZero();
+          A.row(r).setZero();
+          problem_.compliance[r] = 1.0;
+        }
+  }
   problem_.J = J;
   problem_.A = A;
   factored_ = factor_.factor(problem_, problem_.J, problem_.A);
@@ -123,6 +142,23 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   // J'θ' − A'v_c of every constraint.
   VecN bias(rows_);
   for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->bias(kin_, offsets_[i], bias);
+  // Released rows: no bias; a compliant contact's force enters as −Jᵀη on the tree (h += Jᵀη) and
+  // Aᵀη on the payloads.
+  if (any_released_kind_) {
+    compliant_eta_.setZero(rows_);
+    compliant_bc_.setZero(k());
+    for (std::size_t i = 0; i < model_.constraints.size(); ++i) {
+      if (!released_[i]) continue;
+      const auto& c = *model_.constraints[i];
+      for (int r = offsets_[i]; r < offsets_[i] + c.rows(); ++r) bias[r] = 0.0;
+      if (!c.compliant()) continue;
+      const int r = offsets_[i];
+      const double eta = c.compliantForce(kin_);
+      compliant_eta_[r] = eta;
+      problem_.h += eta * J_full_.row(r).transpose();
+      if (k()) compliant_bc_ -= eta * A_full_.row(r).transpose();
+    }
+  }
   problem_.Jdot_qd = bias;
 }
 
@@ -144,12 +180,67 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
   problem_.tau = tau.head(n());
   if (tau.size() == n() + k()) problem_.bc_Gc = gravity_bc_ - tau.tail(k());
   else problem_.bc_Gc = gravity_bc_;
+  if (any_released_kind_ && k()) problem_.bc_Gc += compliant_bc_;
   if (stab) problem_.stab = *stab;
   else problem_.stab.resize(0);
-  if (!factored_) return solveConstrainedBlockLU(problem_);
   Solution s;
-  factor_.solve(problem_, s);
+  if (!factored_) s = solveConstrainedBlockLU(problem_);
+  else factor_.solve(problem_, s);
+  // A compliant contact's η is its force, not the solve's (its row is released).
+  if (any_released_kind_)
+    for (std::size_t i = 0; i < model_.constraints.size(); ++i)
+      if (model_.constraints[i]->compliant()) {
+        const int r = offsets_[i];
+        s.eta[r] = compliant_eta_[r];
+        if (problem_.Ht.size() == 0) s.f[r] = compliant_eta_[r];
+      }
   return s;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::setClosed(int i, bool closed) {
+  const auto& c = *model_.constraints[std::size_t(i)];
+  if (!c.unilateral() || c.compliant())
+    throw std::invalid_argument("ConstrainedMechanism::setClosed: constraint " + std::to_string(i) + " is not a rigid unilateral contact");
+  released_[std::size_t(i)] = char(!closed);
+  invalidate();
+}
+
+template <class S, int Nj, int Nr, int Nl>
+int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, const VecN& tau) {
+  if (!any_released_kind_) return 0;
+  const std::size_t count = model_.constraints.size();
+  auto rigid = [&](std::size_t i) { return model_.constraints[i]->unilateral() && !model_.constraints[i]->compliant(); };
+  // Touchdown: an open contact at or past its plane (φ = −gap ≥ 0) not moving away (−gap' ≥ 0).
+  positionStage(q);
+  int changes = 0;
+  for (std::size_t i = 0; i < count; ++i) {
+    if (!rigid(i) || !released_[i]) continue;
+    const int r = offsets_[i];
+    const double approach = J_full_.row(r).dot(v.head(n())) - (k() ? A_full_.row(r).dot(v.tail(k())) : 0.0);
+    if (phi_full_[r] >= 0.0 && approach >= 0.0) {
+      released_[i] = 0;
+      ++changes;
+    }
+  }
+  // The plastic impact: the least-kinetic-energy velocity that satisfies every closed row.
+  if (changes) {
+    invalidate();
+    projectVelocities(*this, q, v);
+  }
+  // Lift-off: while a closed contact's η would pull, open the one pulling most and solve again.
+  for (std::size_t pass = 0; pass < count; ++pass) {
+    const Solution s = solve(q, v, tau);
+    std::size_t worst = count;
+    double most = 0.0;
+    for (std::size_t i = 0; i < count; ++i)
+      if (rigid(i) && !released_[i] && s.eta[offsets_[i]] < most) most = s.eta[offsets_[i]], worst = i;
+    if (worst == count) break;
+    released_[worst] = 1;
+    invalidate();
+    ++changes;
+  }
+  return changes;
 }
 
 template <class S, int Nj, int Nr, int Nl>

@@ -38,6 +38,8 @@ class ConstrainedFactorT {
     chol_M_.forward(Y_);
     MatRC<Nr, Nr> Lambda(m, m);
     chol_M_.inner(Y_, m, Lambda);
+    if (p.compliance.size())
+      for (int i = 0; i < m; ++i) Lambda(i, i) += p.compliance[i];
     if (!chol_L_.compute(Lambda, m)) return false;
     // Λ⁻¹ Ã, and the Schur complement S = M_c + Ãᵀ Λ⁻¹ Ã.
     A_.resize(m, k);
@@ -120,7 +122,7 @@ ConstrainedSolutionT<Nj, Nr, Nl> solveConstrainedBlockLU(const ConstrainedProble
   if constexpr (Nj == Eigen::Dynamic && Nr == Eigen::Dynamic && Nl == Eigen::Dynamic) {
     return solveConstrainedBlockLU(p);
   } else {
-    const ConstrainedProblem d{p.M, p.h, p.tau, p.J, p.Jdot_qd, p.A, p.Adot_vc, p.Mc, p.bc_Gc, p.Ht, p.Hdot_w, p.stab};
+    const ConstrainedProblem d{p.M, p.h, p.tau, p.J, p.Jdot_qd, p.A, p.Adot_vc, p.Mc, p.bc_Gc, p.Ht, p.Hdot_w, p.stab, p.compliance};
     const ConstrainedSolution x = solveConstrainedBlockLU(d);
     ConstrainedSolutionT<Nj, Nr, Nl> s;
     s.alpha_c = x.alpha_c;

@@ -1,0 +1,171 @@
+// The unilateral plane contact (physics/constraints/plane_contact.h) through the generic mechanism's
+// open/close handling (ConstrainedMechanism::updateContacts), against closed forms:
+//  * a ball dropped from H touches down at √(2H/g) (within a step), the plastic impact removes the
+//    normal velocity and keeps the tangential one (frictionless plane), then it rests with η = m g;
+//  * pulled up harder than its weight, the contact opens and the ball rises as ½ (F/m − g) t²;
+//  * a two-link arm resting its tip on the table presses with the η of its static balance, τ = G − Jᵀ f;
+//  * a compliant plane (k_e) holds the ball at depth m g / k_e, and without damping conserves energy.
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "physics/constrained_mechanism.h"
+#include "physics/constraints/plane_contact.h"
+
+using namespace dyn;
+
+namespace {
+
+using Pos = Planar::Pos;
+constexpr double kM = 0.5, kG = 9.81, kRho = 0.01, kI = 1e-4;
+
+// A ball on x and y carriers (planar, gravity −y) above the table y = 0: q = (x, y).
+MechanismModel<Planar> ball(const PlaneContactParams& p) {
+  MechanismModel<Planar> d;
+  d.tree.gravity << 0, 0, -kG;
+  const int bx = d.tree.addBody(-1, JointType::Prismatic, Pos(1, 0), Planar::Transform{}, Planar::Mat::Zero());
+  const int by = d.tree.addBody(bx, JointType::Prismatic, Pos(0, 1), Planar::Transform{}, Planar::inertia(kM, Pos::Zero(), kI));
+  d.constraints.push_back(std::make_shared<PlaneContact<Planar>>(BodyRef::link(by), Pos::Zero(), Pos(0, 1), p));
+  return d;
+}
+
+PlaneContactParams rigid() {
+  PlaneContactParams p;
+  p.radius = kRho;
+  return p;
+}
+
+struct Run {
+  ConstrainedMechanism<Planar> mech;
+  StepOptions options;
+  VecN q, v;
+  explicit Run(MechanismModel<Planar> d, Integrator integrator = Integrator::RK4) : mech(std::move(d)) {
+    options.dt = 1e-3;
+    options.integrator = integrator;
+    options.drift.kind = Drift::Projection;
+  }
+  // One step as the harness takes it: contacts first, then the integrator. Returns η at the step's start.
+  double step(const VecN& tau) {
+    mech.updateContacts(q, v, tau);
+    const double eta = mech.solve(q, v, tau).eta[0];
+    REQUIRE(dyn::step(mech, options, tau, q, v));
+    return eta;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("plane contact: a dropped ball touches down, stops its normal motion, and rests on its weight") {
+  const double H = 0.05, vx = 0.3;
+  Run run(ball(rigid()));
+  run.q = VecN(2);
+  run.v = VecN(2);
+  run.q << 0.0, kRho + H;
+  run.v << vx, 0.0;
+  const VecN tau = VecN::Zero(2);
+  double touchdown = -1, eta = 0;
+  for (int k = 0; k < 400; ++k) {
+    const bool was_closed = run.mech.closed(0);
+    eta = run.step(tau);
+    if (!was_closed && run.mech.closed(0) && touchdown < 0) touchdown = k * run.options.dt;
+    CHECK(eta >= 0.0);  // a closed contact never pulls
+  }
+  // Detected at the first step start at or below the plane: within one step after √(2H/g).
+  const double t_fall = std::sqrt(2 * H / kG);
+  CHECK(touchdown >= t_fall - 1e-12);
+  CHECK(touchdown <= t_fall + 1.5 * run.options.dt);
+  CHECK(run.mech.closed(0));
+  // Plastic and frictionless: no normal speed, the tangential speed kept, the gap closed.
+  CHECK(std::abs(run.v[1]) < 1e-12);
+  CHECK(std::abs(run.v[0] - vx) < 1e-12);
+  CHECK(std::abs(run.q[1] - kRho) < 1e-9);
+  CHECK(std::abs(eta - kM * kG) < 1e-9);
+}
+
+TEST_CASE("plane contact: pulled up harder than its weight the ball lifts off") {
+  Run run(ball(rigid()));
+  run.q = VecN(2);
+  run.v = VecN::Zero(2);
+  run.q << 0.0, kRho;
+  run.mech.setClosed(0, true);
+  VecN tau = VecN::Zero(2);
+  for (int k = 0; k < 50; ++k) run.step(tau);
+  CHECK(run.mech.closed(0));
+  CHECK(std::abs(run.q[1] - kRho) < 1e-12);
+  // A lift of 1.5 m g: the solve would need η < 0, so the contact opens at once.
+  const double F = 1.5 * kM * kG, T = 0.2;
+  tau[1] = F;
+  const double y0 = run.q[1];
+  const int steps = int(std::lround(T / run.options.dt));
+  for (int k = 0; k < steps; ++k) {
+    CHECK(run.step(tau) == 0.0);
+    CHECK(!run.mech.closed(0));
+  }
+  const double a = F / kM - kG;
+  CHECK(std::abs(run.q[1] - y0 - 0.5 * a * T * T) < 1e-9);
+}
+
+TEST_CASE("plane contact: a two-link arm resting its tip on the table presses with its static balance") {
+  // Links of length 0.4 and 0.3 from the origin, table y = −0.35 under the tip.
+  const double l1 = 0.4, l2 = 0.3, m1 = 1.2, m2 = 0.8;
+  MechanismModel<Planar> d;
+  d.tree.gravity << 0, 0, -kG;
+  const int b1 = d.tree.addBody(-1, JointType::Revolute, Pos(0, 0), Planar::Transform{}, Planar::inertia(m1, Pos(l1 / 2, 0), m1 * l1 * l1 / 12));
+  const int b2 = d.tree.addBody(b1, JointType::Revolute, Pos(0, 0), Planar::Transform{Planar::Rot::Identity(), Pos(l1, 0)},
+                                Planar::inertia(m2, Pos(l2 / 2, 0), m2 * l2 * l2 / 12));
+  PlaneContactParams p;
+  p.height = -0.35;
+  d.constraints.push_back(std::make_shared<PlaneContact<Planar>>(BodyRef::link(b2), Pos(l2, 0), Pos(0, 1), p));
+  Run run(std::move(d));
+  // A configuration with the tip on the table: θ1 = −0.5, θ2 from y_tip = −0.35.
+  const double th1 = -0.5, th2 = std::asin((-0.35 - l1 * std::sin(th1)) / l2) - th1;
+  run.q = VecN(2);
+  run.v = VecN::Zero(2);
+  run.q << th1, th2;
+  // Joint torques that hold the arm with a chosen downward tip force η_d: τ = G − Jᵀ (0, η_d).
+  const double eta_d = 3.0;
+  const VecN G = run.mech.gravityTorque(run.q);
+  MatN J;
+  VecN Jd;
+  run.mech.pointJacobian(b2, Pos(l2, 0), run.q, run.v, J, Jd);
+  const VecN tau = G - J.row(2).transpose() * eta_d;
+  double eta = 0;
+  for (int k = 0; k < 100; ++k) eta = run.step(tau);
+  CHECK(run.mech.closed(0));
+  CHECK(std::abs(eta - eta_d) < 1e-9);
+  CHECK(run.v.norm() < 1e-9);
+  // Less than gravity needs, and the arm lifts its tip: the contact opens.
+  for (int k = 0; k < 100; ++k) run.step(G - J.row(2).transpose() * (-1.0));
+  CHECK(!run.mech.closed(0));
+}
+
+TEST_CASE("plane contact: a compliant table holds the ball at m g / k_e and, undamped, conserves energy") {
+  PlaneContactParams p = rigid();
+  p.stiffness = 2e4;
+  SUBCASE("damped: rests at the static depth") {
+    p.damping = 2 * std::sqrt(p.stiffness * kM);  // critical
+    Run run(ball(p));
+    run.q = VecN(2);
+    run.v = VecN::Zero(2);
+    run.q << 0.0, kRho;
+    double eta = 0;
+    for (int k = 0; k < 500; ++k) eta = run.step(VecN::Zero(2));
+    CHECK(std::abs(run.q[1] - (kRho - kM * kG / p.stiffness)) < 1e-9);
+    CHECK(std::abs(eta - kM * kG) < 1e-6);
+  }
+  SUBCASE("undamped: bounces elastically") {
+    Run run(ball(p));
+    run.options.dt = 2e-4;
+    run.q = VecN(2);
+    run.v = VecN::Zero(2);
+    run.q << 0.0, kRho + 0.02;
+    double max_h = 0;
+    for (int k = 0; k < 1500; ++k) {
+      run.step(VecN::Zero(2));
+      if (k > 500) max_h = std::max(max_h, run.q[1] - kRho);
+    }
+    // Off the table the energy is the ball's alone (the spring is slack): it comes back up to 2 cm.
+    CHECK(std::abs(max_h - 0.02) < 2e-4);
+    CHECK(run.q[1] > kRho - 0.01);
+  }
+}
