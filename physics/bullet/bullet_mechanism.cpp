@@ -227,8 +227,9 @@ struct BulletMechanism<Planar>::Impl {
     std::vector<btMultiBodyLinkCollider*> link_colliders;
     for (auto& c : colliders) link_colliders.push_back(c.get());
     balls.build(world, link_colliders, std::move(list), "BulletMechanism: ");
-    if (!contacts.empty())
-      plan.summary += ", " + std::to_string(contacts.size()) + " plane contact(s) as a sphere on a static plane";
+    if (!contacts.empty())  // before ", PGS n iterations"
+      plan.summary.insert(plan.summary.rfind(", PGS"),
+                          ", " + std::to_string(contacts.size()) + " plane contact(s) as a sphere on a static plane");
   }
 
   void readBullet() {

@@ -92,11 +92,13 @@ struct Arm {
   double gap(const VecN& q) const { return tipPosition(q).z() - params.radius - params.height; }
 };
 
-// A planar disk of mass m (inertia I) on carriers x, y (massless) and turning ψ, its centre the ball's;
-// q = (x, y, ψ). Gravity −y; the plane's normal n lies in the x–y plane.
+// A planar disk of mass m, inertia I, its centre the ball's. Either tree bodies — carriers x, y
+// (massless) and, if `spin`, a revolute turning it; q = (x, y[, ψ]) — or a payload free in (ψ, x, y);
+// q = (ψ, x, y). Gravity −y; the plane's normal lies in the x–y plane.
 struct Disk {
   using Pos = Planar::Pos;
-  double m = 0.5, I = 2e-4, g = 9.81;
+  double m = 0.5, I = 1e-4, g = 9.81;
+  bool spin = true, payload = false;
   Pos normal = Pos::UnitY();
   PlaneContactParams params;
 
@@ -104,13 +106,31 @@ struct Disk {
     MechanismModel<Planar> d;
     auto& t = d.tree;
     t.gravity << 0, 0, -g;
-    int b = t.addBody(-1, JointType::Prismatic, Pos::UnitX(), Planar::Transform(), Planar::Mat::Zero());
-    b = t.addBody(b, JointType::Prismatic, Pos::UnitY(), Planar::Transform(), Planar::Mat::Zero());
-    b = t.addBody(b, JointType::Revolute, Pos::Zero(), Planar::Transform(), Planar::inertia(m, Pos::Zero(), I));
-    d.constraints.push_back(std::make_shared<PlaneContact<Planar>>(BodyRef::link(b), Pos::Zero(), normal, params));
+    BodyRef ball;
+    if (payload) {
+      Payload p;
+      p.mass = m, p.inertia = I;
+      d.payloads.push_back(p);
+      ball = BodyRef::payload(0);
+    } else {
+      const Planar::Mat disk = Planar::inertia(m, Pos::Zero(), I);
+      int b = t.addBody(-1, JointType::Prismatic, Pos::UnitX(), Planar::Transform(), Planar::Mat::Zero());
+      b = t.addBody(b, JointType::Prismatic, Pos::UnitY(), Planar::Transform(), spin ? Planar::Mat::Zero() : disk);
+      if (spin) b = t.addBody(b, JointType::Revolute, Pos::Zero(), Planar::Transform(), disk);
+      ball = BodyRef::link(b);
+    }
+    d.constraints.push_back(std::make_shared<PlaneContact<Planar>>(ball, Pos::Zero(), normal, params));
     return d;
   }
-  double gap(const VecN& q) const { return normal.normalized().dot(Pos(q[0], q[1])) - params.radius - params.height; }
+  int dof() const { return payload ? 3 : spin ? 3 : 2; }
+  int x() const { return payload ? 1 : 0; }  // index of the centre's x in q (y follows)
+  VecN state(const Pos& c) const {
+    VecN q = VecN::Zero(dof());
+    q.segment<2>(x()) = c;
+    return q;
+  }
+  Pos centre(const VecN& q) const { return q.segment<2>(x()); }
+  double gap(const VecN& q) const { return normal.normalized().dot(centre(q)) - params.radius - params.height; }
 };
 
 }  // namespace dyn::bullet::test

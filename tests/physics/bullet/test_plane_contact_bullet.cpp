@@ -32,6 +32,7 @@
 
 #include "physics/bullet/bullet_mechanism.h"
 #include "tests/physics/bullet/plane_contact_description.h"
+#include "tests/physics/bullet/slider_crank_description.h"
 
 using namespace dyn;
 using dyn::bullet::BulletMechanism;
@@ -317,4 +318,181 @@ TEST_CASE("plane_contact, Bullet: the tip lifts off when the torques pull it up"
   REQUIRE(a_n > 0);
   CHECK(worst_eta == 0.0);
   CHECK(arm.gap(qb) == doctest::Approx(gap).epsilon(0.01));
+}
+
+TEST_CASE("plane_contact, Bullet: two balls on one link share the weight by the lever rule") {
+  // A bar on a z carrier (massless) pitching about y, centre of mass a from its middle, balls at both ends.
+  const double m = 1.2, L = 0.4, a = 0.05, g = 9.81;
+  MechanismModel<Spatial> d;
+  d.tree.gravity << 0, 0, 0, 0, 0, -g;
+  int b = d.tree.addBody(-1, JointType::Prismatic, Pos::UnitZ(), Spatial::Transform(), Spatial::Mat::Zero());
+  b = d.tree.addBody(b, JointType::Revolute, Pos::UnitY(), Spatial::Transform(),
+                     Spatial::inertia(m, Pos(a, 0, 0), Eigen::Vector3d(1e-4, m * L * L / 12, m * L * L / 12).asDiagonal()));
+  PlaneContactParams p;
+  p.radius = 0.01;
+  for (double end : {-L / 2, L / 2})
+    d.constraints.push_back(std::make_shared<PlaneContact<Spatial>>(BodyRef::link(b), Pos(end, 0, 0), Pos::UnitZ(), p));
+  const VecN q0 = (VecN(2) << p.radius, 0.0).finished();  // both balls touch z = 0
+  BulletMechanism<Spatial> bullet(d, 1e-3, q0, VecN::Zero(2));
+  VecN q, v;
+  for (int i = 0; i < 300; ++i) bullet.step(VecN::Zero(2));
+  bullet.state(q, v);
+  const double f1 = bullet.constraintForce(0)[5], f2 = bullet.constraintForce(1)[5];
+  MESSAGE(bullet.describe() << "\nleft − m g (L/2 − a)/L: " << f1 - m * g * (L / 2 - a) / L << ", right − m g (L/2 + a)/L: "
+                            << f2 - m * g * (L / 2 + a) / L << ", |q − q0| " << (q - q0).norm());
+  // The massless carrier's stand-in mass (1e-9 m, spatial_mechanism.cpp) adds its weight, 6e-9 N a ball.
+  CHECK(f1 == doctest::Approx(m * g * (L / 2 - a) / L).epsilon(1e-8));
+  CHECK(f2 == doctest::Approx(m * g * (L / 2 + a) / L).epsilon(1e-8));
+  CHECK((q - q0).norm() < 1e-12);
+}
+
+TEST_CASE("plane_contact, Bullet planar: a disk dropped on a floor, on a tilted wall, on a compliant floor") {
+  const double dt = 1e-3, H = 0.05, T = 0.5;
+  for (bool payload : {false, true}) {
+    t::Disk k;
+    k.payload = payload;
+    k.params.height = -0.1;
+    BulletMechanism<Planar> bullet(k.model(), dt, k.state({0.3, k.params.height + H}), VecN::Zero(3));
+    VecN q, v;
+    double touchdown = -1, after = 0, momentum = 0;
+    for (long i = 1; i <= std::lround(T / dt); ++i) {
+      bullet.step(VecN::Zero(3));
+      bullet.state(q, v);
+      const double eta = bullet.constraintForce(0).tail<2>().dot(k.normal);
+      if (touchdown >= 0) after = std::max({after, std::abs(k.gap(q)), v.norm()});
+      else if (eta > 0) touchdown = double(i) * dt;
+      momentum += eta * dt;
+    }
+    const double t_fall = std::sqrt(2 * H / k.g);
+    MESSAGE(std::string(payload ? "payload" : "tree") << " disk: " << bullet.describe() << "\ntouchdown " << touchdown << " (free fall "
+                                           << t_fall << "), worst |gap|, |v| after " << after << ", η " << bullet.constraintForce(0)[2]
+                                           << ", Σ η dt " << momentum << " (m g T " << k.m * k.g * T << ")");
+    CHECK(touchdown >= t_fall - 1e-12);
+    CHECK(touchdown <= t_fall + 2 * dt);
+    CHECK(after < 1e-12);
+    CHECK(bullet.constraintForce(0)[2] == doctest::Approx(k.m * k.g).epsilon(1e-9));
+    CHECK(momentum == doctest::Approx(k.m * k.g * T).epsilon(1e-9));
+  }
+  {  // a frictionless wall tilted by α: the disk slides down it as the discrete step predicts
+    const double alpha = 0.5, T2 = 0.3;
+    t::Disk k;
+    k.normal = {std::sin(alpha), std::cos(alpha)};
+    k.params.radius = 0.02;
+    const t::Disk::Pos c0 = (k.params.height + k.params.radius) * k.normal;
+    BulletMechanism<Planar> bullet(k.model(), dt, k.state(c0), VecN::Zero(3));
+    VecN q, v;
+    double worst = 0;
+    for (long i = 1; i <= std::lround(T2 / dt); ++i) {
+      bullet.step(VecN::Zero(3));
+      bullet.state(q, v);
+      worst = std::max(worst, std::abs(bullet.constraintForce(0).tail<2>().dot(k.normal) - k.m * k.g * std::cos(alpha)));
+    }
+    const double s = (k.centre(q) - c0).dot(t::Disk::Pos(std::cos(alpha), -std::sin(alpha)));
+    const double s_step = 0.5 * k.g * std::sin(alpha) * T2 * (T2 + dt);
+    MESSAGE("tilted wall: slid " << s << " (discrete " << s_step << "), worst |η − m g cos α| " << worst << ", gap " << k.gap(q));
+    CHECK(s == doctest::Approx(s_step).epsilon(1e-9));
+    CHECK(worst < 1e-8);
+    CHECK(std::abs(k.gap(q)) < 1e-12);
+  }
+  {  // compliant floor, critically damped: resting depth m g / k_e
+    t::Disk k;
+    k.params.stiffness = 2e4;
+    k.params.damping = 2 * std::sqrt(k.params.stiffness * k.m);
+    BulletMechanism<Planar> bullet(k.model(), dt, k.state({0, 0}), VecN::Zero(3));
+    VecN q, v;
+    for (int i = 0; i < 1000; ++i) bullet.step(VecN::Zero(3));
+    bullet.state(q, v);
+    const double exact = k.m * k.g / k.params.stiffness;
+    MESSAGE("compliant floor: depth " << -k.gap(q) << " (m g / k_e " << exact << ")");
+    CHECK(-k.gap(q) == doctest::Approx(exact).epsilon(1e-9));
+  }
+}
+
+TEST_CASE("plane_contact, Bullet planar: friction rolls a pushed disk, or lets it skid") {
+  // Pushed at its centre by F, a disk of radius ρ rolls while F I/(I + m ρ²) ≤ μ m g: a = F/(m + I/ρ²),
+  // ω = −v/ρ; above, it skids: a = (F − μ m g)/m, and the friction μ m g spins it at μ m g ρ / I.
+  const double dt = 1e-3, T = 0.2;
+  t::Disk k;
+  k.params.radius = 0.02;
+  k.params.mu = 0.3;
+  k.I = 0.5 * k.m * k.params.radius * k.params.radius;
+  const double rho = k.params.radius, limit = k.params.mu * k.m * k.g, share = k.I / (k.I + k.m * rho * rho);
+  for (double ratio : {0.8, 1.5}) {
+    const double F = ratio * limit / share;
+    BulletMechanism<Planar> bullet(k.model(), dt, k.state({0, rho}), VecN::Zero(3));
+    VecN q, v;
+    for (long i = 1; i <= std::lround(T / dt); ++i) bullet.step((VecN(3) << F, 0, 0).finished());
+    bullet.state(q, v);
+    const bool rolls = ratio < 1;
+    const double a = rolls ? F / (k.m + k.I / (rho * rho)) : (F - limit) / k.m;
+    const double w = rolls ? -a * T / rho : -limit * rho / k.I * T;
+    const double f = rolls ? -F * share : -limit;
+    MESSAGE(std::string(rolls ? "rolls" : "skids") << ": v " << v[0] << " (" << a * T << "), ω " << v[2] << " (" << w << "), f_x "
+                                        << bullet.constraintForce(0)[1] << " (" << f << ")");
+    CHECK(v[0] == doctest::Approx(a * T).epsilon(1e-6));
+    CHECK(v[2] == doctest::Approx(w).epsilon(1e-6));
+    CHECK(bullet.constraintForce(0)[1] == doctest::Approx(f).epsilon(1e-6));
+  }
+}
+
+TEST_CASE("plane_contact, Bullet: descriptions it cannot model are refused naming what") {
+  t::Ball b;
+  auto m = b.model();
+  PlaneContactParams other;
+  other.height = 0.5;
+  m.constraints.push_back(std::make_shared<PlaneContact<Spatial>>(BodyRef::link(2), Pos::Zero(), Pos::UnitZ(), other));
+  std::string what;
+  try {
+    BulletMechanism<Spatial>(m, 1e-3, VecN::Zero(3), VecN::Zero(3));
+  } catch (const std::invalid_argument& e) {
+    what = e.what();
+  }
+  CHECK(what.find("carries balls against different planes") != std::string::npos);
+}
+
+TEST_CASE("plane_contact, Bullet planar: a contact inside a weld-made fixed joint's subtree (slider crank)") {
+  // Cut at joint 1, Bullet's tree is world → slider → (weld) link 3 → link 2 → link 1, and the weld's
+  // force is the Newton–Euler balance of links 1–3: a table under link 2 must enter it. The slider's own
+  // Newton equation (free x: m_s a_x = the weld's force on it) checks that balance independently.
+  t::SliderCrankModel p;
+  const double l[3] = {0.5, 0.4, 0.3}, mass[3] = {1.0, 0.8, 0.5};
+  for (int i = 0; i < 3; ++i) p.links[std::size_t(i)] = {l[i], mass[i], mass[i] * l[i] * l[i] / 12.0, Eigen::Vector2d(l[i] / 2, 0)};
+  p.load_mass = 0.5;
+  p.gravity = {0.0, -9.81};
+  const double t1 = kPi / 4, a12 = std::asin(-l[0] * std::sin(t1) / l[1]);
+  p.q0 = {t1, a12 - t1, -a12};
+  p.qd0.setZero();
+  VecN q0(4), v0 = VecN::Zero(4);
+  q0 << p.q0, t::sliderOf(p, p.q0, p.qd0)[0];
+  const double dt = 1e-3;
+  // Link 2's middle moves along u from rest: put a frictionless table across it, facing −u.
+  MechanismModel<Planar> d = t::sliderCrankDescription(p);
+  Planar::Pos u;
+  {
+    BulletMechanism<Planar> free(d, dt, q0, v0);
+    free.step(VecN::Zero(3));
+    VecN q, v;
+    free.state(q, v);
+    const double a1 = q0[0], a12_ = q0[0] + q0[1];
+    const Planar::Pos e1(-std::sin(a1), std::cos(a1)), e12(-std::sin(a12_), std::cos(a12_));
+    u = (l[0] * v[0] * e1 + l[1] / 2 * (v[0] + v[1]) * e12).normalized();  // velocity of link 2's middle
+  }
+  const Planar::Pos mid = l[0] * Planar::Pos(std::cos(q0[0]), std::sin(q0[0])) +
+                          l[1] / 2 * Planar::Pos(std::cos(q0[0] + q0[1]), std::sin(q0[0] + q0[1]));
+  PlaneContactParams table;
+  table.height = (-u).dot(mid);
+  d.constraints.push_back(std::make_shared<PlaneContact<Planar>>(BodyRef::link(1), Planar::Pos(l[1] / 2, 0), -u, table));
+  BulletMechanism<Planar> bullet(d, dt, q0, v0);
+  VecN q, v, v_prev = v0;
+  double worst = 0, eta_min = 1e9;
+  for (int i = 0; i < 100; ++i) {
+    bullet.step(VecN::Zero(3));
+    bullet.state(q, v);
+    worst = std::max(worst, std::abs(bullet.constraintForce(0)[1] - p.load_mass * (v[3] - v_prev[3]) / dt));
+    eta_min = std::min(eta_min, bullet.constraintForce(1).tail<2>().dot(-u));
+    v_prev = v;
+  }
+  MESSAGE(bullet.describe() << "\nthe table presses with η ≥ " << eta_min << " N; worst |f_weld,x − m_s a_x| " << worst << " N");
+  CHECK(eta_min > 0.1);
+  CHECK(worst < 1e-8);
 }
