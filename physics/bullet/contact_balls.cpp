@@ -42,6 +42,7 @@ void ContactBalls::build(BulletWorld& world, const std::vector<btMultiBodyLinkCo
     const double R = std::max(b.radius, kMinRadius);
     const double h = b.height - (R - b.radius);
     const bool compliant = b.stiffness > 0;
+    if (b.mu > 10.0) throw std::invalid_argument(who + "μ = " + std::to_string(b.mu) + " > 10: Bullet clips a contact's friction at 10");
     auto same = [&](const Plane& p) { return p.normal == b.normal && p.height == h && p.compliant == compliant; };
     auto it = std::find_if(planes.begin(), planes.end(), same);
     if (it == planes.end()) it = planes.insert(planes.end(), Plane{b.normal, h, compliant, group()});

@@ -7,24 +7,32 @@
 // (solid on the −n side). Only a ball's link and its plane collide: one collision group per ball link
 // and per plane, every other collider keeps mask 0 (shared/notes/bullet-reference.md, pitfall 1).
 //   friction     the link collider's friction is μ, the plane's 1: Bullet multiplies the two (and clips
-//                the product at 10); μ = 0 is frictionless. Two friction directions
+//                the product at 10: μ > 10 is refused); μ = 0 is frictionless. Two friction directions
 //                (SOLVER_USE_2_FRICTION_DIRECTIONS, else Bullet keeps one) clipped together to the cone
-//                |f_t| ≤ μ f_n.
+//                |f_t| ≤ μ f_n; a friction force acts at the sphere's lowest point.
 //   restitution  0 on both: a plastic touchdown.
 //   touchdown    Bullet's contacts are speculative: a ball closer than the breaking threshold gets a row
-//                that lets it reach the plane in the step and no further. The threshold is by default
-//                relative to the shape (≈ 3.5 % of a sphere's radius: 35 µm for 1 mm, less than one step
-//                of a falling ball), so a world with balls uses the absolute gContactBreakingThreshold
-//                (2 cm) instead: without it a small ball sinks up to |v| dt before Bullet sees the plane.
+//                that lets it reach the plane in the step and no further, so it lands exactly on the
+//                plane (gap 0 to rounding, no bounce) and the impact impulse m v is spread over two
+//                steps (the landing step takes m (v − δ/dt), δ the gap at its start; the next the rest):
+//                the force read as impulse / dt spikes for two steps, then is exact (weight to 1e-12).
+//                The threshold is by default relative to the shape (≈ 3.5 % of a sphere's radius: 35 µm
+//                for 1 mm, less than one step of a falling ball), so a world with balls uses the absolute
+//                gContactBreakingThreshold (2 cm) instead: without it a 1 mm ball dropped 5 cm sank
+//                0.3–0.7 mm before Bullet saw the plane and popped back out at 0.1 m/s.
 //   compliance   stiffness k > 0: the ball's collider gets setContactStiffnessAndDamping(k, d) and its
 //                plane (BT_LARGE_FLOAT, 0), so the pair's series stiffness is k and damping d (Bullet adds
-//                dampings; the default 0.1 of a plane is overridden). Bullet's multibody solver turns
-//                them into erp = dt k / (dt k + d), cfm = 1 / (dt (dt k + d)) on the normal row, whose
-//                resting solution is f_n = k · depth exactly (tests: m g / k to 1e-6). A rigid plane gets
-//                no such flag (Baumgarte erp2 on penetration, none happens after a speculative touchdown).
+//                dampings: a plane's default 0.1 is overridden). Bullet's multibody solver turns them
+//                into erp = dt k / (dt k + d), cfm = 1 / (dt (dt k + d)) on the normal row (λ ≥ 0): an
+//                implicit-Euler spring-damper acting only while the ball is below the plane. It rests
+//                at f_n = k · depth exactly (m g / k to 1e-14); moving, it is first order in dt and adds
+//                a numerical damping ratio ≈ ω dt / 2 (ω = √(k/m)): an undamped bounce decays by
+//                ≈ exp(−π ω dt) a period. A rigid plane gets no such flag (Baumgarte erp2 on
+//                penetration, and none happens after a speculative touchdown).
 //   radius       a ball of radius ρ < 1 mm is a 1 mm sphere about the same centre against the plane
 //                moved by (1 mm − ρ) along −n: the gap n·c − ρ − h is the same, the normal force's line
-//                through the centre is the same; only a friction force acts 1 mm − ρ lower.
+//                through the centre is the same; only a friction force acts 1 mm − ρ lower (its moment
+//                about c − ρ n is reported).
 // One link carries balls against one plane with one μ, stiffness, damping and radius (a collider has one
 // of each); more is refused (std::invalid_argument, "not yet").
 #pragma once

@@ -448,6 +448,14 @@ TEST_CASE("plane_contact, Bullet: descriptions it cannot model are refused namin
     what = e.what();
   }
   CHECK(what.find("carries balls against different planes") != std::string::npos);
+  b.params.mu = 12;
+  what.clear();
+  try {
+    BulletMechanism<Spatial>(b.model(), 1e-3, VecN::Zero(3), VecN::Zero(3));
+  } catch (const std::invalid_argument& e) {
+    what = e.what();
+  }
+  CHECK(what.find("> 10: Bullet clips") != std::string::npos);
 }
 
 TEST_CASE("plane_contact, Bullet planar: a contact inside a weld-made fixed joint's subtree (slider crank)") {
