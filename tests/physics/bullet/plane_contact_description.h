@@ -40,10 +40,14 @@ struct Ball {
 struct Arm {
   using Pos = Spatial::Pos;
   double h1 = 0.3, l2 = 0.3, l3 = 0.35, m1 = 2.0, m2 = 1.5, m3 = 1.0, g = 9.81;
+  double product = 0;          // products of inertia of link 3 (Bullet then turns its link onto principal axes)
   PlaneContactParams params;  // height: the table's z
 
-  static Spatial::Mat rod(double m, double l) {  // a thin rod along x from the joint, centre of mass at l/2
-    return Spatial::inertia(m, Pos(l / 2, 0, 0), Eigen::Vector3d(1e-4 * m, m * l * l / 12, m * l * l / 12).asDiagonal());
+  static Spatial::Mat rod(double m, double l, double p = 0) {  // a rod along x from the joint, centre of mass at l/2
+    Eigen::Matrix3d Ic = Eigen::Vector3d(1e-3 * m, m * l * l / 12, m * l * l / 12).asDiagonal();
+    Ic(0, 1) = Ic(1, 0) = p;
+    Ic(0, 2) = Ic(2, 0) = -p / 2;
+    return Spatial::inertia(m, Pos(l / 2, 0, 0), Ic);
   }
   MechanismModel<Spatial> model() const {
     MechanismModel<Spatial> d;
@@ -53,7 +57,7 @@ struct Arm {
         Spatial::inertia(m1, Pos(0, 0, h1 / 2), Eigen::Vector3d(m1 * h1 * h1 / 12, m1 * h1 * h1 / 12, 1e-3).asDiagonal());
     int b = t.addBody(-1, JointType::Revolute, Pos::UnitZ(), Spatial::Transform(), column);
     b = t.addBody(b, JointType::Revolute, Pos::UnitY(), Spatial::translation(Pos(0, 0, h1)), rod(m2, l2));
-    b = t.addBody(b, JointType::Revolute, Pos::UnitY(), Spatial::translation(Pos(l2, 0, 0)), rod(m3, l3));
+    b = t.addBody(b, JointType::Revolute, Pos::UnitY(), Spatial::translation(Pos(l2, 0, 0)), rod(m3, l3, product));
     d.constraints.push_back(std::make_shared<PlaneContact<Spatial>>(BodyRef::link(b), tip(), Pos::UnitZ(), params));
     return d;
   }

@@ -15,20 +15,23 @@
 //    (F − μ m g)/m with friction μ f_n;
 //  * the pen-on-table arm resting its tip: frictionless with τ = G − Jᵀ n η_d it stays and presses with
 //    η_d; with μ = 1 and τ = G/2 the pinned arm is a structure and the table's force is J_Pᵀ⁻¹ (G − τ)
-//    (J_P the Jacobian of the contact point, ρ below the tip: friction acts there); both to 1e-8;
+//    (J_P the Jacobian of the contact point, ρ below the tip: friction acts there); both to 1e-8, also
+//    with products of inertia on the tip link (Bullet turns it onto principal axes, the ball with it);
 //  * lift-off: torques that pull the tip up give η = 0 from the first step and a gap growing as the
 //    free arm's ½ a_n T (T + dt) (1 %);
 //  * two balls on one link share the weight by the lever rule; the planar builder: a disk (tree or
 //    payload) dropped on a floor, pressed on a tilted wall, held by friction and sinking into a
 //    compliant floor, and a contact inside the subtree of a weld-made fixed joint (slider crank): the
 //    weld's force still obeys the slider's Newton equation;
-//  * descriptions Bullet cannot model are refused naming what.
+//  * descriptions Bullet cannot model are refused naming what; runs are deterministic to the byte.
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <cstring>
 #include <functional>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "physics/bullet/bullet_mechanism.h"
 #include "tests/physics/bullet/plane_contact_description.h"
@@ -247,8 +250,10 @@ TEST_CASE("plane_contact, Bullet: arm resting its tip on the table") {
   const Eigen::Matrix3d J = arm.tipJacobian(q0);
   const VecN G = arm.gravityTorque(q0);
   const double dt = 1e-3, T = 0.5;
-  // Frictionless: τ = G − Jᵀ n η_d holds the arm still pressing with η_d.
-  {
+  // Frictionless: τ = G − Jᵀ n η_d holds the arm still pressing with η_d (also with products of inertia
+  // on link 3: its Bullet link is then turned onto principal axes, and the ball with it).
+  for (double product : {0.0, 2e-3}) {
+    arm.product = product;
     const double eta_d = 5.0;
     const VecN tau = G - J.transpose() * Pos::UnitZ() * eta_d;
     BulletMechanism<Spatial> bullet(arm.model(), dt, q0, VecN::Zero(3));
@@ -260,13 +265,14 @@ TEST_CASE("plane_contact, Bullet: arm resting its tip on the table") {
       worst_eta = std::max(worst_eta, std::abs(bullet.constraintForce(0)[5] - eta_d));
       worst_q = std::max(worst_q, (qb - q0).cwiseAbs().maxCoeff());
     }
-    MESSAGE("frictionless, τ = G − Jᵀ n η_d: worst |η − η_d| " << worst_eta << ", worst |θ − θ0| " << worst_q << ", gap " << arm.gap(qb)
+    MESSAGE("frictionless, products " << product << ", τ = G − Jᵀ n η_d: worst |η − η_d| " << worst_eta << ", worst |θ − θ0| " << worst_q << ", gap " << arm.gap(qb)
                                                            << ", f " << bullet.constraintForce(0).transpose());
     CHECK(worst_eta < 1e-8);
     CHECK(worst_q < 1e-9);
   }
   // With friction (μ = 1) and τ = G/2 the tip is pinned: the arm is a structure, f = J⁻ᵀ (G − τ).
   {
+    arm.product = 0;
     arm.params.mu = 1.0;
     const VecN tau = 0.5 * G;
     const Pos f = J.transpose().lu().solve(G - tau);
@@ -503,4 +509,30 @@ TEST_CASE("plane_contact, Bullet planar: a contact inside a weld-made fixed join
   MESSAGE(bullet.describe() << "\nthe table presses with η ≥ " << eta_min << " N; worst |f_weld,x − m_s a_x| " << worst << " N");
   CHECK(eta_min > 0.1);
   CHECK(worst < 1e-8);
+}
+
+TEST_CASE("plane_contact, Bullet: runs are deterministic (same input, same bytes)") {
+  auto run = [] {
+    t::Arm arm;
+    arm.params.mu = 0.4;
+    arm.params.stiffness = 2e4;
+    arm.params.damping = 50;
+    const VecN q0 = (VecN(3) << 0.4, 0.5, 0.9).finished();
+    arm.params.height = arm.tipPosition(q0).z() + 0.002;  // the tip starts 2 mm deep
+    BulletMechanism<Spatial> bullet(arm.model(), 1e-3, q0, VecN::Zero(3));
+    VecN q, v;
+    std::vector<double> out;  // (VecN has a fixed capacity)
+    for (int i = 0; i < 200; ++i) {
+      bullet.step(arm.gravityTorque(q0) * 0.8);
+      bullet.state(q, v);
+      const Spatial::Vec f = bullet.constraintForce(0);
+      out.insert(out.end(), q.data(), q.data() + q.size());
+      out.insert(out.end(), v.data(), v.data() + v.size());
+      out.insert(out.end(), f.data(), f.data() + 6);
+    }
+    return out;
+  };
+  const std::vector<double> a = run(), b = run();
+  REQUIRE(a.size() == b.size());
+  CHECK(std::memcmp(a.data(), b.data(), a.size() * sizeof(double)) == 0);
 }
