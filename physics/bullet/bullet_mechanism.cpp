@@ -1,7 +1,10 @@
 // Bullet 3.24 (double precision) reference model of a planar mechanism description, built from the
 // plan of planar_plan.h: one fixed-base btMultiBody (links at their centres of mass, revolute axes z),
-// btMultiBodyPoint2Point constraints for cut revolute joints and point attachments, and
-// btMultiBodyFixedConstraint for welds that close a loop.
+// btMultiBodyPoint2Point constraints for cut revolute joints and point attachments,
+// btMultiBodyFixedConstraint for welds that close a loop, and for each plane_contact a ball on its link
+// against the plane n·x = h (n in the x–y plane), the model contact_balls.h shares with the spatial
+// builder (μ, restitution 0, rigid or compliant; its second friction direction, along z, has no
+// effective mass here and stays 0).
 //
 // Settings (shared/notes/bullet-reference.md): gravity from the description, PGS with
 // BulletHints::solver_iterations, no damping, no joint-speed cap, never sleep, a collider with mask 0
@@ -19,13 +22,16 @@
 //   fixed constraint the opposite: A receives +λ/dt and the moment +λ_5/dt (row 5: A's frame z = world
 //                    z), B −λ/dt, −λ_5/dt (sign found by the slider's own Newton equation in the
 //                    tests); reported at point_b's world position;
+//   plane_contact    the plane's force on the ball (impulses / dt: normal η n, and friction when μ > 0)
+//                    with its moment about c − ρ n at the step's start (~0 unless friction acts on a
+//                    stand-in ball);
 //   weld realised as the fixed joint P → C: Newton–Euler of the Bullet subtree S beyond it,
 //     F_PC = Σ_S m_k (a_k − g) − F_ext,   M_PC = Σ_S [(c_k − p) × m_k (a_k − g) + I_k α_k] − M_ext(p),
 //   with the link accelerations of the step Bullet took: (q_n, v_n) and a = (v_{n+1} − v_n)/dt on
 //   Bullet's own tree (its step is M(q_n)(v_{n+1} − v_n)/dt + h(q_n, v_n) = τ + J_c(q_n)ᵀλ/dt, so
 //   these balances hold to rounding). F_ext, M_ext: constraint impulses / dt on links of S at their
-//   pivots, link forces (payload pushes) and link torques applied to S (joint torques inside S are
-//   internal). f = ±F_PC (+ if C = b).
+//   pivots, contact forces on links of S, link forces (payload pushes) and link torques applied to S
+//   (joint torques inside S are internal). f = ±F_PC (+ if C = b).
 #include "physics/bullet/bullet_mechanism.h"
 
 #include <btBulletDynamicsCommon.h>
@@ -43,7 +49,9 @@
 #include <tuple>
 
 #include "physics/bullet/bullet_world.h"
+#include "physics/bullet/contact_balls.h"
 #include "physics/bullet/planar_plan.h"
+#include "physics/constraints/plane_contact.h"
 
 #ifndef BT_USE_DOUBLE_PRECISION
 #error "bullet_mechanism.cpp must be built against bullet-float64 (BT_USE_DOUBLE_PRECISION)"
@@ -69,6 +77,15 @@ double unwrap(double raw, double near) {
 
 template <>
 struct BulletMechanism<Planar>::Impl {
+  // A plane_contact of the description: a ball in `balls`, and its force over the last step.
+  struct Contact {
+    int constraint = -1, link = -1, ball = -1;
+    const PlaneContact<Planar>* plane = nullptr;
+    btVector3 centre{0, 0, 0};  // Bullet link frame
+    btVector3 start{0, 0, 0};   // c − ρ n at the last step's start
+    Vec2 f = Vec2::Zero();      // the plane's force on the ball, and its moment about `start`
+    double m = 0;
+  };
   MechanismModel<Planar> model;
   Plan plan;
   double dt;
@@ -85,6 +102,8 @@ struct BulletMechanism<Planar>::Impl {
   std::unique_ptr<btSphereShape> shape;
   std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders;
   std::vector<std::unique_ptr<btMultiBodyConstraint>> closures;
+  std::vector<Contact> contacts;
+  ContactBalls balls;
 
   Impl(const MechanismModel<Planar>& m, double step, const VecN& q0, const VecN& v0)
       : model(m), plan(makePlan(m)), dt(step), world(bt(plan.gravity), m.bullet.solver_iterations) {
@@ -106,11 +125,13 @@ struct BulletMechanism<Planar>::Impl {
     link_force.assign(plan.links.size(), Vec2::Zero());
 
     build();
+    buildContacts();
     setState(q0, v0);
   }
 
   ~Impl() {
     for (auto& c : closures) world->removeMultiBodyConstraint(c.get());
+    balls.clear(world);
     for (auto& c : colliders) world->removeCollisionObject(c.get());
     if (body) world->removeMultiBody(body.get());
     closures.clear();
@@ -177,6 +198,38 @@ struct BulletMechanism<Planar>::Impl {
       c->finalizeMultiDof();
       closures.push_back(std::move(c));
     }
+  }
+
+  // Each plane_contact: a ball at c_b on its body's link (frame at the body's centre of mass, its angle).
+  void buildContacts() {
+    std::vector<ContactBall> list;
+    for (std::size_t c = 0; c < model.constraints.size(); ++c) {
+      const Constraint<Planar>* k = model.constraints[c].get();
+      if (!k->unilateral()) continue;
+      const auto* pc = dynamic_cast<const PlaneContact<Planar>*>(k);
+      if (!pc) throw std::invalid_argument("BulletMechanism: constraint " + std::to_string(c) + " (" + k->kind() + "): not yet");
+      const BodyRef b = pc->body();
+      Contact ct;
+      ct.constraint = int(c), ct.plane = pc, ct.ball = int(list.size());
+      Vec2 com = Vec2::Zero();
+      if (b.kind == BodyRef::Kind::Link) {
+        double mass;
+        Planar::massAndCom(model.tree.bodies[std::size_t(b.index)].inertia, mass, com);
+        ct.link = plan.link_of_tree_body[std::size_t(b.index)];
+      } else {
+        ct.link = plan.link_of_payload[std::size_t(b.index)];
+      }
+      ct.centre = bt(pc->centre() - com);
+      const PlaneContactParams& p = pc->params();
+      list.push_back({ct.link, ct.centre, p.radius, bt(pc->normal()), p.height, p.mu, p.stiffness, p.damping});
+      contacts.push_back(ct);
+    }
+    std::vector<btMultiBodyLinkCollider*> link_colliders;
+    for (auto& c : colliders) link_colliders.push_back(c.get());
+    balls.build(world, link_colliders, std::move(list), "BulletMechanism: ");
+    if (!contacts.empty())  // before ", PGS n iterations"
+      plan.summary.insert(plan.summary.rfind(", PGS"),
+                          ", " + std::to_string(contacts.size()) + " plane contact(s) as a sphere on a static plane");
   }
 
   void readBullet() {
@@ -306,6 +359,8 @@ struct BulletMechanism<Planar>::Impl {
       }
     }
     const std::vector<double> q0 = qb, v0 = qdb;
+    for (Contact& c : contacts)
+      c.start = body->localPosToWorld(c.link, c.centre) - c.plane->params().radius * bt(c.plane->normal());
     world->stepSimulation(dt, 0, dt);  // exactly one step of dt
     readBullet();
     for (int i : plan.cut_joints) cut_theta[std::size_t(i)] = unwrap(rawCutAngle(i), cut_theta[std::size_t(i)]);
@@ -329,6 +384,13 @@ struct BulletMechanism<Planar>::Impl {
   }
 
   void constraintForces(const std::vector<LinkMotion>& start) {
+    for (Contact& c : contacts) {
+      btVector3 f, m;
+      balls.force(world, c.ball, dt, c.start, f, m);
+      c.f = Vec2(f.x(), f.y());
+      c.m = m.z();
+      force[std::size_t(c.constraint)] = {c.m, c.f.x(), c.f.y()};
+    }
     for (std::size_t c = 0; c < plan.constraints.size(); ++c) {
       const PlanConstraint& pc = plan.constraints[c];
       if (pc.constraint < 0) continue;
@@ -371,6 +433,11 @@ struct BulletMechanism<Planar>::Impl {
         F -= f;
         M -= n + cross(s.c + rotate(s.phi, pivot) - p, f);
       }
+    }
+    for (const Contact& ct : contacts) {  // the planes' forces on balls of S
+      if (!in[std::size_t(ct.link)]) continue;
+      F -= ct.f;
+      M -= ct.m + cross(Vec2(ct.start.x(), ct.start.y()) - p, ct.f);
     }
     // F, M: what the parent P applies to C; the description wants a on b.
     const double sign = lw.body == model.constraints[std::size_t(c)]->attachment().b ? 1.0 : -1.0;

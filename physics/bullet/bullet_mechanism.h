@@ -18,7 +18,8 @@ class BulletMechanism {
  public:
   // Planar mechanisms move in Bullet's x–y plane (revolute axes z). Spatial ones (spatial_mechanism.cpp):
   // trees hung from the world, revolute/prismatic joints, rolling constraints modelled as
-  // BulletHints::rolling says. q0, v0: a consistent state.
+  // BulletHints::rolling says. Both model plane_contact as a ball on a static plane (contact_balls.h).
+  // q0, v0: a consistent state.
   // Throws std::invalid_argument for a description it cannot model (the message says what).
   BulletMechanism(const MechanismModel<S>& model, double dt, const VecN& q0, const VecN& v0);
   ~BulletMechanism();
@@ -33,7 +34,8 @@ class BulletMechanism {
   // The state in the description's coordinates.
   void state(VecN& q, VecN& v) const;
   // The force of constraint i over the last step (body a on body b, world axes at its point). Rolling:
-  // the ground's force on the wheel, a pure force at the contact of the step (moment ~0).
+  // the ground's force on the wheel, a pure force at the contact of the step (moment ~0). plane_contact:
+  // the plane's force on the ball (η n, plus friction when μ > 0) at c − ρ n of the step's start.
   typename S::Vec constraintForce(int i) const;
   // One line for summaries and the bench: how the model was built ("btMultiBody cut at joint 1, ...").
   std::string describe() const;

@@ -7,6 +7,7 @@
 //   weld (a held on b, frames aligned)      e = p_P − c_P, d = c_C − p_C, δ = 0 (a weld left out of
 //                                           the tree: a btMultiBodyFixedConstraint)
 //   payload guide (world → payload)         pivot at pose0 with the free coordinate set to 0, q = it
+// Unilateral constraints (plane_contact) are neither: the builder models them as contacts.
 #include "physics/bullet/planar_plan.h"
 
 #include <algorithm>
@@ -110,6 +111,7 @@ struct Builder {
       if (!cut) edges.push_back({Edge::Type::Joint, i, p < 0 ? 0 : 1 + p, 1 + i});
     }
     for (int c = 0; c < int(m.constraints.size()); ++c) {
+      if (m.constraints[std::size_t(c)]->unilateral()) continue;  // a contact: no joint, no constraint (bullet_mechanism.cpp)
       const std::string what = "constraint " + std::to_string(c) + " (" + m.constraints[std::size_t(c)]->kind() + ")";
       const Attachment<Planar> at = m.constraints[std::size_t(c)]->attachment();
       checkBody(at.a, what);
@@ -266,7 +268,7 @@ struct Builder {
       if (edges[k].type == Edge::Type::Joint && !in_tree[k]) cutJoint(edges[k].index);
     for (int c : m.bullet.cut_joints) cutJoint(c);
     for (int c = 0; c < int(m.constraints.size()); ++c) {
-      if (plan.weld_link[std::size_t(c)] >= 0) continue;
+      if (plan.weld_link[std::size_t(c)] >= 0 || m.constraints[std::size_t(c)]->unilateral()) continue;
       const Attachment<Planar> at = m.constraints[std::size_t(c)]->attachment();
       PlanConstraint pc;
       pc.kind = at.rows[0] ? PlanConstraint::Kind::Weld : PlanConstraint::Kind::Point;

@@ -1,7 +1,9 @@
 // The plan of a planar Bullet model (Eigen only, no Bullet): which Bullet links, joints and constraints
 // realise a mechanism description (physics/mechanism.h), and the planar kinematics of that tree.
 //
-// Spanning tree (Kruskal over the description's bodies, then rooted at the world by breadth-first order):
+// Unilateral constraints (plane_contact) take no part in the plan: bullet_mechanism.cpp makes them
+// contacts (contact_balls.h). Spanning tree (Kruskal over the description's bodies, then rooted at the
+// world by breadth-first order):
 //   edges in priority order  payload guides (world → payload), tree joints not in cut_joints, welds
 //   (attachments holding all of ω, x, y). An edge joining two separate components becomes a Bullet
 //   joint; every other edge, and every point attachment (x, y only), becomes a Bullet constraint.

@@ -1,16 +1,22 @@
 // Bullet 3.24 (double precision) reference model of a spatial mechanism description: the trees as one
 // fixed-base btMultiBody (every body whose parent is −1 hangs from the base, which is the world),
-// revolute and prismatic joints about their axes at the X_tree placements, and the rolling kind in
-// one of two models (BulletHints::rolling):
-//   NoSlip    RollingNoSlipConstraint (rolling_constraint.h): the description's three rows, bilateral;
-//   Friction  a sphere of the wheel's radius on the wheel link (under the centre it touches the
-//             ground where an upright disk does) against a static plane z = h, friction μ from the
-//             description (the plane's own friction is 1: Bullet multiplies the two), restitution 0,
-//             two friction directions with Bullet's implicit cone |f_t| ≤ μ f_n.
+// revolute and prismatic joints about their axes at the X_tree placements, and two constraint kinds:
+//   rolling, in one of two models (BulletHints::rolling):
+//     NoSlip    RollingNoSlipConstraint (rolling_constraint.h): the description's three rows, bilateral;
+//     Friction  a ball of the wheel's radius on the wheel link (under the centre it touches the ground
+//               where an upright disk does) against the plane z = h, friction μ (contact_balls.h);
+//   plane_contact: a ball of radius ρ at c_b on its link against the plane n·x = h (any unit n), friction
+//             μ, restitution 0, rigid or with the contact stiffness and damping (k_e, d_e) of the
+//             description (contact_balls.h: the shared ball-on-plane model, and what Bullet does with
+//             ρ < 1 mm, stiffness and its speculative touchdown).
 // Other constraint kinds, cut joints and payloads are refused (std::invalid_argument: "not yet").
-// The rolling force reported is the ground's on the wheel over the step (impulses / dt), a pure force
-// at the contact point the step used (moment ~0): NoSlip's predicted end-of-step point, the friction
-// contact's start-of-step point. Bullet's contact friction holds at the step's start geometry, so a
+// The force reported for a ball contact is the plane's on the ball over the step (impulses / dt: the
+// normal force η n plus, when μ > 0, the friction force; n·f = η ≥ 0), with its moment about the
+// contact point at the step's start (plane_contact: c − ρ n; ~0 unless friction acts on a stand-in
+// ball); the gap is the description's, from the state. The rolling force reported is the ground's on
+// the wheel, a pure force at the contact point the step used (moment ~0): NoSlip's predicted
+// end-of-step point, the friction contact's start-of-step point. Bullet's contact friction holds at the
+// step's start geometry, so a
 // friction wheel's state reads a slip of v φ' dt while it grips (the NoSlip rows avoid this; see
 // rolling_constraint.h); its contact's own slip (start heading, new velocities) is ~1e-12 m/s.
 //
@@ -27,7 +33,7 @@
 //
 // Settings (shared/notes/bullet-reference.md): gravity from the description, PGS with
 // BulletHints::solver_iterations, no damping, no joint-speed cap, never sleep, impulse caps 1e12, a
-// collider on every link (mask 0 but the friction wheel's: pitfall 1), and exactly one
+// collider on every link (mask 0 but the balls' links: pitfall 1), and exactly one
 // stepSimulation(dt, 0, dt) per step. Joint springs and friction are joint torques from the state at
 // the step's start, as in the planar builder.
 #include <btBulletDynamicsCommon.h>
@@ -44,7 +50,9 @@
 
 #include "physics/bullet/bullet_mechanism.h"
 #include "physics/bullet/bullet_world.h"
+#include "physics/bullet/contact_balls.h"
 #include "physics/bullet/rolling_constraint.h"
+#include "physics/constraints/plane_contact.h"
 #include "physics/constraints/rolling.h"
 
 #ifndef BT_USE_DOUBLE_PRECISION
@@ -120,15 +128,22 @@ struct BulletMechanism<Spatial>::Impl {
     const Rolling* rolling = nullptr;
     btVector3 centre, axle;                       // Bullet link frame
     RollingNoSlipConstraint* noslip = nullptr;    // NoSlip
-    btMultiBodyLinkCollider* collider = nullptr;  // the wheel link's collider
-    btRigidBody* ground = nullptr;                // Friction
+    int ball = -1;                                // Friction: its ball in `balls`
     btVector3 start_point{0, 0, 0};               // the no-slip contact point at the last step's start
+  };
+  // A plane_contact of the description: a ball in `balls`.
+  struct Contact {
+    int constraint = -1, link = -1, ball = -1;
+    const PlaneContact<Spatial>* plane = nullptr;
+    btVector3 centre;                             // Bullet link frame
+    btVector3 start_point{0, 0, 0};               // c − ρ n at the last step's start
   };
 
   MechanismModel<Spatial> model;
   double dt;
   std::vector<LinkFrame> frames;
   std::vector<Wheel> wheels;
+  std::vector<Contact> contacts;
   std::vector<Spatial::Vec> force;  // per description constraint, over the last step
   std::string summary;
 
@@ -137,7 +152,7 @@ struct BulletMechanism<Spatial>::Impl {
   std::vector<std::unique_ptr<btCollisionShape>> shapes;
   std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders;
   std::vector<std::unique_ptr<btMultiBodyConstraint>> closures;
-  std::vector<std::unique_ptr<btRigidBody>> grounds;
+  ContactBalls balls;  // Friction wheels and plane contacts
 
   Impl(const MechanismModel<Spatial>& m, double step, const VecN& q0, const VecN& v0) : model(m), dt(step), world(bt(Spatial::linear(m.tree.gravity)), m.bullet.solver_iterations) {
     check(q0, v0);
@@ -149,18 +164,17 @@ struct BulletMechanism<Spatial>::Impl {
     info.m_solverMode &= ~SOLVER_DISABLE_IMPLICIT_CONE_FRICTION;
     buildTree();
     buildColliders();
-    buildWheels();
+    buildConstraints();
     setState(q0, v0);
     summarise();
   }
 
   ~Impl() {
     for (auto& c : closures) world->removeMultiBodyConstraint(c.get());
-    for (auto& g : grounds) world->removeRigidBody(g.get());
+    balls.clear(world);
     for (auto& c : colliders) world->removeCollisionObject(c.get());
     if (body) world->removeMultiBody(body.get());
     closures.clear();
-    grounds.clear();
     colliders.clear();
     body.reset();
   }
@@ -183,10 +197,12 @@ struct BulletMechanism<Spatial>::Impl {
       if (!(b.axis.norm() > 0) || !b.axis.allFinite())
         throw std::invalid_argument(who + "body " + std::to_string(i) + " has no joint axis");
     }
-    for (std::size_t c = 0; c < model.constraints.size(); ++c)
-      if (!dynamic_cast<const Rolling*>(model.constraints[c].get()))
-        throw std::invalid_argument(who + "constraint " + std::to_string(c) + " (" + model.constraints[c]->kind() +
-                                    "): not yet (only rolling)");
+    for (std::size_t c = 0; c < model.constraints.size(); ++c) {
+      const Constraint<Spatial>* k = model.constraints[c].get();
+      if (!dynamic_cast<const Rolling*>(k) && !dynamic_cast<const PlaneContact<Spatial>*>(k))
+        throw std::invalid_argument(who + "constraint " + std::to_string(c) + " (" + k->kind() +
+                                    "): not yet (only rolling and plane_contact)");
+    }
   }
 
   void buildTree() {
@@ -234,9 +250,22 @@ struct BulletMechanism<Spatial>::Impl {
     }
   }
 
-  void buildWheels() {
+  // Rolling wheels (a NoSlip constraint or a Friction ball) and plane contacts (a ball), in description order.
+  void buildConstraints() {
     const bool friction = model.bullet.rolling == RollingModel::Friction;
+    std::vector<ContactBall> list;
     for (std::size_t c = 0; c < model.constraints.size(); ++c) {
+      if (const auto* pc = dynamic_cast<const PlaneContact<Spatial>*>(model.constraints[c].get())) {
+        Contact k;
+        k.constraint = int(c), k.plane = pc, k.link = pc->body().index;
+        const LinkFrame& l = frames[std::size_t(k.link)];
+        k.centre = bt(l.E_p * (pc->centre() - l.com));
+        const PlaneContactParams& p = pc->params();
+        k.ball = int(list.size());
+        list.push_back({k.link, k.centre, p.radius, bt(pc->normal()), p.height, p.mu, p.stiffness, p.damping});
+        contacts.push_back(k);
+        continue;
+      }
       Wheel w;
       w.constraint = int(c);
       w.rolling = dynamic_cast<const Rolling*>(model.constraints[c].get());
@@ -244,9 +273,9 @@ struct BulletMechanism<Spatial>::Impl {
       const LinkFrame& l = frames[std::size_t(w.link)];
       w.centre = bt(l.E_p * (w.rolling->centre() - l.com));
       w.axle = bt(l.E_p * w.rolling->axle());
-      w.collider = colliders[std::size_t(w.link) + 1].get();
       if (friction) {
-        addGround(w, int(wheels.size()));
+        w.ball = int(list.size());
+        list.push_back({w.link, w.centre, w.rolling->radius(), btVector3(0, 0, 1), w.rolling->groundHeight(), w.rolling->mu(), 0.0, 0.0});
       } else {
         auto r = std::make_unique<RollingNoSlipConstraint>(body.get(), w.link, w.centre, w.axle, w.rolling->radius(),
                                                            w.rolling->groundHeight());
@@ -257,43 +286,9 @@ struct BulletMechanism<Spatial>::Impl {
       }
       wheels.push_back(w);
     }
-  }
-
-  // Friction: the wheel's sphere and its own ground plane collide with each other and nothing else
-  // (a collision group pair per wheel: wheels at other heights never touch this plane).
-  void addGround(Wheel& w, int k) {
-    if (k >= 12) throw std::invalid_argument("BulletMechanism (spatial): at most 12 friction wheels");
-    const int wheel_group = 1 << (2 * k + 6), ground_group = 1 << (2 * k + 7);
-    const double r = w.rolling->radius();
-    btCollisionShape* wheel_shape;
-    if (w.centre.length() == 0.0) {
-      shapes.push_back(std::make_unique<btSphereShape>(r));
-      wheel_shape = shapes.back().get();
-    } else {  // the disk's centre is off the link's centre of mass: a sphere placed in a compound
-      shapes.push_back(std::make_unique<btSphereShape>(r));
-      btCollisionShape* sphere = shapes.back().get();
-      auto compound = std::make_unique<btCompoundShape>();
-      compound->addChildShape(btTransform(btQuaternion::getIdentity(), w.centre), sphere);
-      shapes.push_back(std::move(compound));
-      wheel_shape = shapes.back().get();
-    }
-    btMultiBodyLinkCollider* c = w.collider;
-    world->removeCollisionObject(c);
-    c->setCollisionShape(wheel_shape);
-    c->setFriction(w.rolling->mu());
-    c->setRestitution(0.0);
-    c->setRollingFriction(0.0);
-    c->setSpinningFriction(0.0);
-    world->addCollisionObject(c, wheel_group, ground_group);
-
-    shapes.push_back(std::make_unique<btStaticPlaneShape>(btVector3(0, 0, 1), w.rolling->groundHeight()));
-    btRigidBody::btRigidBodyConstructionInfo info(0.0, nullptr, shapes.back().get());
-    info.m_friction = 1.0;  // combined friction = μ_wheel × μ_ground = μ
-    info.m_restitution = 0.0;
-    auto g = std::make_unique<btRigidBody>(info);
-    world->addRigidBody(g.get(), ground_group, wheel_group);
-    w.ground = g.get();
-    grounds.push_back(std::move(g));
+    std::vector<btMultiBodyLinkCollider*> link_colliders;
+    for (auto& c : colliders) link_colliders.push_back(c.get());
+    balls.build(world, link_colliders, std::move(list), "BulletMechanism (spatial): ");
   }
 
   void summarise() {
@@ -306,6 +301,7 @@ struct BulletMechanism<Spatial>::Impl {
         s << ", " << wheels.size() << " rolling wheel(s) as a sphere on a friction plane (μ = " << wheels.front().rolling->mu()
           << ", cone)";
     }
+    if (!contacts.empty()) s << ", " << contacts.size() << " plane contact(s) as a sphere on a static plane";
     s << ", PGS " << model.bullet.solver_iterations << " iterations";
     summary = s.str();
   }
@@ -366,8 +362,11 @@ struct BulletMechanism<Spatial>::Impl {
     }
     for (Wheel& w : wheels)
       w.start_point = rimContact(*body, w.link, w.centre, w.axle, w.rolling->radius()).point;
+    for (Contact& k : contacts)
+      k.start_point = body->localPosToWorld(k.link, k.centre) - k.plane->params().radius * bt(k.plane->normal());
     world->stepSimulation(dt, 0, dt);  // exactly one step of dt
-    for (Wheel& w : wheels) force[std::size_t(w.constraint)] = w.noslip ? noSlipForce(w) : contactForce(w);
+    for (Wheel& w : wheels) force[std::size_t(w.constraint)] = w.noslip ? noSlipForce(w) : ballForce(w.ball, w.start_point);
+    for (Contact& k : contacts) force[std::size_t(k.constraint)] = ballForce(k.ball, k.start_point);
   }
 
   // The constraint's impulses over the step, at the point it was written at: no moment there.
@@ -377,33 +376,14 @@ struct BulletMechanism<Spatial>::Impl {
     return f;
   }
 
-  // The ground's force on the wheel from the contact manifold: normal and both friction impulses over
-  // the step, with its moment about the no-slip contact point at the step's start (zero for an upright
-  // disk up to the contact's penetration); zero when the wheel does not touch.
-  Spatial::Vec contactForce(const Wheel& w) const {
-    Pos f = Pos::Zero(), m = Pos::Zero();
-    const Pos P = eig(w.start_point);
-    for (int i = 0; i < world.dispatcher->getNumManifolds(); ++i) {
-      const btPersistentManifold* man = world.dispatcher->getManifoldByIndexInternal(i);
-      double sign;
-      if (man->getBody0() == w.collider && man->getBody1() == w.ground)
-        sign = 1.0;  // Bullet's impulses act on body 0 along +normal, +friction directions
-      else if (man->getBody1() == w.collider && man->getBody0() == w.ground)
-        sign = -1.0;
-      else
-        continue;
-      for (int j = 0; j < man->getNumContacts(); ++j) {
-        const btManifoldPoint& cp = man->getContactPoint(j);
-        const btVector3 impulse = cp.m_normalWorldOnB * cp.m_appliedImpulse + cp.m_lateralFrictionDir1 * cp.m_appliedImpulseLateral1 +
-                                  cp.m_lateralFrictionDir2 * cp.m_appliedImpulseLateral2;
-        const Pos fj = sign * eig(impulse) / dt;
-        const Pos x = eig(sign > 0 ? cp.getPositionWorldOnA() : cp.getPositionWorldOnB());
-        f += fj;
-        m += (x - P).cross(fj);
-      }
-    }
+  // The plane's force on a ball over the step (normal and friction impulses / dt) with its moment about
+  // P, the contact point at the step's start (a friction wheel: the no-slip point, zero moment for an
+  // upright disk up to the contact's penetration); zero when the ball does not touch.
+  Spatial::Vec ballForce(int ball, const btVector3& P) const {
+    btVector3 f, m;
+    balls.force(world, ball, dt, P, f, m);
     Spatial::Vec out;
-    out << m, f;
+    out << eig(m), eig(f);
     return out;
   }
 };
