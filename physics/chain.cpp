@@ -66,15 +66,20 @@ VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const Ve
           bool with_gravity) {
   const int n = model.dof();
   (void)qd;  // velocities enter through data.v, filled by forwardKinematics
-  const typename S::Vec a0 = with_gravity ? typename S::Vec(-model.gravity) : S::Vec::Zero();
-  // Outward: accelerations, then the net force each body needs.
+  const typename S::Vec a0 = -model.gravity;
+  // Outward: accelerations without gravity (data.a: at θ'' = 0 each link's velocity-product
+  // acceleration), then the net force each body needs, gravity added as the world's acceleration
+  // −g seen in the body's frame (by linearity the same as starting the recursion from −g).
   for (int i = 0; i < n; ++i) {
     const auto& b = model.bodies[i];
-    const typename S::Vec a_parent = b.parent < 0 ? a0 : data.a[b.parent];
-    data.a[i] = S::motion(data.X_up[i], a_parent) + data.S_i[i] * qdd[i] + data.c[i];
+    data.a[i] = (b.parent < 0 ? typename S::Vec(data.S_i[i] * qdd[i]) : typename S::Vec(S::motion(data.X_up[i], data.a[b.parent]) + data.S_i[i] * qdd[i])) + data.c[i];
     // A massless body (a carrier: zero mass and rotational inertia) needs no force of its own.
-    if (S::massless(b.inertia)) data.f[i].setZero();
-    else data.f[i] = S::inertiaTimes(b.inertia, data.a[i]) + S::crossForce(data.v[i], S::inertiaTimes(b.inertia, data.v[i]));
+    if (S::massless(b.inertia)) {
+      data.f[i].setZero();
+      continue;
+    }
+    const typename S::Vec a = with_gravity ? typename S::Vec(data.a[i] + S::motion(data.X_world[i], a0)) : data.a[i];
+    data.f[i] = S::inertiaTimes(b.inertia, a) + S::crossForce(data.v[i], S::inertiaTimes(b.inertia, data.v[i]));
   }
   // Inward: project onto the joint axis, pass the rest to the parent.
   VecN tau(n);

@@ -72,6 +72,7 @@ template <class S>
 void velocityKinematics(const TreeModel<S>& model, const VecN& qd, TreeData<S>& data);
 
 // Inverse dynamics τ = M θ'' + C θ' + G with gravity (or without, when with_gravity is false).
+// Leaves data.a[i] = each body's acceleration without gravity (at θ'' = 0: its J'θ' bias).
 template <class S>
 VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const VecN& qdd,
           bool with_gravity = true);

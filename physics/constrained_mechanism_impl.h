@@ -124,10 +124,8 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   // Link velocities, h = Cθ' + G from RNEA with θ'' = 0, and each link's velocity-product acceleration.
   velocityKinematics(model_.tree, qd, data_);
   problem_.h = rnea(model_.tree, data_, qd, VecN::Zero(nn));
-  for (int i = 0; i < nn; ++i) {
-    const int p = model_.tree.bodies[std::size_t(i)].parent;
-    kin_.link_bias[std::size_t(i)] = (p < 0 ? Vec(Vec::Zero()) : Vec(S::motion(data_.X_up[std::size_t(i)], kin_.link_bias[std::size_t(p)]))) + data_.c[std::size_t(i)];
-  }
+  // RNEA at θ'' = 0 leaves each link's acceleration without gravity: its velocity-product one.
+  for (int i = 0; i < nn; ++i) kin_.link_bias[std::size_t(i)] = data_.a[std::size_t(i)];
   // Joint springs and friction join h.
   if (!model_.joints.empty())
     for (int i = 0; i < nn; ++i) {

@@ -181,6 +181,11 @@ struct MechanismKinematics {
   double angle(const BodyRef& b) const;
   // Rotation taking body-frame coordinates to world coordinates.
   typename S::Rot rotation(const BodyRef& b) const;
+  // A direction given in the body's frame, in world coordinates: rotation(b) d without the matrix.
+  Pos direction(const BodyRef& b, const Pos& d) const {
+    if (b.kind == BodyRef::Kind::Link) return tree->X_world[std::size_t(b.index)].E.transpose() * d;
+    return rotation(b) * d;
+  }
   // The velocity of a world-aligned frame at world point p moving with body b: V = Jb θ' + Ab v_c.
   // Adds sign × the rows of V (mask) into J (tree columns) and A (payload columns) at `row`; A gets
   // −sign, so that J θ' − A v_c = sign × V's rows.

@@ -11,7 +11,7 @@ PointContact<S>::PointContact(BodyRef a, const Pos& point_a, BodyRef b, const Po
 
 template <class S>
 typename S::Pos PointContact<S>::normal(const MechanismKinematics<S>& k) const {
-  return k.rotation(attachment().b) * normal_b_;
+  return k.direction(attachment().b, normal_b_);
 }
 
 template <class S>

@@ -23,7 +23,7 @@ Rolling::Rolling(BodyRef wheel, const Pos& centre_b, const Pos& axle_b, double r
 Rolling::Geometry Rolling::geometry(const MechanismKinematics<Spatial>& k) const {
   Geometry g;
   g.p = k.position(wheel_, centre_b_);
-  g.a = k.rotation(wheel_) * axle_b_;
+  g.a = k.direction(wheel_, axle_b_);
   g.u = kUp - kUp.dot(g.a) * g.a;
   g.un = g.u.norm();
   // A disk lying flat has no lowest point: take the one under the centre.
