@@ -19,6 +19,7 @@ void TreeData<S>::resize(int n) {
   X_up.resize(n);
   X_world.resize(n);
   S_i.resize(n);
+  S_w.resize(n);
   v.resize(n);
   c.resize(n);
   a.resize(n);
@@ -39,6 +40,7 @@ void positionKinematics(const TreeModel<S>& model, const VecN& q, TreeData<S>& d
     data.X_up[i] = S::compose(S::jointTransform(b.joint == JointType::Revolute, b.axis, q[i]), b.X_tree);
     data.S_i[i] = model.motionSubspace(i);
     data.X_world[i] = b.parent < 0 ? data.X_up[i] : S::compose(data.X_up[i], data.X_world[b.parent]);
+    data.S_w[i] = S::motionInverse(data.X_world[i], data.S_i[i]);
   }
 }
 
@@ -98,8 +100,8 @@ template <class S>
 void crbaSparseMass(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M) {
   using Vec = typename S::Vec;
   const int n = model.dof();
-  Vec Sw[kMaxDof], F[kMaxDof];
-  for (int j = 0; j < n; ++j) Sw[j] = S::motionInverse(data.X_world[j], data.S_i[j]);
+  const std::vector<Vec>& Sw = data.S_w;
+  Vec F[kMaxDof];
   M.setZero();
   for (int b = 0; b < n; ++b) {
     if (S::massless(model.bodies[b].inertia)) continue;
@@ -194,7 +196,7 @@ void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
   J.setZero(S::kDim, model.dof());
   // Column j: joint j's axis, seen from the point, for every joint on the path root → body.
   for (int j = body; j >= 0; j = model.bodies[j].parent)
-    J.col(j) = S::motion(X_pw, S::motionInverse(data.X_world[j], data.S_i[j]));
+    J.col(j) = S::motion(X_pw, data.S_w[j]);
 }
 
 template <class S>

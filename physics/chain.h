@@ -51,6 +51,7 @@ struct TreeData {
   std::vector<typename S::Transform> X_up;     // parent → body i
   std::vector<typename S::Transform> X_world;  // world → body i
   std::vector<Vec> S_i, v, c;                  // joint axis, body velocity, velocity-product accel
+  std::vector<Vec> S_w;                        // joint axis in world coordinates (at the world origin)
   std::vector<Vec> a, f;                       // scratch for rnea
   std::vector<typename S::Mat> Ic;             // scratch for aba
   std::vector<typename S::Inertia> Ic_rb;      // scratch for crba (composite rigid-body inertias)

@@ -89,7 +89,7 @@ void MechanismKinematics<S>::addPointJacobian(const BodyRef& b, const Pos& p_wor
     // Column j: joint j's axis seen from the world-aligned frame at p, for every joint root → link.
     const typename S::Transform X_pw = S::translation(p_world);
     for (int j = b.index; j >= 0; j = model->tree.bodies[std::size_t(j)].parent) {
-      const Vec col = S::motion(X_pw, S::motionInverse(tree->X_world[std::size_t(j)], tree->S_i[std::size_t(j)]));
+      const Vec col = S::motion(X_pw, tree->S_w[std::size_t(j)]);
       for (int r = 0, out = row; r < S::kDim; ++r)
         if (rows[std::size_t(r)]) J(out++, j) += sign * col[r];
     }
