@@ -30,8 +30,20 @@ double median(std::vector<double> v) {
   return v.empty() ? 0 : v[v.size() / 2];
 }
 
-// Median wall times, µs, over `steps` steps of fresh runs (restarted when one ends). Each sample
-// includes one pair of clock reads (~20 ns), on both engines alike.
+// The cost of one pair of clock reads (µs, median of many): subtracted from every timed sample, so
+// a sub-microsecond step is not charged the timer's own ~20–50 ns.
+double clockOverhead() {
+  using Micros = std::chrono::duration<double, std::micro>;
+  std::vector<double> pairs(2001);
+  for (double& p : pairs) {
+    const auto t0 = Clock::now();
+    p = Micros(Clock::now() - t0).count();
+  }
+  return median(pairs);
+}
+
+// Median wall times, µs, over `steps` steps of fresh runs (restarted when one ends), less the clock
+// reads' own cost (clockOverhead), on both engines alike.
 struct StepTimes {
   double full = 0;    // Simulation::step: controller, trace row, engine
   double engine = 0;  // Simulation::advanceEngine after each (untimed) step: the engine alone
@@ -41,13 +53,14 @@ struct StepTimes {
 StepTimes stepMicros(const Lab& lab, Engine engine, int steps) {
   using Micros = std::chrono::duration<double, std::micro>;
   std::vector<double> row, full, alone;
+  const double clock = clockOverhead();
   full.reserve(std::size_t(steps));
   alone.reserve(std::size_t(steps));
   auto sim = lab.simulate(engine);
   for (int k = 0; k < steps; ++k) {
     const auto t0 = Clock::now();
     const bool stepped = sim->step(row);
-    const double t = Micros(Clock::now() - t0).count();
+    const double t = Micros(Clock::now() - t0).count() - clock;
     if (stepped) full.push_back(t);
     else sim = lab.simulate(engine);  // wrap around short runs
   }
@@ -60,7 +73,7 @@ StepTimes stepMicros(const Lab& lab, Engine engine, int steps) {
     }
     const auto t0 = Clock::now();
     const bool advanced = sim->advanceEngine();
-    const double t = Micros(Clock::now() - t0).count();
+    const double t = Micros(Clock::now() - t0).count() - clock;
     if (advanced) alone.push_back(t);
   }
   return {median(full), median(alone), !alone.empty()};

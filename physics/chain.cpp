@@ -38,7 +38,7 @@ void positionKinematics(const TreeModel<S>& model, const VecN& q, TreeData<S>& d
     const auto& b = model.bodies[i];
     // Joint placement then joint motion: X_up = X_J(θ_i) X_tree.
     data.X_up[i] = S::compose(S::jointTransform(b.joint == JointType::Revolute, b.axis, q[i]), b.X_tree);
-    data.S_i[i] = model.motionSubspace(i);
+    data.S_i[i] = b.subspace;
     data.X_world[i] = b.parent < 0 ? data.X_up[i] : S::compose(data.X_up[i], data.X_world[b.parent]);
     data.S_w[i] = S::motionInverse(data.X_world[i], data.S_i[i]);
   }
@@ -51,7 +51,8 @@ void velocityKinematics(const TreeModel<S>& model, const VecN& qd, TreeData<S>& 
     const int p = model.bodies[i].parent;
     // Body velocity: the parent's, carried across the joint, plus the joint's own S_i θ'_i.
     const Vec vJ = data.S_i[i] * qd[i];
-    data.v[i] = p < 0 ? vJ : Vec(S::motion(data.X_up[i], data.v[p]) + vJ);
+    if (p < 0) data.v[i] = vJ;
+    else data.v[i] = S::motion(data.X_up[i], data.v[p]) + vJ;
     // Velocity-product acceleration of the joint: c_i = V_i ×m S_i θ'_i.
     data.c[i] = S::crossMotion(data.v[i], vJ);
   }

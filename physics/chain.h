@@ -30,6 +30,7 @@ struct TreeModel {
     typename S::Axis axis;           // prismatic direction (spatial: also the revolute axis)
     typename S::Transform X_tree;    // parent frame → joint frame at θ = 0
     Mat inertia;                     // spatial inertia at the body origin, body coordinates
+    Vec subspace = Vec::Zero();      // motion subspace S_i (set by addBody from joint and axis)
   };
   std::vector<Body> bodies;
   Vec gravity = Vec::Zero();         // spatial acceleration of gravity in world coordinates
@@ -40,6 +41,7 @@ struct TreeModel {
     // Spatial: a unit axis, and placements that do not turn marked so (spatial.h: E is skipped there).
     if constexpr (S::kDim == 6) bodies.push_back({parent, joint, axis.normalized(), S::marked(X_tree), inertia});
     else bodies.push_back({parent, joint, axis, X_tree, inertia});
+    bodies.back().subspace = motionSubspace(int(bodies.size()) - 1);
     return int(bodies.size()) - 1;
   }
   Vec motionSubspace(int i) const;

@@ -44,6 +44,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
   int nq() const override { return n() + k(); }
   void accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a) override;
   void constraint(const VecN& q, VecN& phi, MatN& G) override;
+  void baumgarteTerm(const VecN& q, const VecN& v, double zeta, double omega, VecN& s) override;
   void metric(const VecN& q, MatN& W) override;
   bool correction(const VecN& q, const VecN& e, VecN& dx) override;
 
@@ -100,7 +101,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
   void treeStage(const VecN& q);
   Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab);
   // Forget every cached stage (the released rows changed).
-  void invalidate() { have_position_ = have_last_ = false; }
+  void invalidate() { have_position_ = have_velocity_ = have_last_ = false; }
 
   MechanismModel<S> model_;
   int rows_ = 0;
@@ -114,6 +115,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   VecN gravity_bc_;    // b_c + G_c of the payloads without external forces (b_c = 0: world axes at the centre of mass)
   VecN staged_q_;      // the configuration of the position stage
   bool have_position_ = false;
+  VecN staged_v_;      // the rates of the velocity stage (at staged_q_)
+  bool have_velocity_ = false;
   std::vector<double> tree_angle_;  // planar: each placement's fixed rotation angle
   VecN tree_q_;        // the θ that data_'s transforms are at
   bool have_tree_ = false;

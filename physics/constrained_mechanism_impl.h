@@ -67,6 +67,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::positionStage(const VecN& q) {
   positionKinematics(model_.tree, q.head(nn), data_);
   tree_q_ = q.head(nn);
   have_tree_ = true;
+  have_velocity_ = false;
   problem_.M.resize(nn, nn);
   crba(model_.tree, data_, problem_.M);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
@@ -114,7 +115,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::treeStage(const VecN& q) {
   positionKinematics(model_.tree, q.head(n()), data_);
   tree_q_ = q.head(n());
   have_tree_ = true;
-  have_position_ = false;  // data_ no longer holds the position stage's configuration
+  have_position_ = have_velocity_ = false;  // data_ no longer holds the stages' configuration
 }
 
 template <class S, int Nj, int Nr, int Nl>
@@ -158,6 +159,8 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
     }
   }
   problem_.Jdot_qd = bias;
+  staged_v_ = v;
+  have_velocity_ = true;
 }
 
 template <class S, int Nj, int Nr, int Nl>
@@ -170,7 +173,8 @@ template <class S, int Nj, int Nr, int Nl>
 typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, Nj, Nr, Nl>::evaluate(
     const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
   positionStage(q);
-  velocityStage(v);
+  // The velocity stage too is kept: the trace row's solve and the step's first stage share it.
+  if (!have_velocity_ || v != staged_v_) velocityStage(v);
   // τ: the tree torques, optionally followed by generalised forces on the payload coordinates
   // (an external push w on the payload: M_c α_c + b_c + G_c = Aᵀ f + w).
   if (tau.size() != n() && tau.size() != n() + k())
@@ -204,6 +208,10 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::setClosed(int i, bool closed) {
   invalidate();
 }
 
+// A contact at or past its plane closes unless it separates faster than this (m/s): rounding-size
+// rates (±1e-17 after an impact that reopened) must not leave a penetrating contact open a step.
+constexpr double kSeparating = 1e-9;
+
 template <class S, int Nj, int Nr, int Nl>
 int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, const VecN& tau) {
   if (!any_released_kind_) return 0;
@@ -216,7 +224,7 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
     if (!rigid(i) || !released_[i]) continue;
     const int r = offsets_[i];
     const double approach = J_full_.row(r).dot(v.head(n())) - (k() ? A_full_.row(r).dot(v.tail(k())) : 0.0);
-    if (phi_full_[r] >= 0.0 && approach >= 0.0) {
+    if (phi_full_[r] >= 0.0 && approach >= -kSeparating) {
       released_[i] = 0;
       ++changes;
     }
@@ -227,7 +235,9 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
     projectVelocities(*this, q, v);
   }
   // Lift-off: while a closed contact's η would pull, open the one pulling most and solve again.
-  for (std::size_t pass = 0; pass < count; ++pass) {
+  bool any_closed = false;
+  for (std::size_t i = 0; i < count; ++i) any_closed = any_closed || (rigid(i) && !released_[i]);
+  for (std::size_t pass = 0; any_closed && pass < count; ++pass) {
     const Solution s = solve(q, v, tau);
     std::size_t worst = count;
     double most = 0.0;
@@ -278,6 +288,20 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::constraint(const VecN& q, VecN& phi, M
 }
 
 template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::baumgarteTerm(const VecN& q, const VecN& v, double zeta, double omega, VecN& s) {
+  positionStage(q);
+  // s = −2ζω (J θ' − A v_c) − ω² φ from the stage's own J and A (released rows are zero there).
+  const int nn = n(), kk = k();
+  s.resize(rows_);
+  for (int r = 0; r < rows_; ++r) {
+    double gv = 0.0;
+    for (int j = 0; j < nn; ++j) gv += problem_.J(r, j) * v[j];
+    for (int j = 0; j < kk; ++j) gv -= problem_.A(r, j) * v[nn + j];
+    s[r] = -2.0 * zeta * omega * gv - omega * omega * phi_[r];
+  }
+}
+
+template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::metric(const VecN& q, MatN& W) {
   positionStage(q);
   W = MatN::Zero(n() + k(), n() + k());
@@ -315,6 +339,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::constraintReport(int i, const Solution
 template <class S, int Nj, int Nr, int Nl>
 double ConstrainedMechanism<S, Nj, Nr, Nl>::kineticEnergy(const VecN& q, const VecN& v) {
   positionStage(q);
+  have_velocity_ = false;  // data_'s velocities are this query's now
   velocityKinematics(model_.tree, VecN(v.head(n())), data_);
   double T = dyn::kineticEnergy(model_.tree, data_);
   for (std::size_t i = 0, off = std::size_t(n()); i < model_.payloads.size(); ++i) {
@@ -381,6 +406,7 @@ template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::pointJacobian(int link, const Pos& point, const VecN& q, const VecN& qd,
                                                         MatN& J, VecN& Jdot_qd) {
   treeStage(q);
+  have_velocity_ = false;
   velocityKinematics(model_.tree, VecN(qd.head(n())), data_);
   dyn::pointJacobian(model_.tree, data_, link, point, J, Jdot_qd);
 }
@@ -395,6 +421,7 @@ template <class S, int Nj, int Nr, int Nl>
 VecN ConstrainedMechanism<S, Nj, Nr, Nl>::gravityTorque(const VecN& q) {
   const VecN zero = VecN::Zero(n());
   treeStage(q);
+  have_velocity_ = false;
   velocityKinematics(model_.tree, zero, data_);
   return rnea(model_.tree, data_, zero, zero);
 }
@@ -402,6 +429,7 @@ VecN ConstrainedMechanism<S, Nj, Nr, Nl>::gravityTorque(const VecN& q) {
 template <class S, int Nj, int Nr, int Nl>
 VecN ConstrainedMechanism<S, Nj, Nr, Nl>::inverseDynamics(const VecN& q, const VecN& qd, const VecN& qdd) {
   treeStage(q);
+  have_velocity_ = false;
   velocityKinematics(model_.tree, VecN(qd.head(n())), data_);
   return rnea(model_.tree, data_, qd, qdd);
 }

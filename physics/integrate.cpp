@@ -11,14 +11,18 @@ namespace {
 const VecN* baumgarte(ConstrainedSystem& sys, const DriftOptions& d, const VecN& q, const VecN& v,
                       VecN& s) {
   if (d.kind != Drift::Baumgarte) return nullptr;
-  VecN phi;
-  MatN G;
-  sys.constraint(q, phi, G);
-  s = -2.0 * d.zeta * d.omega * (G * v) - d.omega * d.omega * phi;
+  sys.baumgarteTerm(q, v, d.zeta, d.omega, s);
   return &s;
 }
 
 }  // namespace
+
+void ConstrainedSystem::baumgarteTerm(const VecN& q, const VecN& v, double zeta, double omega, VecN& s) {
+  VecN phi;
+  MatN G;
+  constraint(q, phi, G);
+  s = -2.0 * zeta * omega * (G * v) - omega * omega * phi;
+}
 
 bool ConstrainedSystem::correction(const VecN& q, const VecN& e, VecN& dx) {
   // Minimum-W-norm dx with G dx = e is eq. (2) for impulses with M = W, J = G and no payload:

@@ -37,6 +37,9 @@ class ConstrainedSystem {
                              VecN& a) = 0;
   // φ(q) and G(q) (G v = 0 is the velocity constraint).
   virtual void constraint(const VecN& q, VecN& phi, MatN& G) = 0;
+  // Baumgarte's s = −2ζω G v − ω² φ at (q, v). The default builds φ and G; a mechanism may answer
+  // from its own position stage.
+  virtual void baumgarteTerm(const VecN& q, const VecN& v, double zeta, double omega, VecN& s);
   // The projection metric W (mass matrix), positive definite.
   virtual void metric(const VecN& q, MatN& W) = 0;
   // The projection's step: the correction dx of least W-norm with G(q) dx = e,

@@ -160,7 +160,9 @@ struct Spatial {
   // The same transform, marked unturned when E is exactly the identity.
   static Transform marked(const Transform& X) { return {X.E, X.r, X.E != Rot::Identity()}; }
 
-  static double dot(const Vec& a, const Vec& b) { return a.dot(b); }
+  DYN_INLINE static double dot(const Vec& a, const Vec& b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5];
+  }
   static Eigen::Matrix3d skew(const Pos& p) {
     Eigen::Matrix3d s;
     s << 0, -p.z(), p.y(), p.z(), 0, -p.x(), -p.y(), p.x(), 0;
@@ -234,8 +236,8 @@ struct Spatial {
     if (!bc.turned) return {ab.E, ab.r + ab.E.transpose() * bc.r, true};
     return {bc.E * ab.E, ab.r + ab.E.transpose() * bc.r, true};
   }
-  static Transform inverse(const Transform& X) { return {X.E.transpose(), -X.E * X.r, X.turned}; }
-  static Transform translation(const Pos& p) { return {Rot::Identity(), p, false}; }
+  DYN_INLINE static Transform inverse(const Transform& X) { return {X.E.transpose(), -X.E * X.r, X.turned}; }
+  DYN_INLINE static Transform translation(const Pos& p) { return {Rot::Identity(), p, false}; }
 
   DYN_INLINE static Vec crossMotion(const Vec& v, const Vec& m) {
     // (ω × m_ω, ω × m_v + v × m_ω)
@@ -316,11 +318,14 @@ struct Spatial {
     return s;
   }
   // Revolute: E = R(a, q)ᵀ = c 1 + (1 − c) a aᵀ − s [a]× (Rodrigues, transposed); prismatic: r = a q.
-  static Transform jointTransform(bool revolute, const Axis& a, double q) {
+  DYN_INLINE static Transform jointTransform(bool revolute, const Axis& a, double q) {
     if (!revolute) return {Rot::Identity(), a * q, false};
-    const double c = std::cos(q), s = std::sin(q);
-    Rot E = (1.0 - c) * a * a.transpose() - s * skew(a);
-    E.diagonal().array() += c;
+    const double c = std::cos(q), s = std::sin(q), t = 1.0 - c;
+    const double x = a[0], y = a[1], z = a[2];
+    Rot E;
+    E(0, 0) = c + t * x * x, E(0, 1) = t * x * y + s * z, E(0, 2) = t * x * z - s * y;
+    E(1, 0) = t * x * y - s * z, E(1, 1) = c + t * y * y, E(1, 2) = t * y * z + s * x;
+    E(2, 0) = t * x * z + s * y, E(2, 1) = t * y * z - s * x, E(2, 2) = c + t * z * z;
     return {E, Pos::Zero(), true};
   }
   DYN_INLINE static Vec classicalAcceleration(const Vec& a, const Vec& v) {
@@ -331,13 +336,13 @@ struct Spatial {
     return out;
   }
   DYN_INLINE static Pos worldPoint(const Transform& X0, const Pos& p) { return X0.r + X0.E.transpose() * p; }
-  static bool massless(const Mat& I) { return I(5, 5) == 0 && I(0, 0) == 0 && I(1, 1) == 0 && I(2, 2) == 0; }
+  DYN_INLINE static bool massless(const Mat& I) { return I(5, 5) == 0 && I(0, 0) == 0 && I(1, 1) == 0 && I(2, 2) == 0; }
   static void massAndCom(const Mat& I, double& m, Pos& c) {
     m = I(5, 5);
     const Eigen::Matrix3d mC = I.block<3, 3>(0, 3);
     c = m > 0 ? Pos(Pos(mC(2, 1), mC(0, 2), mC(1, 0)) / m) : Pos(Pos::Zero());
   }
-  static Pos linear(const Vec& v) { return v.tail<3>(); }
+  DYN_INLINE static Pos linear(const Vec& v) { return v.tail<3>(); }
 };
 
 }  // namespace dyn
