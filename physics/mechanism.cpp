@@ -127,12 +127,13 @@ typename S::Vec MechanismKinematics<S>::pointVelocity(const BodyRef& b, const Po
 }
 
 template <class S>
-typename S::Vec MechanismKinematics<S>::pointBias(const BodyRef& b, const Pos& p_world) const {
+typename S::Vec MechanismKinematics<S>::pointBias(const BodyRef& b, const Pos& p_world, Vec* velocity) const {
+  if (velocity) *velocity = pointVelocity(b, p_world);
   if (b.kind == BodyRef::Kind::Link) {
     // The link's velocity-product acceleration (θ'' = 0), at p, as a classical acceleration.
     const std::size_t i = std::size_t(b.index);
     const typename S::Transform X_pw = S::translation(p_world);
-    const Vec v_p = S::motion(X_pw, S::motionInverse(tree->X_world[i], tree->v[i]));
+    const Vec v_p = velocity ? *velocity : S::motion(X_pw, S::motionInverse(tree->X_world[i], tree->v[i]));
     const Vec a_p = S::motion(X_pw, S::motionInverse(tree->X_world[i], link_bias[i]));
     return S::classicalAcceleration(a_p, v_p);
   }

@@ -193,7 +193,8 @@ struct MechanismKinematics {
                         double sign, int row, MatN& J, MatN& A) const;
   // The classical acceleration at p_world of that frame when θ'' = 0 and α_c = 0: J'θ' − A'v_c's
   // share of body b (velocity stage required).
-  Vec pointBias(const BodyRef& b, const Pos& p_world) const;
+  // With `velocity`, also that frame's spatial velocity (pointVelocity), computed on the way.
+  Vec pointBias(const BodyRef& b, const Pos& p_world, Vec* velocity = nullptr) const;
   // The full spatial velocity of that frame (velocity stage required).
   Vec pointVelocity(const BodyRef& b, const Pos& p_world) const;
 };

@@ -44,7 +44,8 @@ void Rolling::position(const MechanismKinematics<Spatial>& k, int row, VecN& phi
 
 void Rolling::bias(const MechanismKinematics<Spatial>& k, int row, VecN& b) const {
   const Geometry g = geometry(k);
-  const Vec V = k.pointVelocity(wheel_, g.P);
+  Vec V;
+  const Pos a_mat = Spatial::linear(k.pointBias(wheel_, g.P, &V));
   const Pos w = V.head<3>(), rho = g.P - g.p;
   // ḋ from a' = ω × a (zero for a disk lying flat, whose d is held at n).
   Pos d_dot = Pos::Zero();
@@ -54,7 +55,6 @@ void Rolling::bias(const MechanismKinematics<Spatial>& k, int row, VecN& b) cons
     d_dot = (u_dot - g.d * g.d.dot(u_dot)) / g.un;
   }
   // The material point's classical bias acceleration, less its centripetal part, plus ω × (Ṗ − ṗ).
-  const Pos a_mat = Spatial::linear(k.pointBias(wheel_, g.P));
   const Pos a_geo = a_mat - w.cross(w.cross(rho)) + w.cross(-radius_ * d_dot);
   for (int i = 0; i < 3; ++i) b[row + i] = -a_geo[i];
 }
