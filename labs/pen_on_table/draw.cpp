@@ -15,6 +15,7 @@ namespace {
 const Color kColumn{0.35f, 0.38f, 0.45f, 1.0f}, kArm{0.23f, 0.42f, 0.68f, 1.0f}, kPen{0.95f, 0.75f, 0.15f, 1.0f};
 const Color kJoint{0.15f, 0.15f, 0.18f, 1.0f}, kRef{0.20f, 0.65f, 0.30f, 1.0f}, kInk{0.10f, 0.10f, 0.45f, 1.0f};
 const Color kForce{0.85f, 0.15f, 0.10f, 1.0f}, kTable{0.86f, 0.78f, 0.64f, 1.0f}, kGhost{0.55f, 0.35f, 0.75f, 0.35f};
+const Color kFloor{0.90f, 0.90f, 0.88f, 1.0f};
 
 // The arm's joints and tip at θ: base, shoulder, elbow, the ball's centre (the closed form of mechanism.h).
 struct Pose {
@@ -53,21 +54,25 @@ void PenOnTableLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, 
   const Params& p = s_.params;
   const double z_t = p.table_height, r = s_.circle.radius;
   const Eigen::Vector3d c(s_.circle.centre.x(), s_.circle.centre.y(), z_t);
-  // The table: a square round the circle reaching back to the column; the camera holds the arm and table.
+  // The floor (z = 0) the column stands on, and the table: a block from the floor up to z_t round the
+  // circle, with a 5 cm grid on its top. The camera holds the floor, the table and the arm's reach.
   const double half = std::max(2.0 * r, 0.12);
-  const Eigen::Vector3d table_centre = c + Eigen::Vector3d(-0.5 * half, 0, 0);
-  const Eigen::Vector2d table_half(1.5 * half, 1.5 * half);
-  s.planes.push_back({table_centre, Eigen::Matrix3d::Identity(), table_half, kTable, 0.02, 0.05, {0.70f, 0.62f, 0.50f, 1.0f}});
+  const Eigen::Vector3d table_centre = c + Eigen::Vector3d(-0.25 * half, 0, 0);
+  const Eigen::Vector2d table_half(1.25 * half, 1.5 * half);
+  const double floor_z = std::min(0.0, z_t - 0.05);
+  s.planes.push_back({table_centre, Eigen::Matrix3d::Identity(), table_half, kTable, z_t - floor_z, 0.05, {0.70f, 0.62f, 0.50f, 1.0f}});
   Eigen::AlignedBox3d box;
-  box.extend(table_centre - Eigen::Vector3d(table_half.x(), table_half.y(), 0.02));
+  box.extend(table_centre - Eigen::Vector3d(table_half.x(), table_half.y(), 0));
   box.extend(table_centre + Eigen::Vector3d(table_half.x(), table_half.y(), 0));
-  box.extend(Eigen::Vector3d(0, 0, 0));
-  box.extend(Eigen::Vector3d(0, 0, p.links[0].length + p.links[1].length * 0.8));
+  box.extend(Eigen::Vector3d(-p.links[0].radius, -p.links[0].radius, floor_z));
+  box.extend(Eigen::Vector3d(p.links[0].radius, p.links[0].radius, p.links[0].length + 0.8 * p.links[1].length));
+  const Eigen::Vector3d floor_centre(box.center().x(), box.center().y(), floor_z);
+  s.planes.push_back({floor_centre, Eigen::Matrix3d::Identity(), 0.5 * box.sizes().head<2>() + Eigen::Vector2d(0.05, 0.05), kFloor, 0.0, 0.1});
   s.camera.ortho = false;
   s.camera.fov_y_deg = 35;
   s.camera.up = {0, 0, 1};
   s.camera.target = box.center();
-  s.camera.eye = box.center() + Eigen::Vector3d(0.9, -1.1, 0.75);
+  s.camera.eye = box.center() + Eigen::Vector3d(0.9, -1.1, 1.1);
   s.framing.fit = true;
   s.framing.bounds = box;
 
@@ -92,11 +97,12 @@ void PenOnTableLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, 
   if (ghost && row < ghost->rows()) drawArm(p, *ghost, row, true, s);
   drawArm(p, tr, row, false, s);
   s.spheres.push_back({Eigen::Vector3d(tr.at(row, "x_d"), tr.at(row, "y_d"), tr.at(row, "z_des")), 0.006, kRef});
-  // The table's push on the pen, η = −f_z, up from the tip.
-  const double eta = -tr.at(row, "f_z");
-  if (eta > 1e-9) {
-    const Eigen::Vector3d tip(tr.at(row, "x_p"), tr.at(row, "y_p"), tr.at(row, "z_p"));
-    s.arrows.push_back({tip, Eigen::Vector3d(0, 0, eta * s_.arrow_scale), 0.004, kForce});
+  // The force the pen applies to the table, f_z ẑ (the lecture's sign: down while pressing), ending on
+  // the table beside the tip (3 cm to the camera's right, so the pen does not hide it).
+  const double f_z = tr.at(row, "f_z");
+  if (f_z < -1e-9) {
+    const Eigen::Vector3d beside = Eigen::Vector3d(tr.at(row, "x_p"), tr.at(row, "y_p"), z_t) + 0.03 * Eigen::Vector3d(1.1, 0.9, 0).normalized();
+    s.arrows.push_back({beside - Eigen::Vector3d(0, 0, f_z * s_.arrow_scale), Eigen::Vector3d(0, 0, f_z * s_.arrow_scale), 0.003, kForce});
   }
 }
 
@@ -113,14 +119,15 @@ void PenOnTableLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const 
              {"f_meas", fmt("%.2f N", tr.at(row, "f_meas"))},
              {"z_des - z_t", fmt("%.2f mm", 1e3 * (tr.at(row, "z_des") - s_.params.table_height))},
              {"contact", tr.at(row, "contact") > 0.5 ? "yes" : "no (lifted)"}};
-  // Live plots over the last three seconds: every step, up to and including this row.
-  Series force{"f_z (N)", {}, kForce}, setpoint{"f_zd (N)", {}, kRef}, height{"z_des (m)", {}, kArm};
+  // Live plots over the last three seconds, every step up to this row: f_z, its error from f_zd (the
+  // plot's zero line is the set point), and the commanded height above the table.
+  Series force{"f_z (N)", {}, kForce}, error{"f_z - f_zd (N)", {}, kRef}, height{"z_des - z_t (mm)", {}, kArm};
   for (std::size_t r = liveWindowStart(row, 3.0, s_.step.dt); r <= row; ++r) {
     force.values.push_back(float(tr.at(r, "f_z")));
-    setpoint.values.push_back(float(tr.at(r, "f_zd")));
-    height.values.push_back(float(tr.at(r, "z_des")));
+    error.values.push_back(float(tr.at(r, "f_z") - tr.at(r, "f_zd")));
+    height.values.push_back(float(1e3 * (tr.at(r, "z_des") - s_.params.table_height)));
   }
-  o.plots = {force, setpoint, height};
+  o.plots = {force, error, height};
 }
 
 }  // namespace dyn::pen_on_table

@@ -207,6 +207,8 @@ std::unique_ptr<Simulation> PenOnTableLab::simulate(Engine engine) const {
   VecN q, v;
   initialState(q, v);
   const double z0 = mech->tip(q).z();
+  // A pen that starts on a rigid table starts in contact (its gap is 0 up to rounding, either sign).
+  if (s_.start_height == 0 && s_.params.table_stiffness == 0) mech->setClosed(0, true);
   std::unique_ptr<MechanismEngine> stepper;
   if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<Mechanism>>(*mech, s_.step, q, v);
   else stepper = std::make_unique<BulletEngine<Spatial>>(mech->model(), s_.step.dt, q, v);
