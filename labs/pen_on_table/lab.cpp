@@ -51,11 +51,24 @@ class Hooks final : public StepHooks {
            eta > 0 ? 1.0 : 0.0,    gap,         r.energy,  r.work,   residual};
   }
   void observe(const StepRecord& r) override { ctrl_.measure(-Spatial::linear(r.forces[0]).z()); }
+  // The lab's watchdog: an unstable force loop on a unilateral contact does not blow up, it hammers the
+  // table (a bounded limit cycle of lift-offs); the run stops after max_liftoffs of them.
+  std::string stop(const StepRecord& r) override {
+    const bool contact = Spatial::linear(r.forces[0]).z() > 0;
+    if (touched_ && in_contact_ && !contact && ++liftoffs_ >= s_.max_liftoffs)
+      return "stopped: the pen lifted off the table " + std::to_string(liftoffs_) + " times after touching down, at t = " +
+             fmt("%.4g", r.t) + " s (the force loop oscillates)";
+    touched_ = touched_ || contact;
+    in_contact_ = contact;
+    return {};
+  }
 
  private:
   const Settings& s_;
   Mechanism mech_;
   Controller ctrl_;
+  bool touched_ = false, in_contact_ = false;
+  int liftoffs_ = 0;
 };
 
 Link parseLink(const JsonView& j) {
@@ -171,8 +184,9 @@ Settings parseSettings(const JsonView& c) {
   if (!(cc.gains.K_z > 0)) gains["K_z"].fail("expected a spring constant K_z > 0 (N/m): z_des = z_ref − (f − f_zd)/K_z");
 
   if (c.has("metrics")) {
-    c["metrics"].onlyKeys({"overshoot_window"});
+    c["metrics"].onlyKeys({"overshoot_window", "max_liftoffs"});
     s.overshoot_window = c["metrics"]["overshoot_window"].positive(1e3);
+    if (c["metrics"].has("max_liftoffs")) s.max_liftoffs = int(c["metrics"]["max_liftoffs"].integer(1, 1000000));
   }
   if (c.has("drawing")) {
     c["drawing"].onlyKeys({"arrow_scale"});
