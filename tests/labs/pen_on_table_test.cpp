@@ -12,7 +12,8 @@
 //    passive energy only falls (plastic
 //    touchdowns); with the controller the table does no work while the pen presses;
 //  * hand vs Bullet: contact onset and the force after settling, within tolerances stated per dt;
-//  * bad inputs (table out of reach, D_z ≤ 0, a circle outside the workspace) get one line.
+//  * bad inputs (table out of reach, D_z ≤ 0, a circle outside the workspace) get one line;
+//  * the same input (noise seeded) gives the same trace on both engines.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -342,4 +343,17 @@ TEST_CASE("pen_on_table: bad inputs get one line naming the JSON path") {
   CHECK(inputError({{"initial", {{"height", 0.9}}}}).find("/initial/height: expected a start the arm can reach") == 0);
   CHECK(inputError({{"mechanism", {{"links", {{{"length", 0.3}, {"mass", 2.0}, {"radius", 0.04}}}}}}}).find("/mechanism/links") == 0);
   CHECK(inputError({{"controller", {{"kind", "constant"}, {"torques", {1.0}}}}}).find("/controller/torques") == 0);
+}
+
+TEST_CASE("pen_on_table: the same input gives the same trace, noise included (seeded)") {
+  json patch = withRun(gains(2000, 70, 150, 4000), 1.0);
+  patch["controller"]["noise"] = 0.5;
+  for (const Engine e : {Engine::Hand, Engine::Bullet}) {
+    const Trace a = run(*makeLab(patch), e), b = run(*makeLab(patch), e);
+    CHECK(a.data == b.data);
+  }
+  // Another seed, another noise.
+  json other = patch;
+  other["controller"]["seed"] = 2;
+  CHECK(run(*makeLab(patch), Engine::Hand).data != run(*makeLab(other), Engine::Hand).data);
 }
