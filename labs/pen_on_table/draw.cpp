@@ -54,25 +54,34 @@ void PenOnTableLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, 
   const Params& p = s_.params;
   const double z_t = p.table_height, r = s_.circle.radius;
   const Eigen::Vector3d c(s_.circle.centre.x(), s_.circle.centre.y(), z_t);
-  // The floor (z = 0) the column stands on, and the table: a block from the floor up to z_t round the
-  // circle, with a 5 cm grid on its top. The camera holds the floor, the table and the arm's reach.
+  // The table: a block from the floor (z = 0) up to z_t round the circle, with a 5 cm grid on its top.
   const double half = std::max(2.0 * r, 0.12);
   const Eigen::Vector3d table_centre = c + Eigen::Vector3d(-0.25 * half, 0, 0);
   const Eigen::Vector2d table_half(1.25 * half, 1.5 * half);
   const double floor_z = std::min(0.0, z_t - 0.05);
   s.planes.push_back({table_centre, Eigen::Matrix3d::Identity(), table_half, kTable, z_t - floor_z, 0.05, {0.70f, 0.62f, 0.50f, 1.0f}});
+  // What the camera holds: the table block, the column, and where the arm went over the run (both runs).
   Eigen::AlignedBox3d box;
-  box.extend(table_centre - Eigen::Vector3d(table_half.x(), table_half.y(), 0));
+  box.extend(table_centre + Eigen::Vector3d(-table_half.x(), -table_half.y(), floor_z - z_t));
   box.extend(table_centre + Eigen::Vector3d(table_half.x(), table_half.y(), 0));
   box.extend(Eigen::Vector3d(-p.links[0].radius, -p.links[0].radius, floor_z));
-  box.extend(Eigen::Vector3d(p.links[0].radius, p.links[0].radius, p.links[0].length + 0.8 * p.links[1].length));
-  const Eigen::Vector3d floor_centre(box.center().x(), box.center().y(), floor_z);
-  s.planes.push_back({floor_centre, Eigen::Matrix3d::Identity(), 0.5 * box.sizes().head<2>() + Eigen::Vector2d(0.05, 0.05), kFloor, 0.0, 0.1});
+  for (const Trace* t : {&tr, ghost})
+    if (t)
+      for (std::size_t k = 0; k < t->rows(); k += std::max<std::size_t>(1, t->rows() / 200)) {
+        const Pose a = pose(p, t->at(k, "q1"), t->at(k, "q2"), t->at(k, "q3"));
+        for (const Eigen::Vector3d& x : {a.shoulder, a.elbow, a.centre}) {
+          box.extend(x + Eigen::Vector3d::Constant(p.links[1].radius));
+          box.extend(x - Eigen::Vector3d::Constant(p.links[1].radius));
+        }
+      }
+  // The floor the column stands on: exactly the box's footprint (so it is framed too).
+  s.planes.push_back({Eigen::Vector3d(box.center().x(), box.center().y(), floor_z), Eigen::Matrix3d::Identity(),
+                      0.5 * box.sizes().head<2>(), kFloor, 0.0, 0.1});
   s.camera.ortho = false;
   s.camera.fov_y_deg = 35;
   s.camera.up = {0, 0, 1};
   s.camera.target = box.center();
-  s.camera.eye = box.center() + Eigen::Vector3d(0.9, -1.1, 1.1);
+  s.camera.eye = box.center() + Eigen::Vector3d(0.9, -1.1, 0.6);
   s.framing.fit = true;
   s.framing.bounds = box;
 
