@@ -1,0 +1,345 @@
+// Pen-on-table lab: parses pen_on_table.json, runs the hand-written model (eq. (3) with the unilateral
+// plane contact, touchdown and lift-off between steps) or the Bullet reference (the tip a sphere on a
+// static plane) with the same controller, and measures the runs.
+#include "labs/pen_on_table/lab.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "labs/mechanism_simulation.h"
+#include "labs/numbers.h"
+#include "labs/settings.h"
+
+namespace dyn::pen_on_table {
+namespace {
+
+constexpr double kMaxLength = 10, kMaxMass = 1e3, kMaxGravity = 1e3, kMaxTorque = 1e3, kMaxRate = 1e3, kMaxForce = 1e3;
+// The workspace the circle must lie in: the elbow at least this far from stretched or folded
+// (|sin θ3| ≥ 0.25, θ3 within 14.5° … 165.5°) and the tip this far from the base axis (θ1 defined).
+constexpr double kMinElbowSine = 0.25, kMinAxisDistance = 0.05;
+
+// The one place the trace row is laid out.
+const std::vector<std::string> kColumns = {"t",     "q1",    "q2",     "q3",      "tau1",  "tau2",   "tau3",
+                                           "x_p",   "y_p",   "z_p",    "x_d",     "y_d",   "z_des",  "f_z",
+                                           "f_zd",  "f_meas", "contact", "gap",   "energy", "work", "constraint_residual"};
+
+// The arm the controller believes in: without the pen's extra load, the table where it expects it.
+Params believed(const Params& p, const ControllerConfig& c) {
+  Params b = p;
+  b.pen_load = 0;
+  b.table_height = c.table_assumed;
+  return b;
+}
+
+// The lab's part of a run on either engine (labs/mechanism_simulation.h).
+class Hooks final : public StepHooks {
+ public:
+  Hooks(const Settings& s, double z0)
+      : s_(s), mech_(s.params), ctrl_(s.controller, s.circle, believed(s.params, s.controller), s.step.dt, z0) {}
+  VecN torque(double t, const VecN& q, const VecN& v) override { return ctrl_.torque(t, q, v); }
+  void row(const StepRecord& r, std::vector<double>& out) override {
+    // f_z: the force the pen applies to the table (the lecture's sign), −η of the table's push.
+    const double eta = Spatial::linear(r.forces[0]).z(), f_z = -eta;
+    const Eigen::Vector3d p = mech_.tip(r.q);
+    const double gap = p.z() - s_.params.table_height;
+    // Bullet's rows are not the hand model's: on a rigid table its residual is the tip's penetration.
+    const double residual = std::max(r.residual, s_.params.table_stiffness > 0 ? 0.0 : std::max(0.0, -gap));
+    const Target& d = ctrl_.target();
+    out = {r.t,       r.q[0],      r.q[1],      r.q[2],    r.tau[0], r.tau[1], r.tau[2],         p.x(),
+           p.y(),     p.z(),       d.p.x(),     d.p.y(),   d.p.z(),  f_z,      s_.controller.f_zd, d.f_meas,
+           eta > 0 ? 1.0 : 0.0,    gap,         r.energy,  r.work,   residual};
+  }
+  void observe(const StepRecord& r) override { ctrl_.measure(-Spatial::linear(r.forces[0]).z()); }
+  // The lab's watchdog: an unstable force loop on a unilateral contact does not blow up, it hammers the
+  // table (a bounded limit cycle of lift-offs); the run stops after max_liftoffs of them.
+  std::string stop(const StepRecord& r) override {
+    const bool contact = Spatial::linear(r.forces[0]).z() > 0;
+    if (touched_ && in_contact_ && !contact && ++liftoffs_ >= s_.max_liftoffs)
+      return "stopped: the pen lifted off the table " + std::to_string(liftoffs_) + " times after touching down, at t = " +
+             fmt("%.4g", r.t) + " s (the force loop oscillates)";
+    touched_ = touched_ || contact;
+    in_contact_ = contact;
+    return {};
+  }
+
+ private:
+  const Settings& s_;
+  Mechanism mech_;
+  Controller ctrl_;
+  bool touched_ = false, in_contact_ = false;
+  int liftoffs_ = 0;
+};
+
+Link parseLink(const JsonView& j) {
+  j.onlyKeys({"length", "mass", "radius"});
+  return {j["length"].positive(kMaxLength), j["mass"].positive(kMaxMass), j["radius"].positive(1.0)};
+}
+
+// Where the circle (or the start point) leaves the workspace: empty if nowhere, else the reason.
+std::string outOfReach(const Params& p, const Eigen::Vector3d& tip) {
+  const double R = std::hypot(tip.x(), tip.y());
+  const double d = std::hypot(R, tip.z() + p.tip_radius - p.links[0].length);
+  if (R < kMinAxisDistance) return "is " + fmt("%.3g", R) + " m from the base axis (at least 0.05 m keeps θ1 defined)";
+  if (elbowSine(p, tip) < kMinElbowSine)
+    return "is " + fmt("%.3g", d) + " m from the shoulder (the arm reaches " + fmt("%.3g", std::abs(p.links[1].length - p.links[2].length)) +
+           " to " + fmt("%.3g", p.links[1].length + p.links[2].length) + " m; the elbow must stay 14.5° from stretched or folded)";
+  return {};
+}
+
+}  // namespace
+
+Settings parseSettings(const JsonView& c) {
+  Settings s;
+  c.onlyKeys({"lab", "title", "description", "mechanism", "table", "initial", "simulation", "controller", "gains", "reference",
+              "metrics", "metric_docs", "rubric", "drawing", "submission_options", "map", "figures"});
+  // The arm.
+  const JsonView m = c["mechanism"];
+  m.onlyKeys({"links", "tip_radius", "pen_load", "gravity"});
+  auto& p = s.params;
+  m["links"].size(3, 3);
+  for (std::size_t i = 0; i < 3; ++i) p.links[i] = parseLink(m["links"].at(i));
+  p.tip_radius = m["tip_radius"].inRange(0, 0.1);
+  p.pen_load = m.has("pen_load") ? m["pen_load"].inRange(0, kMaxMass) : 0.0;
+  p.gravity = m["gravity"].inRange(0, kMaxGravity);
+  // The table.
+  const JsonView tb = c["table"];
+  tb.onlyKeys({"height", "stiffness", "damping", "mu"});
+  p.table_height = tb["height"].inRange(-kMaxLength, kMaxLength);
+  p.table_stiffness = tb.has("stiffness") ? tb["stiffness"].inRange(0, 1e9) : 0.0;
+  p.table_damping = tb.has("damping") ? tb["damping"].inRange(0, 1e7) : 0.0;
+  if (p.table_damping > 0 && p.table_stiffness == 0)
+    tb["damping"].fail("expected 0 on a rigid table (stiffness 0): damping belongs to a compliant table");
+  p.mu = tb.has("mu") ? tb["mu"].inRange(0, 10) : 0.0;
+
+  // The circle on the table.
+  const JsonView ref = c["reference"];
+  ref.onlyKeys({"centre", "radius", "frequency", "start", "ramp"});
+  auto& circle = s.circle;
+  if (!ref["centre"].raw().is_array() || ref["centre"].raw().size() != 2) ref["centre"].fail("expected the circle's centre [x, y] in metres");
+  circle.centre = {ref["centre"].at(0).inRange(-kMaxLength, kMaxLength), ref["centre"].at(1).inRange(-kMaxLength, kMaxLength)};
+  circle.radius = ref["radius"].positive(1.0);
+  circle.frequency = ref["frequency"].positive(10.0);
+  circle.start = ref["start"].inRange(0, 1e4);
+  circle.ramp = ref["ramp"].inRange(0, 1e4);
+  // The table must be within the arm's reach under the circle's centre, and the whole circle inside.
+  const Eigen::Vector3d centre(circle.centre.x(), circle.centre.y(), p.table_height);
+  if (std::abs(p.table_height + p.tip_radius - p.links[0].length) >= p.links[1].length + p.links[2].length)
+    tb["height"].fail("expected a table the arm can reach: z_t = " + fmt("%.3g", p.table_height) + " m is out of reach of the shoulder at " +
+                      fmt("%.3g", p.links[0].length) + " m (reach " + fmt("%.3g", p.links[1].length + p.links[2].length) + " m)");
+  if (const std::string why = outOfReach(p, centre); !why.empty())
+    ref["centre"].fail("expected the circle's centre within the arm's workspace on the table: it " + why);
+  for (int k = 0; k < 72; ++k) {
+    const double a = 2 * M_PI * k / 72;
+    const Eigen::Vector3d pt = centre + circle.radius * Eigen::Vector3d(std::cos(a), std::sin(a), 0);
+    if (const std::string why = outOfReach(p, pt); !why.empty())
+      ref["radius"].fail("expected a circle inside the arm's workspace: its point at " + fmt("%.0f", 360.0 * k / 72) + "° " + why);
+  }
+
+  // The start: above the circle's first point.
+  const JsonView init = c["initial"];
+  init.onlyKeys({"height", "rates"});
+  s.start_height = init["height"].inRange(0, 1.0);
+  const Eigen::Vector3d start = centre + Eigen::Vector3d(circle.radius, 0, s.start_height);
+  if (const std::string why = outOfReach(p, start); !why.empty()) init["height"].fail("expected a start the arm can reach: the tip there " + why);
+  if (init.has("rates")) {
+    init["rates"].size(3, 3);
+    for (std::size_t i = 0; i < 3; ++i) s.rates0[Eigen::Index(i)] = init["rates"].at(i).inRange(-kMaxRate, kMaxRate);
+  }
+
+  const SimulationSettings sim = parseSimulation(c["simulation"]);
+  if (sim.step.drift.kind == Drift::Independent)
+    c["simulation"]["drift"].fail("expected none, baumgarte or projection: the arm has no independent-coordinate form");
+  s.step = sim.step;
+  s.duration = sim.duration;
+
+  // The controller.
+  const JsonView ctl = c["controller"];
+  ctl.onlyKeys({"kind", "force_law", "inner_loop", "force_setpoint", "delay", "noise", "seed", "table_height_assumed",
+                "approach_speed", "torques"});
+  auto& cc = s.controller;
+  const std::string kind = ctl["kind"].oneOf({"none", "constant", "accommodation"});
+  cc.kind = kind == "none" ? ControllerKind::None : kind == "constant" ? ControllerKind::Constant : ControllerKind::Accommodation;
+  cc.law = ctl["force_law"].oneOf({"damper", "spring"}) == "damper" ? ForceLaw::Damper : ForceLaw::Spring;
+  cc.inner = ctl.has("inner_loop") && ctl["inner_loop"].oneOf({"pd_gravity", "inverse_dynamics"}) == "inverse_dynamics"
+                 ? InnerLoop::InverseDynamics
+                 : InnerLoop::PdGravity;
+  cc.f_zd = ctl["force_setpoint"].inRange(-kMaxForce, kMaxForce);
+  if (!(cc.f_zd < 0)) ctl["force_setpoint"].fail("expected a set point f_zd < 0 (N): the force the pen applies to the table, negative pressing");
+  cc.delay = ctl["delay"].inRange(0, 1);
+  cc.noise = ctl.has("noise") ? ctl["noise"].inRange(0, kMaxForce) : 0.0;
+  cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1L << 53)) : 1;
+  cc.table_assumed = ctl.has("table_height_assumed") ? ctl["table_height_assumed"].inRange(-kMaxLength, kMaxLength) : p.table_height;
+  cc.approach_speed = ctl["approach_speed"].positive(10.0);
+  if (cc.kind == ControllerKind::Constant) {
+    ctl["torques"].size(3, 3);
+    for (std::size_t i = 0; i < 3; ++i) cc.torques[Eigen::Index(i)] = ctl["torques"].at(i).inRange(-kMaxTorque, kMaxTorque);
+  }
+  const auto g = parseGains(c["gains"], {"kp", "kv", "D_z", "K_z"});
+  cc.gains = {g.at("kp"), g.at("kv"), g.at("D_z"), g.at("K_z")};
+  const JsonView gains = c["gains"];
+  if (!(cc.gains.kp > 0)) gains["kp"].fail("expected a position gain k_p > 0 (N/m): the spring's z_ref is f_zd / k_p below the table");
+  if (!(cc.gains.kv >= 0)) gains["kv"].fail("expected a damping gain k_v ≥ 0 (N·s/m)");
+  if (!(cc.gains.D_z > 0)) gains["D_z"].fail("expected a damper constant D_z > 0 (N·s/m): ż_des = −(f − f_zd)/D_z");
+  if (!(cc.gains.K_z > 0)) gains["K_z"].fail("expected a spring constant K_z > 0 (N/m): z_des = z_ref − (f − f_zd)/K_z");
+
+  if (c.has("metrics")) {
+    c["metrics"].onlyKeys({"overshoot_window", "max_liftoffs"});
+    s.overshoot_window = c["metrics"]["overshoot_window"].positive(1e3);
+    if (c["metrics"].has("max_liftoffs")) s.max_liftoffs = int(c["metrics"]["max_liftoffs"].integer(1, 1000000));
+  }
+  if (c.has("drawing")) {
+    c["drawing"].onlyKeys({"arrow_scale"});
+    s.arrow_scale = c["drawing"]["arrow_scale"].positive(1e3);
+  }
+  return s;
+}
+
+PenOnTableLab::PenOnTableLab(Settings s) : s_(std::move(s)) {}
+
+void PenOnTableLab::initialState(VecN& q, VecN& v) const {
+  const Eigen::Vector3d start(s_.circle.centre.x() + s_.circle.radius, s_.circle.centre.y(), s_.params.table_height + s_.start_height);
+  Eigen::Vector3d th;
+  inverseKinematics(s_.params, start, th);  // parseSettings checked the start is reachable
+  q = th;
+  v = s_.rates0;
+}
+
+std::vector<std::string> PenOnTableLab::columns() const { return kColumns; }
+
+std::string PenOnTableLab::unit(const std::string& c) const {
+  static const std::map<std::string, std::string> units = {
+      {"t", "s"},      {"q1", "rad"},   {"q2", "rad"},   {"q3", "rad"},     {"tau1", "N·m"},  {"tau2", "N·m"},
+      {"tau3", "N·m"}, {"x_p", "m"},    {"y_p", "m"},    {"z_p", "m"},      {"x_d", "m"},     {"y_d", "m"},
+      {"z_des", "m"},  {"f_z", "N"},    {"f_zd", "N"},   {"f_meas", "N"},   {"contact", "1"}, {"gap", "m"},
+      {"energy", "J"}, {"work", "J"},   {"constraint_residual", "m"}};
+  return unitIn(units, c);
+}
+
+std::unique_ptr<Simulation> PenOnTableLab::simulate(Engine engine) const {
+  auto mech = std::make_unique<Mechanism>(s_.params);
+  VecN q, v;
+  initialState(q, v);
+  const double z0 = mech->tip(q).z();
+  // A pen that starts on a rigid table starts in contact (its gap is 0 up to rounding, either sign).
+  if (s_.start_height == 0 && s_.params.table_stiffness == 0) mech->setClosed(0, true);
+  std::unique_ptr<MechanismEngine> stepper;
+  if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<Mechanism>>(*mech, s_.step, q, v);
+  else stepper = std::make_unique<BulletEngine<Spatial>>(mech->model(), s_.step.dt, q, v);
+  return std::make_unique<MechanismSimulation<Mechanism>>(engine, std::move(mech), std::move(stepper), std::make_unique<Hooks>(s_, z0),
+                                                          kColumns, s_.step.dt, s_.duration);
+}
+
+json PenOnTableLab::metrics(const Trace& tr) const {
+  const std::size_t n = tr.rows();
+  const double dt = s_.step.dt, f_zd = s_.controller.f_zd, t_draw = drawingStart();
+  const double t_end = n ? tr.at(n - 1, "t") : 0.0;
+  // Touchdown: the first row in contact (none: the run's end, and every force metric counts from the start).
+  std::size_t first = n;
+  for (std::size_t r = 0; r < n && first == n; ++r)
+    if (tr.at(r, "contact") > 0.5) first = r;
+  const double touchdown = first < n ? tr.at(first, "t") : t_end;
+  std::vector<double> ef, ef_draw, ep;
+  double overshoot = 0, lost = 0, pull = -INFINITY, tau = 0, drift = 0, residual = 0, radius = 0, gap_min = INFINITY, ss = 0;
+  std::size_t drawn = 0, ss_rows = 0;
+  const double e0 = n ? tr.at(0, "energy") : 0.0;
+  for (std::size_t r = 0; r < n; ++r) {
+    const double t = tr.at(r, "t"), e = tr.at(r, "f_z") - f_zd;
+    const bool contact = tr.at(r, "contact") > 0.5;
+    if (r >= first || first == n) ef.push_back(e);
+    if (r >= first && t <= touchdown + s_.overshoot_window) overshoot = std::max(overshoot, -e);
+    if (r >= first && !contact) lost += dt;
+    if (contact) pull = std::max(pull, tr.at(r, "f_z"));
+    if (t >= t_end - 1.0) ss += e, ++ss_rows;
+    if (t >= t_draw) {
+      ef_draw.push_back(e);
+      const Eigen::Vector2d p(tr.at(r, "x_p"), tr.at(r, "y_p")), d(tr.at(r, "x_d"), tr.at(r, "y_d"));
+      ep.push_back((p - d).norm());
+      radius += (p - s_.circle.centre).norm(), ++drawn;
+    }
+    for (const char* c : {"tau1", "tau2", "tau3"}) tau = std::max(tau, std::abs(tr.at(r, c)));
+    drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
+    residual = std::max(residual, tr.at(r, "constraint_residual"));
+    gap_min = std::min(gap_min, tr.at(r, "gap"));
+  }
+  radius = drawn ? radius / double(drawn) : 0.0;
+  return {{"touchdown_time", touchdown},
+          {"f_rms", rms(ef)},
+          {"f_rms_drawing", ef_draw.empty() ? std::abs(f_zd) : rms(ef_draw)},
+          {"f_overshoot", overshoot},
+          {"f_ss_error", ss_rows ? ss / double(ss_rows) : 0.0},
+          {"contact_lost_time", lost},
+          {"f_pull_max", std::isfinite(pull) ? pull : 0.0},
+          {"radius", radius},
+          {"radius_error", drawn ? std::abs(radius - s_.circle.radius) : s_.circle.radius},
+          {"track_rms", ep.empty() ? 0.0 : rms(ep)},
+          {"tau_max", tau},
+          {"gap_min", n ? gap_min : 0.0},
+          {"energy_drift", drift},
+          {"energy_initial", e0},
+          {"max_constraint_residual", residual},
+          {"steps", n}};
+}
+
+json PenOnTableLab::agreement(const Trace& a, const Trace& b) const {
+  const std::size_t n = std::min(a.rows(), b.rows());
+  const auto touchdown = [](const Trace& tr, std::size_t rows) {
+    for (std::size_t r = 0; r < rows; ++r)
+      if (tr.at(r, "contact") > 0.5) return tr.at(r, "t");
+    return rows ? tr.at(rows - 1, "t") : 0.0;
+  };
+  const double ta = touchdown(a, n), tb = touchdown(b, n), settled = std::max(ta, tb) + s_.overshoot_window;
+  double dq = 0, dp = 0, df = 0, df_sum = 0, mismatch = 0;
+  std::size_t compared = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    for (const char* c : {"q1", "q2", "q3"}) dq = std::max(dq, std::abs(a.at(r, c) - b.at(r, c)));
+    dp = std::max(dp, Eigen::Vector3d(a.at(r, "x_p") - b.at(r, "x_p"), a.at(r, "y_p") - b.at(r, "y_p"), a.at(r, "z_p") - b.at(r, "z_p")).norm());
+    const bool ca = a.at(r, "contact") > 0.5, cb = b.at(r, "contact") > 0.5;
+    if (ca != cb) mismatch += s_.step.dt;
+    // The force once both have touched down and settled: the touchdown impulse itself is excluded
+    // (the hand model takes it as a velocity jump, Bullet spreads it over two steps).
+    if (a.at(r, "t") >= settled && ca && cb) {
+      const double d = std::abs(a.at(r, "f_z") - b.at(r, "f_z"));
+      df = std::max(df, d), df_sum += d, ++compared;
+    }
+  }
+  json out = {{"rows_compared", n},
+              {"max_dq", dq},
+              {"max_dp", dp},
+              {"touchdown_hand", ta},
+              {"touchdown_bullet", tb},
+              {"d_touchdown", std::abs(ta - tb)},
+              {"max_df_settled", df},
+              {"mean_df_settled", compared ? df_sum / double(compared) : 0.0},
+              {"contact_mismatch_time", mismatch}};
+  out.update(engineHealth(metrics(a), metrics(b)));
+  return out;
+}
+
+std::string PenOnTableLab::agreementUnit(const std::string& key) const {
+  static const std::map<std::string, std::string> units = {
+      {"max_dq", "rad"},          {"max_dp", "m"},           {"touchdown_hand", "s"}, {"touchdown_bullet", "s"}, {"d_touchdown", "s"},
+      {"max_df_settled", "N"},    {"mean_df_settled", "N"},  {"contact_mismatch_time", "s"}};
+  return unitIn(units, key);
+}
+
+std::string PenOnTableLab::referenceEngine() const {
+  Mechanism mech(s_.params);
+  VecN q, v;
+  initialState(q, v);
+  return bullet::BulletMechanism<Spatial>(mech.model(), s_.step.dt, q, v).describe();
+}
+
+// Passive (τ = 0) under gravity the arm falls onto the table, and the plastic touchdown takes energy by
+// design; the check's patch takes gravity out and sets the arm turning about the column instead: a free
+// spatial arm, off the table, whose energy RK4 + projection keeps (tests/labs/pen_on_table_test.cpp).
+Lab::PassiveEnergy PenOnTableLab::passiveEnergy() const {
+  return {1e-9, 0.0, {{"mechanism", {{"gravity", 0.0}}}, {"initial", {{"rates", {0.6, -0.2, 0.1}}}}}};
+}
+
+DYNLAB_REGISTER_LAB(pen_on_table, "Pen on table: draw a circle while pressing with a set force (position accommodation, a unilateral contact)",
+                    [](const JsonView& config) -> std::unique_ptr<Lab> {
+                      return std::make_unique<PenOnTableLab>(parseSettings(config));
+                    });
+
+}  // namespace dyn::pen_on_table
