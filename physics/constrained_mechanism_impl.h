@@ -284,7 +284,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::constraint(const VecN& q, VecN& phi, M
   // G = [J, −A]: G v = J θ' − A v_c.
   G.resize(rows_, n() + k());
   G.leftCols(n()) = problem_.J;
-  G.rightCols(k()) = -MatN(problem_.A);
+  if (k()) G.rightCols(k()) = -MatN(problem_.A);
 }
 
 template <class S, int Nj, int Nr, int Nl>
