@@ -34,7 +34,8 @@ struct UiArgs {
 };
 
 struct FigureArgs {
-  std::string lab, config, gains, out, engine = "both", format = "pdf", title, scenario;
+  std::string lab, config, out, engine = "both", format = "pdf", title, scenario;
+  std::vector<std::string> gains;  // none or one: one run; several: each a run, overlaid on every plot
   std::string size;              // WxH of stills and plots (empty: 1920x1080 stills, 800x450 plots)
   std::string y_scale = "auto";  // plots: auto (log when the data span decades), linear or log
   double font_scale = 1.0;       // plots' text size

@@ -7,11 +7,14 @@
 // and stills at the start, middle and end. Everything is checked before anything is simulated or
 // written; output goes through Staging, and a figure run owns DIR/plot_* and DIR/still_*. Under
 // --scenario NAME the run is the rubric scenario's, as the grader runs it (commands.h applyScenario).
+// Several --gains files are several runs (damper vs spring): every plot overlays them, each curve
+// named by its file (grading/plot_curves.h runSeries); stills need one run.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <set>
+#include <tuple>
 
 #include "app/commands.h"
 #include "app/movie.h"
@@ -65,10 +68,11 @@ void addPlot(std::vector<FigurePlot>& plots, FigurePlot p, bool replace = false)
   if (!p.curves.empty()) plots.push_back(std::move(p));
 }
 
-// "plot_f_Ty+f_des" against t; "plot_y-vs-x+y_d-vs-x_d" for an x–y plot.
+// "plot_f_Ty+f_des" against t; "plot_y-vs-x+y_d-vs-x_d" for an x–y plot; "-where-contact" after a masked curve.
 std::string fileStem(const std::vector<PlotCurve>& curves) {
   std::vector<std::string> parts;
-  for (const auto& c : curves) parts.push_back(c.x == "t" ? c.y : c.y + "-vs-" + c.x);
+  for (const auto& c : curves)
+    parts.push_back((c.x == "t" ? c.y : c.y + "-vs-" + c.x) + (c.mask.empty() ? "" : "-where-" + c.mask));
   return "plot_" + join(parts, "+");
 }
 
@@ -85,8 +89,8 @@ std::vector<FigurePlot> rubricPlots(const LoadedLab& loaded) {
     const std::string x = r.x.empty() ? "t" : r.x, ref_x = r.reference_x.empty() ? x : r.reference_x;
     FigurePlot p{{}, r.ylabel, r.xlabel, ""};
     for (const auto& c : r.columns)
-      if (known(c) && (x == "t" || known(x))) p.curves.push_back({c, x});
-    if (!r.reference.empty() && known(r.reference) && (ref_x == "t" || known(ref_x))) p.curves.push_back({r.reference, ref_x});
+      if (known(c) && (x == "t" || known(x))) p.curves.push_back({c, x, ""});
+    if (!r.reference.empty() && known(r.reference) && (ref_x == "t" || known(ref_x))) p.curves.push_back({r.reference, ref_x, ""});
     addPlot(plots, p);
   }
   return plots;
@@ -108,7 +112,7 @@ std::vector<FigurePlot> overlayPlots(const Lab& lab, const Trace& trace) {
   lab.overlay(trace, 0, overlay);
   for (const Series& s : overlay.plots) {
     const std::string name = s.name.substr(0, s.name.find(" ("));
-    if (trace.column(name) >= 0) addPlot(plots, {{{name, "t"}}, s.name, "", ""});
+    if (trace.column(name) >= 0) addPlot(plots, {{{name, "t", ""}}, s.name, "", ""});
   }
   return plots;
 }
@@ -117,8 +121,8 @@ std::vector<FigurePlot> overlayPlots(const Lab& lab, const Trace& trace) {
 // rubric); without any, fillLabels derives them from the columns.
 FigurePlot labelled(const std::vector<PlotCurve>& curves, const std::vector<FigurePlot>& lab_plots) {
   const auto key = [](const std::vector<PlotCurve>& cs) {
-    std::set<std::pair<std::string, std::string>> k;
-    for (const auto& c : cs) k.insert({c.y, c.x});
+    std::set<std::tuple<std::string, std::string, std::string>> k;
+    for (const auto& c : cs) k.insert({c.y, c.x, c.mask});
     return k;
   };
   FigurePlot p{curves, "", "", ""};
@@ -136,11 +140,10 @@ void fillLabels(const Lab& lab, FigurePlot& p) {
   if (p.xlabel.empty()) p.xlabel = parametric(p.curves) ? axisLabel(lab, xColumns(p.curves)) : "t (s)";
 }
 
-// One plot of the runs: each curve a colour, hand solid and Bullet dashed; a curve the engines
-// share exactly (a reference, a setpoint) is drawn once, as both engines'. An x–y plot is linear,
-// with equal scales when its axes have one unit (metres against metres).
-PlotSpec plotSpec(const Lab& lab, const FigurePlot& p, const std::string& title, const RunResult* hand,
-                  const RunResult* bullet, const FigureArgs& a) {
+// One plot of the runs: runSeries's curves (hand solid, Bullet dashed; each run named when there are
+// several). An x–y plot is linear, with equal scales when its axes have one unit (metres against metres).
+PlotSpec plotSpec(const Lab& lab, const FigurePlot& p, const std::string& title, const std::vector<PlotRun>& runs,
+                  const FigureArgs& a) {
   PlotSpec spec;
   spec.title = title;
   spec.font_scale = a.font_scale;
@@ -149,22 +152,22 @@ PlotSpec plotSpec(const Lab& lab, const FigurePlot& p, const std::string& title,
   spec.ylabel = p.ylabel;
   spec.parametric = parametric(p.curves);
   spec.equal_aspect = spec.parametric && sameUnit(lab, xColumns(p.curves), yColumns(p.curves));
-  for (std::size_t k = 0; k < p.curves.size(); ++k) {
-    const PlotCurve& c = p.curves[k];
-    const std::string name = curvesText({c});
-    const auto series = [&](const RunResult* r, const std::string& col) {
-      return r ? r->trace.series(col) : std::vector<double>{};
-    };
-    const std::vector<double> hy = series(hand, c.y), by = series(bullet, c.y);
-    const std::vector<double> hx = series(hand, c.x), bx = series(bullet, c.x);
-    if (hand && bullet && hy == by && (c.x == "t" || hx == bx)) {
-      spec.series.push_back({name + " (hand, Bullet)", hx, hy, PlotSeries::Style::Solid, int(k)});
-      continue;
-    }
-    if (hand) spec.series.push_back({name + " (hand)", hx, hy, PlotSeries::Style::Solid, int(k)});
-    if (bullet) spec.series.push_back({name + " (Bullet)", bx, by, PlotSeries::Style::Dashed, int(k)});
-  }
+  spec.series = runSeries(p.curves, runs);
   return spec;
+}
+
+// A gains file in a legend: its last component, terminal-safe, at most 32 bytes; the path as given
+// when another run's file has the same name.
+std::string runName(const std::vector<std::string>& files, std::size_t i) {
+  const auto base = [](const std::string& f) { return fs::path(f).filename().string(); };
+  std::string s = base(files[i]);
+  for (std::size_t j = 0; j < files.size(); ++j)
+    if (j != i && base(files[j]) == s) s = files[i];
+  s = termText(s);
+  if (s.size() <= 32) return s;
+  std::size_t cut = s.size() - 31;
+  while (cut < s.size() && (static_cast<unsigned char>(s[cut]) & 0xC0) == 0x80) ++cut;  // not inside a character
+  return "…" + s.substr(cut);
 }
 
 // A figure run owns what an earlier one may have left: DIR/plot_*.{pdf,svg,png} and DIR/still_*.png.
@@ -185,7 +188,7 @@ std::vector<std::string> ownedFigures(const fs::path& dir) {
 
 int figure(const FigureArgs& a) {
   // Check every input before simulating or writing anything.
-  LoadedLab loaded;
+  std::vector<LoadedLab> loads;  // one per gains file (none: the lab's own gains)
   std::pair<int, int> size{1920, 1080}, plot_size{800, 450};
   std::vector<std::vector<PlotCurve>> requested;
   std::vector<double> stills = a.stills;
@@ -201,8 +204,22 @@ int figure(const FigureArgs& a) {
       if (draws_plots && (size.first < 100 || size.second < 100))
         badOption("--size", a.size, "expected at least 100x100 for a plot");
     }
-    loaded = loadLab(a.lab, a.config, a.gains, a.duration);
-    applyScenario(loaded, a.scenario, a.gains, a.duration);
+    // Each gains file once (the same file twice, however spelled, is a mistake); several: no stills.
+    std::set<fs::path> seen;
+    for (const auto& g : a.gains) {
+      std::error_code ec;
+      const fs::path key = fs::weakly_canonical(fs::path(g), ec);
+      if (!seen.insert(ec ? fs::path(g) : key).second)
+        badOption("--gains", g, "expected each gains file once (it is given twice)");
+    }
+    if (a.gains.size() > 1 && !a.stills.empty())
+      badOption("--still", fmt("%g", a.stills.front()), "expected one --gains file with --still (a still shows one run)");
+    const std::vector<std::string> gains_files = a.gains.empty() ? std::vector<std::string>{""} : a.gains;
+    for (const auto& g : gains_files) {
+      loads.push_back(loadLab(a.lab, a.config, g, a.duration));
+      applyScenario(loads.back(), a.scenario, g, a.duration);
+    }
+    const LoadedLab& loaded = loads.front();
     const std::vector<std::string> columns = loaded.lab->columns();
     for (const auto& spec : a.plots) requested.push_back(parsePlotCurves(spec, columns, "<command line>", "--plot " + spec));
     const double duration = loaded.lab->duration();
@@ -216,26 +233,34 @@ int figure(const FigureArgs& a) {
     for (const auto& curves : requested) plots.push_back(labelled(curves, known));
     own_set = a.plots.empty() && stills.empty();
     if (own_set) {
-      stills = {0.0, 0.5 * duration, duration};
+      if (loads.size() == 1) stills = {0.0, 0.5 * duration, duration};
       plots = rubric_plots;
     }
   } catch (const InputError& e) {
     std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
     return 2;
   }
-  const Lab& lab = *loaded.lab;
+  const Lab& lab = *loads.front().lab;
   const fs::path out = a.out.empty() ? defaultOut(a.lab, a.scenario, "figures") : fs::path(a.out);
   const std::string lab_title = a.scenario.empty() ? a.lab : a.lab + " (" + a.scenario + ")";
   try {
     // A bar on a terminal for each stage (nothing otherwise): the runs, then the figures.
-    auto run = [&](Engine engine) {
+    auto run = [&](const Lab& l, Engine engine) {
       Progress bar(std::string("simulating ") + (engine == Engine::Hand ? "hand" : "Bullet"),
-                   std::size_t(std::max(1L, std::lround(lab.duration() / lab.dt()))));
-      return runEngine(lab, engine, -1, [&](long steps) { bar.set(std::size_t(steps)); });
+                   std::size_t(std::max(1L, std::lround(l.duration() / l.dt()))));
+      return runEngine(l, engine, -1, [&](long steps) { bar.set(std::size_t(steps)); });
     };
-    std::optional<RunResult> hand, bullet;
-    if (a.engine != "bullet") hand = run(Engine::Hand);
-    if (a.engine != "hand") bullet = run(Engine::Bullet);
+    // Each gains file's runs (in the order given); the first one's are the stills'.
+    std::vector<std::optional<RunResult>> hands(loads.size()), bullets(loads.size());
+    std::vector<PlotRun> runs;
+    for (std::size_t i = 0; i < loads.size(); ++i) {
+      if (a.engine != "bullet") hands[i] = run(*loads[i].lab, Engine::Hand);
+      if (a.engine != "hand") bullets[i] = run(*loads[i].lab, Engine::Bullet);
+    }
+    for (std::size_t i = 0; i < loads.size(); ++i)
+      runs.push_back({loads.size() > 1 ? runName(a.gains, i) : "", hands[i] ? &hands[i]->trace : nullptr,
+                      bullets[i] ? &bullets[i]->trace : nullptr});
+    const std::optional<RunResult>&hand = hands.front(), &bullet = bullets.front();
     const RunResult& shown = hand ? *hand : *bullet;
 
     // The lab's own set: its rubric's plots (else its overlay's), then the figures it declares
@@ -260,7 +285,7 @@ int figure(const FigureArgs& a) {
       const std::string title =
           !a.title.empty() ? a.title : lab_title + ": " + (p.title.empty() ? curvesText(p.curves) : p.title);
       writePlot(staging.path(name).string(),
-                plotSpec(lab, p, title, hand ? &*hand : nullptr, bullet ? &*bullet : nullptr, a), plot_size.first,
+                plotSpec(lab, p, title, runs, a), plot_size.first,
                 plot_size.second);
       written.push_back(name);
     }
@@ -285,8 +310,10 @@ int figure(const FigureArgs& a) {
     staging.commit();
 
     std::string status = "ok";
-    for (const auto* r : {&hand, &bullet})
-      if (*r && !(*r)->failure.empty()) status = std::string(r == &hand ? "hand" : "bullet") + ": " + (*r)->failure;
+    for (std::size_t i = 0; i < loads.size(); ++i)
+      for (const auto* r : {&hands[i], &bullets[i]})
+        if (*r && !(*r)->failure.empty())
+          status = (runs[i].name.empty() ? "" : runs[i].name + ", ") + (r == &hands[i] ? "hand" : "bullet") + ": " + (*r)->failure;
     std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n", termText(lab_title).c_str(), lab.duration(),
                 lab.dt(), a.engine.c_str(), status.c_str());
     for (const auto& name : written) std::printf("  %s\n", (out / name).c_str());

@@ -67,7 +67,9 @@ int dispatch(int argc, char** argv) {
                                          "and end");
   f->add_option("LAB", fig.lab, "Lab name (see `dynlab list`)")->required();
   f->add_option("--config", fig.config, "Lab config JSON (default: labs/LAB/LAB.json)");
-  f->add_option("--gains", fig.gains, "Gains JSON: {\"gains\": {...}} as in a submission");
+  f->add_option("--gains", fig.gains, "Gains JSON: {\"gains\": {...}} as in a submission (repeatable: each file a run, "
+                                     "overlaid on every plot and named in the legend by its file, e.g. damper vs spring)")
+      ->allow_extra_args(false);
   f->add_option("--duration", fig.duration, "Override the simulated duration (s)");
   f->add_option("--engine", fig.engine, "Which engine(s) to run: hand solid, Bullet dashed (plots) or as a ghost (stills)")
       ->check(CLI::IsMember({"hand", "bullet", "both"}));

@@ -2,6 +2,7 @@
 #include "grading/plot_curves.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace dyn {
 namespace {
@@ -38,7 +39,7 @@ std::vector<PlotCurve> parsePlotCurves(const std::string& spec, const std::vecto
                                        const std::string& file, const std::string& path) {
   const std::string grammar =
       "expected trace columns separated by commas, each against t or as Y:X for column Y against column X "
-      "(\"y:x, y_d:x_d\")";
+      "(\"y:x, y_d:x_d\"), optionally @M to draw it only where column M is nonzero (\"y:x@contact\")";
   // Each name is a column of the lab; the error lists them.
   const auto column = [&](const std::string& raw) {
     const std::string name = trim(raw);
@@ -51,9 +52,13 @@ std::vector<PlotCurve> parsePlotCurves(const std::string& spec, const std::vecto
   std::vector<PlotCurve> curves;
   std::string against_t, against_column;  // one curve of each kind, for the error that mixes them
   for (const std::string& item : split(spec, ',')) {
-    const std::vector<std::string> sides = split(item, ':');
+    // "Y:X@M": the mask after '@', then the sides.
+    const std::vector<std::string> masked = split(item, '@');
+    if (masked.size() > 2) throw InputError(file, path, "\"" + trim(item) + "\" has two '@'; " + grammar);
+    const std::vector<std::string> sides = split(masked[0], ':');
     if (sides.size() > 2) throw InputError(file, path, "\"" + trim(item) + "\" has two ':'; " + grammar);
-    PlotCurve c{column(sides[0]), sides.size() == 2 ? column(sides[1]) : "t"};
+    PlotCurve c{column(sides[0]), sides.size() == 2 ? column(sides[1]) : "t",
+                masked.size() == 2 ? column(masked[1]) : ""};
     (c.x == "t" ? against_t : against_column) = trim(item);
     if (std::find(curves.begin(), curves.end(), c) == curves.end()) curves.push_back(c);
   }
@@ -82,8 +87,84 @@ std::vector<std::string> xColumns(const std::vector<PlotCurve>& curves) {
 
 std::string curvesText(const std::vector<PlotCurve>& curves) {
   std::vector<std::string> parts;
-  for (const auto& c : curves) parts.push_back(c.x == "t" ? c.y : c.y + " vs " + c.x);
+  for (const auto& c : curves)
+    parts.push_back((c.x == "t" ? c.y : c.y + " vs " + c.x) + (c.mask.empty() ? "" : " where " + c.mask));
   return join(parts, ", ");
+}
+
+CurvePoints curvePoints(const Trace& trace, const PlotCurve& curve) {
+  CurvePoints p{trace.series(curve.x), trace.series(curve.y)};
+  if (curve.mask.empty()) return p;
+  const std::vector<double> mask = trace.series(curve.mask);
+  for (std::size_t i = 0; i < mask.size(); ++i)
+    if (!(std::isfinite(mask[i]) && mask[i] != 0)) {
+      p.y[i] = NAN;
+      if (curve.x != "t") p.x[i] = NAN;
+    }
+  return p;
+}
+
+namespace {
+
+// The same points, a NaN (a masked point) equal to a NaN.
+bool samePoints(const CurvePoints& a, const CurvePoints& b) {
+  const auto same = [](const std::vector<double>& u, const std::vector<double>& v) {
+    return u.size() == v.size() &&
+           std::equal(u.begin(), u.end(), v.begin(), [](double p, double q) { return p == q || (std::isnan(p) && std::isnan(q)); });
+  };
+  return same(a.x, b.x) && same(a.y, b.y);
+}
+
+}  // namespace
+
+std::vector<PlotSeries> runSeries(const std::vector<PlotCurve>& curves, const std::vector<PlotRun>& runs) {
+  std::vector<PlotSeries> out;
+  const bool several = runs.size() > 1;
+  int colour = 0;
+  for (std::size_t k = 0; k < curves.size(); ++k) {
+    const std::string name = curvesText({curves[k]});
+    // Every engine's points of this curve, in run order, hand before Bullet.
+    struct Source {
+      std::size_t run;
+      bool bullet;
+      CurvePoints points;
+    };
+    std::vector<Source> sources;
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      if (runs[r].hand) sources.push_back({r, false, curvePoints(*runs[r].hand, curves[k])});
+      if (runs[r].bullet) sources.push_back({r, true, curvePoints(*runs[r].bullet, curves[k])});
+    }
+    const auto all_same = [&](std::size_t run, bool any_run) {
+      std::size_t n = 0;
+      const Source* first = nullptr;
+      for (const auto& s : sources)
+        if (any_run || s.run == run) {
+          if (first && !samePoints(first->points, s.points)) return false;
+          first = first ? first : &s, ++n;
+        }
+      return n > 1;
+    };
+    const auto style = [](bool bullet) { return bullet ? PlotSeries::Style::Dashed : PlotSeries::Style::Solid; };
+    // Several runs that all agree: one curve for all of them.
+    if (several && all_same(0, true)) {
+      out.push_back({name + " (every run)", sources[0].points.x, sources[0].points.y, PlotSeries::Style::Solid, colour++});
+      continue;
+    }
+    // Each run: its engines once when they agree, else each (one colour per run and curve).
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      const std::string prefix = several ? runs[r].name + ", " : "";
+      const int c = several ? colour++ : int(k);
+      if (all_same(r, false)) {
+        const Source& s = *std::find_if(sources.begin(), sources.end(), [&](const Source& s) { return s.run == r; });
+        out.push_back({name + " (" + prefix + "hand, Bullet)", s.points.x, s.points.y, PlotSeries::Style::Solid, c});
+        continue;
+      }
+      for (const auto& s : sources)
+        if (s.run == r)
+          out.push_back({name + " (" + prefix + (s.bullet ? "Bullet" : "hand") + ")", s.points.x, s.points.y, style(s.bullet), c});
+    }
+  }
+  return out;
 }
 
 std::string axisLabel(const Lab& lab, const std::vector<std::string>& columns) {
