@@ -93,6 +93,8 @@ std::string curvesText(const std::vector<PlotCurve>& curves) {
 }
 
 CurvePoints curvePoints(const Trace& trace, const PlotCurve& curve) {
+  for (const auto* c : {&curve.x, &curve.y, &curve.mask})
+    if (!c->empty()) trace.require(*c);  // a column the trace lacks: std::out_of_range naming it
   CurvePoints p{trace.series(curve.x), trace.series(curve.y)};
   if (curve.mask.empty()) return p;
   const std::vector<double> mask = trace.series(curve.mask);
