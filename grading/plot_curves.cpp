@@ -147,9 +147,9 @@ std::vector<PlotSeries> runSeries(const std::vector<PlotCurve>& curves, const st
       return n > 1;
     };
     const auto style = [](bool bullet) { return bullet ? PlotSeries::Style::Dashed : PlotSeries::Style::Solid; };
-    // Several runs that all agree: one curve for all of them.
+    // Several runs that all agree (a set point): one curve for all of them, dashed (drawn on top).
     if (several && all_same(0, true)) {
-      out.push_back({name + " (every run)", sources[0].points.x, sources[0].points.y, PlotSeries::Style::Solid, colour++});
+      out.push_back({name + " (every run)", sources[0].points.x, sources[0].points.y, PlotSeries::Style::Dashed, colour++});
       continue;
     }
     // Each run: its engines once when they agree, else each (one colour per run and curve).

@@ -58,8 +58,8 @@ struct PlotRun {
 // Every run's series of the curves, hand solid and Bullet dashed. One run: each curve a colour,
 // "y (hand)", "y (Bullet)", or once as "y (hand, Bullet)" when both engines give the same points (a
 // reference, a setpoint). Several runs (gains files overlaid): each curve of each run a colour,
-// "y (NAME, hand)", "y (NAME, Bullet)" (or "y (NAME, hand, Bullet)"), and once as "y (every run)"
-// when every run and engine gives the same points.
+// "y (NAME, hand)", "y (NAME, Bullet)" (or "y (NAME, hand, Bullet)"), and once, dashed, as
+// "y (every run)" when every run and engine gives the same points (a set point).
 std::vector<PlotSeries> runSeries(const std::vector<PlotCurve>& curves, const std::vector<PlotRun>& runs);
 
 // An axis label of columns with the lab's units: "x, x_d (m)" when they share one, else each its

@@ -132,6 +132,8 @@ TEST_CASE("runSeries, several runs: each curve of each run named by its run; one
   CHECK(s[0].label == "y (damper.json, hand)");
   CHECK(s[1].label == "y (spring.json, hand)");
   CHECK(s[2].label == "x (every run)");
+  CHECK(s[2].style == PlotSeries::Style::Dashed);  // a set point on top of the responses
+  CHECK(s[0].style == PlotSeries::Style::Solid);
   CHECK(s[0].y == a.series("y"));
   CHECK(s[1].y == b.series("y"));
   CHECK(s[0].color != s[1].color);
