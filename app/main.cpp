@@ -76,8 +76,9 @@ int dispatch(int argc, char** argv) {
   f->add_option("--out", fig.out, "Output directory (default: out/LAB/figures)");
   f->add_option("--plot", fig.plots, "Trace columns to plot against t, e.g. theta,theta_d, or Y:X for column Y "
                                      "against column X, e.g. \"y:x, y_d:x_d\" (the path in the plane; equal scales "
-                                     "when both axes have one unit) (repeatable: one plot each); written as "
-                                     "plot_<cols joined by +>.<format> (Y:X as Y-vs-X)")
+                                     "when both axes have one unit); a curve followed by @M is drawn only where "
+                                     "column M is nonzero, e.g. \"y_p:x_p@contact\" (repeatable: one plot each); "
+                                     "written as plot_<cols joined by +>.<format> (Y:X as Y-vs-X, @M as -where-M)")
       ->allow_extra_args(false);
   f->add_option("--still", fig.stills, "Render the scene at this time (s), nearest trace row (repeatable); "
                                        "written as still_<t>.png")
