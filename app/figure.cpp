@@ -274,7 +274,7 @@ int figure(const FigureArgs& a) {
     Staging staging(out);
     const std::vector<std::string> earlier = ownedFigures(out);
     staging.owns(earlier);
-    std::vector<std::string> written;
+    std::vector<std::string> written, skipped;
     std::set<std::string> names;
     Progress bar("figures", plots.size() + stills.size());
     std::size_t made = 0;
@@ -284,9 +284,19 @@ int figure(const FigureArgs& a) {
       if (!names.insert(name).second) continue;
       const std::string title =
           !a.title.empty() ? a.title : lab_title + ": " + (p.title.empty() ? curvesText(p.curves) : p.title);
-      writePlot(staging.path(name).string(),
-                plotSpec(lab, p, title, runs, a), plot_size.first,
-                plot_size.second);
+      const PlotSpec spec = plotSpec(lab, p, title, runs, a);
+      // Masks that are 0 all run long leave nothing to draw: said below, never an empty picture.
+      const auto drawn = [](const PlotSeries& ser) {
+        for (std::size_t i = 0; i < ser.x.size(); ++i)
+          if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i])) return true;
+        return false;
+      };
+      const bool masked = std::any_of(p.curves.begin(), p.curves.end(), [](const PlotCurve& c) { return !c.mask.empty(); });
+      if (masked && std::none_of(spec.series.begin(), spec.series.end(), drawn)) {
+        skipped.push_back(name + " (" + curvesText(p.curves) + ": nothing to draw, its masks are 0 throughout)");
+        continue;
+      }
+      writePlot(staging.path(name).string(), spec, plot_size.first, plot_size.second);
       written.push_back(name);
     }
     if (!stills.empty()) {
@@ -317,6 +327,7 @@ int figure(const FigureArgs& a) {
     std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n", termText(lab_title).c_str(), lab.duration(),
                 lab.dt(), a.engine.c_str(), status.c_str());
     for (const auto& name : written) std::printf("  %s\n", (out / name).c_str());
+    for (const auto& why : skipped) std::printf("  not written: %s\n", termText(why).c_str());
     // An earlier figure run's figures this one did not remake are gone: said, never silent.
     std::string removed;
     for (const auto& name : earlier)

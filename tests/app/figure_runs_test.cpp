@@ -68,7 +68,14 @@ TEST_CASE("dynlab figure --plot Y:X@M: the pen's ink where contact, named; the l
   CHECK(has(svg, "y_p vs x_p where contact (hand)"));
   CHECK(has(svg, "x (m)"));  // the lab's labels for exactly these curves (its "figures")
   CHECK_FALSE(has(svg, "x_p, x_d (m)"));
-  // The lab's own set, two runs (so no stills): the ink is one of its figures, each run's named.
+  // Before touchdown the mask is 0 throughout: nothing drawn, and said so (the other plot is written).
+  const Result early = dynlab(dir, "figure pen_on_table --engine hand --duration 0.05 --out early --format svg "
+                                   "--plot 'y_p:x_p@contact' --plot z_p");
+  INFO("stdout: ", early.out, "\nstderr: ", early.err);
+  CHECK(early.code == 0);
+  CHECK(names(dir / "early") == std::vector<std::string>{"plot_z_p.svg"});
+  CHECK(has(early.out, "not written: plot_y_p-vs-x_p-where-contact.svg (y_p vs x_p where contact: nothing to draw"));
+    // The lab's own set, two runs (so no stills): the ink is one of its figures, each run's named.
   const Result two = dynlab(dir, "figure pen_on_table --gains " + quote(kPen + "mediocre.json") + " --gains " +
                                      quote(kPen + "spring.json") + " --engine hand --duration 0.5 --out two --format svg");
   INFO("stdout: ", two.out, "\nstderr: ", two.err);
