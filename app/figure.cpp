@@ -260,7 +260,8 @@ int figure(const FigureArgs& a) {
     for (std::size_t i = 0; i < loads.size(); ++i)
       runs.push_back({loads.size() > 1 ? runName(a.gains, i) : "", hands[i] ? &hands[i]->trace : nullptr,
                       bullets[i] ? &bullets[i]->trace : nullptr});
-    const std::optional<RunResult>&hand = hands.front(), &bullet = bullets.front();
+    const std::optional<RunResult>& hand = hands.front();
+    const std::optional<RunResult>& bullet = bullets.front();
     const RunResult& shown = hand ? *hand : *bullet;
 
     // The lab's own set: its rubric's plots (else its overlay's), then the figures it declares
