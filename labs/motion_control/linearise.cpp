@@ -38,6 +38,9 @@ std::vector<LinearLoop> MotionControlLab::linearise() const {
         default:
           l = {l.name, "joint loop (no feedback)" + where, {}, {0, b, m}, l.delay};
       }
+      // A pole–zero pair at s = 0 (pid without k_I) cancels: the loop is PD.
+      while (l.num.size() > 1 && l.den.size() > 1 && l.num[0] == 0 && l.den[0] == 0)
+        l.num.erase(l.num.begin()), l.den.erase(l.den.begin());
       loops.push_back(l);
     }
   }
