@@ -102,13 +102,14 @@ Eigen::VectorXd staticDeflection(const Params& p, const Eigen::VectorXd& theta) 
   Eigen::VectorXd d = Eigen::VectorXd::Zero(n);
   if (!p.flexible) return d;
   ArmMechanism mech(describe(p));
-  // Fixed point: the springs carry the gravity torque across each joint at the deflected pose.
-  for (int it = 0; it < 50; ++it) {
+  // Fixed point: the springs carry the gravity torque across each joint at the deflected pose
+  // (G of the spring joints, springs excluded: k_i δ_i + G_i = 0).
+  for (int it = 0; it < 200; ++it) {
     VecN q, v;
     treeState(p, theta, d, q, v);
     const VecN G = mech.gravityTorque(q);
     Eigen::VectorXd next(n);
-    for (int i = 0; i < n; ++i) next[i] = -(G[2 * i + 1] - p.stiffness[std::size_t(i)] * d[i]) / p.stiffness[std::size_t(i)];
+    for (int i = 0; i < n; ++i) next[i] = -G[2 * i + 1] / p.stiffness[std::size_t(i)];
     const double change = (next - d).cwiseAbs().maxCoeff();
     d = next;
     if (change < 1e-14) break;
