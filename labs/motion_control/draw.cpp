@@ -11,7 +11,7 @@ namespace dyn::motion_control {
 namespace {
 
 const Color kLink{0.23f, 0.42f, 0.68f, 1.0f}, kJoint{0.15f, 0.15f, 0.18f, 1.0f}, kSat{0.85f, 0.15f, 0.15f, 1.0f};
-const Color kDesired{0.20f, 0.65f, 0.30f, 0.35f}, kGhost{0.55f, 0.35f, 0.75f, 0.35f}, kSpring{0.85f, 0.55f, 0.20f, 1.0f};
+const Color kDesired{0.20f, 0.65f, 0.30f, 0.55f}, kGhost{0.55f, 0.35f, 0.75f, 0.35f}, kSpring{0.85f, 0.55f, 0.20f, 1.0f};
 const Color kBase{0.55f, 0.55f, 0.55f, 1.0f};
 
 Eigen::Vector3d at(const Eigen::Vector2d& p, double z = 0) { return {p.x(), p.y(), z}; }
@@ -31,14 +31,19 @@ void drawArm(const std::vector<Eigen::Vector2d>& p, Color link, Color joint, dou
 
 void MotionControlLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene& s) const {
   const int n = s_.plant.n();
-  double reach = 0;
-  for (const Link& l : s_.plant.links) reach += l.length;
   s.camera.ortho = true;
   s.camera.eye = {0, 0, 5};
   s.camera.target = {0, 0, 0};
   s.framing.fit = true;
-  s.framing.bounds.extend(Eigen::Vector3d(-reach - 0.05, -reach - 0.05, 0));
-  s.framing.bounds.extend(Eigen::Vector3d(reach + 0.05, reach + 0.05, 0));
+  // The space the arm and its desired pose sweep over the whole run (both engines), and the mount.
+  const Eigen::Vector3d pad(0.05, 0.05, 0.05);
+  for (const Trace* t : {&tr, ghost}) {
+    if (!t || t->rows() == 0) continue;
+    for (std::size_t r = 0; r < t->rows(); r += std::max<std::size_t>(1, t->rows() / 200))
+      for (const char* base : {"q", "qd"})
+        for (const auto& p : jointPoints(s_.plant, angles(*t, r, base, n))) s.framing.bounds.extend(at(p) - pad), s.framing.bounds.extend(at(p) + pad);
+  }
+  s.framing.bounds.extend(Eigen::Vector3d(-0.1, -0.1, 0));
   s.boxes.push_back({{0, -0.03, -0.03}, {0.05, 0.03, 0.02}, Eigen::Matrix3d::Identity(), kBase});
   // Desired pose and the Bullet run behind the arm.
   drawArm(jointPoints(s_.plant, angles(tr, row, "qd", n)), kDesired, kDesired, 0.012, -0.06, s);
