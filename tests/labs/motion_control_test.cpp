@@ -8,9 +8,14 @@
 //    outboard of joint i)/k_i, by hand;
 //  * anti-windup: clamping keeps |u_I| ≤ τ_max, back-calculation within (k_P + k_I T_t)e of it, none grows;
 //  * hand vs Bullet over 1 s of PID tracking: |Δθ| ≤ 5 mrad (Bullet's first-order step at dt = 1 ms);
+//  * the fixed–free spring chain (lecture §1): small-oscillation frequencies from eig(M⁻¹K) equal
+//    2√(k/J) sin((2j−1)π/(2(2N+1))) (equal J, k) to 1e-10, and the simulated chain released in its
+//    first mode swings at ω_1 (one period within 1e-4 relative);
 //  * bad inputs get one line naming the JSON path.
 #include <doctest/doctest.h>
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -202,4 +207,47 @@ TEST_CASE("motion_control: bad inputs get one line naming the path") {
   CHECK(inputError({{"controller", {{"kind", "lqr"}}}}).rfind("/controller/kind", 0) == 0);
   CHECK(inputError({{"trajectory", {{"move_time", 0.0}}}}).rfind("/trajectory/move_time", 0) == 0);
   CHECK(inputError(json::object()) == "accepted");
+}
+
+TEST_CASE("motion_control: the fixed-free spring chain's frequencies are eig(M^-1 K) and the closed form") {
+  // N coaxial discs (inertia J each, no gravity) on revolute joints with springs k: relative angles in
+  // the tree, absolute in the lecture; eig(M⁻¹K) is the same in both (a change of coordinates).
+  const int N = 5;
+  const double J = 0.02, k = 30.0;
+  MechanismModel<Planar> d;
+  for (int i = 0; i < N; ++i) {
+    d.tree.addBody(i - 1, JointType::Revolute, Planar::Axis::Zero(), Planar::translation(Planar::Pos::Zero()),
+                   Planar::inertia(1.0, Eigen::Vector2d::Zero(), J));
+    JointProperties spring;
+    spring.stiffness = k;
+    d.joints.push_back(spring);
+  }
+  d.tree.gravity.setZero();
+  ArmMechanism chain(d);
+  const Eigen::MatrixXd M = Eigen::MatrixXd(chain.massMatrix(VecN::Zero(N)));
+  const Eigen::MatrixXd K = k * Eigen::MatrixXd::Identity(N, N);
+  Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(K, M);
+  for (int j = 1; j <= N; ++j) {
+    const double closed = 2 * std::sqrt(k / J) * std::sin((2 * j - 1) * M_PI / (2 * (2 * N + 1)));
+    CHECK(std::sqrt(eig.eigenvalues()[j - 1]) == doctest::Approx(closed).epsilon(1e-10));
+  }
+  // Released at rest in mode 1 (small amplitude), the chain returns to it after one period 2π/ω_1.
+  const double w1 = std::sqrt(eig.eigenvalues()[0]);
+  const Eigen::VectorXd shape = 0.01 * eig.eigenvectors().col(0);
+  VecN q = shape, v = VecN::Zero(N);
+  StepOptions o;
+  o.dt = 1e-4;
+  o.integrator = Integrator::RK4;
+  const VecN tau = VecN::Zero(N);
+  // Time the first downward zero crossing of the first joint after half a period, then a full period later.
+  double t = 0, prev = q[0];
+  std::vector<double> crossings;
+  while (crossings.size() < 2 && t < 10) {
+    REQUIRE(dyn::step(chain, o, tau, q, v));
+    t += o.dt;
+    if ((prev > 0) != (q[0] > 0)) crossings.push_back(t - o.dt * q[0] / (q[0] - prev));
+    prev = q[0];
+  }
+  REQUIRE(crossings.size() == 2);
+  CHECK(2 * (crossings[1] - crossings[0]) == doctest::Approx(2 * M_PI / w1).epsilon(1e-4));
 }
