@@ -35,15 +35,27 @@ void MotionControlLab::scene(const Trace& tr, std::size_t row, const Trace* ghos
   s.camera.eye = {0, 0, 5};
   s.camera.target = {0, 0, 0};
   s.framing.fit = true;
-  // The space the arm and its desired pose sweep over the whole run (both engines), and the mount.
-  const Eigen::Vector3d pad(0.05, 0.05, 0.05);
-  for (const Trace* t : {&tr, ghost}) {
-    if (!t || t->rows() == 0) continue;
-    for (std::size_t r = 0; r < t->rows(); r += std::max<std::size_t>(1, t->rows() / 200))
-      for (const char* base : {"q", "qd"})
-        for (const auto& p : jointPoints(s_.plant, angles(*t, r, base, n))) s.framing.bounds.extend(at(p) - pad), s.framing.bounds.extend(at(p) + pad);
+  // The desired paths of the joints and the tip over the whole run (faint green): where the arm is
+  // asked to go. They span the space the run sweeps, which the renderer frames (a still camera).
+  const Trajectory& T = s_.trajectory;
+  std::vector<Polyline> paths(static_cast<std::size_t>(n));
+  for (int k = 0; k <= 200; ++k) {
+    Eigen::VectorXd q, qd, qdd;
+    T.at(s_.duration * k / 200.0, q, qd, qdd);
+    const auto pts = jointPoints(s_.plant, q);
+    for (int i = 0; i < n; ++i) paths[std::size_t(i)].points.push_back(at(pts[std::size_t(i) + 1], -0.08));
   }
-  s.framing.bounds.extend(Eigen::Vector3d(-0.1, -0.1, 0));
+  auto extend = [&](const Eigen::Vector3d& p) {
+    s.framing.bounds.extend(p - Eigen::Vector3d(0.03, 0.03, 0.03)), s.framing.bounds.extend(p + Eigen::Vector3d(0.03, 0.03, 0.03));
+  };
+  for (auto& path : paths) {
+    for (const auto& p : path.points) extend(p);
+    path.color = {0.20f, 0.65f, 0.30f, 0.45f};
+    s.polylines.push_back(std::move(path));
+  }
+  for (const Trace* t : {&tr, ghost})
+    if (t && row < t->rows())
+      for (const auto& p : jointPoints(s_.plant, angles(*t, row, "q", n))) extend(at(p));
   s.boxes.push_back({{0, -0.03, -0.03}, {0.05, 0.03, 0.02}, Eigen::Matrix3d::Identity(), kBase});
   // Desired pose and the Bullet run behind the arm.
   drawArm(jointPoints(s_.plant, angles(tr, row, "qd", n)), kDesired, kDesired, 0.012, -0.06, s);
