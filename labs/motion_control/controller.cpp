@@ -1,0 +1,99 @@
+// The arm's controllers and trajectory; equations in controller.h.
+#include "labs/motion_control/controller.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace dyn::motion_control {
+namespace {
+
+// Quintic blend s(u), u ∈ [0, 1], with zero rate and acceleration at both ends, and its derivatives.
+void quintic(double u, double& s, double& sd, double& sdd) {
+  u = std::clamp(u, 0.0, 1.0);
+  s = u * u * u * (10 - 15 * u + 6 * u * u);
+  sd = 30 * u * u * (1 - u) * (1 - u);
+  sdd = 60 * u * (1 - u) * (1 - 2 * u);
+}
+
+double sat(double x) { return std::clamp(x, -1.0, 1.0); }
+
+}  // namespace
+
+void Trajectory::at(double t, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen::VectorXd& qdd) const {
+  const Eigen::VectorXd d = folded - outstretched;
+  double s = 0, sd = 0, sdd = 0;
+  if (t < t2()) {
+    quintic(t / move_time, s, sd, sdd);
+    q = outstretched + s * d, qd = sd / move_time * d, qdd = sdd / (move_time * move_time) * d;
+  } else if (t < t4()) {
+    quintic((t - t2()) / move_time, s, sd, sdd);
+    q = folded - s * d, qd = -sd / move_time * d, qdd = -sdd / (move_time * move_time) * d;
+  } else {
+    const double w = 2 * M_PI / period, tau = t - t4();
+    q = outstretched + 0.5 * (1 - std::cos(w * tau)) * amplitude;
+    qd = 0.5 * w * std::sin(w * tau) * amplitude;
+    qdd = 0.5 * w * w * std::cos(w * tau) * amplitude;
+  }
+}
+
+Controller::Controller(const ControllerConfig& c, const Trajectory& traj, const Params& model)
+    : c_(c), traj_(traj), model_params_(model), model_(std::make_unique<ArmMechanism>(describeRigid(model))),
+      u_i_(Eigen::VectorXd::Zero(model.n())) {}
+
+Eigen::VectorXd Controller::torque(double t, const Eigen::VectorXd& th, const Eigen::VectorXd& thd) {
+  const int n = int(th.size());
+  const double dt = last_t_ < 0 ? 0.0 : t - last_t_;
+  last_t_ = t;
+  Eigen::VectorXd q_d, qd_d, qdd_d;
+  traj_.at(t, q_d, qd_d, qdd_d);
+  const Eigen::VectorXd e = th - q_d, ed = thd - qd_d;
+  Eigen::VectorXd tau = Eigen::VectorXd::Zero(n);
+  const auto& fr = model_params_.friction;
+  switch (c_.kind) {
+    case Kind::None: break;
+    case Kind::Constant: tau = c_.constant; break;
+    case Kind::Pid:
+      tau = -(c_.kp.cwiseProduct(e) + c_.kd.cwiseProduct(ed)) + u_i_;
+      if (c_.coulomb_compensation)
+        for (int i = 0; i < n; ++i) tau[i] += fr[std::size_t(i)].coulomb * sat(qd_d[i] / c_.compensation_width);
+      break;
+    case Kind::ComputedTorque: {
+      const Eigen::VectorXd a = qdd_d - c_.kp.cwiseProduct(e) - c_.kd.cwiseProduct(ed);
+      tau = model_->inverseDynamics(VecN(th), VecN(thd), VecN(a));
+      for (int i = 0; i < n; ++i)
+        tau[i] += fr[std::size_t(i)].viscous * thd[i] +
+                  fr[std::size_t(i)].coulomb * sat(thd[i] / std::max(model_params_.coulomb_width, 1e-12));
+      break;
+    }
+    case Kind::PdGravity:
+      tau = -c_.kp.cwiseProduct(e) - c_.kd.cwiseProduct(thd) + Eigen::VectorXd(model_->gravityTorque(VecN(th)));
+      break;
+  }
+  // The plant interface: each joint clipped to ±τ_max.
+  const Eigen::VectorXd raw = tau;
+  for (int i = 0; i < n; ++i) tau[i] = std::clamp(tau[i], -c_.tau_max[i], c_.tau_max[i]);
+  saturated_ = (raw - tau).cwiseAbs().maxCoeff() > 0;
+  // The integrator, after the output is known (anti-windup reads the saturation).
+  if (c_.kind == Kind::Pid)
+    for (int i = 0; i < n; ++i) {
+      const double push = -c_.ki[i] * e[i];  // u_I's rate without anti-windup
+      if (c_.anti_windup == AntiWindup::Clamping) {
+        const bool clipped = raw[i] != tau[i];
+        if (!(clipped && push * raw[i] > 0)) u_i_[i] += push * dt;
+        u_i_[i] = std::clamp(u_i_[i], -c_.tau_max[i], c_.tau_max[i]);
+      } else if (c_.anti_windup == AntiWindup::BackCalculation) {
+        u_i_[i] += (push + (tau[i] - raw[i]) / c_.tracking_time) * dt;
+      } else {
+        u_i_[i] += push * dt;
+      }
+    }
+  return tau;
+}
+
+double Controller::lyapunov(const Eigen::VectorXd& e, const Eigen::VectorXd& th, const Eigen::VectorXd& thd) {
+  const MatN M = model_->massMatrix(VecN(th));
+  const Eigen::VectorXd v = thd;
+  return 0.5 * v.dot(Eigen::MatrixXd(M) * v) + 0.5 * e.dot(c_.kp.cwiseProduct(e));
+}
+
+}  // namespace dyn::motion_control
