@@ -1,0 +1,77 @@
+// What the impedance lab shows: the arm, the reference pose as a green ghost, the Bullet run as a
+// violet ghost, the target impedance as a spring (and a damper rod) from x_ref to the tip, the
+// external force as a red arrow at the tip, the wall as a grey slab; the overlay with x − x_ref and F.
+#include <algorithm>
+#include <cmath>
+
+#include "labs/impedance/lab.h"
+#include "labs/numbers.h"
+
+namespace dyn::impedance {
+namespace {
+
+const Color kLink{0.23f, 0.42f, 0.68f, 1.0f}, kJoint{0.15f, 0.15f, 0.18f, 1.0f}, kRef{0.20f, 0.65f, 0.30f, 0.55f};
+const Color kGhost{0.55f, 0.35f, 0.75f, 0.35f}, kSpring{0.85f, 0.55f, 0.20f, 1.0f}, kForce{0.85f, 0.15f, 0.15f, 1.0f};
+const Color kWall{0.55f, 0.55f, 0.55f, 1.0f};
+
+Eigen::Vector3d at(const Eigen::Vector2d& p, double z = 0) { return {p.x(), p.y(), z}; }
+
+Eigen::Vector3d angles(const Trace& tr, std::size_t r) { return {tr.at(r, "q1"), tr.at(r, "q2"), tr.at(r, "q3")}; }
+
+void drawArm(const std::vector<Eigen::Vector2d>& p, Color link, Color joint, double radius, double z, Scene& s) {
+  for (std::size_t i = 0; i + 1 < p.size(); ++i) s.capsules.push_back({at(p[i], z), at(p[i + 1], z), radius, link});
+  for (std::size_t i = 0; i + 1 < p.size(); ++i) s.spheres.push_back({at(p[i], z + 0.01), radius * 1.35, joint});
+}
+
+}  // namespace
+
+void ImpedanceLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene& s) const {
+  s.camera.ortho = true;
+  s.camera.eye = {0, 0, 5};
+  s.framing.fit = true;
+  const auto ref = motion_control::jointPoints(s_.plant, s_.pose);
+  auto extend = [&](const Eigen::Vector2d& p) {
+    s.framing.bounds.extend(at(p) - Eigen::Vector3d(0.08, 0.08, 0.03)), s.framing.bounds.extend(at(p) + Eigen::Vector3d(0.08, 0.08, 0.03));
+  };
+  for (const auto& p : ref) extend(p);
+  // The whole run's tip path frames the camera (a still camera over the run).
+  for (std::size_t r = 0; r < tr.rows(); r += std::max<std::size_t>(1, tr.rows() / 100)) extend({tr.at(r, "x"), tr.at(r, "y")});
+  s.boxes.push_back({{0, -0.03, -0.03}, {0.05, 0.03, 0.02}, Eigen::Matrix3d::Identity(), kWall});
+  if (s_.wall.enabled) {
+    const Eigen::Vector2d tip = ref.back();
+    s.boxes.push_back({{s_.wall.x + 0.02, tip.y(), -0.02}, {0.02, 0.25, 0.02}, Eigen::Matrix3d::Identity(), kWall});
+    extend({s_.wall.x + 0.05, tip.y()});
+  }
+  drawArm(ref, kRef, kRef, 0.012, -0.06, s);
+  if (ghost && row < ghost->rows()) drawArm(motion_control::jointPoints(s_.plant, angles(*ghost, row)), kGhost, kGhost, 0.016, -0.04, s);
+  const auto p = motion_control::jointPoints(s_.plant, angles(tr, row));
+  drawArm(p, kLink, kJoint, 0.018, 0.0, s);
+  // The target impedance between x_ref and the tip: a coil (K_des) beside a damper rod (D_des).
+  const Eigen::Vector2d xr(tr.at(row, "x_ref"), tr.at(row, "y_ref")), tip = p.back();
+  const Eigen::Vector2d d = tip - xr, side = d.norm() > 1e-9 ? Eigen::Vector2d(-d.y(), d.x()).normalized() : Eigen::Vector2d(0, 1);
+  s.spheres.push_back({at(xr, 0.03), 0.012, kRef});
+  s.springs.push_back({at(xr + 0.015 * side, 0.04), at(tip + 0.015 * side, 0.04), 0.012, kSpring, 6});
+  s.capsules.push_back({at(xr - 0.015 * side, 0.04), at(xr - 0.015 * side + 0.6 * d, 0.04), 0.008, kJoint});
+  s.capsules.push_back({at(tip - 0.015 * side - 0.5 * d, 0.04), at(tip - 0.015 * side, 0.04), 0.004, kJoint});
+  // The force on the tip (environment and wall), 0.01 m per newton, at most 0.3 m.
+  const Eigen::Vector2d F(tr.at(row, "F_ext_x"), tr.at(row, "F_ext_y"));
+  if (F.norm() > 1e-6) s.arrows.push_back({at(tip, 0.05), at(std::min(0.3, 0.01 * F.norm()) * F.normalized()), 0.008, kForce});
+}
+
+void ImpedanceLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
+  static const char* kinds[] = {"none", "constant", "joint space", "task space", "feedback linearisation"};
+  o.title = "impedance control";
+  o.lines = {{"t", fmt("%.3f s", tr.at(row, "t"))},
+             {"realisation", kinds[int(s_.kind)]},
+             {"x - x_ref", fmt("%.1f mm", 1e3 * (tr.at(row, "x") - tr.at(row, "x_ref")))},
+             {"y - y_ref", fmt("%.1f mm", 1e3 * (tr.at(row, "y") - tr.at(row, "y_ref")))},
+             {"F_ext", fmt("(%.1f, ", tr.at(row, "F_ext_x")) + fmt("%.1f) N", tr.at(row, "F_ext_y"))}};
+  Series dx{"x - x_ref (mm)", {}, {0.85f, 0.15f, 0.15f, 1}}, dy{"y - y_ref (mm)", {}, {0.23f, 0.42f, 0.68f, 1}};
+  for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) {
+    dx.values.push_back(float(1e3 * (tr.at(r, "x") - tr.at(r, "x_ref"))));
+    dy.values.push_back(float(1e3 * (tr.at(r, "y") - tr.at(r, "y_ref"))));
+  }
+  o.plots = {dx, dy};
+}
+
+}  // namespace dyn::impedance

@@ -1,0 +1,299 @@
+// Impedance lab: parses impedance.json, runs the motion-control arm (its mechanism description,
+// reused) on the hand-written model or on Bullet, with the tip force applied as the generalised
+// force J_tipᵀ F_ext in both engines and the wall as a planar PlaneContact, and measures the runs.
+#include "labs/impedance/lab.h"
+
+#include <cmath>
+#include <map>
+#include <random>
+
+#include "labs/delay_line.h"
+#include "labs/mechanism_simulation.h"
+#include "labs/numbers.h"
+#include "labs/settings.h"
+#include "physics/constraints/plane_contact.h"
+
+namespace dyn::impedance {
+namespace {
+
+using motion_control::ArmMechanism;
+using motion_control::Params;
+constexpr double kMaxLength = 100, kMaxMass = 1e6, kMaxForce = 1e5;
+
+Eigen::Vector3d parse3(const JsonView& j, double lo, double hi, double scale = 1.0) {
+  j.size(3, 3);
+  return {j.at(0).inRange(lo, hi) * scale, j.at(1).inRange(lo, hi) * scale, j.at(2).inRange(lo, hi) * scale};
+}
+
+// The arm with the wall (if any) as a unilateral plane contact on the tip ball.
+MechanismModel<Planar> describeWithWall(const Settings& s) {
+  MechanismModel<Planar> d = motion_control::describe(s.plant);
+  if (!s.wall.enabled) return d;
+  PlaneContactParams c;
+  c.radius = s.wall.radius;
+  c.height = -s.wall.x;  // outward normal −x̂: n·x = −x_wall
+  c.stiffness = s.wall.stiffness;
+  c.damping = s.wall.damping;
+  d.constraints.push_back(std::make_shared<PlaneContact<Planar>>(BodyRef::link(2), Planar::Pos(s.plant.links[2].length, 0.0),
+                                                                 Planar::Pos(-1.0, 0.0), c));
+  return d;
+}
+
+// The task Jacobian rows (x, y, φ) and J'θ' from the mechanism's point Jacobian rows (ω, vx, vy).
+void taskJacobian(ArmMechanism& m, const Params& p, const VecN& q, const VecN& v, Eigen::Matrix3d& J, Eigen::Vector3d& Jdv) {
+  MatN J3;
+  VecN jd;
+  m.pointJacobian(2, Planar::Pos(p.links[2].length, 0.0), q, v, J3, jd);
+  J.row(0) = J3.row(1), J.row(1) = J3.row(2), J.row(2) = J3.row(0);
+  Jdv << jd[1], jd[2], jd[0];
+}
+
+// The lab's controller: the chosen realisation of the target impedance on measured F.
+class Hooks final : public StepHooks {
+ public:
+  explicit Hooks(const Settings& s)
+      : s_(s), model_(motion_control::describeRigid(s.model)), plant_(motion_control::describeRigid(s.plant)),
+        hold_(std::max(1L, std::lround(s.period / s.step.dt))), rng_(12345),
+        fx_(s.delay, s.step.dt), fy_(s.delay, s.step.dt) {
+    x_ref_ = tipPose(s.plant, s.pose);
+    x_des_ = x_ref_, v_des_.setZero(), a_des_.setZero();
+    tau_ = Eigen::Vector3d::Zero();
+  }
+  VecN torque(double t, const VecN& q, const VecN& v) override {
+    // The environment's force at the tip as a generalised force (both engines alike).
+    const Eigen::Vector2d F = s_.force.at(t);
+    Eigen::Matrix3d J;
+    Eigen::Vector3d Jdv;
+    taskJacobian(plant_, s_.plant, q, v, J, Jdv);
+    f_applied_ = F;
+    if (k_++ % hold_ == 0) tau_ = control(q, v);
+    const Eigen::Vector3d ext = J.topRows<2>().transpose() * F;
+    return VecN(tau_ + ext);
+  }
+  void row(const StepRecord& r, std::vector<double>& out) override {
+    const Eigen::Vector3d x = tipPose(s_.plant, r.q.head<3>());
+    Eigen::Vector2d f = f_applied_;
+    // The wall's push on the tip (plane on body: the constraint's force is body on world).
+    if (s_.wall.enabled && !r.forces.empty() && r.forces[0].size() >= 3) f += Eigen::Vector2d(r.forces[0][1], r.forces[0][2]);
+    f_total_ = f;
+    out.clear();
+    out.push_back(r.t);
+    for (int i = 0; i < 3; ++i) out.push_back(r.q[i]);
+    for (int i = 0; i < 3; ++i) out.push_back(tau_[i]);
+    for (int i = 0; i < 3; ++i) out.push_back(x[i]);
+    for (int i = 0; i < 3; ++i) out.push_back(x_ref_[i]);
+    out.push_back(x_des_[0]);
+    out.push_back(x_des_[1]);
+    out.push_back(f[0]);
+    out.push_back(f[1]);
+    out.push_back(r.energy);
+    out.push_back(r.work);
+  }
+  void observe(const StepRecord& r) override {
+    (void)r;
+    // The force sensor: what it reads now arrives `delay` later, with noise.
+    std::normal_distribution<double> n(0.0, 1.0);
+    const double nx = s_.noise > 0 ? s_.noise * n(rng_) : 0, ny = s_.noise > 0 ? s_.noise * n(rng_) : 0;
+    fx_.push(f_total_[0] + nx), fy_.push(f_total_[1] + ny);
+  }
+
+ private:
+  Eigen::Vector3d control(const VecN& q, const VecN& v) {
+    const Eigen::Vector3d th = q.head<3>(), thd = v.head<3>();
+    const Eigen::Vector3d F(fx_.value(), fy_.value(), 0.0);
+    const Target& T = s_.target;
+    Eigen::Vector3d tau = Eigen::Vector3d::Zero();
+    switch (s_.kind) {
+      case Kind::None: break;
+      case Kind::Constant: tau = s_.constant; break;
+      case Kind::TaskSpace: {
+        // τ = Ĝ + Jᵀ(K_des e + D_des ė), e = x_ref − x: the arm keeps its own Λ(q).
+        Eigen::Matrix3d J;
+        Eigen::Vector3d Jdv;
+        taskJacobian(model_, s_.model, q, v, J, Jdv);
+        const Eigen::Vector3d e = x_ref_ - tipPose(s_.model, th), ed = -J * thd;
+        tau = model_.gravityTorque(VecN(th)) + J.transpose() * (T.K.cwiseProduct(e) + T.D.cwiseProduct(ed));
+        break;
+      }
+      case Kind::FeedbackLinearisation: {
+        // ẍ* = M_des⁻¹(F − D_des ẋ − K_des (x − x_ref)); θ'' = J⁻¹(ẍ* − J'θ'); τ = M̂θ'' + ĥ − Jᵀ F.
+        Eigen::Matrix3d J;
+        Eigen::Vector3d Jdv;
+        taskJacobian(model_, s_.model, q, v, J, Jdv);
+        const Eigen::Vector3d x = tipPose(s_.model, th), xd = J * thd;
+        const Eigen::Vector3d a = (F - T.D.cwiseProduct(xd) - T.K.cwiseProduct(x - x_ref_)).cwiseQuotient(T.M);
+        const Eigen::Vector3d qdd = J.partialPivLu().solve(a - Jdv);
+        tau = model_.inverseDynamics(VecN(th), VecN(thd), VecN(qdd)) - J.transpose() * F;
+        break;
+      }
+      case Kind::JointSpace: {
+        // The impedance model on measured F gives x_des, v_des, a_des (semi-implicit Euler over the
+        // control period); inverse kinematics gives θ_des; a computed-torque joint loop tracks it.
+        const double h = s_.period;
+        a_des_ = (F - T.D.cwiseProduct(v_des_) - T.K.cwiseProduct(x_des_ - x_ref_)).cwiseQuotient(T.M);
+        v_des_ += h * a_des_;
+        x_des_ += h * v_des_;
+        Eigen::Vector3d thd_des = th;
+        if (!inverseKinematics(s_.model, x_des_, th, thd_des)) thd_des = th;
+        Eigen::Matrix3d Jd;
+        Eigen::Vector3d Jdv;
+        const Eigen::Vector3d zero = Eigen::Vector3d::Zero();
+        taskJacobian(model_, s_.model, VecN(thd_des), VecN(zero), Jd, Jdv);
+        const Eigen::Vector3d w_des = Jd.partialPivLu().solve(v_des_);
+        taskJacobian(model_, s_.model, VecN(thd_des), VecN(w_des), Jd, Jdv);
+        const Eigen::Vector3d al_des = Jd.partialPivLu().solve(a_des_ - Jdv);
+        const Eigen::Vector3d qdd = al_des - s_.joint_kp * (th - thd_des) - s_.joint_kd * (thd - w_des);
+        tau = model_.inverseDynamics(VecN(th), VecN(thd), VecN(qdd));
+        break;
+      }
+    }
+    return tau.cwiseMax(-s_.tau_max).cwiseMin(s_.tau_max);
+  }
+
+  const Settings& s_;
+  ArmMechanism model_, plant_;
+  long hold_, k_ = 0;
+  std::mt19937 rng_;
+  DelayLine fx_, fy_;
+  Eigen::Vector3d tau_, x_ref_, x_des_, v_des_, a_des_;
+  Eigen::Vector2d f_applied_ = Eigen::Vector2d::Zero(), f_total_ = Eigen::Vector2d::Zero();
+};
+
+}  // namespace
+
+Eigen::Vector2d Force::at(double t) const {
+  if (t < start || (hold > 0 && t >= start + rise + hold)) return Eigen::Vector2d::Zero();
+  const double ramp = rise > 0 ? std::min(1.0, (t - start) / rise) : 1.0;
+  return ramp * value;
+}
+
+Eigen::Vector3d tipPose(const Params& p, const Eigen::Vector3d& th) {
+  const auto pts = motion_control::jointPoints(p, th);
+  return {pts.back().x(), pts.back().y(), th.sum()};
+}
+
+bool inverseKinematics(const Params& p, const Eigen::Vector3d& x, const Eigen::Vector3d& like, Eigen::Vector3d& th) {
+  const double l1 = p.links[0].length, l2 = p.links[1].length, l3 = p.links[2].length;
+  const Eigen::Vector2d w(x[0] - l3 * std::cos(x[2]), x[1] - l3 * std::sin(x[2]));
+  const double c2 = (w.squaredNorm() - l1 * l1 - l2 * l2) / (2 * l1 * l2);
+  if (!(std::abs(c2) <= 1)) return false;
+  const double s2 = (like[1] >= 0 ? 1 : -1) * std::sqrt(1 - c2 * c2);
+  th[1] = std::atan2(s2, c2);
+  th[0] = std::atan2(w.y(), w.x()) - std::atan2(l2 * s2, l1 + l2 * c2);
+  th[2] = x[2] - th[0] - th[1];
+  // Keep the angles on the branch nearest `like` (continuity across ±π).
+  for (int i = 0; i < 3; i += 2) th[i] += 2 * M_PI * std::round((like[i] - th[i]) / (2 * M_PI));
+  return true;
+}
+
+Settings parseSettings(const JsonView& c) {
+  Settings s;
+  c.onlyKeys({"lab", "title", "description", "mechanism", "model", "pose_deg", "environment", "simulation", "controller",
+              "gains", "metrics", "rubric", "drawing", "submission_options", "metric_docs", "map", "figures"});
+  const JsonView m = c["mechanism"];
+  m.onlyKeys({"links", "payload", "gravity", "torque_limit"});
+  m["links"].size(3, 3);
+  for (std::size_t i = 0; i < 3; ++i) {
+    const JsonView l = m["links"].at(i);
+    l.onlyKeys({"length", "mass", "inertia", "com"});
+    l["com"].size(2, 2);
+    s.plant.links.push_back({l["length"].positive(kMaxLength), l["mass"].positive(kMaxMass), l["inertia"].positive(kMaxMass),
+                             {l["com"].at(0).inRange(-kMaxLength, kMaxLength), l["com"].at(1).inRange(-kMaxLength, kMaxLength)}});
+  }
+  s.plant.friction.assign(3, {});
+  s.plant.payload = m["payload"].inRange(0, kMaxMass);
+  m["gravity"].size(2, 2);
+  s.plant.gravity = {m["gravity"].at(0).inRange(-1e3, 1e3), m["gravity"].at(1).inRange(-1e3, 1e3)};
+  s.tau_max = parse3(m["torque_limit"], 1e-6, kMaxForce);
+  s.plant.stiffness.assign(3, 0.0);
+  const JsonView md = c["model"];
+  md.onlyKeys({"payload"});
+  s.model = s.plant;
+  s.model.payload = md["payload"].inRange(0, kMaxMass);
+  s.pose = parse3(c["pose_deg"], -360, 360, M_PI / 180);
+  // The task Jacobian must be square and invertible at the reference pose (away from singularities).
+  if (std::abs(std::sin(s.pose[1])) < 1e-3)
+    c["pose_deg"].fail("a pose away from the task Jacobian's singularity (elbow angle not 0° or 180°)");
+
+  const JsonView env = c["environment"];
+  env.onlyKeys({"force", "wall", "sensor_noise", "sensor_delay"});
+  const JsonView f = env["force"];
+  f.onlyKeys({"value", "start", "rise", "hold"});
+  f["value"].size(2, 2);
+  s.force.value = {f["value"].at(0).inRange(-kMaxForce, kMaxForce), f["value"].at(1).inRange(-kMaxForce, kMaxForce)};
+  s.force.start = f["start"].inRange(0, 1e4);
+  s.force.rise = f["rise"].inRange(0, 1e4);
+  s.force.hold = f["hold"].inRange(0, 1e4);
+  const JsonView w = env["wall"];
+  w.onlyKeys({"enabled", "x", "stiffness", "damping", "radius"});
+  s.wall.enabled = w["enabled"].boolean();
+  s.wall.x = w["x"].inRange(-kMaxLength, kMaxLength);
+  s.wall.stiffness = w["stiffness"].inRange(0, 1e9);
+  s.wall.damping = w["damping"].inRange(0, 1e7);
+  s.wall.radius = w["radius"].inRange(0, 1);
+  s.noise = env["sensor_noise"].inRange(0, kMaxForce);
+  s.delay = env["sensor_delay"].inRange(0, 1);
+
+  const SimulationSettings sim = parseSimulation(c["simulation"]);
+  s.step = sim.step;
+  s.duration = sim.duration;
+  if (s.wall.enabled && tipPose(s.plant, s.pose)[0] + s.wall.radius > s.wall.x)
+    c["environment"]["wall"]["x"].fail("a wall to the right of the tip at the reference pose");
+
+  const JsonView ctl = c["controller"];
+  ctl.onlyKeys({"kind", "control_period", "constant_torque"});
+  const std::string kind = ctl["kind"].oneOf({"none", "constant", "joint_space", "task_space", "feedback_linearisation"});
+  s.kind = kind == "none" ? Kind::None : kind == "constant" ? Kind::Constant : kind == "joint_space" ? Kind::JointSpace
+           : kind == "task_space" ? Kind::TaskSpace : Kind::FeedbackLinearisation;
+  s.period = ctl["control_period"].inRange(s.step.dt, 1.0);
+  const double ratio = s.period / s.step.dt;
+  if (std::abs(ratio - std::round(ratio)) > 1e-6) ctl["control_period"].fail("expected a whole multiple of /simulation/dt");
+  s.constant = ctl.has("constant_torque") ? parse3(ctl["constant_torque"], -kMaxForce, kMaxForce) : Eigen::Vector3d::Zero();
+
+  // The target per axis: K and M given, D from the damping ratio, D = 2ζ√(KM).
+  const auto g = parseGains(c["gains"], {"k_xy", "k_phi", "m_xy", "m_phi", "zeta", "joint_kp", "joint_kd"});
+  for (const char* k : {"k_xy", "k_phi", "m_xy", "m_phi"})
+    if (!(g.at(k) > 0)) c["gains"][k].fail(std::string("a positive ") + k + " (the target impedance must be positive definite)");
+  s.target.K << g.at("k_xy"), g.at("k_xy"), g.at("k_phi");
+  s.target.M << g.at("m_xy"), g.at("m_xy"), g.at("m_phi");
+  for (int i = 0; i < 3; ++i) s.target.D[i] = 2 * g.at("zeta") * std::sqrt(s.target.K[i] * s.target.M[i]);
+  s.joint_kp = g.at("joint_kp"), s.joint_kd = g.at("joint_kd");
+  return s;
+}
+
+ImpedanceLab::ImpedanceLab(Settings s) : s_(std::move(s)) {}
+
+std::vector<std::string> ImpedanceLab::columns() const {
+  return {"t", "q1", "q2", "q3", "tau1", "tau2", "tau3", "x", "y", "phi", "x_ref", "y_ref", "phi_ref",
+          "x_des", "y_des", "F_ext_x", "F_ext_y", "energy", "work"};
+}
+
+std::string ImpedanceLab::unit(const std::string& c) const {
+  static const std::map<std::string, std::string> u = {
+      {"t", "s"}, {"q1", "rad"}, {"q2", "rad"}, {"q3", "rad"}, {"tau1", "N·m"}, {"tau2", "N·m"}, {"tau3", "N·m"},
+      {"x", "m"}, {"y", "m"}, {"phi", "rad"}, {"x_ref", "m"}, {"y_ref", "m"}, {"phi_ref", "rad"}, {"x_des", "m"},
+      {"y_des", "m"}, {"F_ext_x", "N"}, {"F_ext_y", "N"}, {"energy", "J"}, {"work", "J"}};
+  return unitIn(u, c);
+}
+
+std::unique_ptr<Simulation> ImpedanceLab::simulate(Engine engine) const {
+  auto mech = std::make_unique<ArmMechanism>(describeWithWall(s_));
+  VecN q = VecN(s_.pose), v = VecN::Zero(3);
+  std::unique_ptr<MechanismEngine> stepper;
+  if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<ArmMechanism>>(*mech, s_.step, q, v);
+  else stepper = std::make_unique<BulletEngine<Planar>>(mech->model(), s_.step.dt, q, v);
+  return std::make_unique<MechanismSimulation<ArmMechanism>>(engine, std::move(mech), std::move(stepper),
+                                                             std::make_unique<Hooks>(s_), columns(), s_.step.dt, s_.duration);
+}
+
+// Passive with no push and no wall the arm swings freely: RK4 keeps E within 1e-6·|E0|.
+Lab::PassiveEnergy ImpedanceLab::passiveEnergy() const {
+  return {1e-6, 1.0, {{"environment", {{"force", {{"value", {0.0, 0.0}}}}, {"wall", {{"enabled", false}}}}}}};
+}
+
+DYNLAB_REGISTER_LAB(impedance, "Impedance control: make the hand feel like a chosen mass-spring-damper, three ways",
+                    [](const JsonView& config) -> std::unique_ptr<Lab> {
+                      return std::make_unique<ImpedanceLab>(parseSettings(config));
+                    });
+
+}  // namespace dyn::impedance

@@ -1,0 +1,80 @@
+// The impedance-control lab (lecture §4): the motion-control lab's 3-link arm (reused from
+// labs/motion_control/mechanism.h) asked to make its hand feel like a chosen mass-spring-damper
+//   M_des ẍ + D_des ẋ + K_des (x − x_ref) = F_ext,   x = (x_tip, y_tip, φ_tip), per axis (diagonal),
+// realised three ways (controller kind): joint_space, task_space, feedback_linearisation; plus none
+// and constant. The environment: a tip force (step or push) and/or a wall (a planar PlaneContact).
+#pragma once
+#include <Eigen/Core>
+
+#include "labs/lab.h"
+#include "labs/motion_control/mechanism.h"
+
+namespace dyn::impedance {
+
+enum class Kind { None, Constant, JointSpace, TaskSpace, FeedbackLinearisation };
+
+struct Target {
+  Eigen::Vector3d M, D, K;  // per task axis (x, y, φ): kg or kg·m², N·s/m or N·m·s/rad, N/m or N·m/rad
+};
+
+// F_ext(t) at the tip: zero before start, ramps to value over rise, held for hold (0: for ever), then off.
+struct Force {
+  Eigen::Vector2d value = Eigen::Vector2d::Zero();
+  double start = 0.2, rise = 0, hold = 0;
+  Eigen::Vector2d at(double t) const;
+};
+
+struct Wall {
+  bool enabled = false;
+  double x = 1.0;           // m, the wall is the plane x = x_wall (the arm on its left)
+  double stiffness = 0;     // N/m, 0 rigid
+  double damping = 0;       // N·s/m (compliant)
+  double radius = 0.01;     // m, the tip's ball
+};
+
+struct Settings {
+  motion_control::Params plant, model;  // the arm, and as the controller believes it (rigid, frictionless)
+  Eigen::Vector3d pose;                 // rad, the initial joint angles: x_ref is the tip pose there
+  Eigen::Vector3d tau_max, constant;    // N·m
+  Kind kind = Kind::TaskSpace;
+  Target target;
+  double joint_kp = 400, joint_kd = 40; // joint_space's inner computed-torque loop (1/s², 1/s)
+  double period = 0.001;                // s, control period
+  double noise = 0, delay = 0;          // force sensor: Gaussian σ (N), delay (s)
+  Force force;
+  Wall wall;
+  StepOptions step;
+  double duration = 1;
+};
+
+Settings parseSettings(const JsonView& config);
+// The unit step response of ẍ + 2ζω ẋ + ω² x = ω² from rest (the target's push response / static).
+double unitStep(double omega, double zeta, double t);
+// Task coordinates (x, y, φ) of the tip at joint angles θ.
+Eigen::Vector3d tipPose(const motion_control::Params& p, const Eigen::Vector3d& theta);
+// Joint angles of tip pose x (planar 3R, elbow on the side of `like`); false if out of reach.
+bool inverseKinematics(const motion_control::Params& p, const Eigen::Vector3d& x, const Eigen::Vector3d& like,
+                       Eigen::Vector3d& theta);
+
+class ImpedanceLab final : public Lab {
+ public:
+  explicit ImpedanceLab(Settings s);
+  std::vector<std::string> columns() const override;
+  std::string unit(const std::string& column) const override;
+  double dt() const override { return s_.step.dt; }
+  double duration() const override { return s_.duration; }
+  std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  json metrics(const Trace& trace) const override;
+  json agreement(const Trace& hand, const Trace& bullet) const override;
+  std::string agreementUnit(const std::string& key) const override;
+  PassiveEnergy passiveEnergy() const override;
+  std::vector<LinearLoop> linearise() const override;
+  void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
+  void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
+  const Settings& settings() const { return s_; }
+
+ private:
+  Settings s_;
+};
+
+}  // namespace dyn::impedance

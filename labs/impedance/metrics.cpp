@@ -1,0 +1,130 @@
+// What the impedance lab measures. Along the force direction û (the push), with d(t) = û·(x − x_ref):
+//   stiffness        K_id = |F| / d_static, d_static the mean displacement over the last 20 % of the push
+//   omega_n, zeta    the 2nd-order step response d_s(1 − …) best fitting d(t) over the push (grid, then
+//                    refined), against the target's ω_t = √(K/M_des), ζ_t = D/(2√(KM_des))
+//   coupling         max |off-axis displacement| / max |d| over the push
+//   wall_overshoot   (peak − final)/final of the wall's normal force, when there is a wall
+#include <cmath>
+#include <map>
+
+#include "labs/impedance/lab.h"
+#include "labs/numbers.h"
+
+namespace dyn::impedance {
+
+// The unit step response of ẍ + 2ζω ẋ + ω² x = ω² (from rest at 0).
+double unitStep(double w, double z, double t) {
+  if (t <= 0) return 0;
+  if (z < 1 - 1e-9) {
+    const double wd = w * std::sqrt(1 - z * z);
+    return 1 - std::exp(-z * w * t) * (std::cos(wd * t) + z * w / wd * std::sin(wd * t));
+  }
+  if (z <= 1 + 1e-9) return 1 - std::exp(-w * t) * (1 + w * t);
+  const double r = w * std::sqrt(z * z - 1), s1 = -z * w + r, s2 = -z * w - r;
+  return 1 + (s2 * std::exp(s1 * t) - s1 * std::exp(s2 * t)) / (s1 - s2);
+}
+
+namespace {
+
+struct Fit {
+  double w = 0, z = 0, cost = 1e300;
+};
+
+// Least squares over (ω, ζ) of d_s·unitStep against samples (t − t0, d).
+Fit fitStep(const std::vector<double>& t, const std::vector<double>& d, double ds, double w0) {
+  Fit best;
+  auto cost = [&](double w, double z) {
+    double c = 0;
+    for (std::size_t i = 0; i < t.size(); ++i) c += std::pow(d[i] - ds * unitStep(w, z, t[i]), 2);
+    return c;
+  };
+  for (int i = 0; i <= 60; ++i)
+    for (int j = 0; j <= 40; ++j) {
+      const double w = w0 * std::pow(10.0, -1.0 + 2.0 * i / 60), z = 0.02 * std::pow(150.0, j / 40.0);
+      if (const double c = cost(w, z); c < best.cost) best = {w, z, c};
+    }
+  // Refine: shrinking pattern search.
+  double hw = 0.05, hz = 0.1;
+  for (int it = 0; it < 60; ++it) {
+    bool moved = false;
+    for (const auto& [a, b] : {std::pair{1, 0}, {-1, 0}, {0, 1}, {0, -1}}) {
+      const double w = best.w * (1 + a * hw), z = std::max(1e-3, best.z * (1 + b * hz));
+      if (const double c = cost(w, z); c < best.cost) best = {w, z, c}, moved = true;
+    }
+    if (!moved) hw *= 0.5, hz *= 0.5;
+  }
+  return best;
+}
+
+}  // namespace
+
+json ImpedanceLab::metrics(const Trace& tr) const {
+  const Force& f = s_.force;
+  const double fn = f.value.norm();
+  const Eigen::Vector2d u = fn > 0 ? Eigen::Vector2d(f.value / fn) : Eigen::Vector2d(1, 0), v(-u.y(), u.x());
+  const double t_end = f.hold > 0 ? f.start + f.rise + f.hold : s_.duration;
+  const double k_des = u.x() * u.x() * s_.target.K[0] + u.y() * u.y() * s_.target.K[1];
+  const double m_des = u.x() * u.x() * s_.target.M[0] + u.y() * u.y() * s_.target.M[1];
+  const double d_des = u.x() * u.x() * s_.target.D[0] + u.y() * u.y() * s_.target.D[1];
+  std::vector<double> ts, ds, last;
+  double d_max = 0, off_max = 0, drift = 0, wall_peak = 0, wall_final = 0;
+  const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
+  for (std::size_t r = 0; r < tr.rows(); ++r) {
+    const double t = tr.at(r, "t");
+    const Eigen::Vector2d e(tr.at(r, "x") - tr.at(r, "x_ref"), tr.at(r, "y") - tr.at(r, "y_ref"));
+    drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
+    if (s_.wall.enabled) {
+      wall_peak = std::max(wall_peak, -tr.at(r, "F_ext_x") - (t >= f.start ? -f.at(t).x() : 0.0));
+      wall_final = -tr.at(r, "F_ext_x") + f.at(t).x();
+    }
+    if (t < f.start || t >= t_end) continue;
+    ts.push_back(t - f.start - f.rise / 2);
+    ds.push_back(u.dot(e));
+    d_max = std::max(d_max, std::abs(u.dot(e)));
+    off_max = std::max(off_max, std::abs(v.dot(e)));
+    if (t >= t_end - 0.2 * (t_end - f.start)) last.push_back(u.dot(e));
+  }
+  double d_static = 0;
+  for (double x : last) d_static += x / double(std::max<std::size_t>(1, last.size()));
+  json m = {{"energy_drift", drift}, {"max_constraint_residual", 0.0}, {"steps", tr.rows()}};
+  m["stiffness_target"] = k_des;
+  m["omega_target"] = std::sqrt(k_des / m_des);
+  m["zeta_target"] = d_des / (2 * std::sqrt(k_des * m_des));
+  if (fn > 0 && std::abs(d_static) > 1e-12 && !ts.empty()) {
+    const double k_id = fn / d_static;
+    const Fit fit = fitStep(ts, ds, d_static, std::sqrt(k_des / m_des));
+    m["stiffness"] = k_id;
+    m["stiffness_error"] = std::abs(k_id / k_des - 1);
+    m["omega_n"] = fit.w;
+    m["zeta"] = fit.z;
+    m["omega_error"] = std::abs(fit.w / std::sqrt(k_des / m_des) - 1);
+    m["zeta_error"] = std::abs(fit.z - d_des / (2 * std::sqrt(k_des * m_des)));
+    m["coupling"] = d_max > 0 ? off_max / d_max : 0.0;
+    m["fit_rms"] = std::sqrt(fit.cost / double(ts.size())) / std::abs(d_static);
+  } else {
+    for (const char* k : {"stiffness", "stiffness_error", "omega_n", "zeta", "omega_error", "zeta_error", "coupling", "fit_rms"})
+      m[k] = 0.0;
+  }
+  m["wall_force_peak"] = wall_peak;
+  m["wall_overshoot"] = wall_final > 1e-9 ? std::max(0.0, wall_peak / wall_final - 1) : 0.0;
+  return m;
+}
+
+json ImpedanceLab::agreement(const Trace& a, const Trace& b) const {
+  const std::size_t rows = std::min(a.rows(), b.rows());
+  double dx = 0, dtau = 0;
+  for (std::size_t r = 0; r < rows; ++r) {
+    dx = std::max({dx, std::abs(a.at(r, "x") - b.at(r, "x")), std::abs(a.at(r, "y") - b.at(r, "y"))});
+    for (const char* c : {"tau1", "tau2", "tau3"}) dtau = std::max(dtau, std::abs(a.at(r, c) - b.at(r, c)));
+  }
+  json out = {{"rows_compared", rows}, {"max_dx", dx}, {"max_dtau", dtau}};
+  out.update(engineHealth(metrics(a), metrics(b)));
+  return out;
+}
+
+std::string ImpedanceLab::agreementUnit(const std::string& key) const {
+  static const std::map<std::string, std::string> units = {{"max_dx", "m"}, {"max_dtau", "N·m"}};
+  return unitIn(units, key);
+}
+
+}  // namespace dyn::impedance
