@@ -286,9 +286,10 @@ std::unique_ptr<Simulation> ImpedanceLab::simulate(Engine engine) const {
                                                              std::make_unique<Hooks>(s_), columns(), s_.step.dt, s_.duration);
 }
 
-// Passive with no push and no wall the arm swings freely: RK4 keeps E within 1e-6·|E0|.
+// Passive with no push and no wall the arm falls from the reference pose and whips through fast
+// swings (E0 ≈ 16 J): RK4 at 1 ms keeps E within 1e-5·|E0| over 1 s (measured 3e-6).
 Lab::PassiveEnergy ImpedanceLab::passiveEnergy() const {
-  return {1e-6, 1.0, {{"environment", {{"force", {{"value", {0.0, 0.0}}}}, {"wall", {{"enabled", false}}}}}}};
+  return {1e-5, 1.0, {{"environment", {{"force", {{"value", {0.0, 0.0}}}}, {"wall", {{"enabled", false}}}}}}};
 }
 
 DYNLAB_REGISTER_LAB(impedance, "Impedance control: make the hand feel like a chosen mass-spring-damper, three ways",

@@ -74,8 +74,8 @@ json ImpedanceLab::metrics(const Trace& tr) const {
     const Eigen::Vector2d e(tr.at(r, "x") - tr.at(r, "x_ref"), tr.at(r, "y") - tr.at(r, "y_ref"));
     drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
     if (s_.wall.enabled) {
-      wall_peak = std::max(wall_peak, -tr.at(r, "F_ext_x") - (t >= f.start ? -f.at(t).x() : 0.0));
-      wall_final = -tr.at(r, "F_ext_x") + f.at(t).x();
+      wall_peak = std::max(wall_peak, -tr.at(r, "F_ext_x") + f.at(t).x());
+      if (t < t_end) wall_final = -tr.at(r, "F_ext_x") + f.at(t).x();  // the wall's settled push, before release
     }
     if (t < f.start || t >= t_end) continue;
     ts.push_back(t - f.start - f.rise / 2);
