@@ -88,6 +88,13 @@ class Hooks final : public StepHooks {
     out.push_back(f[1]);
     out.push_back(r.energy);
     out.push_back(r.work);
+    // The target's analytic response to the push (a step on, a step off): x_ref + K⁻¹F (on − off).
+    const Force& push = s_.force;
+    const double t_on = push.start + push.rise / 2, t_off = push.hold > 0 ? t_on + push.rise / 2 + push.hold : 1e300;
+    for (int a = 0; a < 2; ++a) {
+      const double w = std::sqrt(s_.target.K[a] / s_.target.M[a]), z = s_.target.D[a] / (2 * std::sqrt(s_.target.K[a] * s_.target.M[a]));
+      out.push_back(x_ref_[a] + push.value[a] / s_.target.K[a] * (unitStep(w, z, r.t - t_on) - unitStep(w, z, r.t - t_off)));
+    }
   }
   void observe(const StepRecord& r) override {
     (void)r;
@@ -265,14 +272,14 @@ ImpedanceLab::ImpedanceLab(Settings s) : s_(std::move(s)) {}
 
 std::vector<std::string> ImpedanceLab::columns() const {
   return {"t", "q1", "q2", "q3", "tau1", "tau2", "tau3", "x", "y", "phi", "x_ref", "y_ref", "phi_ref",
-          "x_des", "y_des", "F_ext_x", "F_ext_y", "energy", "work"};
+          "x_des", "y_des", "F_ext_x", "F_ext_y", "energy", "work", "x_target", "y_target"};
 }
 
 std::string ImpedanceLab::unit(const std::string& c) const {
   static const std::map<std::string, std::string> u = {
       {"t", "s"}, {"q1", "rad"}, {"q2", "rad"}, {"q3", "rad"}, {"tau1", "N·m"}, {"tau2", "N·m"}, {"tau3", "N·m"},
       {"x", "m"}, {"y", "m"}, {"phi", "rad"}, {"x_ref", "m"}, {"y_ref", "m"}, {"phi_ref", "rad"}, {"x_des", "m"},
-      {"y_des", "m"}, {"F_ext_x", "N"}, {"F_ext_y", "N"}, {"energy", "J"}, {"work", "J"}};
+      {"y_des", "m"}, {"x_target", "m"}, {"y_target", "m"}, {"F_ext_x", "N"}, {"F_ext_y", "N"}, {"energy", "J"}, {"work", "J"}};
   return unitIn(u, c);
 }
 
