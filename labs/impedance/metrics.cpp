@@ -4,6 +4,7 @@
 //                    refined), against the target's ω_t = √(K/M_des), ζ_t = D/(2√(KM_des))
 //   coupling         max |off-axis displacement| / max |d| over the push
 //   wall_overshoot   (peak − final)/final of the wall's normal force, when there is a wall
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -62,7 +63,9 @@ json ImpedanceLab::metrics(const Trace& tr) const {
   const Force& f = s_.force;
   const double fn = f.value.norm();
   const Eigen::Vector2d u = fn > 0 ? Eigen::Vector2d(f.value / fn) : Eigen::Vector2d(1, 0), v(-u.y(), u.x());
-  const double t_end = f.hold > 0 ? f.start + f.rise + f.hold : s_.duration;
+  // The push's window, cut at the run's end (a shortened run still reads its last 20 %).
+  const double t_run = tr.rows() ? tr.at(tr.rows() - 1, "t") + s_.step.dt : s_.duration;
+  const double t_end = std::min(t_run, f.hold > 0 ? f.start + f.rise + f.hold : s_.duration);
   const double k_des = u.x() * u.x() * s_.target.K[0] + u.y() * u.y() * s_.target.K[1];
   const double m_des = u.x() * u.x() * s_.target.M[0] + u.y() * u.y() * s_.target.M[1];
   const double d_des = u.x() * u.x() * s_.target.D[0] + u.y() * u.y() * s_.target.D[1];

@@ -1,0 +1,119 @@
+// The impedance lab (labs/impedance) against the lecture's §4 claims, cheap runs only:
+//  * feedback linearisation with an exact model and force feedback: the push response equals the
+//    target's analytic step response (x_target) within 0.5 % of the static displacement F/K at
+//    dt = 0.2 ms (the one-step sensor delay and the zero-order hold cost O(ω dt));
+//  * task_space: the static displacement is K_des⁻¹F (exact gravity model), 1e-3 relative;
+//    its apparent mass is the arm's Λ_xx(q), not M_des: ω fitted ≈ √(K/Λ_xx) within 3 %;
+//  * joint_space: the joint loop adds its compliance in series, K_id < K_des, and approaches it as K_p grows;
+//  * hand vs Bullet over a push: |Δx| ≤ 0.5 mm (Bullet's first-order step at dt = 1 ms);
+//  * bad inputs (K_des not positive, a singular reference pose, a wall behind the tip) get one line.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <string>
+
+#include "labs/impedance/lab.h"
+#include "labs/run.h"
+
+using namespace dyn;
+using namespace dyn::impedance;
+
+namespace {
+
+const std::string kFile = "impedance.json (test)";
+
+json config(const json& patch) { return mergePatch(loadJsonFile(defaultConfigPath("impedance")), patch); }
+
+std::unique_ptr<Lab> makeLab(const json& patch) {
+  const LabEntry* entry = findLab("impedance");
+  REQUIRE(entry != nullptr);
+  return buildLab(*entry, config(patch), kFile);
+}
+
+std::string inputError(const json& patch) {
+  try {
+    makeLab(patch);
+  } catch (const InputError& e) {
+    return e.path() + ": " + e.expected();
+  }
+  return "accepted";
+}
+
+json gains(const char* kind, double k, double zeta, double joint_kp = 2500, double joint_kd = 100) {
+  return {{"controller", {{"kind", kind}}},
+          {"gains", {{"k_xy", {{"value", k}}}, {"zeta", {{"value", zeta}}}, {"joint_kp", {{"value", joint_kp}}},
+                     {"joint_kd", {{"value", joint_kd}}}}}};
+}
+
+}  // namespace
+
+TEST_CASE("feedback linearisation with an exact model is the target's analytic push response") {
+  json p = gains("feedback_linearisation", 400, 0.5);
+  p["simulation"] = {{"dt", 0.0002}, {"duration", 1.2}};
+  p["controller"]["control_period"] = 0.0002;
+  const auto lab = makeLab(p);
+  const RunResult r = runEngine(*lab, Engine::Hand);
+  REQUIRE(r.failure.empty());
+  const double d_static = 10.0 / 400;
+  double worst = 0;
+  for (std::size_t i = 0; i < r.trace.rows(); ++i)
+    worst = std::max({worst, std::abs(r.trace.at(i, "x") - r.trace.at(i, "x_target")), std::abs(r.trace.at(i, "y") - r.trace.at(i, "y_target"))});
+  MESSAGE("feedback linearisation: max |x − x_target| = ", worst, " m against F/K = ", d_static, " m");
+  CHECK(worst <= 0.005 * d_static);
+  // And the metrics read the target back: ζ and ω within 2 %.
+  const json m = lab->metrics(r.trace);
+  CHECK(m["zeta"].get<double>() == doctest::Approx(0.5).epsilon(0.02));
+  CHECK(m["omega_n"].get<double>() == doctest::Approx(std::sqrt(400.0)).epsilon(0.02));
+}
+
+TEST_CASE("task_space: static stiffness is K_des, the apparent mass is the arm's own Λ") {
+  const auto lab = makeLab(gains("task_space", 300, 1.5));
+  const RunResult r = runEngine(*lab, Engine::Hand);
+  REQUIRE(r.failure.empty());
+  const json m = lab->metrics(r.trace);
+  MESSAGE("task_space: K_id = ", m["stiffness"].get<double>(), " N/m for K_des = 300");
+  CHECK(m["stiffness_error"].get<double>() < 1e-3);
+  // Under-damped so the frequency is well defined: ω fitted against √(K/Λ_xx) from the screening's Λ.
+  const auto lab2 = makeLab(gains("task_space", 300, 0.3));
+  const RunResult r2 = runEngine(*lab2, Engine::Hand);
+  REQUIRE(r2.failure.empty());
+  const auto loops = lab2->linearise();
+  REQUIRE(loops.size() == 2);
+  const double lambda_xx = loops[0].den[2];
+  const double w_fit = lab2->metrics(r2.trace)["omega_n"].get<double>();
+  MESSAGE("task_space: ω fitted ", w_fit, " rad/s, √(K/Λ_xx) = ", std::sqrt(300 / lambda_xx), " (Λ_xx = ", lambda_xx, " kg)");
+  CHECK(w_fit == doctest::Approx(std::sqrt(300 / lambda_xx)).epsilon(0.03));
+  CHECK(std::abs(lambda_xx - 1.0) > 0.1);  // the point: the arm's Λ is not the M_des = 1 kg asked for
+}
+
+TEST_CASE("joint_space: the joint loop's compliance in series, shrinking as K_p grows") {
+  double previous = 1e9;
+  for (double kp : {400.0, 2500.0, 20000.0}) {
+    const auto lab = makeLab(gains("joint_space", 400, 1.0, kp, 2 * std::sqrt(kp)));
+    const RunResult r = runEngine(*lab, Engine::Hand);
+    REQUIRE(r.failure.empty());
+    const double err = lab->metrics(r.trace)["stiffness_error"].get<double>();
+    MESSAGE("joint_space K_p = ", kp, ": |K_id/K_des − 1| = ", err);
+    CHECK(err < previous);
+    previous = err;
+  }
+  CHECK(previous < 0.05);
+}
+
+TEST_CASE("hand vs Bullet over a push") {
+  const auto lab = makeLab(gains("feedback_linearisation", 400, 0.7));
+  const RunResult h = runEngine(*lab, Engine::Hand), b = runEngine(*lab, Engine::Bullet);
+  REQUIRE(h.failure.empty());
+  REQUIRE(b.failure.empty());
+  const double dx = lab->agreement(h.trace, b.trace)["max_dx"].get<double>();
+  MESSAGE("hand vs Bullet: max |Δx| = ", dx, " m");
+  CHECK(dx <= 5e-4);
+}
+
+TEST_CASE("bad inputs get one line naming the JSON path") {
+  CHECK(inputError({{"gains", {{"k_xy", {{"value", 0.0}}}}}}).find("/gains/k_xy") != std::string::npos);
+  CHECK(inputError({{"pose_deg", {30.0, 0.0, -45.0}}}).find("/pose_deg: a pose away from the task Jacobian's singularity") == 0);
+  CHECK(inputError({{"environment", {{"wall", {{"enabled", true}, {"x", 0.1}}}}}}).find("/environment/wall/x") == 0);
+  CHECK(inputError({{"controller", {{"kind", "admittance"}}}}).find("/controller/kind") == 0);
+  CHECK(inputError(json::object()) == "accepted");
+}
