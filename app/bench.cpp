@@ -143,7 +143,13 @@ json errorAgainst(const Lab& lab, const Trace& run, const Trace& reference) {
 }  // namespace
 
 int bench(const BenchArgs& a) {
+  for (const std::string& name : a.labs)
+    if (!findLab(name)) {
+      std::fprintf(stderr, "error: <command line>: LAB: unknown lab \"%s\" (see dynlab list)\n", name.c_str());
+      return 2;
+    }
   for (const auto& entry : labRegistry()) {
+    if (!a.labs.empty() && std::find(a.labs.begin(), a.labs.end(), entry.name) == a.labs.end()) continue;
     LoadedLab loaded;
     try {
       loaded = loadLab(entry.name);

@@ -55,6 +55,7 @@ struct CompareArgs {
 struct BenchArgs {
   bool json = false;
   int steps = 4000, frames = 60;
+  std::vector<std::string> labs;  // empty: every registered lab
 };
 
 // --scenario NAME (run, figure): rebuilds the loaded lab under the rubric scenario's patch and noise

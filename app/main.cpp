@@ -150,6 +150,7 @@ int dispatch(int argc, char** argv) {
 
   BenchArgs bench_args;
   auto* b = cli.add_subcommand("bench", "Benchmark: hand-written vs Bullet step time, render/PNG/video frame rates");
+  b->add_option("labs", bench_args.labs, "Labs to measure (default: every registered lab)");
   b->add_flag("--json", bench_args.json, "One JSON object per lab");
   b->add_option("--steps", bench_args.steps, "Steps timed per engine")->check(CLI::Range(100, 1000000));
   b->add_option("--frames", bench_args.frames, "Frames timed per output kind")->check(CLI::Range(5, 10000));
