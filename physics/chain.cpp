@@ -26,6 +26,9 @@ void TreeData<S>::resize(int n) {
   f.resize(n);
   Ic.resize(n);
   Ic_rb.resize(n);
+  I_w.resize(n);
+  v_w.resize(n);
+  a_w.resize(n);
   U.resize(n);
   pA.resize(n);
   D.resize(n);

@@ -58,6 +58,10 @@ struct TreeData {
   std::vector<typename S::Mat> Ic;             // scratch for aba
   std::vector<typename S::Inertia> Ic_rb;      // scratch for crba (composite rigid-body inertias)
   std::vector<Vec> U, pA;                      // scratch for aba
+  // World coordinates (chain_world.h): inertias I_i^w, link velocities V_i and velocity-product
+  // accelerations A_i (θ'' = 0, no gravity), all at the world origin.
+  std::vector<typename S::Inertia> I_w;
+  std::vector<Vec> v_w, a_w;
   std::vector<double> D, u;
   explicit TreeData(const TreeModel<S>& model) { resize(model.dof()); }
   void resize(int n);

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "physics/chain_world.h"
 #include "physics/constrained_mechanism.h"
 
 namespace dyn {
@@ -31,7 +32,6 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
   kin_.tree = &data_;
   kin_.payload_pose.assign(model_.payloads.size(), Eigen::Vector3d::Zero());
   kin_.payload_rate.assign(model_.payloads.size(), Eigen::Vector3d::Zero());
-  kin_.link_bias.assign(std::size_t(n()), Vec::Zero());
   kin_.payload_cs.assign(model_.payloads.size(), Eigen::Vector2d(1, 0));
   kin_.link_angle.assign(std::size_t(n()), 0.0);
   // Planar: the fixed part of each link's angle, its placement's rotation (X_tree.E = rotation(angle)).
@@ -68,8 +68,10 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::positionStage(const VecN& q) {
   tree_q_ = q.head(nn);
   have_tree_ = true;
   have_velocity_ = false;
+  // World inertias (shared with the velocity stage), then M from their composites.
+  worldInertias(model_.tree, data_);
   problem_.M.resize(nn, nn);
-  crba(model_.tree, data_, problem_.M);
+  crbaWorld(model_.tree, data_, problem_.M);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
   if constexpr (S::kDim == 3)
     for (int i = 0; i < nn; ++i) {
@@ -122,11 +124,9 @@ template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   const int nn = n();
   const VecN qd = v.head(nn);
-  // Link velocities, h = Cθ' + G from RNEA with θ'' = 0, and each link's velocity-product acceleration.
-  velocityKinematics(model_.tree, qd, data_);
-  problem_.h = rnea(model_.tree, data_, qd, VecN::Zero(nn));
-  // RNEA at θ'' = 0 leaves each link's acceleration without gravity: its velocity-product one.
-  for (int i = 0; i < nn; ++i) kin_.link_bias[std::size_t(i)] = data_.a[std::size_t(i)];
+  // Link velocities, each link's velocity-product acceleration and h = Cθ' + G, in world coordinates.
+  problem_.h.resize(nn);
+  biasForcesWorld(model_.tree, data_, qd, problem_.h);
   // Joint springs and friction join h.
   if (!model_.joints.empty())
     for (int i = 0; i < nn; ++i) {
@@ -338,10 +338,10 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::constraintReport(int i, const Solution
 
 template <class S, int Nj, int Nr, int Nl>
 double ConstrainedMechanism<S, Nj, Nr, Nl>::kineticEnergy(const VecN& q, const VecN& v) {
+  // The velocity stage at (q, v): usually the step's own (the trace row asks at the step's start).
   positionStage(q);
-  have_velocity_ = false;  // data_'s velocities are this query's now
-  velocityKinematics(model_.tree, VecN(v.head(n())), data_);
-  double T = dyn::kineticEnergy(model_.tree, data_);
+  if (!have_velocity_ || v != staged_v_) velocityStage(v);
+  double T = kineticEnergyWorld(model_.tree, data_);
   for (std::size_t i = 0, off = std::size_t(n()); i < model_.payloads.size(); ++i) {
     const Payload& p = model_.payloads[i];
     const double diag[3] = {p.inertia, p.mass, p.mass};

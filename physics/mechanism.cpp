@@ -115,7 +115,7 @@ template <class S>
 typename S::Vec MechanismKinematics<S>::pointVelocity(const BodyRef& b, const Pos& p_world) const {
   if (b.kind == BodyRef::Kind::Link) {
     const std::size_t i = std::size_t(b.index);
-    return S::motion(S::translation(p_world), S::motionInverse(tree->X_world[i], tree->v[i]));
+    return S::motion(S::translation(p_world), tree->v_w[i]);
   }
   if constexpr (S::kDim == 3) {
     if (b.kind == BodyRef::Kind::Payload) {
@@ -133,8 +133,8 @@ typename S::Vec MechanismKinematics<S>::pointBias(const BodyRef& b, const Pos& p
     // The link's velocity-product acceleration (θ'' = 0), at p, as a classical acceleration.
     const std::size_t i = std::size_t(b.index);
     const typename S::Transform X_pw = S::translation(p_world);
-    const Vec v_p = velocity ? *velocity : S::motion(X_pw, S::motionInverse(tree->X_world[i], tree->v[i]));
-    const Vec a_p = S::motion(X_pw, S::motionInverse(tree->X_world[i], link_bias[i]));
+    const Vec v_p = velocity ? *velocity : S::motion(X_pw, tree->v_w[i]);
+    const Vec a_p = S::motion(X_pw, tree->a_w[i]);
     return S::classicalAcceleration(a_p, v_p);
   }
   if constexpr (S::kDim == 3) {

@@ -159,7 +159,8 @@ struct MechanismModel {
 };
 
 // The kinematics of every body at one state, what constraint kinds read: filled by the mechanism in
-// a position stage (θ, x_c) and a velocity stage (θ', v_c).
+// a position stage (θ, x_c) and a velocity stage (θ', v_c). Links' velocities and velocity-product
+// accelerations are the tree's world-coordinate ones (TreeData v_w, a_w: chain_world.h).
 template <class S>
 struct MechanismKinematics {
   using Vec = typename S::Vec;
@@ -172,8 +173,6 @@ struct MechanismKinematics {
   std::vector<Eigen::Vector2d> payload_cs;
   // Planar: each link's absolute angle (the sum of its path's joint angles and fixed placements).
   std::vector<double> link_angle;
-  // Each link's velocity-product acceleration (θ'' = 0, no gravity), body coordinates: J'θ' of its points.
-  std::vector<Vec> link_bias;
 
   // World position of a point given in a body's frame (the world's frame is the world).
   Pos position(const BodyRef& b, const Pos& p) const;

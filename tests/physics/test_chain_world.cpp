@@ -1,0 +1,87 @@
+// The world-coordinate stages (chain_world.h) against the body-coordinate algorithms (chain.h):
+// M from world composites = CRBA, h = RNEA at θ'' = 0, the link velocities and velocity-product
+// accelerations = the body-frame ones carried to the world origin, T = ½ θ'ᵀ M θ'. Trees with
+// prismatic joints, turned placements, massless carriers and a branch.
+#include <doctest/doctest.h>
+
+#include <Eigen/Geometry>
+
+#include "physics/chain_world.h"
+#include "tests/physics/arms.h"
+
+using namespace dyn;
+
+namespace {
+
+TreeModel<Spatial> branchedSpatialTree() {
+  using Pos = Spatial::Pos;
+  TreeModel<Spatial> t;
+  t.gravity << 0, 0, 0, 0, 0, -9.81;
+  const Spatial::Transform turned{Eigen::AngleAxisd(0.4, Pos(1, 2, 3).normalized()).toRotationMatrix(), Pos(0.1, -0.2, 0.3)};
+  const Eigen::Matrix3d Ic = (Eigen::Matrix3d() << 0.02, 0.003, -0.001, 0.003, 0.01, 0.002, -0.001, 0.002, 0.015).finished();
+  int b = t.addBody(-1, JointType::Prismatic, Pos::UnitX(), Spatial::Transform(), Spatial::Mat::Zero());
+  b = t.addBody(b, JointType::Prismatic, Pos(0, 1, 1), turned, Spatial::Mat::Zero());
+  const int hub = t.addBody(b, JointType::Revolute, Pos::UnitZ(), Spatial::translation({0, 0, 0.2}), Spatial::inertia(1.2, Pos(0.02, 0, 0.05), Ic));
+  t.addBody(hub, JointType::Revolute, Pos::UnitY(), turned, Spatial::inertia(2.0, Pos(0.05, 0.01, -0.02), Ic));
+  t.addBody(hub, JointType::Revolute, Pos(1, 0, 1), Spatial::translation({0.3, 0, 0}), Spatial::inertia(0.7, Pos(0.2, 0, 0.1), 0.5 * Ic));
+  return t;
+}
+
+TreeModel<Planar> planarWithSlider() {
+  TreeModel<Planar> t = test::planarArm();
+  t.addBody(2, JointType::Prismatic, Planar::Axis(1, 0), Planar::translation({0.2, 0.0}), Planar::inertia(0.4, Planar::Pos(0.01, 0.02), 0.001));
+  return t;
+}
+
+template <class S>
+void checkWorldStages(TreeModel<S> t, const VecN& q, const VecN& qd) {
+  TreeData<S> body(t), world(t);
+  const int n = t.dof();
+  forwardKinematics(t, q, qd, body);
+  const MatN M = crba(t, body);
+  const VecN h = rnea(t, body, qd, VecN::Zero(n));  // leaves body.a: the velocity-product accelerations
+
+  positionKinematics(t, q, world);
+  worldInertias(t, world);
+  Eigen::MatrixXd Mw(n, n);
+  crbaWorld(t, world, Mw);
+  Eigen::VectorXd hw(n);
+  biasForcesWorld(t, world, qd, hw);
+
+  const double scale = M.norm();
+  CHECK((Mw - M).norm() < 1e-13 * scale);
+  CHECK((Mw - Mw.transpose()).norm() == 0.0);
+  CHECK((hw - h).norm() < 1e-12 * (1 + h.norm()));
+  for (int i = 0; i < n; ++i) {
+    const typename S::Vec v = S::motionInverse(body.X_world[i], body.v[i]);
+    const typename S::Vec a = S::motionInverse(body.X_world[i], body.a[i]);
+    CHECK((world.v_w[i] - v).norm() < 1e-13 * (1 + v.norm()));
+    CHECK((world.a_w[i] - a).norm() < 1e-12 * (1 + a.norm()));
+  }
+  const double T = 0.5 * qd.dot(M * qd);
+  CHECK(kineticEnergyWorld(t, world) == doctest::Approx(T).epsilon(1e-13));
+  CHECK(kineticEnergy(t, body) == doctest::Approx(T).epsilon(1e-13));
+}
+
+}  // namespace
+
+TEST_CASE("world-coordinate stages equal CRBA and RNEA: spatial arm") {
+  VecN q(3), qd(3);
+  q << 0.3, -0.7, 1.1;
+  qd << 0.9, -1.3, 0.7;
+  checkWorldStages(test::spatialArm(), q, qd);
+}
+
+TEST_CASE("world-coordinate stages equal CRBA and RNEA: carriers, turned placements, a branch") {
+  VecN q(5), qd(5);
+  q << 0.3, -0.7, 1.1, 0.5, -1.2;
+  qd << 0.4, -0.2, 1.5, -0.8, 2.1;
+  checkWorldStages(branchedSpatialTree(), q, qd);
+}
+
+TEST_CASE("world-coordinate stages equal CRBA and RNEA: planar arm with a slider") {
+  VecN q(4), qd(4);
+  q << 0.3, -0.7, 1.1, 0.05;
+  qd << 0.9, -1.3, 0.7, -0.3;
+  checkWorldStages(planarWithSlider(), q, qd);
+}
