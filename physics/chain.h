@@ -31,6 +31,8 @@ struct TreeModel {
     typename S::Transform X_tree;    // parent frame → joint frame at θ = 0
     Mat inertia;                     // spatial inertia at the body origin, body coordinates
     Vec subspace = Vec::Zero();      // motion subspace S_i (set by addBody from joint and axis)
+    // Spatial: the inertia about the centre of mass {m, c, I_c} (Spatial::Central, set by addBody).
+    typename S::Central central{};
   };
   std::vector<Body> bodies;
   Vec gravity = Vec::Zero();         // spatial acceleration of gravity in world coordinates
@@ -42,6 +44,7 @@ struct TreeModel {
     if constexpr (S::kDim == 6) bodies.push_back({parent, joint, axis.normalized(), S::marked(X_tree), inertia});
     else bodies.push_back({parent, joint, axis, X_tree, inertia});
     bodies.back().subspace = motionSubspace(int(bodies.size()) - 1);
+    bodies.back().central = S::central(inertia);
     return int(bodies.size()) - 1;
   }
   Vec motionSubspace(int i) const;

@@ -8,8 +8,10 @@ void worldInertias(const TreeModel<S>& model, TreeData<S>& data) {
   typename S::Inertia zero{};
   if constexpr (S::kDim == 3) zero.setZero();
   for (int i = 0; i < model.dof(); ++i) {
-    const auto& I = model.bodies[std::size_t(i)].inertia;
-    data.I_w[i] = S::massless(I) ? zero : S::inertiaInParent(data.X_world[i], S::compact(I));
+    const auto& b = model.bodies[std::size_t(i)];
+    if (S::massless(b.inertia)) data.I_w[i] = zero;
+    else if constexpr (S::kDim == 6) data.I_w[i] = S::inertiaInParent(data.X_world[i], b.central);  // from the centre of mass
+    else data.I_w[i] = S::inertiaInParent(data.X_world[i], b.inertia);
   }
 }
 

@@ -108,6 +108,9 @@ struct Planar {
   // CRBA's composite inertias: planar ones are already compact.
   using Inertia = Mat;
   static const Mat& compact(const Mat& I) { return I; }
+  // (Spatial's centre-of-mass form; planar transforms the 3×3 form directly.)
+  struct Central {};
+  static Central central(const Mat&) { return {}; }
   // Rigid-body inertia at the body origin: mass m, centre of mass c, inertia Ic about c.
   static Mat inertia(double m, const Pos& c, double Ic) {
     Mat I;
@@ -298,6 +301,45 @@ struct Spatial {
     out.Io.noalias() -= out.m * r * r.transpose() + r * out.h.transpose() + out.h * r.transpose();
     out.Io.diagonal().array() += out.m * rr + 2.0 * rh;
     out.h += out.m * r;
+    return out;
+  }
+  // The same inertia about the centre of mass: mass m, centre c and I_c (body coordinates).
+  struct Central {
+    double m = 0;
+    Pos c = Pos::Zero();
+    Eigen::Matrix3d Ic = Eigen::Matrix3d::Zero();
+  };
+  static Central central(const Mat& I) {
+    Central out;
+    massAndCom(I, out.m, out.c);
+    // I_O = I_c + m(|c|² 1 − c cᵀ)
+    out.Ic = I.block<3, 3>(0, 0) - out.m * (out.c.squaredNorm() * Eigen::Matrix3d::Identity() - out.c * out.c.transpose());
+    return out;
+  }
+  // Xᵀ I X from the centre-of-mass form: the centre c_A = r + Eᵀ c, the central inertia turned
+  // (Eᵀ I_c E, symmetric: six entries), then about A's origin, I_O = Eᵀ I_c E + m(|c_A|² 1 − c_A c_Aᵀ), h = m c_A.
+  // Cheaper than inertiaInParent on the origin form: one rotation, no cross terms in h.
+  DYN_INLINE static Inertia inertiaInParent(const Transform& X, const Central& C) {
+    Inertia out;
+    out.m = C.m;
+    Pos cA;
+    double B[3][3];  // I_c E
+    if (X.turned) {
+      for (int i = 0; i < 3; ++i) cA[i] = X.r[i] + X.E(0, i) * C.c[0] + X.E(1, i) * C.c[1] + X.E(2, i) * C.c[2];
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) B[i][j] = C.Ic(i, 0) * X.E(0, j) + C.Ic(i, 1) * X.E(1, j) + C.Ic(i, 2) * X.E(2, j);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j <= i; ++j) out.Io(i, j) = out.Io(j, i) = X.E(0, i) * B[0][j] + X.E(1, i) * B[1][j] + X.E(2, i) * B[2][j];
+    } else {
+      for (int i = 0; i < 3; ++i) cA[i] = X.r[i] + C.c[i];
+      out.Io = C.Ic;
+    }
+    const double cc = cA.squaredNorm();
+    for (int i = 0; i < 3; ++i) {
+      for (int j = 0; j < 3; ++j) out.Io(i, j) -= C.m * cA[i] * cA[j];
+      out.Io(i, i) += C.m * cc;
+      out.h[i] = C.m * cA[i];
+    }
     return out;
   }
   static Mat inertia(double m, const Pos& c, const Eigen::Matrix3d& Ic) {
