@@ -21,34 +21,18 @@
 
 #include "labs/motion_control/lab.h"
 #include "labs/run.h"
+#include "tests/labs/lab_fixture.h"
 
 using namespace dyn;
 using namespace dyn::motion_control;
 
 namespace {
 
-const std::string kFile = "motion_control.json (test)";
-
-json config(const json& patch) { return mergePatch(loadJsonFile(defaultConfigPath("motion_control")), patch); }
-
-std::unique_ptr<Lab> makeLab(const json& patch) {
-  const LabEntry* entry = findLab("motion_control");
-  REQUIRE(entry != nullptr);
-  return buildLab(*entry, config(patch), kFile);
-}
+const test::LabFixture fixture("motion_control");
 
 Settings settings(const json& patch) {
-  const json c = config(patch);
-  return parseSettings(JsonView(c, kFile));
-}
-
-std::string inputError(const json& patch) {
-  try {
-    makeLab(patch);
-  } catch (const InputError& e) {
-    return e.path() + ": " + e.expected();
-  }
-  return "accepted";
+  const json c = fixture.config(patch);
+  return parseSettings(JsonView(c, fixture.file));
 }
 
 json noFriction() {
@@ -81,9 +65,9 @@ void setPoint(Settings s, const Eigen::VectorXd& theta0, const Eigen::VectorXd& 
 TEST_CASE("motion_control: tau = 0 without friction conserves energy, rigid and flexible") {
   for (bool flexible : {false, true}) {
     CAPTURE(flexible);
-    const auto lab = makeLab({{"controller", {{"kind", "none"}}},
-                              {"mechanism", {{"friction", noFriction()}, {"flexible", {{"enabled", flexible}}}}},
-                              {"simulation", {{"duration", 1.0}, {"dt", flexible ? 2.5e-4 : 1e-3}}}});
+    const auto lab = fixture.makeLab({{"controller", {{"kind", "none"}}},
+                                      {"mechanism", {{"friction", noFriction()}, {"flexible", {{"enabled", flexible}}}}},
+                                      {"simulation", {{"duration", 1.0}, {"dt", flexible ? 2.5e-4 : 1e-3}}}});
     const RunResult r = runEngine(*lab, Engine::Hand);
     REQUIRE(r.failure.empty());
     double worst = 0;
@@ -96,7 +80,7 @@ TEST_CASE("motion_control: tau = 0 without friction conserves energy, rigid and 
 }
 
 TEST_CASE("motion_control: with friction, E − E0 = work of τ and of friction") {
-  const auto lab = makeLab({{"simulation", {{"duration", 1.5}}}});
+  const auto lab = fixture.makeLab({{"simulation", {{"duration", 1.5}}}});
   const RunResult r = runEngine(*lab, Engine::Hand);
   REQUIRE(r.failure.empty());
   const json m = lab->metrics(r.trace);
@@ -191,7 +175,7 @@ TEST_CASE("motion_control: anti-windup bounds the integrator under saturation") 
 }
 
 TEST_CASE("motion_control: hand and Bullet agree") {
-  const auto lab = makeLab({{"simulation", {{"duration", 1.0}}}});
+  const auto lab = fixture.makeLab({{"simulation", {{"duration", 1.0}}}});
   const RunResult h = runEngine(*lab, Engine::Hand), b = runEngine(*lab, Engine::Bullet);
   REQUIRE(h.failure.empty());
   REQUIRE(b.failure.empty());
@@ -201,12 +185,12 @@ TEST_CASE("motion_control: hand and Bullet agree") {
 }
 
 TEST_CASE("motion_control: bad inputs get one line naming the path") {
-  CHECK(inputError({{"controller", {{"control_period", 0.0015}}}}) ==
+  CHECK(fixture.inputError({{"controller", {{"control_period", 0.0015}}}}) ==
         "/controller/control_period: expected a whole multiple of the simulation step /simulation/dt");
-  CHECK(inputError({{"mechanism", {{"torque_limit", {1.0, 2.0}}}}}).rfind("/mechanism/torque_limit", 0) == 0);
-  CHECK(inputError({{"controller", {{"kind", "lqr"}}}}).rfind("/controller/kind", 0) == 0);
-  CHECK(inputError({{"trajectory", {{"move_time", 0.0}}}}).rfind("/trajectory/move_time", 0) == 0);
-  CHECK(inputError(json::object()) == "accepted");
+  CHECK(fixture.inputError({{"mechanism", {{"torque_limit", {1.0, 2.0}}}}}).rfind("/mechanism/torque_limit", 0) == 0);
+  CHECK(fixture.inputError({{"controller", {{"kind", "lqr"}}}}).rfind("/controller/kind", 0) == 0);
+  CHECK(fixture.inputError({{"trajectory", {{"move_time", 0.0}}}}).rfind("/trajectory/move_time", 0) == 0);
+  CHECK(fixture.inputError(json::object()) == "accepted");
 }
 
 TEST_CASE("motion_control: the fixed-free spring chain's frequencies are eig(M^-1 K) and the closed form") {
