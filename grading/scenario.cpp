@@ -76,6 +76,7 @@ ScreenResult screenLoops(const Lab& lab) {
     }
     note += "; delay margin " + fmtMs(a.delay_margin) + " against " + fmtMs(loop.delay) + " of delay";
     if (!marginal && a.delay_margin < loop.delay) note += " — the delay alone destabilises it";
+    if (!loop.remark.empty()) note += "; " + loop.remark;
     r.notes.push_back(note + ".");
   }
   return r;

@@ -21,6 +21,7 @@ struct LinearLoop {
   std::string what;  // plain words for feedback, e.g. "force loop (integral law)"
   Poly num, den;     // L(s) without the delay
   double delay = 0;  // s
+  std::string remark = {};  // what the lab adds to the screening's sentence (e.g. a vibration mode), or empty
 };
 
 struct LoopAnalysis {

@@ -14,15 +14,14 @@
 
 #include "labs/grasp/lab.h"
 #include "labs/run.h"
+#include "tests/labs/lab_fixture.h"
 
 using namespace dyn;
 using namespace dyn::grasp;
 
 namespace {
 
-const std::string kFile = "grasp.json (test)";
-
-json defaultConfig() { return loadJsonFile(defaultConfigPath("grasp")); }
+const test::LabFixture fixture("grasp");
 
 // Gains that hold the grip through the whole exercise, as a config patch: firm, not the answer (they
 // score about 11.4/16, no integral squeeze; the instructor's good.json stays out of a student copy).
@@ -30,12 +29,6 @@ json gripGains() {
   json gains = {{"kp_pos", 500}, {"kd_pos", 12}, {"kp_psi", 0.8}, {"kd_psi", 0.015}, {"f_squeeze", 3.5}, {"ki_int", 0}};
   for (auto& [k, g] : gains.items()) g = json{{"value", g}};
   return gains;
-}
-
-std::unique_ptr<Lab> makeLab(const json& patch) {
-  const LabEntry* entry = findLab("grasp");
-  REQUIRE(entry != nullptr);
-  return buildLab(*entry, mergePatch(defaultConfig(), patch), kFile);
 }
 
 const Settings& settingsOf(const Lab& lab) { return dynamic_cast<const GraspLab&>(lab).settings(); }
@@ -47,25 +40,10 @@ json passive(double duration, double dt) {
           {"simulation", {{"dt", dt}, {"duration", duration}, {"integrator", "rk4"}, {"drift", "projection"}}}};
 }
 
-Trace run(const Lab& lab, Engine engine) {
-  RunResult r = runEngine(lab, engine);
-  REQUIRE_MESSAGE(r.failure.empty(), r.failure);
-  return std::move(r.trace);
-}
-
 double energyError(const Trace& tr) {
   double worst = 0;
   for (std::size_t r = 0; r < tr.rows(); ++r) worst = std::max(worst, std::abs(tr.at(r, "energy") - tr.at(0, "energy")));
   return worst;
-}
-
-std::string inputError(const json& patch) {
-  try {
-    makeLab(patch);
-  } catch (const InputError& e) {
-    return e.path() + ": " + e.expected();
-  }
-  return "accepted";
 }
 
 // A state away from the start: the object displaced and moving, the fingers assembled on it.
@@ -78,8 +56,8 @@ void someState(const Mechanism& mech, VecN& q, VecN& v) {
 TEST_CASE("grasp: the passive fall conserves energy, keeps the contacts closed, and RK4 is fourth order") {
   // The fall passes a stretched finger at t ≈ 1.63 s, where the mechanism's mobility changes and the
   // accelerations peak: at dt = 1 ms RK4 loses ~2e-6 of E there, at 0.5 ms 16× less.
-  const auto coarse = makeLab(passive(2.0, 1e-3)), fine = makeLab(passive(2.0, 5e-4));
-  const Trace a = run(*coarse, Engine::Hand), b = run(*fine, Engine::Hand);
+  const auto coarse = fixture.makeLab(passive(2.0, 1e-3)), fine = fixture.makeLab(passive(2.0, 5e-4));
+  const Trace a = fixture.run(*coarse, Engine::Hand), b = fixture.run(*fine, Engine::Hand);
   const double e0 = std::abs(a.at(0, "energy")), ea = energyError(a), eb = energyError(b);
   MESSAGE("passive |ΔE|/E over 2 s: dt 1 ms ", ea / e0, ", dt 0.5 ms ", eb / e0);
   CHECK(eb / e0 < 1e-6);
@@ -92,7 +70,7 @@ TEST_CASE("grasp: the passive fall conserves energy, keeps the contacts closed, 
 }
 
 TEST_CASE("grasp: the object's Newton–Euler equation holds with the reported contact forces") {
-  const auto lab = makeLab(json::object());
+  const auto lab = fixture.makeLab(json::object());
   const Settings& s = settingsOf(*lab);
   Mechanism mech(s.params);
   VecN q, v;
@@ -121,7 +99,7 @@ TEST_CASE("grasp: the object's Newton–Euler equation holds with the reported c
 }
 
 TEST_CASE("grasp: the internal force changes no object acceleration (F ∈ N(Aᵀ))") {
-  const auto lab = makeLab(json::object());
+  const auto lab = fixture.makeLab(json::object());
   Mechanism mech(settingsOf(*lab).params);
   VecN q, v;
   someState(mech, q, v);
@@ -148,7 +126,7 @@ TEST_CASE("grasp: in a static hold the least squeeze is m g / (2 μ)") {
   // The object held still by the controller (no motion in the reference, no friction, no delay): each
   // contact carries half the weight tangentially, so both margins are μ s − m g / 2.
   const json hold = {{"reference", {{"lift", 0.0}, {"sideways", 0.0}, {"tilt_deg", 0.0}}}, {"mechanism", {{"joint_friction", nullptr}}}};
-  const auto lab = makeLab(hold);
+  const auto lab = fixture.makeLab(hold);
   const Settings& base = settingsOf(*lab);
   Mechanism mech(base.params);
   VecN q, v;
@@ -186,8 +164,8 @@ TEST_CASE("grasp: hand and Bullet agree within tolerances stated per dt") {
   double previous = 0;
   for (const double dt : {1e-3, 5e-4}) {
     const json patch = {{"gains", gripGains()}, {"simulation", {{"dt", dt}}}};
-    const auto lab = makeLab(patch);
-    const Trace h = run(*lab, Engine::Hand), b = run(*lab, Engine::Bullet);
+    const auto lab = fixture.makeLab(patch);
+    const Trace h = fixture.run(*lab, Engine::Hand), b = fixture.run(*lab, Engine::Bullet);
     const json agree = lab->agreement(h, b);
     MESSAGE("dt ", dt, ": ", agree.dump());
     CHECK(agree["max_dpos"].get<double>() < 2e-5 * (dt / 1e-3));
@@ -200,7 +178,7 @@ TEST_CASE("grasp: hand and Bullet agree within tolerances stated per dt") {
 }
 
 TEST_CASE("grasp: a slipping grasp stops the run with a sentence; a push's work is in the energy balance") {
-  const auto slip = makeLab({{"gains", {{"f_squeeze", {{"value", 1.0}}}}}});
+  const auto slip = fixture.makeLab({{"gains", {{"f_squeeze", {{"value", 1.0}}}}}});
   const RunResult r = runEngine(*slip, Engine::Hand);
   CHECK(r.failure.rfind("stopped: the grasp slipped at contact ", 0) == 0);
   CHECK(r.failure.find("> μ f_n = ") != std::string::npos);
@@ -209,47 +187,47 @@ TEST_CASE("grasp: a slipping grasp stops the run with a sentence; a push's work 
   CHECK(r.trace.rows() < std::size_t(std::lround(slip->duration() / slip->dt())));
   CHECK(stoppedSentence(r.failure, 1.0) == r.failure);
   // A 1 N push: the object moves off its path and back, and E − E0 − W stays ~0 with W counting it.
-  const auto pushed = makeLab({{"disturbance", {{"force", {1.0, 0.0}}, {"start", 1.2}, {"duration", 0.1}}}});
-  const auto calm = makeLab(json::object());
-  const Trace p = run(*pushed, Engine::Hand), c = run(*calm, Engine::Hand);
+  const auto pushed = fixture.makeLab({{"disturbance", {{"force", {1.0, 0.0}}, {"start", 1.2}, {"duration", 0.1}}}});
+  const auto calm = fixture.makeLab(json::object());
+  const Trace p = fixture.run(*pushed, Engine::Hand), c = fixture.run(*calm, Engine::Hand);
   const std::size_t k = std::size_t(1.3 / pushed->dt());
   CHECK(p.at(k, "x_o") - c.at(k, "x_o") > 1e-3);
   CHECK(pushed->metrics(p)["energy_drift"].get<double>() < 1e-4);
-  const Trace pb = run(*pushed, Engine::Bullet);
+  const Trace pb = fixture.run(*pushed, Engine::Bullet);
   CHECK(pb.at(k, "x_o") - c.at(k, "x_o") > 1e-3);  // Bullet feels the push too
 }
 
 TEST_CASE("grasp: bad inputs get one line naming the JSON path") {
-  CHECK(inputError({{"mechanism", {{"mu", 0.0}}}}).find("/mechanism/mu: expected a friction coefficient") == 0);
-  CHECK(inputError({{"mechanism", {{"mu", -0.5}}}}).find("/mechanism/mu") == 0);
-  CHECK(inputError({{"initial", {{"y", 0.5}}}}).find("/initial: expected an object pose the fingers can reach: finger 1 cannot reach") == 0);
-  json one = defaultConfig()["mechanism"]["fingers"];
+  CHECK(fixture.inputError({{"mechanism", {{"mu", 0.0}}}}).find("/mechanism/mu: expected a friction coefficient") == 0);
+  CHECK(fixture.inputError({{"mechanism", {{"mu", -0.5}}}}).find("/mechanism/mu") == 0);
+  CHECK(fixture.inputError({{"initial", {{"y", 0.5}}}}).find("/initial: expected an object pose the fingers can reach: finger 1 cannot reach") == 0);
+  json one = fixture.defaults()["mechanism"]["fingers"];
   one.erase(1);
-  CHECK(inputError({{"mechanism", {{"fingers", one}}}}).find("/mechanism/fingers: expected 2 or 3 fingers") == 0);
-  json four = defaultConfig()["mechanism"]["fingers"];
+  CHECK(fixture.inputError({{"mechanism", {{"fingers", one}}}}).find("/mechanism/fingers: expected 2 or 3 fingers") == 0);
+  json four = fixture.defaults()["mechanism"]["fingers"];
   four.push_back(four[0]);
   four.push_back(four[1]);
-  CHECK(inputError({{"mechanism", {{"fingers", four}}}}).find("/mechanism/fingers: expected 2 or 3 fingers") == 0);
-  json three_links = defaultConfig()["mechanism"]["fingers"];
+  CHECK(fixture.inputError({{"mechanism", {{"fingers", four}}}}).find("/mechanism/fingers: expected 2 or 3 fingers") == 0);
+  json three_links = fixture.defaults()["mechanism"]["fingers"];
   three_links[0]["links"].push_back(three_links[0]["links"][0]);
-  CHECK(inputError({{"mechanism", {{"fingers", three_links}}}}).find("/mechanism/fingers/0/links: expected the two links") == 0);
-  json same = defaultConfig()["mechanism"]["fingers"];
+  CHECK(fixture.inputError({{"mechanism", {{"fingers", three_links}}}}).find("/mechanism/fingers/0/links: expected the two links") == 0);
+  json same = fixture.defaults()["mechanism"]["fingers"];
   same[1]["contact"] = same[0]["contact"];
   same[1]["normal"] = same[0]["normal"];
   same[1]["base"] = same[0]["base"];
   same[1]["elbow"] = same[0]["elbow"];
-  CHECK(inputError({{"mechanism", {{"fingers", same}}}}).find("/mechanism/fingers: expected contact points that hold") == 0);
-  CHECK(inputError({{"controller", {{"kind", "constant"}, {"torques", {0.1, 0.2}}}}}).find("/controller/torques: expected one torque per joint") == 0);
+  CHECK(fixture.inputError({{"mechanism", {{"fingers", same}}}}).find("/mechanism/fingers: expected contact points that hold") == 0);
+  CHECK(fixture.inputError({{"controller", {{"kind", "constant"}, {"torques", {0.1, 0.2}}}}}).find("/controller/torques: expected one torque per joint") == 0);
 }
 
 TEST_CASE("grasp: three fingers hold the object too (the finger count comes from the JSON)") {
-  json fingers = defaultConfig()["mechanism"]["fingers"];
+  json fingers = fixture.defaults()["mechanism"]["fingers"];
   // A third finger from above, pressing on the top mid-point.
   fingers.push_back({{"base", {0.0, 0.30}}, {"links", fingers[0]["links"]}, {"elbow", "positive"},
                      {"contact", {0.0, 0.02}}, {"normal", {0.0, 1.0}}});
-  const auto lab = makeLab({{"mechanism", {{"fingers", fingers}}}, {"simulation", {{"duration", 1.0}}}, {"gains", gripGains()}});
-  CHECK(lab->columns().size() == makeLab(json::object())->columns().size() + 2 + 2 + 2 + 2);  // q, τ, f_xy, f_nt of finger 3
-  const Trace tr = run(*lab, Engine::Hand);
+  const auto lab = fixture.makeLab({{"mechanism", {{"fingers", fingers}}}, {"simulation", {{"duration", 1.0}}}, {"gains", gripGains()}});
+  CHECK(lab->columns().size() == fixture.makeLab(json::object())->columns().size() + 2 + 2 + 2 + 2);  // q, τ, f_xy, f_nt of finger 3
+  const Trace tr = fixture.run(*lab, Engine::Hand);
   double residual = 0;
   for (std::size_t r = 0; r < tr.rows(); ++r) residual = std::max(residual, tr.at(r, "constraint_residual"));
   CHECK(residual < 1e-9);

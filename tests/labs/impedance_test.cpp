@@ -14,30 +14,14 @@
 
 #include "labs/impedance/lab.h"
 #include "labs/run.h"
+#include "tests/labs/lab_fixture.h"
 
 using namespace dyn;
 using namespace dyn::impedance;
 
 namespace {
 
-const std::string kFile = "impedance.json (test)";
-
-json config(const json& patch) { return mergePatch(loadJsonFile(defaultConfigPath("impedance")), patch); }
-
-std::unique_ptr<Lab> makeLab(const json& patch) {
-  const LabEntry* entry = findLab("impedance");
-  REQUIRE(entry != nullptr);
-  return buildLab(*entry, config(patch), kFile);
-}
-
-std::string inputError(const json& patch) {
-  try {
-    makeLab(patch);
-  } catch (const InputError& e) {
-    return e.path() + ": " + e.expected();
-  }
-  return "accepted";
-}
+const test::LabFixture fixture("impedance");
 
 json gains(const char* kind, double k, double zeta, double joint_kp = 2500, double joint_kd = 100) {
   return {{"controller", {{"kind", kind}}},
@@ -51,7 +35,7 @@ TEST_CASE("feedback linearisation with an exact model is the target's analytic p
   json p = gains("feedback_linearisation", 400, 0.5);
   p["simulation"] = {{"dt", 0.0002}, {"duration", 1.2}};
   p["controller"]["control_period"] = 0.0002;
-  const auto lab = makeLab(p);
+  const auto lab = fixture.makeLab(p);
   const RunResult r = runEngine(*lab, Engine::Hand);
   REQUIRE(r.failure.empty());
   const double d_static = 10.0 / 400;
@@ -67,14 +51,14 @@ TEST_CASE("feedback linearisation with an exact model is the target's analytic p
 }
 
 TEST_CASE("task_space: static stiffness is K_des, the apparent mass is the arm's own Λ") {
-  const auto lab = makeLab(gains("task_space", 300, 1.5));
+  const auto lab = fixture.makeLab(gains("task_space", 300, 1.5));
   const RunResult r = runEngine(*lab, Engine::Hand);
   REQUIRE(r.failure.empty());
   const json m = lab->metrics(r.trace);
   MESSAGE("task_space: K_id = ", m["stiffness"].get<double>(), " N/m for K_des = 300");
   CHECK(m["stiffness_error"].get<double>() < 1e-3);
   // Under-damped so the frequency is well defined: ω fitted against √(K/Λ_xx) from the screening's Λ.
-  const auto lab2 = makeLab(gains("task_space", 300, 0.3));
+  const auto lab2 = fixture.makeLab(gains("task_space", 300, 0.3));
   const RunResult r2 = runEngine(*lab2, Engine::Hand);
   REQUIRE(r2.failure.empty());
   const auto loops = lab2->linearise();
@@ -89,7 +73,7 @@ TEST_CASE("task_space: static stiffness is K_des, the apparent mass is the arm's
 TEST_CASE("joint_space: the joint loop's compliance in series, shrinking as K_p grows") {
   double previous = 1e9;
   for (double kp : {400.0, 2500.0, 20000.0}) {
-    const auto lab = makeLab(gains("joint_space", 400, 1.0, kp, 2 * std::sqrt(kp)));
+    const auto lab = fixture.makeLab(gains("joint_space", 400, 1.0, kp, 2 * std::sqrt(kp)));
     const RunResult r = runEngine(*lab, Engine::Hand);
     REQUIRE(r.failure.empty());
     const double err = lab->metrics(r.trace)["stiffness_error"].get<double>();
@@ -101,7 +85,7 @@ TEST_CASE("joint_space: the joint loop's compliance in series, shrinking as K_p 
 }
 
 TEST_CASE("hand vs Bullet over a push") {
-  const auto lab = makeLab(gains("feedback_linearisation", 400, 0.7));
+  const auto lab = fixture.makeLab(gains("feedback_linearisation", 400, 0.7));
   const RunResult h = runEngine(*lab, Engine::Hand), b = runEngine(*lab, Engine::Bullet);
   REQUIRE(h.failure.empty());
   REQUIRE(b.failure.empty());
@@ -111,9 +95,9 @@ TEST_CASE("hand vs Bullet over a push") {
 }
 
 TEST_CASE("bad inputs get one line naming the JSON path") {
-  CHECK(inputError({{"gains", {{"k_xy", {{"value", 0.0}}}}}}).find("/gains/k_xy") != std::string::npos);
-  CHECK(inputError({{"pose_deg", {30.0, 0.0, -45.0}}}).find("/pose_deg: a pose away from the task Jacobian's singularity") == 0);
-  CHECK(inputError({{"environment", {{"wall", {{"enabled", true}, {"x", 0.1}}}}}}).find("/environment/wall/x") == 0);
-  CHECK(inputError({{"controller", {{"kind", "admittance"}}}}).find("/controller/kind") == 0);
-  CHECK(inputError(json::object()) == "accepted");
+  CHECK(fixture.inputError({{"gains", {{"k_xy", {{"value", 0.0}}}}}}).find("/gains/k_xy") != std::string::npos);
+  CHECK(fixture.inputError({{"pose_deg", {30.0, 0.0, -45.0}}}).find("/pose_deg: a pose away from the task Jacobian's singularity") == 0);
+  CHECK(fixture.inputError({{"environment", {{"wall", {{"enabled", true}, {"x", 0.1}}}}}}).find("/environment/wall/x") == 0);
+  CHECK(fixture.inputError({{"controller", {{"kind", "admittance"}}}}).find("/controller/kind") == 0);
+  CHECK(fixture.inputError(json::object()) == "accepted");
 }

@@ -22,34 +22,14 @@
 #include "labs/pen_on_table/lab.h"
 #include "labs/run.h"
 #include "physics/linear.h"
+#include "tests/labs/lab_fixture.h"
 
 using namespace dyn;
 using namespace dyn::pen_on_table;
 
 namespace {
 
-const std::string kFile = "pen_on_table.json (test)";
-
-std::unique_ptr<Lab> makeLab(const json& patch) {
-  const LabEntry* entry = findLab("pen_on_table");
-  REQUIRE(entry != nullptr);
-  return buildLab(*entry, mergePatch(loadJsonFile(defaultConfigPath("pen_on_table")), patch), kFile);
-}
-
-Trace run(const Lab& lab, Engine engine) {
-  RunResult r = runEngine(lab, engine);
-  REQUIRE_MESSAGE(r.failure.empty(), r.failure);
-  return std::move(r.trace);
-}
-
-std::string inputError(const json& patch) {
-  try {
-    makeLab(patch);
-  } catch (const InputError& e) {
-    return e.path() + ": " + e.expected();
-  }
-  return "accepted";
-}
+const test::LabFixture fixture("pen_on_table");
 
 // A patch with these gains, force law and run length.
 json gains(double kp, double kv, double D_z, double K_z, const char* law = "damper") {
@@ -158,7 +138,7 @@ TEST_CASE("pen_on_table: the free arm off the table keeps its energy (RK4 + proj
 TEST_CASE("pen_on_table: resting on the table under τ = G − J_zᵀ η_d the table pushes with η_d") {
   const double eta_d = 4.0, h = 1e-6;
   json patch = withRun({{"initial", {{"height", 0.0}}}}, 0.5);
-  auto lab0 = makeLab(patch);
+  auto lab0 = fixture.makeLab(patch);
   const auto& lab = dynamic_cast<const PenOnTableLab&>(*lab0);
   const Params& p = lab.settings().params;
   VecN q, v;
@@ -175,7 +155,7 @@ TEST_CASE("pen_on_table: resting on the table under τ = G − J_zᵀ η_d the t
   for (const Engine e : {Engine::Hand, Engine::Bullet}) {
     const std::string engine = name(e);
     CAPTURE(engine);
-    const Trace tr = run(*makeLab(patch), e);
+    const Trace tr = fixture.run(*fixture.makeLab(patch), e);
     double df = 0, dq = 0;
     for (std::size_t r = 2; r < tr.rows(); ++r) {  // Bullet: the rest from its second step on
       df = std::max(df, std::abs(tr.at(r, "f_z") + eta_d));
@@ -197,8 +177,8 @@ TEST_CASE("pen_on_table: the damper on a rigid table is the lecture's integral f
   patch["initial"]["height"] = 0.0;
   patch["controller"]["delay"] = 0.0;
   patch["reference"]["start"] = 10.0;
-  const auto lab = makeLab(patch);
-  const Trace tr = run(*lab, Engine::Hand);
+  const auto lab = fixture.makeLab(patch);
+  const Trace tr = fixture.run(*lab, Engine::Hand);
   const double f_zd = -5;
   double worst = 0;
   for (std::size_t r = 0; r < tr.rows(); ++r) worst = std::max(worst, std::abs(tr.at(r, "f_z") - f_zd * (1 - std::exp(-k * tr.at(r, "t")))));
@@ -211,12 +191,12 @@ TEST_CASE("pen_on_table: the damper on a rigid table is the lecture's integral f
   json fast = withRun(gains(kp2, 60, D2, 4000), 1.5);
   fast["initial"]["height"] = 0.0;
   fast["reference"]["start"] = 10.0;
-  for (const auto& loop : makeLab(fast)->linearise())
+  for (const auto& loop : fixture.makeLab(fast)->linearise())
     if (loop.name == "force") CHECK(analyseLoop(loop).delay_margin == doctest::Approx(margin).epsilon(1e-6));
   auto settles = [&](double total_delay) {
     json p = fast;
     p["controller"]["delay"] = total_delay - 1e-3;  // the damper's z_des step adds one
-    const RunResult res = runEngine(*makeLab(p), Engine::Hand);
+    const RunResult res = runEngine(*fixture.makeLab(p), Engine::Hand);
     if (!res.failure.empty()) {  // the lab's watchdog: the pen hammered the table
       MESSAGE("loop delay ", total_delay * 1e3, " ms: ", res.failure);
       return false;
@@ -238,14 +218,14 @@ TEST_CASE("pen_on_table: the spring's steady-state error is −(k_p K_z/(k_p + K
     patch["table"]["height"] = 0.1 + delta;
     patch["controller"]["table_height_assumed"] = 0.1;
     patch["reference"]["start"] = 10.0;
-    const auto lab = makeLab(patch);
-    const json m = lab->metrics(run(*lab, Engine::Hand));
+    const auto lab = fixture.makeLab(patch);
+    const json m = lab->metrics(fixture.run(*lab, Engine::Hand));
     const double expected = -k_eff * delta;
     MESSAGE("spring, table ", delta * 1e3, " mm off: f_ss_error ", m["f_ss_error"].get<double>(), " N, closed form ", expected, " N");
     CHECK(std::abs(m["f_ss_error"].get<double>() - expected) < 1e-6);
   }
   // Its screening loop is the proportional k_p/K_z.
-  for (const auto& loop : makeLab(gains(kp, 60, 100, K_z, "spring"))->linearise())
+  for (const auto& loop : fixture.makeLab(gains(kp, 60, 100, K_z, "spring"))->linearise())
     if (loop.name == "force") CHECK(loop.num == Poly{kp / K_z});
 }
 
@@ -254,7 +234,7 @@ TEST_CASE("pen_on_table: the contact never pulls, and lifts off when the force l
   for (const Engine e : {Engine::Hand, Engine::Bullet}) {
     const std::string engine = name(e);
     CAPTURE(engine);
-    const auto lab = makeLab(patch);
+    const auto lab = fixture.makeLab(patch);
     // The lab's watchdog stops the limit cycle after 20 lift-offs: the trace up to there is kept.
     const RunResult res = runEngine(*lab, e);
     CHECK(res.failure.rfind("stopped: the pen lifted off the table 20 times", 0) == 0);
@@ -274,8 +254,8 @@ TEST_CASE("pen_on_table: the contact never pulls, and lifts off when the force l
 
 TEST_CASE("pen_on_table: energy — passive it only falls (plastic touchdowns), controlled the pressed table does no work") {
   // τ = 0 under gravity: the arm falls onto the table. Before touchdown E is constant; after, it never rises.
-  const auto passive = makeLab(withRun({{"controller", {{"kind", "none"}}}}, 1.0));
-  const Trace tr = run(*passive, Engine::Hand);
+  const auto passive = fixture.makeLab(withRun({{"controller", {{"kind", "none"}}}}, 1.0));
+  const Trace tr = fixture.run(*passive, Engine::Hand);
   const double e0 = tr.at(0, "energy");
   double before = 0, rise = 0;
   bool touched = false;
@@ -291,8 +271,8 @@ TEST_CASE("pen_on_table: energy — passive it only falls (plastic touchdowns), 
   CHECK(e0 - tr.at(tr.rows() - 1, "energy") > 1e-3);
   // The damper pressing and drawing: once the pen is down, E − E0 − ∫τ·θ' stays where the touchdown left it
   // (the plastic impact takes energy; the projection out of the touchdown step's penetration gives some back).
-  const auto lab = makeLab(withRun(gains(2000, 70, 150, 4000), 3.0));
-  const Trace c = run(*lab, Engine::Hand);
+  const auto lab = fixture.makeLab(withRun(gains(2000, 70, 150, 4000), 3.0));
+  const Trace c = fixture.run(*lab, Engine::Hand);
   const double t_down = lab->metrics(c)["touchdown_time"].get<double>() + 0.01;
   double lo = INFINITY, hi = -INFINITY;
   for (std::size_t r = 0; r < c.rows(); ++r)
@@ -313,8 +293,8 @@ TEST_CASE("pen_on_table: hand and Bullet agree on contact onset and on the force
   int k = 0;
   for (const double dt : {1e-3, 5e-4}) {
     CAPTURE(dt);
-    const auto lab = makeLab(withRun(gains(2000, 70, 150, 4000), 2.0, dt));
-    const Trace a = run(*lab, Engine::Hand), b = run(*lab, Engine::Bullet);
+    const auto lab = fixture.makeLab(withRun(gains(2000, 70, 150, 4000), 2.0, dt));
+    const Trace a = fixture.run(*lab, Engine::Hand), b = fixture.run(*lab, Engine::Bullet);
     const json g = lab->agreement(a, b);
     MESSAGE("dt ", dt, ": touchdown hand ", g["touchdown_hand"].get<double>(), " s, Bullet ", g["touchdown_bullet"].get<double>(),
             " s; settled force: max ", g["max_df_settled"].get<double>(), " N, mean ", g["mean_df_settled"].get<double>(), " N; max |Δp| ",
@@ -329,31 +309,31 @@ TEST_CASE("pen_on_table: hand and Bullet agree on contact onset and on the force
 }
 
 TEST_CASE("pen_on_table: bad inputs get one line naming the JSON path") {
-  CHECK(inputError({{"table", {{"height", 1.2}}}}).find("/table/height: expected a table the arm can reach") == 0);
-  CHECK(inputError({{"table", {{"height", -0.5}}}}).find("/table/height: expected a table the arm can reach") == 0);
-  CHECK(inputError({{"gains", {{"D_z", {{"min", -1.0}, {"value", 0.0}}}}}}).find("/gains/D_z: expected a damper constant D_z > 0") == 0);
-  CHECK(inputError({{"gains", {{"K_z", {{"min", -5.0}, {"value", -2.0}}}}}}).find("/gains/K_z: expected a spring constant") == 0);
-  CHECK(inputError({{"reference", {{"radius", 0.3}}}}).find("/reference/radius: expected a circle inside the arm's workspace") == 0);
-  CHECK(inputError({{"reference", {{"centre", {0.01, 0.0}}}}}).find("/reference/centre: expected the circle's centre within") == 0);
-  CHECK(inputError({{"reference", {{"centre", {0.4}}}}}).find("/reference/centre: expected the circle's centre [x, y]") == 0);
-  CHECK(inputError({{"controller", {{"force_setpoint", 5.0}}}}).find("/controller/force_setpoint: expected a set point f_zd < 0") == 0);
-  CHECK(inputError({{"controller", {{"force_law", "integral"}}}}).find("/controller/force_law") == 0);
-  CHECK(inputError({{"table", {{"damping", 5.0}}}}).find("/table/damping: expected 0 on a rigid table") == 0);
-  CHECK(inputError({{"simulation", {{"drift", "independent"}}}}).find("/simulation/drift: expected none, baumgarte or projection") == 0);
-  CHECK(inputError({{"initial", {{"height", 0.9}}}}).find("/initial/height: expected a start the arm can reach") == 0);
-  CHECK(inputError({{"mechanism", {{"links", {{{"length", 0.3}, {"mass", 2.0}, {"radius", 0.04}}}}}}}).find("/mechanism/links") == 0);
-  CHECK(inputError({{"controller", {{"kind", "constant"}, {"torques", {1.0}}}}}).find("/controller/torques") == 0);
+  CHECK(fixture.inputError({{"table", {{"height", 1.2}}}}).find("/table/height: expected a table the arm can reach") == 0);
+  CHECK(fixture.inputError({{"table", {{"height", -0.5}}}}).find("/table/height: expected a table the arm can reach") == 0);
+  CHECK(fixture.inputError({{"gains", {{"D_z", {{"min", -1.0}, {"value", 0.0}}}}}}).find("/gains/D_z: expected a damper constant D_z > 0") == 0);
+  CHECK(fixture.inputError({{"gains", {{"K_z", {{"min", -5.0}, {"value", -2.0}}}}}}).find("/gains/K_z: expected a spring constant") == 0);
+  CHECK(fixture.inputError({{"reference", {{"radius", 0.3}}}}).find("/reference/radius: expected a circle inside the arm's workspace") == 0);
+  CHECK(fixture.inputError({{"reference", {{"centre", {0.01, 0.0}}}}}).find("/reference/centre: expected the circle's centre within") == 0);
+  CHECK(fixture.inputError({{"reference", {{"centre", {0.4}}}}}).find("/reference/centre: expected the circle's centre [x, y]") == 0);
+  CHECK(fixture.inputError({{"controller", {{"force_setpoint", 5.0}}}}).find("/controller/force_setpoint: expected a set point f_zd < 0") == 0);
+  CHECK(fixture.inputError({{"controller", {{"force_law", "integral"}}}}).find("/controller/force_law") == 0);
+  CHECK(fixture.inputError({{"table", {{"damping", 5.0}}}}).find("/table/damping: expected 0 on a rigid table") == 0);
+  CHECK(fixture.inputError({{"simulation", {{"drift", "independent"}}}}).find("/simulation/drift: expected none, baumgarte or projection") == 0);
+  CHECK(fixture.inputError({{"initial", {{"height", 0.9}}}}).find("/initial/height: expected a start the arm can reach") == 0);
+  CHECK(fixture.inputError({{"mechanism", {{"links", {{{"length", 0.3}, {"mass", 2.0}, {"radius", 0.04}}}}}}}).find("/mechanism/links") == 0);
+  CHECK(fixture.inputError({{"controller", {{"kind", "constant"}, {"torques", {1.0}}}}}).find("/controller/torques") == 0);
 }
 
 TEST_CASE("pen_on_table: the same input gives the same trace, noise included (seeded)") {
   json patch = withRun(gains(2000, 70, 150, 4000), 1.0);
   patch["controller"]["noise"] = 0.5;
   for (const Engine e : {Engine::Hand, Engine::Bullet}) {
-    const Trace a = run(*makeLab(patch), e), b = run(*makeLab(patch), e);
+    const Trace a = fixture.run(*fixture.makeLab(patch), e), b = fixture.run(*fixture.makeLab(patch), e);
     CHECK(a.data == b.data);
   }
   // Another seed, another noise.
   json other = patch;
   other["controller"]["seed"] = 2;
-  CHECK(run(*makeLab(patch), Engine::Hand).data != run(*makeLab(other), Engine::Hand).data);
+  CHECK(fixture.run(*fixture.makeLab(patch), Engine::Hand).data != fixture.run(*fixture.makeLab(other), Engine::Hand).data);
 }

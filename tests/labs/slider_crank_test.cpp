@@ -19,22 +19,14 @@
 
 #include "labs/run.h"
 #include "labs/slider_crank/lab.h"
+#include "tests/labs/lab_fixture.h"
 
 using namespace dyn;
 using namespace dyn::slider_crank;
 
 namespace {
 
-const std::string kFile = "slider_crank.json (test)";
-
-json defaultConfig() { return loadJsonFile(defaultConfigPath("slider_crank")); }
-
-// The default config with `patch` merged in (RFC 7386), built through the registry.
-std::unique_ptr<Lab> makeLab(const json& patch) {
-  const LabEntry* entry = findLab("slider_crank");
-  REQUIRE(entry != nullptr);
-  return buildLab(*entry, mergePatch(defaultConfig(), patch), kFile);
-}
+const test::LabFixture fixture("slider_crank");
 
 // τ = 0, no control: the passive mechanism falling under gravity from the default 60° crank angle.
 json passive(double duration = 2.0, double dt = 1e-3, const char* integrator = "rk4",
@@ -44,13 +36,6 @@ json passive(double duration = 2.0, double dt = 1e-3, const char* integrator = "
 }
 
 const Settings& settingsOf(const Lab& lab) { return dynamic_cast<const SliderCrankLab&>(lab).settings(); }
-
-Trace run(const Lab& lab, Engine engine) {
-  RunResult r = runEngine(lab, engine);
-  REQUIRE_MESSAGE(r.failure.empty(), r.failure);
-  REQUIRE(r.trace.rows() == std::size_t(std::lround(lab.duration() / lab.dt())));
-  return std::move(r.trace);
-}
 
 double maxAbs(const std::vector<double>& x) {
   double m = 0;
@@ -148,14 +133,14 @@ TEST_CASE("the slider_crank lab is registered in this binary") {
   REQUIRE(entry != nullptr);
   CHECK(entry->name == "slider_crank");
   CHECK_FALSE(entry->summary.empty());
-  CHECK(makeLab(json::object())->columns() == std::vector<std::string>{
+  CHECK(fixture.makeLab(json::object())->columns() == std::vector<std::string>{
             "t", "q1", "q2", "q3", "x_c", "v_c", "f_Tx", "f_Ty", "tau_T", "tau1", "tau2", "tau3", "energy",
             "constraint_residual", "x_d", "f_des", "f_meas", "work"});
 }
 
 TEST_CASE("passive run (τ = 0, RK4 + projection, dt = 1 ms, 2 s): energy conserved, φ = 0, and it moves") {
-  const auto lab = makeLab(passive());
-  const Trace tr = run(*lab, Engine::Hand);
+  const auto lab = fixture.makeLab(passive());
+  const Trace tr = fixture.run(*lab, Engine::Hand);
   const auto energy = tr.series("energy"), residual = tr.series("constraint_residual"), q1 = tr.series("q1"),
              tau1 = tr.series("tau1");
   CHECK(maxAbs(tau1) == 0.0);  // really passive
@@ -190,10 +175,10 @@ TEST_CASE("passive run (τ = 0, RK4 + projection, dt = 1 ms, 2 s): energy conser
 TEST_CASE("the constraint force is the force the motion needs and does no work on the closed mechanism") {
   // Conventions (mechanism.h, constrained.h): f_T = (τ_T, f_Tx, f_Ty) is the force the arm applies
   // to the slider; arm: M θ'' + Cθ' + G = τ − Jᵀ f_T; slider (load separate): m_c x_c'' = f_Tx.
-  const auto lab = makeLab(passive(1.0));
+  const auto lab = fixture.makeLab(passive(1.0));
   const Settings& s = settingsOf(*lab);
   const double dt = s.step.dt, mc = s.params.load_mass;
-  const Trace tr = run(*lab, Engine::Hand);
+  const Trace tr = fixture.run(*lab, Engine::Hand);
   const auto v_c = tr.series("v_c"), f_Tx = tr.series("f_Tx");
   REQUIRE(maxAbs(f_Tx) > 1.0);  // the slider is really pushed (up to ~20 N through the dead centre)
 
@@ -270,7 +255,7 @@ TEST_CASE("drift handling (RK4, dt = 1 ms, τ = 0)") {
   // φ'' + 2ζωφ' + ω²φ = e (ω = 50 rad/s): |φ| ~ e/ω², bounded, not growing. Projection holds |φ|
   // at its Newton tolerance (1e-12), independent coordinates rebuild θ exactly (1e-16).
   const double T = 6.0;
-  auto residuals = [&](const char* drift) { return run(*makeLab(passive(T, 1e-3, "rk4", drift)), Engine::Hand); };
+  auto residuals = [&](const char* drift) { return fixture.run(*fixture.makeLab(passive(T, 1e-3, "rk4", drift)), Engine::Hand); };
 
   SUBCASE("none: grows steadily but stays small") {
     const Trace tr = residuals("none");
@@ -308,14 +293,14 @@ TEST_CASE("convergence order: semi-implicit Euler is first order, RK4 fourth") {
   // Errors at dt = 2, 1, 0.5 ms (projection on): q1 at t = 0.5 s against RK4 at 0.25 ms (its own
   // error is ~1e-12 rad, far below every error compared), and max |E − E0| over 1 s. Halving dt
   // should divide the error by 2 (Euler) and 16 (RK4); bands leave room for higher-order terms.
-  const auto reference = makeLab(passive(1.0, 2.5e-4, "rk4"));
-  const Trace ref = run(*reference, Engine::Hand);
+  const auto reference = fixture.makeLab(passive(1.0, 2.5e-4, "rk4"));
+  const Trace ref = fixture.run(*reference, Engine::Hand);
   const double q1_ref = ref.at(rowAt(*reference, 0.5), "q1");
   for (const char* integrator : {"semi_implicit_euler", "rk4"}) {
     std::vector<double> dq, de;
     for (double dt : {2e-3, 1e-3, 5e-4}) {
-      const auto lab = makeLab(passive(1.0, dt, integrator));
-      const Trace tr = run(*lab, Engine::Hand);
+      const auto lab = fixture.makeLab(passive(1.0, dt, integrator));
+      const Trace tr = fixture.run(*lab, Engine::Hand);
       dq.push_back(std::abs(tr.at(rowAt(*lab, 0.5), "q1") - q1_ref));
       de.push_back(energyError(tr));
       MESSAGE(std::string(integrator), " dt = ", dt, ": |q1 - q1_ref|(0.5 s) = ", dq.back(), " rad, max |E - E0| = ", de.back(), " J");
@@ -342,8 +327,8 @@ TEST_CASE("hand-written model vs Bullet") {
   auto both = [](const json& patch, double dt) {
     json p = patch;
     p["simulation"]["dt"] = dt;
-    auto lab = makeLab(p);
-    Trace hand = run(*lab, Engine::Hand), bullet = run(*lab, Engine::Bullet);
+    auto lab = fixture.makeLab(p);
+    Trace hand = fixture.run(*lab, Engine::Hand), bullet = fixture.run(*lab, Engine::Bullet);
     const json ag = lab->agreement(hand, bullet);
     // The lab's agreement is the largest difference of the traces: recompute one of them here.
     CHECK(ag["rows_compared"] == hand.rows());
@@ -408,20 +393,20 @@ TEST_CASE("determinism: the same config gives the same trace hash, for both engi
   const json noisy = {{"controller", {{"noise_std", 0.2}, {"seed", 7}}}, {"simulation", {{"duration", 1.0}}}};
   for (Engine e : {Engine::Hand, Engine::Bullet}) {
     INFO("engine ", name(e));
-    const Trace a = run(*makeLab(noisy), e), b = run(*makeLab(noisy), e);
+    const Trace a = fixture.run(*fixture.makeLab(noisy), e), b = fixture.run(*fixture.makeLab(noisy), e);
     CHECK(a.hash() == b.hash());
     CHECK(a.csv() == b.csv());
     // The hash sees the data: another seed gives another trajectory and another hash.
     json other = noisy;
     other["controller"]["seed"] = 8;
-    CHECK(run(*makeLab(other), e).hash() != a.hash());
+    CHECK(fixture.run(*fixture.makeLab(other), e).hash() != a.hash());
   }
 }
 
 TEST_CASE("the projection step through eq. (2) for impulses equals the W-metric formula") {
   // Mechanism::correction answers dx = W⁻¹Gᵀ(G W⁻¹ Gᵀ)⁻¹ e from its factored eq. (2) (τ − h = 0,
   // J'θ' = −e); the generic ConstrainedSystem::correction builds W and G and factors them itself.
-  const auto lab = makeLab(json::object());
+  const auto lab = fixture.makeLab(json::object());
   Mechanism mech(settingsOf(*lab).params);
   for (double theta1 : {0.3, 1.0, 2.0, -1.2}) {
     CAPTURE(theta1);
@@ -447,10 +432,10 @@ TEST_CASE("the force loop starts from a measured force: no start-up dip") {
   // loop starts from a measured force). With a zero-filled delay line the integral law saw a 5 N
   // error for the first 10 ms and dipped to −6.9 N (37 % overshoot); primed, only the motion's own
   // disturbance remains (measured 0.12 N over the first 0.3 s), on both engines.
-  const auto lab = makeLab({{"simulation", {{"duration", 0.3}}}});
+  const auto lab = fixture.makeLab({{"simulation", {{"duration", 0.3}}}});
   for (Engine e : {Engine::Hand, Engine::Bullet}) {
     INFO("engine ", std::string(name(e)));
-    const Trace tr = run(*lab, e);
+    const Trace tr = fixture.run(*lab, e);
     double worst = 0;
     for (std::size_t r = 0; r < tr.rows(); ++r) worst = std::max(worst, std::abs(tr.at(r, "f_Ty") - tr.at(r, "f_des")));
     MESSAGE(std::string(name(e)), ": max |f_Ty − f_des| over the first 0.3 s = ", worst, " N");

@@ -13,34 +13,14 @@
 
 #include "labs/run.h"
 #include "labs/unicycle/lab.h"
+#include "tests/labs/lab_fixture.h"
 
 using namespace dyn;
 using namespace dyn::unicycle;
 
 namespace {
 
-const std::string kFile = "unicycle.json (test)";
-
-std::unique_ptr<Lab> makeLab(const json& patch) {
-  const LabEntry* entry = findLab("unicycle");
-  REQUIRE(entry != nullptr);
-  return buildLab(*entry, mergePatch(loadJsonFile(defaultConfigPath("unicycle")), patch), kFile);
-}
-
-Trace run(const Lab& lab, Engine engine) {
-  RunResult r = runEngine(lab, engine);
-  REQUIRE_MESSAGE(r.failure.empty(), r.failure);
-  return std::move(r.trace);
-}
-
-std::string inputError(const json& patch) {
-  try {
-    makeLab(patch);
-  } catch (const InputError& e) {
-    return e.path() + ": " + e.expected();
-  }
-  return "accepted";
-}
+const test::LabFixture fixture("unicycle");
 
 json constantTorques(double tau_y, double tau_z, double duration, double dt) {
   return {{"controller", {{"kind", "constant"}, {"tau_drive", tau_y}, {"tau_steer", tau_z}}},
@@ -52,8 +32,8 @@ json constantTorques(double tau_y, double tau_z, double duration, double dt) {
 
 TEST_CASE("unicycle: from rest under constant torques the hand run is the closed form") {
   const double tau_y = 0.04, tau_z = 0.003, T = 5.0;
-  const auto lab = makeLab(constantTorques(tau_y, tau_z, T + 1e-3, 1e-3));
-  const Trace tr = run(*lab, Engine::Hand);
+  const auto lab = fixture.makeLab(constantTorques(tau_y, tau_z, T + 1e-3, 1e-3));
+  const Trace tr = fixture.run(*lab, Engine::Hand);
   const Params& p = dynamic_cast<const UnicycleLab&>(*lab).settings().params;
   const double th_dd = tau_y / (p.axle_inertia + p.mass * p.radius * p.radius), ph_dd = tau_z / p.steer_inertia;
   // The row at t = T, and the closed form's x, y by Simpson's rule (200 000 intervals: error ~1e-15).
@@ -78,9 +58,9 @@ TEST_CASE("unicycle: from rest under constant torques the hand run is the closed
 
 TEST_CASE("unicycle: with no torque it rolls a circle of radius r θ'/φ', held by m r θ' φ'") {
   const double th = 20.0, ph = 1.5;
-  const auto lab = makeLab({{"controller", {{"kind", "none"}}}, {"initial", {{"theta_rate", th}, {"phi_rate", ph}}},
-                            {"simulation", {{"duration", 4.0}}}});
-  const Trace tr = run(*lab, Engine::Hand);
+  const auto lab = fixture.makeLab({{"controller", {{"kind", "none"}}}, {"initial", {{"theta_rate", th}, {"phi_rate", ph}}},
+                                    {"simulation", {{"duration", 4.0}}}});
+  const Trace tr = fixture.run(*lab, Engine::Hand);
   const Params& p = dynamic_cast<const UnicycleLab&>(*lab).settings().params;
   const double radius = p.radius * th / ph;
   double worst_r = 0, worst_e = 0, worst_lat = 0, worst_n = 0, slip = 0;
@@ -100,14 +80,14 @@ TEST_CASE("unicycle: with no torque it rolls a circle of radius r θ'/φ', held 
 }
 
 TEST_CASE("unicycle: bad inputs get one line naming the JSON path") {
-  CHECK(inputError({{"mechanism", {{"radius", 0.0}}}}).find("/mechanism/radius: expected the wheel radius r > 0") == 0);
-  CHECK(inputError({{"mechanism", {{"radius", -0.1}}}}).find("/mechanism/radius") == 0);
-  CHECK(inputError({{"mechanism", {{"mu", -0.5}}}}).find("/mechanism/mu: expected a friction coefficient") == 0);
-  CHECK(inputError({{"reference", {{"points", "a circle"}}}}).find("/reference/points: expected the path as a list of points") == 0);
-  CHECK(inputError({{"reference", {{"points", {1.0, 2.0}}}}}).find("/reference/points/0: expected a point [x, y]") == 0);
-  CHECK(inputError({{"reference", {{"points", {{0.0, 0.0}}}}}}).find("/reference/points") == 0);
-  CHECK(inputError({{"reference", {{"points", {{0.0, 0.0}, {0.0, 0.0}}}}}}).find("/reference/points/1: expected a point distinct") == 0);
-  CHECK(inputError({{"gains", {{"a_lat", {{"value", 0.0}}}}}}).find("/gains/a_lat") == 0);
-  const std::string missing = inputError({{"controller", {{"kind", "constant"}}}});
+  CHECK(fixture.inputError({{"mechanism", {{"radius", 0.0}}}}).find("/mechanism/radius: expected the wheel radius r > 0") == 0);
+  CHECK(fixture.inputError({{"mechanism", {{"radius", -0.1}}}}).find("/mechanism/radius") == 0);
+  CHECK(fixture.inputError({{"mechanism", {{"mu", -0.5}}}}).find("/mechanism/mu: expected a friction coefficient") == 0);
+  CHECK(fixture.inputError({{"reference", {{"points", "a circle"}}}}).find("/reference/points: expected the path as a list of points") == 0);
+  CHECK(fixture.inputError({{"reference", {{"points", {1.0, 2.0}}}}}).find("/reference/points/0: expected a point [x, y]") == 0);
+  CHECK(fixture.inputError({{"reference", {{"points", {{0.0, 0.0}}}}}}).find("/reference/points") == 0);
+  CHECK(fixture.inputError({{"reference", {{"points", {{0.0, 0.0}, {0.0, 0.0}}}}}}).find("/reference/points/1: expected a point distinct") == 0);
+  CHECK(fixture.inputError({{"gains", {{"a_lat", {{"value", 0.0}}}}}}).find("/gains/a_lat") == 0);
+  const std::string missing = fixture.inputError({{"controller", {{"kind", "constant"}}}});
   CHECK_MESSAGE(missing.find("tau_drive") != std::string::npos, missing);
 }
