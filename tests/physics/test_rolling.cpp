@@ -109,8 +109,10 @@ TEST_CASE("rolling: with no torque the wheel rolls a circle of radius r θ'/φ',
   CHECK(worst_radius < 1e-9);
   CHECK(worst_energy < 1e-12);
   CHECK(worst_force < 1e-9);
-  CHECK(std::abs(v[4] - th) < 1e-12);
-  CHECK(std::abs(v[3] - ph) < 1e-12);
+  // Rates kept to rounding over 4,000 steps (the stages work at the world origin, up to 2.7 m away:
+  // a few ulp of r × f per step).
+  CHECK(std::abs(v[4] - th) < 1e-11);
+  CHECK(std::abs(v[3] - ph) < 1e-11);
 }
 
 TEST_CASE("rolling: the contact force does no work (energy change = work of the torques)") {
