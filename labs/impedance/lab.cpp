@@ -16,7 +16,6 @@
 namespace dyn::impedance {
 namespace {
 
-using motion_control::ArmMechanism;
 using motion_control::Params;
 constexpr double kMaxLength = 100, kMaxMass = 1e6, kMaxForce = 1e5;
 
