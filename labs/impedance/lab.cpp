@@ -16,7 +16,6 @@
 namespace dyn::impedance {
 namespace {
 
-using motion_control::ArmMechanism;
 using motion_control::Params;
 constexpr double kMaxLength = 100, kMaxMass = 1e6, kMaxForce = 1e5;
 
@@ -40,7 +39,8 @@ MechanismModel<Planar> describeWithWall(const Settings& s) {
 }
 
 // The task Jacobian rows (x, y, φ) and J'θ' from the mechanism's point Jacobian rows (ω, vx, vy).
-void taskJacobian(ArmMechanism& m, const Params& p, const VecN& q, const VecN& v, Eigen::Matrix3d& J, Eigen::Vector3d& Jdv) {
+template <class Mech>
+void taskJacobian(Mech& m, const Params& p, const VecN& q, const VecN& v, Eigen::Matrix3d& J, Eigen::Vector3d& Jdv) {
   MatN J3;
   VecN jd;
   m.pointJacobian(2, Planar::Pos(p.links[2].length, 0.0), q, v, J3, jd);
@@ -53,7 +53,7 @@ class Hooks final : public StepHooks {
  public:
   explicit Hooks(const Settings& s)
       : s_(s), model_(motion_control::describeRigid(s.model)), plant_(motion_control::describeRigid(s.plant)),
-        hold_(std::max(1L, std::lround(s.period / s.step.dt))), rng_(12345),
+        inner_(s.inner, s.model), hold_(std::max(1L, std::lround(s.period / s.step.dt))), rng_(12345),
         fx_(s.delay, s.step.dt), fy_(s.delay, s.step.dt) {
     x_ref_ = tipPose(s.plant, s.pose);
     x_des_ = x_ref_, v_des_.setZero(), a_des_.setZero();
@@ -66,7 +66,7 @@ class Hooks final : public StepHooks {
     Eigen::Vector3d Jdv;
     taskJacobian(plant_, s_.plant, q, v, J, Jdv);
     f_applied_ = F;
-    if (k_++ % hold_ == 0) tau_ = control(q, v);
+    if (k_++ % hold_ == 0) tau_ = control(t, q, v);
     const Eigen::Vector3d ext = J.topRows<2>().transpose() * F;
     return VecN(tau_ + ext);
   }
@@ -75,6 +75,10 @@ class Hooks final : public StepHooks {
     Eigen::Vector2d f = f_applied_;
     // The wall's push on the tip (plane on body: the constraint's force is body on world).
     if (s_.wall.enabled && !r.forces.empty() && r.forces[0].size() >= 3) f += Eigen::Vector2d(r.forces[0][1], r.forces[0][2]);
+    // A rigid wall's plastic impact: the hand engine jumps θ' at the step's start (eq. (2) for
+    // impulses), and the contact force it reports after that leaves the impulse out; the row carries
+    // it as P/dt, the step's mean force, as Bullet's impulse-based contact reports it.
+    if (s_.wall.enabled && s_.wall.stiffness == 0 && r.engine == Engine::Hand) f.x() -= impactImpulse(r.q, r.v) / s_.step.dt;
     f_total_ = f;
     out.clear();
     out.push_back(r.t);
@@ -95,6 +99,8 @@ class Hooks final : public StepHooks {
       const double w = std::sqrt(s_.target.K[a] / s_.target.M[a]), z = s_.target.D[a] / (2 * std::sqrt(s_.target.K[a] * s_.target.M[a]));
       out.push_back(x_ref_[a] + push.value[a] / s_.target.K[a] * (unitStep(w, z, r.t - t_on) - unitStep(w, z, r.t - t_off)));
     }
+    // The target spring's force at the hand, K_des,x (x − x_ref): against x, the line of slope K_des.
+    out.push_back(s_.target.K[0] * (x[0] - x_ref_[0]));
   }
   void observe(const StepRecord& r) override {
     (void)r;
@@ -105,7 +111,21 @@ class Hooks final : public StepHooks {
   }
 
  private:
-  Eigen::Vector3d control(const VecN& q, const VecN& v) {
+  // The impulse P = Λ_n v_n (N·s) of a plastic impact on the wall at (q, v), as the engine's
+  // touchdown test sees it (the ball at or past the plane, moving into it); 0 otherwise.
+  // Λ_n = (J_n M⁻¹ J_nᵀ)⁻¹, J_n the tip's x row: the least-kinetic-energy jump that stops v_n.
+  double impactImpulse(const VecN& q, const VecN& v) {
+    const Eigen::Vector3d th = q.head<3>();
+    Eigen::Matrix3d J;
+    Eigen::Vector3d Jdv;
+    taskJacobian(plant_, s_.plant, q, v, J, Jdv);
+    const double vn = J.row(0).dot(v.head<3>());
+    if (vn <= 0 || tipPose(s_.plant, th)[0] + s_.wall.radius < s_.wall.x) return 0;
+    const Eigen::Matrix3d M = plant_.massMatrix(q);
+    return vn / J.row(0).dot(M.ldlt().solve(Eigen::Vector3d(J.row(0).transpose())));
+  }
+
+  Eigen::Vector3d control(double t, const VecN& q, const VecN& v) {
     const Eigen::Vector3d th = q.head<3>(), thd = v.head<3>();
     const Eigen::Vector3d F(fx_.value(), fy_.value(), 0.0);
     const Target& T = s_.target;
@@ -135,7 +155,8 @@ class Hooks final : public StepHooks {
       }
       case Kind::JointSpace: {
         // The impedance model on measured F gives x_des, v_des, a_des (semi-implicit Euler over the
-        // control period); inverse kinematics gives θ_des; a computed-torque joint loop tracks it.
+        // control period); inverse kinematics gives θ_des, θ_des', θ_des''; the motion-control lab's
+        // joint controller (pid, computed_torque or pd_gravity) tracks them.
         const double h = s_.period;
         a_des_ = (F - T.D.cwiseProduct(v_des_) - T.K.cwiseProduct(x_des_ - x_ref_)).cwiseQuotient(T.M);
         v_des_ += h * a_des_;
@@ -149,8 +170,8 @@ class Hooks final : public StepHooks {
         const Eigen::Vector3d w_des = Jd.partialPivLu().solve(v_des_);
         taskJacobian(model_, s_.model, VecN(thd_des), VecN(w_des), Jd, Jdv);
         const Eigen::Vector3d al_des = Jd.partialPivLu().solve(a_des_ - Jdv);
-        const Eigen::Vector3d qdd = al_des - s_.joint_kp * (th - thd_des) - s_.joint_kd * (thd - w_des);
-        tau = model_.inverseDynamics(VecN(th), VecN(thd), VecN(qdd));
+        const motion_control::Reference ref{thd_des, w_des, al_des};
+        tau = inner_.torque(t, th, thd, ref);
         break;
       }
     }
@@ -158,7 +179,8 @@ class Hooks final : public StepHooks {
   }
 
   const Settings& s_;
-  ArmMechanism model_, plant_;
+  motion_control::FixedArm<3> model_, plant_;  // fixed sizes: the controller's kinematics unrolled
+  motion_control::Controller inner_;
   long hold_, k_ = 0;
   std::mt19937 rng_;
   DelayLine fx_, fy_;
@@ -248,7 +270,7 @@ Settings parseSettings(const JsonView& c) {
     c["environment"]["wall"]["x"].fail("a wall to the right of the tip at the reference pose");
 
   const JsonView ctl = c["controller"];
-  ctl.onlyKeys({"kind", "control_period", "constant_torque"});
+  ctl.onlyKeys({"kind", "inner", "joint_scale", "control_period", "constant_torque"});
   const std::string kind = ctl["kind"].oneOf({"none", "constant", "joint_space", "task_space", "feedback_linearisation"});
   s.kind = kind == "none" ? Kind::None : kind == "constant" ? Kind::Constant : kind == "joint_space" ? Kind::JointSpace
            : kind == "task_space" ? Kind::TaskSpace : Kind::FeedbackLinearisation;
@@ -258,13 +280,28 @@ Settings parseSettings(const JsonView& c) {
   s.constant = ctl.has("constant_torque") ? parse3(ctl["constant_torque"], -kMaxForce, kMaxForce) : Eigen::Vector3d::Zero();
 
   // The target per axis: K and M given, D from the damping ratio, D = 2ζ√(KM).
-  const auto g = parseGains(c["gains"], {"k_xy", "k_phi", "m_xy", "m_phi", "zeta", "joint_kp", "joint_kd"});
+  const auto g = parseGains(c["gains"], {"k_xy", "k_phi", "m_xy", "m_phi", "zeta", "joint_kp", "joint_ki", "joint_kd"});
   for (const char* k : {"k_xy", "k_phi", "m_xy", "m_phi"})
     if (!(g.at(k) > 0)) c["gains"][k].fail(std::string("a positive ") + k + " (the target impedance must be positive definite)");
   s.target.K << g.at("k_xy"), g.at("k_xy"), g.at("k_phi");
   s.target.M << g.at("m_xy"), g.at("m_xy"), g.at("m_phi");
   for (int i = 0; i < 3; ++i) s.target.D[i] = 2 * g.at("zeta") * std::sqrt(s.target.K[i] * s.target.M[i]);
-  s.joint_kp = g.at("joint_kp"), s.joint_kd = g.at("joint_kd");
+  // joint_space's inner loop, the motion-control lab's controller: computed_torque's K_p, K_d act on
+  // the error dynamics (1/s², 1/s, every joint alike); pid's and pd_gravity's are torques per error,
+  // spread over the joints by joint_scale. Absent (older configs): computed torque, as before.
+  motion_control::ControllerConfig& in = s.inner;
+  const std::string inner = ctl.has("inner") ? ctl["inner"].oneOf({"pid", "computed_torque", "pd_gravity"}) : "computed_torque";
+  in.kind = inner == "pid" ? motion_control::Kind::Pid : inner == "pd_gravity" ? motion_control::Kind::PdGravity
+                                                                              : motion_control::Kind::ComputedTorque;
+  const Eigen::Vector3d scale = ctl.has("joint_scale") ? parse3(ctl["joint_scale"], 0, 1e3) : Eigen::Vector3d(1.0, 0.5, 0.05);
+  const Eigen::Vector3d ones = Eigen::Vector3d::Ones(), per = in.kind == motion_control::Kind::ComputedTorque ? ones : scale;
+  in.kp = g.at("joint_kp") * per, in.kd = g.at("joint_kd") * per;
+  in.ki = in.kind == motion_control::Kind::Pid ? Eigen::VectorXd(g.at("joint_ki") * scale) : Eigen::VectorXd::Zero(3);
+  in.anti_windup = motion_control::AntiWindup::Clamping;
+  in.coulomb_compensation = false;  // the arm here has no joint friction
+  in.tau_max = s.tau_max;
+  in.constant = Eigen::VectorXd::Zero(3);
+  in.period = s.period;
   return s;
 }
 
@@ -272,25 +309,37 @@ ImpedanceLab::ImpedanceLab(Settings s) : s_(std::move(s)) {}
 
 std::vector<std::string> ImpedanceLab::columns() const {
   return {"t", "q1", "q2", "q3", "tau1", "tau2", "tau3", "x", "y", "phi", "x_ref", "y_ref", "phi_ref",
-          "x_des", "y_des", "F_ext_x", "F_ext_y", "energy", "work", "x_target", "y_target"};
+          "x_des", "y_des", "F_ext_x", "F_ext_y", "energy", "work", "x_target", "y_target", "F_spring_x"};
 }
 
 std::string ImpedanceLab::unit(const std::string& c) const {
   static const std::map<std::string, std::string> u = {
       {"t", "s"}, {"q1", "rad"}, {"q2", "rad"}, {"q3", "rad"}, {"tau1", "N·m"}, {"tau2", "N·m"}, {"tau3", "N·m"},
       {"x", "m"}, {"y", "m"}, {"phi", "rad"}, {"x_ref", "m"}, {"y_ref", "m"}, {"phi_ref", "rad"}, {"x_des", "m"},
-      {"y_des", "m"}, {"x_target", "m"}, {"y_target", "m"}, {"F_ext_x", "N"}, {"F_ext_y", "N"}, {"energy", "J"}, {"work", "J"}};
+      {"y_des", "m"}, {"x_target", "m"}, {"y_target", "m"}, {"F_ext_x", "N"}, {"F_ext_y", "N"}, {"F_spring_x", "N"}, {"energy", "J"}, {"work", "J"}};
   return unitIn(u, c);
 }
 
-std::unique_ptr<Simulation> ImpedanceLab::simulate(Engine engine) const {
-  auto mech = std::make_unique<ArmMechanism>(describeWithWall(s_));
-  VecN q = VecN(s_.pose), v = VecN::Zero(3);
+namespace {
+
+// A run on mechanism type M (its sizes fixed: every loop of the step unrolled).
+template <class M>
+std::unique_ptr<Simulation> run(const Settings& s, Engine engine, const std::vector<std::string>& columns) {
+  auto mech = std::make_unique<M>(describeWithWall(s));
+  VecN q = VecN(s.pose), v = VecN::Zero(3);
   std::unique_ptr<MechanismEngine> stepper;
-  if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<ArmMechanism>>(*mech, s_.step, q, v);
-  else stepper = std::make_unique<BulletEngine<Planar>>(mech->model(), s_.step.dt, q, v);
-  return std::make_unique<MechanismSimulation<ArmMechanism>>(engine, std::move(mech), std::move(stepper),
-                                                             std::make_unique<Hooks>(s_), columns(), s_.step.dt, s_.duration);
+  if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<M>>(*mech, s.step, q, v);
+  else stepper = std::make_unique<BulletEngine<Planar>>(mech->model(), s.step.dt, q, v);
+  return std::make_unique<MechanismSimulation<M>>(engine, std::move(mech), std::move(stepper), std::make_unique<Hooks>(s),
+                                                  columns, s.step.dt, s.duration);
+}
+
+}  // namespace
+
+// The arm alone: 3 joints, no rows; with the wall: 3 joints, its one contact row (mechanism.cpp).
+std::unique_ptr<Simulation> ImpedanceLab::simulate(Engine engine) const {
+  if (s_.wall.enabled) return run<WallArm>(s_, engine, columns());
+  return run<motion_control::FixedArm<3>>(s_, engine, columns());
 }
 
 // Passive with no push and no wall the arm falls from the reference pose and whips through fast

@@ -7,9 +7,13 @@
 #include <Eigen/Core>
 
 #include "labs/lab.h"
+#include "labs/motion_control/controller.h"
 #include "labs/motion_control/mechanism.h"
 
 namespace dyn::impedance {
+
+// The hand engine's arm with the wall's contact row (fixed sizes; instantiated in mechanism.cpp).
+using WallArm = ConstrainedMechanism<Planar, 3, 1, 0>;
 
 enum class Kind { None, Constant, JointSpace, TaskSpace, FeedbackLinearisation };
 
@@ -38,7 +42,9 @@ struct Settings {
   Eigen::Vector3d tau_max, constant;    // N·m
   Kind kind = Kind::TaskSpace;
   Target target;
-  double joint_kp = 400, joint_kd = 40; // joint_space's inner computed-torque loop (1/s², 1/s)
+  // joint_space's inner loop: the motion-control lab's joint controller (pid, computed_torque or
+  // pd_gravity with its gains, labs/motion_control/controller.h) tracking θ_des from inverse kinematics.
+  motion_control::ControllerConfig inner;
   double period = 0.001;                // s, control period
   double noise = 0, delay = 0;          // force sensor: Gaussian σ (N), delay (s)
   Force force;
@@ -72,6 +78,9 @@ class ImpedanceLab final : public Lab {
   void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
   void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
   const Settings& settings() const { return s_; }
+  // The drawing's spring glyph: along the push (x̂ without one), its stretch magnified g times.
+  Eigen::Vector2d pushDirection() const;
+  double springMagnification() const;
 
  private:
   Settings s_;

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace dyn::motion_control {
 namespace {
@@ -37,15 +38,25 @@ void Trajectory::at(double t, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen::Ve
 }
 
 Controller::Controller(const ControllerConfig& c, const Trajectory& traj, const Params& model)
-    : c_(c), traj_(traj), model_params_(model), model_(std::make_unique<ArmMechanism>(describeRigid(model))),
+    : c_(c), traj_(traj), has_traj_(true), model_params_(model),
+      model_(std::make_unique<ArmMechanism>(describeRigid(model))), u_i_(Eigen::VectorXd::Zero(model.n())) {}
+
+Controller::Controller(const ControllerConfig& c, const Params& model)
+    : c_(c), model_params_(model), model_(std::make_unique<ArmMechanism>(describeRigid(model))),
       u_i_(Eigen::VectorXd::Zero(model.n())) {}
 
 Eigen::VectorXd Controller::torque(double t, const Eigen::VectorXd& th, const Eigen::VectorXd& thd) {
+  if (!has_traj_) throw std::logic_error("motion_control::Controller: no trajectory; call torque(t, θ, θ', reference)");
+  Reference ref;
+  traj_.at(t, ref.q, ref.qd, ref.qdd);
+  return torque(t, th, thd, ref);
+}
+
+Eigen::VectorXd Controller::torque(double t, const Eigen::VectorXd& th, const Eigen::VectorXd& thd, const Reference& ref) {
   const int n = int(th.size());
   const double dt = last_t_ < 0 ? 0.0 : t - last_t_;
   last_t_ = t;
-  Eigen::VectorXd q_d, qd_d, qdd_d;
-  traj_.at(t, q_d, qd_d, qdd_d);
+  const Eigen::VectorXd &q_d = ref.q, &qd_d = ref.qd, &qdd_d = ref.qdd;
   const Eigen::VectorXd e = th - q_d, ed = thd - qd_d;
   Eigen::VectorXd tau = Eigen::VectorXd::Zero(n);
   const auto& fr = model_params_.friction;

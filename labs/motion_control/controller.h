@@ -37,6 +37,12 @@ struct Trajectory {
   void at(double t, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen::VectorXd& qdd) const;
 };
 
+// The joint reference at one instant: θ_d, θ_d', θ_d'' (the trajectory's, or an outer loop's such as
+// the impedance lab's inverse kinematics).
+struct Reference {
+  Eigen::VectorXd q, qd, qdd;
+};
+
 struct ControllerConfig {
   Kind kind = Kind::Pid;
   AntiWindup anti_windup = AntiWindup::Clamping;
@@ -53,8 +59,13 @@ class Controller {
  public:
   // model: the parameters the controller believes (payload, friction estimate), rigid.
   Controller(const ControllerConfig& c, const Trajectory& traj, const Params& model);
-  // The saturated torque at time t from motor-side angles and rates; saturated() tells if it clipped.
+  // Without a trajectory: the reference comes from the caller (the hook below) at every call.
+  Controller(const ControllerConfig& c, const Params& model);
+  // The saturated torque at time t from motor-side angles and rates, tracking the trajectory;
+  // saturated() tells if it clipped.
   Eigen::VectorXd torque(double t, const Eigen::VectorXd& th, const Eigen::VectorXd& thd);
+  // The reference hook: the same laws tracking a reference the caller gives (an outer loop).
+  Eigen::VectorXd torque(double t, const Eigen::VectorXd& th, const Eigen::VectorXd& thd, const Reference& ref);
   bool saturated() const { return saturated_; }
   // V = ½θ'ᵀM̂θ' + ½eᵀK_p e at the given state (model M̂).
   double lyapunov(const Eigen::VectorXd& e, const Eigen::VectorXd& th, const Eigen::VectorXd& thd);
@@ -64,6 +75,7 @@ class Controller {
  private:
   ControllerConfig c_;
   Trajectory traj_;
+  bool has_traj_ = false;
   Params model_params_;
   std::unique_ptr<ArmMechanism> model_;
   Eigen::VectorXd u_i_;

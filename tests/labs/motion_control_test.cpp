@@ -11,6 +11,7 @@
 //  * the fixed–free spring chain (lecture §1): small-oscillation frequencies from eig(M⁻¹K) equal
 //    2√(k/J) sin((2j−1)π/(2(2N+1))) (equal J, k) to 1e-10, and the simulated chain released in its
 //    first mode swings at ω_1 (one period within 1e-4 relative);
+//  * the reference hook (torque(t, θ, θ', reference)) equals the trajectory form exactly;
 //  * bad inputs get one line naming the JSON path.
 //  * flexible screening (linearise.cpp): one flexible joint's twist after a fast 3° move rings at the
 //    screened least damped mode's frequency within 2 % (0.5 % measured; pid, computed torque, PD + gravity);
@@ -249,6 +250,31 @@ TEST_CASE("motion_control: anti-windup bounds the integrator under saturation") 
     if (aw == AntiWindup::BackCalculation) CHECK(peak <= bound + 1e-9);
     if (aw == AntiWindup::BackCalculation) CHECK(peak > 0);
   }
+}
+
+TEST_CASE("motion_control: the reference hook is the trajectory's law, bit for bit, for every controller") {
+  // The same controller fed the trajectory's (θ_d, θ_d', θ_d'') by the caller (the impedance lab's
+  // inner loop) gives the same torques and integrator as the one reading its own trajectory.
+  for (const char* kind : {"pid", "computed_torque", "pd_gravity"}) {
+    const Settings s = settings({{"controller", {{"kind", kind}}}});
+    Controller own(s.controller, s.trajectory, s.model), hooked(s.controller, s.model);
+    double worst = 0;
+    for (int k = 0; k < 3000; ++k) {
+      const double t = k * 1e-3;
+      const Eigen::Vector3d th(0.1 * std::sin(3 * t), -0.2 * t, 0.05), rate(0.3 * std::cos(3 * t), -0.2, 0.0);
+      Reference ref;
+      s.trajectory.at(t, ref.q, ref.qd, ref.qdd);
+      const Eigen::VectorXd a = own.torque(t, th, rate), b = hooked.torque(t, th, rate, ref);
+      worst = std::max({worst, (a - b).cwiseAbs().maxCoeff(), (own.integral() - hooked.integral()).cwiseAbs().maxCoeff()});
+    }
+    CAPTURE(kind);
+    CHECK(worst == 0.0);
+  }
+  // Without a trajectory the trajectory form says what to call instead.
+  const Settings s = settings(json::object());
+  Controller hooked(s.controller, s.model);
+  CHECK_THROWS_WITH_AS(hooked.torque(0.0, Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()),
+                       doctest::Contains("no trajectory"), std::logic_error);
 }
 
 TEST_CASE("motion_control: hand and Bullet agree") {
