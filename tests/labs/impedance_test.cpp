@@ -92,12 +92,12 @@ TEST_CASE("joint_space: the motion-control lab's pid and pd_gravity as the inner
   json p = gains("joint_space", 400, 1.0, 3000, 60);
   p["controller"]["inner"] = "pid";
   p["gains"]["joint_ki"] = {{"value", 30000.0}};
-  const auto pid = makeLab(p);
+  const auto pid = fixture.makeLab(p);
   const RunResult r = runEngine(*pid, Engine::Hand);
   REQUIRE(r.failure.empty());
   const double pid_err = pid->metrics(r.trace)["stiffness_error"].get<double>();
   p["controller"]["inner"] = "pd_gravity";
-  const auto pd = makeLab(p);
+  const auto pd = fixture.makeLab(p);
   const RunResult r2 = runEngine(*pd, Engine::Hand);
   REQUIRE(r2.failure.empty());
   const double pd_err = pd->metrics(r2.trace)["stiffness_error"].get<double>();
@@ -106,7 +106,7 @@ TEST_CASE("joint_space: the motion-control lab's pid and pd_gravity as the inner
   CHECK(pd_err > 5 * pid_err);
   // An unknown inner loop is named.
   p["controller"]["inner"] = "admittance";
-  CHECK(inputError(p).find("/controller/inner") == 0);
+  CHECK(fixture.inputError(p).find("/controller/inner") == 0);
 }
 
 TEST_CASE("a rigid wall's impact: the impulse counts, hand and Bullet agree, dt does not matter") {
@@ -115,7 +115,7 @@ TEST_CASE("a rigid wall's impact: the impulse counts, hand and Bullet agree, dt 
   p["simulation"] = {{"duration", 0.6}};
   p["environment"]["force"]["hold"] = 0.4;
   auto peak = [&](const json& patch, Engine e, double* settled = nullptr) {
-    const auto lab = makeLab(patch);
+    const auto lab = fixture.makeLab(patch);
     const RunResult r = runEngine(*lab, e);
     REQUIRE(r.failure.empty());
     const json m = lab->metrics(r.trace);
