@@ -23,11 +23,6 @@
 namespace dyn {
 
 namespace detail {
-// Storage of a VecIn that had to evaluate an expression (declared before the Map that points into it).
-struct VecInStorage {
-  VecN own;                         // up to kMaxDof values: on the stack
-  std::unique_ptr<double[]> large;  // more: on the heap (large chains only)
-};
 // True when x binds to a plain vector without a copy (contiguous, unit stride).
 template <class D>
 inline constexpr bool kBindsDirectly =
@@ -35,33 +30,36 @@ inline constexpr bool kBindsDirectly =
 }  // namespace detail
 
 // A read-only vector argument of any size. A contiguous vector (VecN, Eigen::VectorXd, a head()) is
-// viewed where it lies; any other expression (VecN::Zero(n), a + b) is evaluated into a VecN on the
-// stack when n ≤ kMaxDof (into a heap vector beyond), so the labs' calls never allocate, as
-// Eigen::Ref<const VectorXd> would for an expression. Pass by const reference; it may point into its
-// argument, so it is neither copied nor kept.
-class VecIn : private detail::VecInStorage, public Eigen::Map<const Eigen::VectorXd> {
-  using Map = Eigen::Map<const Eigen::VectorXd>;
-
+// viewed where it lies, at the cost of a pointer; any other expression (VecN::Zero(n), a + b) is
+// evaluated into a buffer on the stack when n ≤ kMaxDof (on the heap beyond), so the labs' calls
+// never allocate, as Eigen::Ref<const VectorXd> would for an expression. Pass by const reference;
+// it may point into its argument, so it is neither copied nor kept.
+class VecIn {
  public:
   template <class D>
-  VecIn(const Eigen::MatrixBase<D>& x) : VecInStorage(stored(x)), Map(source(x), x.size()) {}  // NOLINT: implicit
+  VecIn(const Eigen::MatrixBase<D>& x) : n_(x.size()) {  // NOLINT: implicit on purpose
+    if constexpr (detail::kBindsDirectly<D>) {
+      p_ = x.derived().data();
+    } else {
+      double* to = buf_;
+      if (n_ > kMaxDof) large_.reset(to = new double[std::size_t(n_)]);
+      Eigen::Map<Eigen::VectorXd>(to, n_) = x;
+      p_ = to;
+    }
+  }
   VecIn(const VecIn&) = delete;
   VecIn& operator=(const VecIn&) = delete;
 
+  double operator[](Eigen::Index i) const { return p_[i]; }
+  Eigen::Index size() const { return n_; }
+  const double* data() const { return p_; }
+  Eigen::Map<const Eigen::VectorXd> vector() const { return {p_, n_}; }
+
  private:
-  template <class D>
-  static VecInStorage stored(const Eigen::MatrixBase<D>& x) {
-    if constexpr (detail::kBindsDirectly<D>) return {};
-    else if (x.size() <= kMaxDof) return {VecN(x), nullptr};
-    auto large = std::make_unique<double[]>(std::size_t(x.size()));
-    Eigen::Map<Eigen::VectorXd>(large.get(), x.size()) = x;
-    return {VecN(), std::move(large)};
-  }
-  template <class D>
-  const double* source(const Eigen::MatrixBase<D>& x) const {
-    if constexpr (detail::kBindsDirectly<D>) return x.derived().data();
-    else return x.size() <= kMaxDof ? own.data() : large.get();
-  }
+  const double* p_;
+  Eigen::Index n_;
+  double buf_[kMaxDof];              // an evaluated expression of up to kMaxDof values
+  std::unique_ptr<double[]> large_;  // or more (large chains only)
 };
 
 enum class JointType { Revolute, Prismatic };
