@@ -251,6 +251,14 @@ int benchScaling(const BenchArgs& a) {
     std::fprintf(stderr, "error: <command line>: --scaling times a chain, not a lab: leave LAB out\n");
     return 2;
   }
+  // The output folder first: a bad --out fails before half a minute of timing, not after.
+  const fs::path out = a.out.empty() ? fs::path("out/bench") : fs::path(a.out);
+  try {
+    fs::create_directories(out);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: --out: %s\n", e.what());
+    return 2;
+  }
   const double clock_us = clockOverhead();
   std::vector<Row> rows;
   Progress progress("chains", std::size(kSizes) * (kEngines + 1));
@@ -269,9 +277,7 @@ int benchScaling(const BenchArgs& a) {
     progress.set(rows.size() * (kEngines + 1));
   }
   progress.done();
-  const fs::path out = a.out.empty() ? fs::path("out/bench") : fs::path(a.out);
   try {
-    fs::create_directories(out);
     writeFileChecked((out / "scaling.csv").string(), csvOf(rows));
     std::string why;
     if (!writePng((out / "scaling.png").string(), drawFigure(rows, 900, 540), &why))
