@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <iostream>
 
+#include "app/bench.h"
 #include "app/commands.h"
 #include "app/movie.h"
 #include "labs/run.h"
@@ -23,15 +24,12 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 namespace dyn::app {
-namespace {
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0 : v[v.size() / 2];
 }
 
-// The cost of one pair of clock reads (µs, median of many): subtracted from every timed sample, so
-// a sub-microsecond step is not charged the timer's own ~20–50 ns.
 double clockOverhead() {
   using Micros = std::chrono::duration<double, std::micro>;
   std::vector<double> pairs(2001);
@@ -41,6 +39,8 @@ double clockOverhead() {
   }
   return median(pairs);
 }
+
+namespace {
 
 // Median wall times, µs, over `steps` steps of fresh runs (restarted when one ends), less the clock
 // reads' own cost (clockOverhead), on both engines alike.
@@ -143,13 +143,14 @@ json errorAgainst(const Lab& lab, const Trace& run, const Trace& reference) {
 }  // namespace
 
 int bench(const BenchArgs& a) {
-  for (const std::string& name : a.labs)
-    if (!findLab(name)) {
-      std::fprintf(stderr, "error: <command line>: LAB: unknown lab \"%s\" (see dynlab list)\n", name.c_str());
-      return 2;
-    }
+  bool found = a.lab.empty();
+  for (const auto& entry : labRegistry()) found = found || entry.name == a.lab;
+  if (!found) {
+    std::fprintf(stderr, "error: <command line>: LAB: unknown lab \"%s\" (see dynlab list)\n", a.lab.c_str());
+    return 2;
+  }
   for (const auto& entry : labRegistry()) {
-    if (!a.labs.empty() && std::find(a.labs.begin(), a.labs.end(), entry.name) == a.labs.end()) continue;
+    if (!a.lab.empty() && entry.name != a.lab) continue;
     LoadedLab loaded;
     try {
       loaded = loadLab(entry.name);

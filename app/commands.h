@@ -55,7 +55,9 @@ struct CompareArgs {
 struct BenchArgs {
   bool json = false;
   int steps = 4000, frames = 60;
-  std::vector<std::string> labs;  // empty: every registered lab
+  std::string lab;         // empty: every lab
+  bool scaling = false;    // the chain-length sweep instead (app/bench_scaling.cpp)
+  std::string out;         // --scaling: where scaling.csv and scaling.png go (default out/bench)
 };
 
 // --scenario NAME (run, figure): rebuilds the loaded lab under the rubric scenario's patch and noise
@@ -83,6 +85,8 @@ int writeAutograderZip(const std::string& lab, const std::string& out);
 int figure(const FigureArgs& args);
 int printSchema(const std::string& lab);
 int bench(const BenchArgs& args);
+// dynlab bench --scaling: hand ABA, hand CRBA + Cholesky and Bullet on chains of 3 … 1,000 links.
+int benchScaling(const BenchArgs& args);
 // Grades both, prints a table per test, writes OUT/comparison.md and OUT/plots/ (app/compare.cpp).
 int compare(const CompareArgs& args);
 // Replaces this process with dynlab-ui (next to /proc/self/exe); returns only on failure (1).

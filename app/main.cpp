@@ -150,10 +150,14 @@ int dispatch(int argc, char** argv) {
 
   BenchArgs bench_args;
   auto* b = cli.add_subcommand("bench", "Benchmark: hand-written vs Bullet step time, render/PNG/video frame rates");
-  b->add_option("labs", bench_args.labs, "Labs to measure (default: every registered lab)");
   b->add_flag("--json", bench_args.json, "One JSON object per lab");
   b->add_option("--steps", bench_args.steps, "Steps timed per engine")->check(CLI::Range(100, 1000000));
   b->add_option("--frames", bench_args.frames, "Frames timed per output kind")->check(CLI::Range(5, 10000));
+  b->add_option("LAB", bench_args.lab, "Only this lab (default: every lab)");
+  b->add_flag("--scaling", bench_args.scaling,
+              "Step cost against chain length (3 to 1,000 links): hand ABA, hand CRBA + Cholesky, Bullet; "
+              "a table, OUT/scaling.csv and OUT/scaling.png");
+  b->add_option("--out", bench_args.out, "--scaling: output directory (default: out/bench)");
 
   CourseCommands course(cli);  // dynlab handout, dynlab map (app/course.h)
 
@@ -171,7 +175,7 @@ int dispatch(int argc, char** argv) {
   if (*c) return checkResults(results_file);
   if (*s) return printSchema(schema_lab);
   if (*k) return compare(cmp);
-  if (*b) return bench(bench_args);
+  if (*b) return bench_args.scaling ? benchScaling(bench_args) : bench(bench_args);
   if (course.chosen()) return course.run();
   if (*u) {
     ui.extra = u->remaining();

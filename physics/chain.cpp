@@ -2,6 +2,8 @@
 // planar and spatial algebra and instantiated for both (see chain.h for the equations).
 #include "physics/chain.h"
 
+#include <stdexcept>
+
 namespace dyn {
 
 template <class S>
@@ -36,7 +38,7 @@ void TreeData<S>::resize(int n) {
 }
 
 template <class S>
-void positionKinematics(const TreeModel<S>& model, const VecN& q, TreeData<S>& data) {
+void positionKinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
   for (int i = 0; i < model.dof(); ++i) {
     const auto& b = model.bodies[i];
     // Joint placement then joint motion: X_up = X_J(θ_i) X_tree.
@@ -48,7 +50,7 @@ void positionKinematics(const TreeModel<S>& model, const VecN& q, TreeData<S>& d
 }
 
 template <class S>
-void velocityKinematics(const TreeModel<S>& model, const VecN& qd, TreeData<S>& data) {
+void velocityKinematics(const TreeModel<S>& model, const VecIn& qd, TreeData<S>& data) {
   using Vec = typename S::Vec;
   for (int i = 0; i < model.dof(); ++i) {
     const int p = model.bodies[i].parent;
@@ -62,14 +64,14 @@ void velocityKinematics(const TreeModel<S>& model, const VecN& qd, TreeData<S>& 
 }
 
 template <class S>
-void forwardKinematics(const TreeModel<S>& model, const VecN& q, const VecN& qd, TreeData<S>& data) {
+void forwardKinematics(const TreeModel<S>& model, const VecIn& q, const VecIn& qd, TreeData<S>& data) {
   positionKinematics(model, q, data);
   velocityKinematics(model, qd, data);
 }
 
 template <class S>
-VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const VecN& qdd,
-          bool with_gravity) {
+void rnea(const TreeModel<S>& model, TreeData<S>& data, const VecIn& qd, const VecIn& qdd,
+          Eigen::Ref<Eigen::VectorXd> tau, bool with_gravity) {
   const int n = model.dof();
   (void)qd;  // velocities enter through data.v, filled by forwardKinematics
   const typename S::Vec a0 = -model.gravity;
@@ -89,12 +91,17 @@ VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const Ve
     data.f[i] = S::inertiaTimes(I, a) + S::crossForce(data.v[i], S::inertiaTimes(I, data.v[i]));
   }
   // Inward: project onto the joint axis, pass the rest to the parent.
-  VecN tau(n);
   for (int i = n - 1; i >= 0; --i) {
     tau[i] = S::dot(data.S_i[i], data.f[i]);
     const int p = model.bodies[i].parent;
     if (p >= 0) data.f[p] += S::forceTranspose(data.X_up[i], data.f[i]);
   }
+}
+
+template <class S>
+VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecIn& qd, const VecIn& qdd, bool with_gravity) {
+  VecN tau(model.dof());
+  rnea(model, data, qd, qdd, tau, with_gravity);
   return tau;
 }
 
@@ -106,14 +113,13 @@ void crbaSparseMass(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eig
   using Vec = typename S::Vec;
   const int n = model.dof();
   const std::vector<Vec>& Sw = data.S_w;
-  Vec F[kMaxDof];
   M.setZero();
   for (int b = 0; b < n; ++b) {
     if (S::massless(model.bodies[b].inertia)) continue;
     const typename S::Inertia Iw = S::inertiaInParent(data.X_world[b], S::compact(model.bodies[b].inertia));
     for (int i = b; i >= 0; i = model.bodies[i].parent) {
-      F[i] = S::inertiaTimes(Iw, Sw[i]);
-      for (int j = b; j >= i; j = model.bodies[j].parent) M(j, i) += S::dot(Sw[j], F[i]);
+      const Vec F = S::inertiaTimes(Iw, Sw[i]);
+      for (int j = b; j >= i; j = model.bodies[j].parent) M(j, i) += S::dot(Sw[j], F);
     }
   }
   for (int i = 0; i < n; ++i)
@@ -123,9 +129,7 @@ void crbaSparseMass(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eig
 template <class S>
 void crba(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M) {
   const int n = model.dof();
-  int massive = 0;
-  for (int i = 0; i < n; ++i) massive += !S::massless(model.bodies[i].inertia);
-  if (2 * massive <= n) return crbaSparseMass(model, data, M);
+  if (2 * model.massive <= n) return crbaSparseMass(model, data, M);
   for (int i = 0; i < n; ++i) data.Ic_rb[i] = S::compact(model.bodies[i].inertia);
   // Composite inertias, leaves to root: Ic_p += X^T Ic_i X.
   for (int i = n - 1; i >= 0; --i) {
@@ -153,7 +157,8 @@ MatN crba(const TreeModel<S>& model, TreeData<S>& data) {
 }
 
 template <class S>
-VecN aba(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const VecN& tau) {
+void aba(const TreeModel<S>& model, TreeData<S>& data, const VecIn& qd, const VecIn& tau,
+         Eigen::Ref<Eigen::VectorXd> qdd) {
   (void)qd;
   const int n = model.dof();
   using Vec = typename S::Vec;
@@ -177,7 +182,6 @@ VecN aba(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const Vec
     }
   }
   // Outward: accelerations.
-  VecN qdd(n);
   const Vec a0 = -model.gravity;
   for (int i = 0; i < n; ++i) {
     const int p = model.bodies[i].parent;
@@ -185,6 +189,12 @@ VecN aba(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const Vec
     qdd[i] = (data.u[i] - S::dot(data.U[i], a_in)) / data.D[i];
     data.a[i] = a_in + data.S_i[i] * qdd[i];
   }
+}
+
+template <class S>
+VecN aba(const TreeModel<S>& model, TreeData<S>& data, const VecIn& qd, const VecIn& tau) {
+  VecN qdd(model.dof());
+  aba(model, data, qd, tau, qdd);
   return qdd;
 }
 
@@ -197,6 +207,7 @@ template <class S>
 void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
                    const typename S::Pos& point, MatN& J) {
   // World origin → the world-aligned frame at the point.
+  if (model.dof() > kMaxDof) throw std::length_error("pointJacobian: J holds at most kMaxDof columns");
   const typename S::Transform X_pw = S::translation(pointPosition(data, body, point));
   J.setZero(S::kDim, model.dof());
   // Column j: joint j's axis, seen from the point, for every joint on the path root → body.
@@ -210,7 +221,10 @@ void pointJacobianDot(const TreeModel<S>& model, const TreeData<S>& data, int bo
   using Vec = typename S::Vec;
   const typename S::Transform X_pw = S::translation(pointPosition(data, body, point));
   // The path root → body, and the velocity-product acceleration along it (θ'' = 0, no gravity).
-  int path[kMaxDof];
+  int stack_path[kMaxDof];
+  std::vector<int> long_path;  // a path longer than kMaxDof: on the heap (large chains only)
+  int* path = stack_path;
+  if (model.dof() > kMaxDof) long_path.resize(std::size_t(model.dof())), path = long_path.data();
   int depth = 0;
   for (int j = body; j >= 0; j = model.bodies[j].parent) path[depth++] = j;
   Vec a_bias = Vec::Zero();
@@ -250,6 +264,17 @@ double potentialEnergy(const TreeModel<S>& model, const TreeData<S>& data) {
   return U;
 }
 
+TreeModel<Planar> uniformPlanarChain(int n, double length, double mass, double g) {
+  TreeModel<Planar> m;
+  for (int i = 0; i < n; ++i) {
+    const Planar::Pos joint = i == 0 ? Planar::Pos::Zero() : Planar::Pos(length, 0.0);
+    m.addBody(i - 1, JointType::Revolute, Planar::Axis::Zero(), Planar::translation(joint),
+              Planar::inertia(mass, Planar::Pos(length / 2, 0.0), mass * length * length / 12));
+  }
+  m.gravity << 0, 0, -g;
+  return m;
+}
+
 VecN springTorque(const VecN& k, const VecN& q) { return springStiffnessMatrix(k) * q; }
 
 MatN springStiffnessMatrix(const VecN& k) {
@@ -274,13 +299,17 @@ double springEnergy(const VecN& k, const VecN& q) {
 #define DYNLAB_INSTANTIATE(S)                                                                     \
   template struct TreeModel<S>;                                                                   \
   template struct TreeData<S>;                                                                    \
-  template void forwardKinematics<S>(const TreeModel<S>&, const VecN&, const VecN&, TreeData<S>&); \
-  template void positionKinematics<S>(const TreeModel<S>&, const VecN&, TreeData<S>&);           \
-  template void velocityKinematics<S>(const TreeModel<S>&, const VecN&, TreeData<S>&);            \
-  template VecN rnea<S>(const TreeModel<S>&, TreeData<S>&, const VecN&, const VecN&, bool);       \
+  template void forwardKinematics<S>(const TreeModel<S>&, const VecIn&, const VecIn&, TreeData<S>&); \
+  template void positionKinematics<S>(const TreeModel<S>&, const VecIn&, TreeData<S>&);           \
+  template void velocityKinematics<S>(const TreeModel<S>&, const VecIn&, TreeData<S>&);            \
+  template void rnea<S>(const TreeModel<S>&, TreeData<S>&, const VecIn&, const VecIn&,             \
+                        Eigen::Ref<Eigen::VectorXd>, bool);                                       \
+  template VecN rnea<S>(const TreeModel<S>&, TreeData<S>&, const VecIn&, const VecIn&, bool);     \
   template MatN crba<S>(const TreeModel<S>&, TreeData<S>&);                                       \
   template void crba<S>(const TreeModel<S>&, TreeData<S>&, Eigen::Ref<Eigen::MatrixXd>);          \
-  template VecN aba<S>(const TreeModel<S>&, TreeData<S>&, const VecN&, const VecN&);              \
+  template void aba<S>(const TreeModel<S>&, TreeData<S>&, const VecIn&, const VecIn&,              \
+                       Eigen::Ref<Eigen::VectorXd>);                                              \
+  template VecN aba<S>(const TreeModel<S>&, TreeData<S>&, const VecIn&, const VecIn&);            \
   template void pointJacobian<S>(const TreeModel<S>&, const TreeData<S>&, int, const S::Pos&,     \
                                  MatN&, VecN&);                                                   \
   template void pointJacobian<S>(const TreeModel<S>&, const TreeData<S>&, int, const S::Pos&, MatN&); \

@@ -10,13 +10,57 @@
 //                      point of a link
 //   springTorque       K θ, K tridiagonal: P_K = Σ K_i/2 (θ_i − θ_{i−1})²
 // Model (fixed) and Data (per-state scratch) are kept apart, as in MuJoCo.
+// Any size: vectors come in as VecIn (a VecN, an Eigen::VectorXd or a contiguous head() binds without
+// a copy) and go out into a caller-sized Eigen::Ref<Eigen::VectorXd>; the VecN-returning forms (and
+// crba's MatN, pointJacobian) are for chains of at most kMaxDof joints, as the labs use them.
 #pragma once
+#include <memory>
 #include <vector>
 
 #include "physics/spatial.h"
 #include "physics/types.h"
 
 namespace dyn {
+
+namespace detail {
+// True when x binds to a plain vector without a copy (contiguous, unit stride).
+template <class D>
+inline constexpr bool kBindsDirectly =
+    Eigen::internal::traits<Eigen::Ref<const Eigen::VectorXd>>::template match<D>::MatchAtCompileTime;
+}  // namespace detail
+
+// A read-only vector argument of any size. A contiguous vector (VecN, Eigen::VectorXd, a head()) is
+// viewed where it lies, at the cost of a pointer; any other expression (VecN::Zero(n), a + b) is
+// evaluated into a buffer on the stack when n ≤ kMaxDof (on the heap beyond), so the labs' calls
+// never allocate, as Eigen::Ref<const VectorXd> would for an expression. Pass by const reference;
+// it may point into its argument, so it is neither copied nor kept.
+class VecIn {
+ public:
+  template <class D>
+  VecIn(const Eigen::MatrixBase<D>& x) : n_(x.size()) {  // NOLINT: implicit on purpose
+    if constexpr (detail::kBindsDirectly<D>) {
+      p_ = x.derived().data();
+    } else {
+      double* to = buf_;
+      if (n_ > kMaxDof) large_.reset(to = new double[std::size_t(n_)]);
+      Eigen::Map<Eigen::VectorXd>(to, n_) = x;
+      p_ = to;
+    }
+  }
+  VecIn(const VecIn&) = delete;
+  VecIn& operator=(const VecIn&) = delete;
+
+  double operator[](Eigen::Index i) const { return p_[i]; }
+  Eigen::Index size() const { return n_; }
+  const double* data() const { return p_; }
+  Eigen::Map<const Eigen::VectorXd> vector() const { return {p_, n_}; }
+
+ private:
+  const double* p_;
+  Eigen::Index n_;
+  double buf_[kMaxDof];              // an evaluated expression of up to kMaxDof values
+  std::unique_ptr<double[]> large_;  // or more (large chains only)
+};
 
 enum class JointType { Revolute, Prismatic };
 
@@ -36,6 +80,7 @@ struct TreeModel {
   };
   std::vector<Body> bodies;
   Vec gravity = Vec::Zero();         // spatial acceleration of gravity in world coordinates
+  int massive = 0;                   // bodies with mass or inertia (addBody counts them; crba's choice)
 
   int dof() const { return int(bodies.size()); }
   int addBody(int parent, JointType joint, const typename S::Axis& axis,
@@ -45,6 +90,7 @@ struct TreeModel {
     else bodies.push_back({parent, joint, axis, X_tree, inertia});
     bodies.back().subspace = motionSubspace(int(bodies.size()) - 1);
     bodies.back().central = S::central(inertia);
+    massive += !S::massless(inertia);
     return int(bodies.size()) - 1;
   }
   Vec motionSubspace(int i) const;
@@ -72,19 +118,23 @@ struct TreeData {
 
 // Fills X_up, X_world, v, c from (θ, θ'). Every other algorithm reads these.
 template <class S>
-void forwardKinematics(const TreeModel<S>& model, const VecN& q, const VecN& qd, TreeData<S>& data);
+void forwardKinematics(const TreeModel<S>& model, const VecIn& q, const VecIn& qd, TreeData<S>& data);
 // The two stages of forwardKinematics. Position: X_up, X_world, S_i from θ (enough for crba,
 // pointPosition, the J of pointJacobian and potentialEnergy). Velocity, after the position stage:
 // v and c from θ' (rnea, aba, J'θ', kineticEnergy).
 template <class S>
-void positionKinematics(const TreeModel<S>& model, const VecN& q, TreeData<S>& data);
+void positionKinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data);
 template <class S>
-void velocityKinematics(const TreeModel<S>& model, const VecN& qd, TreeData<S>& data);
+void velocityKinematics(const TreeModel<S>& model, const VecIn& qd, TreeData<S>& data);
 
 // Inverse dynamics τ = M θ'' + C θ' + G with gravity (or without, when with_gravity is false).
 // Leaves data.a[i] = each body's acceleration without gravity (at θ'' = 0: its J'θ' bias).
+// Into tau (sized n by the caller), or returned (n ≤ kMaxDof).
 template <class S>
-VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const VecN& qdd,
+void rnea(const TreeModel<S>& model, TreeData<S>& data, const VecIn& qd, const VecIn& qdd,
+          Eigen::Ref<Eigen::VectorXd> tau, bool with_gravity = true);
+template <class S>
+VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecIn& qd, const VecIn& qdd,
           bool with_gravity = true);
 
 // Joint-space inertia M(θ), symmetric positive definite (into M, sized n × n by the caller, or returned).
@@ -93,12 +143,16 @@ void crba(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::Matrix
 template <class S>
 MatN crba(const TreeModel<S>& model, TreeData<S>& data);
 
-// Forward dynamics θ'' = M⁻¹ (τ − C θ' − G) in O(N).
+// Forward dynamics θ'' = M⁻¹ (τ − C θ' − G) in O(N), into qdd (sized n by the caller) or returned
+// (n ≤ kMaxDof).
 template <class S>
-VecN aba(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, const VecN& tau);
+void aba(const TreeModel<S>& model, TreeData<S>& data, const VecIn& qd, const VecIn& tau,
+         Eigen::Ref<Eigen::VectorXd> qdd);
+template <class S>
+VecN aba(const TreeModel<S>& model, TreeData<S>& data, const VecIn& qd, const VecIn& tau);
 
 // A frame at `point` (body coordinates) with world-aligned axes:
-//   V_P = J θ',  classical acceleration = J θ'' + J'θ'.
+//   V_P = J θ',  classical acceleration = J θ'' + J'θ'.  J is kDim × n: n ≤ kMaxDof (std::length_error).
 template <class S>
 void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
                    const typename S::Pos& point, MatN& J, VecN& Jdot_qd);
@@ -119,6 +173,11 @@ template <class S>
 double kineticEnergy(const TreeModel<S>& model, const TreeData<S>& data);
 template <class S>
 double potentialEnergy(const TreeModel<S>& model, const TreeData<S>& data);
+
+// A planar serial chain of n equal uniform rods (length, mass; inertia m l²/12 about the centre),
+// joint i revolute at the tip of link i−1, joint 0 at the world origin, gravity g along −y; θ = 0
+// is the outstretched chain along +x. The motion-control arm's kind of chain at any n.
+TreeModel<Planar> uniformPlanarChain(int n, double length, double mass, double g = 9.81);
 
 // Joint springs between consecutive joints: K θ with K tridiagonal (lecture §1), and P_K.
 VecN springTorque(const VecN& stiffness, const VecN& q);

@@ -50,6 +50,7 @@
 
 #include "physics/bullet/bullet_world.h"
 #include "physics/bullet/contact_balls.h"
+#include "physics/bullet/planar_multibody.h"
 #include "physics/bullet/planar_plan.h"
 #include "physics/constraints/plane_contact.h"
 
@@ -62,11 +63,6 @@ namespace {
 
 using Vec2 = Eigen::Vector2d;
 
-btVector3 bt(const Vec2& v) { return {v.x(), v.y(), 0.0}; }
-btVector3 inertia3(double izz) { return {izz, izz, izz}; }  // out-of-plane values only need to be ≥ 0
-btQuaternion rotParentToThis(double delta) {
-  return delta == 0.0 ? btQuaternion::getIdentity() : btQuaternion(btVector3(0, 0, 1), -delta);
-}
 // The same angle modulo 2π, nearest to `near` (exact when no turn is added).
 double unwrap(double raw, double near) {
   constexpr double kTurn = 2.0 * std::numbers::pi;
@@ -141,27 +137,7 @@ struct BulletMechanism<Planar>::Impl {
 
   void build() {
     const int n = int(plan.links.size());
-    body = std::make_unique<btMultiBody>(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true, /*canSleep=*/false);
-    body->setBaseWorldTransform(btTransform::getIdentity());
-    for (int k = 0; k < n; ++k) {
-      const PlanLink& l = plan.links[std::size_t(k)];
-      const btQuaternion rot = rotParentToThis(l.delta);
-      if (l.joint == PlanLink::Joint::Revolute)
-        body->setupRevolute(k, l.mass, inertia3(l.inertia), l.parent, rot, btVector3(0, 0, 1), bt(l.e), bt(l.d), true);
-      else if (l.joint == PlanLink::Joint::Prismatic)
-        body->setupPrismatic(k, l.mass, inertia3(l.inertia), l.parent, rot, bt(l.axis), bt(l.e), bt(l.d), true);
-      else
-        body->setupFixed(k, l.mass, inertia3(l.inertia), l.parent, rot, bt(l.e), bt(l.d));
-    }
-    body->finalizeMultiDof();
-    // Pitfall 2: no damping, no velocity cap, never sleep.
-    body->setLinearDamping(0.0);
-    body->setAngularDamping(0.0);
-    body->setMaxCoordinateVelocity(1e6);
-    body->setCanSleep(false);
-    body->setHasSelfCollision(false);
-    body->setUseGyroTerm(true);
-    world->addMultiBody(body.get());
+    body = makePlanarMultiBody(plan, *world.world);
 
     // Pitfall 1: every link needs a collider for the constraints to act; mask 0 = no contacts.
     shape = std::make_unique<btSphereShape>(0.01);

@@ -5,6 +5,9 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
+#include <cmath>
+#include <limits>
+#include <random>
 
 #include "tests/physics/arms.h"
 
@@ -180,4 +183,147 @@ TEST_CASE("CRBA with massless carriers (the Σ Jᵀ I J form) equals RNEA column
   CHECK((M - M.transpose()).norm() == 0.0);
   // The two leaves are on separate branches: no inertia couples them.
   CHECK(M(4, 5) == 0.0);
+}
+
+// ---------------------------------------------------------------- chains of any size
+namespace {
+
+// A planar chain of n links with varied lengths, masses, centres of mass (off the link axis) and
+// inertias, deterministic (a fixed-seed generator), as Eigen::VectorXd states: sizes beyond kMaxDof.
+TreeModel<Planar> variedPlanarChain(int n, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(0.5, 1.5);
+  TreeModel<Planar> m;
+  double previous = 0;
+  for (int i = 0; i < n; ++i) {
+    const double L = 0.2 * u(rng), mass = u(rng);
+    m.addBody(i - 1, JointType::Revolute, Planar::Axis::Zero(), Planar::translation(Planar::Pos(previous, 0.0)),
+              Planar::inertia(mass, Planar::Pos(0.5 * L, 0.02 * (u(rng) - 1.0)), mass * L * L / 12 * u(rng)));
+    previous = L;
+  }
+  m.gravity << 0, 0, -9.81;
+  return m;
+}
+
+// The same idea in space: revolute joints about varied unit axes, placements along varied offsets.
+TreeModel<Spatial> variedSpatialChain(int n, std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  TreeModel<Spatial> m;
+  for (int i = 0; i < n; ++i) {
+    const Spatial::Pos axis = Spatial::Pos(u(rng), u(rng), 1.0).normalized();
+    const Spatial::Pos offset = i == 0 ? Spatial::Pos::Zero() : Spatial::Pos(0.1, 0.02 * u(rng), 0.02 * u(rng));
+    const Eigen::Matrix3d Ic = Eigen::Vector3d(1e-3 * (2 + u(rng)), 1e-3 * (2 + u(rng)), 1e-3 * (2 + u(rng))).asDiagonal();
+    m.addBody(i - 1, JointType::Revolute, axis, Spatial::translation(offset),
+              Spatial::inertia(0.5 + 0.2 * u(rng), Spatial::Pos(0.05, 0.01 * u(rng), 0.0), Ic));
+  }
+  m.gravity << 0, 0, 0, 0, 0, -9.81;
+  return m;
+}
+
+// ABA's θ'' against the O(N³) route: M θ'' = τ − RNEA(θ, θ', 0), M by CRBA, solved by Cholesky.
+// Both are backward stable, so they may differ by about cond(M) ε ‖θ''‖ (cond(M) of a long chain
+// reaches 1e6–1e8): the tolerance is 100 cond(M) ε, relative to ‖θ''‖; a wrong ABA is off by O(1).
+template <class S>
+void abaEqualsCrbaSolve(const TreeModel<S>& model, std::mt19937& rng) {
+  const int n = model.dof();
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  Eigen::VectorXd q(n), qd(n), tau(n);
+  for (int i = 0; i < n; ++i) q[i] = u(rng), qd[i] = u(rng), tau[i] = 5 * u(rng);
+  TreeData<S> data(model);
+  forwardKinematics(model, q, qd, data);
+  Eigen::VectorXd h(n), qdd_aba(n);
+  rnea(model, data, qd, Eigen::VectorXd::Zero(n), h);
+  Eigen::MatrixXd M(n, n);
+  crba(model, data, M);
+  aba(model, data, qd, tau, qdd_aba);
+  const Eigen::VectorXd qdd_crba = M.llt().solve(tau - h);
+  const Eigen::VectorXd eig = Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(M, Eigen::EigenvaluesOnly).eigenvalues();
+  const double cond = eig.maxCoeff() / eig.minCoeff();
+  const double rel = (qdd_aba - qdd_crba).norm() / qdd_crba.norm();
+  INFO("n = " << n << ", cond(M) = " << cond << ", |Δθ''|/|θ''| = " << rel);
+  CHECK(rel < 100 * cond * std::numeric_limits<double>::epsilon());
+  // And RNEA of ABA's answer gives τ back (the output overloads write into plain vectors).
+  Eigen::VectorXd tau_back(n);
+  forwardKinematics(model, q, qd, data);
+  rnea(model, data, qd, qdd_aba, tau_back);
+  CHECK((tau_back - tau).norm() < 1e-6 * tau.norm());
+}
+
+// Total energy of a chain at (q, qd).
+double energy(const TreeModel<Planar>& model, TreeData<Planar>& data, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+  forwardKinematics(model, q, qd, data);
+  return kineticEnergy(model, data) + potentialEnergy(model, data);
+}
+
+// |E(t) − E(0)| over `duration` of the passive chain under RK4 with ABA, relative to its kinetic energy at the end.
+double rk4EnergyDrift(const TreeModel<Planar>& model, const Eigen::VectorXd& q0, const Eigen::VectorXd& qd0, double dt,
+                      double duration, double* kinetic = nullptr) {
+  const int n = model.dof();
+  TreeData<Planar> data(model);
+  const Eigen::VectorXd tau = Eigen::VectorXd::Zero(n);
+  auto accel = [&](const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+    Eigen::VectorXd a(n);
+    forwardKinematics(model, q, qd, data);
+    aba(model, data, qd, tau, a);
+    return a;
+  };
+  Eigen::VectorXd q = q0, qd = qd0;
+  const double E0 = energy(model, data, q, qd);
+  double worst = 0;
+  for (int k = 0; k < int(std::lround(duration / dt)); ++k) {
+    const Eigen::VectorXd a1 = accel(q, qd), v1 = qd;
+    const Eigen::VectorXd a2 = accel(q + 0.5 * dt * v1, qd + 0.5 * dt * a1), v2 = qd + 0.5 * dt * a1;
+    const Eigen::VectorXd a3 = accel(q + 0.5 * dt * v2, qd + 0.5 * dt * a2), v3 = qd + 0.5 * dt * a2;
+    const Eigen::VectorXd a4 = accel(q + dt * v3, qd + dt * a3), v4 = qd + dt * a3;
+    q += dt / 6 * (v1 + 2 * v2 + 2 * v3 + v4);
+    qd += dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4);
+    worst = std::max(worst, std::abs(energy(model, data, q, qd) - E0));
+  }
+  forwardKinematics(model, q, qd, data);
+  if (kinetic) *kinetic = kineticEnergy(model, data);
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("chains beyond kMaxDof: ABA equals the CRBA + Cholesky solve of τ − RNEA(θ'' = 0)") {
+  std::mt19937 rng(13);
+  for (int n : {50, 200}) abaEqualsCrbaSolve(variedPlanarChain(n, rng), rng);
+  abaEqualsCrbaSolve(variedSpatialChain(50, rng), rng);
+}
+
+TEST_CASE("a free 100-link chain conserves energy under RK4 + ABA, converging at fourth order") {
+  // The passive chain (τ = 0, gravity) from a bent, moving start, 0.1 s. RK4's energy error is
+  // O(dt⁴): at dt = 1 ms it is a tiny fraction of the kinetic energy gained, and halving dt cuts it
+  // about 16× (> 8 asserted). A wrong ABA (not the chain's M⁻¹) breaks both.
+  const TreeModel<Planar> chain = uniformPlanarChain(100, 0.05, 0.1);
+  Eigen::VectorXd q0(100), qd0(100);
+  for (int i = 0; i < 100; ++i) q0[i] = (i == 0 ? -1.2 : 0.0) + 0.05 * std::sin(0.3 * i), qd0[i] = 0.2 * std::cos(0.2 * i);
+  double kinetic = 0;
+  const double coarse = rk4EnergyDrift(chain, q0, qd0, 1e-3, 0.1, &kinetic);
+  const double fine = rk4EnergyDrift(chain, q0, qd0, 5e-4, 0.1);
+  INFO("drift at dt 1 ms " << coarse << " J, at 0.5 ms " << fine << " J, kinetic energy " << kinetic << " J");
+  CHECK(coarse < 1e-6 * kinetic);
+  CHECK(coarse / fine > 8);
+}
+
+TEST_CASE("VecIn views vectors in place and evaluates expressions (on the stack up to kMaxDof)") {
+  Eigen::VectorXd big = Eigen::VectorXd::LinSpaced(40, 0, 1);
+  const VecIn whole(big);
+  CHECK(whole.data() == big.data());
+  const VecIn head(big.head(10));
+  CHECK(head.data() == big.data());
+  VecN small = VecN::Ones(5);
+  const VecIn expr(2 * small);
+  CHECK(expr.data() != small.data());
+  CHECK(expr.size() == 5);
+  CHECK(expr[4] == 2.0);
+  const VecIn large(2 * big);
+  CHECK(large.size() == 40);
+  CHECK(large[39] == 2.0);
+  // pointJacobian's J (a MatN) cannot hold more than kMaxDof columns: it says so.
+  const TreeModel<Planar> chain = uniformPlanarChain(30, 0.1, 1.0);
+  TreeData<Planar> data(chain);
+  positionKinematics(chain, Eigen::VectorXd::Zero(30), data);
+  MatN J;
+  CHECK_THROWS_AS(pointJacobian(chain, data, 29, Planar::Pos(0.1, 0.0), J), std::length_error);
 }

@@ -1,0 +1,13 @@
+// Timing helpers shared by the bench commands (app/bench.cpp, app/bench_scaling.cpp).
+#pragma once
+#include <vector>
+
+namespace dyn::app {
+
+// The middle value (0 for none).
+double median(std::vector<double> v);
+// The cost of one pair of clock reads (µs, median of many): subtracted from every timed sample, so
+// a sub-microsecond step is not charged the timer's own ~20–50 ns.
+double clockOverhead();
+
+}  // namespace dyn::app
