@@ -100,7 +100,10 @@ LoopAnalysis analyseLoop(const LinearLoop& loop, int order) {
       const std::complex<double> L = polyEval(loop.num, {0, wc}) / polyEval(loop.den, {0, wc});
       double pm = M_PI + std::arg(L);
       if (pm > M_PI) pm -= 2 * M_PI;
-      const double dm = pm > 0 ? pm / wc : 0.0;
+      // The least delay that turns this crossover's phase to −π: PM/ω_c, or one more turn when the
+      // phase is already past it (a conditionally stable loop with several crossovers, e.g. a
+      // flexible joint's resonance: stable without delay, so the turn is still ahead).
+      const double dm = (pm > 0 ? pm : pm + 2 * M_PI) / wc;
       if (!crossed || dm < best) {
         best = dm;
         a.crossover = wc;

@@ -2,7 +2,7 @@
 //   open loop      L(s) = N(s)/D(s) · e^{−sT}            (T: measurement delay)
 //   Padé (n, n)    e^{−sT} ≈ P(−sT)/P(sT),  P(x) = Σ_k (2n−k)! n! / ((2n)! k! (n−k)!) x^k
 //   closed loop    D(s) P(sT) + N(s) P(−sT) = 0            → poles (companion-matrix eigenvalues)
-//   margins        |L(jω_c)| = 1:  PM = π + ∠L(jω_c),  delay margin = PM / ω_c (total delay tolerated)
+//   margins        |L(jω_c)| = 1:  PM = π + ∠L(jω_c),  delay margin = min over crossovers of PM / ω_c (PM + 2π where PM ≤ 0)
 // Polynomials are coefficient vectors in ascending powers of s.
 #pragma once
 #include <complex>

@@ -76,3 +76,22 @@ TEST_CASE("a loop unstable without delay has no delay margin") {
   CHECK_FALSE(a.stable);
   CHECK(a.delay_margin == 0.0);
 }
+
+TEST_CASE("a conditionally stable loop (flexible joint under PD): the margin is the least delay to −π") {
+  // PD on the motor of a rotor J_m – spring k – link m_L pair, lightly damped (b in the spring):
+  //   L(s) = (k_d s + k_p)(m_L s² + b s + k) / (s² (J_m m_L s² + (J_m + m_L)(b s + k))).
+  // Near the resonance |L| crosses 1 several times and the phase passes −π between them, yet the loop
+  // without delay is stable: the margin there is (PM + 2π)/ω_c, not 0.
+  const double Jm = 0.01, mL = 0.05, k = 50, b = 0.02, kp = 2, kd = 0.2;
+  LinearLoop loop{"flex", "flexible joint", polyMul({kp, kd}, {k, b, mL}), polyMul({0, 0, 1}, {(Jm + mL) * k, (Jm + mL) * b, Jm * mL}), 0.0};
+  const LoopAnalysis free = analyseLoop(loop);
+  REQUIRE(free.stable);
+  MESSAGE("delay margin ", free.delay_margin, " s at crossover ", free.crossover, " rad/s, PM ", free.phase_margin);
+  CHECK(free.delay_margin > 0);
+  CHECK(free.delay_margin < kUnboundedDelay);
+  // A high-order Padé (its phase is right to ωT ≈ 2π) brackets it on the closed-loop poles.
+  loop.delay = 0.97 * free.delay_margin;
+  CHECK(analyseLoop(loop, 8).stable);
+  loop.delay = 1.03 * free.delay_margin;
+  CHECK_FALSE(analyseLoop(loop, 8).stable);
+}
