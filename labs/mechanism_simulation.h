@@ -189,4 +189,23 @@ class MechanismSimulation final : public Simulation {
   std::string failure_;
 };
 
+// The Bullet engine for a description of either algebra (deduced from the model).
+template <class S>
+std::unique_ptr<MechanismEngine> bulletEngine(const MechanismModel<S>& model, double dt, const VecN& q0, const VecN& v0) {
+  return std::make_unique<BulletEngine<S>>(model, dt, q0, v0);
+}
+
+// A lab's run: mechanism `mech` from the consistent state (q, v), stepped by the hand engine or by
+// Bullet's model of the same description, with the lab's hooks and trace columns.
+template <class M>
+std::unique_ptr<Simulation> simulateMechanism(Engine engine, std::unique_ptr<M> mech, const StepOptions& step, const VecN& q,
+                                              const VecN& v, std::unique_ptr<StepHooks> hooks,
+                                              const std::vector<std::string>& columns, double duration) {
+  std::unique_ptr<MechanismEngine> stepper;
+  if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<M>>(*mech, step, q, v);
+  else stepper = bulletEngine(mech->model(), step.dt, q, v);
+  return std::make_unique<MechanismSimulation<M>>(engine, std::move(mech), std::move(stepper), std::move(hooks), columns,
+                                                  step.dt, duration);
+}
+
 }  // namespace dyn

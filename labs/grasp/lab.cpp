@@ -234,11 +234,7 @@ std::unique_ptr<Simulation> GraspLab::simulate(Engine engine) const {
   auto mech = std::make_unique<Mechanism>(s_.params);
   VecN q, v;
   mech->assemble(s_.pose0, Eigen::Vector3d::Zero(), q, v);
-  std::unique_ptr<MechanismEngine> stepper;
-  if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<Mechanism>>(*mech, s_.step, q, v);
-  else stepper = std::make_unique<BulletEngine<Planar>>(mech->model(), s_.step.dt, q, v);
-  return std::make_unique<MechanismSimulation<Mechanism>>(engine, std::move(mech), std::move(stepper),
-                                                          std::make_unique<Hooks>(s_, q, v), columns_, s_.step.dt, s_.duration);
+  return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::make_unique<Hooks>(s_, q, v), columns_, s_.duration);
 }
 
 json GraspLab::metrics(const Trace& tr) const {

@@ -327,11 +327,7 @@ template <class M>
 std::unique_ptr<Simulation> run(const Settings& s, Engine engine, const std::vector<std::string>& columns) {
   auto mech = std::make_unique<M>(describeWithWall(s));
   VecN q = VecN(s.pose), v = VecN::Zero(3);
-  std::unique_ptr<MechanismEngine> stepper;
-  if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<M>>(*mech, s.step, q, v);
-  else stepper = std::make_unique<BulletEngine<Planar>>(mech->model(), s.step.dt, q, v);
-  return std::make_unique<MechanismSimulation<M>>(engine, std::move(mech), std::move(stepper), std::make_unique<Hooks>(s),
-                                                  columns, s.step.dt, s.duration);
+  return simulateMechanism(engine, std::move(mech), s.step, q, v, std::make_unique<Hooks>(s), columns, s.duration);
 }
 
 }  // namespace

@@ -223,11 +223,7 @@ std::unique_ptr<Simulation> PenOnTableLab::simulate(Engine engine) const {
   const double z0 = mech->tip(q).z();
   // A pen that starts on a rigid table starts in contact (its gap is 0 up to rounding, either sign).
   if (s_.start_height == 0 && s_.params.table_stiffness == 0) mech->setClosed(0, true);
-  std::unique_ptr<MechanismEngine> stepper;
-  if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<Mechanism>>(*mech, s_.step, q, v);
-  else stepper = std::make_unique<BulletEngine<Spatial>>(mech->model(), s_.step.dt, q, v);
-  return std::make_unique<MechanismSimulation<Mechanism>>(engine, std::move(mech), std::move(stepper), std::make_unique<Hooks>(s_, z0),
-                                                          kColumns, s_.step.dt, s_.duration);
+  return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::make_unique<Hooks>(s_, z0), kColumns, s_.duration);
 }
 
 json PenOnTableLab::metrics(const Trace& tr) const {

@@ -147,11 +147,7 @@ std::unique_ptr<Simulation> SliderCrankLab::simulate(Engine engine) const {
   auto mech = std::make_unique<Mechanism>(s_.params);
   VecN q, v;
   mech->initialState(s_.theta1, s_.theta1_rate, s_.branch, q, v);
-  std::unique_ptr<MechanismEngine> stepper;
-  if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<Mechanism>>(*mech, s_.step, q, v);
-  else stepper = std::make_unique<BulletEngine<Planar>>(mech->model(), s_.step.dt, q, v);
-  return std::make_unique<MechanismSimulation<Mechanism>>(engine, std::move(mech), std::move(stepper),
-                                                          std::make_unique<Hooks>(s_, q, v), kColumns, s_.step.dt, s_.duration);
+  return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::make_unique<Hooks>(s_, q, v), kColumns, s_.duration);
 }
 
 json SliderCrankLab::metrics(const Trace& tr) const {

@@ -187,12 +187,7 @@ std::unique_ptr<Simulation> UnicycleLab::simulate(Engine engine) const {
   auto mech = std::make_unique<Mechanism>(s_.params);
   VecN q, v;
   mech->state(s_.x0, s_.y0, s_.phi0, 0.0, s_.phi_rate0, s_.theta_rate0, q, v);
-  std::unique_ptr<MechanismEngine> stepper;
-  if (engine == Engine::Hand) stepper = std::make_unique<HandEngine<Mechanism>>(*mech, s_.step, q, v);
-  else stepper = std::make_unique<BulletEngine<Spatial>>(mech->model(), s_.step.dt, q, v);
-  return std::make_unique<MechanismSimulation<Mechanism>>(engine, std::move(mech), std::move(stepper),
-                                                          std::make_unique<Hooks>(s_, path_, engine, q, v), kColumns, s_.step.dt,
-                                                          s_.duration);
+  return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::make_unique<Hooks>(s_, path_, engine, q, v), kColumns, s_.duration);
 }
 
 json UnicycleLab::metrics(const Trace& tr) const {
