@@ -158,6 +158,18 @@ struct Scene {
   std::vector<Cone> cones;
   std::vector<Spring> springs;
   Framing framing;  // fit: the renderer chooses the camera (see Framing)
+
+  // A spatial lab's view: perspective, z up, looking at box from its centre + `from`, and the
+  // renderer fitting box in the frame (Framing).
+  void framePerspective(const Eigen::AlignedBox3d& box, const Eigen::Vector3d& from, double fov_y_deg = 35) {
+    camera.ortho = false;
+    camera.fov_y_deg = fov_y_deg;
+    camera.up = {0, 0, 1};
+    camera.target = box.center();
+    camera.eye = box.center() + from;
+    framing.fit = true;
+    framing.bounds = box;
+  }
 };
 
 // ---- Pure helpers for labs (no GL) ----------------------------------------------------------

@@ -77,13 +77,7 @@ void PenOnTableLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, 
   // The floor the column stands on: exactly the box's footprint (so it is framed too).
   s.planes.push_back({Eigen::Vector3d(box.center().x(), box.center().y(), floor_z), Eigen::Matrix3d::Identity(),
                       0.5 * box.sizes().head<2>(), kFloor, 0.0, 0.1});
-  s.camera.ortho = false;
-  s.camera.fov_y_deg = 35;
-  s.camera.up = {0, 0, 1};
-  s.camera.target = box.center();
-  s.camera.eye = box.center() + Eigen::Vector3d(0.9, -1.1, 0.6);
-  s.framing.fit = true;
-  s.framing.bounds = box;
+  s.framePerspective(box, Eigen::Vector3d(0.9, -1.1, 0.6));
 
   // The reference circle on the table.
   Polyline circle{{}, 1.5, kRef};

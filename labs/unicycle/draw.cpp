@@ -48,13 +48,7 @@ void UnicycleLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Sc
   // A margin of floor round the course (the ground is drawn exactly this big, so it is framed too).
   box.extend(box.min() - Eigen::Vector3d(r + 0.15, r + 0.15, 0));
   box.extend(box.max() + Eigen::Vector3d(r + 0.15, r + 0.15, 2 * r));
-  s.camera.ortho = false;
-  s.camera.fov_y_deg = 35;
-  s.camera.up = {0, 0, 1};
-  s.camera.target = box.center();
-  s.camera.eye = box.center() + Eigen::Vector3d(0, -1.2, 1.0);
-  s.framing.fit = true;
-  s.framing.bounds = box;
+  s.framePerspective(box, Eigen::Vector3d(0, -1.2, 1.0));
 
   // Ground, path, leader.
   const Eigen::Vector3d size = box.sizes();
