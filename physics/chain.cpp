@@ -1,6 +1,7 @@
 // Tree algorithms of lecture eq. (1) — RNEA, CRBA, ABA, point Jacobians — written once for
 // planar and spatial algebra and instantiated for both (see chain.h for the equations).
 #include "physics/chain.h"
+#include "physics/chain_world.h"
 
 #include <stdexcept>
 
@@ -105,48 +106,11 @@ VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecIn& qd, const V
   return tau;
 }
 
-// M = Σ_b J_bᵀ I_b J_b over the bodies with mass (T = ½ Σ V_bᵀ I_b V_b), in world coordinates: the
-// axes S_j^w of the joints on b's path and b's inertia I_b^w. Cheaper than composites when most
-// bodies are massless carriers (the unicycle's x, y, z and heading).
-template <class S>
-void crbaSparseMass(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M) {
-  using Vec = typename S::Vec;
-  const int n = model.dof();
-  const std::vector<Vec>& Sw = data.S_w;
-  M.setZero();
-  for (int b = 0; b < n; ++b) {
-    if (S::massless(model.bodies[b].inertia)) continue;
-    const typename S::Inertia Iw = S::inertiaInParent(data.X_world[b], S::compact(model.bodies[b].inertia));
-    for (int i = b; i >= 0; i = model.bodies[i].parent) {
-      const Vec F = S::inertiaTimes(Iw, Sw[i]);
-      for (int j = b; j >= i; j = model.bodies[j].parent) M(j, i) += S::dot(Sw[j], F);
-    }
-  }
-  for (int i = 0; i < n; ++i)
-    for (int j = i + 1; j < n; ++j) M(i, j) = M(j, i);
-}
-
+// M from composite inertias in world coordinates (chain_world.h: they simply add there).
 template <class S>
 void crba(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M) {
-  const int n = model.dof();
-  if (2 * model.massive <= n) return crbaSparseMass(model, data, M);
-  for (int i = 0; i < n; ++i) data.Ic_rb[i] = S::compact(model.bodies[i].inertia);
-  // Composite inertias, leaves to root: Ic_p += X^T Ic_i X.
-  for (int i = n - 1; i >= 0; --i) {
-    const int p = model.bodies[i].parent;
-    if (p >= 0) data.Ic_rb[p] += S::inertiaInParent(data.X_up[i], data.Ic_rb[i]);
-  }
-  M.setZero();
-  for (int i = 0; i < n; ++i) {
-    typename S::Vec F = S::inertiaTimes(data.Ic_rb[i], data.S_i[i]);
-    M(i, i) = S::dot(data.S_i[i], F);
-    // Carry the composite force up the ancestors: M_ij = S_j · F.
-    for (int j = i; model.bodies[j].parent >= 0;) {
-      F = S::forceTranspose(data.X_up[j], F);
-      j = model.bodies[j].parent;
-      M(i, j) = M(j, i) = S::dot(data.S_i[j], F);
-    }
-  }
+  worldInertias(model, data);
+  crbaWorld(model, data, M);
 }
 
 template <class S>

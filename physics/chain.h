@@ -80,7 +80,6 @@ struct TreeModel {
   };
   std::vector<Body> bodies;
   Vec gravity = Vec::Zero();         // spatial acceleration of gravity in world coordinates
-  int massive = 0;                   // bodies with mass or inertia (addBody counts them; crba's choice)
 
   int dof() const { return int(bodies.size()); }
   int addBody(int parent, JointType joint, const typename S::Axis& axis,
@@ -90,7 +89,6 @@ struct TreeModel {
     else bodies.push_back({parent, joint, axis, X_tree, inertia});
     bodies.back().subspace = motionSubspace(int(bodies.size()) - 1);
     bodies.back().central = S::central(inertia);
-    massive += !S::massless(inertia);
     return int(bodies.size()) - 1;
   }
   Vec motionSubspace(int i) const;
@@ -137,7 +135,8 @@ template <class S>
 VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecIn& qd, const VecIn& qdd,
           bool with_gravity = true);
 
-// Joint-space inertia M(θ), symmetric positive definite (into M, sized n × n by the caller, or returned).
+// Joint-space inertia M(θ), symmetric positive definite (into M, sized n × n by the caller, or returned),
+// from world-coordinate composite inertias (chain_world.h); leaves data.I_w for biasForcesWorld.
 template <class S>
 void crba(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M);
 template <class S>

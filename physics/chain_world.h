@@ -1,5 +1,5 @@
-// Tree dynamics in world coordinates: the mechanism's position and velocity stages (lecture eq. (1):
-// the same M and C θ' + G as chain.h's crba and rnea, which work in body coordinates).
+// Tree dynamics in world coordinates: chain.h's crba, and the mechanism's velocity stage (lecture
+// eq. (1): the same C θ' + G as chain.h's rnea, which works in body coordinates).
 // With every body's inertia and joint axis in world coordinates at the world origin,
 // I_i^w = X_iᵀ I_i X_i and S_i^w (X_i: world → body i, from positionKinematics), the recursions
 // need no transform per joint (Featherstone's absolute-coordinate form; MuJoCo works this way too):

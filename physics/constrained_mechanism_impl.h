@@ -68,10 +68,9 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::positionStage(const VecN& q) {
   tree_q_ = q.head(nn);
   have_tree_ = true;
   have_velocity_ = false;
-  // World inertias (shared with the velocity stage), then M from their composites.
-  worldInertias(model_.tree, data_);
+  // M from world composite inertias; the world inertias stay for the velocity stage.
   problem_.M.resize(nn, nn);
-  crbaWorld(model_.tree, data_, problem_.M);
+  crba(model_.tree, data_, problem_.M);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
   if constexpr (S::kDim == 3)
     for (int i = 0; i < nn; ++i) {

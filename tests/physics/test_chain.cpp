@@ -154,9 +154,9 @@ TEST_CASE("joint springs: K is tridiagonal and K θ is the gradient of P_K") {
   }
 }
 
-TEST_CASE("CRBA with massless carriers (the Σ Jᵀ I J form) equals RNEA columns") {
+TEST_CASE("CRBA with massless carriers equals RNEA columns") {
   // Three prismatic carriers (one placement turned), a heading joint, and two massive leaves on a
-  // branch: 2 of 6 bodies carry mass, so crba takes its sparse-mass route.
+  // branch: 2 of 6 bodies carry mass (the unicycle's kind of tree).
   using Pos = Spatial::Pos;
   TreeModel<Spatial> t;
   t.gravity << 0, 0, 0, 0, 0, -9.81;
