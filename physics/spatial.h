@@ -287,22 +287,6 @@ struct Spatial {
     for (int i = 0; i < 3; ++i) out[i] += hu[i], out[3 + i] = I.m * v[3 + i] - hw[i];
     return out;
   }
-  // Xᵀ I X: turn about the origin (I_O → Eᵀ I_O E, h → Eᵀ h), then move the origin by −r (parallel
-  // axes, no division, so massless bodies pass):
-  //   I_O → I_O + m(|r|² 1 − r rᵀ) + 2 (r·h) 1 − r hᵀ − h rᵀ,   h → h + m r.
-  DYN_INLINE static Inertia inertiaInParent(const Transform& X, const Inertia& I) {
-    Inertia out = I;
-    if (X.turned) {
-      out.Io = X.E.transpose() * I.Io * X.E;
-      out.h = X.E.transpose() * I.h;
-    }
-    const Pos& r = X.r;
-    const double rh = r.dot(out.h), rr = r.dot(r);
-    out.Io.noalias() -= out.m * r * r.transpose() + r * out.h.transpose() + out.h * r.transpose();
-    out.Io.diagonal().array() += out.m * rr + 2.0 * rh;
-    out.h += out.m * r;
-    return out;
-  }
   // The same inertia about the centre of mass: mass m, centre c and I_c (body coordinates).
   struct Central {
     double m = 0;
@@ -317,8 +301,8 @@ struct Spatial {
     return out;
   }
   // Xᵀ I X from the centre-of-mass form: the centre c_A = r + Eᵀ c, the central inertia turned
-  // (Eᵀ I_c E, symmetric: six entries), then about A's origin, I_O = Eᵀ I_c E + m(|c_A|² 1 − c_A c_Aᵀ), h = m c_A.
-  // Cheaper than inertiaInParent on the origin form: one rotation, no cross terms in h.
+  // (Eᵀ I_c E, symmetric: six entries), then about A's origin, I_O = Eᵀ I_c E + m(|c_A|² 1 − c_A c_Aᵀ), h = m c_A:
+  // one rotation, no cross terms in h (cheaper than transforming the origin form).
   DYN_INLINE static Inertia inertiaInParent(const Transform& X, const Central& C) {
     Inertia out;
     out.m = C.m;
