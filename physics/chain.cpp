@@ -3,6 +3,7 @@
 #include "physics/chain.h"
 #include "physics/chain_world.h"
 
+#include <cmath>
 #include <stdexcept>
 
 namespace dyn {
@@ -42,9 +43,21 @@ template <class S>
 void positionKinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
   for (int i = 0; i < model.dof(); ++i) {
     const auto& b = model.bodies[i];
+    data.S_i[i] = b.subspace;
+    if constexpr (S::kDim == 6) {
+      // A revolute joint about a coordinate axis: X_world = X_J ∘ (X_tree ∘ X_world,parent) turns two
+      // rows, and its world axis is a row of E (spatial.h turnAbout, coordinateAxisInWorld).
+      if (b.joint == JointType::Revolute && b.coordinate_axis >= 0) {
+        const double c = std::cos(q[i]), s = std::sin(q[i]);
+        const int k = b.coordinate_axis;
+        data.X_up[i] = S::turnAbout(k, c, s, b.X_tree);
+        data.X_world[i] = b.parent < 0 ? data.X_up[i] : S::turnAbout(k, c, s, S::compose(b.X_tree, data.X_world[b.parent]));
+        data.S_w[i] = S::coordinateAxisInWorld(k, data.X_world[i]);
+        continue;
+      }
+    }
     // Joint placement then joint motion: X_up = X_J(θ_i) X_tree.
     data.X_up[i] = S::compose(S::jointTransform(b.joint == JointType::Revolute, b.axis, q[i]), b.X_tree);
-    data.S_i[i] = b.subspace;
     data.X_world[i] = b.parent < 0 ? data.X_up[i] : S::compose(data.X_up[i], data.X_world[b.parent]);
     data.S_w[i] = S::motionInverse(data.X_world[i], data.S_i[i]);
   }
@@ -109,7 +122,6 @@ VecN rnea(const TreeModel<S>& model, TreeData<S>& data, const VecIn& qd, const V
 // M from composite inertias in world coordinates (chain_world.h: they simply add there).
 template <class S>
 void crba(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M) {
-  worldInertias(model, data);
   crbaWorld(model, data, M);
 }
 

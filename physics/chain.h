@@ -77,6 +77,8 @@ struct TreeModel {
     Vec subspace = Vec::Zero();      // motion subspace S_i (set by addBody from joint and axis)
     // Spatial: the inertia about the centre of mass {m, c, I_c} (Spatial::Central, set by addBody).
     typename S::Central central{};
+    // Spatial: 0, 1 or 2 when the axis is that coordinate axis (set by addBody), else −1.
+    int coordinate_axis = -1;
   };
   std::vector<Body> bodies;
   Vec gravity = Vec::Zero();         // spatial acceleration of gravity in world coordinates
@@ -89,6 +91,9 @@ struct TreeModel {
     else bodies.push_back({parent, joint, axis, X_tree, inertia});
     bodies.back().subspace = motionSubspace(int(bodies.size()) - 1);
     bodies.back().central = S::central(inertia);
+    if constexpr (S::kDim == 6)
+      for (int k = 0; k < 3; ++k)
+        if (bodies.back().axis == S::Axis::Unit(k)) bodies.back().coordinate_axis = k;
     return int(bodies.size()) - 1;
   }
   Vec motionSubspace(int i) const;

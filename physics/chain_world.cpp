@@ -4,22 +4,18 @@
 namespace dyn {
 
 template <class S>
-void worldInertias(const TreeModel<S>& model, TreeData<S>& data) {
-  typename S::Inertia zero{};
-  if constexpr (S::kDim == 3) zero.setZero();
-  for (int i = 0; i < model.dof(); ++i) {
-    const auto& b = model.bodies[std::size_t(i)];
-    if (S::massless(b.inertia)) data.I_w[i] = zero;
-    else if constexpr (S::kDim == 6) data.I_w[i] = S::inertiaInParent(data.X_world[i], b.central);  // from the centre of mass
-    else data.I_w[i] = S::inertiaInParent(data.X_world[i], b.inertia);
-  }
-}
-
-template <class S>
 void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M) {
   const int n = model.dof();
+  // World inertias (kept for the velocity stage), each also its composite's first term.
+  typename S::Inertia zero{};
+  if constexpr (S::kDim == 3) zero.setZero();
+  for (int i = 0; i < n; ++i) {
+    const auto& b = model.bodies[std::size_t(i)];
+    if (S::massless(b.inertia)) data.I_w[i] = data.Ic_rb[i] = zero;
+    else if constexpr (S::kDim == 6) data.I_w[i] = data.Ic_rb[i] = S::inertiaInParent(data.X_world[i], b.central);  // from the centre of mass
+    else data.I_w[i] = data.Ic_rb[i] = S::inertiaInParent(data.X_world[i], b.inertia);
+  }
   // Composite inertias, leaves to root: in one frame they simply add.
-  for (int i = 0; i < n; ++i) data.Ic_rb[i] = data.I_w[i];
   for (int i = n - 1; i >= 0; --i) {
     const int p = model.bodies[std::size_t(i)].parent;
     if (p >= 0) data.Ic_rb[p] += data.Ic_rb[i];
@@ -66,7 +62,6 @@ double kineticEnergyWorld(const TreeModel<S>& model, const TreeData<S>& data) {
 }
 
 #define DYNLAB_INSTANTIATE(S)                                                                  \
-  template void worldInertias<S>(const TreeModel<S>&, TreeData<S>&);                           \
   template void crbaWorld<S>(const TreeModel<S>&, TreeData<S>&, Eigen::Ref<Eigen::MatrixXd>);  \
   template void biasForcesWorld<S>(const TreeModel<S>&, TreeData<S>&, const VecN&, Eigen::Ref<Eigen::VectorXd>); \
   template double kineticEnergyWorld<S>(const TreeModel<S>&, const TreeData<S>&);

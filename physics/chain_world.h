@@ -15,13 +15,11 @@
 
 namespace dyn {
 
-// I_i^w of every body (zero for massless ones), after positionKinematics.
-template <class S>
-void worldInertias(const TreeModel<S>& model, TreeData<S>& data);
-// M(θ) from the world inertias (into M, sized n × n by the caller).
+// M(θ) (into M, sized n × n by the caller), after positionKinematics; leaves I_i^w of every body in
+// data.I_w (zero for massless ones).
 template <class S>
 void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M);
-// h = C θ' + G (into h, sized n by the caller), leaving data.v_w and data.a_w; after worldInertias.
+// h = C θ' + G (into h, sized n by the caller), leaving data.v_w and data.a_w; after crbaWorld.
 template <class S>
 void biasForcesWorld(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, Eigen::Ref<Eigen::VectorXd> h);
 // ½ Σ V_i · I_i^w V_i from the last biasForcesWorld.

@@ -126,7 +126,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // Unilateral and compliant kinds: which constraints are released, their rows before the release
   // (φ, J, A: gaps and compliant forces read them), and the compliant forces of the velocity stage.
   std::vector<char> released_;
-  bool any_released_kind_ = false;
+  std::vector<char> compliant_, rigid_contact_;  // per constraint: a compliant contact; a rigid unilateral one
+  bool any_released_kind_ = false, any_compliant_ = false;
   VecN phi_full_;
   MatN J_full_, A_full_;
   VecN compliant_eta_;   // per row: the compliant force η (0 elsewhere)

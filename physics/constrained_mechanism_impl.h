@@ -22,6 +22,9 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
     // Rigid unilateral contacts start open (updateContacts closes them); compliant ones never close.
     const bool released = c->unilateral() || c->compliant();
     released_.push_back(char(released));
+    compliant_.push_back(char(c->compliant()));
+    rigid_contact_.push_back(char(c->unilateral() && !c->compliant()));
+    any_compliant_ = any_compliant_ || c->compliant();
     any_released_kind_ = any_released_kind_ || released;
   }
   auto fits = [](int fixed, int actual) { return fixed == Eigen::Dynamic || fixed == actual; };
@@ -56,6 +59,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
   gravity_bc_ = problem_.bc_Gc;
   problem_.A.setZero(rows_, kk);
   phi_.setZero(rows_);
+  phi_full_.setZero(rows_);
 }
 
 template <class S, int Nj, int Nr, int Nl>
@@ -86,25 +90,25 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::positionStage(const VecN& q) {
     kin_.payload_cs[i] = p.free[0] || psi != 0.0 ? Eigen::Vector2d(std::cos(psi), std::sin(psi)) : Eigen::Vector2d(1.0, 0.0);
   }
   // Every constraint's φ, J and A rows, then eq. (2) factored at this configuration.
-  MatN J = MatN::Zero(rows_, nn), A = MatN::Zero(rows_, kk);
-  for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->position(kin_, offsets_[i], phi_, J, A);
-  // Released rows (open or compliant contacts) are kept aside and zeroed: with compliance 1, η = 0.
+  J_full_.setZero(rows_, nn);
+  A_full_.setZero(rows_, kk);
+  for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->position(kin_, offsets_[i], phi_full_, J_full_, A_full_);
+  phi_ = phi_full_;
+  problem_.J = J_full_;
+  problem_.A = A_full_;
+  // Released rows (open or compliant contacts) are zeroed in the solve (the full rows stay for gaps
+  // and compliant forces): with compliance 1, η = 0.
   if (any_released_kind_) {
-    phi_full_ = phi_;
-    J_full_ = J;
-    A_full_ = A;
     problem_.compliance.setZero(rows_);
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
       if (released_[i])
         for (int r = offsets_[i]; r < offsets_[i] + model_.constraints[i]->rows(); ++r) {
           phi_[r] = 0.0;
-          J.row(r).setZero();
-          A.row(r).setZero();
+          problem_.J.row(r).setZero();
+          if (kk) problem_.A.row(r).setZero();
           problem_.compliance[r] = 1.0;
         }
   }
-  problem_.J = J;
-  problem_.A = A;
   factored_ = factor_.factor(problem_, problem_.J, problem_.A);
   staged_q_ = q;
   have_position_ = true;
@@ -143,13 +147,15 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   // Released rows: no bias; a compliant contact's force enters as −Jᵀη on the tree (h += Jᵀη) and
   // Aᵀη on the payloads.
   if (any_released_kind_) {
-    compliant_eta_.setZero(rows_);
-    compliant_bc_.setZero(k());
+    if (any_compliant_) {
+      compliant_eta_.setZero(rows_);
+      compliant_bc_.setZero(k());
+    }
     for (std::size_t i = 0; i < model_.constraints.size(); ++i) {
       if (!released_[i]) continue;
       const auto& c = *model_.constraints[i];
       for (int r = offsets_[i]; r < offsets_[i] + c.rows(); ++r) bias[r] = 0.0;
-      if (!c.compliant()) continue;
+      if (!compliant_[i]) continue;
       const int r = offsets_[i];
       const double eta = c.compliantForce(kin_);
       compliant_eta_[r] = eta;
@@ -181,16 +187,16 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
   problem_.tau = tau.head(n());
   if (tau.size() == n() + k()) problem_.bc_Gc = gravity_bc_ - tau.tail(k());
   else problem_.bc_Gc = gravity_bc_;
-  if (any_released_kind_ && k()) problem_.bc_Gc += compliant_bc_;
+  if (any_compliant_ && k()) problem_.bc_Gc += compliant_bc_;
   if (stab) problem_.stab = *stab;
   else problem_.stab.resize(0);
   Solution s;
   if (!factored_) s = solveConstrainedBlockLU(problem_);
   else factor_.solve(problem_, s);
   // A compliant contact's η is its force, not the solve's (its row is released).
-  if (any_released_kind_)
+  if (any_compliant_)
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
-      if (model_.constraints[i]->compliant()) {
+      if (compliant_[i]) {
         const int r = offsets_[i];
         s.eta[r] = compliant_eta_[r];
         if (problem_.Ht.size() == 0) s.f[r] = compliant_eta_[r];
@@ -215,7 +221,7 @@ template <class S, int Nj, int Nr, int Nl>
 int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, const VecN& tau) {
   if (!any_released_kind_) return 0;
   const std::size_t count = model_.constraints.size();
-  auto rigid = [&](std::size_t i) { return model_.constraints[i]->unilateral() && !model_.constraints[i]->compliant(); };
+  auto rigid = [&](std::size_t i) { return rigid_contact_[i] != 0; };
   // Touchdown: an open contact at or past its plane (φ = −gap ≥ 0) not moving away (−gap' ≥ 0).
   positionStage(q);
   int changes = 0;

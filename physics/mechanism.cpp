@@ -112,6 +112,30 @@ void MechanismKinematics<S>::addPointJacobian(const BodyRef& b, const Pos& p_wor
 }
 
 template <class S>
+void MechanismKinematics<S>::addDirectionJacobian(const BodyRef& b, const Pos& p_world, const Pos& d, double sign, int row,
+                                                  MatN& J, MatN& A) const {
+  if (b.kind == BodyRef::Kind::Link) {
+    // Column j: d · (the linear velocity at p of joint j's unit motion), for every joint root → link.
+    const typename S::Transform X_pw = S::translation(p_world);
+    for (int j = b.index; j >= 0; j = model->tree.bodies[std::size_t(j)].parent)
+      J(row, j) += sign * d.dot(S::linear(S::motion(X_pw, tree->S_w[std::size_t(j)])));
+  } else if (b.kind == BodyRef::Kind::Payload) {
+    if constexpr (S::kDim == 3) {
+      // d · the linear rows of Φ(p − c), on the payload's free coordinates.
+      const Payload& pl = model->payloads[std::size_t(b.index)];
+      const Eigen::Vector3d& x = payload_pose[std::size_t(b.index)];
+      const Eigen::Vector2d r(p_world.x() - x[1], p_world.y() - x[2]);
+      int col = model->payloadOffset(b.index);
+      for (int c = 0; c < 3; ++c) {
+        if (!pl.free[std::size_t(c)]) continue;
+        const Eigen::Vector3d phi_c = shiftPlanar(r, Eigen::Vector3d::Unit(c));
+        A(row, col++) -= sign * (d.x() * phi_c[1] + d.y() * phi_c[2]);
+      }
+    }
+  }
+}
+
+template <class S>
 typename S::Vec MechanismKinematics<S>::pointVelocity(const BodyRef& b, const Pos& p_world) const {
   if (b.kind == BodyRef::Kind::Link) {
     const std::size_t i = std::size_t(b.index);

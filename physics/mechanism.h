@@ -190,6 +190,10 @@ struct MechanismKinematics {
   // −sign, so that J θ' − A v_c = sign × V's rows.
   void addPointJacobian(const BodyRef& b, const Pos& p_world, const std::array<bool, S::kDim>& rows,
                         double sign, int row, MatN& J, MatN& A) const;
+  // One row along a world direction d: adds sign × d·v(p) (v(p): the linear velocity of b's point at
+  // p_world) into J and A at `row` (A with −sign, as above): addPointJacobian's rows combined along d
+  // without forming them.
+  void addDirectionJacobian(const BodyRef& b, const Pos& p_world, const Pos& d, double sign, int row, MatN& J, MatN& A) const;
   // The classical acceleration at p_world of that frame when θ'' = 0 and α_c = 0: J'θ' − A'v_c's
   // share of body b (velocity stage required).
   // With `velocity`, also that frame's spatial velocity (pointVelocity), computed on the way.

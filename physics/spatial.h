@@ -292,12 +292,14 @@ struct Spatial {
     double m = 0;
     Pos c = Pos::Zero();
     Eigen::Matrix3d Ic = Eigen::Matrix3d::Zero();
+    bool diagonal = true;  // I_c diagonal in body axes (cylinders and boxes along them: most links)
   };
   static Central central(const Mat& I) {
     Central out;
     massAndCom(I, out.m, out.c);
     // I_O = I_c + m(|c|² 1 − c cᵀ)
     out.Ic = I.block<3, 3>(0, 0) - out.m * (out.c.squaredNorm() * Eigen::Matrix3d::Identity() - out.c * out.c.transpose());
+    out.diagonal = out.Ic(0, 1) == 0 && out.Ic(0, 2) == 0 && out.Ic(1, 2) == 0 && out.Ic(1, 0) == 0 && out.Ic(2, 0) == 0 && out.Ic(2, 1) == 0;
     return out;
   }
   // Xᵀ I X from the centre-of-mass form: the centre c_A = r + Eᵀ c, the central inertia turned
@@ -310,8 +312,13 @@ struct Spatial {
     double B[3][3];  // I_c E
     if (X.turned) {
       for (int i = 0; i < 3; ++i) cA[i] = X.r[i] + X.E(0, i) * C.c[0] + X.E(1, i) * C.c[1] + X.E(2, i) * C.c[2];
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) B[i][j] = C.Ic(i, 0) * X.E(0, j) + C.Ic(i, 1) * X.E(1, j) + C.Ic(i, 2) * X.E(2, j);
+      if (C.diagonal) {
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) B[i][j] = C.Ic(i, i) * X.E(i, j);
+      } else {
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j) B[i][j] = C.Ic(i, 0) * X.E(0, j) + C.Ic(i, 1) * X.E(1, j) + C.Ic(i, 2) * X.E(2, j);
+      }
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j <= i; ++j) out.Io(i, j) = out.Io(j, i) = X.E(0, i) * B[0][j] + X.E(1, i) * B[1][j] + X.E(2, i) * B[2][j];
     } else {
@@ -353,6 +360,32 @@ struct Spatial {
     E(1, 0) = t * x * y - s * z, E(1, 1) = c + t * y * y, E(1, 2) = t * y * z + s * x;
     E(2, 0) = t * x * z + s * y, E(2, 1) = t * y * z - s * x, E(2, 2) = c + t * z * z;
     return {E, Pos::Zero(), true};
+  }
+  // A turn about coordinate axis k (Featherstone's Rx, Ry, Rz: most joints), E_J = R_k(q)ᵀ, applied to
+  // a transform: X_J ∘ X = {E_J E, r}. E_J mixes two rows of E (i = k+1, j = k+2 mod 3):
+  //   row i ← c E_i + s E_j,  row j ← c E_j − s E_i,  row k unchanged  (12 products, not a full 27).
+  DYN_INLINE static Transform turnAbout(int k, double c, double s, const Transform& X) {
+    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    Transform out{X.E, X.r, true};
+    if (!X.turned) {  // E_J itself
+      out.E.setZero();
+      out.E(i, i) = out.E(j, j) = c, out.E(i, j) = s, out.E(j, i) = -s, out.E(k, k) = 1.0;
+      return out;
+    }
+    for (int col = 0; col < 3; ++col) {
+      const double ei = out.E(i, col), ej = out.E(j, col);
+      out.E(i, col) = c * ei + s * ej;
+      out.E(j, col) = c * ej - s * ei;
+    }
+    return out;
+  }
+  // The axis of a revolute joint about coordinate axis k of a body at X_world, in world coordinates
+  // at the origin: X⁻¹ (e_k, 0) = (E_kᵀ, r × E_kᵀ) (E_k: row k of E).
+  DYN_INLINE static Vec coordinateAxisInWorld(int k, const Transform& X) {
+    Vec out;
+    for (int c = 0; c < 3; ++c) out[c] = X.turned ? X.E(k, c) : (c == k ? 1.0 : 0.0);
+    cross3(X.r.data(), out.data(), out.data() + 3);
+    return out;
   }
   DYN_INLINE static Vec classicalAcceleration(const Vec& a, const Vec& v) {
     Vec out;

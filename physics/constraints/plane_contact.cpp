@@ -38,15 +38,10 @@ double PlaneContact<S>::gap(const MechanismKinematics<S>& k) const {
 
 template <class S>
 void PlaneContact<S>::position(const MechanismKinematics<S>& k, int row, VecN& phi, MatN& J, MatN& A) const {
-  phi[row] = -gap(k);
-  // −n·v(c): the centre's translation rows, then their combination along n.
-  constexpr int d = int(S::Pos::RowsAtCompileTime);
-  MatN Jt = MatN::Zero(d, J.cols()), At = MatN::Zero(d, A.cols());
-  k.addPointJacobian(body_, k.position(body_, centre_b_), translations<S>(), -1.0, 0, Jt, At);
-  for (int i = 0; i < d; ++i) {
-    J.row(row) += normal_[i] * Jt.row(i);
-    if (A.cols()) A.row(row) += normal_[i] * At.row(i);
-  }
+  const Pos c = k.position(body_, centre_b_);
+  phi[row] = -(normal_.dot(c) - params_.radius - params_.height);
+  // −n·v(c): the centre's velocity along n.
+  k.addDirectionJacobian(body_, c, normal_, -1.0, row, J, A);
 }
 
 template <class S>

@@ -46,7 +46,6 @@ void checkWorldStages(TreeModel<S> t, const VecN& q, const VecN& qd) {
   const VecN h = rnea(t, body, qd, VecN::Zero(n));  // leaves body.a: the velocity-product accelerations
 
   positionKinematics(t, q, world);
-  worldInertias(t, world);
   Eigen::MatrixXd Mw(n, n);
   crbaWorld(t, world, Mw);
   Eigen::VectorXd hw(n);
