@@ -88,3 +88,44 @@ TEST_CASE("world-coordinate stages equal RNEA: planar arm with a slider") {
   qd << 0.9, -1.3, 0.7, -0.3;
   checkWorldStages(planarWithSlider(), q, qd);
 }
+
+TEST_CASE("fast paths equal the general ones: joints about coordinate axes, diagonal central inertias") {
+  // The same trees with every fast path switched off: the general Rodrigues transform, the full
+  // product with X_world of the parent, the full I_c E.
+  // An elbow arm of cylinders along their axes (the pen's kind: central inertias exactly diagonal).
+  TreeModel<Spatial> cylinders;
+  cylinders.gravity << 0, 0, 0, 0, 0, -9.81;
+  const Eigen::Matrix3d Iz = Eigen::Vector3d(0.03, 0.03, 0.002).asDiagonal(), Ix = Eigen::Vector3d(0.001, 0.02, 0.02).asDiagonal();
+  cylinders.addBody(-1, JointType::Revolute, Spatial::Pos::UnitZ(), Spatial::Transform(), Spatial::inertia(2.0, {0, 0, 0.15}, Iz));
+  cylinders.addBody(0, JointType::Revolute, Spatial::Pos::UnitY(), Spatial::translation({0, 0, 0.3}), Spatial::inertia(1.5, {0.15, 0, 0}, Ix));
+  cylinders.addBody(1, JointType::Revolute, Spatial::Pos::UnitX(), Spatial::translation({0.3, 0, 0}), Spatial::inertia(1.0, {0.17, 0, 0}, Ix));
+  int axes = 0, diagonal = 0;
+  for (const TreeModel<Spatial>& fast : {test::spatialArm(), branchedSpatialTree(), cylinders}) {
+    TreeModel<Spatial> general = fast;
+    for (auto& b : general.bodies) {
+      axes += b.coordinate_axis >= 0;
+      diagonal += b.central.diagonal && b.central.m > 0;
+      b.coordinate_axis = -1;
+      b.central.diagonal = false;
+    }
+    const int n = fast.dof();
+    VecN q(n);
+    for (int i = 0; i < n; ++i) q[i] = 0.7 * i - 1.1;
+    TreeData<Spatial> a(fast), b(general);
+    positionKinematics(fast, q, a);
+    positionKinematics(general, q, b);
+    for (int i = 0; i < n; ++i) {
+      CHECK((a.X_world[i].E - b.X_world[i].E).norm() < 1e-15);
+      CHECK((a.X_world[i].r - b.X_world[i].r).norm() < 1e-15);
+      CHECK((a.X_up[i].E - b.X_up[i].E).norm() < 1e-15);
+      CHECK((a.S_w[i] - b.S_w[i]).norm() < 1e-15);
+    }
+    Eigen::MatrixXd Ma(n, n), Mb(n, n);
+    crbaWorld(fast, a, Ma);
+    crbaWorld(general, b, Mb);
+    CHECK((Ma - Mb).norm() < 1e-15 * Mb.norm());
+  }
+  // The fast paths were exercised: axes x, y, z (y also on a turned placement), diagonal inertias.
+  CHECK(axes >= 8);
+  CHECK(diagonal >= 3);
+}

@@ -169,3 +169,33 @@ TEST_CASE("plane contact: a compliant table holds the ball at m g / k_e and, und
     CHECK(run.q[1] > kRho - 0.01);
   }
 }
+
+TEST_CASE("plane contact: its row is the contact point's Jacobian rows combined along the normal") {
+  // addDirectionJacobian (one row along d) against addPointJacobian's translation rows, dotted with d:
+  // on a link of a planar arm and on a payload.
+  MechanismModel<Planar> d;
+  d.tree.gravity << 0, 0, -kG;
+  int b = d.tree.addBody(-1, JointType::Revolute, Pos::Zero(), Planar::Transform{}, Planar::inertia(1.0, Pos(0.2, 0), 0.01));
+  b = d.tree.addBody(b, JointType::Revolute, Pos::Zero(), Planar::translation({0.4, 0}), Planar::inertia(0.5, Pos(0.15, 0), 0.005));
+  Payload load;
+  load.mass = 0.3, load.inertia = 1e-3;
+  load.pose0 = {0.4, 0.5, 0.2};
+  d.payloads.push_back(load);
+  d.constraints.push_back(std::make_shared<PlaneContact<Planar>>(BodyRef::link(b), Pos(0.3, 0), Pos(0, 1), rigid()));
+  ConstrainedMechanism<Planar> mech(d);
+  VecN q(5);
+  q << 0.4, -0.9, 0.4, 0.5, 0.2;
+  mech.stage(q);
+  const auto& k = mech.kinematics();
+  const Pos dir = Pos(0.6, -0.8);
+  const Pos p(0.35, 0.25);
+  for (const BodyRef body : {BodyRef::link(1), BodyRef::payload(0)}) {
+    MatN J = MatN::Zero(1, 2), A = MatN::Zero(1, 3), Jr = MatN::Zero(2, 2), Ar = MatN::Zero(2, 3);
+    k.addDirectionJacobian(body, p, dir, -1.0, 0, J, A);
+    k.addPointJacobian(body, p, {false, true, true}, -1.0, 0, Jr, Ar);
+    const MatN Jd = dir.transpose() * Jr, Ad = dir.transpose() * Ar;
+    CHECK((J - Jd).norm() < 1e-15);
+    CHECK((A - Ad).norm() < 1e-15);
+    CHECK(J.norm() + A.norm() > 0.1);  // not trivially zero
+  }
+}
