@@ -37,7 +37,8 @@ void biasForcesWorld(const TreeModel<S>& model, TreeData<S>& data, const VecN& q
     const auto& b = model.bodies[std::size_t(i)];
     const Vec vJ = data.S_w[i] * qd[i];
     data.v_w[i] = b.parent < 0 ? vJ : Vec(data.v_w[b.parent] + vJ);
-    const Vec c = S::crossMotion(data.v_w[i], vJ);
+    // (A root's V_i ×m S_i θ'_i is S_i θ'_i × itself: zero.)
+    const Vec c = b.parent < 0 ? Vec(Vec::Zero()) : S::crossMotion(data.v_w[i], vJ);
     data.a_w[i] = b.parent < 0 ? c : Vec(data.a_w[b.parent] + c);
     if (S::massless(b.inertia)) {
       data.f[i].setZero();

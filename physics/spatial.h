@@ -325,12 +325,10 @@ struct Spatial {
       for (int i = 0; i < 3; ++i) cA[i] = X.r[i] + C.c[i];
       out.Io = C.Ic;
     }
-    const double cc = cA.squaredNorm();
-    for (int i = 0; i < 3; ++i) {
-      for (int j = 0; j < 3; ++j) out.Io(i, j) -= C.m * cA[i] * cA[j];
-      out.Io(i, i) += C.m * cc;
-      out.h[i] = C.m * cA[i];
-    }
+    for (int i = 0; i < 3; ++i) out.h[i] = C.m * cA[i];
+    const double mcc = out.h[0] * cA[0] + out.h[1] * cA[1] + out.h[2] * cA[2];  // m |c_A|²
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j <= i; ++j) out.Io(i, j) = out.Io(j, i) = out.Io(i, j) - out.h[i] * cA[j] + (i == j ? mcc : 0.0);
     return out;
   }
   static Mat inertia(double m, const Pos& c, const Eigen::Matrix3d& Ic) {
