@@ -99,7 +99,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   void velocityStage(const VecN& v);
   // The tree's transforms alone at θ (controller queries), cached like the position stage.
   void treeStage(const VecN& q);
-  Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab);
+  // The solve at a state; without with_qdd, α_c, η and f only (θ'' left unset).
+  Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd = true);
   // Forget every cached stage (the released rows changed).
   void invalidate() { have_position_ = have_velocity_ = have_last_ = false; }
 
@@ -120,7 +121,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
   std::vector<double> tree_angle_;  // planar: each placement's fixed rotation angle
   VecN tree_q_;        // the θ that data_'s transforms are at
   bool have_tree_ = false;
-  VecN last_q_, last_v_, last_tau_;
+  VecN last_tau_;      // the last solve without stabilisation: at the staged (q, v) and this τ
   Solution last_;
   bool have_last_ = false;
   // Unilateral and compliant kinds: which constraints are released, their rows before the release

@@ -127,6 +127,7 @@ template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   const int nn = n();
   const VecN qd = v.head(nn);
+  have_last_ = false;  // the last solve was at other rates
   // Link velocities, each link's velocity-product acceleration and h = Cθ' + G, in world coordinates.
   problem_.h.resize(nn);
   biasForcesWorld(model_.tree, data_, qd, problem_.h);
@@ -176,7 +177,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stage(const VecN& q, const VecN* v) {
 
 template <class S, int Nj, int Nr, int Nl>
 typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, Nj, Nr, Nl>::evaluate(
-    const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
+    const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd) {
   positionStage(q);
   // The velocity stage too is kept: the trace row's solve and the step's first stage share it.
   if (!have_velocity_ || v != staged_v_) velocityStage(v);
@@ -192,7 +193,7 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
   else problem_.stab.resize(0);
   Solution s;
   if (!factored_) s = solveConstrainedBlockLU(problem_);
-  else factor_.solve(problem_, s);
+  else factor_.solve(problem_, s, with_qdd);
   // A compliant contact's η is its force, not the solve's (its row is released).
   if (any_compliant_)
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
@@ -243,7 +244,7 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
   bool any_closed = false;
   for (std::size_t i = 0; i < count; ++i) any_closed = any_closed || (rigid(i) && !released_[i]);
   for (std::size_t pass = 0; any_closed && pass < count; ++pass) {
-    const Solution s = solve(q, v, tau);
+    const Solution s = evaluate(q, v, tau, nullptr, false);  // η alone
     std::size_t worst = count;
     double most = 0.0;
     for (std::size_t i = 0; i < count; ++i)
@@ -262,8 +263,6 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
   Solution s = evaluate(q, v, tau, stab);
   // Kept: the integrator's first stage usually comes back to this state (the trace row's solve).
   if (!stab) {
-    last_q_ = q;
-    last_v_ = v;
     last_tau_ = tau;
     last_ = s;
     have_last_ = true;
@@ -274,8 +273,10 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::accelerations(const VecN& q, const VecN& v, const VecN& tau,
                                                         const VecN* stab, VecN& a) {
-  // The state solve() was last asked about: the same answer (a pure function of q, v, τ).
-  const bool known = !stab && have_last_ && q == last_q_ && v == last_v_ && tau.size() == last_tau_.size() && tau == last_tau_;
+  // The state solve() was last asked about: the same answer (a pure function of q, v, τ). The stages
+  // are still at (q, v): any restaging clears have_last_.
+  const bool known = !stab && have_last_ && have_position_ && have_velocity_ && q == staged_q_ && v == staged_v_ &&
+                     tau.size() == last_tau_.size() && tau == last_tau_;
   const Solution s = known ? last_ : evaluate(q, v, tau, stab);
   a.resize(n() + k());
   a.head(n()) = s.qdd;

@@ -58,9 +58,9 @@ class ConstrainedFactorT {
   }
 
   // The solution at p's right-hand side (τ − h, J'θ', A'v_c, H'w, s, b_c + G_c), with the
-  // configuration last factored. Ht as in p (empty: eq. 2).
+  // configuration last factored. Ht as in p (empty: eq. 2). Without with_qdd: α_c, η, f only.
   template <class Problem, class Solution>
-  void solve(const Problem& p, Solution& s) const {
+  void solve(const Problem& p, Solution& s, bool with_qdd = true) const {
     const int n = this->n(), m = this->m(), k = this->k();  // compile-time where the sizes are fixed
     // y = L⁻¹ (τ − h), and r = J̃ M⁻¹ (τ − h) + H̃ (J'θ' + H'w − A'v_c − s).
     MatRC<Nj, 1> y(n);
@@ -92,6 +92,8 @@ class ConstrainedFactorT {
     }
     if (contacts) s.f.noalias() = p.Ht.transpose() * s.eta;
     else s.f = s.eta;
+    s.ok = true;
+    if (!with_qdd) return;
     // θ'' = M⁻¹ (τ − h − J̃ᵀ η) = L⁻ᵀ D⁻¹ (y − Y η).
     s.qdd.resize(n);
     for (int i = 0; i < n; ++i) {
