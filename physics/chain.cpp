@@ -39,28 +39,44 @@ void TreeData<S>::resize(int n) {
   u.resize(n);
 }
 
-template <class S>
-void positionKinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
+namespace {
+
+// positionKinematics, and with kParentFrames false its world part alone (X_world, S_w).
+template <bool kParentFrames, class S>
+void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
   for (int i = 0; i < model.dof(); ++i) {
     const auto& b = model.bodies[i];
-    data.S_i[i] = b.subspace;
+    if constexpr (kParentFrames) data.S_i[i] = b.subspace;
     if constexpr (S::kDim == 6) {
       // A revolute joint about a coordinate axis: X_world = X_J ∘ (X_tree ∘ X_world,parent) turns two
       // rows, and its world axis is a row of E (spatial.h turnAbout, coordinateAxisInWorld).
       if (b.joint == JointType::Revolute && b.coordinate_axis >= 0) {
         const double c = std::cos(q[i]), s = std::sin(q[i]);
         const int k = b.coordinate_axis;
-        data.X_up[i] = S::turnAbout(k, c, s, b.X_tree);
-        data.X_world[i] = b.parent < 0 ? data.X_up[i] : S::turnAbout(k, c, s, S::compose(b.X_tree, data.X_world[b.parent]));
+        if constexpr (kParentFrames) data.X_up[i] = S::turnAbout(k, c, s, b.X_tree);
+        data.X_world[i] = S::turnAbout(k, c, s, b.parent < 0 ? b.X_tree : S::compose(b.X_tree, data.X_world[b.parent]));
         data.S_w[i] = S::coordinateAxisInWorld(k, data.X_world[i]);
         continue;
       }
     }
     // Joint placement then joint motion: X_up = X_J(θ_i) X_tree.
-    data.X_up[i] = S::compose(S::jointTransform(b.joint == JointType::Revolute, b.axis, q[i]), b.X_tree);
-    data.X_world[i] = b.parent < 0 ? data.X_up[i] : S::compose(data.X_up[i], data.X_world[b.parent]);
-    data.S_w[i] = S::motionInverse(data.X_world[i], data.S_i[i]);
+    const typename S::Transform X_up = S::compose(S::jointTransform(b.joint == JointType::Revolute, b.axis, q[i]), b.X_tree);
+    if constexpr (kParentFrames) data.X_up[i] = X_up;
+    data.X_world[i] = b.parent < 0 ? X_up : S::compose(X_up, data.X_world[b.parent]);
+    data.S_w[i] = S::motionInverse(data.X_world[i], b.subspace);
   }
+}
+
+}  // namespace
+
+template <class S>
+void positionKinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
+  kinematics<true>(model, q, data);
+}
+
+template <class S>
+void worldKinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
+  kinematics<false>(model, q, data);
 }
 
 template <class S>
@@ -277,6 +293,7 @@ double springEnergy(const VecN& k, const VecN& q) {
   template struct TreeData<S>;                                                                    \
   template void forwardKinematics<S>(const TreeModel<S>&, const VecIn&, const VecIn&, TreeData<S>&); \
   template void positionKinematics<S>(const TreeModel<S>&, const VecIn&, TreeData<S>&);           \
+  template void worldKinematics<S>(const TreeModel<S>&, const VecIn&, TreeData<S>&);              \
   template void velocityKinematics<S>(const TreeModel<S>&, const VecIn&, TreeData<S>&);            \
   template void rnea<S>(const TreeModel<S>&, TreeData<S>&, const VecIn&, const VecIn&,             \
                         Eigen::Ref<Eigen::VectorXd>, bool);                                       \

@@ -129,6 +129,10 @@ template <class S>
 void positionKinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data);
 template <class S>
 void velocityKinematics(const TreeModel<S>& model, const VecIn& qd, TreeData<S>& data);
+// The world part of positionKinematics alone: X_world and S_w (what chain_world.h and point
+// positions read; X_up and S_i are left as they were).
+template <class S>
+void worldKinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data);
 
 // Inverse dynamics τ = M θ'' + C θ' + G with gravity (or without, when with_gravity is false).
 // Leaves data.a[i] = each body's acceleration without gravity (at θ'' = 0: its J'θ' bias).

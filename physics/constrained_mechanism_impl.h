@@ -67,10 +67,12 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::positionStage(const VecN& q) {
   // The projection, the trace row and the next step's first stage revisit the same configuration.
   if (have_position_ && q == staged_q_) return;
   const int nn = n(), kk = k();
-  // Tree transforms and M from CRBA.
-  positionKinematics(model_.tree, q.head(nn), data_);
-  tree_q_ = q.head(nn);
-  have_tree_ = true;
+  // World transforms and joint axes, unless a controller's query just staged the whole tree at θ (the
+  // parent frames are treeStage's, for the body-frame queries).
+  if (!have_tree_ || q.head(nn) != tree_q_) {
+    worldKinematics(model_.tree, q.head(nn), data_);
+    have_tree_ = false;
+  }
   have_velocity_ = false;
   // M from world composite inertias; the world inertias stay for the velocity stage.
   problem_.M.resize(nn, nn);

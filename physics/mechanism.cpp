@@ -172,6 +172,17 @@ typename S::Vec MechanismKinematics<S>::pointBias(const BodyRef& b, const Pos& p
   return Vec::Zero();
 }
 
+template <class S>
+double MechanismKinematics<S>::directionBias(const BodyRef& b, const Pos& p_world, const Pos& d) const {
+  if (b.kind == BodyRef::Kind::Link) {
+    // pointBias's link case, only its linear rows along d.
+    const std::size_t i = std::size_t(b.index);
+    const typename S::Transform X_pw = S::translation(p_world);
+    return d.dot(S::linear(S::classicalAcceleration(S::motion(X_pw, tree->a_w[i]), S::motion(X_pw, tree->v_w[i]))));
+  }
+  return d.dot(S::linear(pointBias(b, p_world)));
+}
+
 template struct MechanismModel<Planar>;
 template struct MechanismModel<Spatial>;
 template struct MechanismKinematics<Planar>;

@@ -198,6 +198,8 @@ struct MechanismKinematics {
   // share of body b (velocity stage required).
   // With `velocity`, also that frame's spatial velocity (pointVelocity), computed on the way.
   Vec pointBias(const BodyRef& b, const Pos& p_world, Vec* velocity = nullptr) const;
+  // d · pointBias's linear rows (a classical acceleration's component along world direction d).
+  double directionBias(const BodyRef& b, const Pos& p_world, const Pos& d) const;
   // The full spatial velocity of that frame (velocity stage required).
   Vec pointVelocity(const BodyRef& b, const Pos& p_world) const;
 };

@@ -46,7 +46,7 @@ void PlaneContact<S>::position(const MechanismKinematics<S>& k, int row, VecN& p
 
 template <class S>
 void PlaneContact<S>::bias(const MechanismKinematics<S>& k, int row, VecN& b) const {
-  b[row] = -normal_.dot(S::linear(k.pointBias(body_, k.position(body_, centre_b_))));
+  b[row] = -k.directionBias(body_, k.position(body_, centre_b_), normal_);
 }
 
 template <class S>
