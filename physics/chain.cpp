@@ -112,7 +112,7 @@ void rnea(const TreeModel<S>& model, TreeData<S>& data, const VecIn& qd, const V
     const auto& b = model.bodies[i];
     data.a[i] = (b.parent < 0 ? typename S::Vec(data.S_i[i] * qdd[i]) : typename S::Vec(S::motion(data.X_up[i], data.a[b.parent]) + data.S_i[i] * qdd[i])) + data.c[i];
     // A massless body (a carrier: zero mass and rotational inertia) needs no force of its own.
-    if (S::massless(b.inertia)) {
+    if (b.massless) {
       data.f[i].setZero();
       continue;
     }

@@ -79,6 +79,7 @@ struct TreeModel {
     typename S::Central central{};
     // Spatial: 0, 1 or 2 when the axis is that coordinate axis (set by addBody), else −1.
     int coordinate_axis = -1;
+    bool massless = false;           // zero inertia: a carrier (set by addBody)
   };
   std::vector<Body> bodies;
   Vec gravity = Vec::Zero();         // spatial acceleration of gravity in world coordinates
@@ -91,6 +92,7 @@ struct TreeModel {
     else bodies.push_back({parent, joint, axis, X_tree, inertia});
     bodies.back().subspace = motionSubspace(int(bodies.size()) - 1);
     bodies.back().central = S::central(inertia);
+    bodies.back().massless = S::massless(inertia);
     if constexpr (S::kDim == 6)
       for (int k = 0; k < 3; ++k)
         if (bodies.back().axis == S::Axis::Unit(k)) bodies.back().coordinate_axis = k;

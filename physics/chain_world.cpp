@@ -11,7 +11,7 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::M
   if constexpr (S::kDim == 3) zero.setZero();
   for (int i = 0; i < n; ++i) {
     const auto& b = model.bodies[std::size_t(i)];
-    if (S::massless(b.inertia)) data.I_w[i] = data.Ic_rb[i] = zero;
+    if (b.massless) data.I_w[i] = data.Ic_rb[i] = zero;
     else if constexpr (S::kDim == 6) data.I_w[i] = data.Ic_rb[i] = S::inertiaInParent(data.X_world[i], b.central);  // from the centre of mass
     else data.I_w[i] = data.Ic_rb[i] = S::inertiaInParent(data.X_world[i], b.inertia);
   }
@@ -40,7 +40,7 @@ void biasForcesWorld(const TreeModel<S>& model, TreeData<S>& data, const VecN& q
     // (A root's V_i ×m S_i θ'_i is S_i θ'_i × itself: zero.)
     const Vec c = b.parent < 0 ? Vec(Vec::Zero()) : S::crossMotion(data.v_w[i], vJ);
     data.a_w[i] = b.parent < 0 ? c : Vec(data.a_w[b.parent] + c);
-    if (S::massless(b.inertia)) {
+    if (b.massless) {
       data.f[i].setZero();
       continue;
     }

@@ -95,7 +95,12 @@ class ConstrainedMechanism : public ConstrainedSystem {
   void stage(const VecN& q, const VecN* v = nullptr);
 
  protected:
-  void positionStage(const VecN& q);
+  // The projection, the trace row and the next step's first stage revisit the same configuration:
+  // checked here, inline, so that a revisit costs a comparison.
+  void positionStage(const VecN& q) {
+    if (!have_position_ || q != staged_q_) stagePosition(q);
+  }
+  void stagePosition(const VecN& q);
   void velocityStage(const VecN& v);
   // The tree's transforms alone at θ (controller queries), cached like the position stage.
   void treeStage(const VecN& q);

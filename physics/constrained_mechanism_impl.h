@@ -63,9 +63,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
 }
 
 template <class S, int Nj, int Nr, int Nl>
-void ConstrainedMechanism<S, Nj, Nr, Nl>::positionStage(const VecN& q) {
-  // The projection, the trace row and the next step's first stage revisit the same configuration.
-  if (have_position_ && q == staged_q_) return;
+void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   const int nn = n(), kk = k();
   // World transforms and joint axes, unless a controller's query just staged the whole tree at θ (the
   // parent frames are treeStage's, for the body-frame queries).

@@ -306,8 +306,7 @@ struct Spatial {
   // (Eᵀ I_c E, symmetric: six entries), then about A's origin, I_O = Eᵀ I_c E + m(|c_A|² 1 − c_A c_Aᵀ), h = m c_A:
   // one rotation, no cross terms in h (cheaper than transforming the origin form).
   DYN_INLINE static Inertia inertiaInParent(const Transform& X, const Central& C) {
-    Inertia out;
-    out.m = C.m;
+    Inertia out{C.m, Pos(), Eigen::Matrix3d()};  // every entry is set below
     Pos cA;
     double B[3][3];  // I_c E
     if (X.turned) {
@@ -363,7 +362,7 @@ struct Spatial {
   // a transform: X_J ∘ X = {E_J E, r}. E_J mixes two rows of E (i = k+1, j = k+2 mod 3):
   //   row i ← c E_i + s E_j,  row j ← c E_j − s E_i,  row k unchanged  (12 products, not a full 27).
   DYN_INLINE static Transform turnAbout(int k, double c, double s, const Transform& X) {
-    const int i = (k + 1) % 3, j = (k + 2) % 3;
+    const int i = k == 2 ? 0 : k + 1, j = i == 2 ? 0 : i + 1;
     Transform out{X.E, X.r, true};
     if (!X.turned) {  // E_J itself
       out.E.setZero();
