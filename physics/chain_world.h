@@ -15,7 +15,7 @@
 
 namespace dyn {
 
-// M(θ) (into M, sized n × n by the caller), after positionKinematics; leaves I_i^w of every body in
+// M(θ) (into M, sized n × n by the caller), after positionKinematics (or worldKinematics); leaves I_i^w of every body in
 // data.I_w (zero for massless ones).
 template <class S>
 void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M);
