@@ -15,8 +15,8 @@
 
 namespace dyn {
 
-// M(θ) (into M, sized n × n by the caller), after positionKinematics (or worldKinematics); leaves I_i^w of every body in
-// data.I_w (zero for massless ones).
+// M(θ) (into M, sized n × n by the caller), after positionKinematics (or worldKinematics); leaves
+// I_i^w of every body in data.I_w (zero for massless ones).
 template <class S>
 void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::MatrixXd> M);
 // h = C θ' + G (into h, sized n by the caller), leaving data.v_w and data.a_w; after crbaWorld.
