@@ -16,6 +16,15 @@ Eigen::Vector3d shiftPlanar(const Eigen::Vector2d& r, const Eigen::Vector3d& v) 
   return {v[0], v[1] - v[0] * r.y(), v[2] + v[0] * r.x()};
 }
 
+// Each free coordinate of a planar payload at pose x (its columns from `col` on): f(column, Φ(p − c) e_c),
+// the velocity at world point p that the coordinate's unit rate gives.
+template <class F>
+void payloadColumns(const Payload& pl, const Eigen::Vector3d& x, int col, const Eigen::Vector2d& p, F&& f) {
+  const Eigen::Vector2d r(p.x() - x[1], p.y() - x[2]);
+  for (int c = 0; c < 3; ++c)
+    if (pl.free[std::size_t(c)]) f(col++, shiftPlanar(r, Eigen::Vector3d::Unit(c)));
+}
+
 }  // namespace
 
 template <class S>
@@ -96,17 +105,11 @@ void MechanismKinematics<S>::addPointJacobian(const BodyRef& b, const Pos& p_wor
   } else if (b.kind == BodyRef::Kind::Payload) {
     if constexpr (S::kDim == 3) {
       // Φ(p − c) on the payload's free coordinates; A enters with the opposite sign (J θ' − A v_c).
-      const Payload& pl = model->payloads[std::size_t(b.index)];
-      const Eigen::Vector3d& x = payload_pose[std::size_t(b.index)];
-      const Eigen::Vector2d r(p_world.x() - x[1], p_world.y() - x[2]);
-      int col = model->payloadOffset(b.index);
-      for (int c = 0; c < 3; ++c) {
-        if (!pl.free[std::size_t(c)]) continue;
-        const Eigen::Vector3d phi_c = shiftPlanar(r, Eigen::Vector3d::Unit(c));
-        for (int i = 0, out = row; i < 3; ++i)
-          if (rows[std::size_t(i)]) A(out++, col) -= sign * phi_c[i];
-        ++col;
-      }
+      payloadColumns(model->payloads[std::size_t(b.index)], payload_pose[std::size_t(b.index)], model->payloadOffset(b.index), p_world,
+                     [&](int col, const Eigen::Vector3d& phi_c) {
+                       for (int i = 0, out = row; i < 3; ++i)
+                         if (rows[std::size_t(i)]) A(out++, col) -= sign * phi_c[i];
+                     });
     }
   }
 }
@@ -122,15 +125,8 @@ void MechanismKinematics<S>::addDirectionJacobian(const BodyRef& b, const Pos& p
   } else if (b.kind == BodyRef::Kind::Payload) {
     if constexpr (S::kDim == 3) {
       // d · the linear rows of Φ(p − c), on the payload's free coordinates.
-      const Payload& pl = model->payloads[std::size_t(b.index)];
-      const Eigen::Vector3d& x = payload_pose[std::size_t(b.index)];
-      const Eigen::Vector2d r(p_world.x() - x[1], p_world.y() - x[2]);
-      int col = model->payloadOffset(b.index);
-      for (int c = 0; c < 3; ++c) {
-        if (!pl.free[std::size_t(c)]) continue;
-        const Eigen::Vector3d phi_c = shiftPlanar(r, Eigen::Vector3d::Unit(c));
-        A(row, col++) -= sign * (d.x() * phi_c[1] + d.y() * phi_c[2]);
-      }
+      payloadColumns(model->payloads[std::size_t(b.index)], payload_pose[std::size_t(b.index)], model->payloadOffset(b.index), p_world,
+                     [&](int col, const Eigen::Vector3d& phi_c) { A(row, col) -= sign * (d.x() * phi_c[1] + d.y() * phi_c[2]); });
     }
   }
 }
