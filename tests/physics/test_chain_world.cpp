@@ -120,6 +120,14 @@ TEST_CASE("fast paths equal the general ones: joints about coordinate axes, diag
       CHECK((a.X_up[i].E - b.X_up[i].E).norm() < 1e-15);
       CHECK((a.S_w[i] - b.S_w[i]).norm() < 1e-15);
     }
+    // The mechanism's position stage computes the world part alone: the same numbers, bit for bit.
+    TreeData<Spatial> w(fast);
+    worldKinematics(fast, q, w);
+    for (int i = 0; i < n; ++i) {
+      CHECK(w.X_world[i].E == a.X_world[i].E);
+      CHECK(w.X_world[i].r == a.X_world[i].r);
+      CHECK(w.S_w[i] == a.S_w[i]);
+    }
     Eigen::MatrixXd Ma(n, n), Mb(n, n);
     crbaWorld(fast, a, Ma);
     crbaWorld(general, b, Mb);
