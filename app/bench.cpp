@@ -42,41 +42,80 @@ double clockOverhead() {
 
 namespace {
 
-// Median wall times, µs, over `steps` steps of fresh runs (restarted when one ends), less the clock
-// reads' own cost (clockOverhead), on both engines alike.
+// Wall times per step, µs, less the clock reads' own cost (clockOverhead), on every engine alike.
 struct StepTimes {
-  double full = 0;    // Simulation::step: controller, trace row, engine
-  double engine = 0;  // Simulation::advanceEngine after each (untimed) step: the engine alone
+  double full = 0;    // median Simulation::step: controller, trace row, engine
+  double engine = 0;  // median Simulation::advanceEngine after each (untimed) step: the engine alone
   bool has_engine = false;
+  std::vector<double> full_blocks, engine_blocks;  // the same medians, block by block
 };
 
-StepTimes stepMicros(const Lab& lab, Engine engine, int steps) {
+// The runs compared, timed in turn in short blocks (hand, Bullet, hand, ... 50 steps each): this
+// machine's clock speed wanders by half within milliseconds (a fixed chain of multiply-adds takes 0.83
+// to 1.26 µs from one 2 ms block to the next), so engines timed one after the other would each catch
+// their own phase and their ratio would move by ±10 % from run to run. Blocks keep each engine's data
+// in cache (one step each in turn would time the hand step after Bullet's had evicted it).
+struct TimedRun {
+  const Lab* lab;
+  Engine engine;
+};
+constexpr int kBlock = 50;
+
+std::vector<StepTimes> stepMicros(const std::vector<TimedRun>& runs, int steps) {
   using Micros = std::chrono::duration<double, std::micro>;
-  std::vector<double> row, full, alone;
+  const std::size_t count = runs.size();
+  std::vector<double> row;
+  std::vector<StepTimes> out(count);
+  std::vector<std::vector<double>> full(count), alone(count);
   const double clock = clockOverhead();
-  full.reserve(std::size_t(steps));
-  alone.reserve(std::size_t(steps));
-  auto sim = lab.simulate(engine);
-  for (int k = 0; k < steps; ++k) {
-    const auto t0 = Clock::now();
-    const bool stepped = sim->step(row);
-    const double t = Micros(Clock::now() - t0).count() - clock;
-    if (stepped) full.push_back(t);
-    else sim = lab.simulate(engine);  // wrap around short runs
-  }
-  // The engine alone: every other step, with the torque of the step before held (500 Hz control).
-  sim = lab.simulate(engine);
-  for (int k = 0; k < steps; ++k) {
-    if (!sim->step(row)) {
-      sim = lab.simulate(engine);
-      continue;
+  std::vector<std::unique_ptr<Simulation>> sims;
+  auto restart = [&](std::size_t i) { sims[i] = runs[i].lab->simulate(runs[i].engine); };
+  for (const TimedRun& r : runs) sims.push_back(r.lab->simulate(r.engine));
+  // One block of run i: the full step, or the engine alone every other step with the torque of the
+  // step before held (500 Hz control). Short runs wrap around.
+  auto block = [&](std::size_t i, bool engine_alone, std::vector<double>& all) {
+    std::vector<double> times;
+    for (int k = 0; k < kBlock; ++k) {
+      if (engine_alone) {
+        if (!sims[i]->step(row)) {
+          restart(i);
+          continue;
+        }
+        const auto t0 = Clock::now();
+        const bool advanced = sims[i]->advanceEngine();
+        const double t = Micros(Clock::now() - t0).count() - clock;
+        if (advanced) times.push_back(t);
+      } else {
+        const auto t0 = Clock::now();
+        const bool stepped = sims[i]->step(row);
+        const double t = Micros(Clock::now() - t0).count() - clock;
+        if (stepped) times.push_back(t);
+        else restart(i);
+      }
     }
-    const auto t0 = Clock::now();
-    const bool advanced = sim->advanceEngine();
-    const double t = Micros(Clock::now() - t0).count() - clock;
-    if (advanced) alone.push_back(t);
+    all.insert(all.end(), times.begin(), times.end());
+    return median(times);
+  };
+  const int rounds = std::max(1, steps / kBlock);
+  for (int r = 0; r < rounds; ++r)
+    for (std::size_t i = 0; i < count; ++i) out[i].full_blocks.push_back(block(i, false, full[i]));
+  for (std::size_t i = 0; i < count; ++i) restart(i);
+  for (int r = 0; r < rounds; ++r)
+    for (std::size_t i = 0; i < count; ++i) out[i].engine_blocks.push_back(block(i, true, alone[i]));
+  for (std::size_t i = 0; i < count; ++i) {
+    out[i].full = median(full[i]);
+    out[i].engine = median(alone[i]);
+    out[i].has_engine = !alone[i].empty();
   }
-  return {median(full), median(alone), !alone.empty()};
+  return out;
+}
+
+// How many times slower `slow` is than `fast`: the median over blocks timed side by side.
+double ratio(const std::vector<double>& slow, const std::vector<double>& fast) {
+  std::vector<double> r;
+  for (std::size_t k = 0; k < slow.size() && k < fast.size(); ++k)
+    if (fast[k] > 0) r.push_back(slow[k] / fast[k]);
+  return median(r);
 }
 
 // Frames per second of draw+read (+ PNG, + video) over `frames` frames of the hand run.
@@ -159,25 +198,30 @@ int bench(const BenchArgs& a) {
       return 2;
     }
     const Lab& lab = *loaded.lab;
-    const StepTimes hand_t = stepMicros(lab, Engine::Hand, a.steps);
-    const StepTimes bullet_t = stepMicros(lab, Engine::Bullet, a.steps);
+    const Variant variant = firstOrderVariant(loaded);
+    const std::unique_ptr<Lab>& first_order = variant.lab;
+    const std::string& first_scheme = variant.scheme;
+    const std::string scheme = schemeOf(loaded.config, loaded.config_file);
+    // Every engine timed in the same stretch of time, in turn (stepMicros).
+    std::vector<TimedRun> runs{{&lab, Engine::Hand}, {&lab, Engine::Bullet}};
+    if (first_order) runs.push_back({first_order.get(), Engine::Hand});
+    const std::vector<StepTimes> times = stepMicros(runs, a.steps);
+    const StepTimes hand_t = times[0], bullet_t = times[1];
+    const StepTimes first_t = first_order ? times[2] : StepTimes{};
     // The headline compares the engines alone, when the lab offers it.
     const bool alone = hand_t.has_engine && bullet_t.has_engine;
     const double hand = alone ? hand_t.engine : hand_t.full, bullet = alone ? bullet_t.engine : bullet_t.full;
     // Speed with accuracy: errors of whole runs against the configured hand run.
     const RunResult reference = runEngine(lab, Engine::Hand);
     const json bullet_error = errorAgainst(lab, runEngine(lab, Engine::Bullet).trace, reference.trace);
-    const Variant variant = firstOrderVariant(loaded);
-    const std::unique_ptr<Lab>& first_order = variant.lab;
-    const std::string& first_scheme = variant.scheme;
-    const std::string scheme = schemeOf(loaded.config, loaded.config_file);
-    StepTimes first_t;
     json first_error;
-    if (first_order) {
-      first_t = stepMicros(*first_order, Engine::Hand, a.steps);
-      first_error = errorAgainst(lab, runEngine(*first_order, Engine::Hand).trace, reference.trace);
-    }
+    if (first_order) first_error = errorAgainst(lab, runEngine(*first_order, Engine::Hand).trace, reference.trace);
     const double first_us = first_t.has_engine ? first_t.engine : first_t.full;
+    // Ratios from the blocks timed side by side (stepMicros), not from the overall medians.
+    auto blocks = [&](const StepTimes& t) { return alone ? t.engine_blocks : t.full_blocks; };
+    const double speedup = ratio(blocks(bullet_t), blocks(hand_t));
+    const double speedup_full = ratio(bullet_t.full_blocks, hand_t.full_blocks);
+    const double speedup_first = first_order ? ratio(blocks(bullet_t), first_t.has_engine ? first_t.engine_blocks : first_t.full_blocks) : 0.0;
     const Fps fps = frameRates(lab, reference.trace, a.frames);
     const json grading = gradeThroughput(entry.name, 5);
     if (a.json) {
@@ -185,10 +229,10 @@ int bench(const BenchArgs& a) {
                   {"step_timed", alone ? "engine" : "full"},
                   {"hand_us_per_step", hand},
                   {"bullet_us_per_step", bullet},
-                  {"bullet_over_hand", bullet / hand},
+                  {"bullet_over_hand", speedup},
                   {"hand_full_us_per_step", hand_t.full},
                   {"bullet_full_us_per_step", bullet_t.full},
-                  {"bullet_over_hand_full", bullet_t.full / hand_t.full},
+                  {"bullet_over_hand_full", speedup_full},
                   {"hand_scheme", scheme},
                   {"bullet_error", bullet_error},
                   {"render_fps", fps.render},
@@ -198,7 +242,7 @@ int bench(const BenchArgs& a) {
       if (first_order) {
         out["hand_first_order_scheme"] = first_scheme;
         out["hand_first_order_us_per_step"] = first_us;
-        out["bullet_over_hand_first_order"] = bullet / first_us;
+        out["bullet_over_hand_first_order"] = speedup_first;
         out["hand_first_order_error"] = first_error;
       }
       for (const auto& [k, v] : grading.items()) out[k] = v;
@@ -207,14 +251,14 @@ int bench(const BenchArgs& a) {
       std::printf("%s\n", entry.name.c_str());
       if (alone)
         std::printf("  engine step     hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median; advance one dt, control held)\n",
-                    hand, bullet, bullet / hand);
+                    hand, bullet, speedup);
       std::printf("  full step       hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median; + controller, trace row)\n",
-                  hand_t.full, bullet_t.full, bullet_t.full / hand_t.full);
+                  hand_t.full, bullet_t.full, speedup_full);
       std::printf("  speed and error of whole runs against the reference (hand, %s, dt %g s):\n", scheme.c_str(), lab.dt());
       std::printf("    hand   %-34s %6.2f µs   reference\n", scheme.c_str(), hand);
       if (first_order)
         std::printf("    hand   %-34s %6.2f µs   Bullet/hand %.1fx   %s\n", first_scheme.c_str(), first_us,
-                    bullet / first_us, describeAgreement(lab, first_error).c_str());
+                    speedup_first, describeAgreement(lab, first_error).c_str());
       std::printf("    %-41s %6.2f µs                      %s\n", lab.referenceEngine().c_str(), bullet,
                   describeAgreement(lab, bullet_error).c_str());
       std::printf("  640x480 fps     render %.0f   +PNG %.0f   +video %.0f\n", fps.render, fps.png, fps.video);
