@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <string>
 
 #include "app/bench.h"
 #include "app/commands.h"
@@ -110,12 +111,18 @@ std::vector<StepTimes> stepMicros(const std::vector<TimedRun>& runs, int steps) 
   return out;
 }
 
-// How many times slower `slow` is than `fast`: the median over blocks timed side by side.
-double ratio(const std::vector<double>& slow, const std::vector<double>& fast) {
+// How many times slower `slow` is than `fast`, block by block (timed side by side): the median, and
+// the middle half of the blocks' ratios (how much the measurement itself moves).
+struct Ratio {
+  double median = 0, low = 0, high = 0;  // median, 25th and 75th percentiles
+};
+Ratio ratio(const std::vector<double>& slow, const std::vector<double>& fast) {
   std::vector<double> r;
   for (std::size_t k = 0; k < slow.size() && k < fast.size(); ++k)
     if (fast[k] > 0) r.push_back(slow[k] / fast[k]);
-  return median(r);
+  if (r.empty()) return {};
+  std::sort(r.begin(), r.end());
+  return {r[r.size() / 2], r[r.size() / 4], r[(3 * r.size()) / 4]};
 }
 
 // Frames per second of draw+read (+ PNG, + video) over `frames` frames of the hand run.
@@ -219,9 +226,9 @@ int bench(const BenchArgs& a) {
     const double first_us = first_t.has_engine ? first_t.engine : first_t.full;
     // Ratios from the blocks timed side by side (stepMicros), not from the overall medians.
     auto blocks = [&](const StepTimes& t) { return alone ? t.engine_blocks : t.full_blocks; };
-    const double speedup = ratio(blocks(bullet_t), blocks(hand_t));
-    const double speedup_full = ratio(bullet_t.full_blocks, hand_t.full_blocks);
-    const double speedup_first = first_order ? ratio(blocks(bullet_t), first_t.has_engine ? first_t.engine_blocks : first_t.full_blocks) : 0.0;
+    const Ratio speedup = ratio(blocks(bullet_t), blocks(hand_t));
+    const Ratio speedup_full = ratio(bullet_t.full_blocks, hand_t.full_blocks);
+    const Ratio speedup_first = first_order ? ratio(blocks(bullet_t), first_t.has_engine ? first_t.engine_blocks : first_t.full_blocks) : Ratio{};
     const Fps fps = frameRates(lab, reference.trace, a.frames);
     const json grading = gradeThroughput(entry.name, 5);
     if (a.json) {
@@ -229,10 +236,11 @@ int bench(const BenchArgs& a) {
                   {"step_timed", alone ? "engine" : "full"},
                   {"hand_us_per_step", hand},
                   {"bullet_us_per_step", bullet},
-                  {"bullet_over_hand", speedup},
+                  {"bullet_over_hand", speedup.median},
+                  {"bullet_over_hand_quartiles", {speedup.low, speedup.high}},
                   {"hand_full_us_per_step", hand_t.full},
                   {"bullet_full_us_per_step", bullet_t.full},
-                  {"bullet_over_hand_full", speedup_full},
+                  {"bullet_over_hand_full", speedup_full.median},
                   {"hand_scheme", scheme},
                   {"bullet_error", bullet_error},
                   {"render_fps", fps.render},
@@ -242,7 +250,8 @@ int bench(const BenchArgs& a) {
       if (first_order) {
         out["hand_first_order_scheme"] = first_scheme;
         out["hand_first_order_us_per_step"] = first_us;
-        out["bullet_over_hand_first_order"] = speedup_first;
+        out["bullet_over_hand_first_order"] = speedup_first.median;
+        out["bullet_over_hand_first_order_quartiles"] = {speedup_first.low, speedup_first.high};
         out["hand_first_order_error"] = first_error;
       }
       for (const auto& [k, v] : grading.items()) out[k] = v;
@@ -251,15 +260,21 @@ int bench(const BenchArgs& a) {
       std::printf("%s\n", entry.name.c_str());
       if (alone)
         std::printf("  engine step     hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median; advance one dt, control held)\n",
-                    hand, bullet, speedup);
+                    hand, bullet, speedup.median);
       std::printf("  full step       hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median; + controller, trace row)\n",
-                  hand_t.full, bullet_t.full, speedup_full);
+                  hand_t.full, bullet_t.full, speedup_full.median);
       std::printf("  speed and error of whole runs against the reference (hand, %s, dt %g s):\n", scheme.c_str(), lab.dt());
       std::printf("    hand   %-34s %6.2f µs   reference\n", scheme.c_str(), hand);
+      // The first-order ratio with the middle half of its blocks; the Bullet line's errors aligned under it.
+      char ratio_text[96] = "";
       if (first_order)
-        std::printf("    hand   %-34s %6.2f µs   Bullet/hand %.1fx   %s\n", first_scheme.c_str(), first_us,
-                    speedup_first, describeAgreement(lab, first_error).c_str());
-      std::printf("    %-41s %6.2f µs                      %s\n", lab.referenceEngine().c_str(), bullet,
+        std::snprintf(ratio_text, sizeof ratio_text, "Bullet/hand %.1fx (blocks %.1f–%.1f)", speedup_first.median, speedup_first.low,
+                      speedup_first.high);
+      if (first_order)
+        std::printf("    hand   %-34s %6.2f µs   %s   %s\n", first_scheme.c_str(), first_us, ratio_text,
+                    describeAgreement(lab, first_error).c_str());
+      const int pad = int(std::string(ratio_text).size()) - 2;  // "–" is 3 bytes, 1 column
+      std::printf("    %-41s %6.2f µs   %*s   %s\n", lab.referenceEngine().c_str(), bullet, std::max(pad, 0), "",
                   describeAgreement(lab, bullet_error).c_str());
       std::printf("  640x480 fps     render %.0f   +PNG %.0f   +video %.0f\n", fps.render, fps.png, fps.video);
       if (!grading.empty())
