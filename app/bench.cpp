@@ -225,10 +225,10 @@ int bench(const BenchArgs& a) {
     if (first_order) first_error = errorAgainst(lab, runEngine(*first_order, Engine::Hand).trace, reference.trace);
     const double first_us = first_t.has_engine ? first_t.engine : first_t.full;
     // Ratios from the blocks timed side by side (stepMicros), not from the overall medians.
-    auto blocks = [&](const StepTimes& t) { return alone ? t.engine_blocks : t.full_blocks; };
+    auto blocks = [&](const StepTimes& t) -> const std::vector<double>& { return alone ? t.engine_blocks : t.full_blocks; };
     const Ratio speedup = ratio(blocks(bullet_t), blocks(hand_t));
     const Ratio speedup_full = ratio(bullet_t.full_blocks, hand_t.full_blocks);
-    const Ratio speedup_first = first_order ? ratio(blocks(bullet_t), first_t.has_engine ? first_t.engine_blocks : first_t.full_blocks) : Ratio{};
+    const Ratio speedup_first = first_order ? ratio(blocks(bullet_t), blocks(first_t)) : Ratio{};
     const Fps fps = frameRates(lab, reference.trace, a.frames);
     const json grading = gradeThroughput(entry.name, 5);
     if (a.json) {
@@ -267,12 +267,12 @@ int bench(const BenchArgs& a) {
       std::printf("    hand   %-34s %6.2f µs   reference\n", scheme.c_str(), hand);
       // The first-order ratio with the middle half of its blocks; the Bullet line's errors aligned under it.
       char ratio_text[96] = "";
-      if (first_order)
+      if (first_order) {
         std::snprintf(ratio_text, sizeof ratio_text, "Bullet/hand %.1fx (blocks %.1f–%.1f)", speedup_first.median, speedup_first.low,
                       speedup_first.high);
-      if (first_order)
         std::printf("    hand   %-34s %6.2f µs   %s   %s\n", first_scheme.c_str(), first_us, ratio_text,
                     describeAgreement(lab, first_error).c_str());
+      }
       const int pad = int(std::string(ratio_text).size()) - 2;  // "–" is 3 bytes, 1 column
       std::printf("    %-41s %6.2f µs   %*s   %s\n", lab.referenceEngine().c_str(), bullet, std::max(pad, 0), "",
                   describeAgreement(lab, bullet_error).c_str());
