@@ -53,9 +53,9 @@ void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
       if (b.joint == JointType::Revolute && b.coordinate_axis >= 0) {
         const double c = std::cos(q[i]), s = std::sin(q[i]);
         const int k = b.coordinate_axis;
-        if constexpr (kParentFrames) data.X_up[i] = S::turnAbout(k, c, s, b.X_tree);
-        data.X_world[i] = S::turnAbout(k, c, s, b.parent < 0 ? b.X_tree : S::compose(b.X_tree, data.X_world[b.parent]));
-        data.S_w[i] = S::coordinateAxisInWorld(k, data.X_world[i]);
+        if constexpr (kParentFrames) S::turnAbout(k, c, s, b.X_tree, nullptr, data.X_up[i]);
+        S::turnAbout(k, c, s, b.X_tree, b.parent < 0 ? nullptr : &data.X_world[b.parent], data.X_world[i]);
+        S::coordinateAxisInWorld(k, data.X_world[i], data.S_w[i]);
         continue;
       }
     }

@@ -358,31 +358,50 @@ struct Spatial {
     E(2, 0) = t * x * z + s * y, E(2, 1) = t * y * z - s * x, E(2, 2) = c + t * z * z;
     return {E, Pos::Zero(), true};
   }
-  // A turn about coordinate axis k (Featherstone's Rx, Ry, Rz: most joints), E_J = R_k(q)ᵀ, applied to
-  // a transform: X_J ∘ X = {E_J E, r}. E_J mixes two rows of E (i = k+1, j = k+2 mod 3):
+  // A joint turning about coordinate axis k (Featherstone's Rx, Ry, Rz: most joints) after its
+  // placement: out = X_J ∘ X_tree ∘ P, P the parent's world transform (null at the root), E_J = R_k(q)ᵀ.
+  // E_J mixes two rows of E (i = k+1, j = k+2 mod 3):
   //   row i ← c E_i + s E_j,  row j ← c E_j − s E_i,  row k unchanged  (12 products, not a full 27).
-  DYN_INLINE static Transform turnAbout(int k, double c, double s, const Transform& X) {
+  // Written entry by entry into out: a Transform built on the stack and then copied whole is reloaded
+  // 16 bytes at a time from its 8-byte stores, which stalls on store forwarding (a tenth of the step).
+  DYN_INLINE static void turnAbout(int k, double c, double s, const Transform& X_tree, const Transform* P, Transform& out) {
     const int i = k == 2 ? 0 : k + 1, j = i == 2 ? 0 : i + 1;
-    Transform out{X.E, X.r, true};
-    if (!X.turned) {  // E_J itself
-      out.E.setZero();
+    // X_tree ∘ P = {E_tree E_P, r_P + E_Pᵀ r_tree}.
+    double E[3][3], r[3];
+    bool turned = X_tree.turned;
+    if (!P) {
+      for (int a = 0; a < 3; ++a) {
+        r[a] = X_tree.r[a];
+        for (int b = 0; b < 3; ++b) E[a][b] = X_tree.E(a, b);
+      }
+    } else {
+      for (int a = 0; a < 3; ++a)
+        r[a] = P->r[a] + (P->turned ? P->E(0, a) * X_tree.r[0] + P->E(1, a) * X_tree.r[1] + P->E(2, a) * X_tree.r[2] : X_tree.r[a]);
+      const Transform& F = X_tree.turned ? X_tree : *P;  // the one that turns, if only one does
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+          E[a][b] = X_tree.turned && P->turned ? X_tree.E(a, 0) * P->E(0, b) + X_tree.E(a, 1) * P->E(1, b) + X_tree.E(a, 2) * P->E(2, b) : F.E(a, b);
+      turned = X_tree.turned || P->turned;
+    }
+    for (int a = 0; a < 3; ++a) out.r[a] = r[a];
+    out.turned = true;
+    if (!turned) {  // E_J itself
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) out.E(a, b) = 0.0;
       out.E(i, i) = out.E(j, j) = c, out.E(i, j) = s, out.E(j, i) = -s, out.E(k, k) = 1.0;
-      return out;
+      return;
     }
     for (int col = 0; col < 3; ++col) {
-      const double ei = out.E(i, col), ej = out.E(j, col);
-      out.E(i, col) = c * ei + s * ej;
-      out.E(j, col) = c * ej - s * ei;
+      out.E(i, col) = c * E[i][col] + s * E[j][col];
+      out.E(j, col) = c * E[j][col] - s * E[i][col];
+      out.E(k, col) = E[k][col];
     }
-    return out;
   }
   // The axis of a revolute joint about coordinate axis k of a body at X_world, in world coordinates
-  // at the origin: X⁻¹ (e_k, 0) = (E_kᵀ, r × E_kᵀ) (E_k: row k of E).
-  DYN_INLINE static Vec coordinateAxisInWorld(int k, const Transform& X) {
-    Vec out;
+  // at the origin: X⁻¹ (e_k, 0) = (E_kᵀ, r × E_kᵀ) (E_k: row k of E), into out.
+  DYN_INLINE static void coordinateAxisInWorld(int k, const Transform& X, Vec& out) {
     for (int c = 0; c < 3; ++c) out[c] = X.turned ? X.E(k, c) : (c == k ? 1.0 : 0.0);
     cross3(X.r.data(), out.data(), out.data() + 3);
-    return out;
   }
   DYN_INLINE static Vec classicalAcceleration(const Vec& a, const Vec& v) {
     Vec out;
