@@ -366,7 +366,8 @@ struct Spatial {
   // 16 bytes at a time from its 8-byte stores, which stalls on store forwarding (a tenth of the step).
   DYN_INLINE static void turnAbout(int k, double c, double s, const Transform& X_tree, const Transform* P, Transform& out) {
     const int i = k == 2 ? 0 : k + 1, j = i == 2 ? 0 : i + 1;
-    // X_tree ∘ P = {E_tree E_P, r_P + E_Pᵀ r_tree}.
+    // X_tree ∘ P = {E_tree E_P, r_P + E_Pᵀ r_tree}, summed as Eigen's products sum (x0 + (x1 + x2)): the
+    // same bits as compose().
     double E[3][3], r[3];
     bool turned = X_tree.turned;
     if (!P) {
@@ -376,11 +377,11 @@ struct Spatial {
       }
     } else {
       for (int a = 0; a < 3; ++a)
-        r[a] = P->r[a] + (P->turned ? P->E(0, a) * X_tree.r[0] + P->E(1, a) * X_tree.r[1] + P->E(2, a) * X_tree.r[2] : X_tree.r[a]);
+        r[a] = P->r[a] + (P->turned ? P->E(0, a) * X_tree.r[0] + (P->E(1, a) * X_tree.r[1] + P->E(2, a) * X_tree.r[2]) : X_tree.r[a]);
       const Transform& F = X_tree.turned ? X_tree : *P;  // the one that turns, if only one does
       for (int a = 0; a < 3; ++a)
         for (int b = 0; b < 3; ++b)
-          E[a][b] = X_tree.turned && P->turned ? X_tree.E(a, 0) * P->E(0, b) + X_tree.E(a, 1) * P->E(1, b) + X_tree.E(a, 2) * P->E(2, b) : F.E(a, b);
+          E[a][b] = X_tree.turned && P->turned ? X_tree.E(a, 0) * P->E(0, b) + (X_tree.E(a, 1) * P->E(1, b) + X_tree.E(a, 2) * P->E(2, b)) : F.E(a, b);
       turned = X_tree.turned || P->turned;
     }
     for (int a = 0; a < 3; ++a) out.r[a] = r[a];

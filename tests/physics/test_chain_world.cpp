@@ -137,3 +137,34 @@ TEST_CASE("fast paths equal the general ones: joints about coordinate axes, diag
   CHECK(axes >= 8);
   CHECK(diagonal >= 3);
 }
+
+TEST_CASE("a coordinate-axis turn written in place has the bits of compose() and the turned rows") {
+  // Spatial::turnAbout writes X_J ∘ X_tree ∘ P entry by entry (no whole-Transform copies): it must
+  // sum in compose()'s order, for turned and unturned placements and parents alike.
+  using Pos = Spatial::Pos;
+  const Spatial::Transform turned{Eigen::AngleAxisd(0.4, Pos(1, 2, 3).normalized()).toRotationMatrix(), Pos(0.1, -0.2, 0.3)};
+  const Spatial::Transform parent{Eigen::AngleAxisd(-1.3, Pos(-2, 1, 0.5).normalized()).toRotationMatrix(), Pos(0.7, 0.3, -0.9)};
+  const Spatial::Transform shifted = Spatial::translation({0.3, -0.1, 0.2}), still = Spatial::marked(Spatial::Transform());
+  int cases = 0;
+  for (const Spatial::Transform& tree : {turned, shifted})
+    for (const Spatial::Transform* P : {&parent, &still, static_cast<const Spatial::Transform*>(nullptr)})
+      for (int k = 0; k < 3; ++k) {
+        const double c = std::cos(0.3 + k), s = std::sin(0.3 + k);
+        const Spatial::Transform X = P ? Spatial::compose(tree, *P) : tree;
+        // E_J mixes rows i = k+1 and j = k+2 of X.E (E_J itself when X does not turn).
+        const int i = (k + 1) % 3, j = (k + 2) % 3;
+        Eigen::Matrix3d E = X.turned ? X.E : Eigen::Matrix3d::Identity();
+        for (int col = 0; col < 3; ++col) {
+          const double ei = E(i, col), ej = E(j, col);
+          E(i, col) = c * ei + s * ej;
+          E(j, col) = c * ej - s * ei;
+        }
+        Spatial::Transform out;
+        Spatial::turnAbout(k, c, s, tree, P, out);
+        CHECK(out.E == E);
+        CHECK(out.r == X.r);
+        CHECK(out.turned);
+        ++cases;
+      }
+  CHECK(cases == 18);
+}
