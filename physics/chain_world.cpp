@@ -12,7 +12,7 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::M
   for (int i = 0; i < n; ++i) {
     const auto& b = model.bodies[std::size_t(i)];
     if (b.massless) data.I_w[i] = data.Ic_rb[i] = zero;
-    else if constexpr (S::kDim == 6) data.I_w[i] = data.Ic_rb[i] = S::inertiaInParent(data.X_world[i], b.central);  // from the centre of mass
+    else if constexpr (S::kDim == 6) S::inertiaInParent(data.X_world[i], b.central, data.I_w[i], data.Ic_rb[i]);  // from the centre of mass
     else data.I_w[i] = data.Ic_rb[i] = S::inertiaInParent(data.X_world[i], b.inertia);
   }
   // Composite inertias, leaves to root: in one frame they simply add.

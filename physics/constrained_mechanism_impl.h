@@ -74,7 +74,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   have_velocity_ = false;
   // M from world composite inertias; the world inertias stay for the velocity stage.
   problem_.M.resize(nn, nn);
-  crba(model_.tree, data_, problem_.M);
+  crbaWorld(model_.tree, data_, problem_.M);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
   if constexpr (S::kDim == 3)
     for (int i = 0; i < nn; ++i) {
@@ -277,10 +277,16 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::accelerations(const VecN& q, const Vec
   // are still at (q, v): any restaging clears have_last_.
   const bool known = !stab && have_last_ && have_position_ && have_velocity_ && q == staged_q_ && v == staged_v_ &&
                      tau.size() == last_tau_.size() && tau == last_tau_;
-  const Solution s = known ? last_ : evaluate(q, v, tau, stab);
   a.resize(n() + k());
-  a.head(n()) = s.qdd;
-  a.tail(k()) = s.alpha_c;
+  // Entry by entry, at the fixed sizes where known: θ'' was just stored 8 bytes at a time, and a block
+  // copy (memcpy) reloads it 16 bytes at a time, which stalls on store forwarding.
+  const int nn = Nj == Eigen::Dynamic ? n() : Nj, kk = Nl == Eigen::Dynamic ? k() : Nl;
+  auto put = [&](const Solution& s) {
+    for (int i = 0; i < nn; ++i) a[i] = s.qdd[i];
+    for (int i = 0; i < kk; ++i) a[nn + i] = s.alpha_c[i];
+  };
+  if (known) put(last_);
+  else put(evaluate(q, v, tau, stab));
 }
 
 template <class S, int Nj, int Nr, int Nl>

@@ -305,10 +305,13 @@ struct Spatial {
   // Xᵀ I X from the centre-of-mass form: the centre c_A = r + Eᵀ c, the central inertia turned
   // (Eᵀ I_c E, symmetric: six entries), then about A's origin, I_O = Eᵀ I_c E + m(|c_A|² 1 − c_A c_Aᵀ), h = m c_A:
   // one rotation, no cross terms in h (cheaper than transforming the origin form).
-  DYN_INLINE static Inertia inertiaInParent(const Transform& X, const Central& C) {
-    Inertia out{C.m, Pos(), Eigen::Matrix3d()};  // every entry is set below
+  // Written entry by entry into out and its copy (CRBA's composite starts as the body's own): an
+  // Inertia returned whole and copied is reloaded 16 bytes at a time from 8-byte stores, a
+  // store-forwarding stall.
+  DYN_INLINE static void inertiaInParent(const Transform& X, const Central& C, Inertia& out, Inertia& copy) {
+    out.m = copy.m = C.m;
     Pos cA;
-    double B[3][3];  // I_c E
+    double B[3][3], Io[3][3];  // I_c E, and the lower triangle of Eᵀ I_c E
     if (X.turned) {
       for (int i = 0; i < 3; ++i) cA[i] = X.r[i] + X.E(0, i) * C.c[0] + X.E(1, i) * C.c[1] + X.E(2, i) * C.c[2];
       if (C.diagonal) {
@@ -319,16 +322,18 @@ struct Spatial {
           for (int j = 0; j < 3; ++j) B[i][j] = C.Ic(i, 0) * X.E(0, j) + C.Ic(i, 1) * X.E(1, j) + C.Ic(i, 2) * X.E(2, j);
       }
       for (int i = 0; i < 3; ++i)
-        for (int j = 0; j <= i; ++j) out.Io(i, j) = out.Io(j, i) = X.E(0, i) * B[0][j] + X.E(1, i) * B[1][j] + X.E(2, i) * B[2][j];
+        for (int j = 0; j <= i; ++j) Io[i][j] = X.E(0, i) * B[0][j] + X.E(1, i) * B[1][j] + X.E(2, i) * B[2][j];
     } else {
       for (int i = 0; i < 3; ++i) cA[i] = X.r[i] + C.c[i];
-      out.Io = C.Ic;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j <= i; ++j) Io[i][j] = C.Ic(i, j);
     }
-    for (int i = 0; i < 3; ++i) out.h[i] = C.m * cA[i];
-    const double mcc = out.h[0] * cA[0] + out.h[1] * cA[1] + out.h[2] * cA[2];  // m |c_A|²
+    double h[3];
+    for (int i = 0; i < 3; ++i) h[i] = C.m * cA[i];
+    const double mcc = h[0] * cA[0] + h[1] * cA[1] + h[2] * cA[2];  // m |c_A|²
+    for (int i = 0; i < 3; ++i) out.h[i] = copy.h[i] = h[i];
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j <= i; ++j) out.Io(i, j) = out.Io(j, i) = out.Io(i, j) - out.h[i] * cA[j] + (i == j ? mcc : 0.0);
-    return out;
+      for (int j = 0; j <= i; ++j) out.Io(i, j) = out.Io(j, i) = copy.Io(i, j) = copy.Io(j, i) = Io[i][j] - h[i] * cA[j] + (i == j ? mcc : 0.0);
   }
   static Mat inertia(double m, const Pos& c, const Eigen::Matrix3d& Ic) {
     const Eigen::Matrix3d C = skew(c);
