@@ -119,16 +119,13 @@ void MechanismKinematics<S>::addDirectionJacobian(const BodyRef& b, const Pos& p
                                                   MatN& J, MatN& A) const {
   if (b.kind == BodyRef::Kind::Link) {
     if constexpr (S::kDim == 6) {
-      // Spatial, written out: the linear velocity at p of joint j's unit motion (ω, v) is v − p × ω,
-      // S::motion's operations in its order (and the dot's, x0 + (x1 + x2)), read entry by entry: p
-      // was just stored 8 bytes at a time, and copying it whole into a Transform reloads it 16 bytes at a
-      // time, which stalls on store forwarding.
+      // Spatial: the linear velocity at p of joint j's unit motion, S::linearAt (the dot summed as
+      // Eigen's, x0 + (x1 + x2)). p was just stored 8 bytes at a time, and copying it whole into a
+      // Transform reloads it 16 bytes at a time, which stalls on store forwarding.
       for (int j = b.index; j >= 0; j = model->tree.bodies[std::size_t(j)].parent) {
-        const double* s = tree->S_w[std::size_t(j)].data();
-        double pw[3];
-        S::cross3(p_world.data(), s, pw);
-        const double u0 = s[3] - pw[0], u1 = s[4] - pw[1], u2 = s[5] - pw[2];
-        J(row, j) += sign * (d[0] * u0 + (d[1] * u1 + d[2] * u2));
+        double u[3];
+        S::linearAt(p_world, tree->S_w[std::size_t(j)].data(), u);
+        J(row, j) += sign * (d[0] * u[0] + (d[1] * u[1] + d[2] * u[2]));
       }
       return;
     }
@@ -188,16 +185,13 @@ double MechanismKinematics<S>::directionBias(const BodyRef& b, const Pos& p_worl
     // pointBias's link case, only its linear rows along d.
     const std::size_t i = std::size_t(b.index);
     if constexpr (S::kDim == 6) {
-      // Written out as above: at p, a_p = (α, a − p × α) and v_p = (ω, v − p × ω); d·(a_p + ω × v_p).
-      const double* a = tree->a_w[i].data();
+      // As above: at p, a_p = (α, a − p × α) and v_p = (ω, v − p × ω); d·(a_p + ω × v_p).
       const double* v = tree->v_w[i].data();
-      double pa[3], pv[3], vp[3], wv[3];
-      S::cross3(p_world.data(), a, pa);
-      S::cross3(p_world.data(), v, pv);
-      for (int r = 0; r < 3; ++r) vp[r] = v[3 + r] - pv[r];
+      double ap[3], vp[3], wv[3];
+      S::linearAt(p_world, tree->a_w[i].data(), ap);
+      S::linearAt(p_world, v, vp);
       S::cross3(v, vp, wv);
-      const double l0 = (a[3] - pa[0]) + wv[0], l1 = (a[4] - pa[1]) + wv[1], l2 = (a[5] - pa[2]) + wv[2];
-      return d[0] * l0 + (d[1] * l1 + d[2] * l2);
+      return d[0] * (ap[0] + wv[0]) + (d[1] * (ap[1] + wv[1]) + d[2] * (ap[2] + wv[2]));
     }
     const typename S::Transform X_pw = S::translation(p_world);
     return d.dot(S::linear(S::classicalAcceleration(S::motion(X_pw, tree->a_w[i]), S::motion(X_pw, tree->v_w[i]))));

@@ -185,11 +185,17 @@ struct Spatial {
   DYN_INLINE static void mulT3(const Rot& E, const double* x, double* o) {  // o = Eᵀ x
     for (int i = 0; i < 3; ++i) o[i] = E(0, i) * x[0] + E(1, i) * x[1] + E(2, i) * x[2];
   }
+  // The linear part of motion v = (ω, v) seen at point p with unturned axes: v − p × ω (motion() by
+  // translation(p) without building the Transform). Entry by entry, from 6 doubles at v.
+  DYN_INLINE static void linearAt(const Pos& p, const double* v, double* out) {
+    double pw[3];
+    cross3(p.data(), v, pw);
+    for (int i = 0; i < 3; ++i) out[i] = v[3 + i] - pw[i];
+  }
   DYN_INLINE static Vec motion(const Transform& X, const Vec& v) {
     // (E ω, E (v − r × ω))
-    double rw[3], u[3];
-    cross3(X.r.data(), v.data(), rw);
-    for (int i = 0; i < 3; ++i) u[i] = v[3 + i] - rw[i];
+    double u[3];
+    linearAt(X.r, v.data(), u);
     Vec out;
     if (!X.turned) {
       for (int i = 0; i < 3; ++i) out[i] = v[i], out[3 + i] = u[i];
