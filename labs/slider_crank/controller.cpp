@@ -16,10 +16,10 @@ double Reference::velocity(double t) const {
 Controller::Controller(const ControllerConfig& c, const Reference& r, const Params& model, double dt)
     : config_(c), reference_(r), model_(model), dt_(dt), sensor_(c.delay, dt), rng_(c.seed) {}
 
-void Controller::primeMeasurement(const VecN& q, const VecN& v) {
+void Controller::primeMeasurement(Mechanism& plant, const VecN& q, const VecN& v) {
   sensor_.fill(config_.f_des);
   const Eigen::Vector3d tau = torque(0.0, q.head(3), v.head(3), q[3], v[3]);
-  sensor_.fill(model_.solve(q, v, VecN(tau)).f[2]);
+  sensor_.fill(plant.solve(q, v, VecN(tau)).f[2]);
 }
 
 void Controller::measure(double f_Ty) {

@@ -5,7 +5,8 @@
 //     open loop      ξ = f_des
 //     proportional   ξ = f_des − k_pf (f_meas − f_des)          (needs k_pf < 1 under delay)
 //     integral       ξ = f_des − k_if ∫ (f_meas − f_des) dt     (robust to the delay)
-// The same controller drives both engines; it uses the hand-written model for G and J.
+// The same controller drives both engines; it uses the hand-written model for G and J (the arm
+// without its tool: the tool's weight m_t g reaches the rail as a disturbance only feedback removes).
 #pragma once
 #include <cstdint>
 #include <random>
@@ -51,8 +52,8 @@ class Controller {
   void measure(double f_Ty);
   // The sensor has been measuring before t = 0 (the lecture's loop starts from a measured force,
   // not from 0 N): with the force loop at rest (f_meas = f_des), the force the t = 0 torque
-  // produces at the initial state (q, v) fills the delay line.
-  void primeMeasurement(const VecN& q, const VecN& v);
+  // produces on the real arm (plant) at the initial state (q, v) fills the delay line.
+  void primeMeasurement(Mechanism& plant, const VecN& q, const VecN& v);
   double measured() const;  // what the force law currently sees
   const Reference& reference() const { return reference_; }
   const ControllerConfig& config() const { return config_; }

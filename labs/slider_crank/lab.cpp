@@ -41,11 +41,13 @@ struct RowState {
 };
 
 // The lab's part of a run on either engine (labs/mechanism_simulation.h): the force controller, the
-// trace row, and the force sensor, which sees f_Ty of each step `delay` later.
+// trace row, and the force sensor, which sees f_Ty of each step `delay` later. The controller's
+// model is the arm without its tool; the sensor measures the arm as it is.
 class Hooks final : public StepHooks {
  public:
-  Hooks(const Settings& s, const VecN& q0, const VecN& v0) : s_(s), ctrl_(s.controller, s.reference, s.params, s.step.dt) {
-    ctrl_.primeMeasurement(q0, v0);
+  Hooks(const Settings& s, const VecN& q0, const VecN& v0) : s_(s), ctrl_(s.controller, s.reference, controllerModel(s.params), s.step.dt) {
+    Mechanism plant(s.params);
+    ctrl_.primeMeasurement(plant, q0, v0);
   }
   VecN torque(double t, const VecN& q, const VecN& v) override {
     return ctrl_.torque(t, q.head(3), v.head(3), q[3], v[3]);
@@ -64,16 +66,23 @@ class Hooks final : public StepHooks {
 
 }  // namespace
 
+Params controllerModel(const Params& plant) {
+  Params model = plant;
+  model.tool_mass = 0.0;  // the tool is what the model does not know
+  return model;
+}
+
 Settings parseSettings(const JsonView& c) {
   Settings s;
   c.onlyKeys({"lab", "title", "description", "mechanism", "initial", "simulation", "controller", "gains",
               "reference", "metrics", "rubric", "scenarios", "drawing", "submission_options",
               "metric_docs", "map"});
   const JsonView m = c["mechanism"];
-  m.onlyKeys({"links", "load_mass", "gravity"});
+  m.onlyKeys({"links", "load_mass", "tool_mass", "gravity"});
   m["links"].size(3, 3);
   for (int i = 0; i < 3; ++i) s.params.links[i] = parseLink(m["links"].at(i));
   s.params.load_mass = m["load_mass"].positive(kMaxMass);
+  s.params.tool_mass = m.has("tool_mass") ? m["tool_mass"].inRange(0, kMaxMass) : 0.0;
   m["gravity"].size(2, 2);
   s.params.gravity = {m["gravity"].at(0).inRange(-kMaxGravity, kMaxGravity),
                       m["gravity"].at(1).inRange(-kMaxGravity, kMaxGravity)};

@@ -17,6 +17,9 @@ struct Settings {
   double arrow_scale = 0.02;  // m per N, drawing only
 };
 
+// The arm the controller knows: the plant without its tool (mechanism/tool_mass is unmodelled).
+Params controllerModel(const Params& plant);
+
 // Reads and validates the lab JSON; throws InputError naming file and path.
 Settings parseSettings(const JsonView& config);
 

@@ -22,8 +22,10 @@ MechanismModel<Planar> describe(const Params& p) {
   for (int i = 0; i < 3; ++i) {
     const Link& l = p.links[std::size_t(i)];
     const Planar::Pos offset = i == 0 ? Planar::Pos::Zero() : Planar::Pos(p.links[std::size_t(i - 1)].length, 0.0);
-    d.tree.addBody(i - 1, JointType::Revolute, Planar::Axis::Zero(), Planar::translation(offset),
-                   Planar::inertia(l.mass, l.com, l.inertia));
+    Planar::Mat inertia = Planar::inertia(l.mass, l.com, l.inertia);
+    // The tool: a point mass at link 3's tip (spatial inertias in one frame add).
+    if (i == 2 && p.tool_mass > 0) inertia += Planar::inertia(p.tool_mass, Planar::Pos(l.length, 0.0), 0.0);
+    d.tree.addBody(i - 1, JointType::Revolute, Planar::Axis::Zero(), Planar::translation(offset), inertia);
   }
   d.tree.gravity << 0.0, p.gravity.x(), p.gravity.y();
   // The slider: a payload on a guide along world x (its rotational inertia never matters).

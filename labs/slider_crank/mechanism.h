@@ -6,6 +6,7 @@
 // the inverse kinematics from the crank angle θ1 (the independent coordinate, regular everywhere when
 // l1 < l2; x_c is not, at the dead centres), its branch, and the closed-form joint points for drawing.
 // For Bullet, the loop is cut at joint 1 (20× more accurate than welding the tip; notes/bullet-reference.md).
+// A tool at the tip (tool_mass) is part of link 3: its weight hangs on the arm, straight above the rail.
 #pragma once
 #include <array>
 
@@ -21,6 +22,7 @@ struct Link {
 struct Params {
   std::array<Link, 3> links;
   double load_mass = 0.5;                 // m_c, kg
+  double tool_mass = 0.0;                 // kg, a point mass at link 3's tip: the arm's tool, part of link 3
   Eigen::Vector2d gravity{0.0, -9.81};    // world, m/s²
 };
 
