@@ -13,10 +13,12 @@
 #include <Eigen/Dense>
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <string>
 #include <tuple>
 #include <vector>
 
+#include "grading/grade.h"
 #include "labs/run.h"
 #include "labs/slider_crank/lab.h"
 #include "tests/labs/lab_fixture.h"
@@ -80,8 +82,15 @@ Eigen::Vector2d rot(double a, const Eigen::Vector2d& v) {
 Eigen::Vector2d perp(const Eigen::Vector2d& v) { return {-v.y(), v.x()}; }
 double cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
 
-Eigen::Vector3d inverseDynamics(const Params& p, const Eigen::Vector3d& q, const Eigen::Vector3d& qd,
+Eigen::Vector3d inverseDynamics(const Params& plant, const Eigen::Vector3d& q, const Eigen::Vector3d& qd,
                                 const Eigen::Vector3d& qdd, const Eigen::Vector3d& fT) {
+  // The tool, a point mass at link 3's tip, joins link 3 (centre of mass, parallel-axis theorem).
+  Params p = plant;
+  Link& L3 = p.links[2];
+  const Eigen::Vector2d tip(L3.length, 0.0), c = (L3.mass * L3.com + p.tool_mass * tip) / (L3.mass + p.tool_mass);
+  L3.inertia += L3.mass * (L3.com - c).squaredNorm() + p.tool_mass * (tip - c).squaredNorm();
+  L3.mass += p.tool_mass;
+  L3.com = c;
   Eigen::Vector2d a_joint = Eigen::Vector2d::Zero();  // acceleration of joint i (world)
   double phi = 0, om = 0, al = 0;
   Eigen::Vector2d e[3], rc[3], ac[3];
@@ -339,7 +348,8 @@ TEST_CASE("hand-written model vs Bullet") {
   SUBCASE("controlled run (force control, 4 s, the former default gains)") {
     // kp_x 400, kd_x 40, ki_f 40: a well-damped loop (the shipped defaults are now weaker on purpose,
     // and their underdamped motion lets the engines drift apart further, still first order).
-    const json tuned = {{"gains", {{"kp_x", {{"value", 400.0}}}, {"kd_x", {{"value", 40.0}}}, {"ki_f", {{"value", 40.0}}}}}};
+    const json tuned = {{"gains", {{"kp_x", {{"value", 400.0}}}, {"kd_x", {{"value", 40.0}}}, {"ki_f", {{"value", 40.0}}}}},
+                       {"controller", {{"force_law", "integral"}}}};
     // Measured at dt = 1 ms: |Δq| 1.74e-4 rad, |Δx_c| 4.9e-5 m, |Δf| 2.1e-3 N (f_Ty ≈ −5 N),
     // halving exactly with dt (2.0×) from 4 ms down to 0.25 ms. The PD loop on x_c and the integral
     // force loop keep the two runs from separating, so C·dt holds over the whole run.
@@ -432,7 +442,10 @@ TEST_CASE("the force loop starts from a measured force: no start-up dip") {
   // loop starts from a measured force). With a zero-filled delay line the integral law saw a 5 N
   // error for the first 10 ms and dipped to −6.9 N (37 % overshoot); primed, only the motion's own
   // disturbance remains (measured 0.12 N over the first 0.3 s), on both engines.
-  const auto lab = fixture.makeLab({{"simulation", {{"duration", 0.3}}}});
+  // The integral law (whose t = 0 torque does not depend on the measurement), without the tool
+  // (whose weight is a real error from t = 0, not a start-up artefact).
+  const auto lab = fixture.makeLab({{"simulation", {{"duration", 0.3}}}, {"controller", {{"force_law", "integral"}}},
+                                    {"mechanism", {{"tool_mass", 0.0}}}});
   for (Engine e : {Engine::Hand, Engine::Bullet}) {
     INFO("engine ", std::string(name(e)));
     const Trace tr = fixture.run(*lab, e);
@@ -442,4 +455,33 @@ TEST_CASE("the force loop starts from a measured force: no start-up dip") {
     CHECK(worst < 0.3);
     CHECK(std::abs(tr.at(0, "f_meas") - tr.at(0, "f_Ty")) < 1e-6);  // the first measurement is the force at t = 0
   }
+}
+
+TEST_CASE("the tool the controller does not know: open loop leaves its weight m_t g on the rail") {
+  // Statics: the tool hangs at the tip, straight above the rail, so its weight passes whole into
+  // f_Ty; gravity compensation from the model (without the tool) leaves exactly m_t g unrejected.
+  const json zero = {{"gains", {{"kp_x", {{"value", 0.0}}}, {"kd_x", {{"value", 0.0}}}, {"kp_f", {{"value", 0.0}}}, {"ki_f", {{"value", 0.0}}}}},
+                     {"simulation", {{"duration", 1.0}}}};
+  const auto lab = fixture.makeLab(zero);
+  const Params& p = settingsOf(*lab).params;
+  REQUIRE(p.tool_mass > 0);
+  const Trace tr = fixture.run(*lab, Engine::Hand);
+  double worst = 0;
+  for (std::size_t r = 0; r < tr.rows(); ++r)
+    worst = std::max(worst, std::abs(std::abs(tr.at(r, "f_Ty") - tr.at(r, "f_des")) - p.tool_mass * std::abs(p.gravity.y())));
+  CHECK(worst < 1e-6);
+  CHECK(std::abs(tr.at(tr.rows() - 1, "x_c") - tr.at(0, "x_c")) < 1e-6);  // doing nothing: the slider stays
+}
+
+TEST_CASE("the shipped examples: the integral law ahead of the proportional one, unstable_integral unstable") {
+  const auto dir = std::filesystem::path(defaultConfigPath("slider_crank")).parent_path() / "examples";
+  auto grade = [&](const char* name) {
+    const GradeOutcome g = gradeSubmission((dir / name).string(), GradeOptions{});
+    REQUIRE(g.error.empty());
+    return g.results;
+  };
+  const json integral = grade("integral.json"), proportional = grade("proportional.json");
+  // Same motion gains; under the delay kp_f < 1 leaves ≥ m_t g / 2 on the rail, the integral law removes it.
+  CHECK(integral.at("score").get<double>() - proportional.at("score").get<double>() >= 0.15 * 15);
+  CHECK(grade("unstable_integral.json").at("output").get<std::string>().find("unstable") != std::string::npos);
 }

@@ -9,7 +9,10 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <filesystem>
 #include <string>
+
+#include "grading/grade.h"
 
 #include "labs/run.h"
 #include "labs/unicycle/lab.h"
@@ -90,4 +93,36 @@ TEST_CASE("unicycle: bad inputs get one line naming the JSON path") {
   CHECK(fixture.inputError({{"gains", {{"a_lat", {{"value", 0.0}}}}}}).find("/gains/a_lat") == 0);
   const std::string missing = fixture.inputError({{"controller", {{"kind", "constant"}}}});
   CHECK_MESSAGE(missing.find("tau_drive") != std::string::npos, missing);
+}
+
+namespace {
+// The grade of a shipped example (labs/unicycle/examples/<name>.json): results.json.
+json gradeExample(const std::string& name) {
+  const auto dir = std::filesystem::path(defaultConfigPath("unicycle")).parent_path() / "examples";
+  const GradeOutcome g = gradeSubmission((dir / (name + ".json")).string(), GradeOptions{});
+  REQUIRE(g.error.empty());
+  return g.results;
+}
+double testScore(const json& results, const std::string& test) {
+  for (const auto& t : results.at("tests"))
+    if (t.at("name") == test) return t.at("score").get<double>();
+  FAIL("no test " << test);
+  return -1;
+}
+}  // namespace
+
+TEST_CASE("unicycle: examples named for a verdict get it") {
+  // unstable: a heading loop without damping, which the half-step hold destabilises.
+  CHECK(gradeExample("unstable").at("output").get<std::string>().find("unstable") != std::string::npos);
+  // unstable_with_delay: stiff loops that the 20 ms actuation delay drives past the steer torque limit.
+  CHECK(gradeExample("unstable_with_delay").at("output").get<std::string>().find("actuation_delay**: unstable") != std::string::npos);
+  // skidding: stable loops whose leader corners at 6 m/s²: m a_lat = 12 N > μ m g = 5.9 N on the slippery
+  // floor, so it skids there, and nothing is unstable.
+  const json skid = gradeExample("skidding");
+  CHECK(skid.at("output").get<std::string>().find("unstable") == std::string::npos);
+  CHECK(testScore(skid, "No skid on a slippery floor (μ = 0.3)") == 0.0);
+  // slows_in_turns: the same loops with a_lat 1.85 (m a_lat = 3.7 N < 5.9 N) hold the slippery floor.
+  const json slow = gradeExample("slows_in_turns");
+  CHECK(testScore(slow, "No skid on a slippery floor (μ = 0.3)") > 0.5 * 3);
+  CHECK(slow.at("score").get<double>() > skid.at("score").get<double>());
 }
