@@ -55,17 +55,21 @@ void Controller::primeMeasurement(Mechanism& plant, const VecN& q, const VecN& v
   if (g.ki_int > 0 && g.k_cone > 0) integral_ = g.k_cone * coneNeed(q.tail(3), forces()) / g.ki_int;
   const VecN F = forces();
   sensor_.fill(model_.internalForce(q.tail(3), F));
+  tangent_ = tangential(q.tail(3), F);
   need_.fill(coneNeed(q.tail(3), F));
 }
 
-double Controller::coneNeed(const Eigen::Vector3d& pose, const VecN& F) const {
-  // max_i |f_t,i| / μ̂, f_t,i along the tangent ẑ × n_i of contact i.
-  double worst = 0;
+VecN Controller::tangential(const Eigen::Vector3d& pose, const VecN& F) const {
+  VecN ft(model_.fingers());
   for (int i = 0; i < model_.fingers(); ++i) {
     const Eigen::Vector2d n = model_.contactNormal(i, pose[0]);
-    worst = std::max(worst, std::abs(F.segment<2>(2 * i).dot(Eigen::Vector2d(-n.y(), n.x()))));
+    ft[i] = F.segment<2>(2 * i).dot(Eigen::Vector2d(-n.y(), n.x()));
   }
-  return worst / model_.params().mu;
+  return ft;
+}
+
+double Controller::coneNeed(const Eigen::Vector3d& pose, const VecN& F) const {
+  return tangential(pose, F).cwiseAbs().maxCoeff() / model_.params().mu;
 }
 
 void Controller::measure(const VecN& q, const VecN& F) {
@@ -73,7 +77,9 @@ void Controller::measure(const VecN& q, const VecN& F) {
   if (config_.noise_std > 0)
     for (Eigen::Index i = 0; i < Fm.size(); ++i) Fm[i] += config_.noise_std * noise_(rng_);
   sensor_.push(model_.internalForce(q.tail(3), Fm));
-  need_.push(coneNeed(q.tail(3), Fm));
+  // f̄_t' = (f_t,meas − f̄_t) / T_f, then the cone's need from the filtered forces.
+  tangent_ += dt_ / (kTangentFilter + dt_) * (tangential(q.tail(3), Fm) - tangent_);
+  need_.push(tangent_.cwiseAbs().maxCoeff() / model_.params().mu);
   // The squeeze law integrates what it sees.
   integral_ += (setPoint() - measured()) * dt_;
 }

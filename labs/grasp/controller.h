@@ -2,8 +2,8 @@
 //   wrench     W = M_c (α_d) + K_p (x_d − x_o) + K_d (v_d − v_o) − M_c g        on (ψ, x, y), world axes
 //              K_p = diag(k_pψ, k_p, k_p), K_d = diag(k_dψ, k_d, k_d), M_c = diag(I_o, m_o, m_o)
 //   contacts   F = G⁺ W + s d                 (G⁺W moves the object; s d ∈ N(G) = N(Aᵀ) squeezes it)
-//   set point  f_d = f_sq + k_c max_i |f_t,i,meas| / μ̂       (the friction cone's need, from the measured
-//              tangential forces, plus the margin f_sq; k_c = 0: a constant set point f_d = f_sq)
+//   set point  f_d = f_sq + k_c max_i |f̄_t,i| / μ̂           (the friction cone's need, from the measured
+//              tangential forces low-passed over kTangentFilter, plus the margin f_sq; k_c = 0: f_d = f_sq)
 //   squeeze    s = f_sq + k_if ∫ (f_d − f_int,meas) dt     (f_int,meas, f_t,meas: delayed, noisy contact forces)
 //   torques    τ = G(θ) + Jᵀ F                (J: the fingertips' translational Jacobian)
 // The controller's model (object mass and inertia, μ̂) is its own: a heavier object or less friction in
@@ -20,6 +20,9 @@
 #include "labs/grasp/mechanism.h"
 
 namespace dyn::grasp {
+
+// s, the first-order low-pass on the measured tangential forces (noise would otherwise bias max |f_t|).
+inline constexpr double kTangentFilter = 0.05;
 
 enum class ControllerKind { None, Constant, Grasp };
 
@@ -71,12 +74,14 @@ class Controller {
 
  private:
   double coneNeed(const Eigen::Vector3d& pose, const VecN& F) const;  // max_i |f_t,i| / μ̂
+  VecN tangential(const Eigen::Vector3d& pose, const VecN& F) const;   // f_t,i along ẑ × n_i
   ControllerConfig config_;
   Reference reference_;
   Mechanism model_;
   double dt_;
   DelayLine sensor_;               // f_int as measured (from noisy contact forces), `delay` late
-  DelayLine need_;                 // max_i |f_t,i| / μ̂ as measured, `delay` late
+  DelayLine need_;                 // max_i |f̄_t,i| / μ̂ as measured, `delay` late
+  VecN tangent_;                   // f̄_t,i: each contact's measured tangential force, low-passed
   double integral_ = 0, squeeze_ = 0;
   std::mt19937_64 rng_;
   std::normal_distribution<double> noise_{0.0, 1.0};
