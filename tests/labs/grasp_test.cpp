@@ -278,7 +278,7 @@ TEST_CASE("grasp: friction-cone feedback keeps the cone margin at μ f_sq whatev
   for (const double mass : {0.2, 0.3}) {
     const json plant = {{"mechanism", {{"object", {{"mass", mass}}}}}};
     for (const double k_cone : {0.0, 1.0}) {
-      const double f_sq = k_cone > 0 ? 0.5 : 3.5;
+      const double f_sq = k_cone > 0 ? 1.0 : 3.5;  // k_c = 1: a margin μ f_sq for the start, before the integral has caught up with the load
       const json gains = {{"kp_pos", 2000}, {"kd_pos", 50}, {"kp_psi", 2}, {"kd_psi", 0.05}, {"f_squeeze", f_sq}, {"ki_int", 60}, {"k_cone", k_cone}};
       const auto lab = fixture.makeLab(mergePatch(plant, staticHold(3.0, gains)));
       const Trace tr = fixture.run(*lab, Engine::Hand);
