@@ -35,16 +35,41 @@ void Reference::at(double t, Eigen::Vector3d& pose, Eigen::Vector3d& rate, Eigen
 }
 
 Controller::Controller(const ControllerConfig& c, const Reference& r, const Params& model, double dt)
-    : config_(c), reference_(r), model_(model), dt_(dt), sensor_(c.delay, dt, c.gains.f_squeeze), squeeze_(c.gains.f_squeeze), rng_(c.seed) {}
+    : config_(c), reference_(r), model_(model), dt_(dt), sensor_(c.delay, dt, c.gains.f_squeeze), need_(c.delay, dt, 0.0),
+      squeeze_(c.gains.f_squeeze), rng_(c.seed) {}
 
-void Controller::primeMeasurement(const VecN& q, const VecN& v) {
+void Controller::primeMeasurement(Mechanism& plant, const VecN& q, const VecN& v) {
+  // The contact forces the t = 0 torques produce in the plant.
+  auto forces = [&] {
+    const auto sol = plant.solve(q, v, torque(0.0, q, v));
+    VecN F(2 * plant.fingers());
+    for (int i = 0; i < plant.fingers(); ++i) F.segment<2>(2 * i) = plant.constraintForce(i, sol).tail<2>();
+    return F;
+  };
   sensor_.fill(config_.gains.f_squeeze);
-  const VecN tau = torque(0.0, q, v);
-  const auto sol = model_.solve(q, v, tau);
-  VecN F(2 * model_.fingers());
-  for (int i = 0; i < model_.fingers(); ++i) F.segment<2>(2 * i) = model_.constraintForce(i, sol).tail<2>();
-  sensor_.fill(model_.internalForce(q.tail(3), F));
+  need_.fill(0.0);
   integral_ = 0;
+  // The grasp has been holding the object before t = 0: the integral already carries the cone's need
+  // (the squeeze moves no tangential force, so one pass finds it).
+  const Gains& g = config_.gains;
+  if (g.ki_int > 0 && g.k_cone > 0) integral_ = g.k_cone * coneNeed(q.tail(3), forces()) / g.ki_int;
+  const VecN F = forces();
+  sensor_.fill(model_.internalForce(q.tail(3), F));
+  tangent_ = tangential(q.tail(3), F);
+  need_.fill(coneNeed(q.tail(3), F));
+}
+
+VecN Controller::tangential(const Eigen::Vector3d& pose, const VecN& F) const {
+  VecN ft(model_.fingers());
+  for (int i = 0; i < model_.fingers(); ++i) {
+    const Eigen::Vector2d n = model_.contactNormal(i, pose[0]);
+    ft[i] = F.segment<2>(2 * i).dot(Eigen::Vector2d(-n.y(), n.x()));
+  }
+  return ft;
+}
+
+double Controller::coneNeed(const Eigen::Vector3d& pose, const VecN& F) const {
+  return tangential(pose, F).cwiseAbs().maxCoeff() / model_.params().mu;
 }
 
 void Controller::measure(const VecN& q, const VecN& F) {
@@ -52,11 +77,20 @@ void Controller::measure(const VecN& q, const VecN& F) {
   if (config_.noise_std > 0)
     for (Eigen::Index i = 0; i < Fm.size(); ++i) Fm[i] += config_.noise_std * noise_(rng_);
   sensor_.push(model_.internalForce(q.tail(3), Fm));
+  // f̄_t' = (f_t,meas − f̄_t) / T_f, then the cone's need from the filtered forces.
+  tangent_ += dt_ / (kTangentFilter + dt_) * (tangential(q.tail(3), Fm) - tangent_);
+  need_.push(tangent_.cwiseAbs().maxCoeff() / model_.params().mu);
   // The squeeze law integrates what it sees.
-  integral_ += (config_.gains.f_squeeze - measured()) * dt_;
+  integral_ += (setPoint() - measured()) * dt_;
 }
 
 double Controller::measured() const { return sensor_.value(); }
+
+double Controller::setPoint() const { return config_.gains.f_squeeze + config_.gains.k_cone * need_.value(); }
+
+double Controller::setPointFor(const Eigen::Vector3d& pose, const VecN& F) const {
+  return config_.gains.f_squeeze + config_.gains.k_cone * coneNeed(pose, F);
+}
 
 VecN Controller::torque(double t, const VecN& q, const VecN& v) {
   const int n = model_.n();
@@ -77,7 +111,7 @@ VecN Controller::torque(double t, const VecN& q, const VecN& v) {
   VecN d;
   model_.graspMap(pose, G, d);
   const Eigen::Matrix3d GGt = G * G.transpose();
-  squeeze_ = g.f_squeeze + g.ki_int * integral_;
+  squeeze_ = g.f_squeeze + g.ki_int * integral_;  // the integral carries f_d's rise above f_sq
   const VecN F = G.transpose() * GGt.ldlt().solve(W) + squeeze_ * d;
   // Torques: each finger holds its own weight and pushes its share through Jᵀ.
   return model_.gravityTorque(q) + model_.tipJacobian(q).transpose() * F;

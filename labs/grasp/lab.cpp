@@ -53,7 +53,7 @@ std::vector<std::string> makeColumns(int m) {
     for (const char* s : {"_x", "_y"}) c.push_back("f" + std::to_string(i) + s);
   for (int i = 1; i <= m; ++i)
     for (const char* s : {"_n", "_t"}) c.push_back("f" + std::to_string(i) + s);
-  for (const char* s : {"cone_margin", "f_int", "f_int_meas", "squeeze", "energy", "work", "constraint_residual"}) c.push_back(s);
+  for (const char* s : {"cone_margin", "f_int", "f_int_d", "f_int_meas", "squeeze", "energy", "work", "constraint_residual"}) c.push_back(s);
   return c;
 }
 
@@ -62,8 +62,8 @@ std::vector<std::string> makeColumns(int m) {
 class Hooks final : public StepHooks {
  public:
   Hooks(const Settings& s, const VecN& q0, const VecN& v0)
-      : s_(s), ctrl_(s.controller, s.reference, s.params, s.step.dt), model_(s.params) {
-    ctrl_.primeMeasurement(q0, v0);
+      : s_(s), ctrl_(s.controller, s.reference, s.model, s.step.dt), model_(s.params) {
+    ctrl_.primeMeasurement(model_, q0, v0);
   }
   VecN torque(double t, const VecN& q, const VecN& v) override {
     const VecN tau = ctrl_.torque(t, q, v);
@@ -92,7 +92,9 @@ class Hooks final : public StepHooks {
       out.push_back(c[1]);
       if (c[2] < margin_) margin_ = c[2], worst_ = i, worst_fn_ = c[0], worst_ft_ = c[1];
     }
-    for (const double x : {margin_, model_.internalForce(r.q.tail(3), F_), ctrl_.measured(), ctrl_.squeeze(), r.energy, r.work, r.residual})
+    // f_int_d: the set point the squeeze law would aim at with a perfect, undelayed sensor.
+    const double f_int_d = ctrl_.setPointFor(r.q.tail(3), F_);
+    for (const double x : {margin_, model_.internalForce(r.q.tail(3), F_), f_int_d, ctrl_.measured(), ctrl_.squeeze(), r.energy, r.work, r.residual})
       out.push_back(x);
   }
   void observe(const StepRecord& r) override { ctrl_.measure(r.q, F_); }
@@ -124,7 +126,7 @@ class Hooks final : public StepHooks {
 
 Settings parseSettings(const JsonView& c) {
   Settings s;
-  c.onlyKeys({"lab", "title", "description", "mechanism", "initial", "simulation", "controller", "gains", "reference",
+  c.onlyKeys({"lab", "title", "description", "mechanism", "model", "initial", "simulation", "controller", "gains", "reference",
               "disturbance", "metrics", "metric_docs", "rubric", "drawing", "submission_options", "map"});
   const JsonView m = c["mechanism"];
   m.onlyKeys({"fingers", "object", "joint_friction", "mu", "gravity"});
@@ -151,6 +153,16 @@ Settings parseSettings(const JsonView& c) {
   s.params.mu = m["mu"].positive(100);
   s.params.gravity = vec2(m["gravity"], -kMaxGravity, kMaxGravity);
 
+  // The controller's model: the plant's fingers and gravity, its own object and friction coefficient.
+  const JsonView md = c["model"];
+  md.onlyKeys({"object", "mu"});
+  const JsonView mo = md["object"];
+  mo.onlyKeys({"mass", "inertia"});
+  s.model = s.params;
+  s.model.object.mass = mo["mass"].positive(kMaxMass);
+  s.model.object.inertia = mo.has("inertia") ? mo["inertia"].positive(kMaxMass) : s.model.object.mass * sz.squaredNorm() / 12.0;
+  s.model.mu = md["mu"].positive(100);
+
   const JsonView init = c["initial"];
   init.onlyKeys({"x", "y", "psi_deg"});
   s.pose0 = {init["psi_deg"].inRange(-180, 180) * M_PI / 180.0, init["x"].inRange(-kMaxLength, kMaxLength),
@@ -173,8 +185,8 @@ Settings parseSettings(const JsonView& c) {
   cc.delay = ctl.has("delay") ? ctl["delay"].inRange(0, 1) : 0.0;
   cc.noise_std = ctl.has("noise_std") ? ctl["noise_std"].inRange(0, kMaxForce) : 0.0;
   cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1L << 53)) : 1;
-  const auto g = parseGains(c["gains"], {"kp_pos", "kd_pos", "kp_psi", "kd_psi", "f_squeeze", "ki_int"});
-  cc.gains = {g.at("kp_pos"), g.at("kd_pos"), g.at("kp_psi"), g.at("kd_psi"), g.at("f_squeeze"), g.at("ki_int")};
+  const auto g = parseGains(c["gains"], {"kp_pos", "kd_pos", "kp_psi", "kd_psi", "f_squeeze", "ki_int", "k_cone"});
+  cc.gains = {g.at("kp_pos"), g.at("kd_pos"), g.at("kp_psi"), g.at("kd_psi"), g.at("f_squeeze"), g.at("ki_int"), g.at("k_cone")};
 
   const JsonView ref = c["reference"];
   ref.onlyKeys({"lift", "lift_time", "hold", "sideways", "tilt_deg", "period"});
@@ -221,7 +233,7 @@ std::string GraspLab::unit(const std::string& c) const {
   static const std::map<std::string, std::string> units = {
       {"t", "s"},      {"x_o", "m"},       {"y_o", "m"},         {"psi_o", "rad"},   {"vx_o", "m/s"},  {"vy_o", "m/s"},
       {"w_o", "rad/s"}, {"x_d", "m"},      {"y_d", "m"},         {"psi_d", "rad"},   {"cone_margin", "N"},
-      {"f_int", "N"},  {"f_int_meas", "N"}, {"squeeze", "N"},    {"energy", "J"},    {"work", "J"},
+      {"f_int", "N"},  {"f_int_d", "N"}, {"f_int_meas", "N"}, {"squeeze", "N"},    {"energy", "J"},    {"work", "J"},
       {"constraint_residual", "m"}};
   if (std::string u = unitIn(units, c); !u.empty()) return u;
   if (c.size() > 1 && c[0] == 'q' && std::isdigit(static_cast<unsigned char>(c[1]))) return "rad";
@@ -241,7 +253,6 @@ json GraspLab::metrics(const Trace& tr) const {
   std::vector<double> ep, epsi, ef;
   double margin = INFINITY, margin_t = 0, tau_max = 0, drift = 0, residual = 0, ep_max = 0;
   const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
-  const double f_sq = s_.controller.gains.f_squeeze;
   std::vector<int> tau_cols;
   for (int j = 1; j <= 2 * fingers(); ++j) tau_cols.push_back(tr.column("tau" + std::to_string(j)));
   for (std::size_t r = 0; r < tr.rows(); ++r) {
@@ -249,7 +260,7 @@ json GraspLab::metrics(const Trace& tr) const {
     ep.push_back(std::hypot(ex, ey));
     ep_max = std::max(ep_max, ep.back());
     epsi.push_back(tr.at(r, "psi_o") - tr.at(r, "psi_d"));
-    if (tr.at(r, "t") >= s_.settle_time) ef.push_back(tr.at(r, "f_int") - f_sq);
+    if (tr.at(r, "t") >= s_.settle_time) ef.push_back(tr.at(r, "f_int") - tr.at(r, "f_int_d"));
     if (tr.at(r, "cone_margin") < margin) margin = tr.at(r, "cone_margin"), margin_t = tr.at(r, "t");
     for (int c : tau_cols) tau_max = std::max(tau_max, std::abs(tr.data[r * tr.columns.size() + std::size_t(c)]));
     // Energy balance: E − E0 − ∫ (τ·θ' + push·v_o) dt (zero for exact dynamics).

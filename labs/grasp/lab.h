@@ -13,7 +13,8 @@ struct Disturbance {
 };
 
 struct Settings {
-  Params params;
+  Params params;                                    // the plant
+  Params model;                                     // what the controller believes: the plant's fingers, its own object and μ̂
   Eigen::Vector3d pose0 = Eigen::Vector3d::Zero();  // initial object pose (ψ, x, y)
   StepOptions step;
   double duration = 1;

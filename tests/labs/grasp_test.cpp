@@ -233,3 +233,59 @@ TEST_CASE("grasp: three fingers hold the object too (the finger count comes from
   CHECK(residual < 1e-9);
   CHECK(lab->metrics(tr)["pos_rms"].get<double>() < 0.01);
 }
+
+namespace {
+
+// The object held still at its start pose for `duration` s (no lift, no swing), with these gains.
+json staticHold(double duration, const json& gains) {
+  json g = json::object();
+  for (const auto& [k, v] : gains.items()) g[k] = json{{"value", v}};
+  return {{"reference", {{"lift", 0.0}, {"sideways", 0.0}, {"tilt_deg", 0.0}}},
+          {"simulation", {{"duration", duration}}},
+          {"gains", g}};
+}
+
+}  // namespace
+
+TEST_CASE("grasp: an unknown load stays unknown: the model keeps its mass and the PD sags by (m − m̂) g / k_p") {
+  // The rubric's heavier-object scenario changes the plant only.
+  const json scenario = fixture.defaults()["rubric"]["scenarios"]["heavy_object"]["patch"];
+  CHECK_FALSE(scenario.contains("model"));
+  const auto heavy = fixture.makeLab(scenario);
+  const Settings& s = settingsOf(*heavy);
+  const double m = s.params.object.mass, m_hat = s.model.object.mass;
+  CHECK(m > m_hat);
+  CHECK(m_hat == fixture.defaults()["mechanism"]["object"]["mass"].get<double>());
+  // Held still, the fingers' contact forces are the commanded ones (τ − G = Jᵀ F, J invertible), so
+  // the wrench's y part must carry the whole weight: k_p (y_d − y) = (m − m̂) g, the PD's static sag.
+  const double kp = 2000;
+  const json gains = {{"kp_pos", kp}, {"kd_pos", 50}, {"kp_psi", 2}, {"kd_psi", 0.05}, {"f_squeeze", 4.5}, {"ki_int", 60}, {"k_cone", 0}};
+  const auto lab = fixture.makeLab(mergePatch(scenario, staticHold(3.0, gains)));
+  const Trace tr = fixture.run(*lab, Engine::Hand);
+  const std::size_t last = tr.rows() - 1;
+  const double sag = tr.at(last, "y_d") - tr.at(last, "y_o"), closed = (m - m_hat) * std::abs(s.params.gravity.y()) / kp;
+  MESSAGE("static sag ", sag, " m, (m − m̂) g / k_p = ", closed, " m");
+  CHECK(sag == doctest::Approx(closed).epsilon(0.01));
+  CHECK(std::abs(tr.at(last, "x_o") - tr.at(last, "x_d")) < 0.01 * closed);
+}
+
+TEST_CASE("grasp: friction-cone feedback keeps the cone margin at μ f_sq whatever the load; a constant squeeze loses m g / 2") {
+  // Static hold, μ̂ = μ: with k_c = 1 the integral law settles f_n = f_sq + |f_t| / μ, so the margin
+  // μ f_n − |f_t| = μ f_sq for any object mass; with k_c = 0 it is μ f_sq − m g / 2 (each contact
+  // carries half the weight tangentially).
+  const double mu = fixture.defaults()["mechanism"]["mu"];
+  const double g = std::abs(fixture.defaults()["mechanism"]["gravity"][1].get<double>());
+  for (const double mass : {0.2, 0.3}) {
+    const json plant = {{"mechanism", {{"object", {{"mass", mass}}}}}};
+    for (const double k_cone : {0.0, 1.0}) {
+      const double f_sq = k_cone > 0 ? 1.0 : 3.5;  // k_c = 1: a margin μ f_sq for the start, before the integral has caught up with the load
+      const json gains = {{"kp_pos", 2000}, {"kd_pos", 50}, {"kp_psi", 2}, {"kd_psi", 0.05}, {"f_squeeze", f_sq}, {"ki_int", 60}, {"k_cone", k_cone}};
+      const auto lab = fixture.makeLab(mergePatch(plant, staticHold(3.0, gains)));
+      const Trace tr = fixture.run(*lab, Engine::Hand);
+      const double margin = tr.at(tr.rows() - 1, "cone_margin");
+      const double closed = k_cone > 0 ? mu * f_sq : mu * f_sq - mass * g / 2;
+      MESSAGE("m ", mass, " kg, k_c ", k_cone, ": settled margin ", margin, " N, closed form ", closed, " N");
+      CHECK(margin == doctest::Approx(closed).epsilon(0.01));
+    }
+  }
+}

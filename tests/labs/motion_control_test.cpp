@@ -430,3 +430,29 @@ TEST_CASE("motion_control: the flexible screening names the vibration mode in th
     for (const std::string& note : screenLoops(*fixture.makeLab(rigid)).notes) CHECK(note.find("least damped") == std::string::npos);
   }
 }
+
+TEST_CASE("motion_control: the unknown payload stays unknown: PD + gravity settles off by K_p⁻¹ (G − Ĝ)") {
+  // The rubric's payload scenario changes the plant only; the model keeps the nominal payload.
+  const json scenario = fixture.defaults()["rubric"]["scenarios"]["payload_plus_20"]["patch"];
+  CHECK_FALSE(scenario.contains("model"));
+  Settings s = settings(mergePatch(scenario, {{"controller", {{"kind", "pd_gravity"}}},
+                                              {"gains", {{"kp", {{"value", 2000.0}}}, {"kd", {{"value", 60.0}}}}},
+                                              {"mechanism", {{"torque_limit", {1e4, 1e4, 1e4}}}}}));
+  CHECK(s.plant.payload > s.model.payload);
+  CHECK(s.model.payload == fixture.defaults()["model"]["payload"].get<double>());
+  for (auto& f : s.plant.friction) f.coulomb = 0;  // no Coulomb offset at rest
+  for (auto& f : s.model.friction) f.coulomb = 0;
+  // At rest τ = −K_p e + Ĝ(θ) = G(θ): e = −K_p⁻¹ (G − Ĝ)(θ), solved by fixed point about the target.
+  const Eigen::Vector3d target(0.3, -0.6, 0.4);
+  ArmMechanism plant(describe(s.plant)), model(describe(s.model));
+  Eigen::VectorXd e = Eigen::VectorXd::Zero(3);
+  for (int it = 0; it < 50; ++it) {
+    const VecN th = VecN(target + e);
+    e = -(Eigen::VectorXd(plant.gravityTorque(th)) - Eigen::VectorXd(model.gravityTorque(th))).cwiseQuotient(s.controller.kp);
+  }
+  Eigen::VectorXd last;
+  setPoint(s, target, target, 5e-4, 4.0, [&](double, const Eigen::VectorXd& th, const Eigen::VectorXd&, double) { last = th; });
+  MESSAGE("settled error ", (last - target).transpose(), ", closed form ", e.transpose());
+  CHECK(e.cwiseAbs().maxCoeff() > 1e-4);  // the payload's weight is felt
+  CHECK((last - target - e).cwiseAbs().maxCoeff() < 0.01 * e.cwiseAbs().maxCoeff());
+}
