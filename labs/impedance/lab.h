@@ -41,7 +41,10 @@ struct Settings {
   Eigen::Vector3d pose;                 // rad, the initial joint angles: x_ref is the tip pose there
   Eigen::Vector3d tau_max, constant;    // N·m
   Kind kind = Kind::TaskSpace;
-  Target target;
+  // The exercise's target (impedance.json's "target": graded, drawn, x_target) and the impedance the
+  // controller is programmed with (the student's gains k, d, m): the rubric grades the hand against
+  // the target, whatever the gains, so no realisation can dodge it by choosing its own target.
+  Target target, law;
   // joint_space's inner loop: the motion-control lab's joint controller (pid, computed_torque or
   // pd_gravity with its gains, labs/motion_control/controller.h) tracking θ_des from inverse kinematics.
   motion_control::ControllerConfig inner;
