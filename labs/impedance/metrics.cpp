@@ -12,8 +12,9 @@
 //                    stiff wall's a short peak; a window of fixed length reads both alike, whatever dt
 //   wall_overshoot   (peak − settled)/settled, settled: the mean wall force over the push's last 20 %
 //                    (no settled contact: against |F| instead), when there is a wall
-//   wall_force_error |settled − F_t| / F_t, F_t = F_x − K_des (x_wall − r − x_ref): what the target,
-//                    at rest against the wall, presses with (the push along x reaching the wall)
+//   wall_force_error RMS of F_wall − F_t over the push's last 20 %, relative to F_t = F_x − K_des
+//                    (x_wall − r − x_ref), what the target at rest against the wall presses with (the
+//                    push along x reaching the wall): a steady press off by |mean − F_t|, or chattering
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -89,6 +90,7 @@ json ImpedanceLab::metrics(const Trace& tr) const {
   std::vector<double> ts, ds, last, wall;
   double d_max = 0, off_max = 0, drift = 0, wall_settled = 0, miss = 0;
   std::size_t settled_rows = 0;
+  std::vector<double> late_wall;  // the wall force over the push's last 20 %
   const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
   for (std::size_t r = 0; r < tr.rows(); ++r) {
     const double t = tr.at(r, "t");
@@ -97,7 +99,7 @@ json ImpedanceLab::metrics(const Trace& tr) const {
     // The wall's normal push on the tip (it pushes −x): the row's F_ext_x less the applied force.
     if (s_.wall.enabled) wall.push_back(-tr.at(r, "F_ext_x") + f.at(t).x());
     if (t < f.start || t >= t_end) continue;
-    if (s_.wall.enabled && t >= t_end - 0.2 * (t_end - f.start)) wall_settled += wall.back(), ++settled_rows;
+    if (s_.wall.enabled && t >= t_end - 0.2 * (t_end - f.start)) wall_settled += wall.back(), ++settled_rows, late_wall.push_back(wall.back());
     ts.push_back(t - f.start - f.rise / 2);
     ds.push_back(u.dot(e));
     const Eigen::Vector2d e_t(tr.at(r, "x_target") - tr.at(r, "x_ref"), tr.at(r, "y_target") - tr.at(r, "y_ref"));
@@ -147,7 +149,9 @@ json ImpedanceLab::metrics(const Trace& tr) const {
   const double gap = s_.wall.x - s_.wall.radius - (tr.rows() ? tr.at(0, "x_ref") : 0.0);
   const double f_t = std::max(0.0, f.value.x() - s_.target.K[0] * gap);
   m["wall_force_target"] = f_t;
-  m["wall_force_error"] = f_t > 1e-9 ? std::abs(wall_settled / f_t - 1) : 0.0;
+  double miss_wall = 0;  // RMS of F_wall − F_t: a steady press reads |mean − F_t|, a chattering one its swings
+  for (double w : late_wall) miss_wall += (w - f_t) * (w - f_t) / double(late_wall.size());
+  m["wall_force_error"] = f_t > 1e-9 ? std::sqrt(miss_wall) / f_t : 0.0;
   return m;
 }
 
