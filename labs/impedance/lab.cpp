@@ -352,7 +352,7 @@ Lab::PassiveEnergy ImpedanceLab::passiveEnergy() const {
   return {1e-5, 1.0, {{"environment", {{"force", {{"value", {0.0, 0.0}}}}, {"wall", {{"enabled", false}}}}}}};
 }
 
-DYNLAB_REGISTER_LAB(impedance, "Impedance control: make the hand feel like a chosen mass-spring-damper, three ways",
+DYNLAB_REGISTER_LAB(impedance, "Impedance control: make the hand feel like a given mass-spring-damper, three ways",
                     [](const JsonView& config) -> std::unique_ptr<Lab> {
                       return std::make_unique<ImpedanceLab>(parseSettings(config));
                     });

@@ -1,5 +1,6 @@
 // The impedance-control lab (lecture §4): the motion-control lab's 3-link arm (reused from
-// labs/motion_control/mechanism.h) asked to make its hand feel like a chosen mass-spring-damper
+// labs/motion_control/mechanism.h) asked to make its hand feel like a given mass-spring-damper (the
+// exercise's target, impedance.json "target"; the controller's own K, D, M are the student's gains)
 //   M_des ẍ + D_des ẋ + K_des (x − x_ref) = F_ext,   x = (x_tip, y_tip, φ_tip), per axis (diagonal),
 // realised three ways (controller kind): joint_space, task_space, feedback_linearisation; plus none
 // and constant. The environment: a tip force (step or push) and/or a wall (a planar PlaneContact).
