@@ -128,7 +128,7 @@ class Hooks final : public StepHooks {
   Eigen::Vector3d control(double t, const VecN& q, const VecN& v) {
     const Eigen::Vector3d th = q.head<3>(), thd = v.head<3>();
     const Eigen::Vector3d F(fx_.value(), fy_.value(), 0.0);
-    const Target& T = s_.target;
+    const Target& T = s_.law;
     Eigen::Vector3d tau = Eigen::Vector3d::Zero();
     switch (s_.kind) {
       case Kind::None: break;
@@ -218,7 +218,7 @@ bool inverseKinematics(const Params& p, const Eigen::Vector3d& x, const Eigen::V
 Settings parseSettings(const JsonView& c) {
   Settings s;
   c.onlyKeys({"lab", "title", "description", "mechanism", "model", "pose_deg", "environment", "simulation", "controller",
-              "gains", "metrics", "rubric", "drawing", "submission_options", "metric_docs", "map", "figures"});
+              "target", "gains", "metrics", "rubric", "drawing", "submission_options", "metric_docs", "map", "figures"});
   const JsonView m = c["mechanism"];
   m.onlyKeys({"links", "payload", "gravity", "torque_limit"});
   m["links"].size(3, 3);
@@ -279,13 +279,21 @@ Settings parseSettings(const JsonView& c) {
   if (std::abs(ratio - std::round(ratio)) > 1e-6) ctl["control_period"].fail("expected a whole multiple of /simulation/dt");
   s.constant = ctl.has("constant_torque") ? parse3(ctl["constant_torque"], -kMaxForce, kMaxForce) : Eigen::Vector3d::Zero();
 
-  // The target per axis: K and M given, D from the damping ratio, D = 2ζ√(KM).
-  const auto g = parseGains(c["gains"], {"k_xy", "k_phi", "m_xy", "m_phi", "zeta", "joint_kp", "joint_ki", "joint_kd"});
+  // The exercise's target along x and y: K and M given, D = 2ζ√(KM); φ is not graded (the law's).
+  const JsonView tg = c["target"];
+  tg.onlyKeys({"k_xy", "m_xy", "zeta"});
+  const double k_t = tg["k_xy"].positive(1e7), m_t = tg["m_xy"].positive(1e4), z_t = tg["zeta"].inRange(0, 100);
+  // The controller's impedance per axis (the student's gains): what task_space, feedback
+  // linearisation and joint_space's impedance model are programmed with.
+  const auto g = parseGains(c["gains"], {"k_xy", "d_xy", "m_xy", "k_phi", "d_phi", "m_phi", "joint_kp", "joint_ki", "joint_kd"});
   for (const char* k : {"k_xy", "k_phi", "m_xy", "m_phi"})
-    if (!(g.at(k) > 0)) c["gains"][k].fail(std::string("a positive ") + k + " (the target impedance must be positive definite)");
-  s.target.K << g.at("k_xy"), g.at("k_xy"), g.at("k_phi");
-  s.target.M << g.at("m_xy"), g.at("m_xy"), g.at("m_phi");
-  for (int i = 0; i < 3; ++i) s.target.D[i] = 2 * g.at("zeta") * std::sqrt(s.target.K[i] * s.target.M[i]);
+    if (!(g.at(k) > 0)) c["gains"][k].fail(std::string("a positive ") + k + " (the impedance must be positive definite)");
+  s.law.K << g.at("k_xy"), g.at("k_xy"), g.at("k_phi");
+  s.law.M << g.at("m_xy"), g.at("m_xy"), g.at("m_phi");
+  s.law.D << g.at("d_xy"), g.at("d_xy"), g.at("d_phi");
+  s.target = s.law;
+  s.target.K.head<2>().setConstant(k_t), s.target.M.head<2>().setConstant(m_t);
+  s.target.D.head<2>().setConstant(2 * z_t * std::sqrt(k_t * m_t));
   // joint_space's inner loop, the motion-control lab's controller: computed_torque's K_p, K_d act on
   // the error dynamics (1/s², 1/s, every joint alike); pid's and pd_gravity's are torques per error,
   // spread over the joints by joint_scale. Absent (older configs): computed torque, as before.
@@ -344,7 +352,7 @@ Lab::PassiveEnergy ImpedanceLab::passiveEnergy() const {
   return {1e-5, 1.0, {{"environment", {{"force", {{"value", {0.0, 0.0}}}}, {"wall", {{"enabled", false}}}}}}};
 }
 
-DYNLAB_REGISTER_LAB(impedance, "Impedance control: make the hand feel like a chosen mass-spring-damper, three ways",
+DYNLAB_REGISTER_LAB(impedance, "Impedance control: make the hand feel like a given mass-spring-damper, three ways",
                     [](const JsonView& config) -> std::unique_ptr<Lab> {
                       return std::make_unique<ImpedanceLab>(parseSettings(config));
                     });

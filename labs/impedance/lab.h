@@ -1,5 +1,6 @@
 // The impedance-control lab (lecture §4): the motion-control lab's 3-link arm (reused from
-// labs/motion_control/mechanism.h) asked to make its hand feel like a chosen mass-spring-damper
+// labs/motion_control/mechanism.h) asked to make its hand feel like a given mass-spring-damper (the
+// exercise's target, impedance.json "target"; the controller's own K, D, M are the student's gains)
 //   M_des ẍ + D_des ẋ + K_des (x − x_ref) = F_ext,   x = (x_tip, y_tip, φ_tip), per axis (diagonal),
 // realised three ways (controller kind): joint_space, task_space, feedback_linearisation; plus none
 // and constant. The environment: a tip force (step or push) and/or a wall (a planar PlaneContact).
@@ -41,7 +42,10 @@ struct Settings {
   Eigen::Vector3d pose;                 // rad, the initial joint angles: x_ref is the tip pose there
   Eigen::Vector3d tau_max, constant;    // N·m
   Kind kind = Kind::TaskSpace;
-  Target target;
+  // The exercise's target (impedance.json's "target": graded, drawn, x_target) and the impedance the
+  // controller is programmed with (the student's gains k, d, m): the rubric grades the hand against
+  // the target, whatever the gains, so no realisation can dodge it by choosing its own target.
+  Target target, law;
   // joint_space's inner loop: the motion-control lab's joint controller (pid, computed_torque or
   // pd_gravity with its gains, labs/motion_control/controller.h) tracking θ_des from inverse kinematics.
   motion_control::ControllerConfig inner;

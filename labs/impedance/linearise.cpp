@@ -27,7 +27,7 @@ std::vector<LinearLoop> ImpedanceLab::linearise() const {
     LinearLoop l;
     l.name = a == 0 ? "x" : "y";
     l.delay = 0.5 * s_.period;
-    const double K = s_.target.K[a], D = s_.target.D[a], Laa = L.size() ? L(a, a) : 1.0, Lh_aa = Lh.size() ? Lh(a, a) : 1.0;
+    const double K = s_.law.K[a], D = s_.law.D[a], Laa = L.size() ? L(a, a) : 1.0, Lh_aa = Lh.size() ? Lh(a, a) : 1.0;
     const std::string axis = std::string(" along ") + l.name;
     switch (s_.kind) {
       case Kind::TaskSpace:
@@ -36,7 +36,7 @@ std::vector<LinearLoop> ImpedanceLab::linearise() const {
       case Kind::FeedbackLinearisation:
       case Kind::JointSpace:
         l.what = (s_.kind == Kind::JointSpace ? "joint-space impedance" : "feedback-linearised impedance") + axis;
-        l.num = {Lh_aa / Laa * K, Lh_aa / Laa * D}, l.den = {0, 0, s_.target.M[a]};
+        l.num = {Lh_aa / Laa * K, Lh_aa / Laa * D}, l.den = {0, 0, s_.law.M[a]};
         break;
       default:
         l.what = "hand (no feedback)" + axis, l.num = {}, l.den = {0, 0, Laa};

@@ -2,12 +2,19 @@
 //   stiffness        K_id = |F| / d_static, d_static the mean displacement over the last 20 % of the push
 //   omega_n, zeta    the 2nd-order step response d_s(1 − …) best fitting d(t) over the push (grid, then
 //                    refined), against the target's ω_t = √(K/M_des), ζ_t = D/(2√(KM_des))
+//   apparent_mass    M_id = K_id / ω_fit² (kg): the mass the push feels, against the target's M_des
+//   response_error   the largest |d − d_target| over the push (d_target: the target's analytic response),
+//                    relative to the target's static displacement |F|/K_des: stiffness, mass and
+//                    damping at once, the target realised or not
 //   coupling         max |off-axis displacement| / max |d| over the push
 //   wall_force_peak  the largest mean normal force of the wall over any 5 ms window (∫F dt / 5 ms):
 //                    a rigid wall's plastic impact is an impulse P = Λ_n v_n (its row carries P/dt), a
 //                    stiff wall's a short peak; a window of fixed length reads both alike, whatever dt
 //   wall_overshoot   (peak − settled)/settled, settled: the mean wall force over the push's last 20 %
 //                    (no settled contact: against |F| instead), when there is a wall
+//   wall_force_error RMS of F_wall − F_t over the push's last 20 %, relative to F_t = F_x − K_des
+//                    (x_wall − r − x_ref), what the target at rest against the wall presses with (the
+//                    push along x reaching the wall): a steady press off by |mean − F_t|, or chattering
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -81,8 +88,9 @@ json ImpedanceLab::metrics(const Trace& tr) const {
   const double m_des = u.x() * u.x() * s_.target.M[0] + u.y() * u.y() * s_.target.M[1];
   const double d_des = u.x() * u.x() * s_.target.D[0] + u.y() * u.y() * s_.target.D[1];
   std::vector<double> ts, ds, last, wall;
-  double d_max = 0, off_max = 0, drift = 0, wall_settled = 0;
+  double d_max = 0, off_max = 0, drift = 0, wall_settled = 0, miss = 0;
   std::size_t settled_rows = 0;
+  std::vector<double> late_wall;  // the wall force over the push's last 20 %
   const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
   for (std::size_t r = 0; r < tr.rows(); ++r) {
     const double t = tr.at(r, "t");
@@ -91,9 +99,11 @@ json ImpedanceLab::metrics(const Trace& tr) const {
     // The wall's normal push on the tip (it pushes −x): the row's F_ext_x less the applied force.
     if (s_.wall.enabled) wall.push_back(-tr.at(r, "F_ext_x") + f.at(t).x());
     if (t < f.start || t >= t_end) continue;
-    if (s_.wall.enabled && t >= t_end - 0.2 * (t_end - f.start)) wall_settled += wall.back(), ++settled_rows;
+    if (s_.wall.enabled && t >= t_end - 0.2 * (t_end - f.start)) wall_settled += wall.back(), ++settled_rows, late_wall.push_back(wall.back());
     ts.push_back(t - f.start - f.rise / 2);
     ds.push_back(u.dot(e));
+    const Eigen::Vector2d e_t(tr.at(r, "x_target") - tr.at(r, "x_ref"), tr.at(r, "y_target") - tr.at(r, "y_ref"));
+    miss = std::max(miss, std::abs(u.dot(e - e_t)));
     d_max = std::max(d_max, std::abs(u.dot(e)));
     off_max = std::max(off_max, std::abs(v.dot(e)));
     if (t >= t_end - 0.2 * (t_end - f.start)) last.push_back(u.dot(e));
@@ -104,6 +114,7 @@ json ImpedanceLab::metrics(const Trace& tr) const {
   m["stiffness_target"] = k_des;
   m["omega_target"] = std::sqrt(k_des / m_des);
   m["zeta_target"] = d_des / (2 * std::sqrt(k_des * m_des));
+  m["apparent_mass_target"] = m_des;
   if (fn > 0 && std::abs(d_static) > 1e-12 && !ts.empty()) {
     const double k_id = fn / d_static;
     const Fit fit = fitStep(ts, ds, d_static, std::sqrt(k_des / m_des));
@@ -113,10 +124,14 @@ json ImpedanceLab::metrics(const Trace& tr) const {
     m["zeta"] = fit.z;
     m["omega_error"] = std::abs(fit.w / std::sqrt(k_des / m_des) - 1);
     m["zeta_error"] = std::abs(fit.z - d_des / (2 * std::sqrt(k_des * m_des)));
+    m["apparent_mass"] = k_id / (fit.w * fit.w);
+    m["apparent_mass_error"] = std::abs(k_id / (fit.w * fit.w) / m_des - 1);
+    m["response_error"] = miss / (fn / k_des);
     m["coupling"] = d_max > 0 ? off_max / d_max : 0.0;
     m["fit_rms"] = std::sqrt(fit.cost / double(ts.size())) / std::abs(d_static);
   } else {
-    for (const char* k : {"stiffness", "stiffness_error", "omega_n", "zeta", "omega_error", "zeta_error", "coupling", "fit_rms"})
+    for (const char* k : {"stiffness", "stiffness_error", "omega_n", "zeta", "omega_error", "zeta_error", "apparent_mass",
+                          "apparent_mass_error", "response_error", "coupling", "fit_rms"})
       m[k] = 0.0;
   }
   // The wall: the largest 5 ms mean force (a sliding sum over k rows) against the settled force.
@@ -131,6 +146,12 @@ json ImpedanceLab::metrics(const Trace& tr) const {
   m["wall_force_peak"] = wall_peak;
   m["wall_force_settled"] = wall_settled;
   m["wall_overshoot"] = against > 1e-9 ? std::max(0.0, wall_peak / against - 1) : 0.0;
+  const double gap = s_.wall.x - s_.wall.radius - (tr.rows() ? tr.at(0, "x_ref") : 0.0);
+  const double f_t = std::max(0.0, f.value.x() - s_.target.K[0] * gap);
+  m["wall_force_target"] = f_t;
+  double miss_wall = 0;  // RMS of F_wall − F_t: a steady press reads |mean − F_t|, a chattering one its swings
+  for (double w : late_wall) miss_wall += (w - f_t) * (w - f_t) / double(late_wall.size());
+  m["wall_force_error"] = f_t > 1e-9 ? std::sqrt(miss_wall) / f_t : 0.0;
   return m;
 }
 

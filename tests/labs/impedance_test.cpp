@@ -10,6 +10,12 @@
 //  * a rigid wall's plastic impact: its impulse is in the wall force (5 ms window), so the peak stands
 //    well above the settled force, agrees with Bullet within 15 % and does not depend on dt (10 %);
 //  * hand vs Bullet over a push: |Δx| ≤ 0.5 mm (Bullet's first-order step at dt = 1 ms);
+//  * the target is the exercise's (impedance.json "target"): the gains move the hand, never the target;
+//  * the apparent mass each realisation achieves, M_id = K_id/ω_fit²: feedback linearisation and a
+//    stiff joint_space loop give the programmed m_xy (force feedback), task_space the arm's Λ_xx from
+//    the screening whatever m_xy is (its trace does not depend on m_xy at all);
+//  * at rest against a stiff wall the hand presses with F − K_des·gap when its static stiffness is
+//    K_des (feedback linearisation, task space); a stiff pid joint loop chatters on the wall;
 //  * bad inputs (K_des not positive, a singular reference pose, a wall behind the tip) get one line.
 #include <doctest/doctest.h>
 
@@ -27,11 +33,16 @@ namespace {
 
 const test::LabFixture fixture("impedance");
 
-json gains(const char* kind, double k, double zeta, double joint_kp = 2500, double joint_kd = 100) {
+// A realisation programmed with stiffness k, mass m and damping ratio zeta (d = 2ζ√(k m)), graded
+// against the same target (so the target's metrics read the law back).
+json gains(const char* kind, double k, double zeta, double joint_kp = 2500, double joint_kd = 100, double m = 1.0) {
   return {{"controller", {{"kind", kind}}},
-          {"gains", {{"k_xy", {{"value", k}}}, {"zeta", {{"value", zeta}}}, {"joint_kp", {{"value", joint_kp}}},
-                     {"joint_kd", {{"value", joint_kd}}}}}};
+          {"target", {{"k_xy", k}, {"m_xy", m}, {"zeta", zeta}}},
+          {"gains", {{"k_xy", {{"value", k}}}, {"d_xy", {{"value", 2 * zeta * std::sqrt(k * m)}}}, {"m_xy", {{"value", m}}},
+                     {"joint_kp", {{"value", joint_kp}}}, {"joint_kd", {{"value", joint_kd}}}}}};
 }
+
+json metricsOf(const Lab& lab) { return lab.metrics(test::LabFixture::run(lab, Engine::Hand)); }
 
 }  // namespace
 
@@ -72,6 +83,8 @@ TEST_CASE("task_space: static stiffness is K_des, the apparent mass is the arm's
   MESSAGE("task_space: ω fitted ", w_fit, " rad/s, √(K/Λ_xx) = ", std::sqrt(300 / lambda_xx), " (Λ_xx = ", lambda_xx, " kg)");
   CHECK(w_fit == doctest::Approx(std::sqrt(300 / lambda_xx)).epsilon(0.03));
   CHECK(std::abs(lambda_xx - 1.0) > 0.1);  // the point: the arm's Λ is not the M_des = 1 kg asked for
+  // Its identified apparent mass is Λ_xx too.
+  CHECK(lab2->metrics(r2.trace)["apparent_mass"].get<double>() == doctest::Approx(lambda_xx).epsilon(0.05));
 }
 
 TEST_CASE("joint_space: the joint loop's compliance in series, shrinking as K_p grows") {
@@ -144,7 +157,97 @@ TEST_CASE("hand vs Bullet over a push") {
   CHECK(dx <= 5e-4);
 }
 
+TEST_CASE("the target is the exercise's: the gains move the hand, never the target") {
+  // The shipped target, whatever the controller is programmed with.
+  const json shipped = fixture.defaults()["target"];
+  const double k_t = shipped["k_xy"], m_t = shipped["m_xy"], z_t = shipped["zeta"];
+  for (double m : {0.3, 3.0}) {
+    json p = {{"controller", {{"kind", "feedback_linearisation"}}},
+              {"gains", {{"k_xy", {{"value", 200.0}}}, {"d_xy", {{"value", 5.0}}}, {"m_xy", {{"value", m}}}}}};
+    const auto lab = fixture.makeLab(p);
+    const Trace tr = test::LabFixture::run(*lab, Engine::Hand);
+    const json mt = lab->metrics(tr);
+    CHECK(mt["stiffness_target"].get<double>() == doctest::Approx(k_t));
+    CHECK(mt["apparent_mass_target"].get<double>() == doctest::Approx(m_t));
+    CHECK(mt["zeta_target"].get<double>() == doctest::Approx(z_t));
+    // x_target is the target's analytic step response, not the law's: at the push's end F/K_t from x_ref.
+    const std::size_t last = std::size_t(std::lround((0.2 + 1.3) / lab->dt())) - 1;
+    CHECK(tr.at(last, "x_target") - tr.at(last, "x_ref") == doctest::Approx(10.0 / k_t).epsilon(1e-3));
+    // Programmed away from the target, the hand is graded far from it.
+    CHECK(mt["response_error"].get<double>() > 0.5);
+  }
+}
+
+TEST_CASE("apparent mass: force feedback shapes it, task space keeps the arm's") {
+  // The arm's Λ_xx at the reference pose, from the screening of a task_space law.
+  const auto ts = fixture.makeLab(gains("task_space", 500, 0.7));
+  const double lambda_xx = ts->linearise()[0].den[2];
+  for (double m : {0.5, 2.0}) {
+    CAPTURE(m);
+    const json fl = metricsOf(*fixture.makeLab(gains("feedback_linearisation", 500, 0.7, 0, 0, m)));
+    const json js = metricsOf(*fixture.makeLab(gains("joint_space", 500, 0.7, 40000, 400, m)));
+    json tp = gains("task_space", 500, 0.7, 0, 0, 1.0);
+    tp["gains"]["m_xy"] = {{"value", m}};  // task space has no use for m_xy: the same law, the same hand
+    const json tm = metricsOf(*fixture.makeLab(tp));
+    MESSAGE("m_xy = ", m, " kg: feedback linearisation M_id = ", fl["apparent_mass"].get<double>(), ", joint_space ",
+            js["apparent_mass"].get<double>(), ", task_space ", tm["apparent_mass"].get<double>(), " (Λ_xx = ", lambda_xx, ")");
+    CHECK(fl["apparent_mass"].get<double>() == doctest::Approx(m).epsilon(0.03));
+    CHECK(js["apparent_mass"].get<double>() == doctest::Approx(m).epsilon(0.1));
+    CHECK(tm["apparent_mass"].get<double>() == doctest::Approx(lambda_xx).epsilon(0.05));
+  }
+  // task_space's trace does not depend on m_xy: bit for bit the same run.
+  json a = gains("task_space", 500, 0.7), b = a;
+  b["gains"]["m_xy"] = {{"value", 5.0}};
+  const auto la = fixture.makeLab(a), lb = fixture.makeLab(b);
+  const Trace ta = test::LabFixture::run(*la, Engine::Hand), tb = test::LabFixture::run(*lb, Engine::Hand);
+  double diff = 0;
+  for (std::size_t i = 0; i < ta.rows(); ++i) diff = std::max(diff, std::abs(ta.at(i, "x") - tb.at(i, "x")));
+  CHECK(diff == 0.0);
+}
+
+TEST_CASE("at rest on a stiff wall the hand presses with the target's force F − K_des·gap") {
+  const json wall = {{"enabled", true}, {"x", 0.4216}, {"stiffness", 50000.0}, {"damping", 20.0}};
+  // The target's force, computed here from the geometry: the ball's surface x_wall − r − x_ref away.
+  double target = 0;
+  int losses = 0;  // contact lost over the push's last 20 % (1.24–1.5 s)
+  auto run = [&](json p) {
+    p["environment"]["wall"] = wall;
+    const auto lab = fixture.makeLab(p);
+    const Trace tr = test::LabFixture::run(*lab, Engine::Hand);
+    target = 10.0 - 500.0 * (0.4216 - 0.01 - tr.at(0, "x_ref"));
+    losses = 0;
+    for (std::size_t i = 1; i < tr.rows(); ++i)
+      if (tr.at(i, "t") >= 1.24 && tr.at(i, "t") < 1.5 && tr.at(i - 1, "F_ext_x") < 10 - 1e-9 && tr.at(i, "F_ext_x") >= 10 - 1e-9) ++losses;
+    const json m = lab->metrics(tr);
+    CHECK(m["wall_force_target"].get<double>() == doctest::Approx(target).epsilon(1e-9));
+    return m;
+  };
+  const json fl = run(gains("feedback_linearisation", 500, 0.7));
+  CHECK(losses == 0);
+  const json ts = run(gains("task_space", 500, 0.7));
+  CHECK(losses == 0);
+  // A stiff pid joint loop (the shipped joint_space_pid example's gains) tracking x_des into the wall.
+  json pid = gains("joint_space", 500, 0.7, 20000, 200);
+  pid["controller"]["inner"] = "pid";
+  pid["gains"]["joint_ki"] = {{"value", 20000.0}};
+  pid["gains"]["k_phi"] = {{"value", 30.0}};
+  pid["gains"]["d_phi"] = {{"value", 1.7}};
+  const json js = run(pid);
+  MESSAGE("settled wall force: feedback linearisation ", fl["wall_force_settled"].get<double>(), " N, task_space ",
+          ts["wall_force_settled"].get<double>(), " N, the target's ", target, " N; joint_space pid loses contact ", losses,
+          " times late in the push, wall_force_error ", js["wall_force_error"].get<double>());
+  CHECK(target > 1.0);
+  CHECK(fl["wall_force_settled"].get<double>() == doctest::Approx(target).epsilon(0.03));
+  CHECK(ts["wall_force_settled"].get<double>() == doctest::Approx(target).epsilon(0.03));
+  CHECK(fl["wall_force_error"].get<double>() < 0.03);
+  // It chatters: contact lost again and again, the wall force far from the target's in RMS.
+  CHECK(losses >= 3);
+  CHECK(js["wall_force_error"].get<double>() > 0.5);
+}
+
 TEST_CASE("bad inputs get one line naming the JSON path") {
+  CHECK(fixture.inputError({{"target", {{"m_xy", 0.0}}}}).find("/target/m_xy") == 0);
+  CHECK(fixture.inputError({{"target", {{"zeta_des", 0.7}}}}).find("/target") == 0);
   CHECK(fixture.inputError({{"gains", {{"k_xy", {{"value", 0.0}}}}}}).find("/gains/k_xy") != std::string::npos);
   CHECK(fixture.inputError({{"pose_deg", {30.0, 0.0, -45.0}}}).find("/pose_deg: a pose away from the task Jacobian's singularity") == 0);
   CHECK(fixture.inputError({{"environment", {{"wall", {{"enabled", true}, {"x", 0.1}}}}}}).find("/environment/wall/x") == 0);
