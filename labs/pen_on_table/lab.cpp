@@ -69,11 +69,12 @@ class Hooks final : public StepHooks {
   }
   void observe(const StepRecord& r) override { ctrl_.measure(-push(r)); }
   // The lab's watchdog: an unstable force loop on a unilateral contact does not blow up, it hammers the
-  // table (a bounded limit cycle of lift-offs); the run stops after max_liftoffs of them.
+  // table (a bounded limit cycle of lift-offs); the run stops at max_liftoffs (4) of them after the first
+  // touchdown: a stable loop lifts off at most once (the touchdown step's impact reopens the row for a step).
   std::string stop(const StepRecord& r) override {
     const bool contact = push(r) > 0;
     if (touched_ && in_contact_ && !contact && ++liftoffs_ >= s_.max_liftoffs)
-      return "stopped: the pen lifted off the table " + std::to_string(liftoffs_) + " times after touching down, at t = " +
+      return "stopped: the pen bounced, lifting off the table " + std::to_string(liftoffs_) + " times after touching down, at t = " +
              fmt("%.4g", r.t) + " s (the force loop oscillates)";
     touched_ = touched_ || contact;
     in_contact_ = contact;
