@@ -47,6 +47,7 @@ struct Row {
   double score = 0, max_score = 0;
   bool graded = false;           // max_score comes from its own tests
   std::vector<TestScore> tests;  // in rubric order
+  std::string answers;           // the submission's written answers ("name: text", blank-line separated)
 };
 
 // A row from OUT/<folder>/results.json after the grader exited with `exit_code` (0 graded, 2 invalid

@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 namespace dyn::app::batch {
 
 Row failedRow(const Submission& s, const std::string& status, const std::string& reason) {
-  return {s.name, s.folder, status, jsonText(reason), 0, 0, false, {}};
+  return {s.name, s.folder, status, jsonText(reason), 0, 0, false, {}, {}};
 }
 
 Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, const std::string& log_tail) {
@@ -46,12 +46,16 @@ Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, 
   if ((exit_code != 0 && !budget) || !error.is_null() || !r.value("score", json()).is_number())
     return failedRow(s, "internal error", "internal error: the grader exited with status " + std::to_string(exit_code) +
                                               (exit_code == 0 ? " but its results.json holds no grade" : "") + said);
-  Row row{s.name, s.folder, "graded", "", r.value("score", 0.0), 0, true, {}};
+  Row row{s.name, s.folder, "graded", "", r.value("score", 0.0), 0, true, {}, {}};
   try {
     for (const auto& t : r.value("tests", json::array())) {
       row.tests.push_back({t.value("name", "?"), t.value("score", 0.0), t.value("max_score", 0.0)});
       row.max_score += row.tests.back().max_score;
     }
+    // The written answers, for the TA reading the gradebook.
+    if (const json a = extra.value("answers", json::object()); a.is_object())
+      for (const auto& [name, text] : a.items())
+        if (text.is_string()) row.answers += (row.answers.empty() ? "" : "\n\n") + name + ": " + text.get<std::string>();
     // A scenario that did not complete: the watchdog's sentence, or the time budget running out.
     const json scenarios = extra.value("scenarios", json::object());
     for (const auto& [name, sc] : scenarios.items()) {
@@ -112,9 +116,11 @@ std::string gradebookCsv(std::vector<Row> rows, double lab_max) {
     std::snprintf(buf, sizeof buf, "%.4g", x);
     return csvField(buf);
   };
+  // The written answers, last, when any submission has some.
+  const bool answers = std::any_of(rows.begin(), rows.end(), [](const Row& r) { return !r.answers.empty(); });
   std::string csv = "submission,score,max_score,status,reason,folder";
   for (const auto& t : tests) csv += "," + csvField(t);
-  csv += "\n";
+  csv += answers ? ",answers\n" : "\n";
   for (const auto& r : rows) {
     csv += csvField(r.name) + "," + number(r.score) + "," + number(r.graded ? r.max_score : lab_max) + "," +
            csvField(r.status) + "," + csvField(r.reason) + "," + csvField(r.folder);
@@ -123,6 +129,7 @@ std::string gradebookCsv(std::vector<Row> rows, double lab_max) {
       csv += ',';
       if (it != r.tests.end()) csv += number(it->score);
     }
+    if (answers) csv += "," + csvField(r.answers);
     csv += "\n";
   }
   return csv;

@@ -52,6 +52,12 @@ struct CompareArgs {
   bool plots = true;
 };
 
+// dynlab lessons LAB: the rubric's lesson pairs graded, and whether each ranks as the lecture says.
+struct LessonsArgs {
+  std::string lab, config;
+  double time_budget = 300;  // s of wall time per submission
+};
+
 struct BenchArgs {
   bool json = false;
   int steps = 4000, frames = 60;
@@ -89,6 +95,8 @@ int bench(const BenchArgs& args);
 int benchScaling(const BenchArgs& args);
 // Grades both, prints a table per test, writes OUT/comparison.md and OUT/plots/ (app/compare.cpp).
 int compare(const CompareArgs& args);
+// Prints each lesson with both scores; exit 0 when all hold, 1 when one does not, 2 on bad input.
+int lessons(const LessonsArgs& args);
 // Replaces this process with dynlab-ui (next to /proc/self/exe); returns only on failure (1).
 int openUi(const UiArgs& args);
 // CPU cost of grading the lab's instructor/good.json (app/bench_grade.cpp); empty if none.

@@ -14,6 +14,7 @@
 #include "app/output.h"
 #include "grading/escape.h"
 #include "grading/grade.h"
+#include "grading/lessons.h"
 #include "grading/plot.h"
 
 namespace fs = std::filesystem;
@@ -231,6 +232,40 @@ int compare(const CompareArgs& args) {
     return 4;
   }
   return 0;
+}
+
+int lessons(const LessonsArgs& args) {
+  try {
+    // The lab's config and rubric; the pairs live beside the config (labs/LAB/examples/...).
+    const LoadedLab loaded = loadLab(args.lab, args.config);
+    const Rubric rubric = parseRubric(JsonView(loaded.config, loaded.config_file));
+    GradeOptions o;
+    o.expected_lab = args.lab;
+    o.config_file = loaded.config_file;
+    o.time_budget = args.time_budget;
+    const std::string dir = fs::path(loaded.config_file).parent_path().string();
+    std::printf("dynlab lessons %s: %zu lesson(s), each graded by the rubric\n", termText(args.lab).c_str(), rubric.lessons.size());
+    int failed = 0;
+    for (const LessonCheck& c : checkLessons(rubric, dir, o)) {
+      const std::string names = termText(fs::path(c.lesson.better).stem().string()) + " ahead of " +
+                                termText(fs::path(c.lesson.worse).stem().string());
+      if (!c.error.empty()) {
+        std::printf("  ERROR  %s: %s\n", names.c_str(), termText(c.error).c_str());
+      } else {
+        std::printf("  %-6s %s: %s vs %s of %s, lead %s (at least %s)\n", c.holds() ? "holds" : "FAILS", names.c_str(),
+                    pts(c.better).c_str(), pts(c.worse).c_str(), pts(c.max).c_str(), pts(c.better - c.worse).c_str(),
+                    pts(c.lesson.margin * c.max).c_str());
+      }
+      std::printf("         %s\n", termText(c.lesson.about).c_str());
+      failed += !c.holds();
+    }
+    if (failed) std::fprintf(stderr, "error: %d lesson(s) of %s do not hold: the rubric ranks them against the lecture\n", failed,
+                             termText(args.lab).c_str());
+    return failed ? 1 : 0;
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return 2;
+  }
 }
 
 }  // namespace dyn::app

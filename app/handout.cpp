@@ -138,6 +138,9 @@ struct Handout {
       }
       md += "\n";
     }
+    md += "The handout's written questions go in the same file, as text for the course staff (never graded): "
+          "`\"answers\": {\"q1\": \"…\", \"q2\": \"…\"}` (at most " + std::to_string(kMaxAnswers) + " answers of at most " +
+          std::to_string(kMaxAnswerBytes) + " bytes each).\n\n";
     md += "The exact format, as a JSON Schema (`dynlab schema " + lab + "` prints it):\n\n```json\n" +
           submissionSchema(config, lab).dump(2) + "\n```\n\n";
     return md;
@@ -152,11 +155,11 @@ struct Handout {
     for (const auto& t : rubric.tests) add(t.metric);
     for (const auto& l : rubric.leaderboard) add(l.metric);
     const Scenario& nominal = rubric.scenarios.front();
-    std::string md = "### Metrics\n\n| metric | definition | unit | time window |\n|---|---|---|---|\n";
+    std::string md = "### Metrics\n\n| metric | definition | unit | time window | if you fall short |\n|---|---|---|---|---|\n";
     for (const auto& m : used) {
       const MetricDoc d = doc(m, nominal);
       md += "| " + code(m) + " | " + cell(d.what) + " | " + cell(d.unit == "1" ? "1 (dimensionless)" : d.unit) + " | " +
-            cell(d.window) + " |\n";
+            cell(d.window) + " | " + cell(d.advice) + " |\n";
     }
     return md + "\n";
   }
@@ -199,6 +202,18 @@ struct Handout {
     return md;
   }
 
+  // The lecture's points the grade is built to make: each lesson pair, as the rubric states it.
+  std::string lessons() const {
+    if (rubric.lessons.empty()) return "";
+    std::string md = "### What the grade teaches\n\nThe rubric is checked against the lecture: of each pair of "
+                     "designs below, both tuned with care, the first must score ahead of the second by at least the "
+                     "share shown (`dynlab lessons " + lab + "` grades the pairs shipped in the lab's folder).\n\n";
+    for (const auto& l : rubric.lessons)
+      md += "* " + code(fs::path(l.better).stem().string()) + " ahead of " + code(fs::path(l.worse).stem().string()) +
+            " by ≥ " + num(l.margin * 100) + " % of the points: " + l.about + "\n";
+    return md + "\n";
+  }
+
   std::string watchdog() const {
     const Watchdog& w = rubric.watchdog;
     std::string md = "### The watchdog\n\nA run that goes bad is stopped, and its tests score 0: any value becomes "
@@ -219,6 +234,16 @@ struct Handout {
     return md + "\n";
   }
 
+  // Columns worth plotting first: the first test plot's response and reference (the lab's own names).
+  std::string plotColumns() const {
+    for (const auto& t : rubric.tests) {
+      if (!t.plot || t.plot->columns.empty() || !t.plot->x.empty()) continue;
+      return t.plot->columns.front() + (t.plot->reference.empty() ? "" : "," + t.plot->reference);
+    }
+    const std::vector<std::string> columns = buildLab(*entry, config, config_file)->columns();
+    return columns.size() > 1 ? columns[1] : "t";
+  }
+
   std::string howTo() const {
     const std::string L = lab;
     return "## Run, tune, self-grade\n\n"
@@ -227,7 +252,7 @@ struct Handout {
            "| simulate it (traces, summary, video) | `dynlab run " + L + " --gains my_gains.json --video` |\n"
            "| tune it in a window (sliders, live plots, screening) and save it | `dynlab ui " + L + " --gains my_gains.json` |\n"
            "| grade it exactly as the autograder will | `dynlab grade my_gains.json --lab " + L + "` |\n"
-           "| plot any trace column | `dynlab figure " + L + " --gains my_gains.json --plot x_c,x_d` |\n"
+           "| plot any trace column | `dynlab figure " + L + " --gains my_gains.json --plot " + plotColumns() + "` |\n"
            "| see where gains are stable | `dynlab map " + L + " --x GAIN=a:b:n --y GAIN=a:b:n --sim` |\n"
            "| check the format | `dynlab schema " + L + "` |\n\n"
            "`dynlab grade` writes `out/grade/report.html` with every test, its plot and the screening notes: the score it "
@@ -245,7 +270,7 @@ struct Handout {
     md += "## How you are graded\n\nThe grader runs your gains on the hand-written engine in each scenario below "
           "(dt = " + num(config.at("simulation").at("dt")) + " s, " + num(config.at("simulation").at("duration")) +
           " s per run) and screens them on the linearised loops first. " + num(rubric.maxScore()) + " points in all.\n\n";
-    md += metrics() + scenarios() + tests() + watchdog() + leaderboard() + howTo();
+    md += metrics() + scenarios() + tests() + lessons() + watchdog() + leaderboard() + howTo();
     // Any further sections the author wrote (hints first), in their order.
     for (const auto& h : prose.order)
       if (h != "Mechanism" && h != "Exercise") md += "## " + h + "\n\n" + prose.sections.at(h) + "\n";

@@ -148,6 +148,14 @@ int dispatch(int argc, char** argv) {
   k->add_option("--time-budget", cmp.time_budget, "Wall-time budget per submission (s)")->check(CLI::Range(1.0, 86400.0));
   k->add_flag("!--no-plots", cmp.plots, "Skip the plots (faster)");
 
+  LessonsArgs les;
+  auto* l = cli.add_subcommand("lessons", "Grade the rubric's lesson pairs (the lecture's preferred design against its "
+                                          "foil) and check each ranks as the lecture says (exit 1 if one does not)");
+  l->add_option("LAB", les.lab, "Lab name (see `dynlab list`)")->required();
+  l->add_option("--config", les.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json); the pairs' paths are "
+                                        "relative to its folder");
+  l->add_option("--time-budget", les.time_budget, "Wall-time budget per submission (s)")->check(CLI::Range(1.0, 86400.0));
+
   BenchArgs bench_args;
   auto* b = cli.add_subcommand("bench", "Benchmark: hand-written vs Bullet step time, render/PNG/video frame rates");
   b->add_flag("--json", bench_args.json, "One JSON object per lab");
@@ -175,6 +183,7 @@ int dispatch(int argc, char** argv) {
   if (*c) return checkResults(results_file);
   if (*s) return printSchema(schema_lab);
   if (*k) return compare(cmp);
+  if (*l) return lessons(les);
   if (*b) return bench_args.scaling ? benchScaling(bench_args) : bench(bench_args);
   if (course.chosen()) return course.run();
   if (*u) {

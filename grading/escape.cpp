@@ -195,7 +195,17 @@ std::string shellWord(std::string_view s) {
 }
 
 std::string csvField(const std::string& raw) {
-  std::string s = jsonText(raw);
+  // Line breaks and tabs stay (quoted below); other controls (ESC, OSC, bidi overrides) as escapes.
+  std::string s;
+  forEachChar(
+      raw,
+      [&](char32_t cp, std::string_view bytes) {
+        if (cp == '\n' || cp == '\r' || cp == '\t') s += bytes;
+        else if (std::string e = controlEscape(cp); !e.empty()) s += e;
+        else if (isInvisibleControl(cp)) s += codePointEscape(cp);
+        else s += bytes;
+      },
+      [&](unsigned char) { s += kReplacement; });
   if (!s.empty() && (s[0] == '=' || s[0] == '+' || s[0] == '-' || s[0] == '@' || s[0] == '\t' || s[0] == '\r'))
     s.insert(s.begin(), '\'');
   const bool quote = s.find_first_of(",\"\r\n") != std::string::npos || (!s.empty() && (s.front() == ' ' || s.back() == ' '));

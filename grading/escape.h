@@ -49,8 +49,9 @@ std::string termText(std::string_view s);
 // A word for a POSIX shell command line shown to a user: as it is when plain, else '...' quoted.
 std::string shellWord(std::string_view s);
 
-// One CSV field: a leading = + - @ tab or CR gets a ' prefix (no spreadsheet formula), then the
-// field is quoted when it holds , " CR or LF or starts/ends with a space ("" inside). Pass numbers
+// One CSV field: control characters other than line breaks and tabs (ESC, OSC, C1) and bidi
+// controls shown as escapes (\x1b, \u{202E}), a leading = + - @ tab or CR gets a ' prefix (no
+// spreadsheet formula), then the field is quoted when it holds , " CR or LF or starts/ends with a space ("" inside). Pass numbers
 // you format yourself directly; this is for text.
 std::string csvField(const std::string& s);
 

@@ -20,7 +20,20 @@ namespace dyn {
 
 std::string hashHex(const std::string& bytes) { return hashHexOf(fnv1a(bytes.data(), bytes.size())); }
 
-std::string submissionHash(const json& submission) { return hashHex(dumpJson(submission)); }
+json canonicalSubmission(const json& submission) {
+  json out = submission;
+  if (out.is_object()) out.erase("answers");
+  // Every number a double: the parser keeps 1000 an integer and 1000.0 a float, one value.
+  const auto canonical = [](auto& self, json& j) -> void {
+    if (j.is_number()) j = j.get<double>();
+    else if (j.is_structured())
+      for (auto& v : j) self(self, v);
+  };
+  canonical(canonical, out);
+  return out;
+}
+
+std::string submissionHash(const json& submission) { return hashHex(dumpJson(canonicalSubmission(submission))); }
 
 std::string hashHexOf(std::uint64_t h) {
   char out[17];
@@ -89,6 +102,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     GradeReport rep;
     rep.lab = lab_name;
     rep.submission = utf8Quotable(file);  // a file name is not always UTF-8; results.json must be
+    rep.answers = submissionAnswers(view);
     rep.fingerprint = {{"dynlab_version", DYNLAB_VERSION},
                        {"lab_config_hash", hashHex(dumpJson(base))},
                        {"submission_hash", submissionHash(sub)}};
@@ -115,15 +129,15 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     // screening's own).
     const std::map<std::string, MetricDoc> docs = parseMetricDocs(JsonView(base, config_file));
     const std::vector<LinearLoop> loops = base_lab->linearise();
-    auto unitOf = [&](const std::string& metric) {
-      if (const auto it = docs.find(metric); it != docs.end()) return it->second.unit;
-      const auto doc = screeningMetricDoc(metric, loops);
-      return doc ? doc->unit : std::string();
+    auto docOf = [&](const std::string& metric) {
+      if (const auto it = docs.find(metric); it != docs.end()) return it->second;
+      return screeningMetricDoc(metric, loops).value_or(MetricDoc{});
     };
     for (std::size_t i = 0; i < rubric.tests.size(); ++i) {
       const RubricTest& t = rubric.tests[i];
       const ScenarioRun& run = runs.at(t.scenario);
-      GradedTest g{t, 0.0, NAN, "", "", unitOf(t.metric), std::nullopt, ""};
+      const MetricDoc doc = docOf(t.metric);
+      GradedTest g{t, 0.0, NAN, "", "", doc.unit, std::nullopt, "", doc.advice};
       // A test of a simulated metric (not the screening's) gets a plot.
       if (!run.screen.metrics.contains(t.metric)) g.plan = planTestPlot(rubric, i, docs, *base_lab);
       if (run.metrics.contains(t.metric)) {

@@ -64,7 +64,11 @@ std::string replayCommand(const std::string& program, const std::string& results
 std::string hashHex(const std::string& bytes);
 std::string hashHexOf(std::uint64_t h);
 // A submission's hash as the fingerprint records it and scenario seeds derive from it: of its
-// canonical dump (sorted keys), so whitespace and key order do not matter.
+// canonical form (canonicalSubmission), so whitespace, key order and the spelling of a number
+// (1000, 1000.0, 1e3) do not matter, and neither do the free-text answers.
 std::string submissionHash(const json& submission);
+// What a grade depends on, in one spelling: the submission without "answers", every number as a
+// double (its dump then spells equal values alike), keys sorted.
+json canonicalSubmission(const json& submission);
 
 }  // namespace dyn

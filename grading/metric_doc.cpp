@@ -81,10 +81,11 @@ std::map<std::string, MetricDoc> parseMetricDocs(const JsonView& config) {
   all.requireObject();
   for (const auto& [name, _] : all.raw().items()) {
     const JsonView d = all[name];
-    d.onlyKeys({"what", "unit", "window", "from", "to"});
+    d.onlyKeys({"what", "unit", "window", "from", "to", "advice"});
     MetricDoc& doc = docs[name];
     doc = {fillFromConfig(d["what"].string(), config, d["what"].path()), d["unit"].string(),
            fillFromConfig(d["window"].string(), config, d["window"].path())};
+    if (d.has("advice")) doc.advice = fillFromConfig(d["advice"].string(), config, d["advice"].path());
     // The window in numbers: "from"/"to" when given, else what its words say ("from t = {/..} s on").
     doc.from = d.has("from") ? windowBound(d["from"], config) : boundIn(doc.window, {"from t = "}, -INFINITY);
     doc.to = d.has("to") ? windowBound(d["to"], config) : boundIn(doc.window, {"until t = ", " to t = "}, INFINITY);
@@ -102,17 +103,21 @@ std::optional<MetricDoc> screeningMetricDoc(const std::string& metric, const std
        {"the total measurement delay the loop tolerates before it goes unstable (phase margin / crossover "
         "frequency; reported as 1000 s when |L| < 1 at every frequency, 0 when the loop is not stable even "
         "without delay or closes no feedback)",
-        "s", ""}},
+        "s", "",
+        "a short margin comes from a high loop gain (a fast crossover): lower the loop's gain, the margin grows "
+        "roughly as 1/gain"}},
       {"_max_real_pole",
        {"the largest real part of the closed-loop poles (the delay as a Padé approximant): above 0 the loop "
         "is unstable",
-        "1/s", ""}},
+        "1/s", "", "a slow or unstable pole: raise the loop's proportional gain, or lower it if the delay destabilises it"}},
       {"_damping",
        {"the smallest damping ratio ζ = −Re p / |p| of the closed-loop poles (0 when the loop is not stable "
         "or closes no feedback)",
-        "1", ""}},
-      {"_phase_margin_deg", {"the phase margin of the delay-free loop at its crossover", "°", ""}},
-      {"_crossover", {"the crossover frequency, where |L(jω)| = 1 (0 if it never crosses)", "rad/s", ""}}};
+        "1", "", "too little damping: raise the loop's velocity (derivative) gain, or lower its stiffness"}},
+      {"_phase_margin_deg", {"the phase margin of the delay-free loop at its crossover", "°", "",
+                             "a small phase margin: add damping (velocity gain) or lower the loop's gain"}},
+      {"_crossover", {"the crossover frequency, where |L(jω)| = 1 (0 if it never crosses)", "rad/s", "",
+                      "the crossover moves with the loop's gain: higher gain, faster loop, less delay margin"}}};
   for (const auto& loop : loops)
     for (const auto& [suffix, doc] : kinds)
       if (metric == loop.name + suffix) {

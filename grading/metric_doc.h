@@ -8,7 +8,8 @@
 // "from t = ", "until t = " or " to t = " — or "from"/"to" when given (seconds, or "{/pointer}"
 // naming a number); the screening
 // metrics (<loop>_delay_margin, <loop>_damping, ... from grading/scenario.h) are documented here,
-// once for every lab, from the loops the lab reports.
+// once for every lab, from the loops the lab reports. "advice" (optional) is one line for a student
+// whose test on the metric is not at full marks: what usually causes it and which gain moves it.
 #pragma once
 #include <cmath>
 #include <map>
@@ -23,6 +24,7 @@ namespace dyn {
 
 struct MetricDoc {
   std::string what, unit, window;  // unit "1": dimensionless
+  std::string advice;              // what to change when the test falls short (may be empty)
   double from = -INFINITY, to = INFINITY;  // the time window the metric reads (s)
 };
 

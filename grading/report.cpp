@@ -29,6 +29,9 @@ std::string withUnit(double x, const std::string& unit, std::string (*escape)(co
 std::string mdUnit(double x, const std::string& unit) { return withUnit(x, unit, [](const std::string& u) { return mdText(u); }); }
 std::string termUnit(double x, const std::string& unit) { return withUnit(x, unit, [](const std::string& u) { return termText(u); }); }
 
+// A test below its points: its advice is shown.
+bool shortOfFull(const GradedTest& g) { return g.score < g.test.points - 1e-9; }
+
 // The one-paragraph explanation of a test (Markdown), shared by results.json and report.md.
 std::string testText(const GradeReport& r, const GradedTest& g) {
   const ScenarioSummary& sc = scenarioOf(r, g.test.scenario);
@@ -40,6 +43,8 @@ std::string testText(const GradeReport& r, const GradedTest& g) {
     s += "**No credit:** " + mdText(g.note) + ".";
   }
   if (!sc.failure.empty() && std::isfinite(g.value)) s += " (The run itself: " + mdText(sc.failure) + ".)";
+  if (shortOfFull(g) && !g.advice.empty())
+    s += " **What to change:** " + mdText(g.advice) + (g.advice.back() == '.' ? "" : ".");
   return s;
 }
 
@@ -77,6 +82,25 @@ std::string inlinePlot(const GradedTest& g, std::size_t i, std::size_t& budget) 
 
 }  // namespace
 
+std::string answersMarkdown(const json& answers) {
+  if (answers.empty()) return {};
+  // Each answer a quoted block, one escaped line per line of the student's text.
+  std::string md = "\n## Your answers\n";
+  for (const auto& [name, text] : answers.items()) {
+    md += "\n**" + mdText(name) + "**\n\n";
+    const std::string t = text.get<std::string>();
+    for (std::size_t at = 0; at <= t.size();) {
+      std::size_t end = t.find('\n', at);
+      if (end == std::string::npos) end = t.size();
+      std::string line = t.substr(at, end - at);
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      md += "> " + mdText(line) + "  \n";
+      at = end + 1;
+    }
+  }
+  return md;
+}
+
 double GradeReport::score() const {
   double s = 0;
   for (const auto& t : tests) s += t.score;
@@ -101,7 +125,7 @@ json resultsJson(const GradeReport& r) {
                      {"number", std::to_string(i + 1)},
                      {"score", g.score},
                      {"max_score", g.test.points},
-                     {"status", g.score >= g.test.points - 1e-9 ? "passed" : "failed"},
+                     {"status", shortOfFull(g) ? "failed" : "passed"},
                      {"output", renderHtmlFragment(testText(r, g)) +
                                     (r.inline_plots && !g.plot_png.empty() ? inlinePlot(g, i, budget) : "")},
                      {"output_format", "html"},
@@ -135,6 +159,7 @@ json resultsJson(const GradeReport& r) {
                   {"stdout_visibility", "hidden"},
                   {"tests", tests},
                   {"extra_data", {{"lab", r.lab}, {"fingerprint", r.fingerprint}, {"scenarios", scenarios}}}};
+  if (!r.answers.empty()) results["extra_data"]["answers"] = r.answers;
   if (!r.leaderboard.empty()) results["leaderboard"] = r.leaderboard;
   return jsonSanitized(results);  // names, notes and keys as valid UTF-8: dump() cannot throw
 }
@@ -147,12 +172,14 @@ std::string terminalReport(const GradeReport& r) {
                                       termUnit(g.test.full, g.unit) + ", zero " + termUnit(g.test.zero, g.unit) + ")"
                                 : termText(g.note);
     s += "\n";
+    if (shortOfFull(g) && !g.advice.empty()) s += "        → " + termText(g.advice) + "\n";
   }
   for (const auto& sc : r.scenarios)
     if (sc.scenario.name == "nominal")
       for (const auto& n : sc.screen_notes) s += "  screening: " + termText(n) + "\n";
   for (const auto& sc : r.scenarios)
     if (!sc.failure.empty()) s += "  scenario " + termText(sc.scenario.name) + ": " + termText(sc.failure) + "\n";
+  if (!r.answers.empty()) s += "  answers: " + std::to_string(r.answers.size()) + " written answer(s), in report.md for the course staff\n";
   s += "Total: " + points(r.score()) + "/" + points(r.maxScore()) + "\n";
   return s;
 }
@@ -178,6 +205,7 @@ std::string markdownReport(const GradeReport& r) {
     // The image is all ours (plots/NN-slug.png, alt text by number): the heading above names it.
     if (!g.plot.empty()) md += "\n![plot of test " + std::to_string(i + 1) + "](" + g.plot + ")\n";
   }
+  md += answersMarkdown(r.answers);
   md += "\n## Scenarios and gain screening\n\n";
   for (const auto& s : r.scenarios) {
     md += "- **" + mdText(s.scenario.name) + "** (" + mdText(s.scenario.about) + "): " + mdText(scenarioStatus(s)) + ".\n";

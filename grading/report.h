@@ -33,6 +33,7 @@ struct GradedTest {
   std::string unit;    // the metric's unit (its metric_docs or the screening's: "m", "s"; "1" or empty: none)
   std::optional<TestPlotPlan> plan;  // a simulated test's plot (a screening test has none)
   std::string plot_png;              // the plot's bytes once written (inlined in report.html, results.json)
+  std::string advice;                // what to change when short of full marks (the metric's doc), or empty
 };
 
 struct ScenarioSummary {
@@ -52,6 +53,7 @@ struct GradeReport {
   std::vector<GradedTest> tests;
   json leaderboard = json::array();
   json fingerprint;
+  json answers = json::object();  // the submission's free-text "answers" (labs/submission.h), for the TA
   std::string replay;         // the command that re-checks this grade (empty: a generic one)
   bool inline_plots = false;  // results.json carries each test's plot (Gradescope shows it)
   double score() const;
@@ -63,6 +65,8 @@ struct GradeReport {
 constexpr std::size_t kMaxInlinePlotBytes = 600 * 1024;
 
 json resultsJson(const GradeReport& r);
+// report.md's section of the submission's written answers ("" when there are none): every line escaped.
+std::string answersMarkdown(const json& answers);
 std::string terminalReport(const GradeReport& r);
 // report.md: each plot linked (plots/NN-name.png).
 std::string markdownReport(const GradeReport& r);

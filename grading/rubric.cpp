@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 namespace dyn {
 
@@ -63,10 +64,24 @@ void writeSeed(json& config, const Rubric& rubric, std::uint64_t seed, const std
   config[ptr] = seed;
 }
 
+namespace {
+
+// A lesson's submission: a relative path inside the lab's folder ("examples/a.json"), no "..".
+std::string lessonPath(const JsonView& v) {
+  const std::string p = v.string();
+  const std::filesystem::path path(p);
+  bool ok = !p.empty() && path.is_relative() && path.extension() == ".json";
+  for (const auto& part : path) ok = ok && part != ".." && part != ".";
+  if (!ok) v.fail("expected a relative path to a .json submission inside the lab's folder, such as \"examples/a.json\"");
+  return p;
+}
+
+}  // namespace
+
 Rubric parseRubric(const JsonView& config) {
   Rubric r;
   const JsonView rub = config["rubric"];
-  rub.onlyKeys({"seed_target", "scenarios", "watchdog", "tests", "leaderboard"});
+  rub.onlyKeys({"seed_target", "scenarios", "watchdog", "tests", "leaderboard", "lessons"});
   if (rub.has("seed_target")) {
     r.seed_target = rub["seed_target"].string();
     bool ok = r.seed_target.size() > 1 && r.seed_target[0] == '/';
@@ -161,6 +176,18 @@ Rubric parseRubric(const JsonView& config) {
       if (l.has("order")) e.order = l["order"].oneOf({"asc", "desc"});
       if (l.has("scale")) e.scale = l["scale"].positive(1e9);
       r.leaderboard.push_back(e);
+    }
+  }
+
+  // Lessons: pairs of submission files beside the config, and the lead the better one must keep.
+  if (rub.has("lessons")) {
+    for (std::size_t i = 0, n = rub["lessons"].size(0, 20); i < n; ++i) {
+      const JsonView l = rub["lessons"].at(i);
+      l.onlyKeys({"about", "better", "worse", "margin"});
+      Lesson lesson{l["about"].string(), lessonPath(l["better"]), lessonPath(l["worse"]), l["margin"].number()};
+      if (!(lesson.margin >= 0 && lesson.margin <= 1)) l["margin"].fail("expected a share of the points in [0, 1]");
+      if (lesson.better == lesson.worse) l["worse"].fail("expected another submission than \"better\"");
+      r.lessons.push_back(lesson);
     }
   }
   return r;

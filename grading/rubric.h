@@ -13,8 +13,13 @@
 //     (an x–y plot, the path in the plane: "plot": {"x": "x", "columns": ["y"], "reference": "y_d",
 //      "reference_x": "x_d"}; no band, no hatched window)
 //     "leaderboard": [{"name": "tracking RMS (mrad)", "scenario": "nominal", "metric": "theta_rms",
-//                      "scale": 1000, "order": "asc"}]
+//                      "scale": 1000, "order": "asc"}],
+//     "lessons": [{"about": "an integral force law survives the delay, a proportional one does not",
+//                  "better": "examples/integral.json", "worse": "examples/proportional.json", "margin": 0.15}]
 //   }
+// A lesson is the rubric's claim about the lecture: graded by this rubric, the submission "better"
+// (a path relative to the config's folder) scores at least margin × maxScore() more than "worse".
+// tests/labs checks every lab's lessons; `dynlab lessons LAB` prints them.
 // Metrics come from the lab (Lab::metrics of the scenario's trace) or from screening the gains on
 // the linearised loops (<loop>_delay_margin, <loop>_max_real_pole, <loop>_damping, ...).
 #pragma once
@@ -59,6 +64,11 @@ struct LeaderboardEntry {
   double scale = 1;
 };
 
+struct Lesson {
+  std::string about, better, worse;  // better/worse: paths relative to the config's folder
+  double margin = 0;                 // the least lead, as a share of the rubric's points
+};
+
 struct Scenario {
   std::string name, about;
   json patch;  // RFC 7386 merge patch on the lab config
@@ -70,6 +80,7 @@ struct Rubric {
   Watchdog watchdog;
   std::vector<RubricTest> tests;
   std::vector<LeaderboardEntry> leaderboard;
+  std::vector<Lesson> lessons;
   const Scenario* scenario(const std::string& name) const;
   double maxScore() const;
 };

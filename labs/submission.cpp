@@ -1,6 +1,7 @@
 // Applying a submission's gains and options to a lab config; see submission.h.
 #include "labs/submission.h"
 
+#include <cctype>
 #include <sstream>
 
 namespace dyn {
@@ -9,10 +10,10 @@ json applySubmission(const json& config, const JsonView& sub, const std::string&
   sub.requireObject();
   json out = config;
   const json options = config.value("submission_options", json::object());
-  // Top-level keys: lab, gains, and the declared options; nothing else.
+  // Top-level keys: lab, gains, answers and the declared options; nothing else.
   for (const auto& [key, _] : sub.raw().items()) {
-    if (key == "lab" || key == "gains" || options.contains(key)) continue;
-    std::string list = "\"lab\", \"gains\"";
+    if (key == "lab" || key == "gains" || key == "answers" || options.contains(key)) continue;
+    std::string list = "\"lab\", \"gains\", \"answers\"";
     for (const auto& [o, __] : options.items()) list += ", \"" + o + "\"";
     sub[key].fail("unknown key \"" + key + "\" (expected one of: " + list + ")");
   }
@@ -52,7 +53,26 @@ json applySubmission(const json& config, const JsonView& sub, const std::string&
     }
     out[json::json_pointer(decl.at("target").get<std::string>())] = sub[key].raw();
   }
+  submissionAnswers(sub);
   return out;
+}
+
+json submissionAnswers(const JsonView& sub) {
+  if (!sub.has("answers")) return json::object();
+  const JsonView answers = sub["answers"];
+  answers.requireObject();
+  if (answers.raw().size() > kMaxAnswers)
+    answers.fail("expected at most " + std::to_string(kMaxAnswers) + " answers, got " + std::to_string(answers.raw().size()));
+  for (const auto& [key, _] : answers.raw().items()) {
+    bool plain = !key.empty() && key.size() <= 40;
+    for (unsigned char c : key) plain = plain && (std::isalnum(c) || c == '_' || c == '-' || c == '.') && c < 0x80;
+    if (!plain) answers[key].fail("expected an answer's name of 1–40 letters, digits, '_', '-' or '.'");
+    const std::string text = answers[key].string();
+    if (text.size() > kMaxAnswerBytes)
+      answers[key].fail("expected an answer of at most " + std::to_string(kMaxAnswerBytes) + " bytes, got " +
+                        std::to_string(text.size()));
+  }
+  return answers.raw();
 }
 
 void checkSubmissionOptions(const JsonView& config) {
@@ -93,6 +113,12 @@ json submissionSchema(const json& config, const std::string& lab) {
                  {"additionalProperties", false},
                  {"required", {"lab", "gains"}},
                  {"properties", {{"lab", {{"const", lab}}}, {"gains", gains}}}};
+  schema["properties"]["answers"] = {
+      {"type", "object"},
+      {"maxProperties", kMaxAnswers},
+      {"propertyNames", {{"pattern", "^[A-Za-z0-9_.-]{1,40}$"}}},
+      {"additionalProperties", {{"type", "string"}, {"maxLength", kMaxAnswerBytes}}},
+      {"description", "free-text answers to the handout's questions, for the course staff (not graded)"}};
   const json options = config.value("submission_options", json::object());
   for (const auto& [key, d] : options.items())
     schema["properties"][key] = {{"enum", d.at("choices")}, {"description", d.value("doc", "")}};

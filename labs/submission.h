@@ -13,6 +13,13 @@ namespace dyn {
 // submission file and JSON path.
 json applySubmission(const json& config, const JsonView& submission, const std::string& lab, bool strict);
 
+// A submission's free-text "answers" (the handout's written questions, carried to the TA; never
+// graded, never part of the noise seed): an object of at most kMaxAnswers entries, each key a
+// short name (letters, digits, _ - .; at most 40 bytes), each value a string of at most
+// kMaxAnswerBytes bytes. Returns {} when there are none; throws InputError naming the path.
+constexpr std::size_t kMaxAnswers = 20, kMaxAnswerBytes = 4000;
+json submissionAnswers(const JsonView& submission);
+
 // Validates a config's "submission_options" (an object of {"target": JSON pointer to a string
 // value of the config, "choices": [strings], "doc": string}); buildLab calls it for every lab.
 void checkSubmissionOptions(const JsonView& config);

@@ -62,8 +62,15 @@ Poly padeDenominator(double T, int n) {
 
 LoopAnalysis analyseLoop(const LinearLoop& loop, int order) {
   LoopAnalysis a;
-  // Closed-loop characteristic polynomial with the delay as Padé: D P(sT) + N P(−sT).
+  // The controller's integrators at zero gain: a factor s of N and of D that feeds nothing back.
   Poly num = loop.num, den = loop.den;
+  for (int k = 0; k < loop.controller_integrators && num.size() > 1 && den.size() > 1 && num.front() == 0 &&
+                  den.front() == 0;
+       ++k) {
+    num.erase(num.begin());
+    den.erase(den.begin());
+  }
+  // Closed-loop characteristic polynomial with the delay as Padé: D P(sT) + N P(−sT).
   if (loop.delay > 0) {
     num = polyMul(num, padeDenominator(-loop.delay, order));
     den = polyMul(den, padeDenominator(loop.delay, order));

@@ -1,7 +1,8 @@
 // Linear screening of a feedback loop before any simulation (used by the grader):
 //   open loop      L(s) = N(s)/D(s) · e^{−sT}            (T: measurement delay)
 //   Padé (n, n)    e^{−sT} ≈ P(−sT)/P(sT),  P(x) = Σ_k (2n−k)! n! / ((2n)! k! (n−k)!) x^k
-//   closed loop    D(s) P(sT) + N(s) P(−sT) = 0            → poles (companion-matrix eigenvalues)
+//   closed loop    D(s) P(sT) + N(s) P(−sT) = 0            → poles (companion-matrix eigenvalues),
+//                  after cancelling the controller's unused integrators (controller_integrators)
 //   margins        |L(jω_c)| = 1:  PM = π + ∠L(jω_c),  delay margin = min over crossovers of PM / ω_c (PM + 2π where PM ≤ 0)
 // Polynomials are coefficient vectors in ascending powers of s.
 #pragma once
@@ -22,6 +23,10 @@ struct LinearLoop {
   Poly num, den;     // L(s) without the delay
   double delay = 0;  // s
   std::string remark = {};  // what the lab adds to the screening's sentence (e.g. a vibration mode), or empty
+  // Factors s of den that are the controller's own integral action (a PI law's 1/s), not the plant's.
+  // While the integral gain is zero (num has no constant term) such a factor feeds nothing back: it
+  // is cancelled with one of num's, so a PI law with k_I = 0 screens as the P law it is.
+  int controller_integrators = 0;
 };
 
 struct LoopAnalysis {

@@ -151,6 +151,9 @@ TEST_CASE("CSV fields: quoted when needed, formulas neutralised") {
   CHECK(csvField("a,b") == "\"a,b\"");
   CHECK(csvField("say \"hi\"") == "\"say \"\"hi\"\"\"");
   CHECK(csvField("two\nlines") == "\"two\nlines\"");
+  // Terminal escapes and bidi overrides do not reach a spreadsheet or a `cat gradebook.csv` raw.
+  CHECK(csvField("a\x1b]0;title\x07" "b") == "a\\x1B]0;title\\x07b");
+  CHECK(csvField("x\u202Ey") == "x\\u{202E}y");
   CHECK(csvField("=1+1") == "'=1+1");
   CHECK(csvField("+1") == "'+1");
   CHECK(csvField("-2+3") == "'-2+3");

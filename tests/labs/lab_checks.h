@@ -9,6 +9,9 @@
 //   options    every rubric metric exists for every submission option choice (metrics + screening)
 //   grading    every example and every option choice grades to a valid results.json; the default
 //              gains score 20–50 % of the points (a weak, stable start); every simulated test has a plot
+//   lessons    the rubric states at least one lesson, and each holds (grading/lessons.h: the design the
+//              lecture prefers leads its foil by the stated share); doing nothing (every gain at its
+//              minimum) scores below the defaults; the instructor's answers score ≥ 90 %
 //   render     a frame of the scene renders non-blank (OSMesa)
 //   cli        `dynlab run` (the demo: both engines, whole run), `dynlab figure`, `dynlab grade` (and
 //              `dynlab ui` under xvfb-run): exit 0
@@ -23,6 +26,7 @@
 #include <vector>
 
 #include "grading/grade.h"
+#include "grading/lessons.h"
 #include "grading/metric_doc.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
@@ -37,6 +41,8 @@ struct LabCheckOptions {
   std::string examples_dir;  // default: <source>/labs/<name>/examples
   bool cli = true;           // the dynlab binary knows the lab (false for a test's scratch lab)
   std::pair<double, double> defaults_band{0.2, 0.5};  // the share of points the default gains score
+  std::string lab_dir;       // where the lessons' paths start (default: <source>/labs/<name>)
+  std::string instructor_dir;  // the full-credit answers (default: <source>/labs/<name>/instructor; "-": none)
 };
 
 // The lab's example submissions (sorted paths).
@@ -219,6 +225,53 @@ inline void checkGrading(const LabEntry& entry, const std::string& config_file, 
   }
 }
 
+// The share of the points a graded submission scored.
+inline double scoreShare(const GradeOutcome& g) {
+  double max = 0;
+  for (const auto& t : g.results.at("tests")) max += t.at("max_score").get<double>();
+  return max > 0 ? g.results.at("score").get<double>() / max : 0.0;
+}
+
+// The grade teaches the lecture: every lesson pair ranks as stated, doing nothing ranks below the
+// shipped defaults, and the instructor's answers are near full marks.
+inline void checkLessonsAndAnchors(const LabEntry& entry, const std::string& config_file, const json& config,
+                                   const cli::TempDir& dir, const std::string& lab_dir, const std::string& instructor_dir) {
+  INFO("lab ", entry.name, ": lessons");
+  GradeOptions o;
+  o.config_file = config_file;
+  const Rubric rubric = parseRubric(JsonView(config, config_file));
+  CHECK_MESSAGE(!rubric.lessons.empty(), "the rubric states no lesson (rubric/lessons)");
+  for (const LessonCheck& c : checkLessons(rubric, lab_dir, o)) {
+    INFO("lesson ", c.lesson.better, " ahead of ", c.lesson.worse, ": ", c.lesson.about);
+    CHECK_MESSAGE(c.error.empty(), c.error);
+    MESSAGE(entry.name, ": lesson ", c.lesson.better, " ", c.better, " vs ", c.lesson.worse, " ", c.worse, " of ", c.max,
+            " (lead needed ", c.lesson.margin * c.max, ")");
+    CHECK(c.holds());
+  }
+  // Doing nothing: every gain at its declared minimum, the options as the config sets them.
+  json nothing = defaultSubmission(entry.name, config);
+  for (const auto& [name, d] : config.at("gains").items()) nothing["gains"][name] = d.at("min");
+  cli::writeFile(dir / "nothing.json", nothing.dump());
+  cli::writeFile(dir / "defaults_again.json", defaultSubmission(entry.name, config).dump());
+  const GradeOutcome none = gradeSubmission((dir / "nothing.json").string(), o);
+  const GradeOutcome defaults = gradeSubmission((dir / "defaults_again.json").string(), o);
+  checkResults(none);
+  MESSAGE(entry.name, ": every gain at its minimum scores ", none.results.at("score").get<double>(), ", the defaults ",
+          defaults.results.at("score").get<double>());
+  CHECK(none.results.at("score").get<double>() < defaults.results.at("score").get<double>());
+  // The instructor's answers.
+  if (instructor_dir == "-") return;
+  const std::vector<std::string> answers = exampleFiles(instructor_dir);
+  CHECK_MESSAGE(!answers.empty(), "no instructor answer in " << instructor_dir);
+  for (const std::string& file : answers) {
+    INFO("instructor answer ", file);
+    const GradeOutcome g = gradeSubmission(file, o);
+    checkResults(g);
+    MESSAGE(entry.name, ": ", std::filesystem::path(file).filename().string(), " scores ", scoreShare(g) * 100, " %");
+    CHECK(scoreShare(g) >= 0.9);
+  }
+}
+
 inline void checkRender(const LabEntry& entry, const json& config) {
   INFO("lab ", entry.name, ": a rendered frame");
   const auto lab = buildLab(entry, config, "config.json");
@@ -278,6 +331,9 @@ inline void checkLab(const LabEntry& entry, const json& config, const LabCheckOp
   checkPassive(entry, config);
   checkColumnsAndMetrics(entry, config);
   checkGrading(entry, config_file, config, examples, dir, options.defaults_band);
+  const std::string lab_dir = options.lab_dir.empty() ? std::string(DYNLAB_SOURCE_DIR) + "/labs/" + entry.name : options.lab_dir;
+  checkLessonsAndAnchors(entry, config_file, config, dir, lab_dir,
+                         options.instructor_dir.empty() ? lab_dir + "/instructor" : options.instructor_dir);
   checkRender(entry, config);
   if (options.cli) checkCli(entry, config, examples, dir);
 }

@@ -27,7 +27,8 @@ const char* kConfig = R"({
                            "heavy": {"about": "second link 1 kg", "patch": {"mechanism": {"masses": [1.0, 1.0]}}}},
              "watchdog": {"max_steps": 10000, "limits": [{"column": "q1", "min": -50, "max": 50, "what": "the first angle"}]},
              "tests": [{"name": "Settles at the target", "scenario": "nominal", "metric": "e_final", "full": 0.05, "zero": 0.5, "points": 2},
-                       {"name": "Settles with a heavier link", "scenario": "heavy", "metric": "e_final", "full": 0.05, "zero": 0.5, "points": 1}]}
+                       {"name": "Settles with a heavier link", "scenario": "heavy", "metric": "e_final", "full": 0.05, "zero": 0.5, "points": 1}],
+             "lessons": [{"about": "a stiff, damped PD settles where a soft one sags", "better": "good.json", "worse": "soft.json", "margin": 0.3}]}
 })";
 
 const std::vector<std::string> kColumns = {"t", "q1", "q2", "tau1", "tau2", "energy", "constraint_residual", "work"};
@@ -131,8 +132,11 @@ TEST_CASE("a lab described in a test file keeps the whole lab contract, on both 
   CHECK_FALSE(registerLab({"scratch_pendulum", "the same name again", make}));  // a name is taken once
   const test::cli::TempDir dir("scratch_lab_examples");
   test::cli::writeFile(dir / "good.json", R"({"lab": "scratch_pendulum", "gains": {"kp": 60, "kd": 6}})");
+  test::cli::writeFile(dir / "soft.json", R"({"lab": "scratch_pendulum", "gains": {"kp": 16, "kd": 2}})");
   test::LabCheckOptions options;
   options.examples_dir = dir.path.string();
+  options.lab_dir = dir.path.string();  // the lesson's pair
+  options.instructor_dir = "-";
   options.cli = false;  // the dynlab binary does not know a lab made here
   test::checkLab(*findLab("scratch_pendulum"), json::parse(kConfig), options);
   // Both engines really ran the same pendulum: Bullet's first-order step stays close to RK4 over 1 s.

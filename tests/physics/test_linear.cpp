@@ -95,3 +95,24 @@ TEST_CASE("a conditionally stable loop (flexible joint under PD): the margin is 
   loop.delay = 1.03 * free.delay_margin;
   CHECK_FALSE(analyseLoop(loop, 8).stable);
 }
+
+TEST_CASE("a PI loop with k_I = 0 screens as its P loop; the plant's own integrator is never cancelled") {
+  // Speed loop L(s) = (k_P s + k_I) / (s · J s): the first s is the PI law's, the second the plant's.
+  const double J = 0.5, kp = 2.0;
+  LinearLoop pi0{"speed", "speed loop", {0.0, kp}, {0.0, 0.0, J}, 0.0};
+  pi0.controller_integrators = 1;
+  const LoopAnalysis a = analyseLoop(pi0);
+  REQUIRE(a.poles.size() == 1);
+  CHECK(a.poles[0].real() == doctest::Approx(-kp / J));  // the P loop's pole −k_P/J
+  CHECK(a.stable);
+  // The same N/D without the flag: a PD position loop with k_P = 0 leaves the position adrift.
+  LinearLoop pd0 = pi0;
+  pd0.controller_integrators = 0;
+  const LoopAnalysis b = analyseLoop(pd0);
+  REQUIRE(b.poles.size() == 2);
+  CHECK(b.max_real == doctest::Approx(0.0).epsilon(1e-12));
+  // With k_I ≠ 0 nothing is cancelled: the PI loop's two poles.
+  LinearLoop pi = pi0;
+  pi.num = {1.0, kp};
+  CHECK(analyseLoop(pi).poles.size() == 2);
+}
