@@ -69,6 +69,11 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // (2) for impulses), then opens closed ones whose solved η would pull, one at a time (most negative
   // first), until every closed one presses. Returns how many changed; v changes only on impact.
   int updateContacts(const VecN& q, VecN& v, const VecN& tau);
+  // The impulse (N·s; as constraintForce: body a on body b, world axes at its point) that the plastic
+  // impact of the last updateContacts gave constraint i: ∫ f dt over the impact, P = Λ_n v_n for one
+  // contact alone; zero when that call closed nothing (or the solve was singular). A lab that reports a
+  // step's mean contact force, as impulse-based engines do, adds P/dt to the solved force.
+  const Vec& impactImpulse(int i) const { return impact_[std::size_t(i)]; }
   // False while constraint i's rows are released (an open unilateral or a compliant contact).
   bool closed(int i) const { return !released_[std::size_t(i)]; }
   // Close or open a unilateral constraint by hand (initial conditions, tests).
@@ -138,6 +143,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   MatN J_full_, A_full_;
   VecN compliant_eta_;   // per row: the compliant force η (0 elsewhere)
   VecN compliant_bc_;    // payload side: −Aᵀ η of the compliant rows
+  std::vector<Vec> impact_;  // per constraint: the last updateContacts' impact impulse
+  bool any_impact_ = false;
 };
 
 }  // namespace dyn

@@ -57,6 +57,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
       }
   }
   gravity_bc_ = problem_.bc_Gc;
+  impact_.assign(model_.constraints.size(), Vec::Zero());
   problem_.A.setZero(rows_, kk);
   phi_.setZero(rows_);
   phi_full_.setZero(rows_);
@@ -235,10 +236,39 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
       ++changes;
     }
   }
-  // The plastic impact: the least-kinetic-energy velocity that satisfies every closed row.
+  // The plastic impact: the least-kinetic-energy velocity that satisfies every closed row, eq. (2) for
+  // impulses (as correction(): M dθ = −Jᵀ p, J dθ − A dx_c = e = J θ' − A v_c, θ' ← θ' − dθ): the
+  // table's impulse on the closed rows is P = −p.
+  if (any_impact_) {
+    for (Vec& p : impact_) p.setZero();
+    any_impact_ = false;
+  }
   if (changes) {
     invalidate();
-    projectVelocities(*this, q, v);
+    positionStage(q);
+    if (!factored_) {
+      projectVelocities(*this, q, v);  // the block LU's correction: no impulse recorded
+    } else {
+      VecN phi, dx;
+      MatN G;
+      constraint(q, phi, G);
+      Problem impulse;
+      impulse.tau.setZero(n());
+      impulse.h.setZero(n());
+      impulse.Jdot_qd = -(G * v);
+      Solution s;
+      factor_.solve(impulse, s);
+      dx.resize(n() + k());
+      dx.head(n()) = s.qdd;
+      dx.tail(k()) = s.alpha_c;
+      if (dx.allFinite()) {
+        v -= dx;
+        const VecN P = -s.eta;
+        for (std::size_t i = 0; i < count; ++i)
+          if (rigid(i) && !released_[i]) impact_[i] = model_.constraints[i]->force(kin_, P.data() + offsets_[i]);
+        any_impact_ = true;
+      }
+    }
   }
   // Lift-off: while a closed contact's η would pull, open the one pulling most and solve again.
   bool any_closed = false;

@@ -101,8 +101,9 @@ void PenOnTableLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, 
   drawArm(p, tr, row, false, s);
   s.spheres.push_back({Eigen::Vector3d(tr.at(row, "x_d"), tr.at(row, "y_d"), tr.at(row, "z_des")), 0.006, kRef});
   // The force the pen applies to the table, f_z ẑ (the lecture's sign: down while pressing), ending on
-  // the table beside the tip (3 cm to the camera's right, so the pen does not hide it).
-  const double f_z = tr.at(row, "f_z");
+  // the table beside the tip (3 cm to the camera's right, so the pen does not hide it); its 5 ms mean,
+  // so a touchdown's impulse shows as P / 5 ms whatever the step.
+  const double f_z = tr.at(row, "f_z_5ms");
   if (f_z < -1e-9) {
     const Eigen::Vector3d beside = Eigen::Vector3d(tr.at(row, "x_p"), tr.at(row, "y_p"), z_t) + 0.03 * Eigen::Vector3d(1.1, 0.9, 0).normalized();
     s.arrows.push_back({beside - Eigen::Vector3d(0, 0, f_z * s_.arrow_scale), Eigen::Vector3d(0, 0, f_z * s_.arrow_scale), 0.003, kForce});
@@ -118,16 +119,16 @@ void PenOnTableLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const 
                                                             : "accommodation, spring";
   o.lines = {{"t", fmt("%.2f s", tr.at(row, "t"))},
              {"controller", kind},
-             {"f_z", fmt("%.2f N", tr.at(row, "f_z")) + fmt(" (f_zd %.2f N)", c.f_zd)},
+             {"f_z (5 ms)", fmt("%.2f N", tr.at(row, "f_z_5ms")) + fmt(" (f_zd %.2f N)", c.f_zd)},
              {"f_meas", fmt("%.2f N", tr.at(row, "f_meas"))},
              {"z_des - z_t", fmt("%.2f mm", 1e3 * (tr.at(row, "z_des") - s_.params.table_height))},
              {"contact", tr.at(row, "contact") > 0.5 ? "yes" : "no (lifted)"}};
-  // Live plots over the last three seconds, every step up to this row: f_z, its error from f_zd (the
+  // Live plots over the last three seconds, every step up to this row: f_z (5 ms mean), its error from f_zd (the
   // plot's zero line is the set point), and the commanded height above the table.
-  Series force{"f_z (N)", {}, kForce}, error{"f_z - f_zd (N)", {}, kRef}, height{"z_des - z_t (mm)", {}, kArm};
+  Series force{"f_z, 5 ms mean (N)", {}, kForce}, error{"f_z - f_zd (N)", {}, kRef}, height{"z_des - z_t (mm)", {}, kArm};
   for (std::size_t r = liveWindowStart(row, 3.0, s_.step.dt); r <= row; ++r) {
-    force.values.push_back(float(tr.at(r, "f_z")));
-    error.values.push_back(float(tr.at(r, "f_z") - tr.at(r, "f_zd")));
+    force.values.push_back(float(tr.at(r, "f_z_5ms")));
+    error.values.push_back(float(tr.at(r, "f_z_5ms") - tr.at(r, "f_zd")));
     height.values.push_back(float(1e3 * (tr.at(r, "z_des") - s_.params.table_height)));
   }
   o.plots = {force, error, height};

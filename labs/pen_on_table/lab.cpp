@@ -18,11 +18,14 @@ constexpr double kMaxLength = 10, kMaxMass = 1e3, kMaxGravity = 1e3, kMaxTorque 
 // The workspace the circle must lie in: the elbow at least this far from stretched or folded
 // (|sin θ3| ≥ 0.25, θ3 within 14.5° … 165.5°) and the tip this far from the base axis (θ1 defined).
 constexpr double kMinElbowSine = 0.25, kMinAxisDistance = 0.05;
+// s: the window of f_z_5ms, the force's trailing mean (an impact's impulse P reads P / 5 ms at any dt).
+constexpr double kImpactWindow = 0.005;
 
 // The one place the trace row is laid out.
 const std::vector<std::string> kColumns = {"t",     "q1",    "q2",     "q3",      "tau1",  "tau2",   "tau3",
                                            "x_p",   "y_p",   "z_p",    "x_d",     "y_d",   "z_des",  "f_z",
-                                           "f_zd",  "f_meas", "contact", "gap",   "energy", "work", "constraint_residual"};
+                                           "f_zd",  "f_meas", "contact", "gap",   "energy", "work", "constraint_residual",
+                                           "f_z_5ms"};
 
 // The arm the controller believes in: without the pen's extra load, the table where it expects it.
 Params believed(const Params& p, const ControllerConfig& c) {
@@ -33,14 +36,28 @@ Params believed(const Params& p, const ControllerConfig& c) {
 }
 
 // The lab's part of a run on either engine (labs/mechanism_simulation.h).
+// hand: the hand engine's mechanism (its impact impulses), null for Bullet.
 class Hooks final : public StepHooks {
  public:
-  Hooks(const Settings& s, double z0)
-      : s_(s), mech_(s.params), ctrl_(s.controller, s.circle, believed(s.params, s.controller), s.step.dt, z0) {}
+  Hooks(const Settings& s, double z0, const Mechanism* hand)
+      : s_(s), mech_(s.params), ctrl_(s.controller, s.circle, believed(s.params, s.controller), s.step.dt, z0), hand_(hand),
+        window_(std::size_t(std::max(1L, std::lround(kImpactWindow / s.step.dt))), 0.0) {}
   VecN torque(double t, const VecN& q, const VecN& v) override { return ctrl_.torque(t, q, v); }
+  // The step's mean force along ẑ: the table's push η (the solve at the step's start; Bullet: its
+  // impulses over the step / dt) plus, on the hand engine, a touchdown's impact impulse P / dt (the
+  // plastic impact is a velocity jump at the step's start, eq. (2) for impulses), as Bullet and the
+  // impedance lab's wall count it.
+  double push(const StepRecord& r) const {
+    const double eta = Spatial::linear(r.forces[0]).z();
+    return hand_ ? eta + Spatial::linear(hand_->impactImpulse(0)).z() / s_.step.dt : eta;
+  }
   void row(const StepRecord& r, std::vector<double>& out) override {
-    // f_z: the force the pen applies to the table (the lecture's sign), −η of the table's push.
-    const double eta = Spatial::linear(r.forces[0]).z(), f_z = -eta;
+    // f_z: the force the pen applies to the table (the lecture's sign), −η of the table's push; and its
+    // mean over the last 5 ms (the impulse spread over a window of fixed length, whatever dt).
+    const double eta = push(r), f_z = -eta;
+    sum_ += f_z - window_[next_];
+    window_[next_] = f_z;
+    next_ = (next_ + 1) % window_.size();
     const Eigen::Vector3d p = mech_.tip(r.q);
     const double gap = p.z() - s_.params.table_height;
     // Bullet's rows are not the hand model's: on a rigid table its residual is the tip's penetration.
@@ -48,15 +65,16 @@ class Hooks final : public StepHooks {
     const Target& d = ctrl_.target();
     out = {r.t,       r.q[0],      r.q[1],      r.q[2],    r.tau[0], r.tau[1], r.tau[2],         p.x(),
            p.y(),     p.z(),       d.p.x(),     d.p.y(),   d.p.z(),  f_z,      s_.controller.f_zd, d.f_meas,
-           eta > 0 ? 1.0 : 0.0,    gap,         r.energy,  r.work,   residual};
+           eta > 0 ? 1.0 : 0.0,    gap,         r.energy,  r.work,   residual, sum_ / double(window_.size())};
   }
-  void observe(const StepRecord& r) override { ctrl_.measure(-Spatial::linear(r.forces[0]).z()); }
+  void observe(const StepRecord& r) override { ctrl_.measure(-push(r)); }
   // The lab's watchdog: an unstable force loop on a unilateral contact does not blow up, it hammers the
-  // table (a bounded limit cycle of lift-offs); the run stops after max_liftoffs of them.
+  // table (a bounded limit cycle of lift-offs); the run stops at max_liftoffs (4) of them after the first
+  // touchdown: a stable loop lifts off at most once (the touchdown step's impact reopens the row for a step).
   std::string stop(const StepRecord& r) override {
-    const bool contact = Spatial::linear(r.forces[0]).z() > 0;
+    const bool contact = push(r) > 0;
     if (touched_ && in_contact_ && !contact && ++liftoffs_ >= s_.max_liftoffs)
-      return "stopped: the pen lifted off the table " + std::to_string(liftoffs_) + " times after touching down, at t = " +
+      return "stopped: the pen bounced, lifting off the table " + std::to_string(liftoffs_) + " times after touching down, at t = " +
              fmt("%.4g", r.t) + " s (the force loop oscillates)";
     touched_ = touched_ || contact;
     in_contact_ = contact;
@@ -67,6 +85,10 @@ class Hooks final : public StepHooks {
   const Settings& s_;
   Mechanism mech_;
   Controller ctrl_;
+  const Mechanism* hand_;
+  std::vector<double> window_;  // the last 5 ms of f_z (a ring)
+  std::size_t next_ = 0;
+  double sum_ = 0;
   bool touched_ = false, in_contact_ = false;
   int liftoffs_ = 0;
 };
@@ -212,7 +234,7 @@ std::string PenOnTableLab::unit(const std::string& c) const {
       {"t", "s"},      {"q1", "rad"},   {"q2", "rad"},   {"q3", "rad"},     {"tau1", "N·m"},  {"tau2", "N·m"},
       {"tau3", "N·m"}, {"x_p", "m"},    {"y_p", "m"},    {"z_p", "m"},      {"x_d", "m"},     {"y_d", "m"},
       {"z_des", "m"},  {"f_z", "N"},    {"f_zd", "N"},   {"f_meas", "N"},   {"contact", "1"}, {"gap", "m"},
-      {"energy", "J"}, {"work", "J"},   {"constraint_residual", "m"}};
+      {"energy", "J"}, {"work", "J"},   {"constraint_residual", "m"}, {"f_z_5ms", "N"}};
   return unitIn(units, c);
 }
 
@@ -223,7 +245,8 @@ std::unique_ptr<Simulation> PenOnTableLab::simulate(Engine engine) const {
   const double z0 = mech->tip(q).z();
   // A pen that starts on a rigid table starts in contact (its gap is 0 up to rounding, either sign).
   if (s_.start_height == 0 && s_.params.table_stiffness == 0) mech->setClosed(0, true);
-  return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::make_unique<Hooks>(s_, z0), kColumns, s_.duration);
+  auto hooks = std::make_unique<Hooks>(s_, z0, engine == Engine::Hand ? mech.get() : nullptr);
+  return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::move(hooks), kColumns, s_.duration);
 }
 
 json PenOnTableLab::metrics(const Trace& tr) const {
@@ -235,16 +258,20 @@ json PenOnTableLab::metrics(const Trace& tr) const {
   for (std::size_t r = 0; r < n && first == n; ++r)
     if (tr.at(r, "contact") > 0.5) first = r;
   const double touchdown = first < n ? tr.at(first, "t") : t_end;
+  // The force graded is f_z_5ms, the 5 ms mean (an impact's impulse P reads P / 5 ms): the overshoot
+  // from touchdown on, the RMS once the touchdown's own window has passed.
   std::vector<double> ef, ef_draw, ep;
   double overshoot = 0, lost = 0, pull = -INFINITY, tau = 0, drift = 0, residual = 0, radius = 0, gap_min = INFINITY, ss = 0;
   std::size_t drawn = 0, ss_rows = 0;
+  int liftoffs = 0;
   const double e0 = n ? tr.at(0, "energy") : 0.0;
   for (std::size_t r = 0; r < n; ++r) {
-    const double t = tr.at(r, "t"), e = tr.at(r, "f_z") - f_zd;
+    const double t = tr.at(r, "t"), e = tr.at(r, "f_z_5ms") - f_zd;
     const bool contact = tr.at(r, "contact") > 0.5;
-    if (r >= first || first == n) ef.push_back(e);
+    if (first == n || (r >= first && t >= touchdown + kImpactWindow - 1e-9)) ef.push_back(e);
     if (r >= first && t <= touchdown + s_.overshoot_window) overshoot = std::max(overshoot, -e);
     if (r >= first && !contact) lost += dt;
+    if (r > first && r < n && !contact && tr.at(r - 1, "contact") > 0.5) ++liftoffs;
     if (contact) pull = std::max(pull, tr.at(r, "f_z"));
     if (t >= t_end - 1.0) ss += e, ++ss_rows;
     if (t >= t_draw) {
@@ -260,11 +287,12 @@ json PenOnTableLab::metrics(const Trace& tr) const {
   }
   radius = drawn ? radius / double(drawn) : 0.0;
   return {{"touchdown_time", touchdown},
-          {"f_rms", rms(ef)},
+          {"f_rms", ef.empty() ? std::abs(f_zd) : rms(ef)},
           {"f_rms_drawing", ef_draw.empty() ? std::abs(f_zd) : rms(ef_draw)},
           {"f_overshoot", overshoot},
           {"f_ss_error", ss_rows ? ss / double(ss_rows) : 0.0},
           {"contact_lost_time", lost},
+          {"liftoffs", liftoffs},
           {"f_pull_max", std::isfinite(pull) ? pull : 0.0},
           {"radius", radius},
           {"radius_error", drawn ? std::abs(radius - s_.circle.radius) : s_.circle.radius},

@@ -14,7 +14,7 @@ struct Settings {
   double duration = 6;
   ControllerConfig controller;
   double overshoot_window = 0.5;  // s after touchdown: the window of the overshoot metric
-  int max_liftoffs = 20;          // the run stops after this many lift-offs after the first touchdown
+  int max_liftoffs = 4;           // the run stops at this many lift-offs after the first touchdown (it bounces)
   double arrow_scale = 0.01;      // m per N, drawing only
 };
 
