@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 namespace dyn::app::batch {
 
 Row failedRow(const Submission& s, const std::string& status, const std::string& reason) {
-  return {s.name, s.folder, status, jsonText(reason), 0, 0, false, {}, {}};
+  return {s.name, s.folder, status, jsonText(clipText(reason, 600)), 0, 0, false, {}, {}};
 }
 
 Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, const std::string& log_tail) {
@@ -72,7 +72,7 @@ Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, 
     row.status = "timed out";
     row.reason += std::string(row.reason.empty() ? "" : "; ") + "the grading time budget ran out";
   }
-  row.reason = jsonText(row.reason);
+  row.reason = jsonText(clipText(row.reason, 600));
   return row;
 }
 
