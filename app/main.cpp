@@ -13,6 +13,7 @@
 #include "app/check_results.h"
 #include "app/commands.h"
 #include "app/course.h"
+#include "app/submission_file.h"
 #include "labs/utf8.h"
 
 namespace {
@@ -165,6 +166,11 @@ int dispatch(int argc, char** argv) {
   auto* s = cli.add_subcommand("schema", "Print the JSON Schema of a lab's submission");
   s->add_option("LAB", schema_lab, "Lab name")->required();
 
+  std::string upload_dir;
+  auto* sf = cli.add_subcommand("submission-file", "Print which file of an upload folder is graded (the rule the batch and "
+                                                   "run_autograder share), or why none is (exit 2)");
+  sf->add_option("DIR", upload_dir, "The student's upload folder")->required();
+
   UiArgs ui;
   auto* u = cli.add_subcommand("ui", "Tune a lab's gains in a window and watch it move (runs dynlab-ui; options after LAB "
                                      "go to it, see `dynlab-ui --help`)");
@@ -220,6 +226,7 @@ int dispatch(int argc, char** argv) {
   if (*z) return writeAutograderZip(zip_lab, zip_out);
   if (*c) return checkResults(results_file);
   if (*s) return printSchema(schema_lab);
+  if (*sf) return printSubmissionFile(upload_dir);
   if (*k) return compare(cmp);
   if (*l) return lessons(les);
   if (*b) return bench_args.scaling ? benchScaling(bench_args) : bench(bench_args);
