@@ -145,7 +145,12 @@ std::string mdText(std::string_view s) {
     }
     const bool in_word = c == '_' && i > 0 && alnum(line[i - 1]) && alnum(next);
     const bool opens_link = c == ']' && (next == '(' || next == '[' || next == ':');
-    const bool plain = kPlain.find(c) != std::string_view::npos || in_word;
+    // An autolinker keys on "://", "www." and "@": escaping that character (the escape is its own
+    // token in CommonMark/GFM and markdown-it) leaves a URL or an email in reflected text inert.
+    const auto lower = [](char ch) { return char(std::tolower(static_cast<unsigned char>(ch))); };
+    const bool www = c == '.' && i >= 3 && lower(line[i - 1]) == 'w' && lower(line[i - 2]) == 'w' && lower(line[i - 3]) == 'w';
+    const bool links = (c == ':' && line.compare(i + 1, 2, "//") == 0) || www || c == '@';
+    const bool plain = (kPlain.find(c) != std::string_view::npos || in_word) && !links;
     if (isAsciiPunct(c) && (!plain || list_marker || opens_link || (i == 0 && kLineStart.find(c) != std::string_view::npos)))
       out += '\\';
     out += c;

@@ -31,7 +31,8 @@ std::string dumpJson(const nlohmann::json& v, int indent = -1);
 // Text for a Markdown line or table cell: ASCII punctuation that could start a construct is
 // backslash-escaped (no emphasis, link, code, HTML, entity, heading, quote or list marker can
 // start; < > & become entities, so not even the source holds a tag), line breaks and other control
-// characters shown as \n, \r, \xNN: one value, one line.
+// characters shown as \n, \r, \xNN: one value, one line. URLs and emails are inert: the ":" of
+// "://", the "." of "www." and every "@" are escaped, so no autolink forms.
 std::string mdText(std::string_view s);
 
 // An inline code span holding s literally: fenced by a backtick run longer than any inside, control
