@@ -199,7 +199,7 @@ int gradeBatch(const GradeArgs& a) {
       const json j = loadJsonFile(s.file.string(), 1u << 20);
       if (j.is_object() && j.contains("lab") && j["lab"].is_string() && findLab(j["lab"].get<std::string>())) {
         args.lab = j["lab"].get<std::string>();
-        lab_source = "the first submission naming a lab, " + s.name;
+        lab_source = "the first submission naming a lab, " + s.folder;
       }
     } catch (const std::exception&) {
       // Not valid: the next one decides.

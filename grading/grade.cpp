@@ -78,6 +78,7 @@ GradeOutcome failedOutcome(const std::string& full_message, const InputError* e)
 GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
   const auto started = std::chrono::steady_clock::now();
   const Deadline deadline = started + std::chrono::milliseconds(long(opt.time_budget * 1e3));
+  std::string staff_file;  // the lab config once known: an error naming it is the staff's
   try {
     // The submission: a JSON object naming a lab; the lab's config with the gains applied.
     const json sub = loadJsonFile(file, 1u << 20);
@@ -93,6 +94,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
       view["lab"].fail("expected the name of a dynlab lab (" + list + "), got \"" + clipText(lab_name) + "\"");
     }
     const std::string config_file = opt.config_file.empty() ? defaultConfigPath(lab_name) : opt.config_file;
+    staff_file = config_file;
     const json base = loadJsonFile(config_file);
     const auto base_lab = buildLab(*entry, base, config_file);  // the lab config itself must be valid
     const Rubric rubric = parseRubric(JsonView(base, config_file));
@@ -182,7 +184,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
   } catch (const InputError& e) {
     // Blame follows the file: only an error in the submission itself is the student's to fix; one in
     // the lab config or its rubric (--config, a scenario patch) is the staff's, an internal error.
-    if (e.file() != file) return failedOutcome(utf8Quotable(std::string("staff file: ") + e.what()), nullptr);
+    if (!staff_file.empty() && e.file().rfind(staff_file, 0) == 0) return failedOutcome(utf8Quotable(std::string("staff file: ") + e.what()), nullptr);
     return failedOutcome(e.what(), &e);
   } catch (const std::exception& e) {
     // Not the input's fault; what() may quote a path that is not UTF-8.
