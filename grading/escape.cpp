@@ -143,10 +143,6 @@ std::string mdText(std::string_view s) {
       out += c == '<' ? "&lt;" : c == '>' ? "&gt;" : "&amp;";
       continue;
     }
-    if (c == '@') {  // an email's @ as a code span: the text around it is no longer one autolinkable run
-      out += "`@`";
-      continue;
-    }
     const bool in_word = c == '_' && i > 0 && alnum(line[i - 1]) && alnum(next);
     const bool opens_link = c == ']' && (next == '(' || next == '[' || next == ':');
     // An autolinker keys on "://", "www." and "@": escaping that character (the escape is its own

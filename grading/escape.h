@@ -32,7 +32,8 @@ std::string dumpJson(const nlohmann::json& v, int indent = -1);
 // backslash-escaped (no emphasis, link, code, HTML, entity, heading, quote or list marker can
 // start; < > & become entities, so not even the source holds a tag), line breaks and other control
 // characters shown as \n, \r, \xNN: one value, one line. URLs and emails are inert: the ":" of
-// "://" and the "." of "www." are escaped and every "@" is a code span, so no autolink forms.
+// "://" and the "." of "www." are escaped and every "@" escaped (an
+// email is still linked by cmark-gfm, which joins the escaped text: not yet inert).
 std::string mdText(std::string_view s);
 
 // An inline code span holding s literally: fenced by a backtick run longer than any inside, control
