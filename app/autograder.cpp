@@ -150,34 +150,21 @@ fail() {
 mkdir -p "$results_dir"
 rm -rf -- "$results"
 
-# The student's file: submission.json, else the only *.json they uploaded (macOS ._* copies and
-# __MACOSX/ aside). Links, FIFOs and devices are found too, so that they are refused, not skipped.
-file=""
-if [ -e "$submission_dir/submission.json" ] || [ -L "$submission_dir/submission.json" ]; then
-  file="$submission_dir/submission.json"
-else
-  found=()
-  while IFS= read -r -d '' f; do found+=("$f"); done < <(find "$submission_dir" -iname '*.json' ! -type d ! -name '._*' ! -path '*/__MACOSX/*' -print0 2>/dev/null | LC_ALL=C sort -z)
-  case ${#found[@]} in
-    1) file="${found[0]}" ;;
-    0) fail 'No JSON file was found in your submission.\n\nUpload one file named `submission.json` of the form `{\"lab\": \"@LAB@\", \"gains\": {...}}` (see the lab handout for the gain names).' ;;
-    *) fail 'Your submission has several JSON files and none is named `submission.json`, so the grader cannot tell which one to grade.\n\nUpload one file named `submission.json` of the form `{\"lab\": \"@LAB@\", \"gains\": {...}}`.' ;;
-  esac
-fi
-
-# Only a regular file inside the submission folder is read. A symbolic link out of it, a FIFO or a
-# device is refused without being opened: nothing of what it points to reaches the feedback.
-if [ -L "$file" ]; then
-  target="$(realpath -e -- "$file" 2>/dev/null)"
-  root="$(realpath -e -- "$submission_dir" 2>/dev/null)"
-  case "$target" in
-    "$root"/*) file="$target" ;;
-    *) fail 'Your JSON file is a symbolic link to something outside your submission, so it was not read.\n\nUpload the file itself (not a link), named `submission.json`.' ;;
-  esac
-fi
-[ -f "$file" ] || fail 'Your JSON file is not a regular file (it is a folder, a FIFO or a device), so it was not read.\n\nUpload one ordinary file named `submission.json`.'
-
 [ -x "$dynlab" ] || fail 'The autograder is broken: dynlab was not built when the image was set up. This is not your fault; please tell the course staff.'
+
+# The student's file, by the rule the batch grader shares (dynlab submission-file, README "Grading"):
+# submission.json, else the only *.json uploaded, hidden and editor files aside; a link out of the
+# upload, a FIFO or a device is refused unread. The path is printed with a trailing "/" guard so a
+# name ending in a newline survives the command substitution.
+file="$("$dynlab" submission-file "$submission_dir"; rc=$?; printf '/'; exit $rc)"
+select_status=$?
+file="${file%/}"
+file="${file%$'\n'}"
+case $select_status in
+  0) ;;
+  2) fail "Your submission could not be graded: $(json_text "$file").\n\nUpload one file named \`submission.json\` of the form \`{\\\"lab\\\": \\\"@LAB@\\\", \\\"gains\\\": {...}}\` (see the lab handout for the gain names)." ;;
+  *) fail 'The autograder could not look at your submission. This is not your fault; please tell the course staff.' ;;
+esac
 
 # Grade within the time limit; dynlab writes results.json (each test's plot inline, for the student
 # to see on Gradescope), report.md and plots/ itself. Its own

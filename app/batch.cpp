@@ -21,6 +21,8 @@
 #include "app/batch.h"
 #include "app/commands.h"
 #include "app/output.h"
+#include "labs/config.h"
+#include "labs/lab.h"
 #include "grading/escape.h"
 #include "grading/plot.h"
 #include "labs/utf8.h"
@@ -148,6 +150,13 @@ Row finish(const Job& job, int status, double kill_s) {
   return row;
 }
 
+// The summary with the batch's lab stated under its heading.
+std::string withLab(std::string md, const std::string& lab_line) {
+  const std::size_t at = md.find("\n\n");
+  const std::string line = mdText(lab_line.substr(0, 1).size() ? "Lab" + lab_line.substr(3) : lab_line) + "\n\n";
+  return at == std::string::npos ? md + "\n" + line : md.insert(at + 2, line);
+}
+
 }  // namespace
 
 int gradeBatch(const GradeArgs& a) {
@@ -178,6 +187,26 @@ int gradeBatch(const GradeArgs& a) {
     return 2;
   }
   batch::assignFolders(found.submissions, out);
+  // The batch's lab is known before the first grade: --lab, else the lab the first submission (in
+  // name order) that names a known lab names. Every grader gets it, so a submission for another lab
+  // is an invalid row naming both labs, never graded against its own rubric.
+  GradeArgs args = a;
+  std::string lab_source = "--lab";
+  for (const auto& s : found.submissions) {
+    if (!args.lab.empty()) break;
+    if (!s.problem.empty()) continue;
+    try {
+      const json j = loadJsonFile(s.file.string(), 1u << 20);
+      if (j.is_object() && j.contains("lab") && j["lab"].is_string() && findLab(j["lab"].get<std::string>())) {
+        args.lab = j["lab"].get<std::string>();
+        lab_source = "the first submission naming a lab, " + s.folder;
+      }
+    } catch (const std::exception&) {
+      // Not valid: the next one decides.
+    }
+  }
+  const std::string lab_line = args.lab.empty() ? "lab: none (no submission names a known lab)"
+                                                 : "lab: " + args.lab + " (from " + lab_source + ")";
   if (a.plots) warmUpPlotting();  // fonts loaded once here, not in every grader
   const std::size_t total = found.submissions.size();
   const bool tty = isatty(STDERR_FILENO);
@@ -212,7 +241,7 @@ int gradeBatch(const GradeArgs& a) {
       const int log_fd = prepareFolder(j.out, problem);
       if (log_fd >= 0 && j.sub.problem.empty()) {
         j.started = Clock::now();
-        j.pid = spawnGrade(a, j, log_fd);
+        j.pid = spawnGrade(args, j, log_fd);
         if (j.pid < 0) problem = std::string("internal error: the grader could not be started (") + std::strerror(errno) + ")";
       }
       if (log_fd >= 0) ::close(log_fd);
@@ -251,8 +280,8 @@ int gradeBatch(const GradeArgs& a) {
 
   // The gradebook, and its summary beside it (score statistics, histogram, common failure reasons).
   const fs::path book = out / "gradebook.csv", summary = out / "gradebook.md";
-  const double lab_max = batch::labMaxScore(a.lab, a.config, rows);
-  for (const auto& [path, text] : {std::pair{book, batch::gradebookCsv(rows, lab_max)}, std::pair{summary, batch::gradebookMarkdown(rows, lab_max)}}) {
+  const double lab_max = batch::labMaxScore(args.lab, a.config, rows);
+  for (const auto& [path, text] : {std::pair{book, batch::gradebookCsv(rows, lab_max)}, std::pair{summary, withLab(batch::gradebookMarkdown(rows, lab_max), lab_line)}}) {
     try {
       writeFileAtomic(path, text);
     } catch (const std::exception& e) {
@@ -260,8 +289,8 @@ int gradeBatch(const GradeArgs& a) {
       return 1;
     }
   }
-  std::printf("graded %zu submission(s) into %s; gradebook: %s (summary: %s)\n", total, out.c_str(), book.c_str(),
-              summary.c_str());
+  std::printf("graded %zu submission(s) into %s; gradebook: %s (summary: %s)\n%s\n", total, out.c_str(), book.c_str(),
+              summary.c_str(), termText(lab_line).c_str());
   if (problems) std::printf("%zu submission(s) need a look (see the status and reason columns)\n", problems);
   ::close(lock_fd);
   return 0;

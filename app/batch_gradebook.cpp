@@ -18,7 +18,7 @@ namespace fs = std::filesystem;
 namespace dyn::app::batch {
 
 Row failedRow(const Submission& s, const std::string& status, const std::string& reason) {
-  return {s.name, s.folder, status, jsonText(reason), 0, 0, false, {}, {}};
+  return {s.name, s.folder, status, jsonText(clipText(reason, 600)), 0, 0, false, {}, {}};
 }
 
 Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, const std::string& log_tail) {
@@ -41,6 +41,9 @@ Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, 
       return failedRow(s, "internal error", "internal error: " + file + ": " + what);
     return failedRow(s, "invalid submission", what);
   }
+  // Exit 3 with the grader's own account (a staff file's error, a failed plot): that is the reason.
+  if (exit_code == 3 && extra.is_object() && extra.value("internal_error", json()).is_string())
+    return failedRow(s, "internal error", "internal error: " + extra["internal_error"].get<std::string>());
   // Exit 4: the grader's time budget ran out; what it scored before is in its results.json.
   const bool budget = exit_code == 4;
   if ((exit_code != 0 && !budget) || !error.is_null() || !r.value("score", json()).is_number())
@@ -72,7 +75,7 @@ Row rowFromResults(const Submission& s, const fs::path& results, int exit_code, 
     row.status = "timed out";
     row.reason += std::string(row.reason.empty() ? "" : "; ") + "the grading time budget ran out";
   }
-  row.reason = jsonText(row.reason);
+  row.reason = jsonText(clipText(row.reason, 600));
   return row;
 }
 

@@ -7,6 +7,7 @@
 #include <set>
 
 #include "app/batch.h"
+#include "app/submission_file.h"
 #include "grading/grade.h"
 
 namespace fs = std::filesystem;
@@ -24,18 +25,6 @@ bool endsWithJson(const std::string& name) { return name.size() > 5 && lower(nam
 // macOS zip leftovers: __MACOSX/ folders and ._NAME AppleDouble files beside the real ones.
 bool macOsLeftover(const std::string& name) { return name == "__MACOSX" || name.rfind("._", 0) == 0; }
 
-// What kind of file a path is, for "expected a regular file, got a FIFO" (symlinks followed).
-std::string kindOf(const fs::path& p) {
-  struct stat st {};
-  if (::stat(p.c_str(), &st) != 0) return "a dangling link";
-  if (S_ISREG(st.st_mode)) return "";
-  if (S_ISFIFO(st.st_mode)) return "a FIFO";
-  if (S_ISDIR(st.st_mode)) return "a directory";
-  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) return "a device";
-  if (S_ISSOCK(st.st_mode)) return "a socket";
-  return "not a regular file";
-}
-
 // The entries of a folder, by name (byte order), without macOS leftovers.
 std::vector<fs::directory_entry> listed(const fs::path& dir, std::error_code& ec) {
   std::vector<fs::directory_entry> v;
@@ -45,24 +34,12 @@ std::vector<fs::directory_entry> listed(const fs::path& dir, std::error_code& ec
   return v;
 }
 
-// One student's folder: its submission.json, else its only *.json, else why it has none.
+// One student's folder: the file the shared rule chooses (app/submission_file.h), else why none.
 Submission fromFolder(const fs::directory_entry& folder) {
   const std::string name = folder.path().filename().string();
-  std::error_code ec;
-  std::vector<std::string> json_files;
-  for (const auto& e : listed(folder.path(), ec))
-    if (endsWithJson(e.path().filename().string()) && !e.is_directory()) json_files.push_back(e.path().filename().string());
-  Submission s{name + "/", {}, {}, {}};
-  const bool named = std::find(json_files.begin(), json_files.end(), "submission.json") != json_files.end();
-  if (ec) s.problem = "the folder cannot be read (" + ec.message() + ")";
-  else if (named || json_files.size() == 1) {
-    s.name += named ? "submission.json" : json_files[0];
-    s.file = folder.path() / (named ? "submission.json" : json_files[0]);
-  } else if (json_files.empty()) {
-    s.problem = "no JSON file in this folder";
-  } else {
-    s.problem = "several JSON files in this folder and none is named submission.json";
-  }
+  const SubmissionFile chosen = chooseSubmissionFile(folder.path());
+  Submission s{name + "/" + chosen.name, chosen.file, chosen.problem, {}};
+  if (chosen.name.empty()) s.name = name + "/";
   return s;
 }
 
@@ -103,11 +80,11 @@ Found findSubmissions(const fs::path& dir, const fs::path& out) {
       }
       found.submissions.push_back(fromFolder(e));
     } else if (endsWithJson(name)) {
-      Submission s{name, e.path(), {}, {}};
-      if (const std::string kind = kindOf(e.path()); !kind.empty()) {
-        s.file.clear();
-        s.problem = "expected a regular file, got " + kind;
-      }
+      // The same check as a folder's file: a link must stay inside DIR, and lead to a regular file.
+      Submission s{name, {}, {}, {}};
+      fs::path resolved;
+      s.problem = refusedSubmissionFile(e.path(), dir, resolved);
+      if (s.problem.empty()) s.file = resolved;
       found.submissions.push_back(std::move(s));
     } else {
       ++other_files;

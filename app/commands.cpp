@@ -109,6 +109,12 @@ int runLab(const RunArgs& a) {
     loaded = loadLab(a.lab, a.config, a.gains, a.duration);
     applyScenario(loaded, a.scenario, a.gains, a.duration);
     watchdog = runWatchdog(loaded);
+    // A run must hold at least one step: a shorter one would report "ok" over an empty trace.
+    if (loaded.lab->duration() < loaded.lab->dt()) {
+      char what[96];
+      std::snprintf(what, sizeof what, "expected at least one step (dt = %g s), got %g s", loaded.lab->dt(), loaded.lab->duration());
+      throw InputError("<command line>", "--duration", what);
+    }
   } catch (const InputError& e) {
     std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
     return 2;

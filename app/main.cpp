@@ -1,12 +1,19 @@
 // dynlab: the command line. Dispatch only; the work is in labs/, grading/ and render/.
 #include <CLI/CLI.hpp>
 
+#include <csignal>
+#include <cerrno>
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <iostream>
 #include <string>
 
 #include "app/check_results.h"
 #include "app/commands.h"
 #include "app/course.h"
+#include "app/submission_file.h"
 #include "labs/utf8.h"
 
 namespace {
@@ -26,18 +33,49 @@ int internalError(const std::string& what) {
 }
 }  // namespace
 
-// Whatever escapes a command is reported on one line and exits 3: never an abort.
+// Standard output that could not be written (a full disk, /dev/full, a closed pipe): one line on
+// stderr and a non-zero exit, never a success whose output was lost.
+static int checkStdout(int code) {
+  errno = 0;
+  std::cout.flush();
+  if (std::fflush(stdout) == 0 && !std::ferror(stdout) && !std::cout.fail()) return code;
+  const int err = errno;
+  std::fprintf(stderr, "error: cannot write standard output (%s)\n", err ? std::strerror(err) : "write failed");
+  return code == 0 ? 1 : code;
+}
+
+// Whatever escapes a command is reported on one line and exits 3: never an abort. A write past
+// `ulimit -f` (SIGXFSZ) or into a closed pipe (SIGPIPE, `| head`) fails with an error the command
+// reports instead of killing it, so a batch still writes its gradebook.
 int main(int argc, char** argv) {
+  std::signal(SIGPIPE, SIG_IGN);
+  std::signal(SIGXFSZ, SIG_IGN);
+  int code;
   try {
-    return dispatch(argc, argv);
+    code = dispatch(argc, argv);
   } catch (const std::exception& e) {
-    return internalError(e.what());
+    code = internalError(e.what());
   } catch (...) {
-    return internalError("an exception that is not a std::exception");
+    code = internalError("an exception that is not a std::exception");
   }
+  return checkStdout(code);
 }
 
 namespace {
+// Every floating-point option of every command (CLI11 names their type FLOAT) refuses NaN and the
+// infinities: a range check passes NaN (every comparison is false), and inf overflows what uses it.
+void requireFinite(CLI::App& app) {
+  const CLI::Validator finite(
+      [](std::string& text) {
+        const double v = std::strtod(text.c_str(), nullptr);
+        return std::isfinite(v) ? std::string() : "expected a finite number, got \"" + text + "\"";
+      },
+      "FINITE");
+  for (CLI::Option* o : app.get_options())
+    if (o->get_type_name().find("FLOAT") != std::string::npos) o->check(finite);
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) requireFinite(*sub);
+}
+
 int dispatch(int argc, char** argv) {
   using namespace dyn::app;
   CLI::App cli{"dynlab — a teaching lab for the dynamics of constrained mechanisms"};
@@ -128,6 +166,11 @@ int dispatch(int argc, char** argv) {
   auto* s = cli.add_subcommand("schema", "Print the JSON Schema of a lab's submission");
   s->add_option("LAB", schema_lab, "Lab name")->required();
 
+  std::string upload_dir;
+  auto* sf = cli.add_subcommand("submission-file", "Print which file of an upload folder is graded (the rule the batch and "
+                                                   "run_autograder share), or why none is (exit 2)");
+  sf->add_option("DIR", upload_dir, "The student's upload folder")->required();
+
   UiArgs ui;
   auto* u = cli.add_subcommand("ui", "Tune a lab's gains in a window and watch it move (runs dynlab-ui; options after LAB "
                                      "go to it, see `dynlab-ui --help`)");
@@ -169,6 +212,7 @@ int dispatch(int argc, char** argv) {
 
   CourseCommands course(cli);  // dynlab handout, dynlab map (app/course.h)
 
+  requireFinite(cli);
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -182,6 +226,7 @@ int dispatch(int argc, char** argv) {
   if (*z) return writeAutograderZip(zip_lab, zip_out);
   if (*c) return checkResults(results_file);
   if (*s) return printSchema(schema_lab);
+  if (*sf) return printSubmissionFile(upload_dir);
   if (*k) return compare(cmp);
   if (*l) return lessons(les);
   if (*b) return bench_args.scaling ? benchScaling(bench_args) : bench(bench_args);

@@ -1,6 +1,14 @@
 // Staged, atomic output; see output.h.
 #include "app/output.h"
 
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdlib>
 #include <system_error>
 
 #include "labs/file_write.h"
@@ -13,8 +21,49 @@ void writeFileAtomic(const fs::path& path, const std::string& contents) {
   writeFileChecked(path.string(), contents, true);
 }
 
-Staging::Staging(const fs::path& out) : out_(out), staging_(out / ".staging") {
+namespace {
+// A staging folder's name: ".staging-PID-N", private to this process (N counts this process's stagings).
+std::string stagingName() {
+  static std::atomic<int> counter{0};
+  return ".staging-" + std::to_string(::getpid()) + "-" + std::to_string(counter++);
+}
+
+// Staging folders left by a process that no longer runs (killed mid-command), and the shared
+// ".staging" of older versions: removed. Another live process's staging is never touched.
+void removeStale(const fs::path& out) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(out, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name == ".staging") {
+      fs::remove_all(e.path(), ec);
+      continue;
+    }
+    if (name.rfind(".staging-", 0) != 0) continue;
+    const long pid = std::strtol(name.c_str() + 9, nullptr, 10);
+    if (pid > 0 && ::kill(static_cast<pid_t>(pid), 0) != 0 && errno == ESRCH) fs::remove_all(e.path(), ec);
+  }
+}
+
+// An exclusive flock on the folder itself (no lock file to leave behind), released on destruction.
+struct FolderLock {
+  int fd = -1;
+  explicit FolderLock(const fs::path& dir) {
+    fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (fd < 0) throw std::system_error(errno, std::generic_category(), "cannot open " + dir.string());
+    while (::flock(fd, LOCK_EX) != 0)
+      if (errno != EINTR) {
+        const int err = errno;
+        ::close(fd);
+        throw std::system_error(err, std::generic_category(), "cannot lock " + dir.string());
+      }
+  }
+  ~FolderLock() { ::close(fd); }
+};
+}  // namespace
+
+Staging::Staging(const fs::path& out) : out_(out), staging_(out / stagingName()) {
   fs::create_directories(out_);
+  removeStale(out_);
   fs::remove_all(staging_);
   fs::create_directories(staging_);
 }
@@ -52,6 +101,8 @@ void checkOurs(const fs::path& dir) {
 }  // namespace
 
 void Staging::commit() {
+  // One commit into a folder at a time: a concurrent command's set lands whole before or after this one.
+  const FolderLock lock(out_);
   // Nothing is removed unless everything that would be is dynlab's own.
   for (const auto& name : owned_) checkOurs(out_ / name);
   for (const auto& e : fs::directory_iterator(staging_)) checkOurs(out_ / e.path().filename());

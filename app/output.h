@@ -1,5 +1,7 @@
-// Output staging: everything a command writes goes to DIR/.staging first and is moved into
-// place only when the command succeeds, so a failure never leaves half-written results.
+// Output staging: everything a command writes goes to DIR/.staging-PID-N first (private to this
+// process) and is moved into place only when the command succeeds, under an exclusive lock on DIR,
+// so a failure never leaves half-written results and two concurrent commands into one DIR each
+// publish a whole set (the later one wins), never a mix.
 // Every write is checked through close (labs/file_write.h): a full disk is an exception naming
 // the file with the system's error text, never a short file left as if it were valid.
 #pragma once

@@ -46,7 +46,9 @@ namespace {
 // A results.json for a submission that could not be graded at all: the submission's fault (e is
 // its InputError) or an internal error, whose details go to the staff (extra_data, the terminal
 // and report.md), not into the student's feedback.
-GradeOutcome failedOutcome(const std::string& message, const InputError* e) {
+GradeOutcome failedOutcome(const std::string& full_message, const InputError* e) {
+  // What the input said is echoed clipped (a 900 KB key is not quoted whole in any output).
+  const std::string message = clipText(full_message, 600);
   GradeOutcome out;
   out.input_error = e != nullptr;
   out.internal_error = e == nullptr;
@@ -60,7 +62,7 @@ GradeOutcome failedOutcome(const std::string& message, const InputError* e) {
                  {"output_format", "md"},
                  {"tests", json::array()},
                  {"extra_data", {{"dynlab_version", DYNLAB_VERSION}, {"status", out.status()}}}};
-  if (e) out.results["extra_data"]["error"] = {{"file", e->file()}, {"path", e->path().empty() ? "/" : e->path()}, {"expected", e->expected()}};
+  if (e) out.results["extra_data"]["error"] = {{"file", clipText(e->file())}, {"path", e->path().empty() ? "/" : clipText(e->path())}, {"expected", clipText(e->expected())}};
   else out.results["extra_data"]["internal_error"] = message;
   out.results = jsonSanitized(out.results);
   // The terminal: the one-line error goes to stderr (dynlab grade), the report says what kind it was.
@@ -76,6 +78,7 @@ GradeOutcome failedOutcome(const std::string& message, const InputError* e) {
 GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
   const auto started = std::chrono::steady_clock::now();
   const Deadline deadline = started + std::chrono::milliseconds(long(opt.time_budget * 1e3));
+  std::string staff_file;  // the lab config once known: an error naming it is the staff's
   try {
     // The submission: a JSON object naming a lab; the lab's config with the gains applied.
     const json sub = loadJsonFile(file, 1u << 20);
@@ -83,14 +86,15 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     view.requireObject();
     const std::string lab_name = view["lab"].string();
     if (!opt.expected_lab.empty() && lab_name != opt.expected_lab)
-      view["lab"].fail("expected \"" + opt.expected_lab + "\" (this assignment's lab), got \"" + lab_name + "\"");
+      view["lab"].fail("expected \"" + opt.expected_lab + "\" (this assignment's lab), got \"" + clipText(lab_name) + "\"");
     const LabEntry* entry = findLab(lab_name);
     if (!entry) {
       std::string list;
       for (const auto& e : labRegistry()) list += (list.empty() ? "" : ", ") + e.name;
-      view["lab"].fail("expected the name of a dynlab lab (" + list + "), got \"" + lab_name + "\"");
+      view["lab"].fail("expected the name of a dynlab lab (" + list + "), got \"" + clipText(lab_name) + "\"");
     }
     const std::string config_file = opt.config_file.empty() ? defaultConfigPath(lab_name) : opt.config_file;
+    staff_file = config_file;
     const json base = loadJsonFile(config_file);
     const auto base_lab = buildLab(*entry, base, config_file);  // the lab config itself must be valid
     const Rubric rubric = parseRubric(JsonView(base, config_file));
@@ -146,8 +150,9 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
       } else if (!run.failure.empty()) {
         g.note = run.failure;
       } else {
+        // The rubric is the staff's: a metric the lab does not report is never the student's fault.
         throw InputError(config_file, "/rubric/tests/" + std::to_string(i) + "/metric",
-                         "expected a metric this lab reports, got \"" + t.metric + "\"");
+                         "expected a metric this lab reports, got \"" + clipText(t.metric) + "\"");
       }
       rep.tests.push_back(g);
     }
@@ -177,6 +182,9 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
     }
     return out;
   } catch (const InputError& e) {
+    // Blame follows the file: only an error in the submission itself is the student's to fix; one in
+    // the lab config or its rubric (--config, a scenario patch) is the staff's, an internal error.
+    if (!staff_file.empty() && e.file().rfind(staff_file, 0) == 0) return failedOutcome(utf8Quotable(std::string("staff file: ") + e.what()), nullptr);
     return failedOutcome(e.what(), &e);
   } catch (const std::exception& e) {
     // Not the input's fault; what() may quote a path that is not UTF-8.

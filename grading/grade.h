@@ -46,7 +46,10 @@ struct GradeOutcome {
   // With GradeOptions::keep_runs, a graded submission's tests (values, units) and each scenario's run.
   GradeReport graded;
   std::map<std::string, ScenarioRun> runs;
-  const char* status() const { return input_error ? "invalid_submission" : internal_error ? "internal_error" : "graded"; }
+  // A grade the time budget cut short is not "graded": its own status, so no reader takes it for a whole grade.
+  const char* status() const {
+    return input_error ? "invalid_submission" : internal_error ? "internal_error" : out_of_time ? "out_of_time" : "graded";
+  }
 };
 
 GradeOutcome gradeSubmission(const std::string& submission_file, const GradeOptions& options);

@@ -248,9 +248,9 @@ struct Sandbox {
     }();
     return text;
   }
-  // A fake `dynlab grade` (body); `dynlab check-results` stays the real one.
+  // A fake `dynlab grade` (body); `dynlab check-results` and `dynlab submission-file` stay the real ones.
   void fakeDynlab(const std::string& body) {
-    writeText(dynlab, "#!/usr/bin/env bash\n[ \"$1\" = check-results ] && exec '" + std::string(DYNLAB_BIN) + "' \"$@\"\n" +
+    writeText(dynlab, "#!/usr/bin/env bash\n{ [ \"$1\" = check-results ] || [ \"$1\" = submission-file ]; } && exec '" + std::string(DYNLAB_BIN) + "' \"$@\"\n" +
                           body + "\n", true);
   }
   // A fake that writes `json` as its results.json and exits 0.
@@ -616,10 +616,10 @@ TEST_CASE("run_autograder: a link out of the submission, a FIFO or a device is r
     fs::create_symlink("/dev/zero", box.submission / "submission.json");
     CHECK(refused(box).find("symbolic link") != std::string::npos);
   }
-  SUBCASE("submission.json is a folder") {
+  SUBCASE("submission.json is a folder: not a file to grade (the shared rule), so none is found") {
     Sandbox box("folder_in");
     fs::create_directories(box.submission / "submission.json");
-    CHECK(refused(box).find("not a regular file") != std::string::npos);
+    CHECK(refused(box).find("no JSON file") != std::string::npos);
   }
 }
 

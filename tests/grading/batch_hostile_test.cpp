@@ -291,7 +291,7 @@ TEST_CASE("a rerun grades afresh: a stale results.json never counts, a failing g
     CHECK(std::chrono::steady_clock::now() - started < std::chrono::seconds(60));
     const auto row = readBook(dir / "out" / "gradebook.csv").at("fine.json");
     CHECK(row.at("score") == "0");
-    CHECK(row.at("reason") == "expected a regular file, got a FIFO");
+    CHECK(row.at("reason").find("a FIFO, not a regular file") != std::string::npos);
     CHECK(json::parse(readFile(dir / "out" / "fine" / "results.json")).at("score") == 0.0);
   }
   // The other submission is graded as before.
@@ -386,8 +386,8 @@ TEST_CASE("a Gradescope export: one folder per student, macOS leftovers ignored"
   CHECK(book.at("submission_1/submission.json").at("score") == aloneScore("proportional"));
   CHECK(book.at("submission_1/submission.json").at("folder") == "submission_1");
   CHECK(book.at("submission_2/my gains.json").at("status") == "graded");
-  CHECK(book.at("submission_3/").at("reason") == "several JSON files in this folder and none is named submission.json");
-  CHECK(book.at("submission_4/").at("reason") == "no JSON file in this folder");
+  CHECK(book.at("submission_3/").at("reason").find("several JSON files") != std::string::npos);
+  CHECK(book.at("submission_4/").at("reason").find("no JSON file") != std::string::npos);
   CHECK(book.at("submission_4/").at("max_score") == "15");
   CHECK(book.at("top.json").at("status") == "graded");
   CHECK(json::parse(readFile(dir / "out" / "submission_4" / "results.json")).at("score") == 0.0);
@@ -442,5 +442,5 @@ TEST_CASE("a broken lab config is an internal error in every row, not the studen
   const auto row = readBook(dir / "out" / "gradebook.csv").at("fine.json");
   CHECK(row.at("status") == "internal error");
   CHECK(row.at("reason").find("internal error: ") == 0);
-  CHECK(row.at("reason").find("broken.json: /rubric/tests/0/points: expected") != std::string::npos);
+  CHECK(row.at("reason").find("broken.json: /rubric/tests/0/points: expected") != std::string::npos);  // the staff file named, for the staff
 }
