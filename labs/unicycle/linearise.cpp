@@ -20,6 +20,7 @@ std::vector<LinearLoop> UnicycleLab::linearise() const {
   const std::string off = " (controller off)";
   std::vector<LinearLoop> loops;
   loops.push_back({"speed", on ? "speed loop (PI on θ', k_pv and k_iv)" : "speed loop" + off, {g.ki_speed, g.kp_speed}, {0, 0, Jy}, delay});
+  loops.back().controller_integrators = 1;  // the PI law's 1/s: with k_iv = 0 the loop is P on θ'
   loops.push_back({"heading", on ? "heading loop (PD, k_pφ and k_dφ)" : "heading loop" + off, {g.kp_heading, g.kd_heading}, {0, 0, Iz}, delay});
   const double k = g.k_cross * v;
   loops.push_back({"cross", on ? "cross-track loop (k_ct through the heading loop)" : "cross-track loop" + off,
