@@ -62,7 +62,7 @@ TEST_CASE("dynlab figure --plot Y:X@M: the pen's ink where contact, named; the l
                                    " --engine hand --duration 2.6 --out out --format svg --plot 'y_p:x_p@contact, y_d:x_d'");
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   REQUIRE(r.code == 1);  // the watchdog stops the unstable run; the figure is still written
-  CHECK(has(r.out, "lifted off"));
+  CHECK(has(r.out, "the pen bounced"));
   CHECK(names(dir / "out") == std::vector<std::string>{"plot_y_p-vs-x_p-where-contact+y_d-vs-x_d.svg"});
   const std::string svg = test::svgText(readFile(dir / "out/plot_y_p-vs-x_p-where-contact+y_d-vs-x_d.svg"));
   CHECK(has(svg, "y_p vs x_p where contact (hand)"));

@@ -85,7 +85,7 @@ TEST_CASE("the handout follows the config: a changed threshold, bound and window
   const std::string before = readFile(dir / "a/handout.md"), after = readFile(dir / "b/handout.md");
   CHECK_FALSE(has(before, "0.0042"));
   CHECK(has(after, "≤ 0.0042 m"));
-  CHECK(has(after, "| `kp_x` | 80 | 0 | 12345 |"));
+  CHECK(has(after, "| `kp_x` | 150 | 0 | 12345 |"));
   CHECK(has(before, "from t = 0.5 s on"));
   CHECK(has(after, "from t = 0.75 s on"));
   CHECK_FALSE(has(after, "from t = 0.5 s on"));

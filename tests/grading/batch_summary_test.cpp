@@ -77,7 +77,7 @@ TEST_CASE("gradebook.md: counts, statistics, histogram and failure reasons as th
   // Stable gains of the students' kind (not the instructor's answer).
   put(in / "stable.json", R"({"lab": "slider_crank", "gains": {"kp_x": 300, "kd_x": 12, "kp_f": 0.5, "ki_f": 10}})");
   // Unstable too, with other numbers in its sentences: the same kind of failure.
-  put(in / "unstable_too.json", R"({"lab": "slider_crank", "gains": {"kp_x": 400, "kd_x": 40, "kp_f": 0.5, "ki_f": 700}})");
+  put(in / "unstable_too.json", R"({"lab": "slider_crank", "force_law": "integral", "gains": {"kp_x": 400, "kd_x": 40, "kp_f": 0.5, "ki_f": 700}})");
   put(in / "broken.json", R"({"lab": "slider_crank", "gains": {"kp_x": })");
   // A hostile name on a submission that is not graded: it is listed, as text.
   const std::string hostile = "*evil*<b>|x| [a](j:x).json";

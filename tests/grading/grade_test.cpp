@@ -291,14 +291,14 @@ TEST_CASE("a rubric plot of a column the lab lacks is the config's error, found 
 TEST_CASE("feedback gives every metric its unit: the lab's metric_docs, and the screening's own") {
   const GradeOutcome g = grade(kMediocre);
   REQUIRE_FALSE(g.input_error);
-  CHECK(g.report.find("x_rms = 0.01113 m (full 0.003 m, zero 0.03 m)") != std::string::npos);
-  CHECK(g.report.find("f_rms = 0.1483 N (full 0.05 N, zero 0.5 N)") != std::string::npos);
+  CHECK(g.report.find("x_rms = 0.01166 m (full 0.003 m, zero 0.03 m)") != std::string::npos);
+  CHECK(g.report.find("f_rms = 0.1496 N (full 0.05 N, zero 0.5 N)") != std::string::npos);
   CHECK(g.report.find("force_delay_margin = 0.1963 s (full 0.03 s, zero 0.01 s)") != std::string::npos);
-  CHECK(g.report.find("motion_damping = 0.2019 (full 0.7, zero 0.2)") != std::string::npos);  // dimensionless
+  CHECK(g.report.find("motion_damping = 0.1981 (full 0.7, zero 0.2)") != std::string::npos);  // dimensionless
   // The student's view (results.json, HTML) and report.md's table say the same.
   bool found = false;
   for (const auto& t : g.results.at("tests"))
-    if (t.at("name") == "Slider tracks x_d(t)") found = t.at("output").get<std::string>().find("= <strong>0.01113 m</strong>; full credit at 0.003 m") != std::string::npos;
+    if (t.at("name") == "Slider tracks x_d(t)") found = t.at("output").get<std::string>().find("= <strong>0.01166 m</strong>; full credit at 0.003 m") != std::string::npos;
   CHECK(found);
-  CHECK(g.markdown.find("| 0.01113 m | 0.003 m | 0.03 m |") != std::string::npos);
+  CHECK(g.markdown.find("| 0.01166 m | 0.003 m | 0.03 m |") != std::string::npos);
 }

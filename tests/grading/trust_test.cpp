@@ -81,7 +81,7 @@ TEST_CASE("batch: the lab is fixed before it starts; a submission for another la
   CHECK(readFile(dir / "out/gradebook.md").find("Lab: grasp") != std::string::npos);
   const auto book = gradebook(dir / "out/gradebook.csv");
   REQUIRE(book.size() == 2);
-  CHECK(book[0][3] == "graded");
+  CHECK(book[0][3].rfind("graded", 0) == 0);  // "graded", or "graded (unstable run)" when a scenario stops
   CHECK(book[1][3] == "invalid submission");
   CHECK(book[1][4].find("grasp") != std::string::npos);
   CHECK(book[1][4].find("slider_crank") != std::string::npos);

@@ -480,7 +480,7 @@ TEST_CASE("the shipped examples: the integral law ahead of the proportional one,
     REQUIRE(g.error.empty());
     return g.results;
   };
-  const json integral = grade("integral.json"), proportional = grade("proportional.json");
+  const json integral = grade("../instructor/lessons/integral.json"), proportional = grade("proportional.json");
   // Same motion gains; under the delay kp_f < 1 leaves ≥ m_t g / 2 on the rail, the integral law removes it.
   CHECK(integral.at("score").get<double>() - proportional.at("score").get<double>() >= 0.15 * 15);
   CHECK(grade("unstable_integral.json").at("output").get<std::string>().find("unstable") != std::string::npos);

@@ -122,7 +122,7 @@ TEST_CASE("unicycle: examples named for a verdict get it") {
   CHECK(skid.at("output").get<std::string>().find("unstable") == std::string::npos);
   CHECK(testScore(skid, "No skid on a slippery floor (μ = 0.3)") == 0.0);
   // slows_in_turns: the same loops with a_lat 1.85 (m a_lat = 3.7 N < 5.9 N) hold the slippery floor.
-  const json slow = gradeExample("slows_in_turns");
+  const json slow = gradeExample("../instructor/lessons/slows_in_turns");
   CHECK(testScore(slow, "No skid on a slippery floor (μ = 0.3)") > 0.5 * 3);
   CHECK(slow.at("score").get<double>() > skid.at("score").get<double>());
 }

@@ -52,11 +52,11 @@ TEST_CASE("gains and options come from the lab's JSON, in its order, with bounds
   CHECK(g[0].max == 20000.0);
   CHECK(g[0].unit == "N/m");
   CHECK(g[0].doc == "slider position stiffness");
-  CHECK(s.gain("kp_x") == 80.0);
+  CHECK(s.gain("kp_x") == 150.0);
   REQUIRE(s.optionSpecs().size() == 1);
   CHECK(s.optionSpecs()[0].name == "force_law");
   CHECK(s.optionSpecs()[0].choices == std::vector<std::string>{"open_loop", "proportional", "integral"});
-  CHECK(s.option("force_law") == "integral");
+  CHECK(s.option("force_law") == "proportional");
   CHECK(s.title().find("Slider crank") == 0);
   // A run starts at once, with its first row at t = 0.
   CHECK(s.hasRows());
@@ -83,8 +83,8 @@ TEST_CASE("--set NAME=VALUE: gains within bounds, declared options, one clear li
   CHECK(s.gain("kp_x") == 500.0);
   CHECK(s.option("force_law") == "proportional");
   s.resetToLabDefaults();
-  CHECK(s.gain("kp_x") == 80.0);
-  CHECK(s.option("force_law") == "integral");
+  CHECK(s.gain("kp_x") == 150.0);
+  CHECK(s.option("force_law") == "proportional");
 }
 
 TEST_CASE("the session's runs are the runs `dynlab run` makes with the same gains, step for step") {
@@ -121,7 +121,7 @@ TEST_CASE("unstable gains stop the run with the grader's sentence, never a throw
   CHECK(s.gain("ki_f") == 400.0);
   runToEnd(s);
   CHECK(s.finished());
-  CHECK(s.problem() == "unstable: the rail force left its safe range [-500, 500] at t = 0.15 s (f_Ty = 537.8)");
+  CHECK(s.problem() == "unstable: the rail force left its safe range [-500, 500] at t = 0.088 s (f_Ty = -550.3)");
   CHECK(s.screeningUnstable());
   // The same words as a graded run of the nominal scenario (shared RowWatch).
   const LoadedLab loaded = loadLab("slider_crank", "", kExamples + "unstable_integral.json");
@@ -201,9 +201,9 @@ TEST_CASE("the live plots hold every step up to the row on screen; at a watchdog
   }
   // The watchdog stopped it: the plot's last value is the f_Ty the sentence names and the overlay shows.
   REQUIRE(s.finished());
-  CHECK(s.problem().find("(f_Ty = 537.8)") != std::string::npos);
+  CHECK(s.problem().find("(f_Ty = -550.3)") != std::string::npos);
   const float last = s.livePlots()[0].values.back();
-  CHECK(last == doctest::Approx(537.8).epsilon(1e-4));
+  CHECK(last == doctest::Approx(-550.3).epsilon(1e-4));
   Overlay overlay;
   s.lab()->overlay(s.primary(), s.row(), overlay);
   char shown[32];
