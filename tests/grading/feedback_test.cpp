@@ -287,7 +287,7 @@ TEST_CASE("replay differences say what each value was and is now") {
   REQUIRE(diff.size() == 3);
   const std::string all = diff[0] + "\n" + diff[1] + "\n" + diff[2];
   CHECK(all.find("/extra_data/scenarios/nominal/metrics/x_rms: was 0.02 → now 0.0116") != std::string::npos);
-  CHECK(all.find("/tests/0/score: was 2.5 → now 2.04") != std::string::npos);
+  CHECK(all.find("/tests/0/score: was 2.5 → now 2.03") != std::string::npos);
   CHECK(all.find("/tests/1/tags: added, now [\"nominal\"]") != std::string::npos);
 }
 
@@ -330,7 +330,7 @@ TEST_CASE("dynlab grade: the replay hints run as printed, from any folder, and r
   const Result changed = shell(dir, "cd / && " + terminal_hint);
   CHECK(changed.code == 1);
   CHECK(changed.out.find("metric x_rms of test 1 (Slider tracks x_d(t)): was 0.02 → now 0.0116") != std::string::npos);
-  CHECK(changed.out.find("score was 2.5 → now 2.04") != std::string::npos);
+  CHECK(changed.out.find("score was 2.5 → now 2.03") != std::string::npos);
 }
 
 TEST_CASE("inline plots stop at their budget: later ones are named as left out, and replay strips both") {

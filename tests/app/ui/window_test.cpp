@@ -253,7 +253,7 @@ TEST_CASE("unstable gains: the window says why in the grader's words, and does n
   REQUIRE(r.code == 0);
   const json state = loadJsonFile((dir / "state.json").string());
   const std::string problem = state["problem"];
-  CHECK(problem == "unstable: the rail force left its safe range [-500, 500] at t = 0.15 s (f_Ty = 537.8)");
+  CHECK(problem == "unstable: the rail force left its safe range [-500, 500] at t = 0.088 s (f_Ty = -550.3)");
   CHECK(state["finished"] == true);
   CHECK(loadPng(dir / "shot.png").width > 0);
   // The grader stops the nominal scenario with the same sentence.
