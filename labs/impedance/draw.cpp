@@ -46,7 +46,7 @@ void ImpedanceLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, S
   for (const auto& p : ref) extend(p);
   // The whole run's tip path frames the camera (a still camera over the run).
   // The spring glyph's anchor (see below) at a row: tip − L0 û − g (tip − x_ref).
-  const double g = springMagnification();
+  const double g = springMagnification(tr);
   const Eigen::Vector2d u = pushDirection(), side(-u.y(), u.x());
   auto anchorAt = [&](std::size_t r) {
     const Eigen::Vector2d x(tr.at(r, "x"), tr.at(r, "y")), xr(tr.at(r, "x_ref"), tr.at(r, "y_ref"));
@@ -87,9 +87,14 @@ Eigen::Vector2d ImpedanceLab::pushDirection() const {
 
 // The largest of 1, 2, 5, 10, … 100 that draws the target's static stretch |F|/K_des (along the
 // push) at most L0: a 9 mm stretch is drawn ×10 (90 mm against L0 = 150 mm), 20 mm ×5.
-double ImpedanceLab::springMagnification() const {
+double ImpedanceLab::springMagnification(const Trace& tr) const {
   const Eigen::Vector2d u = pushDirection();
-  const double k = u.x() * u.x() * s_.target.K[0] + u.y() * u.y() * s_.target.K[1], d = s_.force.value.norm() / k;
+  const double k = u.x() * u.x() * s_.target.K[0] + u.y() * u.y() * s_.target.K[1];
+  // The larger of the target's stretch and the run's own (a controller softer than the target
+  // stretches further): the anchor then never swings more than L0 and the frame stays on the arm.
+  double d = s_.force.value.norm() / k;
+  for (std::size_t r = 0; r < tr.rows(); ++r)
+    d = std::max(d, std::abs(u.x() * (tr.at(r, "x") - tr.at(r, "x_ref")) + u.y() * (tr.at(r, "y") - tr.at(r, "y_ref"))));
   double g = 1;
   for (double c : {2.0, 5.0, 10.0, 20.0, 50.0, 100.0})
     if (c * d <= kRestLength) g = c;
@@ -104,7 +109,7 @@ void ImpedanceLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
              {"x - x_ref", fmt("%.1f mm", 1e3 * (tr.at(row, "x") - tr.at(row, "x_ref")))},
              {"y - y_ref", fmt("%.1f mm", 1e3 * (tr.at(row, "y") - tr.at(row, "y_ref")))},
              {"F_ext", fmt("(%.1f, ", tr.at(row, "F_ext_x")) + fmt("%.1f) N", tr.at(row, "F_ext_y"))},
-             {"spring glyph", fmt("stretch drawn x%g", springMagnification())}};
+             {"spring glyph", fmt("stretch drawn x%g", springMagnification(tr))}};
   Series dx{"x - x_ref (mm)", {}, {0.85f, 0.15f, 0.15f, 1}}, dy{"y - y_ref (mm)", {}, {0.23f, 0.42f, 0.68f, 1}};
   for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) {
     dx.values.push_back(float(1e3 * (tr.at(r, "x") - tr.at(r, "x_ref"))));

@@ -84,7 +84,7 @@ class ImpedanceLab final : public Lab {
   const Settings& settings() const { return s_; }
   // The drawing's spring glyph: along the push (x̂ without one), its stretch magnified g times.
   Eigen::Vector2d pushDirection() const;
-  double springMagnification() const;
+  double springMagnification(const Trace& tr) const;
 
  private:
   Settings s_;
