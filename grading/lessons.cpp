@@ -15,11 +15,6 @@ std::vector<LessonCheck> checkLessons(const Rubric& rubric, const std::string& l
     if (it == graded.end()) it = graded.emplace(file, gradeSubmission(file, options)).first;
     return it->second;
   };
-  const auto total = [](const GradeOutcome& g) {
-    double max = 0;
-    for (const auto& t : g.results.at("tests")) max += t.at("max_score").get<double>();
-    return max;
-  };
   std::vector<LessonCheck> out;
   for (const Lesson& lesson : rubric.lessons) {
     LessonCheck c;
@@ -32,7 +27,7 @@ std::vector<LessonCheck> checkLessons(const Rubric& rubric, const std::string& l
     if (c.error.empty()) {
       c.better = b.results.at("score").get<double>();
       c.worse = w.results.at("score").get<double>();
-      c.max = total(b);
+      c.max = rubric.maxScore();
     }
     out.push_back(c);
   }
