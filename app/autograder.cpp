@@ -152,7 +152,7 @@ rm -rf -- "$results"
 
 [ -x "$dynlab" ] || fail 'The autograder is broken: dynlab was not built when the image was set up. This is not your fault; please tell the course staff.'
 
-# The student's file, by the rule the batch grader shares (dynlab submission-file, README "Grading"):
+# The student's file, by the rule the batch grader shares (dynlab submission-file, docs/teaching.md "Grading"):
 # submission.json, else the only *.json uploaded, hidden and editor files aside; a link out of the
 # upload, a FIFO or a device is refused unread. The path is printed with a trailing "/" guard so a
 # name ending in a newline survives the command substitution.

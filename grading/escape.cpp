@@ -146,11 +146,14 @@ std::string mdText(std::string_view s) {
     const bool in_word = c == '_' && i > 0 && alnum(line[i - 1]) && alnum(next);
     const bool opens_link = c == ']' && (next == '(' || next == '[' || next == ':');
     // An autolinker keys on "://", "www." and "@": escaping that character (the escape is its own
-    // token in CommonMark/GFM and markdown-it) leaves a URL or an email in reflected text inert.
+    // token in CommonMark/GFM and markdown-it) leaves a URL in reflected text inert. GFM finds an
+    // email inside the text an escape merges back into, so an empty comment splits the text before
+    // its "@" (shown as nothing; the address has no local part left to link; a leading "@" has none).
     const auto lower = [](char ch) { return char(std::tolower(static_cast<unsigned char>(ch))); };
     const bool www = c == '.' && i >= 3 && lower(line[i - 1]) == 'w' && lower(line[i - 2]) == 'w' && lower(line[i - 3]) == 'w';
     const bool links = (c == ':' && line.compare(i + 1, 2, "//") == 0) || www || c == '@';
     const bool plain = (kPlain.find(c) != std::string_view::npos || in_word) && !links;
+    if (c == '@' && i > 0) out += "<!-- -->";  // (never first: a line that starts "<!--" is an HTML block)
     if (isAsciiPunct(c) && (!plain || list_marker || opens_link || (i == 0 && kLineStart.find(c) != std::string_view::npos)))
       out += '\\';
     out += c;
@@ -220,16 +223,5 @@ std::string csvField(const std::string& raw) {
   return out + "\"";
 }
 
-std::string clipText(std::string_view s, std::size_t max_bytes) {
-  if (s.size() <= max_bytes) return std::string(s);
-  // Back off to the start of a UTF-8 character (a continuation byte is 10xxxxxx).
-  const auto boundary = [&](std::size_t at) {
-    while (at > 0 && at < s.size() && (static_cast<unsigned char>(s[at]) & 0xC0) == 0x80) --at;
-    return at;
-  };
-  const std::size_t head = boundary(max_bytes * 2 / 3), tail = boundary(s.size() - max_bytes / 3);
-  return std::string(s.substr(0, head)) + " … (" + std::to_string(tail - head) + " bytes left out) … " +
-         std::string(s.substr(tail));
-}
 
 }  // namespace dyn

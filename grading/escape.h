@@ -14,6 +14,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "labs/utf8.h"
+
 namespace dyn {
 
 // True when bytes are well-formed UTF-8 (no overlongs, surrogates or code points past U+10FFFF).
@@ -32,8 +34,8 @@ std::string dumpJson(const nlohmann::json& v, int indent = -1);
 // backslash-escaped (no emphasis, link, code, HTML, entity, heading, quote or list marker can
 // start; < > & become entities, so not even the source holds a tag), line breaks and other control
 // characters shown as \n, \r, \xNN: one value, one line. URLs and emails are inert: the ":" of
-// "://" and the "." of "www." are escaped and every "@" escaped (an
-// email is still linked by cmark-gfm, which joins the escaped text: not yet inert).
+// "://" and the "." of "www." are escaped, and an empty comment splits the text before every "@"
+// (cmark-gfm links an email across a backslash escape).
 std::string mdText(std::string_view s);
 
 // An inline code span holding s literally: fenced by a backtick run longer than any inside, control
@@ -57,9 +59,6 @@ std::string shellWord(std::string_view s);
 // you format yourself directly; this is for text.
 std::string csvField(const std::string& s);
 
-// Text echoed from input (a key, a value, a message quoting them), at most max_bytes: a longer one
-// keeps its head and tail, cut at character boundaries, joined by " … " and the count of bytes left
-// out, so a 900 KB key is never quoted whole while the message still names where and what was expected.
-std::string clipText(std::string_view s, std::size_t max_bytes = 300);
+// clipText (text echoed from input, at most so many bytes): labs/utf8.h.
 
 }  // namespace dyn

@@ -151,6 +151,7 @@ json resultsJson(const GradeReport& r) {
   }
   for (const auto& s : r.scenarios)
     if (!s.failure.empty()) output += "- Scenario **" + mdText(s.scenario.name) + "**: " + mdText(s.failure) + ".\n";
+  if (!r.plots_note.empty()) output += "- " + mdText(r.plots_note) + "\n";
   json results = {{"score", r.score()},
                   {"output", output},
                   {"output_format", "md"},
@@ -160,6 +161,7 @@ json resultsJson(const GradeReport& r) {
                   {"tests", tests},
                   {"extra_data", {{"lab", r.lab}, {"fingerprint", r.fingerprint}, {"scenarios", scenarios}}}};
   if (!r.answers.empty()) results["extra_data"]["answers"] = r.answers;
+  if (!r.plots_note.empty()) results["extra_data"]["plots_note"] = r.plots_note;
   if (!r.leaderboard.empty()) results["leaderboard"] = r.leaderboard;
   return jsonSanitized(results);  // names, notes and keys as valid UTF-8: dump() cannot throw
 }
@@ -179,6 +181,7 @@ std::string terminalReport(const GradeReport& r) {
       for (const auto& n : sc.screen_notes) s += "  screening: " + termText(n) + "\n";
   for (const auto& sc : r.scenarios)
     if (!sc.failure.empty()) s += "  scenario " + termText(sc.scenario.name) + ": " + termText(sc.failure) + "\n";
+  if (!r.plots_note.empty()) s += "  plots: " + termText(r.plots_note) + "\n";
   if (!r.answers.empty()) s += "  answers: " + std::to_string(r.answers.size()) + " written answer(s), in report.md for the course staff\n";
   s += "Total: " + points(r.score()) + "/" + points(r.maxScore()) + "\n";
   return s;
@@ -198,6 +201,7 @@ std::string markdownReport(const GradeReport& r) {
           points(g.test.points) + " |\n";
   }
   md += "\n## Tests\n";
+  if (!r.plots_note.empty()) md += "\n" + mdText(r.plots_note) + "\n";
   for (std::size_t i = 0; i < r.tests.size(); ++i) {
     const GradedTest& g = r.tests[i];
     md += "\n### " + std::to_string(i + 1) + ". " + mdText(g.test.name) + " — " + points(g.score) + " / " + points(g.test.points) + "\n\n";
@@ -285,6 +289,17 @@ std::string pngDataUri(const std::string& png) {
 }
 
 json withoutInlinePlots(json results) {
+  // A note that the plots could not be drawn (extra_data and its line in the output) is about plots too.
+  if (results.contains("extra_data") && results["extra_data"].is_object() && results["extra_data"].contains("plots_note")) {
+    const json note = results["extra_data"]["plots_note"];
+    results["extra_data"].erase("plots_note");
+    if (note.is_string() && results.contains("output") && results["output"].is_string()) {
+      std::string out = results["output"];
+      const std::string line = "- " + mdText(note.get<std::string>()) + "\n";
+      if (const std::size_t at = out.find(line); at != std::string::npos) out.erase(at, line.size());
+      results["output"] = out;
+    }
+  }
   if (!results.contains("tests") || !results["tests"].is_array()) return results;
   for (auto& t : results["tests"]) {
     if (!t.is_object() || !t.contains("output") || !t["output"].is_string()) continue;

@@ -56,6 +56,7 @@ struct GradeReport {
   json answers = json::object();  // the submission's free-text "answers" (labs/submission.h), for the TA
   std::string replay;         // the command that re-checks this grade (empty: a generic one)
   bool inline_plots = false;  // results.json carries each test's plot (Gradescope shows it)
+  std::string plots_note;     // why there are no plots, when drawing them failed (shown to the reader)
   double score() const;
   double maxScore() const;
 };
@@ -79,8 +80,8 @@ std::string renderHtmlFragment(const std::string& markdown);
 
 // "data:image/png;base64,..." of a PNG's bytes.
 std::string pngDataUri(const std::string& png);
-// results.json without the inline plots resultsJson put into its tests' output (for --replay,
-// which re-grades without plots).
+// results.json without what only plots put there: the inline plots in its tests' output and the note
+// that they could not be drawn (for --replay, which re-grades without plots).
 json withoutInlinePlots(json results);
 
 }  // namespace dyn

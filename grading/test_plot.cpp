@@ -6,7 +6,10 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <stdexcept>
+#include <vector>
 
+#include "grading/isolated.h"
 #include "grading/plot.h"
 #include "grading/plot_curves.h"
 
@@ -181,18 +184,45 @@ TestPlotPlan planTestPlot(const Rubric& rubric, std::size_t i, const std::map<st
 void writeTestPlots(GradeReport& r, const std::map<std::string, ScenarioRun>& runs, const std::string& out_dir,
                     int width_px, int height_px) {
   std::filesystem::create_directories(std::filesystem::path(out_dir) / "plots");
+  struct Planned {
+    std::size_t test;
+    std::string name, path;
+  };
+  std::vector<Planned> planned;
   for (std::size_t i = 0; i < r.tests.size(); ++i) {
-    GradedTest& g = r.tests[i];
-    if (!g.plan) continue;
-    const ScenarioRun& run = runs.at(g.test.scenario);
-    if (run.trace.rows() < 2) continue;
+    const GradedTest& g = r.tests[i];
+    if (!g.plan || runs.at(g.test.scenario).trace.rows() < 2) continue;
     char name[96];
     std::snprintf(name, sizeof name, "plots/%02zu-%s.png", i + 1, slug(g.test.name).c_str());
-    const std::string path = (std::filesystem::path(out_dir) / name).string();
-    writePlot(path, testPlotSpec(g, *g.plan, run), width_px, height_px);
-    std::ifstream in(path, std::ios::binary);
+    planned.push_back({i, name, (std::filesystem::path(out_dir) / name).string()});
+  }
+  if (planned.empty()) return;
+
+  // Drawn in a child process: a plotting library that dies (GLib traps when pango cannot start a
+  // thread under a tight memory limit) costs the plots, never the grade. A plot that cannot be
+  // written (a full disk) is still an error of the machine, as before.
+  const IsolatedOutcome drawn = runIsolated([&] {
+    for (const Planned& p : planned) {
+      const GradedTest& g = r.tests[p.test];
+      writePlot(p.path, testPlotSpec(g, *g.plan, runs.at(g.test.scenario)), width_px, height_px);
+    }
+  }, 120.0);
+  if (drawn.kind == IsolatedOutcome::Kind::Threw) throw std::runtime_error(drawn.message);
+  if (drawn.kind == IsolatedOutcome::Kind::Died) {
+    for (const Planned& p : planned) {
+      std::error_code ec;
+      std::filesystem::remove(p.path, ec);
+      std::filesystem::remove(p.path + ".plplot", ec);
+    }
+    r.plots_note = "The plots could not be drawn on the grading machine (the plotting library " + drawn.message +
+                   "); the scores do not depend on them.";
+    return;
+  }
+  for (const Planned& p : planned) {
+    GradedTest& g = r.tests[p.test];
+    std::ifstream in(p.path, std::ios::binary);
     g.plot_png.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-    g.plot = name;
+    g.plot = p.name;
   }
 }
 

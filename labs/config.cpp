@@ -44,8 +44,9 @@ std::string pointerToken(const std::string& key) {
 }  // namespace
 
 InputError::InputError(std::string file, std::string path, const std::string& expected)
-    : std::runtime_error(oneLine(utf8Quotable(file + ": " + (path.empty() ? "/" : path) + ": " + expected))),
-      file_(utf8Quotable(file)), path_(utf8Quotable(path)), expected_(utf8Quotable(expected)) {}
+    : std::runtime_error(oneLine(utf8Quotable(clipText(file) + ": " + (path.empty() ? "/" : clipText(path)) + ": " +
+                                              clipText(expected, 600)))),
+      file_(utf8Quotable(clipText(file))), path_(utf8Quotable(clipText(path))), expected_(utf8Quotable(clipText(expected, 600))) {}
 
 namespace {
 // Where the parser is, for the JSON path of a duplicate key: one frame per open object or array.

@@ -13,7 +13,8 @@ namespace dyn {
 using nlohmann::json;
 
 // Bad input: the file, the JSON path and what was expected. All three are kept as valid UTF-8
-// (an invalid byte of a file name or value is written \xNN), so they can go into JSON as they are.
+// (an invalid byte of a file name or value is written \xNN), so they can go into JSON as they are,
+// and clipped (clipText: 300 bytes, 600 for what was expected), so a 900 KB key is never quoted whole.
 class InputError : public std::runtime_error {
  public:
   InputError(std::string file, std::string path, const std::string& expected);

@@ -53,4 +53,16 @@ std::string utf8Quotable(std::string_view s) {
   return out;
 }
 
+std::string clipText(std::string_view s, std::size_t max_bytes) {
+  if (s.size() <= max_bytes) return std::string(s);
+  // Back off to the start of a UTF-8 character (a continuation byte is 10xxxxxx).
+  const auto boundary = [&](std::size_t at) {
+    while (at > 0 && at < s.size() && (static_cast<unsigned char>(s[at]) & 0xC0) == 0x80) --at;
+    return at;
+  };
+  const std::size_t head = boundary(max_bytes * 2 / 3), tail = boundary(s.size() - max_bytes / 3);
+  return std::string(s.substr(0, head)) + " … (" + std::to_string(tail - head) + " bytes left out) … " +
+         std::string(s.substr(tail));
+}
+
 }  // namespace dyn

@@ -15,4 +15,9 @@ std::size_t utf8ErrorAt(std::string_view bytes);
 // bytes with each byte of an ill-formed sequence written as the four characters \xNN.
 std::string utf8Quotable(std::string_view bytes);
 
+// Text echoed from input (a key, a value, a message quoting them), at most max_bytes: a longer one
+// keeps its head and tail, cut at character boundaries, joined by " … " and the count of bytes left
+// out, so a 900 KB key is never quoted whole while the message still names where and what was expected.
+std::string clipText(std::string_view s, std::size_t max_bytes = 300);
+
 }  // namespace dyn

@@ -148,6 +148,15 @@ TEST_CASE("limits: NaN and infinite options, runs shorter than a step, clipped e
   CHECK(big.err.size() < 4000);
   CHECK(fs::file_size(dir / "big/results.json") < 20000);
   CHECK(readFile(dir / "big/report.md").size() < 20000);
+  // ...nor in a message a lab builds (run and compare parse the gains with the lab's own parser).
+  for (const std::string cmd : {std::string("run grasp --gains big.json --duration 0.1 --out runbig"),
+                                "compare big.json " + quote(kGood.string()) + " --out cmpbig"}) {
+    const Result r = dynlab(dir, cmd);
+    INFO(cmd);
+    CHECK(r.code == 2);
+    CHECK(r.err.size() < 4000);
+    CHECK(r.err.find("bytes left out") != std::string::npos);
+  }
   // Standard output that cannot be written is an error, not a silent success.
   for (const std::string cmd : {std::string("schema grasp"), std::string("list"), "grade " + quote(kGood.string()) + " --no-plots --out full"}) {
     const Result r = shell(dir, quote(DYNLAB_BIN) + " " + cmd + " >/dev/full 2>full.err; echo $? > full.rc");
@@ -177,7 +186,7 @@ TEST_CASE("a grade cut by its time budget has its own status, not \"graded\"") {
   CHECK(results(dir / "o/results.json")["extra_data"]["status"] == "out_of_time");
 }
 
-TEST_CASE("Markdown output: a URL in reflected text is no link (GFM autolinks on); emails not yet") {
+TEST_CASE("Markdown output: a URL or an email in reflected text is no link (GFM autolinks on)") {
   TempDir dir("trust_autolink");
   writeFile(dir / "sub.json", R"({"lab": "see https://evil.example/x, www.evil.example or mail me@evil.example", "gains": {}})");
   const Result r = dynlab(dir, "grade sub.json --no-plots --out o");
@@ -186,5 +195,35 @@ TEST_CASE("Markdown output: a URL in reflected text is no link (GFM autolinks on
   CHECK(md.find("evil") != std::string::npos);  // the text is there, shown as text
   CHECK(html.find("href=\"https://") == std::string::npos);
   CHECK(html.find("href=\"http://www.") == std::string::npos);
+  CHECK(html.find("mailto:") == std::string::npos);
   CHECK(html.find("evil.example") != std::string::npos);
+  CHECK(html.find("me") != std::string::npos);
+}
+
+TEST_CASE("A plotting library that dies under a memory limit costs the plots, not the grade") {
+  // Under `ulimit -v` GLib traps when pango cannot start a thread: that used to kill the whole grade.
+  TempDir dir("trust_low_memory");
+  const Result r = shell(dir, "ulimit -v 400000 && " + quote(DYNLAB_BIN) + " grade " + quote(kGood.string()) + " --out o");
+  INFO(r.out, r.err);
+  // Never a signal death: graded (with its plots, or none and why), or, if the grade itself ran out
+  // of memory first, an internal error (exit 3) with its one line.
+  CHECK(r.code < 128);
+  if (r.code == 3) {
+    CHECK(r.err.find("error: internal error") != std::string::npos);
+    return;
+  }
+  REQUIRE(r.code == 0);
+  const json res = results(dir / "o/results.json");
+  CHECK(res["score"].get<double>() > 0);
+  // Either every plot was drawn, or none is claimed and the reader is told why.
+  bool any_plot = false;
+  for (const auto& t : res["tests"]) any_plot = any_plot || t["extra_data"].contains("plot");
+  if (!any_plot) {
+    REQUIRE(res["extra_data"].contains("plots_note"));
+    CHECK(res["output"].get<std::string>().find("could not be drawn") != std::string::npos);
+    CHECK(readFile(dir / "o/report.md").find("could not be drawn") != std::string::npos);
+    CHECK(r.out.find("plots: The plots could not be drawn") != std::string::npos);
+  }
+  for (const auto& t : res["tests"])
+    if (t["extra_data"].contains("plot")) CHECK(fs::exists(dir / "o" / t["extra_data"]["plot"].get<std::string>()));
 }

@@ -1,0 +1,102 @@
+// A forked child for work that may die; see isolated.h.
+#include "grading/isolated.h"
+
+#include <poll.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <exception>
+#include <new>
+
+namespace dyn {
+namespace {
+
+constexpr char kThrew = '\x1f';  // precedes an exception's message on the pipe
+constexpr int kThrewStatus = 2, kOutOfMemoryStatus = 3;
+
+void writeAll(int fd, const std::string& s) {
+  for (std::size_t done = 0; done < s.size();) {
+    const ssize_t n = ::write(fd, s.data() + done, s.size() - done);
+    if (n <= 0 && errno != EINTR) return;
+    if (n > 0) done += std::size_t(n);
+  }
+}
+
+// The signal's name, the same in every locale (glibc's abbreviation: "TRAP", "ABRT").
+std::string abbrev(int sig) {
+  const char* a = ::sigabbrev_np(sig);
+  return a ? a : "?";
+}
+
+}  // namespace
+
+IsolatedOutcome runIsolated(const std::function<void()>& work, double timeout_s) {
+  int fds[2];
+  if (::pipe(fds) != 0) return {IsolatedOutcome::Kind::Died, std::string("cannot open a pipe: ") + std::strerror(errno)};
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    const int e = errno;
+    ::close(fds[0]), ::close(fds[1]);
+    return {IsolatedOutcome::Kind::Died, std::string("cannot start a process: ") + std::strerror(e)};
+  }
+  if (pid == 0) {  // the child: its verdict goes up the pipe (what a library prints stays on stderr); it never returns
+    ::close(fds[0]);
+    try {
+      work();
+    } catch (const std::bad_alloc&) {  // out of memory is how the child died, not an error to report
+      ::_exit(kOutOfMemoryStatus);
+    } catch (const std::exception& e) {
+      writeAll(fds[1], std::string(1, kThrew) + e.what());
+      ::_exit(kThrewStatus);
+    } catch (...) {
+      writeAll(fds[1], std::string(1, kThrew) + "unknown error");
+      ::_exit(kThrewStatus);
+    }
+    ::_exit(0);
+  }
+
+  // The parent: read until the child closes the pipe (it exits) or the time is up.
+  ::close(fds[1]);
+  std::string text;
+  bool timed_out = false;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+  for (;;) {
+    const double left = std::chrono::duration<double>(until - std::chrono::steady_clock::now()).count();
+    if (left <= 0) {
+      timed_out = true;
+      break;
+    }
+    pollfd p{fds[0], POLLIN, 0};
+    const int ready = ::poll(&p, 1, int(left * 1000) + 1);
+    if (ready < 0 && errno == EINTR) continue;
+    if (ready <= 0) continue;  // time is checked above
+    char buf[4096];
+    const ssize_t n = ::read(fds[0], buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    if (text.size() < 65536) text.append(buf, std::size_t(n));
+  }
+  ::close(fds[0]);
+  if (timed_out) ::kill(pid, SIGKILL);
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+
+  if (timed_out) return {IsolatedOutcome::Kind::Died, "took longer than " + std::to_string(int(timeout_s)) + " s"};
+  if (WIFEXITED(status) && WEXITSTATUS(status) == 0) return {};
+  if (WIFEXITED(status) && WEXITSTATUS(status) == kThrewStatus) {
+    const std::size_t at = text.rfind(kThrew);
+    if (at != std::string::npos) return {IsolatedOutcome::Kind::Threw, text.substr(at + 1)};
+  }
+  if (WIFEXITED(status) && WEXITSTATUS(status) == kOutOfMemoryStatus) return {IsolatedOutcome::Kind::Died, "ran out of memory"};
+  // How it ended, in words that are the same on every machine (no pid, no time).
+  return {IsolatedOutcome::Kind::Died, WIFSIGNALED(status) ? std::string("stopped by signal ") + std::to_string(WTERMSIG(status)) +
+                                                                 " (SIG" + abbrev(WTERMSIG(status)) + ")"
+                                                           : "exited with status " + std::to_string(WEXITSTATUS(status))};
+}
+
+}  // namespace dyn
