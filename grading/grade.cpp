@@ -76,12 +76,23 @@ GradeOutcome failedOutcome(const std::string& full_message, const InputError* e)
 }  // namespace
 
 GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
+  json sub;
+  try {
+    sub = loadJsonFile(file, 1u << 20);
+  } catch (const InputError& e) {
+    return failedOutcome(e.what(), &e);
+  } catch (const std::exception& e) {
+    return failedOutcome(utf8Quotable(e.what()), nullptr);
+  }
+  return gradeSubmission(sub, file, opt);
+}
+
+GradeOutcome gradeSubmission(const json& sub, const std::string& file, const GradeOptions& opt) {
   const auto started = std::chrono::steady_clock::now();
   const Deadline deadline = started + std::chrono::milliseconds(long(opt.time_budget * 1e3));
   std::string staff_file;  // the lab config once known: an error naming it is the staff's
   try {
     // The submission: a JSON object naming a lab; the lab's config with the gains applied.
-    const json sub = loadJsonFile(file, 1u << 20);
     const JsonView view(sub, file);
     view.requireObject();
     const std::string lab_name = view["lab"].string();
@@ -121,7 +132,7 @@ GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
       if (!used) continue;
       const json cfg = scenarioConfig(applied, rubric, sc, rep.fingerprint["submission_hash"], config_file);
       const auto lab = buildLab(*entry, cfg, config_file + " (scenario " + sc.name + ")");
-      ScenarioRun run = runScenario(*lab, rubric.watchdog, deadline, config_file);
+      ScenarioRun run = runScenario(*lab, rubric.watchdog, deadline, config_file, opt.stop);
       trajectories += hashHex(std::to_string(run.trace.hash()));
       rep.scenarios.push_back({sc, lab->dt(), run.trace.hash(), run.failure, run.failure_time, run.screen.notes,
                                run.metrics, run.out_of_time});

@@ -12,6 +12,7 @@
 // lets `dynlab grade --replay` check it.
 #pragma once
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -32,6 +33,9 @@ struct GradeOptions {
   // (empty: a generic hint). Paths in it are made absolute and shell-quoted.
   std::string replay_program = "dynlab", results_file;
   bool keep_runs = false;    // keep what was graded in the outcome (tools that compare or draw it)
+  // Asked every 1024 steps of every run: true stops the grade as a spent time budget does (the
+  // outcome is "out_of_time"); the Python module's Ctrl-C. Empty: never asked.
+  std::function<bool()> stop;
 };
 
 struct GradeOutcome {
@@ -53,6 +57,9 @@ struct GradeOutcome {
 };
 
 GradeOutcome gradeSubmission(const std::string& submission_file, const GradeOptions& options);
+// A submission already in memory (the Python module's dict): graded exactly as the same JSON in a
+// file; `file` names it in messages and reports.
+GradeOutcome gradeSubmission(const json& submission, const std::string& file, const GradeOptions& options);
 
 // What differs between two results.json, ignoring execution_time (empty: they match): one line per
 // difference, "<JSON path>: was <old> → now <new>" (or "added, now ..." / "removed, was ...").

@@ -112,7 +112,7 @@ std::string RowWatch::budget(long steps) const {
 }
 
 WatchedRun runWatched(const Lab& lab, Engine engine, const Watchdog& wd, Deadline deadline,
-                      const std::string& config_file) {
+                      const std::string& config_file, const StopRequest& stop_request) {
   WatchedRun out;
   Trace& tr = out.trace;
   tr.columns = lab.columns();
@@ -135,6 +135,11 @@ WatchedRun runWatched(const Lab& lab, Engine engine, const Watchdog& wd, Deadlin
     if ((k & 1023) == 0 && std::chrono::steady_clock::now() > deadline) {
       out.out_of_time = true;
       stop(double(k) * lab.dt(), "not graded: the grading time budget ran out");
+      break;
+    }
+    if ((k & 1023) == 0 && stop_request && stop_request()) {
+      out.out_of_time = out.interrupted = true;
+      stop(double(k) * lab.dt(), "not graded: the run was interrupted");
       break;
     }
     if (!sim->step(row)) break;
@@ -169,10 +174,11 @@ const Scenario& findScenario(const Rubric& rubric, const std::string& name, cons
                    "expected one of the rubric's scenarios (" + known + "), got \"" + name + "\"");
 }
 
-ScenarioRun runScenario(const Lab& lab, const Watchdog& wd, Deadline deadline, const std::string& config_file) {
+ScenarioRun runScenario(const Lab& lab, const Watchdog& wd, Deadline deadline, const std::string& config_file,
+                        const StopRequest& stop) {
   ScenarioRun out;
   out.screen = screenLoops(lab);
-  WatchedRun run = runWatched(lab, Engine::Hand, wd, deadline, config_file);
+  WatchedRun run = runWatched(lab, Engine::Hand, wd, deadline, config_file, stop);
   out.trace = std::move(run.trace);
   out.failure = std::move(run.failure);
   out.failure_time = run.failure_time;

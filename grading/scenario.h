@@ -4,6 +4,7 @@
 // a clock, and it only ever stops a run (reported as such, never scored as a result).
 #pragma once
 #include <chrono>
+#include <functional>
 #include <string>
 
 #include "grading/rubric.h"
@@ -30,6 +31,9 @@ struct ScenarioRun {
 };
 
 using Deadline = std::chrono::steady_clock::time_point;
+// Asked every 1024 steps, with the deadline: true stops the run as a spent time budget does (a
+// notebook's Ctrl-C; empty: never asked).
+using StopRequest = std::function<bool()>;
 
 // The watchdog's check of one trace row, shared by graded runs and the tuning window so both say
 // the same sentence. Throws InputError (naming config_file) if a limit names a column the lab lacks.
@@ -54,17 +58,19 @@ struct WatchedRun {
   std::string failure;  // the watchdog's sentence, the step budget, the time budget or the engine's own
   double failure_time = -1;
   bool out_of_time = false;
+  bool interrupted = false;  // the stop request ended it (out_of_time too: nothing is scored from it)
 };
 
 // Runs one engine of the lab, checking every row with RowWatch, the step budget and (every 1024
-// steps) the deadline; `dynlab run` watches both engines with it, the grader the hand-written one.
+// steps) the deadline and the stop request; `dynlab run` watches both engines with it, the grader
+// the hand-written one.
 WatchedRun runWatched(const Lab& lab, Engine engine, const Watchdog& watchdog, Deadline deadline,
-                      const std::string& config_file);
+                      const std::string& config_file, const StopRequest& stop = {});
 
 // Runs the lab's hand-written engine under the watchdog; throws InputError (naming config_file)
 // if a watchdog limit names a column the lab does not have.
 ScenarioRun runScenario(const Lab& lab, const Watchdog& watchdog, Deadline deadline,
-                        const std::string& config_file);
+                        const std::string& config_file, const StopRequest& stop = {});
 
 // The config one rubric scenario runs on, exactly as the grader builds it: the submission's config
 // (its gains applied) merged with the scenario's patch (RFC 7386), and the scenario's noise seed,

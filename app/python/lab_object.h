@@ -1,0 +1,56 @@
+// dynlab.Lab: one lab with its config and the gains set so far. Each object owns its config and
+// its built lab; nothing is shared between two Lab objects but the registry (read only).
+#pragma once
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "app/python/convert.h"
+#include "labs/run.h"
+
+namespace dyn::python {
+
+// What `source` names inputs from Python in messages, where the CLI names a file.
+inline const std::string kGainsSource = "<gains>", kSubmissionSource = "<submission>", kArgument = "<python>";
+
+class LabObject {
+ public:
+  LabObject(const std::string& name, const std::string& config_file);
+
+  std::string name() const { return loaded_.entry->name; }
+  const std::string& configFile() const { return loaded_.config_file; }
+  py::dict gains() const;     // name → value
+  py::dict gainInfo() const;  // name → {value, min, max, unit, doc}
+  py::list columns() const;
+  py::dict units() const;
+  double dt() const { return loaded_.lab->dt(); }
+  double duration() const { return loaded_.lab->duration(); }
+
+  // A submission's gains (and options) applied to the current config, as `dynlab run --gains F`
+  // does; a path is read as that file. Throws InputError (nothing changed) on bad input.
+  void apply(py::handle submission, const std::string& source);
+  // {"lab", "gains": {every gain}, <each option>}: what grading the current gains takes.
+  json submission() const;
+
+  // Both engines (or one) to the end, as `dynlab run`: the summary.json numbers and the traces.
+  py::dict run(const std::string& engine, std::optional<double> duration, const std::string& scenario) const;
+  // Poles and margins of the lab's linearised loops at the current gains (the grader's screening).
+  py::dict screen() const;
+
+ private:
+  LoadedLab loaded_;
+};
+
+// Runs `body` with the GIL released, asking Python for pending signals every 1024 steps through
+// the stop request it is given; a KeyboardInterrupt (or any exception a signal handler raised)
+// is rethrown once body has returned.
+class Interruptible {
+ public:
+  bool operator()();  // the stop request: true once a signal handler raised
+  void rethrow();     // with the GIL held
+
+ private:
+  std::optional<py::error_already_set> pending_;
+};
+
+}  // namespace dyn::python

@@ -1,0 +1,117 @@
+// The `dynlab` Python module: list labs, load one, set and read its gains, run it (NumPy traces),
+// screen and grade it — the CLI's commands over the same core, from a notebook.
+//   import dynlab
+//   lab = dynlab.Lab("slider_crank"); lab.set_gains(k_p=400)
+//   r = lab.run(engine="both", duration=2)   # r["traces"]["hand"]["x"], r["engines"], r["agreement"]
+//   dynlab.grade(lab.submission())["score"]
+// Bad input raises dynlab.InputError (a ValueError) with the CLI's one-line message
+// "<file>: <JSON path>: <what was expected>" and its parts as .file, .path, .expected.
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include "app/python/convert.h"
+#include "app/python/lab_object.h"
+#include "grading/grade.h"
+
+namespace py = pybind11;
+using namespace dyn;
+using namespace dyn::python;
+
+namespace {
+
+// dynlab.grade: a submission dict or file → results.json as a dict, as `dynlab grade` writes it
+// (no plots). A submission the grader refuses raises InputError with `dynlab grade`'s message.
+py::dict grade(py::handle submission, const std::string& lab, const std::string& config, double time_budget) {
+  GradeOptions o;
+  o.expected_lab = lab;
+  o.config_file = config;
+  o.time_budget = time_budget;
+  std::string file;
+  const bool is_file = asPath(submission, file);
+  const json sub = is_file ? json() : toJson(submission);
+  Interruptible interrupted;
+  o.stop = [&] { return interrupted(); };
+  GradeOutcome g;
+  {
+    py::gil_scoped_release release;
+    g = is_file ? gradeSubmission(file, o) : gradeSubmission(sub, kSubmissionSource, o);
+  }
+  interrupted.rethrow();
+  if (g.input_error) {
+    const json e = g.results["extra_data"].value("error", json::object());
+    throw InputError(e.value("file", ""), e.value("path", ""), e.value("expected", ""));
+  }
+  if (g.internal_error) throw std::runtime_error(g.error);
+  return toPython(g.results);
+}
+
+}  // namespace
+
+PYBIND11_MODULE(dynlab, m) {
+  m.doc() = "dynlab: constrained-mechanism dynamics labs (hand-written engine beside Bullet) and their grader";
+  m.attr("__version__") = DYNLAB_VERSION;
+
+  // InputError: a ValueError carrying the CLI's message and its parts.
+  static py::exception<InputError> input_error(m, "InputError", PyExc_ValueError);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const InputError& e) {
+      py::object exc = py::handle(input_error.ptr())(e.what());
+      exc.attr("file") = e.file();
+      exc.attr("path") = e.path().empty() ? "/" : e.path();
+      exc.attr("expected") = e.expected();
+      PyErr_SetObject(input_error.ptr(), exc.ptr());
+    }
+  });
+
+  m.def("labs", [] {
+    py::dict out;
+    for (const auto& e : labRegistry()) out[py::str(e.name)] = e.summary;
+    return out;
+  }, "Every lab: name → one-line summary (dynlab list).");
+
+  py::class_<LabObject>(m, "Lab", "One lab: its config, the gains set so far, runs and screening.")
+      .def(py::init<const std::string&, const std::string&>(), py::arg("name"), py::arg("config") = "",
+           "Loads lab NAME with its default config, or the config file given (dynlab run LAB --config F).")
+      .def_property_readonly("name", &LabObject::name)
+      .def_property_readonly("config", &LabObject::configFile, "The config file the lab was loaded from.")
+      .def_property_readonly("gains", &LabObject::gains, "Current gains: name → value.")
+      .def_property_readonly("gain_info", &LabObject::gainInfo, "Each gain's value, min, max, unit and doc.")
+      .def_property_readonly("columns", &LabObject::columns, "The trace's columns, in order.")
+      .def_property_readonly("units", &LabObject::units, "Each trace column's SI unit ('' if none).")
+      .def_property_readonly("dt", &LabObject::dt)
+      .def_property_readonly("duration", &LabObject::duration)
+      .def("set_gains", [](LabObject& lab, py::object gains, py::kwargs more) {
+        // set_gains({"k_p": 400}), set_gains(k_p=400) or set_gains("gains.json") (a gains file).
+        std::string path;
+        if (!gains.is_none() && asPath(gains, path)) {
+          if (more.size()) throw py::type_error("set_gains: a gains file or keyword gains, not both");
+          lab.apply(gains, path);
+          return;
+        }
+        py::dict g = gains.is_none() ? py::dict() : py::dict(gains);
+        for (const auto& [k, v] : more) g[k] = v;
+        py::dict sub;
+        sub["gains"] = g;
+        lab.apply(sub, kGainsSource);
+      }, py::arg("gains") = py::none(), "Sets gains (dict, keywords or a gains file); bad input raises InputError.")
+      .def("apply", [](LabObject& lab, py::object submission) {
+        std::string path;
+        lab.apply(submission, asPath(submission, path) ? path : kSubmissionSource);
+      }, py::arg("submission"), "Applies a submission (dict or file): its gains and options.")
+      .def("submission", [](const LabObject& lab) { return toPython(lab.submission()); },
+           "The current gains and options as a submission dict (what dynlab.grade takes).")
+      .def("run", &LabObject::run, py::arg("engine") = "both", py::arg("duration") = std::nullopt,
+           py::arg("scenario") = "",
+           "Runs the lab as `dynlab run` does: returns summary.json's fields and 'traces' "
+           "(engine → column → NumPy array). Ctrl-C stops it (KeyboardInterrupt).")
+      .def("screen", &LabObject::screen, "Poles and margins of the linearised loops at the current gains.")
+      .def("grade", [](const LabObject& lab, double time_budget) {
+        return grade(toPython(lab.submission()), lab.name(), lab.configFile(), time_budget);
+      }, py::arg("time_budget") = 300.0, "Grades the current gains (dynlab.grade of submission()).")
+      .def("__repr__", [](const LabObject& lab) { return "<dynlab.Lab " + lab.name() + ">"; });
+
+  m.def("grade", &grade, py::arg("submission"), py::arg("lab") = "", py::arg("config") = "", py::arg("time_budget") = 300.0,
+        "Grades a submission (dict or file) as `dynlab grade` does; returns results.json as a dict.");
+}

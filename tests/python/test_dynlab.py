@@ -1,0 +1,210 @@
+"""The dynlab Python module against the CLI: the same grades, the same traces, the same errors.
+
+Run by ctest with Debian's /usr/bin/python3 and PYTHONPATH at the built module (tests/python/
+CMakeLists.txt); DYNLAB_BIN is the CLI, DYNLAB_SOURCE_DIR the source tree, DYNLAB_TEST_TMP a scratch folder.
+"""
+import csv
+import json
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+import unittest
+
+try:
+    import dynlab
+except ImportError as e:  # the module was not built (no python3-dev / pybind11-dev)
+    print(f"DYNLAB_TEST_SKIPPED: the dynlab module is not built ({e})")
+    sys.exit(0)
+
+import numpy as np
+
+CLI = os.environ["DYNLAB_BIN"]
+SOURCE = os.environ["DYNLAB_SOURCE_DIR"]
+TMP = tempfile.mkdtemp(prefix="python_test_", dir=os.environ.get("DYNLAB_TEST_TMP"))
+
+
+def cli(*args):
+    return subprocess.run([CLI, *args], capture_output=True, text=True, cwd=TMP)
+
+
+def examples(lab):
+    folder = os.path.join(SOURCE, "labs", lab, "examples")
+    return sorted(os.path.join(folder, f) for f in os.listdir(folder) if f.endswith(".json"))
+
+
+def write(name, data):
+    path = os.path.join(TMP, name)
+    with open(path, "w") as f:
+        json.dump(data, f)
+    return path
+
+
+class Listing(unittest.TestCase):
+    def test_labs_are_the_clis(self):
+        names = [line.split()[0] for line in cli("list").stdout.splitlines() if line.strip()]
+        self.assertEqual(list(dynlab.labs()), names)
+        self.assertGreaterEqual(len(names), 5)
+
+    def test_gains_with_bounds_units_docs(self):
+        for name in dynlab.labs():
+            lab = dynlab.Lab(name)
+            with open(os.path.join(SOURCE, "labs", name, name + ".json")) as f:
+                declared = json.load(f)["gains"]
+            self.assertEqual(set(lab.gain_info), set(declared))
+            for g, d in declared.items():
+                info = lab.gain_info[g]
+                self.assertEqual((info["value"], info["min"], info["max"]), (d["value"], d["min"], d["max"]))
+                self.assertEqual((info["unit"], info["doc"]), (d.get("unit", ""), d.get("doc", "")))
+                self.assertEqual(lab.gains[g], d["value"])
+
+
+class Grades(unittest.TestCase):
+    def test_every_lab_grades_as_the_cli(self):
+        # One example per lab (the first), graded from its file and from a dict, against results.json.
+        for name in dynlab.labs():
+            sub = examples(name)[0]
+            with self.subTest(lab=name, submission=os.path.basename(sub)):
+                out = os.path.join(TMP, "grade_" + name)
+                r = cli("grade", sub, "--out", out, "--no-plots")
+                self.assertEqual(r.returncode, 0, r.stderr)
+                with open(os.path.join(out, "results.json")) as f:
+                    expected = json.load(f)
+                with open(sub) as f:
+                    as_dict = json.load(f)
+                for got in (dynlab.grade(sub), dynlab.grade(as_dict, lab=name)):
+                    self.assertEqual(got["score"], expected["score"])
+                    self.assertEqual([t["score"] for t in got["tests"]], [t["score"] for t in expected["tests"]])
+                    self.assertEqual([t["extra_data"].get("value") for t in got["tests"]],
+                                     [t["extra_data"].get("value") for t in expected["tests"]])
+                    self.assertEqual(got["extra_data"]["fingerprint"]["trajectory_hash"],
+                                     expected["extra_data"]["fingerprint"]["trajectory_hash"])
+                    self.assertEqual(got["extra_data"]["status"], "graded")
+
+    def test_lab_grade_is_grade_of_its_submission(self):
+        lab = dynlab.Lab("slider_crank")
+        lab.apply(examples("slider_crank")[0])
+        self.assertEqual(lab.grade()["score"], dynlab.grade(examples("slider_crank")[0])["score"])
+
+
+class Traces(unittest.TestCase):
+    def test_trace_and_summary_are_the_clis(self):
+        for name in dynlab.labs():
+            sub = examples(name)[0]
+            with self.subTest(lab=name):
+                out = os.path.join(TMP, "run_" + name)
+                r = cli("run", name, "--gains", sub, "--duration", "0.3", "--out", out)
+                self.assertEqual(r.returncode, 0, r.stderr)
+                lab = dynlab.Lab(name)
+                lab.set_gains(sub)
+                got = lab.run(duration=0.3)
+                for engine in ("hand", "bullet"):
+                    with open(os.path.join(out, f"trace_{engine}.csv")) as f:
+                        rows = list(csv.reader(f))
+                    self.assertEqual(list(got["traces"][engine]), rows[0])
+                    printed = np.array([[float(x) for x in row] for row in rows[1:]])
+                    mine = np.column_stack([got["traces"][engine][c] for c in rows[0]])
+                    self.assertEqual(mine.shape, printed.shape)
+                    self.assertTrue(np.array_equal(mine, printed), f"{engine} trace differs from the CSV")
+                with open(os.path.join(out, "summary.json")) as f:
+                    summary = json.load(f)
+                for key in ("engines", "agreement", "units", "status", "dt", "duration"):
+                    self.assertEqual(got.get(key), summary.get(key), key)
+
+    def test_two_labs_do_not_interfere(self):
+        a, b = dynlab.Lab("slider_crank"), dynlab.Lab("pen_on_table")
+        first = a.run(engine="hand", duration=0.2)
+        b.set_gains({g: v for g, v in b.gains.items()})
+        b.run(engine="hand", duration=0.2)
+        a2 = dynlab.Lab("slider_crank")
+        a2.set_gains(**{g: info["max"] for g, info in a2.gain_info.items()})
+        a2.run(engine="hand", duration=0.2)
+        again = a.run(engine="hand", duration=0.2)
+        self.assertEqual(first["engines"]["hand"]["trace_hash"], again["engines"]["hand"]["trace_hash"])
+
+    def test_gil_released_during_a_run(self):
+        # A thread counts while the main thread runs the lab: with the GIL held for the whole run
+        # it could not count at all during it.
+        lab = dynlab.Lab("slider_crank")
+        count = [0]
+        stop = threading.Event()
+
+        def counter():
+            while not stop.is_set():
+                count[0] += 1
+        t = threading.Thread(target=counter)
+        t.start()
+        time.sleep(0.02)
+        before = count[0]
+        start = time.perf_counter()
+        lab.run(engine="both", duration=5.0)
+        elapsed = time.perf_counter() - start
+        during = count[0] - before
+        stop.set()
+        t.join()
+        self.assertGreater(elapsed, 0.05)
+        self.assertGreater(during, 1000, f"the counting thread ran {during} times in {elapsed:.2f} s")
+
+    def test_ctrl_c_stops_a_run(self):
+        lab = dynlab.Lab("slider_crank")
+        timer = threading.Timer(0.3, lambda: os.kill(os.getpid(), signal.SIGINT))
+        start = time.perf_counter()
+        timer.start()
+        with self.assertRaises(KeyboardInterrupt):
+            lab.run(engine="both", duration=300)
+        self.assertLess(time.perf_counter() - start, 10)
+        self.assertEqual(lab.run(engine="hand", duration=0.1)["status"], "ok")  # still usable
+
+
+class Errors(unittest.TestCase):
+    def cli_error(self, lab, gains):
+        path = write("bad_gains.json", gains)
+        r = cli("run", lab, "--gains", path, "--duration", "0.01", "--out", os.path.join(TMP, "bad"))
+        self.assertEqual(r.returncode, 2)
+        line = r.stderr.strip()
+        self.assertTrue(line.startswith("error: "), line)
+        return path, line[len("error: "):]
+
+    def test_bad_gains_raise_the_clis_message(self):
+        lab = dynlab.Lab("slider_crank")
+        name, info = next(iter(lab.gain_info.items()))
+        before = lab.gains
+        for gains in ({"no_such_gain": 1.0}, {name: info["max"] * 10 + 1}, {name: "fast"}, {name: [1]}):
+            with self.subTest(gains=gains):
+                path, message = self.cli_error("slider_crank", {"gains": gains})
+                with self.assertRaises(dynlab.InputError) as e:
+                    lab.set_gains(path)
+                self.assertEqual(str(e.exception), message)
+                with self.assertRaises(dynlab.InputError) as e:
+                    lab.set_gains(gains)
+                self.assertEqual(str(e.exception), message.replace(path, "<gains>", 1))
+                self.assertTrue(e.exception.path.startswith("/gains/"))
+                self.assertIsInstance(e.exception, ValueError)
+                self.assertEqual(lab.gains, before)  # nothing changed
+
+    def test_bad_submission_raises_the_grade_message(self):
+        path = write("bad_sub.json", {"lab": "slider_crank", "gains": {"kp_x": -5}})
+        r = cli("grade", path, "--out", os.path.join(TMP, "bad_grade"), "--no-plots")
+        self.assertEqual(r.returncode, 2)
+        message = r.stderr.strip().splitlines()[0][len("error: "):]
+        with self.assertRaises(dynlab.InputError) as e:
+            dynlab.grade(path)
+        self.assertEqual(str(e.exception), message)
+
+    def test_unknown_lab_and_bad_arguments(self):
+        with self.assertRaises(dynlab.InputError) as e:
+            dynlab.Lab("no_such_lab")
+        self.assertIn("unknown lab", str(e.exception))
+        lab = dynlab.Lab("slider_crank")
+        for kwargs in ({"engine": "fast"}, {"duration": -1.0}, {"duration": 1e-9}):
+            with self.subTest(**kwargs), self.assertRaises(dynlab.InputError):
+                lab.run(**kwargs)
+        with self.assertRaises(TypeError):
+            lab.set_gains({"kp_x": {1, 2}})
+
+
+if __name__ == "__main__":
+    unittest.main(verbosity=2)
