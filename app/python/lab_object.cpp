@@ -59,7 +59,8 @@ json LabObject::submission() const {
   // As the tuning window saves one: every gain as a double, and each option as the config sets it.
   json sub = {{"lab", name()}, {"gains", json::object()}};
   for (const auto& [n, g] : loaded_.config.at("gains").items()) sub["gains"][n] = g.at("value").get<double>();
-  for (const auto& [n, o] : loaded_.config.value("submission_options", json::object()).items()) {
+  const json options = loaded_.config.value("submission_options", json::object());
+  for (const auto& [n, o] : options.items()) {
     const json::json_pointer target(o.at("target").get<std::string>());
     if (loaded_.config.contains(target)) sub[n] = loaded_.config.at(target);
   }

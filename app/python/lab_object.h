@@ -53,4 +53,7 @@ class Interruptible {
   std::optional<py::error_already_set> pending_;
 };
 
+// Defines the module's functions and classes in m (module.cpp).
+void defineModule(py::module_& m);
+
 }  // namespace dyn::python

@@ -47,7 +47,8 @@ py::dict grade(py::handle submission, const std::string& lab, const std::string&
 
 }  // namespace
 
-PYBIND11_MODULE(dynlab, m) {
+// The module's contents (an embedding program can add them to its own interpreter too).
+void dyn::python::defineModule(py::module_& m) {
   m.doc() = "dynlab: constrained-mechanism dynamics labs (hand-written engine beside Bullet) and their grader";
   m.attr("__version__") = DYNLAB_VERSION;
 
@@ -115,3 +116,5 @@ PYBIND11_MODULE(dynlab, m) {
   m.def("grade", &grade, py::arg("submission"), py::arg("lab") = "", py::arg("config") = "", py::arg("time_budget") = 300.0,
         "Grades a submission (dict or file) as `dynlab grade` does; returns results.json as a dict.");
 }
+
+PYBIND11_MODULE(dynlab, m) { defineModule(m); }

@@ -28,7 +28,7 @@ TMP = tempfile.mkdtemp(prefix="python_test_", dir=os.environ.get("DYNLAB_TEST_TM
 
 
 def cli(*args):
-    return subprocess.run([CLI, *args], capture_output=True, text=True, cwd=TMP)
+    return subprocess.run([CLI, *args], capture_output=True, encoding="utf-8", errors="replace", cwd=TMP)
 
 
 def examples(lab):
@@ -38,7 +38,7 @@ def examples(lab):
 
 def write(name, data):
     path = os.path.join(TMP, name)
-    with open(path, "w") as f:
+    with open(path, "w", encoding="utf-8") as f:
         json.dump(data, f)
     return path
 
@@ -52,7 +52,7 @@ class Listing(unittest.TestCase):
     def test_gains_with_bounds_units_docs(self):
         for name in dynlab.labs():
             lab = dynlab.Lab(name)
-            with open(os.path.join(SOURCE, "labs", name, name + ".json")) as f:
+            with open(os.path.join(SOURCE, "labs", name, name + ".json"), encoding="utf-8") as f:
                 declared = json.load(f)["gains"]
             self.assertEqual(set(lab.gain_info), set(declared))
             for g, d in declared.items():
@@ -71,9 +71,9 @@ class Grades(unittest.TestCase):
                 out = os.path.join(TMP, "grade_" + name)
                 r = cli("grade", sub, "--out", out, "--no-plots")
                 self.assertEqual(r.returncode, 0, r.stderr)
-                with open(os.path.join(out, "results.json")) as f:
+                with open(os.path.join(out, "results.json"), encoding="utf-8") as f:
                     expected = json.load(f)
-                with open(sub) as f:
+                with open(sub, encoding="utf-8") as f:
                     as_dict = json.load(f)
                 for got in (dynlab.grade(sub), dynlab.grade(as_dict, lab=name)):
                     self.assertEqual(got["score"], expected["score"])
@@ -102,14 +102,14 @@ class Traces(unittest.TestCase):
                 lab.set_gains(sub)
                 got = lab.run(duration=0.3)
                 for engine in ("hand", "bullet"):
-                    with open(os.path.join(out, f"trace_{engine}.csv")) as f:
+                    with open(os.path.join(out, f"trace_{engine}.csv"), encoding="utf-8") as f:
                         rows = list(csv.reader(f))
                     self.assertEqual(list(got["traces"][engine]), rows[0])
                     printed = np.array([[float(x) for x in row] for row in rows[1:]])
                     mine = np.column_stack([got["traces"][engine][c] for c in rows[0]])
                     self.assertEqual(mine.shape, printed.shape)
                     self.assertTrue(np.array_equal(mine, printed), f"{engine} trace differs from the CSV")
-                with open(os.path.join(out, "summary.json")) as f:
+                with open(os.path.join(out, "summary.json"), encoding="utf-8") as f:
                     summary = json.load(f)
                 for key in ("engines", "agreement", "units", "status", "dt", "duration"):
                     self.assertEqual(got.get(key), summary.get(key), key)
