@@ -101,6 +101,12 @@ ModelPtr compile(const std::string& path, std::string* warnings) {
   return ModelPtr(m);
 }
 
+std::string num(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", x);
+  return b;
+}
+
 std::string nameOf(const mjModel* m, int type, int id, const char* what) {
   const char* n = mj_id2name(m, type, id);
   if (n && *n) return n;
@@ -130,7 +136,7 @@ void checkSupported(const std::string& file, const mjModel* m, const LoadOptions
   }
   for (int j = 0; j < m->nv; ++j)
     if (m->dof_armature[j] != 0)
-      fail("joint '" + nameOf(m, mjOBJ_JOINT, m->dof_jntid[j], "joint") + "' has armature " + std::to_string(m->dof_armature[j]) +
+      fail("joint '" + nameOf(m, mjOBJ_JOINT, m->dof_jntid[j], "joint") + "' has armature " + num(m->dof_armature[j]) +
            "; the description has no rotor inertia yet (set armature=\"0\")");
   if (m->opt.density != 0 || m->opt.viscosity != 0 || m->opt.wind[0] != 0 || m->opt.wind[1] != 0 || m->opt.wind[2] != 0)
     fail("<option> density/viscosity/wind: dynlab has no fluid forces (leave them 0)");
@@ -223,7 +229,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
       jt.limited = m->jnt_limited[j] && !(flags & mjDSBL_LIMIT);
       jt.lower = m->jnt_range[2 * j], jt.upper = m->jnt_range[2 * j + 1];
       if (jt.limited)
-        out.notes.push_back("joint '" + jt.name + "': limit [" + std::to_string(jt.lower) + ", " + std::to_string(jt.upper) + "] read, not enforced");
+        out.notes.push_back("joint '" + jt.name + "': limit [" + num(jt.lower) + ", " + num(jt.upper) + "] read, not enforced");
       out.joints.push_back(jt);
     }
     frame[std::size_t(b)] = f;
@@ -255,8 +261,8 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     }
     if (!(flags & (mjDSBL_FRICTIONLOSS | mjDSBL_CONSTRAINT))) p.coulomb = m->dof_frictionloss[j];
     if (p.coulomb > 0)
-      out.notes.push_back("joint '" + out.joints[std::size_t(j)].name + "': frictionloss " + std::to_string(p.coulomb) +
-                          " read as Coulomb friction smoothed over |rate| < " + std::to_string(p.coulomb_width) + " (MuJoCo: exact stiction)");
+      out.notes.push_back("joint '" + out.joints[std::size_t(j)].name + "': frictionloss " + num(p.coulomb) +
+                          " read as Coulomb friction smoothed over |rate| < " + num(p.coulomb_width) + " (MuJoCo: exact stiction)");
     any = any || p.stiffness != 0 || p.viscous != 0 || p.coulomb != 0;
   }
   if (!any) mech.joints.clear();
@@ -324,7 +330,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   for (std::size_t i = 0; i < ties.size(); ++i)
     if (const double gap = full.residual(int(i), out.q0); !(gap <= 1e-9))
       throw ModelFileError(path + ": equality '" + out.closures[i].name + "' does not hold at the reference pose (gap " +
-                           std::to_string(gap) + "); write the file in its closed pose");
+                           num(gap) + "); write the file in its closed pose");
   // Rows identically dependent on the rows before them (a planar loop's out-of-plane rows): J at
   // seeded configurations around q0, side by side; a row is kept when it raises the rank.
   constexpr int kSamples = 4;

@@ -150,7 +150,7 @@ TEST_CASE("the slider crank as MJCF equals the lab's C++ description (M, h, φ, 
 }
 
 TEST_CASE("M and the bias C v + G equal MuJoCo's own (mj_fullM, qfrc_bias) for every example file") {
-  for (const char* name : {"arm3d.xml", "fourbar.xml", "slider_crank.xml"}) {
+  for (const char* name : {"arm3d.xml", "fourbar.xml", "fivebar.xml", "slider_crank.xml", "planar_arm.urdf"}) {
     CAPTURE(std::string(name));
     const model_file::LoadedModel file = model_file::load(model(name));
     model_file::MujocoReference mj(model(name));
@@ -210,6 +210,27 @@ TEST_CASE("four-bar: the connect's dependent row is dropped; a passive run keeps
   CHECK(phi2 < 1e-12);
   CHECK(de2 < 1e-6);
   CHECK(de1 / de2 > 8.0);
+}
+
+TEST_CASE("five-bar: 2 degrees of freedom; URDF arm: the fixed tool fused, limits noted") {
+  const model_file::LoadedModel five = model_file::load(model("fivebar.xml"));
+  CHECK(five.dof == 2);
+  REQUIRE(five.closures.size() == 1);
+  CHECK(five.closures[0].dropped == std::vector<std::string>{"y"});
+  ConstrainedMechanism<Spatial> mech(five.mechanism);
+  const auto [de, phi] = passiveRun(mech, five.q0, 2.0, 1e-3);
+  MESSAGE("five-bar: |E - E0| " << de << " J, |phi| " << phi);
+  CHECK(phi < 1e-12);
+  CHECK(de < 1e-6);
+  const model_file::LoadedModel arm = model_file::load(model("planar_arm.urdf"));
+  CHECK(arm.bodies == std::vector<std::string>{"link1", "link2", "link3"});
+  double mass = 0;
+  Eigen::Vector3d com;
+  Spatial::massAndCom(arm.mechanism.tree.bodies[2].inertia, mass, com);
+  CHECK(mass == doctest::Approx(0.6));  // link3 and the tool
+  CHECK(arm.notes.size() == 2);          // the shoulder's and the wrist's limits
+  REQUIRE(arm.mechanism.joints.size() == 3);
+  CHECK(arm.mechanism.joints[0].viscous == 0.01);
 }
 
 TEST_CASE("hostile and unsupported model files: one line naming the file and the element, within a second") {
