@@ -1,7 +1,8 @@
 // `dynlab model FILE`: a mechanism from an MJCF or URDF file (physics/model_file): loads it, prints
 // what dynlab read (bodies, joints, closures and their kept rows, the freedom left, notes), checks M
-// and the bias against MuJoCo's own, runs it passive with the hand engine (RK4 + projection) and
-// reports the closure residual and the energy balance; writes OUT/trace.csv and OUT/summary.txt.
+// and the bias against MuJoCo's own, runs it passive with the hand engine (RK4 + projection) and/or
+// Bullet and reports each one's closure residual and energy balance and their agreement; writes
+// OUT/trace.csv (hand), OUT/trace_bullet.csv and OUT/summary.txt.
 // Registered on the command line by ModelCommand, so main.cpp only constructs it and asks it to run.
 #pragma once
 #include <CLI/CLI.hpp>
@@ -10,7 +11,7 @@
 namespace dyn::app {
 
 struct ModelArgs {
-  std::string file, out;
+  std::string file, out, engine = "both";
   double duration = 2.0;  // s
   double dt = 1e-3;       // s
   bool ignore_contacts = false;

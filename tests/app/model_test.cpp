@@ -36,10 +36,26 @@ TEST_CASE("dynlab model: the four-bar is read, run passive, and its trace keeps 
   CHECK(swing > 0.5);  // rad: it really moved
   // The pin holds the rocker up: at rest in the first row its force balances gravity with the crank's share.
   CHECK(std::abs(csv.at(0, "f_pin_C_z")) > 0.1);
+  // Bullet beside it, from the same state: the same columns; its pin force over the first step from
+  // rest is the hand engine's η; its closure drifts but stays small.
+  const Csv bt = readCsv(dir / "out/trace_bullet.csv");
+  CHECK(bt.header == csv.header);
+  REQUIRE(bt.rows.size() == csv.rows.size());
+  CHECK(std::abs(bt.at(0, "f_pin_C_z") - csv.at(0, "f_pin_C_z")) < 1e-9);
+  double phi_bt = 0;
+  for (std::size_t i = 0; i < bt.rows.size(); ++i) phi_bt = std::max(phi_bt, bt.at(i, "constraint_residual"));
+  CHECK(phi_bt > 1e-9);
+  CHECK(phi_bt < 1e-3);
+  CHECK(r.out.find("agreement: max |q_hand − q_bullet|∞") != std::string::npos);
   // Same input, same bytes.
-  const std::string first = readFile(dir / "out/trace.csv");
+  const std::string first = readFile(dir / "out/trace.csv"), first_bt = readFile(dir / "out/trace_bullet.csv");
   REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 1 --out out").code == 0);
   CHECK(readFile(dir / "out/trace.csv") == first);
+  CHECK(readFile(dir / "out/trace_bullet.csv") == first_bt);
+  // One engine: only its trace.
+  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.1 --engine hand --out hand_only").code == 0);
+  CHECK(fs::exists(dir / "hand_only/trace.csv"));
+  CHECK_FALSE(fs::exists(dir / "hand_only/trace_bullet.csv"));
 }
 
 TEST_CASE("dynlab model: hostile and unsupported files get one line and exit 2, nothing written") {
