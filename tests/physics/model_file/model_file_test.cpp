@@ -15,8 +15,11 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
+#include <Eigen/LU>
+
 #include "labs/slider_crank/mechanism.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/constraints/point_closure.h"
 #include "physics/model_file/model_file.h"
 
 using namespace dyn;
@@ -202,6 +205,25 @@ TEST_CASE("four-bar: the connect's dependent row is dropped; a passive run keeps
   MatN G;
   mech.constraint(file.q0, phi, G);
   REQUIRE(G.rows() == 2);
+  // Why the row goes: with all three rows, Λ = J M⁻¹ Jᵀ is singular (the y row of J is zero), so the
+  // Schur route cannot factor it and the solve falls back to the full-pivot LU, whose η on the zero row
+  // is arbitrary; the accelerations agree.
+  MechanismModel<Spatial> all = file.mechanism;
+  const auto at = all.constraints[0]->attachment();
+  all.constraints[0] = std::make_shared<PointClosure<Spatial>>(at.a, at.point_a, at.b, at.point_b, PointClosure<Spatial>::translations());
+  ConstrainedMechanism<Spatial> full(all);
+  const VecN q = file.q0 + VecN(Eigen::Vector3d(0.3, -0.2, 0.1)), v = VecN(Eigen::Vector3d(1.0, -2.0, 0.5)), tau = VecN::Zero(3);
+  VecN phi_all;
+  MatN G_all;
+  full.constraint(q, phi_all, G_all);
+  REQUIRE(G_all.rows() == 3);
+  const MatN Minv = mech.massMatrix(q).inverse();
+  const Eigen::Matrix3d Lambda = G_all * Minv * G_all.transpose();
+  CHECK(Eigen::FullPivLU<Eigen::Matrix3d>(Lambda).rank() == 2);
+  CHECK(G_all.row(1).cwiseAbs().maxCoeff() == 0.0);
+  const auto s_kept = mech.solve(q, v, tau), s_all = full.solve(q, v, tau);
+  MESSAGE("four-bar: |qdd(all rows, LU) - qdd(kept rows, Schur)| " << (s_all.qdd - s_kept.qdd).cwiseAbs().maxCoeff());
+  CHECK((s_all.qdd - s_kept.qdd).cwiseAbs().maxCoeff() < 1e-9);
   // Passive swing, 2 s: closure at rounding level, energy error at RK4's order (halving dt: ~1/16).
   const auto [de1, phi1] = passiveRun(mech, file.q0, 2.0, 2e-3);
   const auto [de2, phi2] = passiveRun(mech, file.q0, 2.0, 1e-3);
