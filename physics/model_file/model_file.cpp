@@ -88,13 +88,16 @@ ModelPtr compile(const std::string& path, std::string* warnings) {
   if (name.size() >= mjMAXVFSNAME) throw ModelFileError(path + ": file name longer than MuJoCo's " + std::to_string(mjMAXVFSNAME - 1) + " characters");
   auto vfs = std::make_unique<mjVFS>();
   mj_defaultVFS(vfs.get());
-  if (mj_makeEmptyFileVFS(vfs.get(), name.c_str(), int(bytes.size())) != 0) throw ModelFileError(path + ": MuJoCo's virtual file system refused it");
-  const int at = mj_findFileVFS(vfs.get(), name.c_str());
+  // The virtual file keeps the name alone; loading it by its path keeps the file's folder as the
+  // model's, where MuJoCo looks for includes and meshes.
+  if (mj_makeEmptyFileVFS(vfs.get(), path.c_str(), int(bytes.size())) != 0) throw ModelFileError(path + ": MuJoCo's virtual file system refused it");
+  const int at = mj_findFileVFS(vfs.get(), path.c_str());
+  if (at < 0) throw ModelFileError(path + ": MuJoCo's virtual file system lost it");
   std::copy(bytes.begin(), bytes.end(), static_cast<char*>(vfs->filedata[at]));
   char error[1024] = "";
   mjModel* m = nullptr;
   detail::MujocoGuard guard;
-  MUJOCO_CALL(path, m = mj_loadXML(name.c_str(), vfs.get(), error, sizeof error));
+  MUJOCO_CALL(path, m = mj_loadXML(path.c_str(), vfs.get(), error, sizeof error));
   mj_deleteVFS(vfs.get());
   if (!m) throw ModelFileError(path + ": MuJoCo's parser: " + detail::oneLine(error[0] ? error : "no model"));
   if (warnings) *warnings = detail::oneLine(std::string(error) + " " + guard.warnings());

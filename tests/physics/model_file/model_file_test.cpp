@@ -255,6 +255,14 @@ TEST_CASE("five-bar: 2 degrees of freedom; URDF arm: the fixed tool fused, limit
   CHECK(arm.mechanism.joints[0].viscous == 0.01);
 }
 
+TEST_CASE("an <include> is found beside the file, whatever the working folder") {
+  writeFile("part.xml", mjcf("<joint name=\"j\"/>"));
+  const std::string main = writeFile("with_include.xml", "<mujoco model=\"inc\"><include file=\"part.xml\"/></mujoco>");
+  const model_file::LoadedModel file = model_file::load(main);
+  REQUIRE(file.joints.size() == 1);
+  CHECK(file.joints[0].name == "j");
+}
+
 TEST_CASE("hostile and unsupported model files: one line naming the file and the element, within a second") {
   double seconds = 0;
   CHECK(errorOf("/nonexistent/model.xml").find("no such file") != std::string::npos);
