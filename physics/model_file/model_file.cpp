@@ -175,6 +175,35 @@ void checkSupported(const std::string& file, const mjModel* m, const LoadOptions
     }
 }
 
+// Every number the description reads, finite and within ±kLargest: a mass of 1e308 or an infinite
+// gravity is refused here, not found as NaN mid-run.
+constexpr double kLargest = 1e9;
+void checkNumbers(const std::string& file, const mjModel* m, const mjData* d) {
+  auto check = [&](const mjtNum* x, int count, const std::string& what) {
+    for (int i = 0; i < count; ++i)
+      if (!std::isfinite(x[i]) || std::abs(x[i]) > kLargest)
+        throw ModelFileError(file + ": " + what + " is " + num(x[i]) + "; dynlab reads finite values within ±" + num(kLargest));
+  };
+  check(m->opt.gravity, 3, "<option gravity>");
+  for (int b = 1; b < m->nbody; ++b) {
+    const std::string body = "body '" + nameOf(m, mjOBJ_BODY, b, "body") + "'";
+    check(m->body_mass + b, 1, body + "'s mass");
+    check(m->body_inertia + 3 * b, 3, body + "'s inertia");
+    check(d->xipos + 3 * b, 3, body + "'s centre of mass");
+    check(d->xpos + 3 * b, 3, body + "'s position");
+  }
+  for (int j = 0; j < m->njnt; ++j) {
+    const std::string joint = "joint '" + nameOf(m, mjOBJ_JOINT, j, "joint") + "'";
+    check(d->xanchor + 3 * j, 3, joint + "'s anchor");
+    check(m->qpos0 + j, 1, joint + "'s ref");
+    check(m->qpos_spring + j, 1, joint + "'s springref");
+    check(m->jnt_stiffness + j, 1, joint + "'s stiffness");
+    check(m->dof_damping + j, 1, joint + "'s damping");
+    check(m->dof_frictionloss + j, 1, joint + "'s frictionloss");
+  }
+  for (int e = 0; e < m->neq; ++e) check(m->eq_data + mjNEQDATA * e, mjNEQDATA, "equality '" + nameOf(m, mjOBJ_EQUALITY, e, "equality") + "'s data");
+}
+
 // A MuJoCo body as the description sees it: the tree body it moves with (world: −1).
 struct Frame {
   int link = -1;
@@ -200,6 +229,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   if (!data) throw ModelFileError(path + ": MuJoCo could not make its data");
   mjData* d = data.get();
   MUJOCO_CALL(path, mj_kinematics(m, d));
+  checkNumbers(path, m, d);
   const int flags = m->opt.disableflags;
   out.timestep = m->opt.timestep;
   out.q0 = VecN::Zero(m->nq);

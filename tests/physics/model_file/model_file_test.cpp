@@ -285,6 +285,13 @@ TEST_CASE("hostile and unsupported model files: one line naming the file and the
       "<!ENTITY c \"&b;&b;&b;&b;&b;&b;&b;&b;&b;&b;\"><!ENTITY d \"&c;&c;&c;&c;&c;&c;&c;&c;&c;&c;\">]><mujoco model=\"&d;\"/>";
   CHECK(errorOf(writeFile("laughs.xml", laughs), &seconds).find("nothing moves") != std::string::npos);
   CHECK(seconds < 1.0);
+  // Numbers beyond what a mechanism can mean: refused when read, not found as NaN mid-run.
+  const std::string heavy = "<mujoco><worldbody><body name=\"b\"><joint/><geom size=\"0.1\" mass=\"1e308\" contype=\"0\" "
+                            "conaffinity=\"0\"/></body></worldbody></mujoco>";
+  CHECK(errorOf(writeFile("heavy.xml", heavy)).find("body 'b''s mass is 1e+308") != std::string::npos);
+  const std::string inf_g = "<mujoco><option gravity=\"0 0 -inf\"/><worldbody><body><joint/><geom size=\"0.1\" contype=\"0\" "
+                            "conaffinity=\"0\"/></body></worldbody></mujoco>";
+  CHECK(errorOf(writeFile("inf_gravity.xml", inf_g)).find("<option gravity> is -inf") != std::string::npos);
   // Elements the description cannot hold: named, with what is supported.
   const std::string ball = errorOf(writeFile("ball.xml", mjcf("<joint name=\"shoulder\" type=\"ball\"/>")));
   CHECK(ball.find("joint 'shoulder' (body 'b') is a ball joint; dynlab reads hinge and slide") != std::string::npos);
