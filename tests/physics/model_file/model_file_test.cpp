@@ -234,6 +234,36 @@ TEST_CASE("four-bar: the connect's dependent row is dropped; a passive run keeps
   CHECK(de1 / de2 > 8.0);
 }
 
+TEST_CASE("four-bar: the pin's force satisfies the rocker's Newton–Euler balance about its pivot") {
+  // The rocker turns about the fixed y axis at D: I_D,yy α = [(c − D) × m g + (C − D) × f]_y, with f the
+  // force the coupler applies on it at C (the closure's a on b). Independent of the solve's assembly:
+  // the rocker's own inertia, centre of mass and the reported force alone.
+  const model_file::LoadedModel file = model_file::load(model("fourbar.xml"));
+  ConstrainedMechanism<Spatial> mech(file.mechanism);
+  VecN phi;
+  MatN G;
+  mech.constraint(file.q0, phi, G);
+  const Eigen::MatrixXd kernel = Eigen::FullPivLU<Eigen::MatrixXd>(Eigen::MatrixXd(G)).kernel();
+  REQUIRE(kernel.cols() == 1);
+  const VecN v = VecN(2.0 * kernel.col(0).normalized());  // on the manifold's tangent: J v = 0
+  const auto s = mech.solve(file.q0, v, VecN::Zero(3));
+  const Spatial::Vec f = mech.constraintForce(0, s);
+  const int rocker = 2;
+  const auto& body = file.mechanism.tree.bodies[rocker];
+  double m = 0;
+  Eigen::Vector3d c_body;
+  Spatial::massAndCom(body.inertia, m, c_body);
+  const Eigen::Vector3d D = mech.pointPosition(rocker, Eigen::Vector3d::Zero(), file.q0);
+  const Eigen::Vector3d c = mech.pointPosition(rocker, c_body, file.q0);
+  const Eigen::Vector3d C = mech.kinematics().position(BodyRef::link(rocker), file.mechanism.constraints[0]->attachment().point_b);
+  const Eigen::Vector3d g = file.mechanism.tree.gravity.tail<3>();
+  const double I_yy = body.inertia(1, 1);  // about the pivot; y is the body's y at every θ (it turns about y)
+  const double moment = ((c - D).cross(m * g) + (C - D).cross(Spatial::linear(f)) + f.head<3>()).y();
+  MESSAGE("rocker: I α = " << I_yy * s.qdd[rocker] << " N·m, moments " << moment << " N·m, |f| " << f.norm() << " N");
+  CHECK(std::abs(I_yy * s.qdd[rocker] - moment) < 1e-12 * std::max(1.0, f.norm()));
+  CHECK(f.norm() > 0.1);
+}
+
 TEST_CASE("five-bar: 2 degrees of freedom; URDF arm: the fixed tool fused, limits noted") {
   const model_file::LoadedModel five = model_file::load(model("fivebar.xml"));
   CHECK(five.dof == 2);
