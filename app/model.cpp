@@ -223,6 +223,13 @@ ModelCommand::ModelCommand(CLI::App& cli) {
 }
 
 int model(const ModelArgs& args) {
+  // A trace row per step: bounded before anything runs.
+  constexpr double kMaxSteps = 2e6;
+  if (args.duration / args.dt > kMaxSteps) {
+    std::fprintf(stderr, "error: --duration %g s at --dt %g s is %.0f steps; at most %.0f (a trace row each)\n", args.duration, args.dt,
+                 std::ceil(args.duration / args.dt), kMaxSteps);
+    return 2;
+  }
   model_file::LoadedModel m;
   try {
     model_file::LoadOptions options;

@@ -66,4 +66,5 @@ TEST_CASE("dynlab model: hostile and unsupported files get one line and exit 2, 
                               "<geom size=\"0.1\"/></body></worldbody></mujoco>");
   checkBadInput(dir, "model ball.xml --out o", {"ball.xml", "joint 's'", "ball joint", "hinge and slide"}, dir / "o");
   checkBadInput(dir, "model missing.xml --out o", {"missing.xml", "no such file"}, dir / "o");
+  checkBadInput(dir, "model " + model("fourbar.xml") + " --duration 600 --dt 1e-5 --out o", {"60000000 steps", "at most 2000000"}, dir / "o");
 }
