@@ -262,7 +262,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
       jt.limited = m->jnt_limited[j] && !(flags & mjDSBL_LIMIT);
       jt.lower = m->jnt_range[2 * j], jt.upper = m->jnt_range[2 * j + 1];
       if (jt.limited)
-        out.notes.push_back("joint '" + jt.name + "': limit [" + num(jt.lower) + ", " + num(jt.upper) + "] read, not enforced");
+        out.notes.push_back("joint '" + jt.name + "': limit [" + num(jt.lower) + ", " + num(jt.upper) + "] " + (hinge ? "rad" : "m") + " read, not enforced");
       out.joints.push_back(jt);
     }
     frame[std::size_t(b)] = f;
