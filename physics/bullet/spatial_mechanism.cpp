@@ -437,9 +437,9 @@ struct BulletMechanism<Spatial>::Impl {
     for (Contact& k : contacts)
       k.start_point = body->localPosToWorld(k.link, k.centre) - k.plane->params().radius * bt(k.plane->normal());
     world->stepSimulation(dt, 0, dt);  // exactly one step of dt
+    for (const Loop& l : loops) force[std::size_t(l.constraint)] = loopForce(l);
     for (Wheel& w : wheels) force[std::size_t(w.constraint)] = w.noslip ? noSlipForce(w) : ballForce(w.ball, w.start_point);
     for (Contact& k : contacts) force[std::size_t(k.constraint)] = ballForce(k.ball, k.start_point);
-    for (const Loop& l : loops) force[std::size_t(l.constraint)] = loopForce(l);
   }
 
   // The constraint's impulses over the step, at the point it was written at: no moment there.
