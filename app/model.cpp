@@ -90,7 +90,8 @@ std::string crossCheck(const model_file::LoadedModel& m, ConstrainedMechanism<Sp
   return "  against MuJoCo (mj_fullM, qfrc_bias; q0 and 4 seeded states): max |ΔM| " + fmt(dM) + ", max |Δh| " + fmt(dh) + "\n";
 }
 
-// The power the joints' damping and friction take out of the mechanism (≥ 0).
+// The power the joints' damping and friction take out of the mechanism (≥ 0), with the description's
+// smoothing of Coulomb friction (ConstrainedMechanism's velocity stage).
 double frictionPower(const MechanismModel<Spatial>& d, const VecN& v) {
   double p = 0;
   for (std::size_t i = 0; i < d.joints.size(); ++i) {

@@ -295,7 +295,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     if (!(flags & (mjDSBL_FRICTIONLOSS | mjDSBL_CONSTRAINT))) p.coulomb = m->dof_frictionloss[j];
     if (p.coulomb > 0)
       out.notes.push_back("joint '" + out.joints[std::size_t(j)].name + "': frictionloss " + num(p.coulomb) +
-                          " read as Coulomb friction smoothed over |rate| < " + num(p.coulomb_width) + " (MuJoCo: exact stiction)");
+                          " read as Coulomb friction smoothed over a rate width of " + num(p.coulomb_width) + " (MuJoCo: exact stiction)");
     any = any || p.stiffness != 0 || p.viscous != 0 || p.coulomb != 0;
   }
   if (!any) mech.joints.clear();
