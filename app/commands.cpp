@@ -48,6 +48,13 @@ std::string describeAgreement(const Lab& lab, const json& agreement) {
   return s;
 }
 
+std::string labDisplayName(const json& config, const std::string& lab) {
+  const auto title = config.find("title");
+  if (title == config.end() || !title->is_string() || title->get<std::string>().empty()) return lab;
+  const std::string t = title->get<std::string>();
+  return t.substr(0, t.find(": "));
+}
+
 json defaultsSubmission(const json& config, const std::string& lab) {
   json sub = {{"lab", lab}, {"gains", json::object()}};
   // Gains as numbers in double precision and options as the config sets them, as the tuning window saves them.

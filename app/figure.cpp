@@ -244,7 +244,9 @@ int figure(const FigureArgs& a) {
   }
   const Lab& lab = *loads.front().lab;
   const fs::path out = a.out.empty() ? defaultOut(a.lab, a.scenario, "figures") : fs::path(a.out);
-  const std::string lab_title = a.scenario.empty() ? a.lab : a.lab + " (" + a.scenario + ")";
+  // Titles name the lab as its handout does ("Impedance control"), not by its id.
+  const std::string shown = labDisplayName(loads.front().config, a.lab);
+  const std::string lab_title = a.scenario.empty() ? shown : shown + " (" + a.scenario + ")";
   try {
     // A bar on a terminal for each stage (nothing otherwise): the runs, then the figures.
     auto run = [&](const Lab& l, Engine engine) {
@@ -327,7 +329,8 @@ int figure(const FigureArgs& a) {
       for (const auto* r : {&hands[i], &bullets[i]})
         if (*r && !(*r)->failure.empty())
           status = (runs[i].name.empty() ? "" : runs[i].name + ", ") + (r == &hands[i] ? "hand" : "bullet") + ": " + (*r)->failure;
-    std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n", termText(lab_title).c_str(), lab.duration(),
+    std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n",
+                termText(a.scenario.empty() ? a.lab : a.lab + " (" + a.scenario + ")").c_str(), lab.duration(),
                 lab.dt(), a.engine.c_str(), status.c_str());
     for (const auto& name : written) std::printf("  %s\n", (out / name).c_str());
     for (const auto& why : skipped) std::printf("  not written: %s\n", termText(why).c_str());

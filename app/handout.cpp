@@ -244,6 +244,18 @@ struct Handout {
     return columns.size() > 1 ? columns[1] : "t";
   }
 
+  // A map over the first two gains' whole ranges, 9 points each: a command that runs as printed.
+  std::string mapAxes() const {
+    std::string axes;
+    const char* flags[] = {" --x ", " --y "};
+    int k = 0;
+    for (const auto& [name, g] : config.at("gains").items()) {
+      if (k == 2) break;
+      axes += flags[k++] + name + "=" + num(g.at("min")) + ":" + num(g.at("max")) + ":9";
+    }
+    return k == 2 ? axes : " --x GAIN=from:to:9 --y GAIN=from:to:9";
+  }
+
   std::string howTo() const {
     const std::string L = lab;
     return "## Run, tune, self-grade\n\n"
@@ -253,7 +265,7 @@ struct Handout {
            "| tune it in a window (sliders, live plots, screening) and save it | `dynlab ui " + L + " --gains my_gains.json` |\n"
            "| grade it exactly as the autograder will | `dynlab grade my_gains.json --lab " + L + "` |\n"
            "| plot any trace column | `dynlab figure " + L + " --gains my_gains.json --plot " + plotColumns() + "` |\n"
-           "| see where gains are stable | `dynlab map " + L + " --x GAIN=a:b:n --y GAIN=a:b:n --sim` |\n"
+           "| see where gains are stable (any two gains, NAME=from:to:points) | `dynlab map " + L + mapAxes() + " --sim` |\n"
            "| check the format | `dynlab schema " + L + "` |\n\n"
            "`dynlab grade` writes `out/grade/report.html` with every test, its plot and the screening notes: the score it "
            "prints is the score you will get (the grader is deterministic).\n\n";
