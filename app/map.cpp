@@ -329,8 +329,8 @@ int map(const MapArgs& a) {
     std::printf("dynlab map %s: %d × %d points (%s × %s), %s in %.1f s%s\n", a.lab.c_str(), g.x.n, g.y.n, g.x.name.c_str(),
                 g.y.name.c_str(), a.sim ? "screened and simulated" : "screened", took,
                 a.sim ? (" on " + std::to_string(jobs) + " threads").c_str() : "");
-    std::printf("  %d stable, %d unstable%s\n", stable, int(points.size()) - stable,
-                a.sim ? (" (simulated); the screening agrees at " + std::to_string(agree) + " points").c_str() : "");
+    std::printf("  %d stable, %d %s%s\n", stable, int(points.size()) - stable, pic.unstable_label.c_str(),
+                a.sim ? ("; the screening agrees at " + std::to_string(agree) + " points").c_str() : "");
     std::printf("  map   %s\n", out.c_str());
     if (!a.data.empty()) std::printf("  data  %s\n", a.data.c_str());
     return 0;

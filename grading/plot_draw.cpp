@@ -456,7 +456,7 @@ PlotLayout draw(const Prepared& p, int width_px, int height_px) {
     rows = (rows + columns - 1) / columns;
   }
   const double legend_below = legend.empty() || legend_right ? 0.0 : gap + legend.heightMm(rows);
-  double bottom = 0.6 * ch + axis_below + legend_below;
+  double bottom = 1.0 * ch + axis_below + legend_below;  // the x label's descenders clear the page's edge
   double top = spec.title.empty() ? 1.2 * ch : 3.0 * ch;
   // Equal aspect: widen the data to the frame's shape, re-tick (labels may change width), then
   // trim the frame about its middle so a unit is exactly as long along x as along y.

@@ -51,7 +51,7 @@ std::optional<std::pair<std::string, int>> onTerminal(const TempDir& dir, const 
   ::close(master);
   int status = 0;
   ::waitpid(pid, &status, 0);
-  return {seen, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+  return std::pair<std::string, int>{seen, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
 }
 
 }  // namespace
