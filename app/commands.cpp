@@ -367,8 +367,8 @@ int openUi(const UiArgs& a) {
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
   const fs::path ui = self.parent_path() / "dynlab-ui";
   if (ec || ::access(ui.c_str(), X_OK) != 0) {
-    std::cerr << "error: dynlab ui runs " << ui.string() << ", which is missing; it is built when "
-              << "libglfw3-dev is installed (scripts/setup, then scripts/build)\n";
+    std::cerr << "error: dynlab ui runs " << ui.string() << ", which is missing: build it with `scripts/build "
+              << "dynlab-ui` (scripts/demo builds dynlab alone; the window needs libglfw3-dev, which scripts/setup installs)\n";
     return 1;
   }
   std::vector<std::string> args = {ui.string(), a.lab};

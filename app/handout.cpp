@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 
@@ -244,16 +245,24 @@ struct Handout {
     return columns.size() > 1 ? columns[1] : "t";
   }
 
-  // A map over the first two gains' whole ranges, 9 points each: a command that runs as printed.
+  // A map over the first two gains' whole ranges, 9 points each, that can share a map (the options
+  // the map sets for each, "map"/"gain_options", agree): a command that runs as printed.
   std::string mapAxes() const {
-    std::string axes;
-    const char* flags[] = {" --x ", " --y "};
-    int k = 0;
-    for (const auto& [name, g] : config.at("gains").items()) {
-      if (k == 2) break;
-      axes += flags[k++] + name + "=" + num(g.at("min")) + ":" + num(g.at("max")) + ":9";
-    }
-    return k == 2 ? axes : " --x GAIN=from:to:9 --y GAIN=from:to:9";
+    const json& gains = config.at("gains");
+    const json options = config.contains("map") ? config["map"].value("gain_options", json::object()) : json::object();
+    const auto agree = [&](const std::string& a, const std::string& b) {
+      if (!options.contains(a) || !options.contains(b)) return true;
+      for (const auto& [key, choice] : options[a].items())
+        if (options[b].contains(key) && options[b][key] != choice) return false;
+      return true;
+    };
+    const auto axis = [&](const std::string& flag, const std::string& name) {
+      return flag + name + "=" + num(gains.at(name).at("min")) + ":" + num(gains.at(name).at("max")) + ":9";
+    };
+    for (auto a = gains.begin(); a != gains.end(); ++a)
+      for (auto b = std::next(a); b != gains.end(); ++b)
+        if (agree(a.key(), b.key())) return axis(" --x ", a.key()) + axis(" --y ", b.key());
+    return " --x GAIN=from:to:9 --y GAIN=from:to:9";
   }
 
   std::string howTo() const {

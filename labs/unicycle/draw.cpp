@@ -14,7 +14,7 @@ namespace {
 
 const Color kWheel{0.23f, 0.42f, 0.68f, 1.0f}, kTrack{0.15f, 0.15f, 0.18f, 1.0f}, kRef{0.20f, 0.65f, 0.30f, 1.0f};
 const Color kForce{0.85f, 0.45f, 0.10f, 1.0f}, kSkid{0.90f, 0.10f, 0.10f, 1.0f}, kGhost{0.55f, 0.35f, 0.75f, 0.40f};
-const Color kGround{0.90f, 0.90f, 0.86f, 1.0f}, kLeader{0.80f, 0.10f, 0.55f, 1.0f};  // not the path's green
+const Color kGround{0.90f, 0.90f, 0.86f, 1.0f}, kLeader{0.80f, 0.10f, 0.55f, 0.75f};  // not the path's green; the wheel shows through
 
 Eigen::Vector3d on(double x, double y, double z = 0) { return {x, y, z}; }
 
@@ -59,8 +59,8 @@ void UnicycleLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Sc
   Polyline ref{{}, 2.0, kRef};
   for (const auto& p : path_.polyline()) ref.points.push_back(on(p.x(), p.y()));
   s.polylines.push_back(std::move(ref));
-  // The leader: a ball almost the wheel's size, standing on the path.
-  s.spheres.push_back({on(tr.at(row, "x_d"), tr.at(row, "y_d"), 0.8 * r), 0.8 * r, kLeader});
+  // The leader: a ball of 0.6 wheel radii standing on the path (translucent: the wheel starts on it).
+  s.spheres.push_back({on(tr.at(row, "x_d"), tr.at(row, "y_d"), 0.6 * r), 0.6 * r, kLeader});
 
   // Bullet's friction wheel, translucent, and its track.
   if (ghost && row < ghost->rows()) {

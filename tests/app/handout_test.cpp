@@ -104,6 +104,7 @@ TEST_CASE("every dynlab command a handout prints runs as printed, in every lab")
   TempDir dir("handout_commands");
   for (const auto& lab : labNames(dir)) {
     INFO("lab ", lab);
+    const TempDir student("handout_commands_" + lab);  // one folder per lab: its own my_gains.json
     REQUIRE(dynlab(dir, "handout " + lab + " --out h_" + lab + " --format md").code == 0);
     const std::string md = readFile(dir / ("h_" + lab + "/handout.md"));
     const std::string example = exampleSubmission(md);
@@ -126,9 +127,9 @@ TEST_CASE("every dynlab command a handout prints runs as printed, in every lab")
         if (word.size() > 5 && word.substr(word.size() - 5) == ".json") {
           if (fs::exists(fs::path(DYNLAB_SOURCE_DIR) / word)) {
             word = (fs::path(DYNLAB_SOURCE_DIR) / word).string();
-          } else if (!fs::exists(dir / word)) {
-            fs::create_directories((dir / word).parent_path());
-            writeFile(dir / word, example);
+          } else if (!fs::exists(student / word)) {
+            fs::create_directories((student / word).parent_path());
+            writeFile(student / word, example);
           }
         }
         args += " " + word;
@@ -141,9 +142,9 @@ TEST_CASE("every dynlab command a handout prints runs as printed, in every lab")
           std::cout << "note: xvfb-run not found, `" << command << "` not run\n";
           continue;
         }
-        r = shell(dir, "xvfb-run -a -s '-screen 0 1600x900x24' " + quote(DYNLAB_BIN) + " " + args);
+        r = shell(student, "xvfb-run -a -s '-screen 0 1600x900x24' " + quote(DYNLAB_BIN) + " " + args);
       } else {
-        r = dynlab(dir, args);
+        r = dynlab(student, args);
       }
       INFO("ran: dynlab ", args, "\nstdout: ", r.out, "\nstderr: ", r.err);
       // 0, or 1 for a run the watchdog stopped (the defaults of some labs are meant to fail a scenario).
