@@ -59,7 +59,9 @@ void ImpedanceLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, S
   };
   for (std::size_t r = 0; r < tr.rows(); r += std::max<std::size_t>(1, tr.rows() / 100)) {
     const Eigen::Vector2d x(tr.at(r, "x"), tr.at(r, "y"));
-    extend(x), extend(anchorAt(r)), extend(x + arrowAt(r));
+    extend(x), extend(anchorAt(r));
+    const Eigen::Vector3d head = at(Eigen::Vector2d(x + arrowAt(r)));  // the arrow's head, a small margin round it
+    s.framing.bounds.extend(head - Eigen::Vector3d(0.03, 0.03, 0.03)), s.framing.bounds.extend(head + Eigen::Vector3d(0.03, 0.03, 0.03));
   }
   s.boxes.push_back({{0, -0.03, -0.03}, {0.05, 0.03, 0.02}, Eigen::Matrix3d::Identity(), kWall});
   if (s_.wall.enabled) {

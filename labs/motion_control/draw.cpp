@@ -81,7 +81,7 @@ void MotionControlLab::overlay(const Trace& tr, std::size_t row, Overlay& o) con
              {"torque limit", tr.at(row, "tau_sat") > 0.5 ? "SATURATED" : "within"}};
   for (int i = 0; i < n; ++i)
     o.lines.push_back({"e" + std::to_string(i + 1) + ", tau" + std::to_string(i + 1),
-                       fmt("%.4f rad", tr.at(row, "e" + std::to_string(i + 1))) + ", " +
+                       fmt("%.3f rad", tr.at(row, "e" + std::to_string(i + 1))) + ", " +
                            fmt("%.1f N·m", tr.at(row, "tau" + std::to_string(i + 1)))});
   static const Color palette[] = {{0.85f, 0.15f, 0.15f, 1}, {0.2f, 0.65f, 0.3f, 1}, {0.23f, 0.42f, 0.68f, 1}, {0.85f, 0.55f, 0.2f, 1}};
   std::vector<Series> errs;
