@@ -169,6 +169,47 @@ TEST_CASE("motion_control: with friction, E − E0 = work of τ and of friction"
   CHECK(m["energy_drift"].get<double>() < 1e-3 * moved);
 }
 
+// The largest |Δq| between two hand runs of the same config at steps dt and dt/m, row k against row m k.
+double runGap(const json& patch, double dt, int m) {
+  auto at = [&](double h) {
+    json p = patch;
+    p["simulation"]["dt"] = h;
+    const auto lab = fixture.makeLab(p);
+    const RunResult r = runEngine(*lab, Engine::Hand);
+    REQUIRE_MESSAGE(r.failure.empty(), r.failure);
+    return r.trace;
+  };
+  const Trace a = at(dt), b = at(dt / m);
+  double gap = 0;
+  for (std::size_t r = 0; r < a.rows() && std::size_t(m) * r < b.rows(); ++r)
+    for (const char* c : {"q1", "q2", "q3"}) gap = std::max(gap, std::abs(a.at(r, c) - b.at(std::size_t(m) * r, c)));
+  return gap;
+}
+
+TEST_CASE("motion_control: with Coulomb friction (tanh) the PID run converges at fourth order") {
+  // The controller sampled every 2 ms in every run: the same discrete loop, only the plant's step changes.
+  const json patch = {{"controller", {{"control_period", 2e-3}}}, {"simulation", {{"duration", 1.0}}}};
+  const double coarse = runGap(patch, 1e-3, 2), fine = runGap(patch, 5e-4, 2);
+  MESSAGE("|q(dt) − q(dt/2)| at dt 1 ms: " << coarse << " rad, 0.5 ms: " << fine << " rad, ratio " << coarse / fine);
+  CHECK(coarse < 1e-6);
+  CHECK(coarse / fine > 12.0);  // fourth order: 16 (the clamp's kinks gave 4)
+}
+
+TEST_CASE("motion_control: a passive flexible arm at the lab's default step agrees with dt/4 to 1e-6 rad over 3 s") {
+  const json patch = {{"controller", {{"kind", "none"}}},
+                      {"mechanism", {{"flexible", {{"enabled", true}}}}},
+                      {"simulation", {{"duration", 3.0}}}};
+  const auto lab = fixture.makeLab(patch);
+  const auto& s = dynamic_cast<const MotionControlLab&>(*lab).settings();
+  const double w = std::max(fastestMode(s.plant, s.trajectory.outstretched), fastestMode(s.plant, s.trajectory.folded));
+  MESSAGE("fastest mode " << w << " rad/s, " << s.step.substeps << " sub-steps of dt " << s.step.dt << " s: ω dt = "
+                          << w * s.step.dt / s.step.substeps);
+  CHECK(w * s.step.dt / s.step.substeps <= kResolvedOmegaDt);
+  const double gap = runGap(patch, s.step.dt, 4);
+  MESSAGE("|q(dt) − q(dt/4)| over 3 s: " << gap << " rad");
+  CHECK(gap < 1e-6);
+}
+
 TEST_CASE("motion_control: computed torque with an exact model makes the error dynamics linear") {
   Settings s = settings({{"controller", {{"kind", "computed_torque"}}},
                          {"gains", {{"omega_n", {{"value", 10.0}}}, {"zeta", {{"value", 1.0}}}}},
