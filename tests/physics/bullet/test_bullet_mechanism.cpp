@@ -231,7 +231,7 @@ TEST_CASE("Coulomb friction: creeps at w atanh(τ/F_c) inside the smoothing widt
   b.state(q, v);
   CHECK(v[0] == doctest::Approx(jp.coulomb_width * std::atanh(-0.25 / jp.coulomb)).epsilon(1e-6));
   // The books: friction's work is minus what τ put in at the steady creep (E constant: no gravity).
-  const Books books = b.books();
+  const dyn::Books books = b.books();
   CHECK(books.friction < 0.0);
   CHECK(books.work > 0.0);
 }
