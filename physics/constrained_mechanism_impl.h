@@ -353,9 +353,13 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::setTime(double t) {
 
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::power(const VecN& q, const VecN& v, const VecN& tau, double& work, double& friction) {
-  // The stages are at (q, v) after accelerations() there; restaged only if asked elsewhere.
-  positionStage(q);
-  if (!have_velocity_ || v != staged_v_) velocityStage(v);
+  // Asked right after accelerations(q, v, ...): its velocity stage is at (q, v) (a remembered solve
+  // too: it is the staged state's). Restaged only if that was not so.
+  const bool state_dependent = !model_.joints.empty() || !model_.forces.empty();
+  if (!have_velocity_ || !have_position_ || (state_dependent && (q != staged_q_ || v != staged_v_))) {
+    positionStage(q);
+    velocityStage(v);
+  }
   work = external_power_;
   for (int i = 0; i < int(tau.size()); ++i) work += tau[i] * v[i];
   friction = friction_power_;
