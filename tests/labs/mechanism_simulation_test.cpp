@@ -45,7 +45,7 @@ TEST_CASE("E − E0 − W is at the integrator's error, fourth order, in a drive
                {"pen_on_table", 1e-3, 1e-8, {{"simulation", {{"duration", 0.1}}}}}};
   for (const auto& c : cases) {
     const double coarse = drift(c.lab, c.dt, c.patch), fine = drift(c.lab, c.dt / 2, c.patch);
-    MESSAGE(c.lab << ": |E − E0 − W| at dt " << c.dt << " s: " << coarse << " J, at dt/2: " << fine << " J, ratio " << coarse / fine);
+    MESSAGE(std::string(c.lab) << ": |E − E0 − W| at dt " << c.dt << " s: " << coarse << " J, at dt/2: " << fine << " J, ratio " << coarse / fine);
     CHECK_MESSAGE(coarse < c.bound, c.lab);
     // Fourth order (16), unless both are at rounding level.
     CHECK_MESSAGE((coarse / fine > 12.0 || coarse < 1e-11), c.lab);
@@ -55,7 +55,7 @@ TEST_CASE("E − E0 − W is at the integrator's error, fourth order, in a drive
 TEST_CASE("Bullet's books: E − E0 − W stays within a first-order engine's error") {
   for (const char* lab : {"impedance", "motion_control", "grasp"}) {
     const double d = drift(lab, 1e-3, json::object(), Engine::Bullet);
-    MESSAGE(lab << ": Bullet |E − E0 − W| " << d << " J");
+    MESSAGE(std::string(lab) << ": Bullet |E − E0 − W| " << d << " J");
     CHECK_MESSAGE(d < 5e-2, lab);
   }
 }
