@@ -1,7 +1,7 @@
 // The motion-control lab (labs/motion_control) against the lecture's §4 claims, cheap runs only:
 //  * τ = 0 without friction conserves energy to 1e-6 J in 1 s (RK4), rigid and flexible (springs included);
 //  * with friction and a controller, E − E0 equals the work of τ plus the friction's (the RK4 books);
-//  * with Coulomb friction (F_c tanh(θ'/w)) the PID run converges at fourth order (dt 0.5 → 0.25 ms);
+//  * with Coulomb friction (F_c tanh(θ'/w)) the PID run converges at fourth order (dt 0.25 → 0.125 ms; the clamp: second);
 //  * a passive flexible arm at the lab's default step (sub-stepped: ω dt ≤ 0.05) agrees with dt/4 to 1e-6 rad over 3 s;
 //  * computed torque with an exact model (friction included): e(t) = (e0 + (e0' + ω e0) t) e^{−ωt}
 //    for ζ = 1, within 1e-3·|e0| at dt = 0.2 ms (the 1-step zero-order hold costs O(ω dt));
@@ -193,13 +193,13 @@ double runGap(const json& patch, double dt, int m) {
 TEST_CASE("motion_control: with Coulomb friction (tanh) the PID run converges at fourth order") {
   // The controller sampled every 2 ms in every run: the same discrete loop, only the plant's step
   // changes. F_c tanh(θ'/w) at w = 0.01 rad/s turns over in w/|θ''| ≈ 1 ms where a joint reverses:
-  // RK4 resolves it from dt 0.5 ms on (at 1 ms the gap to dt/2 is 7e-5 rad, ratio 7). The clamp's
-  // kinks held it at second order (ratio 4) at any dt.
+  // RK4 resolves it from dt 0.5 ms on (at 1 ms the gap to dt/2 is 7e-5 rad, ratio 7; at 0.5 ms 1.1e-5).
+  // The clamp's kinks held it at second order once resolved: 2.5e-7 then 6.2e-8 rad here (ratio 4).
   const json patch = {{"controller", {{"control_period", 2e-3}}}, {"simulation", {{"duration", 1.0}}}};
-  const double coarse = runGap(patch, 5e-4, 2), fine = runGap(patch, 2.5e-4, 2);
-  MESSAGE("|q(dt) − q(dt/2)| at dt 0.5 ms: " << coarse << " rad, 0.25 ms: " << fine << " rad, ratio " << coarse / fine);
-  CHECK(fine < 1e-6);
-  CHECK(coarse / fine > 12.0);  // fourth order: 16
+  const double coarse = runGap(patch, 2.5e-4, 2), fine = runGap(patch, 1.25e-4, 2);
+  MESSAGE("|q(dt) − q(dt/2)| at dt 0.25 ms: " << coarse << " rad, 0.125 ms: " << fine << " rad, ratio " << coarse / fine);
+  CHECK(fine < 1e-7);
+  CHECK(coarse / fine > 12.0);  // fourth order (16) or better
 }
 
 TEST_CASE("motion_control: a passive flexible arm at the lab's default step agrees with dt/4 to 1e-6 rad over 3 s") {
