@@ -1,8 +1,10 @@
 // The generic constrained mechanism: any MechanismModel (mechanism.h) through the one solve of
 // eqs. (2)/(3) (constrained_solve.h), as a ConstrainedSystem for the integrators (integrate.h).
 //   position stage (θ, x_c):  tree transforms, M (CRBA), every constraint's φ, J, A; M_c; factor (2)
-//   velocity stage (θ', v_c): tree velocities, h = Cθ' + G + K(θ − θ_r) + B θ' + F_c sat(θ'/w) (RNEA),
-//                             every constraint's bias J'θ' − A'v_c, payload b_c + G_c
+//   velocity stage (θ', v_c): tree velocities, h = Cθ' + G + K(θ − θ_r) + B θ' + F_c tanh(θ'/w) (RNEA),
+//                             every constraint's bias J'θ' − A'v_c, payload b_c + G_c, the external
+//                             forces at the clock's time (h −= J_Pᵀ F, payloads' share likewise) and
+//                             the power of those forces and of friction (the books: integrate.h)
 //   solve:                    α_c, η (the constraint forces) and θ'' together
 // Both stages are cached: the projection, the trace row and the next step's first RK4 stage revisit
 // the same configuration, and the trace row's solve is the first stage's.
@@ -47,6 +49,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   void baumgarteTerm(const VecN& q, const VecN& v, double zeta, double omega, VecN& s) override;
   void metric(const VecN& q, MatN& W) override;
   bool correction(const VecN& q, const VecN& e, VecN& dx) override;
+  void setTime(double t) override;
+  void power(const VecN& q, const VecN& v, const VecN& tau, double& work, double& friction) override;
 
   // The full solve at a state (τ: n tree torques, or n + k: then also generalised forces w on the
   // payload coordinates, an external push: M_c α_c + b_c + G_c = Aᵀ f + w): α_c, η, f and θ''. Remembered: the integrator's
@@ -145,6 +149,10 @@ class ConstrainedMechanism : public ConstrainedSystem {
   VecN compliant_bc_;    // payload side: −Aᵀ η of the compliant rows
   std::vector<Vec> impact_;  // per constraint: the last updateContacts' impact impulse
   bool any_impact_ = false;
+  // External forces (at the velocity stage's time): the payloads' share Aᵀ F of b_c + G_c, their power
+  // F·V_P; and the joint friction's power.
+  VecN external_bc_;
+  double external_power_ = 0, friction_power_ = 0;
 };
 
 }  // namespace dyn

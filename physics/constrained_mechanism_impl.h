@@ -132,17 +132,41 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   // Link velocities, each link's velocity-product acceleration and h = Cθ' + G, in world coordinates.
   problem_.h.resize(nn);
   biasForcesWorld(model_.tree, data_, qd, problem_.h);
-  // Joint springs and friction join h.
+  // Joint springs and friction join h; friction's power for the books.
+  friction_power_ = 0.0;
   if (!model_.joints.empty())
     for (int i = 0; i < nn; ++i) {
       const JointProperties& j = model_.joints[std::size_t(i)];
-      const double w = j.coulomb_width > 0 ? j.coulomb_width : 1e-12;
-      problem_.h[i] += j.stiffness * (staged_q_[i] - j.rest) + j.viscous * qd[i] + j.coulomb * std::clamp(qd[i] / w, -1.0, 1.0);
+      const double f = j.friction(qd[i]);
+      problem_.h[i] += j.stiffness * (staged_q_[i] - j.rest) + f;
+      friction_power_ -= f * qd[i];
     }
   // Payload rates: the free coordinates' rates, zero for the held ones.
   for (std::size_t i = 0, off = std::size_t(nn); i < model_.payloads.size(); ++i)
     for (std::size_t c = 0; c < 3; ++c)
       kin_.payload_rate[i][Eigen::Index(c)] = model_.payloads[i].free[c] ? v[Eigen::Index(off++)] : 0.0;
+  // External forces at the clock's time: Q = [J, −A]ᵀ F through the point's Jacobian (h −= JᵀF on the
+  // tree, b_c + G_c += AᵀF on the payloads), and their power F·V_P.
+  external_power_ = 0.0;
+  if (!model_.forces.empty()) {
+    const int kk = k();
+    external_bc_.setZero(kk);
+    MatN Jp(S::kDim, nn), Ap(S::kDim, kk);
+    std::array<bool, S::kDim> all;
+    all.fill(true);
+    for (const auto& force : model_.forces) {
+      const BodyRef b = force->body();
+      const Pos p = kin_.position(b, force->point());
+      const Vec V = kin_.pointVelocity(b, p);
+      const Vec F = force->force(time_, p, V);
+      external_power_ += F.dot(V);
+      Jp.setZero();
+      if (kk) Ap.setZero();
+      kin_.addPointJacobian(b, p, all, 1.0, 0, Jp, Ap);
+      problem_.h.noalias() -= Jp.transpose() * F;
+      if (kk) external_bc_.noalias() += Ap.transpose() * F;
+    }
+  }
   // J'θ' − A'v_c of every constraint.
   VecN bias(rows_);
   for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->bias(kin_, offsets_[i], bias);
@@ -190,6 +214,7 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
   if (tau.size() == n() + k()) problem_.bc_Gc = gravity_bc_ - tau.tail(k());
   else problem_.bc_Gc = gravity_bc_;
   if (any_compliant_ && k()) problem_.bc_Gc += compliant_bc_;
+  if (!model_.forces.empty() && k()) problem_.bc_Gc += external_bc_;
   if (stab) problem_.stab = *stab;
   else problem_.stab.resize(0);
   Solution s;
@@ -317,6 +342,27 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::accelerations(const VecN& q, const Vec
   };
   if (known) put(last_);
   else put(evaluate(q, v, tau, stab));
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::setTime(double t) {
+  // Time-dependent forces: a new time is a new velocity stage (and no remembered solve).
+  if (t != time_ && !model_.forces.empty()) have_velocity_ = have_last_ = false;
+  time_ = t;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::power(const VecN& q, const VecN& v, const VecN& tau, double& work, double& friction) {
+  // Asked right after accelerations(q, v, ...): its velocity stage is at (q, v) (a remembered solve
+  // too: it is the staged state's). Restaged only if that was not so.
+  const bool state_dependent = !model_.joints.empty() || !model_.forces.empty();
+  if (!have_velocity_ || !have_position_ || (state_dependent && (q != staged_q_ || v != staged_v_))) {
+    positionStage(q);
+    velocityStage(v);
+  }
+  work = external_power_;
+  for (int i = 0; i < int(tau.size()); ++i) work += tau[i] * v[i];
+  friction = friction_power_;
 }
 
 template <class S, int Nj, int Nr, int Nl>

@@ -1,6 +1,8 @@
 // Impedance lab: parses impedance.json, runs the motion-control arm (its mechanism description,
-// reused) on the hand-written model or on Bullet, with the tip force applied as the generalised
-// force J_tipᵀ F_ext in both engines and the wall as a planar PlaneContact, and measures the runs.
+// reused) on the hand-written model or on Bullet, with the tip force an external force of the
+// description (physics/forces.h push: each engine evaluates J_tipᵀ F_ext inside its step, at every RK4
+// stage for the hand engine, while the controller's τ is held over its period) and the wall as a
+// planar PlaneContact, and measures the runs.
 #include "labs/impedance/lab.h"
 
 #include <cmath>
@@ -12,6 +14,7 @@
 #include "labs/numbers.h"
 #include "labs/settings.h"
 #include "physics/constraints/plane_contact.h"
+#include "physics/forces.h"
 
 namespace dyn::impedance {
 namespace {
@@ -24,9 +27,14 @@ Eigen::Vector3d parse3(const JsonView& j, double lo, double hi, double scale = 1
   return {j.at(0).inRange(lo, hi) * scale, j.at(1).inRange(lo, hi) * scale, j.at(2).inRange(lo, hi) * scale};
 }
 
-// The arm with the wall (if any) as a unilateral plane contact on the tip ball.
+// The arm with the push on the tip (an external force, if any) and the wall (if any) as a unilateral
+// plane contact on the tip ball.
 MechanismModel<Planar> describeWithWall(const Settings& s) {
   MechanismModel<Planar> d = motion_control::describe(s.plant);
+  const Planar::Pos tip(s.plant.links[2].length, 0.0);
+  if (s.force.value != Eigen::Vector2d::Zero())
+    d.forces.push_back(std::make_shared<PushForce<Planar>>(BodyRef::link(2), tip, Planar::Vec(0.0, s.force.value.x(), s.force.value.y()),
+                                                            s.force.profile()));
   if (!s.wall.enabled) return d;
   PlaneContactParams c;
   c.radius = s.wall.radius;
@@ -60,15 +68,11 @@ class Hooks final : public StepHooks {
     tau_ = Eigen::Vector3d::Zero();
   }
   VecN torque(double t, const VecN& q, const VecN& v) override {
-    // The environment's force at the tip as a generalised force (both engines alike).
-    const Eigen::Vector2d F = s_.force.at(t);
-    Eigen::Matrix3d J;
-    Eigen::Vector3d Jdv;
-    taskJacobian(plant_, s_.plant, q, v, J, Jdv);
-    f_applied_ = F;
+    // The controller, sampled; the push at the tip is the mechanism's (describeWithWall), here only for
+    // the trace row and the sensor.
+    f_applied_ = s_.force.at(t);
     if (k_++ % hold_ == 0) tau_ = control(t, q, v);
-    const Eigen::Vector3d ext = J.topRows<2>().transpose() * F;
-    return VecN(tau_ + ext);
+    return VecN(tau_);
   }
   void row(const StepRecord& r, std::vector<double>& out) override {
     const Eigen::Vector3d x = tipPose(s_.plant, r.q.head<3>());
@@ -190,11 +194,7 @@ class Hooks final : public StepHooks {
 
 }  // namespace
 
-Eigen::Vector2d Force::at(double t) const {
-  if (t < start || (hold > 0 && t >= start + rise + hold)) return Eigen::Vector2d::Zero();
-  const double ramp = rise > 0 ? std::min(1.0, (t - start) / rise) : 1.0;
-  return ramp * value;
-}
+Eigen::Vector2d Force::at(double t) const { return profile().at(t) * value; }
 
 Eigen::Vector3d tipPose(const Params& p, const Eigen::Vector3d& th) {
   const auto pts = motion_control::jointPoints(p, th);

@@ -175,6 +175,7 @@ struct BulletMechanism<Spatial>::Impl {
 
   Impl(const MechanismModel<Spatial>& m, double step, const VecN& q0, const VecN& v0) : model(m), dt(step), world(bt(Spatial::linear(m.tree.gravity)), m.bullet.solver_iterations) {
     check(q0, v0);
+    if (!m.forces.empty()) throw std::invalid_argument("BulletMechanism (spatial): external forces are not modelled yet");
     frames = linkFrames(m.tree);
     force.assign(m.constraints.size(), Spatial::Vec::Zero());
     btContactSolverInfo& info = world->getSolverInfo();
@@ -424,11 +425,13 @@ struct BulletMechanism<Spatial>::Impl {
     if (tau_in.size() != n) throw std::invalid_argument("BulletMechanism::step: τ needs one value per tree joint (" + std::to_string(n) + ")");
     VecN q, v;
     state(q, v);
+    VecN friction = VecN::Zero(n);
     for (int i = 0; i < n; ++i) {
       double tau = tau_in[i];
       if (!model.joints.empty()) {  // spring, viscous and Coulomb friction from the step's start
         const JointProperties& jp = model.joints[std::size_t(i)];
-        tau -= jp.stiffness * (q[i] - jp.rest) + jp.viscous * v[i] + jp.coulomb * std::clamp(v[i] / jp.coulomb_width, -1.0, 1.0);
+        friction[i] = jp.friction(v[i]);
+        tau -= jp.stiffness * (q[i] - jp.rest) + friction[i];
       }
       body->addJointTorque(i, tau);  // pitfall 3: cleared after every step
     }
@@ -440,7 +443,15 @@ struct BulletMechanism<Spatial>::Impl {
     for (const Loop& l : loops) force[std::size_t(l.constraint)] = loopForce(l);
     for (Wheel& w : wheels) force[std::size_t(w.constraint)] = w.noslip ? noSlipForce(w) : ballForce(w.ball, w.start_point);
     for (Contact& k : contacts) force[std::size_t(k.constraint)] = ballForce(k.ball, k.start_point);
+    // The books: the held torques along the step's displacement.
+    VecN q1, v1;
+    state(q1, v1);
+    for (int i = 0; i < n; ++i) {
+      books.work += tau_in[i] * (q1[i] - q[i]);
+      books.friction -= friction[i] * (q1[i] - q[i]);
+    }
   }
+  Books books;
 
   // The constraint's impulses over the step, at the point it was written at: no moment there.
   Spatial::Vec noSlipForce(const Wheel& w) const {
@@ -467,7 +478,12 @@ BulletMechanism<Spatial>::BulletMechanism(const MechanismModel<Spatial>& model, 
 template <>
 BulletMechanism<Spatial>::~BulletMechanism() {}
 template <>
-void BulletMechanism<Spatial>::step(const VecN& tau) { impl_->step(tau); }
+void BulletMechanism<Spatial>::step(const VecN& tau, double t) {
+  (void)t;  // no time-dependent forces: the spatial builder refuses external forces
+  impl_->step(tau);
+}
+template <>
+Books BulletMechanism<Spatial>::books() const { return impl_->books; }
 template <>
 void BulletMechanism<Spatial>::state(VecN& q, VecN& v) const { impl_->state(q, v); }
 template <>
