@@ -86,30 +86,35 @@ void summarise(LoopAnalysis& a) {
 void analyseSampled(const LinearLoop& loop, LoopAnalysis& a) {
   const SampledLoop& d = loop.sampled;
   const double T = d.period;
+  const int N = std::max(0, d.steps);
   Poly gn, gd;
   zeroOrderHold(d.plant_num, d.plant_den, T, gn, gd);
-  const Poly num = polyMul(d.ctrl_num, gn);
-  Poly den = polyMul(d.ctrl_den, gd);
-  den.insert(den.begin(), std::size_t(std::max(0, d.steps)), 0.0);  // × z^N
+  const Poly num = polyMul(d.ctrl_num, gn), den_free = polyMul(d.ctrl_den, gd);
+  Poly den = den_free;
+  den.insert(den.begin(), std::size_t(N), 0.0);  // × z^N
   a.poles.clear();
   for (const auto& z : polyRoots(polyAdd(den, num)))
     if (std::abs(z) > 1e-300) a.poles.push_back(std::log(z) / T);  // z = 0: a mode gone in one step
   std::sort(a.poles.begin(), a.poles.end(), [](auto x, auto y) { return x.real() != y.real() ? x.real() > y.real() : x.imag() > y.imag(); });
   summarise(a);
-  // Crossovers on the unit circle below the Nyquist frequency π/T, the loop's own delays inside L(z).
+  // The margin from the loop without its N whole steps (their phase is ωNT exactly): crossovers on the
+  // unit circle below the Nyquist frequency π/T. The stated delay beyond the whole steps (the hold's
+  // T/2, an Euler integrator's) is already in L's phase: margin = that + PM/ω_c, above the stated
+  // delay exactly when NT < PM/ω_c, i.e. when the loop is stable.
   const auto L = [&](double w) {
     const std::complex<double> z = std::polar(1.0, w * T);
-    return polyEval(num, z) / polyEval(den, z);
+    return polyEval(num, z) / polyEval(den_free, z);
   };
   const std::vector<Crossing> cs = crossings(L, 1e-3, M_PI / T * (1 - 1e-9));
+  const double base = loop.delay - N * T;
   if (a.stable) {
     const double extra = cs.empty() ? (std::abs(L(M_PI / T)) < 1.0 ? kUnboundedDelay : 0.0) : extraDelay(cs);
-    a.delay_margin = std::min(kUnboundedDelay, loop.delay + extra);
+    a.delay_margin = std::min(kUnboundedDelay, base + extra);
   } else {
-    // Past its margin: the delay less what the phase overshoots at the crossover (never above the delay).
-    double extra = 0;
-    for (const Crossing& c : cs) extra = std::min(extra, c.pm / c.w);
-    a.delay_margin = extra < 0 ? std::max(0.0, loop.delay + extra) : 0.0;
+    // Past its margin (or unstable without the delay: no margin at all); never above the stated delay.
+    double extra = cs.empty() ? -base : kUnboundedDelay;
+    for (const Crossing& c : cs) extra = std::min(extra, c.pm > 0 ? c.pm / c.w : -base);
+    a.delay_margin = std::clamp(base + extra, 0.0, loop.delay);
   }
 }
 
