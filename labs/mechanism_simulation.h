@@ -47,14 +47,15 @@ class HandEngine final : public MechanismEngine {
       : mech_(mech), options_(options), q_(std::move(q0)), v_(std::move(v0)), forces_(mech.model().constraints.size()) {}
   void state(VecN& q, VecN& v) const override { q = q_, v = v_; }
   bool step(const VecN& tau, bool with_forces) override {
-    // Unilateral contacts close (with an impact on v) or open between steps.
+    // Unilateral contacts close (with an impact on v) or open at the step's start ...
     mech_.updateContacts(q_, v_, tau);
     // The constraint forces at the step's start: the solve the first RK4 stage reuses.
     if (with_forces) {
       const auto sol = mech_.solve(q_, v_, tau);
       for (std::size_t i = 0; i < forces_.size(); ++i) forces_[i] = mech_.constraintForce(int(i), sol);
     }
-    if (!dyn::step(mech_, options_, tau, q_, v_)) failure_ = "the constraint projection failed";
+    // ... and a touchdown inside the step is located and closed there (the step retaken to it).
+    if (!mech_.stepLocatingContacts(options_, tau, q_, v_)) failure_ = "the constraint projection failed";
     return failure_.empty();
   }
   const std::vector<VecN>& forces() const override { return forces_; }

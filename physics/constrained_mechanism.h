@@ -73,6 +73,13 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // (2) for impulses), then opens closed ones whose solved η would pull, one at a time (most negative
   // first), until every closed one presses. Returns how many changed; v changes only on impact.
   int updateContacts(const VecN& q, VecN& v, const VecN& tau);
+  // One integrator step (dyn::step) with its touchdowns located: when an open rigid unilateral contact
+  // ends the step past its plane (φ > 0), the step is retaken from its start to the crossing — the
+  // sub-step h with φ(h) = 0, by regula falsi (Illinois) on h, landing within kTouchdownDepth past the
+  // plane — the contact closed there by updateContacts (its plastic impact, then the lift-off check),
+  // and the rest of the step taken from there. A step without a crossing costs one look at φ of the
+  // open contacts at its end (the projection's own position stage). False if the integrator failed.
+  bool stepLocatingContacts(const StepOptions& options, const VecN& tau, VecN& q, VecN& v);
   // The impulse (N·s; as constraintForce: body a on body b, world axes at its point) that the plastic
   // impact of the last updateContacts gave constraint i: ∫ f dt over the impact, P = Λ_n v_n for one
   // contact alone; zero when that call closed nothing (or the solve was singular). A lab that reports a
@@ -115,6 +122,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   void treeStage(const VecN& q);
   // The solve at a state; without with_qdd, α_c, η and f only (θ'' left unset).
   Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd = true);
+  // The deepest φ (= −gap) of the open rigid unilateral contacts at q, −∞ if none is open.
+  double openDepth(const VecN& q);
   // Forget every cached stage (the released rows changed).
   void invalidate() { have_position_ = have_velocity_ = have_last_ = false; }
 
@@ -142,7 +151,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // (φ, J, A: gaps and compliant forces read them), and the compliant forces of the velocity stage.
   std::vector<char> released_;
   std::vector<char> compliant_, rigid_contact_;  // per constraint: a compliant contact; a rigid unilateral one
-  bool any_released_kind_ = false, any_compliant_ = false;
+  bool any_released_kind_ = false, any_compliant_ = false, any_rigid_contact_ = false;
   VecN phi_full_;
   MatN J_full_, A_full_;
   VecN compliant_eta_;   // per row: the compliant force η (0 elsewhere)

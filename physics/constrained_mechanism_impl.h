@@ -26,6 +26,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
     rigid_contact_.push_back(char(c->unilateral() && !c->compliant()));
     any_compliant_ = any_compliant_ || c->compliant();
     any_released_kind_ = any_released_kind_ || released;
+    any_rigid_contact_ = any_rigid_contact_ || rigid_contact_.back();
   }
   auto fits = [](int fixed, int actual) { return fixed == Eigen::Dynamic || fixed == actual; };
   if (!fits(Nj, n()) || !fits(Nr, rows_) || !fits(Nl, k()))
@@ -310,6 +311,71 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
     ++changes;
   }
   return changes;
+}
+
+// m: how far past its plane a located touchdown may land (the root-finder's tolerance on φ).
+constexpr double kTouchdownDepth = 1e-13;
+
+template <class S, int Nj, int Nr, int Nl>
+double ConstrainedMechanism<S, Nj, Nr, Nl>::openDepth(const VecN& q) {
+  positionStage(q);
+  double depth = -INFINITY;
+  for (std::size_t i = 0; i < released_.size(); ++i)
+    if (rigid_contact_[i] && released_[i]) depth = std::max(depth, phi_full_[offsets_[i]]);
+  return depth;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+bool ConstrainedMechanism<S, Nj, Nr, Nl>::stepLocatingContacts(const StepOptions& o, const VecN& tau, VecN& q, VecN& v) {
+  if (!any_rigid_contact_) return dyn::step(*this, o, tau, q, v);
+  StepOptions sub = o;  // the part of the step still to take
+  // At most a few touchdowns per step (a contact the impact reopens may come back at once): past
+  // them the step ends as it lands, and the next step's updateContacts closes what it finds.
+  for (int event = 0;; ++event) {
+    bool open = false;
+    for (std::size_t i = 0; i < released_.size(); ++i) open = open || (rigid_contact_[i] && released_[i]);
+    if (!open) return dyn::step(*this, sub, tau, q, v);
+    const VecN q0 = q, v0 = v;
+    // The clock and the books advance with every step taken: a trial restarts them from here.
+    const double t0 = time();
+    const Books b0 = books();
+    if (!dyn::step(*this, sub, tau, q, v)) return false;
+    if (event == 3 || !(openDepth(q) > 0.0)) return true;
+    // A crossing inside the step: bracket it from the start (φ < 0 there, else nothing to locate).
+    double lo = 0.0, f_lo = openDepth(q0), hi = sub.dt, f_hi = openDepth(q), depth = f_hi;
+    if (!(f_lo < 0.0)) return true;
+    VecN q_hi = q, v_hi = v;
+    double t_hi = time();
+    Books b_hi = books();
+    int side = 0;  // Illinois: the end kept twice in a row has its value halved (depth: its true φ)
+    for (int it = 0; it < 100 && depth > kTouchdownDepth && hi - lo > 1e-15 * o.dt; ++it) {
+      double h = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+      if (!(h > lo && h < hi)) h = 0.5 * (lo + hi);
+      StepOptions trial = o;
+      trial.dt = h;
+      VecN qt = q0, vt = v0;
+      setTime(t0);
+      books() = b0;
+      if (!dyn::step(*this, trial, tau, qt, vt)) return false;
+      const double f = openDepth(qt);
+      if (f > 0.0) {
+        hi = h, f_hi = depth = f, q_hi = qt, v_hi = vt, t_hi = time(), b_hi = books();
+        if (side == 1) f_lo *= 0.5;
+        side = 1;
+      } else {
+        lo = h, f_lo = f;
+        if (side == -1) f_hi *= 0.5;
+        side = -1;
+      }
+    }
+    // At the touchdown (at most kTouchdownDepth past the plane): close it, then the rest of the step.
+    q = q_hi, v = v_hi;
+    setTime(t_hi);
+    books() = b_hi;
+    updateContacts(q, v, tau);
+    sub.dt -= hi;
+    if (!(sub.dt > 1e-15 * o.dt)) return true;
+  }
 }
 
 template <class S, int Nj, int Nr, int Nl>

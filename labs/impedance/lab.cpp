@@ -6,6 +6,7 @@
 #include "labs/impedance/lab.h"
 
 #include <cmath>
+#include <functional>
 #include <map>
 #include <random>
 
@@ -59,6 +60,8 @@ void taskJacobian(Mech& m, const Params& p, const VecN& q, const VecN& v, Eigen:
 // The lab's controller: the chosen realisation of the target impedance on measured F.
 class Hooks final : public StepHooks {
  public:
+  // The x impulse (N·s) the hand engine's last step gave the tip at a rigid wall (unset: none).
+  std::function<double()> impulse;
   explicit Hooks(const Settings& s)
       : s_(s), model_(motion_control::describeRigid(s.model)), plant_(motion_control::describeRigid(s.plant)),
         inner_(s.inner, s.model), hold_(std::max(1L, std::lround(s.period / s.step.dt))), rng_(12345),
@@ -79,10 +82,11 @@ class Hooks final : public StepHooks {
     Eigen::Vector2d f = f_applied_;
     // The wall's push on the tip (plane on body: the constraint's force is body on world).
     if (s_.wall.enabled && !r.forces.empty() && r.forces[0].size() >= 3) f += Eigen::Vector2d(r.forces[0][1], r.forces[0][2]);
-    // A rigid wall's plastic impact: the hand engine jumps θ' at the step's start (eq. (2) for
-    // impulses), and the contact force it reports after that leaves the impulse out; the row carries
-    // it as P/dt, the step's mean force, as Bullet's impulse-based contact reports it.
-    if (s_.wall.enabled && s_.wall.stiffness == 0 && r.engine == Engine::Hand) f.x() -= impactImpulse(r.q, r.v) / s_.step.dt;
+    // A rigid wall's plastic impact: the hand engine jumps θ' at the touchdown it locates inside the
+    // step (eq. (2) for impulses), and the contact force it reports at the step's start leaves the
+    // impulse out; the row carries it as P/dt, the step's mean force, as Bullet's impulse-based contact
+    // reports it (the engine's own record: ConstrainedMechanism::impactImpulse).
+    if (impulse && r.engine == Engine::Hand) f.x() += impulse() / s_.step.dt;
     f_total_ = f;
     out.clear();
     out.push_back(r.t);
@@ -115,20 +119,6 @@ class Hooks final : public StepHooks {
   }
 
  private:
-  // The impulse P = Λ_n v_n (N·s) of a plastic impact on the wall at (q, v), as the engine's
-  // touchdown test sees it (the ball at or past the plane, moving into it); 0 otherwise.
-  // Λ_n = (J_n M⁻¹ J_nᵀ)⁻¹, J_n the tip's x row: the least-kinetic-energy jump that stops v_n.
-  double impactImpulse(const VecN& q, const VecN& v) {
-    const Eigen::Vector3d th = q.head<3>();
-    Eigen::Matrix3d J;
-    Eigen::Vector3d Jdv;
-    taskJacobian(plant_, s_.plant, q, v, J, Jdv);
-    const double vn = J.row(0).dot(v.head<3>());
-    if (vn <= 0 || tipPose(s_.plant, th)[0] + s_.wall.radius < s_.wall.x) return 0;
-    const Eigen::Matrix3d M = plant_.massMatrix(q);
-    return vn / J.row(0).dot(M.ldlt().solve(Eigen::Vector3d(J.row(0).transpose())));
-  }
-
   Eigen::Vector3d control(double t, const VecN& q, const VecN& v) {
     const Eigen::Vector3d th = q.head<3>(), thd = v.head<3>();
     const Eigen::Vector3d F(fx_.value(), fy_.value(), 0.0);
@@ -335,7 +325,10 @@ template <class M>
 std::unique_ptr<Simulation> run(const Settings& s, Engine engine, const std::vector<std::string>& columns) {
   auto mech = std::make_unique<M>(describeWithWall(s));
   VecN q = VecN(s.pose), v = VecN::Zero(3);
-  return simulateMechanism(engine, std::move(mech), s.step, q, v, std::make_unique<Hooks>(s), columns, s.duration);
+  auto hooks = std::make_unique<Hooks>(s);
+  if (engine == Engine::Hand && s.wall.enabled && s.wall.stiffness == 0)
+    hooks->impulse = [hand = mech.get()] { return hand->impactImpulse(0)[1]; };  // (τ, f_x, f_y): f_x
+  return simulateMechanism(engine, std::move(mech), s.step, q, v, std::move(hooks), columns, s.duration);
 }
 
 }  // namespace
