@@ -90,14 +90,14 @@ std::string crossCheck(const model_file::LoadedModel& m, ConstrainedMechanism<Sp
   return "  against MuJoCo (mj_fullM, qfrc_bias; q0 and 4 seeded states): max |ΔM| " + fmt(dM) + ", max |Δh| " + fmt(dh) + "\n";
 }
 
-// The power the joints' damping and friction take out of the mechanism (≥ 0), with the description's
-// smoothing of Coulomb friction (ConstrainedMechanism's velocity stage).
+// The power the joints' damping and friction take out of the mechanism (≥ 0), by the description's
+// law (JointProperties::friction), for Bullet's books; the hand engine integrates its own (Books).
 double frictionPower(const MechanismModel<Spatial>& d, const VecN& v) {
   double p = 0;
   for (std::size_t i = 0; i < d.joints.size(); ++i) {
     const JointProperties& j = d.joints[i];
-    const double w = v[Eigen::Index(i)], width = j.coulomb_width > 0 ? j.coulomb_width : 1e-12;
-    p += j.viscous * w * w + j.coulomb * std::clamp(w / width, -1.0, 1.0) * w;
+    const double w = v[Eigen::Index(i)];
+    p += j.friction(w) * w;
   }
   return p;
 }
@@ -149,15 +149,15 @@ Run runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mec
   const int steps = int(std::lround(args.duration / args.dt)), n = mech.n();
   VecN q = m.q0, v = VecN::Zero(n);
   const VecN tau = VecN::Zero(n);
-  double work = 0, power = frictionPower(m.mechanism, v);
+  // The books (friction's work) integrated with the motion, at RK4's order (integrate.h).
+  mech.setTime(0);
+  mech.books() = Books{};
   for (int k = 0; k <= steps; ++k) {
     const auto s = mech.solve(q, v, tau);
-    record(run, mech, k * args.dt, q, v, work, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()));
+    const Books b = mech.books();
+    record(run, mech, k * args.dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()));
     if (k == steps) break;
     if (!(run.ok = step(mech, o, tau, q, v) && q.allFinite() && v.allFinite())) break;
-    const double p = frictionPower(m.mechanism, v);
-    work -= 0.5 * (power + p) * args.dt;  // trapezoid rule
-    power = p;
   }
   return run;
 }
