@@ -247,7 +247,7 @@ LoopAnalysis analyseLoop(const LinearLoop& loop, int order) {
     if (p.real() >= 0) best = 0.0;
   a.delay_margin = best;
   // The loop as it runs, when the lab gives it: its poles and margin in discrete time.
-  if (loop.sampled.period > 0) analyseSampled(loop, a);
+  if (loop.sampled.period > 0 && loop.sampled.steps <= kMaxSampledSteps) analyseSampled(loop, a);
   return a;
 }
 

@@ -28,6 +28,9 @@ using Poly = std::vector<double>;  // c0 + c1 s + c2 s² + …
 //   C(z) = ctrl_num/ctrl_den    the controller's own discrete dynamics, polynomials in z (an integrator
 //                               by explicit Euler, updated after use: T/(z − 1))
 //   steps                       the measurement's delay in whole steps
+// A delay of more than kMaxSampledSteps steps (a step far shorter than the delay, where the sampled and
+// the continuous loop agree) is screened in continuous time: N steps are N + deg poles to find.
+inline constexpr int kMaxSampledSteps = 200;
 struct SampledLoop {
   double period = 0;
   Poly plant_num = {}, plant_den = {};

@@ -191,3 +191,20 @@ TEST_CASE("sampled integral loop a z^{−N}/(z − 1): delay margin π/(2ω_c), 
     CHECK(rate == doctest::Approx(an.max_real).epsilon(0.02));
   }
 }
+
+TEST_CASE("a delay of more than kMaxSampledSteps steps is screened in continuous time (a grade's budget holds)") {
+  // dt 10 µs against a 10 ms delay is 1000 steps: 1000 discrete poles to find, seconds per screening;
+  // at such a step the sampled and the continuous loop agree, and the continuous answer is the same one.
+  const double T = 1e-5, k = 20;
+  const int N = 1000;
+  LinearLoop loop{"force", "integral", {k}, {0, 1}, (N + 0.5) * T};
+  const LoopAnalysis continuous = analyseLoop(loop);
+  loop.sampled = {T, {1}, {1}, {k * T}, {-1, 1}, N};
+  REQUIRE(N > kMaxSampledSteps);
+  const LoopAnalysis an = analyseLoop(loop);
+  CHECK(an.delay_margin == continuous.delay_margin);
+  CHECK(an.max_real == continuous.max_real);
+  CHECK(an.poles.size() == continuous.poles.size());
+  // The closed form of the continuous integral loop k e^{−sτ}/s: margin π/(2k).
+  CHECK(an.delay_margin == doctest::Approx(M_PI / (2 * k)).epsilon(1e-3));
+}
