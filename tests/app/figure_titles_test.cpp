@@ -8,34 +8,14 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/app/cli_run.h"
+#include "tests/app/png_ink.h"
 
 using namespace dyn::test::cli;
+using dyn::test::Ink;
+using dyn::test::inkOf;
 using nlohmann::json;
 
 namespace {
-
-// Where a PNG has ink (any pixel not white): its box, and whether any lies within `strip` pixels of
-// an edge (a title cut off by the page).
-struct Ink {
-  int width = 0, height = 0, x0 = 0, y0 = 0, x1 = -1, y1 = -1;
-  bool at_edge = false;
-};
-Ink inkOf(const fs::path& png, int strip = 2) {
-  Ink ink;
-  int n = 0;
-  unsigned char* data = stbi_load(png.string().c_str(), &ink.width, &ink.height, &n, 3);
-  REQUIRE(data != nullptr);
-  ink.x0 = ink.width, ink.y0 = ink.height;
-  for (int y = 0; y < ink.height; ++y)
-    for (int x = 0; x < ink.width; ++x) {
-      const unsigned char* p = data + (std::size_t(y) * ink.width + x) * 3;
-      if (p[0] > 250 && p[1] > 250 && p[2] > 250) continue;
-      ink.x0 = std::min(ink.x0, x), ink.x1 = std::max(ink.x1, x), ink.y0 = std::min(ink.y0, y), ink.y1 = std::max(ink.y1, y);
-      ink.at_edge = ink.at_edge || x < strip || y < strip || x >= ink.width - strip || y >= ink.height - strip;
-    }
-  stbi_image_free(data);
-  return ink;
-}
 
 // An SVG's text as written: PLplot's svg device writes every character as "&#xNN;".
 std::string svgText(const std::string& svg) {

@@ -26,6 +26,7 @@
 #include <cmath>
 #include <string>
 
+#include "tests/physics/reference_rk4.h"
 #include "labs/impedance/lab.h"
 #include "labs/run.h"
 #include "tests/labs/lab_fixture.h"
@@ -70,19 +71,7 @@ Eigen::Vector3d referencePush(const Settings& s, const Eigen::Vector2d& F, doubl
     const Eigen::MatrixXd M = arm.massMatrix(q);
     return VecN(M.ldlt().solve(Eigen::VectorXd(J.transpose() * Fs - arm.inverseDynamics(q, v, VecN::Zero(3)))));
   };
-  VecN q = VecN(s.pose), v = VecN::Zero(3);
-  for (long k = 0; k < std::lround(T / dt); ++k) {
-    const VecN a1 = accel(q, v);
-    const VecN q2 = q + 0.5 * dt * v, v2 = v + 0.5 * dt * a1;
-    const VecN a2 = accel(q2, v2);
-    const VecN q3 = q + 0.5 * dt * v2, v3 = v + 0.5 * dt * a2;
-    const VecN a3 = accel(q3, v3);
-    const VecN q4 = q + dt * v3, v4 = v + dt * a3;
-    const VecN a4 = accel(q4, v4);
-    q += dt / 6 * (v + 2 * v2 + 2 * v3 + v4);
-    v += dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4);
-  }
-  return q;
+  return dyn::test::referenceRk4(accel, VecN(s.pose), VecN::Zero(3), dt, std::lround(T / dt));
 }
 
 }  // namespace

@@ -11,6 +11,7 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 
+#include "tests/physics/reference_rk4.h"
 #include "physics/constrained_mechanism_impl.h"
 #include "physics/forces.h"
 #include "tests/physics/arms.h"
@@ -79,19 +80,7 @@ VecN referenceRun(double dt, double T) {
     const Eigen::MatrixXd M = arm.massMatrix(q);
     return VecN(M.ldlt().solve(Eigen::VectorXd(J.transpose() * F - h)));
   };
-  VecN q = startAngles(), v = VecN::Zero(3);
-  for (long k = 0; k < std::lround(T / dt); ++k) {
-    const VecN a1 = accel(q, v);
-    const VecN q2 = q + 0.5 * dt * v, v2 = v + 0.5 * dt * a1;
-    const VecN a2 = accel(q2, v2);
-    const VecN q3 = q + 0.5 * dt * v2, v3 = v + 0.5 * dt * a2;
-    const VecN a3 = accel(q3, v3);
-    const VecN q4 = q + dt * v3, v4 = v + dt * a3;
-    const VecN a4 = accel(q4, v4);
-    q += dt / 6 * (v + 2 * v2 + 2 * v3 + v4);
-    v += dt / 6 * (a1 + 2 * a2 + 2 * a3 + a4);
-  }
-  return q;
+  return dyn::test::referenceRk4(accel, startAngles(), VecN::Zero(3), dt, std::lround(T / dt));
 }
 
 Pos tipPosition(const VecN& q) {
