@@ -160,6 +160,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
       const Pos p = kin_.position(b, force->point());
       const Vec V = kin_.pointVelocity(b, p);
       const Vec F = force->force(time_, p, V);
+      if (F.isZero(0.0)) continue;  // a push outside its window: no Jacobian to build
       external_power_ += F.dot(V);
       Jp.setZero();
       if (kk) Ap.setZero();
