@@ -50,7 +50,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   void metric(const VecN& q, MatN& W) override;
   bool correction(const VecN& q, const VecN& e, VecN& dx) override;
   void setTime(double t) override;
-  void power(const VecN& q, const VecN& v, const VecN& tau, double& work, double& friction) override;
+  void derivatives(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a, double& work,
+                   double& friction) override;
 
   // The full solve at a state (τ: n tree torques, or n + k: then also generalised forces w on the
   // payload coordinates, an external push: M_c α_c + b_c + G_c = Aᵀ f + w): α_c, η, f and θ''. Remembered: the integrator's

@@ -328,14 +328,17 @@ double ConstrainedMechanism<S, Nj, Nr, Nl>::openDepth(const VecN& q) {
 
 template <class S, int Nj, int Nr, int Nl>
 bool ConstrainedMechanism<S, Nj, Nr, Nl>::stepLocatingContacts(const StepOptions& o, const VecN& tau, VecN& q, VecN& v) {
-  if (!any_rigid_contact_) return dyn::step(*this, o, tau, q, v);
+  auto anyOpen = [&] {
+    for (std::size_t i = 0; i < released_.size(); ++i)
+      if (rigid_contact_[i] && released_[i]) return true;
+    return false;
+  };
+  if (!any_rigid_contact_ || !anyOpen()) return dyn::step(*this, o, tau, q, v);
   StepOptions sub = o;  // the part of the step still to take
   // At most a few touchdowns per step (a contact the impact reopens may come back at once): past
   // them the step ends as it lands, and the next step's updateContacts closes what it finds.
   for (int event = 0;; ++event) {
-    bool open = false;
-    for (std::size_t i = 0; i < released_.size(); ++i) open = open || (rigid_contact_[i] && released_[i]);
-    if (!open) return dyn::step(*this, sub, tau, q, v);
+    if (!anyOpen()) return dyn::step(*this, sub, tau, q, v);
     const VecN q0 = q, v0 = v;
     // The clock and the books advance with every step taken: a trial restarts them from here.
     const double t0 = time();
@@ -419,14 +422,10 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::setTime(double t) {
 }
 
 template <class S, int Nj, int Nr, int Nl>
-void ConstrainedMechanism<S, Nj, Nr, Nl>::power(const VecN& q, const VecN& v, const VecN& tau, double& work, double& friction) {
-  // Asked right after accelerations(q, v, ...): its velocity stage is at (q, v) (a remembered solve
-  // too: it is the staged state's). Restaged only if that was not so.
-  const bool state_dependent = !model_.joints.empty() || !model_.forces.empty();
-  if (!have_velocity_ || !have_position_ || (state_dependent && (q != staged_q_ || v != staged_v_))) {
-    positionStage(q);
-    velocityStage(v);
-  }
+void ConstrainedMechanism<S, Nj, Nr, Nl>::derivatives(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab,
+                                                      VecN& a, double& work, double& friction) {
+  // After accelerations() the stages are at (q, v) and the clock's time: their powers are this state's.
+  ConstrainedMechanism::accelerations(q, v, tau, stab, a);
   work = external_power_;
   for (int i = 0; i < int(tau.size()); ++i) work += tau[i] * v[i];
   friction = friction_power_;

@@ -62,8 +62,9 @@ void projectVelocities(ConstrainedSystem& sys, const VecN& q, VecN& v) {
   if (sys.correction(q, G * v, dx)) v -= dx;
 }
 
-void ConstrainedSystem::power(const VecN& q, const VecN& v, const VecN& tau, double& work, double& friction) {
-  (void)q;
+void ConstrainedSystem::derivatives(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a,
+                                    double& work, double& friction) {
+  accelerations(q, v, tau, stab, a);
   work = tau.dot(v.head(tau.size()));
   friction = 0.0;
 }
@@ -80,8 +81,7 @@ bool stepOnce(ConstrainedSystem& sys, const StepOptions& o, double dt, const Vec
   double w1, f1;
   Books& books = sys.books();
   if (o.integrator == Integrator::SemiImplicitEuler) {
-    sys.accelerations(q, v, tau, baumgarte(sys, o.drift, q, v, s), a);
-    sys.power(q, v, tau, w1, f1);
+    sys.derivatives(q, v, tau, baumgarte(sys, o.drift, q, v, s), a, w1, f1);
     v += dt * a;
     q += dt * v;
     books.work += dt * w1;
@@ -90,20 +90,16 @@ bool stepOnce(ConstrainedSystem& sys, const StepOptions& o, double dt, const Vec
     // Classic RK4 on (q, v, W, D), each stage at its own time.
     VecN a1, a2, a3, a4;
     double w2, w3, w4, f2, f3, f4;
-    sys.accelerations(q, v, tau, baumgarte(sys, o.drift, q, v, s), a1);
-    sys.power(q, v, tau, w1, f1);
+    sys.derivatives(q, v, tau, baumgarte(sys, o.drift, q, v, s), a1, w1, f1);
     const VecN v1 = v;
     const VecN q2 = q + 0.5 * dt * v1, v2 = v + 0.5 * dt * a1;
     sys.setTime(t0 + 0.5 * dt);
-    sys.accelerations(q2, v2, tau, baumgarte(sys, o.drift, q2, v2, s), a2);
-    sys.power(q2, v2, tau, w2, f2);
+    sys.derivatives(q2, v2, tau, baumgarte(sys, o.drift, q2, v2, s), a2, w2, f2);
     const VecN q3 = q + 0.5 * dt * v2, v3 = v + 0.5 * dt * a2;
-    sys.accelerations(q3, v3, tau, baumgarte(sys, o.drift, q3, v3, s), a3);
-    sys.power(q3, v3, tau, w3, f3);
+    sys.derivatives(q3, v3, tau, baumgarte(sys, o.drift, q3, v3, s), a3, w3, f3);
     const VecN q4 = q + dt * v3, v4 = v + dt * a3;
     sys.setTime(t0 + kInside * dt);
-    sys.accelerations(q4, v4, tau, baumgarte(sys, o.drift, q4, v4, s), a4);
-    sys.power(q4, v4, tau, w4, f4);
+    sys.derivatives(q4, v4, tau, baumgarte(sys, o.drift, q4, v4, s), a4, w4, f4);
     q += dt / 6.0 * (v1 + 2.0 * v2 + 2.0 * v3 + v4);
     v += dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
     books.work += dt / 6.0 * (w1 + 2.0 * w2 + 2.0 * w3 + w4);

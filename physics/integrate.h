@@ -46,9 +46,10 @@ class ConstrainedSystem {
   // The clock: the time of the state being evaluated (step() sets each stage's and leaves the step's end).
   virtual void setTime(double t) { time_ = t; }
   double time() const { return time_; }
-  // The power at (q, v), asked right after accelerations(q, v, τ, ...): (τ + Q_ext)·v into `work`, the
-  // joint friction's into `friction`. The default: τ·v, no friction.
-  virtual void power(const VecN& q, const VecN& v, const VecN& tau, double& work, double& friction);
+  // One evaluation for the integrator: a = accelerations(q, v, τ, stab), and the power at (q, v):
+  // (τ + Q_ext)·v into `work`, the joint friction's into `friction`. The default: τ·v, no friction.
+  virtual void derivatives(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a, double& work,
+                           double& friction);
   // What step() has integrated so far (see Books); a lab may reset it.
   Books& books() { return books_; }
   const Books& books() const { return books_; }
