@@ -146,13 +146,16 @@ std::string fmt(double x) {
   return buf;
 }
 
-// A reason with every number as # ("t = 0.15 s" → "t = # s"; "f_Ty" and "q1" stay): the same kind
-// of failure, whatever the numbers, is one line of the summary.
+// A reason with every number as # ("t = 0.15 s" → "t = # s"; "f_Ty", "q1" and "UTF-8" stay): the
+// same kind of failure, whatever the numbers, is one line of the summary.
 std::string reasonKind(const std::string& reason) {
   std::string out;
+  const auto wordChar = [](char ch) { return std::isalnum(static_cast<unsigned char>(ch)) || ch == '_'; };
   for (std::size_t i = 0; i < reason.size();) {
     const unsigned char c = static_cast<unsigned char>(reason[i]);
-    const bool word = !out.empty() && (std::isalnum(static_cast<unsigned char>(out.back())) || out.back() == '_');
+    // Inside a word, or a word's hyphenated part ("UTF-8", "ISO-8859-1"): a name, not a number.
+    const bool hyphenated = out.size() >= 2 && out.back() == '-' && wordChar(out[out.size() - 2]);
+    const bool word = (!out.empty() && wordChar(out.back())) || hyphenated;
     const bool sign = (c == '-' || c == '+') && i + 1 < reason.size() && std::isdigit(static_cast<unsigned char>(reason[i + 1]));
     if (word || !(std::isdigit(c) || sign)) {
       out += reason[i++];

@@ -48,6 +48,13 @@ std::string describeAgreement(const Lab& lab, const json& agreement) {
   return s;
 }
 
+std::string labDisplayName(const json& config, const std::string& lab) {
+  const auto title = config.find("title");
+  if (title == config.end() || !title->is_string() || title->get<std::string>().empty()) return lab;
+  const std::string t = title->get<std::string>();
+  return t.substr(0, t.find(": "));
+}
+
 json defaultsSubmission(const json& config, const std::string& lab) {
   json sub = {{"lab", lab}, {"gains", json::object()}};
   // Gains as numbers in double precision and options as the config sets them, as the tuning window saves them.
@@ -360,8 +367,8 @@ int openUi(const UiArgs& a) {
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
   const fs::path ui = self.parent_path() / "dynlab-ui";
   if (ec || ::access(ui.c_str(), X_OK) != 0) {
-    std::cerr << "error: dynlab ui runs " << ui.string() << ", which is missing; it is built when "
-              << "libglfw3-dev is installed (scripts/setup, then scripts/build)\n";
+    std::cerr << "error: dynlab ui runs " << ui.string() << ", which is missing: build it with `scripts/build "
+              << "dynlab-ui` (scripts/demo builds dynlab alone; the window needs libglfw3-dev, which scripts/setup installs)\n";
     return 1;
   }
   std::vector<std::string> args = {ui.string(), a.lab};

@@ -75,6 +75,8 @@ void applyScenario(LoadedLab& loaded, const std::string& scenario, const std::st
                    std::optional<double> duration);
 // {"lab", <options as the config sets them>, "gains": {every gain's value}}: the lab's defaults as a submission.
 json defaultsSubmission(const json& config, const std::string& lab);
+// The lab's name for people: its JSON "title" up to the first ": " ("Impedance control"), else its id.
+std::string labDisplayName(const json& config, const std::string& lab);
 // Where a command writes by default: out/LAB/SUB, or out/LAB/scenarios/NAME/SUB under a scenario.
 std::filesystem::path defaultOut(const std::string& lab, const std::string& scenario, const std::string& sub = "");
 

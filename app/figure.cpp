@@ -37,6 +37,7 @@ namespace {
 struct FigurePlot {
   std::vector<PlotCurve> curves;
   std::string ylabel, xlabel, title;
+  std::vector<std::pair<std::string, double>> levels;  // constant levels across (a wall), from "figures"
 };
 
 // Bad command-line input: "<command line>: OPTION VALUE: expected ...", exit code 2.
@@ -100,7 +101,7 @@ std::vector<FigurePlot> rubricPlots(const LoadedLab& loaded) {
 std::vector<FigurePlot> declaredPlots(const LoadedLab& loaded) {
   std::vector<FigurePlot> plots;
   for (const LabFigure& f : parseLabFigures(JsonView(loaded.config, loaded.config_file), loaded.lab->columns()))
-    addPlot(plots, {f.curves, f.ylabel, f.xlabel, f.title});
+    addPlot(plots, {f.curves, f.ylabel, f.xlabel, f.title, f.levels});
   return plots;
 }
 
@@ -117,8 +118,8 @@ std::vector<FigurePlot> overlayPlots(const Lab& lab, const Trace& trace) {
   return plots;
 }
 
-// A requested plot with the lab's own labels for exactly these curves (from its "figures", else its
-// rubric); without any, fillLabels derives them from the columns.
+// A requested plot with the lab's own labels and levels for exactly these curves (from its
+// "figures", else its rubric); without any, fillLabels derives them from the columns.
 FigurePlot labelled(const std::vector<PlotCurve>& curves, const std::vector<FigurePlot>& lab_plots) {
   const auto key = [](const std::vector<PlotCurve>& cs) {
     std::set<std::tuple<std::string, std::string, std::string>> k;
@@ -128,7 +129,7 @@ FigurePlot labelled(const std::vector<PlotCurve>& curves, const std::vector<Figu
   FigurePlot p{curves, "", "", ""};
   for (const auto& q : lab_plots)
     if (key(q.curves) == key(curves)) {
-      p.ylabel = q.ylabel, p.xlabel = q.xlabel;
+      p.ylabel = q.ylabel, p.xlabel = q.xlabel, p.levels = q.levels;
       break;
     }
   return p;
@@ -153,6 +154,12 @@ PlotSpec plotSpec(const Lab& lab, const FigurePlot& p, const std::string& title,
   spec.parametric = parametric(p.curves);
   spec.equal_aspect = spec.parametric && sameUnit(lab, xColumns(p.curves), yColumns(p.curves));
   spec.series = runSeries(p.curves, runs);
+  // Levels across the run's time (a plot against t), dashed black (the palette's last colour).
+  const Trace* first = runs.empty() ? nullptr : runs.front().hand ? runs.front().hand : runs.front().bullet;
+  if (!spec.parametric && first && first->rows() > 1) {
+    const double t0 = first->at(0, "t"), t1 = first->at(first->rows() - 1, "t");
+    for (const auto& [label, y] : p.levels) spec.series.push_back({label, {t0, t1}, {y, y}, PlotSeries::Style::Dashed, 6});
+  }
   return spec;
 }
 
@@ -244,7 +251,9 @@ int figure(const FigureArgs& a) {
   }
   const Lab& lab = *loads.front().lab;
   const fs::path out = a.out.empty() ? defaultOut(a.lab, a.scenario, "figures") : fs::path(a.out);
-  const std::string lab_title = a.scenario.empty() ? a.lab : a.lab + " (" + a.scenario + ")";
+  // Titles name the lab as its handout does ("Impedance control"), not by its id.
+  const std::string shown = labDisplayName(loads.front().config, a.lab);
+  const std::string lab_title = a.scenario.empty() ? shown : shown + " (" + a.scenario + ")";
   try {
     // A bar on a terminal for each stage (nothing otherwise): the runs, then the figures.
     auto run = [&](const Lab& l, Engine engine) {
@@ -327,7 +336,8 @@ int figure(const FigureArgs& a) {
       for (const auto* r : {&hands[i], &bullets[i]})
         if (*r && !(*r)->failure.empty())
           status = (runs[i].name.empty() ? "" : runs[i].name + ", ") + (r == &hands[i] ? "hand" : "bullet") + ": " + (*r)->failure;
-    std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n", termText(lab_title).c_str(), lab.duration(),
+    std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n",
+                termText(a.scenario.empty() ? a.lab : a.lab + " (" + a.scenario + ")").c_str(), lab.duration(),
                 lab.dt(), a.engine.c_str(), status.c_str());
     for (const auto& name : written) std::printf("  %s\n", (out / name).c_str());
     for (const auto& why : skipped) std::printf("  not written: %s\n", termText(why).c_str());

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <sstream>
 
@@ -244,6 +245,26 @@ struct Handout {
     return columns.size() > 1 ? columns[1] : "t";
   }
 
+  // A map over the first two gains' whole ranges, 9 points each, that can share a map (the options
+  // the map sets for each, "map"/"gain_options", agree): a command that runs as printed.
+  std::string mapAxes() const {
+    const json& gains = config.at("gains");
+    const json options = config.contains("map") ? config["map"].value("gain_options", json::object()) : json::object();
+    const auto agree = [&](const std::string& a, const std::string& b) {
+      if (!options.contains(a) || !options.contains(b)) return true;
+      for (const auto& [key, choice] : options[a].items())
+        if (options[b].contains(key) && options[b][key] != choice) return false;
+      return true;
+    };
+    const auto axis = [&](const std::string& flag, const std::string& name) {
+      return flag + name + "=" + num(gains.at(name).at("min")) + ":" + num(gains.at(name).at("max")) + ":9";
+    };
+    for (auto a = gains.begin(); a != gains.end(); ++a)
+      for (auto b = std::next(a); b != gains.end(); ++b)
+        if (agree(a.key(), b.key())) return axis(" --x ", a.key()) + axis(" --y ", b.key());
+    return " --x GAIN=from:to:9 --y GAIN=from:to:9";
+  }
+
   std::string howTo() const {
     const std::string L = lab;
     return "## Run, tune, self-grade\n\n"
@@ -253,7 +274,7 @@ struct Handout {
            "| tune it in a window (sliders, live plots, screening) and save it | `dynlab ui " + L + " --gains my_gains.json` |\n"
            "| grade it exactly as the autograder will | `dynlab grade my_gains.json --lab " + L + "` |\n"
            "| plot any trace column | `dynlab figure " + L + " --gains my_gains.json --plot " + plotColumns() + "` |\n"
-           "| see where gains are stable | `dynlab map " + L + " --x GAIN=a:b:n --y GAIN=a:b:n --sim` |\n"
+           "| see where gains are stable (any two gains, NAME=from:to:points) | `dynlab map " + L + mapAxes() + " --sim` |\n"
            "| check the format | `dynlab schema " + L + "` |\n\n"
            "`dynlab grade` writes `out/grade/report.html` with every test, its plot and the screening notes: the score it "
            "prints is the score you will get (the grader is deterministic).\n\n";

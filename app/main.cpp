@@ -13,6 +13,7 @@
 #include "app/check_results.h"
 #include "app/commands.h"
 #include "app/course.h"
+#include "app/model.h"
 #include "app/submission_file.h"
 #include "labs/utf8.h"
 
@@ -211,6 +212,7 @@ int dispatch(int argc, char** argv) {
   b->add_option("--out", bench_args.out, "--scaling: output directory (default: out/bench)");
 
   CourseCommands course(cli);  // dynlab handout, dynlab map (app/course.h)
+  ModelCommand model_file(cli);  // dynlab model FILE (app/model.h)
 
   requireFinite(cli);
   try {
@@ -231,6 +233,7 @@ int dispatch(int argc, char** argv) {
   if (*l) return lessons(les);
   if (*b) return bench_args.scaling ? benchScaling(bench_args) : bench(bench_args);
   if (course.chosen()) return course.run();
+  if (model_file.chosen()) return model_file.run();
   if (*u) {
     ui.extra = u->remaining();
     return openUi(ui);

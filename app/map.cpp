@@ -16,6 +16,7 @@
 #include <set>
 #include <thread>
 
+#include "app/commands.h"
 #include "app/course.h"
 #include "app/map_plot.h"
 #include "app/output.h"
@@ -207,6 +208,28 @@ std::string csv(const Grid& g, const std::vector<Point>& points) {
   return out;
 }
 
+// The legend's word for the simulated cells that did not complete, from why they stopped: a
+// lab's own watchdog says it ("stopped: the grasp slipped at ..." → "the grasp slipped"), any
+// other failure is an unstable run.
+std::string stoppedLabel(const std::vector<Point>& points) {
+  std::set<std::string> kinds;
+  bool unstable = false;
+  for (const Point& p : points) {
+    if (p.sim_stable != 0) continue;
+    const std::string& f = p.sim_failure;
+    if (f.rfind("stopped: ", 0) != 0) {
+      unstable = true;
+      continue;
+    }
+    const std::size_t at = f.find(" at ", 9);
+    kinds.insert(f.substr(9, at == std::string::npos ? std::string::npos : at - 9));
+  }
+  std::string lab_words;
+  for (const auto& k : kinds) lab_words += (lab_words.empty() ? "" : " or ") + k;
+  if (lab_words.empty()) return "unstable (watchdog)";
+  return unstable ? "unstable, or stopped: " + lab_words : "stopped: " + lab_words;
+}
+
 double seconds(std::chrono::steady_clock::time_point since) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
 }
@@ -287,12 +310,12 @@ int map(const MapArgs& a) {
         s += ", " + key + " " + g.config.at(json::json_pointer(o.at("target").get<std::string>())).get<std::string>();
       return s;
     }() : "";
-    pic.title = a.lab + (a.sim ? ": simulated, " + fmtConfigNumber(g.config["simulation"]["duration"].get<double>()) + " s per point" : ": screening")
+    pic.title = labDisplayName(g.config, a.lab) + (a.sim ? ": simulated, " + fmtConfigNumber(g.config["simulation"]["duration"].get<double>()) + " s per point" : ": screening")
                 + law;
     pic.xlabel = g.x.label();
     pic.ylabel = g.y.label();
     pic.stable_label = a.sim ? "stable (run completes)" : "stable";
-    pic.unstable_label = a.sim ? "unstable (watchdog)" : "unstable";
+    pic.unstable_label = a.sim ? stoppedLabel(points) : "unstable";
     pic.boundary_label = "screening boundary";
     if (!g.metric.empty()) {
       const auto docs = parseMetricDocs(JsonView(g.config, g.file));
@@ -306,8 +329,8 @@ int map(const MapArgs& a) {
     std::printf("dynlab map %s: %d × %d points (%s × %s), %s in %.1f s%s\n", a.lab.c_str(), g.x.n, g.y.n, g.x.name.c_str(),
                 g.y.name.c_str(), a.sim ? "screened and simulated" : "screened", took,
                 a.sim ? (" on " + std::to_string(jobs) + " threads").c_str() : "");
-    std::printf("  %d stable, %d unstable%s\n", stable, int(points.size()) - stable,
-                a.sim ? (" (simulated); the screening agrees at " + std::to_string(agree) + " points").c_str() : "");
+    std::printf("  %d stable, %d %s%s\n", stable, int(points.size()) - stable, pic.unstable_label.c_str(),
+                a.sim ? ("; the screening agrees at " + std::to_string(agree) + " points").c_str() : "");
     std::printf("  map   %s\n", out.c_str());
     if (!a.data.empty()) std::printf("  data  %s\n", a.data.c_str());
     return 0;

@@ -215,7 +215,10 @@ void draw(const MapPicture& m, int width_px, int height_px) {
   };
   if (!values) add(m.stable_label, PL_LEGEND_COLOR_BOX, kStable, kInk);
   add(values ? m.unstable_label + " (no value)" : m.unstable_label, PL_LEGEND_COLOR_BOX, values ? kNoValue : kUnstable, kInk);
-  if (!m.boundary.empty()) add(m.boundary_label, PL_LEGEND_LINE, kInk, kInk);
+  // The boundary is listed only where it is drawn: where the field changes sign on the grid.
+  const bool crosses = std::any_of(m.boundary.begin(), m.boundary.end(), [](double b) { return b > 0; }) &&
+                       std::any_of(m.boundary.begin(), m.boundary.end(), [](double b) { return b < 0; });
+  if (crosses && m.xs.size() > 1 && m.ys.size() > 1) add(m.boundary_label, PL_LEGEND_LINE, kInk, kInk);
 
   // The right-hand column holds the legend and the labelled colour bar at their measured widths:
   // each at most 40 % of the page (longer texts are drawn smaller), the frame takes the rest.

@@ -47,13 +47,16 @@ namespace {
 // its InputError) or an internal error, whose details go to the staff (extra_data, the terminal
 // and report.md), not into the student's feedback.
 GradeOutcome failedOutcome(const std::string& full_message, const InputError* e) {
-  // What the input said is echoed clipped (a 900 KB key is not quoted whole in any output).
+  // What the input said is echoed clipped (a 900 KB key is not quoted whole in any output); the
+  // student's feedback names their file by its name alone (never the grader's folders).
   const std::string message = clipText(full_message, 600);
+  const std::string shown =
+      e ? clipText(InputError(std::filesystem::path(e->file()).filename().string(), e->path(), e->expected()).what(), 600) : message;
   GradeOutcome out;
   out.input_error = e != nullptr;
   out.internal_error = e == nullptr;
   const std::string feedback =
-      e ? "**Your submission could not be graded.**\n\n" + mdText(message) + "\n\nFix it and resubmit."
+      e ? "**Your submission could not be graded.**\n\n" + mdText(shown) + "\n\nFix it and resubmit."
         : "**The grader failed while grading your submission.** This is an internal error, not a problem with your "
           "submission, and no score was given. Please resubmit later, and tell the course staff if it happens again.";
   out.results = {{"score", 0.0},
@@ -68,7 +71,7 @@ GradeOutcome failedOutcome(const std::string& full_message, const InputError* e)
   // The terminal: the one-line error goes to stderr (dynlab grade), the report says what kind it was.
   out.error = termText(e ? message : "internal error: " + message);
   out.report = std::string("Score: 0 (not graded") + (e ? "" : ": internal error") + ")\n";
-  out.markdown = std::string("# dynlab grade\n\n**Not graded") + (e ? "" : " (internal error)") + ":** " + mdText(message) + "\n";
+  out.markdown = std::string("# dynlab grade\n\n**Not graded") + (e ? "" : " (internal error)") + ":** " + mdText(shown) + "\n";
   out.html = renderHtml(out.markdown);
   return out;
 }

@@ -107,8 +107,8 @@ std::optional<MetricDoc> screeningMetricDoc(const std::string& metric, const std
         "a short margin comes from a high loop gain (a fast crossover): lower the loop's gain, the margin grows "
         "roughly as 1/gain"}},
       {"_max_real_pole",
-       {"the largest real part of the closed-loop poles (the delay as a Padé approximant): above 0 the loop "
-        "is unstable",
+       {"the largest real part of the closed-loop poles (a sampled loop: ln z / dt of its discrete poles, hold "
+        "and delay in steps included; else the delay as a Padé approximant): above 0 the loop is unstable",
         "1/s", "", "a slow or unstable pole: raise the loop's proportional gain, or lower it if the delay destabilises it"}},
       {"_damping",
        {"the smallest damping ratio ζ = −Re p / |p| of the closed-loop poles (0 when the loop is not stable "

@@ -192,7 +192,7 @@ std::vector<LabFigure> parseLabFigures(const JsonView& config, const std::vector
   const JsonView figures = config["figures"];
   for (std::size_t i = 0, n = figures.size(1, 20); i < n; ++i) {
     const JsonView f = figures.at(i);
-    f.onlyKeys({"plot", "title", "xlabel", "ylabel"});
+    f.onlyKeys({"plot", "title", "xlabel", "ylabel", "levels"});
     const JsonView plot = f["plot"];
     LabFigure fig{parsePlotCurves(plot.string(), columns, plot.file(), plot.path()), "", "", ""};
     // Titles and labels are drawn on one line: short, and no control characters.
@@ -204,6 +204,29 @@ std::vector<LabFigure> parseLabFigures(const JsonView& config, const std::vector
       return s;
     };
     fig.title = text("title"), fig.xlabel = text("xlabel"), fig.ylabel = text("ylabel");
+    if (f.has("levels")) {
+      const JsonView levels = f["levels"];
+      // A pointer into the config (this file's, scenario patches applied) and the value there.
+      const auto target = [&](const JsonView& ptr) {
+        const std::string p = ptr.string();
+        try {
+          const json::json_pointer at(p);
+          if (!p.empty() && config.raw().contains(at)) return JsonView(config.raw().at(at), config.file(), p);
+        } catch (const json::exception&) {
+        }
+        ptr.fail("expected a JSON pointer to a value of the lab's config, e.g. \"/environment/wall/x\"");
+      };
+      for (std::size_t k = 0, m = levels.size(0, 5); k < m; ++k) {
+        const JsonView l = levels.at(k);
+        l.onlyKeys({"label", "at", "minus", "when"});
+        double y = target(l["at"]).number();
+        if (l.has("minus")) y -= target(l["minus"]).number();
+        const std::string label = l["label"].string();
+        if (label.empty() || label.size() > 200 || std::any_of(label.begin(), label.end(), [](unsigned char c) { return c < 0x20 || c == 0x7F; }))
+          l["label"].fail("expected one line of 1 to 200 bytes, without control characters");
+        if (!l.has("when") || target(l["when"]).boolean()) fig.levels.emplace_back(label, y);
+      }
+    }
     out.push_back(fig);
   }
   return out;

@@ -74,10 +74,14 @@ bool sameUnit(const Lab& lab, const std::vector<std::string>& xs, const std::vec
 struct LabFigure {
   std::vector<PlotCurve> curves;
   std::string title, xlabel, ylabel;  // empty: derived (the lab and columns; columns with units)
+  std::vector<std::pair<std::string, double>> levels;  // constant y levels drawn across (label, y)
 };
 
 // Reads config["figures"] (absent: none): an array of at most 20 objects with "plot" (the --plot
-// grammar above) and optional "title", "xlabel", "ylabel" strings (one line, at most 200 bytes).
+// grammar above) and optional "title", "xlabel", "ylabel" strings (one line, at most 200 bytes),
+// and optional "levels": at most 5 {"label", "at", "minus", "when"}, a level y = config[at] −
+// config[minus] (JSON pointers to numbers; "minus" optional) drawn only when config[when] (a
+// pointer to a boolean, optional) is true, e.g. a wall that only some scenarios enable.
 // Throws InputError naming the file and the JSON path ("/figures/0/plot").
 std::vector<LabFigure> parseLabFigures(const JsonView& config, const std::vector<std::string>& columns);
 

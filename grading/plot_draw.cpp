@@ -20,6 +20,7 @@ constexpr double kMmPerPx = 25.4 / 72.0;  // the cairo devices' resolution: 1 px
 constexpr double kHuge = 1e100;           // |values| beyond this are clamped (PLplot needs finite spans)
 constexpr double kCharHeightPx = 9.0;     // PLplot character height: ~12 px tick labels, 15 px title
 constexpr double kGlyphWidth = 0.7;       // a generous average glyph width, in character heights
+constexpr double kTitleGlyphWidth = 0.85; // the bold title's (measured ~0.78 on long titles)
 constexpr double kMaxRightLegend = 0.3;   // wider legends (fraction of the page) go below the frame
 constexpr double kXTicks = 8, kYTicks = 6;  // about this many tick intervals per axis
 constexpr double kRough = 40;             // a series crossing its range this often is noise-like
@@ -33,6 +34,17 @@ constexpr Rgb kPalette[] = {{0, 114, 178}, {213, 94, 0},   {0, 158, 115}, {204, 
                             {230, 159, 0}, {86, 180, 233}, {0, 0, 0}};
 constexpr int kPaletteSize = sizeof kPalette / sizeof kPalette[0];
 constexpr PLINT kFaint0 = kPalette0 + kPaletteSize;
+
+// Characters (code points) of UTF-8 text, and its first n of them.
+std::size_t utf8Chars(const std::string& s) {
+  return static_cast<std::size_t>(std::count_if(s.begin(), s.end(), [](char c) { return (static_cast<unsigned char>(c) & 0xC0) != 0x80; }));
+}
+std::string utf8Prefix(const std::string& s, std::size_t n) {
+  std::size_t at = 0;
+  for (std::size_t seen = 0; at < s.size(); ++at)
+    if ((static_cast<unsigned char>(s[at]) & 0xC0) != 0x80 && seen++ == n) break;
+  return s.substr(0, at);
+}
 
 // PLplot reads '#' as its escape character; "##" is a literal '#'.
 std::string plText(const std::string& s) {
@@ -444,7 +456,7 @@ PlotLayout draw(const Prepared& p, int width_px, int height_px) {
     rows = (rows + columns - 1) / columns;
   }
   const double legend_below = legend.empty() || legend_right ? 0.0 : gap + legend.heightMm(rows);
-  double bottom = 0.6 * ch + axis_below + legend_below;
+  double bottom = 1.0 * ch + axis_below + legend_below;  // the x label's descenders clear the page's edge
   double top = spec.title.empty() ? 1.2 * ch : 3.0 * ch;
   // Equal aspect: widen the data to the frame's shape, re-tick (labels may change width), then
   // trim the frame about its middle so a unit is exactly as long along x as along y.
@@ -501,8 +513,20 @@ PlotLayout draw(const Prepared& p, int width_px, int height_px) {
   if (!spec.xlabel.empty()) plmtex("b", 3.3, 0.5, 0.5, plText(spec.xlabel).c_str());
   if (!spec.ylabel.empty()) plmtex("l", ytick_w * kGlyphWidth + 2.2, 0.5, 0.5, plText(spec.ylabel).c_str());
   if (!spec.title.empty()) {
-    plschr(ch, 1.25);
-    plmtex("t", 1.2, 0.5, 0.5, ("#<bold/>" + plText(spec.title)).c_str());
+    // Centred on the page (it may be wider than the frame), shrunk to fit it down to the tick
+    // labels' size, and beyond that cut at the end with "…": never cut by the page's edge.
+    const double room = page_w - 1.2 * ch, per_char = kTitleGlyphWidth * ch;
+    std::string title = spec.title;
+    std::size_t chars = utf8Chars(title);
+    const double s = std::clamp(room / (per_char * double(chars)), 1.0, 1.25);
+    if (per_char * s * double(chars) > room) {
+      const std::size_t keep = static_cast<std::size_t>(std::max(1.0, room / (per_char * s) - 1));
+      title = utf8Prefix(title, keep);
+      while (!title.empty() && (title.back() == ' ' || title.back() == ',')) title.pop_back();
+      title += "…";
+    }
+    plschr(ch, s);
+    plmtex("t", 1.2 * 1.25 / s, (0.5 * page_w - left) / frame_w, 0.5, ("#<bold/>" + plText(title)).c_str());
     plschr(ch, 1.0);
   }
 

@@ -125,7 +125,8 @@ json resultsJson(const GradeReport& r) {
                      {"number", std::to_string(i + 1)},
                      {"score", g.score},
                      {"max_score", g.test.points},
-                     {"status", shortOfFull(g) ? "failed" : "passed"},
+                     // Gradescope paints "failed" red: only a test that earned nothing is (0.94 / 1 is not).
+                     {"status", g.score > 1e-9 ? "passed" : "failed"},
                      {"output", renderHtmlFragment(testText(r, g)) +
                                     (r.inline_plots && !g.plot_png.empty() ? inlinePlot(g, i, budget) : "")},
                      {"output_format", "html"},

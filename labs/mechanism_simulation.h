@@ -3,9 +3,12 @@
 //   (q, v) at t_k → τ = controller(t_k, q, v) → E(q, v), |φ(q)| by the hand model (both engines alike)
 //   → the engine steps with τ held, giving the constraint forces of the step (hand: eq. (2) solved at the
 //     step's start, the solve its first RK4 stage reuses; Bullet: impulses over the step / dt)
-//   → the lab writes the trace row → work += τ·(θ'_k + θ'_k+1)/2 dt (+ the joint friction's power, by
-//     the trapezoid: what friction dissipates is work done on the mechanism) → the controller observes
+//   → the lab writes the trace row (work: the engine's books up to t_k: the work of τ and of the external
+//     forces plus the joint friction's, integrated by the hand engine with the motion's own RK4 stages,
+//     estimated by Bullet's as force held × displacement per step) → the controller observes
 //   → a non-finite state or row ends the run with a plain sentence.
+// The engine's clock is set to t_k = k dt before each step: external forces (mechanism.h) are functions
+// of time and motion that the engines evaluate inside the step, unlike τ, which the controller samples.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -30,6 +33,10 @@ class MechanismEngine {
   // The force of each constraint over the last step (body a on body b, world axes at its point).
   virtual const std::vector<VecN>& forces() const = 0;
   virtual std::string failure() const { return {}; }
+  // The time of the state the next step starts from.
+  virtual void setTime(double t) = 0;
+  // The work done on the mechanism since the start (integrate.h Books): of τ and the external forces, of friction.
+  virtual Books books() const = 0;
 };
 
 // The hand-written engine: eq. (2)/(3) through the generic mechanism M, integrated by physics/integrate.
@@ -40,18 +47,21 @@ class HandEngine final : public MechanismEngine {
       : mech_(mech), options_(options), q_(std::move(q0)), v_(std::move(v0)), forces_(mech.model().constraints.size()) {}
   void state(VecN& q, VecN& v) const override { q = q_, v = v_; }
   bool step(const VecN& tau, bool with_forces) override {
-    // Unilateral contacts close (with an impact on v) or open between steps.
+    // Unilateral contacts close (with an impact on v) or open at the step's start ...
     mech_.updateContacts(q_, v_, tau);
     // The constraint forces at the step's start: the solve the first RK4 stage reuses.
     if (with_forces) {
       const auto sol = mech_.solve(q_, v_, tau);
       for (std::size_t i = 0; i < forces_.size(); ++i) forces_[i] = mech_.constraintForce(int(i), sol);
     }
-    if (!dyn::step(mech_, options_, tau, q_, v_)) failure_ = "the constraint projection failed";
+    // ... and a touchdown inside the step is located and closed there (the step retaken to it).
+    if (!mech_.stepLocatingContacts(options_, tau, q_, v_)) failure_ = "the constraint projection failed";
     return failure_.empty();
   }
   const std::vector<VecN>& forces() const override { return forces_; }
   std::string failure() const override { return failure_; }
+  void setTime(double t) override { mech_.setTime(t); }
+  Books books() const override { return mech_.books(); }
 
  private:
   M& mech_;
@@ -70,16 +80,19 @@ class BulletEngine final : public MechanismEngine {
   void state(VecN& q, VecN& v) const override { world_.state(q, v); }
   bool step(const VecN& tau, bool with_forces) override {
     (void)with_forces;  // Bullet's impulses come with every step
-    world_.step(tau);
+    world_.step(tau, t_);
     for (std::size_t i = 0; i < forces_.size(); ++i) forces_[i] = world_.constraintForce(int(i));
     return true;
   }
   const std::vector<VecN>& forces() const override { return forces_; }
+  void setTime(double t) override { t_ = t; }
+  Books books() const override { return world_.books(); }
   std::string describe() const { return world_.describe(); }
 
  private:
   bullet::BulletMechanism<S> world_;
   std::vector<VecN> forces_;
+  double t_ = 0;
 };
 
 // Everything the lab's trace row and sensors may read about one step.
@@ -90,7 +103,7 @@ struct StepRecord {
   const VecN& v;                     // (θ', v_c) at t
   const VecN& tau;                   // the torque held over the step
   const std::vector<VecN>& forces;   // each constraint's force over the step
-  double energy, residual, work;     // E(q, v), |φ(q)|∞ (velocity-level kinds: also |Jθ' − Av_c|∞), ∫ (τ + τ_friction)·θ' dt up to t
+  double energy, residual, work;     // E(q, v), |φ(q)|∞ (velocity-level kinds: also |Jθ' − Av_c|∞), W + D up to t (Books)
 };
 
 // The lab's part of a run: its control law, its trace row, its sensors.
@@ -127,14 +140,15 @@ class MechanismSimulation final : public Simulation {
     // |φ(q)|, and for velocity-level kinds (rolling) |J θ' − A v_c| as well: they have no φ.
     const double energy = model_->energy(q_, v_);
     const double residual = model_->holonomic() ? model_->residual(q_) : model_->residual(q_, v_);
-    advance(true);
-    const StepRecord r{engine_, t, q_, v_, tau_, stepper_->forces(), energy, residual, work_};
+    const double work = work_;
+    advance(true, t);
+    const StepRecord r{engine_, t, q_, v_, tau_, stepper_->forces(), energy, residual, work};
     hooks_->row(r, row);
-    // The next state, the work of τ over the step (trapezoid), then what the sensors saw.
+    // The next state, the books up to it, then what the sensors saw.
     VecN q1, v1;
     stepper_->state(q1, v1);
-    const int n = int(tau_.size());
-    work_ += (tau_.dot(0.5 * (v_.head(n) + v1.head(n))) + 0.5 * (frictionPower(v_) + frictionPower(v1))) * dt_;
+    const Books books = stepper_->books();
+    work_ = books.work + books.friction;
     hooks_->observe(r);
     if (failure_.empty())
       if (std::string why = hooks_->stop(r); !why.empty()) failure_ = std::move(why);
@@ -153,7 +167,7 @@ class MechanismSimulation final : public Simulation {
 
   bool advanceEngine() override {
     if (k_ >= steps_ || !failure_.empty()) return false;
-    advance(false);
+    advance(false, double(k_) * dt_);
     stepper_->state(q_, v_);
     ++k_;
     return true;
@@ -163,18 +177,8 @@ class MechanismSimulation final : public Simulation {
   M& model() { return *model_; }
 
  private:
-  // The power of the joints' viscous and Coulomb friction at rates v (≤ 0).
-  double frictionPower(const VecN& v) const {
-    double p = 0;
-    const auto& joints = model_->model().joints;
-    for (std::size_t i = 0; i < joints.size(); ++i) {
-      const JointProperties& j = joints[i];
-      const double w = j.coulomb_width > 0 ? j.coulomb_width : 1e-12, qd = v[Eigen::Index(i)];
-      p -= (j.viscous * qd + j.coulomb * std::clamp(qd / w, -1.0, 1.0)) * qd;
-    }
-    return p;
-  }
-  void advance(bool with_forces) {
+  void advance(bool with_forces, double t) {
+    stepper_->setTime(t);
     if (!stepper_->step(tau_, with_forces) && failure_.empty()) failure_ = stepper_->failure();
   }
   Engine engine_;

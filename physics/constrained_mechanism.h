@@ -1,8 +1,10 @@
 // The generic constrained mechanism: any MechanismModel (mechanism.h) through the one solve of
 // eqs. (2)/(3) (constrained_solve.h), as a ConstrainedSystem for the integrators (integrate.h).
 //   position stage (θ, x_c):  tree transforms, M (CRBA), every constraint's φ, J, A; M_c; factor (2)
-//   velocity stage (θ', v_c): tree velocities, h = Cθ' + G + K(θ − θ_r) + B θ' + F_c sat(θ'/w) (RNEA),
-//                             every constraint's bias J'θ' − A'v_c, payload b_c + G_c
+//   velocity stage (θ', v_c): tree velocities, h = Cθ' + G + K(θ − θ_r) + B θ' + F_c tanh(θ'/w) (RNEA),
+//                             every constraint's bias J'θ' − A'v_c, payload b_c + G_c, the external
+//                             forces at the clock's time (h −= J_Pᵀ F, payloads' share likewise) and
+//                             the power of those forces and of friction (the books: integrate.h)
 //   solve:                    α_c, η (the constraint forces) and θ'' together
 // Both stages are cached: the projection, the trace row and the next step's first RK4 stage revisit
 // the same configuration, and the trace row's solve is the first stage's.
@@ -47,6 +49,9 @@ class ConstrainedMechanism : public ConstrainedSystem {
   void baumgarteTerm(const VecN& q, const VecN& v, double zeta, double omega, VecN& s) override;
   void metric(const VecN& q, MatN& W) override;
   bool correction(const VecN& q, const VecN& e, VecN& dx) override;
+  void setTime(double t) override;
+  void derivatives(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a, double& work,
+                   double& friction) override;
 
   // The full solve at a state (τ: n tree torques, or n + k: then also generalised forces w on the
   // payload coordinates, an external push: M_c α_c + b_c + G_c = Aᵀ f + w): α_c, η, f and θ''. Remembered: the integrator's
@@ -69,6 +74,13 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // (2) for impulses), then opens closed ones whose solved η would pull, one at a time (most negative
   // first), until every closed one presses. Returns how many changed; v changes only on impact.
   int updateContacts(const VecN& q, VecN& v, const VecN& tau);
+  // One integrator step (dyn::step) with its touchdowns located: when an open rigid unilateral contact
+  // ends the step past its plane (φ > 0), the step is retaken from its start to the crossing — the
+  // sub-step h with φ(h) = 0, by regula falsi (Illinois) on h, landing within kTouchdownDepth past the
+  // plane — the contact closed there by updateContacts (its plastic impact, then the lift-off check),
+  // and the rest of the step taken from there. A step without a crossing costs one look at φ of the
+  // open contacts at its end (the projection's own position stage). False if the integrator failed.
+  bool stepLocatingContacts(const StepOptions& options, const VecN& tau, VecN& q, VecN& v);
   // The impulse (N·s; as constraintForce: body a on body b, world axes at its point) that the plastic
   // impact of the last updateContacts gave constraint i: ∫ f dt over the impact, P = Λ_n v_n for one
   // contact alone; zero when that call closed nothing (or the solve was singular). A lab that reports a
@@ -111,6 +123,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   void treeStage(const VecN& q);
   // The solve at a state; without with_qdd, α_c, η and f only (θ'' left unset).
   Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd = true);
+  // The deepest φ (= −gap) of the open rigid unilateral contacts at q, −∞ if none is open.
+  double openDepth(const VecN& q);
   // Forget every cached stage (the released rows changed).
   void invalidate() { have_position_ = have_velocity_ = have_last_ = false; }
 
@@ -138,13 +152,17 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // (φ, J, A: gaps and compliant forces read them), and the compliant forces of the velocity stage.
   std::vector<char> released_;
   std::vector<char> compliant_, rigid_contact_;  // per constraint: a compliant contact; a rigid unilateral one
-  bool any_released_kind_ = false, any_compliant_ = false;
+  bool any_released_kind_ = false, any_compliant_ = false, any_rigid_contact_ = false;
   VecN phi_full_;
   MatN J_full_, A_full_;
   VecN compliant_eta_;   // per row: the compliant force η (0 elsewhere)
   VecN compliant_bc_;    // payload side: −Aᵀ η of the compliant rows
   std::vector<Vec> impact_;  // per constraint: the last updateContacts' impact impulse
   bool any_impact_ = false;
+  // External forces (at the velocity stage's time): the payloads' share Aᵀ F of b_c + G_c, their power
+  // F·V_P; and the joint friction's power.
+  VecN external_bc_;
+  double external_power_ = 0, friction_power_ = 0;
 };
 
 }  // namespace dyn

@@ -26,6 +26,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
     rigid_contact_.push_back(char(c->unilateral() && !c->compliant()));
     any_compliant_ = any_compliant_ || c->compliant();
     any_released_kind_ = any_released_kind_ || released;
+    any_rigid_contact_ = any_rigid_contact_ || rigid_contact_.back();
   }
   auto fits = [](int fixed, int actual) { return fixed == Eigen::Dynamic || fixed == actual; };
   if (!fits(Nj, n()) || !fits(Nr, rows_) || !fits(Nl, k()))
@@ -132,17 +133,42 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   // Link velocities, each link's velocity-product acceleration and h = Cθ' + G, in world coordinates.
   problem_.h.resize(nn);
   biasForcesWorld(model_.tree, data_, qd, problem_.h);
-  // Joint springs and friction join h.
+  // Joint springs and friction join h; friction's power for the books.
+  friction_power_ = 0.0;
   if (!model_.joints.empty())
     for (int i = 0; i < nn; ++i) {
       const JointProperties& j = model_.joints[std::size_t(i)];
-      const double w = j.coulomb_width > 0 ? j.coulomb_width : 1e-12;
-      problem_.h[i] += j.stiffness * (staged_q_[i] - j.rest) + j.viscous * qd[i] + j.coulomb * std::clamp(qd[i] / w, -1.0, 1.0);
+      const double f = j.friction(qd[i]);
+      problem_.h[i] += j.stiffness * (staged_q_[i] - j.rest) + f;
+      friction_power_ -= f * qd[i];
     }
   // Payload rates: the free coordinates' rates, zero for the held ones.
   for (std::size_t i = 0, off = std::size_t(nn); i < model_.payloads.size(); ++i)
     for (std::size_t c = 0; c < 3; ++c)
       kin_.payload_rate[i][Eigen::Index(c)] = model_.payloads[i].free[c] ? v[Eigen::Index(off++)] : 0.0;
+  // External forces at the clock's time: Q = [J, −A]ᵀ F through the point's Jacobian (h −= JᵀF on the
+  // tree, b_c + G_c += AᵀF on the payloads), and their power F·V_P.
+  external_power_ = 0.0;
+  if (!model_.forces.empty()) {
+    const int kk = k();
+    external_bc_.setZero(kk);
+    MatN Jp(S::kDim, nn), Ap(S::kDim, kk);
+    std::array<bool, S::kDim> all;
+    all.fill(true);
+    for (const auto& force : model_.forces) {
+      const BodyRef b = force->body();
+      const Pos p = kin_.position(b, force->point());
+      const Vec V = kin_.pointVelocity(b, p);
+      const Vec F = force->force(time_, p, V);
+      if (F.isZero(0.0)) continue;  // a push outside its window: no Jacobian to build
+      external_power_ += F.dot(V);
+      Jp.setZero();
+      if (kk) Ap.setZero();
+      kin_.addPointJacobian(b, p, all, 1.0, 0, Jp, Ap);
+      problem_.h.noalias() -= Jp.transpose() * F;
+      if (kk) external_bc_.noalias() += Ap.transpose() * F;
+    }
+  }
   // J'θ' − A'v_c of every constraint.
   VecN bias(rows_);
   for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->bias(kin_, offsets_[i], bias);
@@ -190,6 +216,7 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
   if (tau.size() == n() + k()) problem_.bc_Gc = gravity_bc_ - tau.tail(k());
   else problem_.bc_Gc = gravity_bc_;
   if (any_compliant_ && k()) problem_.bc_Gc += compliant_bc_;
+  if (!model_.forces.empty() && k()) problem_.bc_Gc += external_bc_;
   if (stab) problem_.stab = *stab;
   else problem_.stab.resize(0);
   Solution s;
@@ -287,6 +314,74 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
   return changes;
 }
 
+// m: how far past its plane a located touchdown may land (the root-finder's tolerance on φ).
+constexpr double kTouchdownDepth = 1e-13;
+
+template <class S, int Nj, int Nr, int Nl>
+double ConstrainedMechanism<S, Nj, Nr, Nl>::openDepth(const VecN& q) {
+  positionStage(q);
+  double depth = -INFINITY;
+  for (std::size_t i = 0; i < released_.size(); ++i)
+    if (rigid_contact_[i] && released_[i]) depth = std::max(depth, phi_full_[offsets_[i]]);
+  return depth;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+bool ConstrainedMechanism<S, Nj, Nr, Nl>::stepLocatingContacts(const StepOptions& o, const VecN& tau, VecN& q, VecN& v) {
+  auto anyOpen = [&] {
+    for (std::size_t i = 0; i < released_.size(); ++i)
+      if (rigid_contact_[i] && released_[i]) return true;
+    return false;
+  };
+  if (!any_rigid_contact_ || !anyOpen()) return dyn::step(*this, o, tau, q, v);
+  StepOptions sub = o;  // the part of the step still to take
+  // At most a few touchdowns per step (a contact the impact reopens may come back at once): past
+  // them the step ends as it lands, and the next step's updateContacts closes what it finds.
+  for (int event = 0;; ++event) {
+    if (!anyOpen()) return dyn::step(*this, sub, tau, q, v);
+    const VecN q0 = q, v0 = v;
+    // The clock and the books advance with every step taken: a trial restarts them from here.
+    const double t0 = time();
+    const Books b0 = books();
+    if (!dyn::step(*this, sub, tau, q, v)) return false;
+    if (event == 3 || !(openDepth(q) > 0.0)) return true;
+    // A crossing inside the step: bracket it from the start (φ < 0 there, else nothing to locate).
+    double lo = 0.0, f_lo = openDepth(q0), hi = sub.dt, f_hi = openDepth(q), depth = f_hi;
+    if (!(f_lo < 0.0)) return true;
+    VecN q_hi = q, v_hi = v;
+    double t_hi = time();
+    Books b_hi = books();
+    int side = 0;  // Illinois: the end kept twice in a row has its value halved (depth: its true φ)
+    for (int it = 0; it < 100 && depth > kTouchdownDepth && hi - lo > 1e-15 * o.dt; ++it) {
+      double h = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+      if (!(h > lo && h < hi)) h = 0.5 * (lo + hi);
+      StepOptions trial = o;
+      trial.dt = h;
+      VecN qt = q0, vt = v0;
+      setTime(t0);
+      books() = b0;
+      if (!dyn::step(*this, trial, tau, qt, vt)) return false;
+      const double f = openDepth(qt);
+      if (f > 0.0) {
+        hi = h, f_hi = depth = f, q_hi = qt, v_hi = vt, t_hi = time(), b_hi = books();
+        if (side == 1) f_lo *= 0.5;
+        side = 1;
+      } else {
+        lo = h, f_lo = f;
+        if (side == -1) f_hi *= 0.5;
+        side = -1;
+      }
+    }
+    // At the touchdown (at most kTouchdownDepth past the plane): close it, then the rest of the step.
+    q = q_hi, v = v_hi;
+    setTime(t_hi);
+    books() = b_hi;
+    updateContacts(q, v, tau);
+    sub.dt -= hi;
+    if (!(sub.dt > 1e-15 * o.dt)) return true;
+  }
+}
+
 template <class S, int Nj, int Nr, int Nl>
 typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, Nj, Nr, Nl>::solve(
     const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
@@ -317,6 +412,23 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::accelerations(const VecN& q, const Vec
   };
   if (known) put(last_);
   else put(evaluate(q, v, tau, stab));
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::setTime(double t) {
+  // Time-dependent forces: a new time is a new velocity stage (and no remembered solve).
+  if (t != time_ && !model_.forces.empty()) have_velocity_ = have_last_ = false;
+  time_ = t;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::derivatives(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab,
+                                                      VecN& a, double& work, double& friction) {
+  // After accelerations() the stages are at (q, v) and the clock's time: their powers are this state's.
+  ConstrainedMechanism::accelerations(q, v, tau, stab, a);
+  work = external_power_;
+  for (int i = 0; i < int(tau.size()); ++i) work += tau[i] * v[i];
+  friction = friction_power_;
 }
 
 template <class S, int Nj, int Nr, int Nl>

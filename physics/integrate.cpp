@@ -2,6 +2,8 @@
 // independent coordinates) for any ConstrainedSystem; equations in integrate.h.
 #include "physics/integrate.h"
 
+#include <algorithm>
+
 #include "physics/constrained.h"
 
 namespace dyn {
@@ -60,27 +62,50 @@ void projectVelocities(ConstrainedSystem& sys, const VecN& q, VecN& v) {
   if (sys.correction(q, G * v, dx)) v -= dx;
 }
 
-bool step(ConstrainedSystem& sys, const StepOptions& o, const VecN& tau, VecN& q, VecN& v) {
-  const double dt = o.dt;
+void ConstrainedSystem::derivatives(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a,
+                                    double& work, double& friction) {
+  accelerations(q, v, tau, stab, a);
+  work = tau.dot(v.head(tau.size()));
+  friction = 0.0;
+}
+
+namespace {
+
+// The last stage's time, just inside the step (see integrate.h).
+constexpr double kInside = 1.0 - 1e-9;
+
+// One step of dt from the clock's time t0: the motion, the books, the drift handling.
+bool stepOnce(ConstrainedSystem& sys, const StepOptions& o, double dt, const VecN& tau, VecN& q, VecN& v) {
+  const double t0 = sys.time();
   VecN s, a;
+  double w1, f1;
+  Books& books = sys.books();
   if (o.integrator == Integrator::SemiImplicitEuler) {
-    sys.accelerations(q, v, tau, baumgarte(sys, o.drift, q, v, s), a);
+    sys.derivatives(q, v, tau, baumgarte(sys, o.drift, q, v, s), a, w1, f1);
     v += dt * a;
     q += dt * v;
+    books.work += dt * w1;
+    books.friction += dt * f1;
   } else {
-    // Classic RK4 on (q, v).
+    // Classic RK4 on (q, v, W, D), each stage at its own time.
     VecN a1, a2, a3, a4;
-    sys.accelerations(q, v, tau, baumgarte(sys, o.drift, q, v, s), a1);
+    double w2, w3, w4, f2, f3, f4;
+    sys.derivatives(q, v, tau, baumgarte(sys, o.drift, q, v, s), a1, w1, f1);
     const VecN v1 = v;
     const VecN q2 = q + 0.5 * dt * v1, v2 = v + 0.5 * dt * a1;
-    sys.accelerations(q2, v2, tau, baumgarte(sys, o.drift, q2, v2, s), a2);
+    sys.setTime(t0 + 0.5 * dt);
+    sys.derivatives(q2, v2, tau, baumgarte(sys, o.drift, q2, v2, s), a2, w2, f2);
     const VecN q3 = q + 0.5 * dt * v2, v3 = v + 0.5 * dt * a2;
-    sys.accelerations(q3, v3, tau, baumgarte(sys, o.drift, q3, v3, s), a3);
+    sys.derivatives(q3, v3, tau, baumgarte(sys, o.drift, q3, v3, s), a3, w3, f3);
     const VecN q4 = q + dt * v3, v4 = v + dt * a3;
-    sys.accelerations(q4, v4, tau, baumgarte(sys, o.drift, q4, v4, s), a4);
+    sys.setTime(t0 + kInside * dt);
+    sys.derivatives(q4, v4, tau, baumgarte(sys, o.drift, q4, v4, s), a4, w4, f4);
     q += dt / 6.0 * (v1 + 2.0 * v2 + 2.0 * v3 + v4);
     v += dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
+    books.work += dt / 6.0 * (w1 + 2.0 * w2 + 2.0 * w3 + w4);
+    books.friction += dt / 6.0 * (f1 + 2.0 * f2 + 2.0 * f3 + f4);
   }
+  sys.setTime(t0 + dt);
   switch (o.drift.kind) {
     case Drift::Projection: {
       const bool ok = projectPositions(sys, o.drift, q);
@@ -92,6 +117,22 @@ bool step(ConstrainedSystem& sys, const StepOptions& o, const VecN& tau, VecN& q
     default:
       return true;
   }
+}
+
+}  // namespace
+
+bool step(ConstrainedSystem& sys, const StepOptions& o, const VecN& tau, VecN& q, VecN& v) {
+  const int n = std::max(1, o.substeps);
+  if (n == 1) return stepOnce(sys, o, o.dt, tau, q, v);
+  // Sub-steps: the clock from t0 + i dt/n exactly (no sum of n rounded sub-steps).
+  const double t0 = sys.time(), h = o.dt / n;
+  bool ok = true;
+  for (int i = 0; i < n; ++i) {
+    sys.setTime(t0 + i * h);
+    ok = stepOnce(sys, o, h, tau, q, v) && ok;
+  }
+  sys.setTime(t0 + o.dt);
+  return ok;
 }
 
 bool parseIntegrator(const std::string& n, Integrator& out) {

@@ -4,6 +4,12 @@
 // φ(q) = 0 with velocity form G(q) v = 0 (G = [J, −A] for the lecture's J θ' = A v_c).
 // Integrators:  semi-implicit Euler  v⁺ = v + dt a(q, v),  q⁺ = q + dt v⁺   (1st order, symplectic)
 //               RK4                  classic four-stage                     (4th order)
+//               either in `substeps` equal sub-steps of dt with τ held (stiff modes: ω dt/substeps small)
+// The books: beside (q, v) step() integrates, with the same scheme and stage weights, the work W of τ
+// and of the external forces (power (τ + Q_ext)·v) and D, that of joint friction (≤ 0), so that
+// E − E0 − W − D is at the integrator's own error (τ held: its share is τ·Δq, exactly). The clock: each
+// stage is evaluated at its time t + c dt (time-dependent external forces read it); the last stage just
+// inside the step (t + dt(1 − 1e-9)), so that a force switched on at a step boundary acts from there on.
 // Drift:        none | Baumgarte  s = −2ζω G v − ω² φ  inside the solve
 //               | projection: q ← q − W⁻¹Gᵀ(G W⁻¹ Gᵀ)⁻¹ φ (Newton), v ← v − W⁻¹Gᵀ(G W⁻¹ Gᵀ)⁻¹ G v
 //                 with W the mass matrix (the velocity projection removes the least kinetic energy)
@@ -27,10 +33,26 @@ struct DriftOptions {
   int max_iterations = 10;
 };
 
+// What step() integrates beside the motion (see the top): work of τ and external forces, and of friction.
+struct Books {
+  double work = 0;      // J, W = ∫ (τ + Q_ext)·v dt
+  double friction = 0;  // J, D = −∫ (b θ' + F_c tanh(θ'/w))·θ' dt ≤ 0
+};
+
 // What an integrator needs from a mechanism. The control τ is held over the step (zero-order hold).
 class ConstrainedSystem {
  public:
   virtual ~ConstrainedSystem() = default;
+  // The clock: the time of the state being evaluated (step() sets each stage's and leaves the step's end).
+  virtual void setTime(double t) { time_ = t; }
+  double time() const { return time_; }
+  // One evaluation for the integrator: a = accelerations(q, v, τ, stab), and the power at (q, v):
+  // (τ + Q_ext)·v into `work`, the joint friction's into `friction`. The default: τ·v, no friction.
+  virtual void derivatives(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a, double& work,
+                           double& friction);
+  // What step() has integrated so far (see Books); a lab may reset it.
+  Books& books() { return books_; }
+  const Books& books() const { return books_; }
   virtual int nq() const = 0;
   // Accelerations a = (θ'', α_c) from the solve (2)/(3); stab is the Baumgarte term or null.
   virtual void accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab,
@@ -54,15 +76,21 @@ class ConstrainedSystem {
     (void)v;
     return false;
   }
+
+ protected:
+  double time_ = 0;
+  Books books_;
 };
 
 struct StepOptions {
   double dt = 1e-3;
   Integrator integrator = Integrator::RK4;
   DriftOptions drift;
+  int substeps = 1;  // equal sub-steps of dt (each with its drift handling), τ held over all of them
 };
 
-// One fixed step of (q, v) with τ held. Returns false if a projection failed to converge.
+// One fixed step of (q, v) with τ held, the system's clock and books advanced with it. Returns false if
+// a projection failed to converge.
 bool step(ConstrainedSystem& system, const StepOptions& options, const VecN& tau, VecN& q, VecN& v);
 
 // Projection onto φ = 0 and G v = 0 (also used to make initial conditions consistent).

@@ -48,6 +48,11 @@ std::string MechanismModel<S>::validate() const {
     if (!ok(at.a) || !ok(at.b)) return "constraint " + std::to_string(i) + " names a body the mechanism does not have";
     if (at.a == at.b) return "constraint " + std::to_string(i) + " ties a body to itself";
   }
+  for (std::size_t i = 0; i < forces.size(); ++i) {
+    if (!forces[i]) return "external force " + std::to_string(i) + " is empty";
+    const BodyRef b = forces[i]->body();
+    if (b.isWorld() || !ok(b)) return "external force " + std::to_string(i) + " (" + forces[i]->kind() + ") acts on the world or on a body the mechanism does not have";
+  }
   for (int j : bullet.cut_joints)
     if (j < 0 || j >= n) return "Bullet cut joint " + std::to_string(j) + " is not a joint of the trees";
   if (n + payloadDof() > kMaxDof || rows() > kMaxDof) return "the mechanism is larger than kMaxDof (" + std::to_string(kMaxDof) + ")";

@@ -58,10 +58,14 @@ void setupImGui(GLFWwindow* window) {
   ImGuiStyle& style = ImGui::GetStyle();
   style.WindowRounding = 0.0f;
   style.FrameRounding = 3.0f;
-  style.GrabRounding = 3.0f;
   style.Colors[ImGuiCol_WindowBg] = ImVec4(0.97f, 0.97f, 0.98f, 1.0f);
   style.Colors[ImGuiCol_TitleBgActive] = style.Colors[ImGuiCol_TitleBg] = ImVec4(0.22f, 0.29f, 0.38f, 1.0f);
   style.Colors[ImGuiCol_Text] = ImVec4(0.12f, 0.14f, 0.17f, 1.0f);
+  // A slider's knob is a thin, light bar: the value's digits drawn over it stay readable.
+  style.GrabMinSize = 4.0f;
+  style.GrabRounding = 1.0f;
+  style.Colors[ImGuiCol_SliderGrab] = ImVec4(0.26f, 0.59f, 0.98f, 0.55f);
+  style.Colors[ImGuiCol_SliderGrabActive] = ImVec4(0.26f, 0.59f, 0.98f, 0.75f);
   ImGui_ImplGlfw_InitForOpenGL(window, true);
   if (!ImGui_ImplOpenGL3_Init("#version 330 core")) throw std::runtime_error("Dear ImGui OpenGL3 backend failed to initialise");
 }
@@ -73,7 +77,11 @@ void shutdownImGui() {
 }
 
 // What the last frame showed, for scripted runs and their tests.
-json frameState(const TuningSession& s, const WindowContext& ctx, const Layout& l, long frame) {
+json frameState(const TuningSession& s, const WindowContext& ctx, const Layout& l, long frame, const PanelState& st) {
+  json widgets = json::array();
+  const float scale = std::max(ImGui::GetIO().DisplayFramebufferScale.x, 1e-3f);  // window → framebuffer pixels
+  const auto px = [&](const float* r) { return json{r[0] * scale, r[1] * scale, r[2] * scale, r[3] * scale}; };
+  for (const auto& w : st.widgets) widgets.push_back({{"name", w.name}, {"frame", px(w.frame)}, {"label", px(w.label)}});
   json values = json::object();
   if (s.hasRows())
     for (std::size_t c = 0; c < s.primary().columns.size(); ++c) values[s.primary().columns[c]] = s.primary().at(s.row(), int(c));
@@ -92,7 +100,9 @@ json frameState(const TuningSession& s, const WindowContext& ctx, const Layout& 
           {"screening", s.screening()},
           {"window", {{"width", ctx.width()}, {"height", ctx.height()}}},
           {"viewport", {{"x", l.scene_x}, {"y", l.scene_y}, {"width", l.scene_w}, {"height", l.scene_h}}},
-          {"gl", ctx.description()}};
+          {"gl", ctx.description()},
+          {"gain_sliders", widgets},
+          {"panel_right", st.window_right * scale}};
 }
 
 bool writeText(const std::string& path, const std::string& text) {
@@ -192,7 +202,7 @@ int run(const Args& a) {
         std::cerr << "error: " << a.screenshot << ": cannot write the screenshot\n";
         code = 1;
       }
-      if (!a.state.empty() && !writeText(a.state, frameState(session, *ctx, l, frame).dump(2) + "\n")) {
+      if (!a.state.empty() && !writeText(a.state, frameState(session, *ctx, l, frame, st).dump(2) + "\n")) {
         std::cerr << "error: " << a.state << ": cannot write the state\n";
         code = 1;
       }

@@ -35,6 +35,9 @@ void tooltip(const std::string& text) {
   ImGui::EndTooltip();
 }
 
+// The room right of each slider for its name: the longest name the panel shows, measured.
+float label_room = 70;
+
 // A gain or option changed: restart at once, or remember that a restart is due.
 void changed(TuningSession& session, PanelState& st) {
   if (st.restart_on_change) {
@@ -76,7 +79,7 @@ void runSection(TuningSession& session, PanelState& st) {
   ImGui::Checkbox("loop", &st.loop);
   tooltip("start again when the run ends");
   const double lo = 0.02, hi = 20.0;
-  ImGui::SetNextItemWidth(-70);
+  ImGui::SetNextItemWidth(-label_room);
   ImGui::SliderScalar("speed", ImGuiDataType_Double, &st.speed, &lo, &hi, "%.2fx",
                       ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp);
   tooltip("simulated seconds per second of wall time; the physics always uses the lab's fixed dt");
@@ -114,17 +117,27 @@ void gainsSection(TuningSession& session, PanelState& st) {
     double v = session.gain(g.name);
     std::string format = g.unit.empty() || g.unit == "1" ? "%.4g" : "%.4g " + g.unit;  // "1": dimensionless
     for (std::size_t p = format.find('%', 1); p != std::string::npos; p = format.find('%', p + 2)) format.insert(p, "%");
-    ImGui::SetNextItemWidth(-70);
+    ImGui::SetNextItemWidth(-label_room);
     if (ImGui::SliderScalar(g.name.c_str(), ImGuiDataType_Double, &v, &g.min, &g.max, format.c_str(),
                             ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp))
       session.setGain(g.name, std::clamp(v, g.min, g.max));
+    {
+      const ImVec2 a = ImGui::GetItemRectMin(), b = ImGui::GetItemRectMax();
+      const float frame_right = a.x + ImGui::CalcItemWidth();
+      PanelState::Widget w;
+      w.name = g.name;
+      const float lx = frame_right + ImGui::GetStyle().ItemInnerSpacing.x;
+      const float fr[4] = {a.x, a.y, frame_right, b.y}, lb[4] = {lx, a.y, lx + ImGui::CalcTextSize(g.name.c_str()).x, b.y};
+      std::copy(fr, fr + 4, w.frame), std::copy(lb, lb + 4, w.label);
+      st.widgets.push_back(w);
+    }
     if (ImGui::IsItemDeactivatedAfterEdit()) changed(session, st);
     tooltip(g.doc + "\nunit: " + g.unit + "\nrange [" + fmt("%.4g", g.min) + ", " + fmt("%.4g", g.max) +
             "], lab default " + fmt("%.4g", g.lab_default) + "\nCtrl+click to type a value.");
   }
   for (const OptionSpec& o : session.optionSpecs()) {
     const std::string current = session.option(o.name);
-    ImGui::SetNextItemWidth(-70);
+    ImGui::SetNextItemWidth(-label_room);
     if (ImGui::BeginCombo(o.name.c_str(), current.c_str())) {
       for (const auto& c : o.choices) {
         if (ImGui::Selectable(c.c_str(), c == current) && c != current) {
@@ -179,7 +192,7 @@ void plotsSection(const TuningSession& session, PanelState& st) {
     ImGui::PopID();
   }
   // Any column of the trace over the last two seconds.
-  ImGui::SetNextItemWidth(-70);
+  ImGui::SetNextItemWidth(-label_room);
   const char* chosen = st.plot_column >= 0 && st.plot_column < int(tr.columns.size()) ? tr.columns[st.plot_column].c_str() : "(none)";
   if (ImGui::BeginCombo("column", chosen)) {
     if (ImGui::Selectable("(none)", st.plot_column < 0)) st.plot_column = -1;
@@ -281,9 +294,18 @@ void drawTuningPanel(TuningSession& session, PanelState& st, float x, float widt
   ImGui::SetNextWindowSize(ImVec2(width, height), ImGuiCond_Always);
   const ImGuiWindowFlags flags = ImGuiWindowFlags_NoMove | ImGuiWindowFlags_NoResize | ImGuiWindowFlags_NoCollapse |
                                  ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus;
-  const std::string title = session.title() + "###tuning";
+  // The window's title is the lab's name ("Impedance control", not the whole sentence after it),
+  // which fits the panel; the full title is the OS window's.
+  const std::string full = session.title(), title = full.substr(0, full.find(": ")) + "###tuning";
   ImGui::Begin(title.c_str(), nullptr, flags);
-  ImGui::PushItemWidth(-70);
+  // Every name right of its slider in full: the widest one sets the column.
+  float widest = ImGui::CalcTextSize("speed").x;
+  for (const GainSpec& g : session.gainSpecs()) widest = std::max(widest, ImGui::CalcTextSize(g.name.c_str()).x);
+  for (const OptionSpec& o : session.optionSpecs()) widest = std::max(widest, ImGui::CalcTextSize(o.name.c_str()).x);
+  label_room = std::min(widest + 2 * ImGui::GetStyle().ItemInnerSpacing.x, 0.45f * width);
+  st.widgets.clear();
+  st.window_right = x + width;
+  ImGui::PushItemWidth(-label_room);
   runSection(session, st);
   problemSection(session);
   ImGui::Spacing();

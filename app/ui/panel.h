@@ -4,6 +4,7 @@
 // It reads and changes a TuningSession only; the window loop (main.cpp) owns time and drawing.
 #pragma once
 #include <string>
+#include <vector>
 
 #include "app/ui/session.h"
 
@@ -20,6 +21,14 @@ struct PanelState {
   std::string status;              // last save result
   bool status_is_error = false;
   int plot_column = -1;            // extra live plot: a trace column chosen by the student
+  // Where the last frame drew each gain's slider (window pixels: frame, then its name's text),
+  // for --state and the tests that check names and value digits stay readable.
+  struct Widget {
+    std::string name;
+    float frame[4] = {0, 0, 0, 0}, label[4] = {0, 0, 0, 0};  // x0, y0, x1, y1
+  };
+  std::vector<Widget> widgets;
+  float window_right = 0;          // the panel's right edge (window pixels)
 };
 
 // Saves the session's gains to state.save_path and records the outcome in state.status.

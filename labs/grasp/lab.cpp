@@ -11,6 +11,7 @@
 #include "labs/numbers.h"
 #include "labs/settings.h"
 #include "physics/constraints/point_contact.h"
+#include "physics/forces.h"
 
 namespace dyn::grasp {
 namespace {
@@ -65,14 +66,8 @@ class Hooks final : public StepHooks {
       : s_(s), ctrl_(s.controller, s.reference, s.model, s.step.dt), model_(s.params) {
     ctrl_.primeMeasurement(model_, q0, v0);
   }
-  VecN torque(double t, const VecN& q, const VecN& v) override {
-    const VecN tau = ctrl_.torque(t, q, v);
-    if (!s_.push.active(t)) return tau;
-    // τ followed by the push on the object's (ψ, x, y): a generalised force on the payload.
-    VecN out(tau.size() + 3);
-    out << tau, 0.0, s_.push.force;
-    return out;
-  }
+  // The controller's τ (the push is the mechanism's external force: simulate()).
+  VecN torque(double t, const VecN& q, const VecN& v) override { return ctrl_.torque(t, q, v); }
   void row(const StepRecord& r, std::vector<double>& out) override {
     const int m = model_.fingers(), n = 2 * m;
     Eigen::Vector3d pose_d, rate_d, accel_d;
@@ -243,7 +238,13 @@ std::string GraspLab::unit(const std::string& c) const {
 }
 
 std::unique_ptr<Simulation> GraspLab::simulate(Engine engine) const {
-  auto mech = std::make_unique<Mechanism>(s_.params);
+  // The push on the object's centre of mass: an external force the engines evaluate inside each step.
+  Params params = s_.params;
+  if (s_.push.force != Eigen::Vector2d::Zero() && s_.push.duration > 0)
+    params.forces.push_back(std::make_shared<PushForce<Planar>>(BodyRef::payload(0), Planar::Pos::Zero(),
+                                                                 Planar::Vec(0.0, s_.push.force.x(), s_.push.force.y()),
+                                                                 ForceProfile{s_.push.start, 0.0, s_.push.duration}));
+  auto mech = std::make_unique<Mechanism>(params);
   VecN q, v;
   mech->assemble(s_.pose0, Eigen::Vector3d::Zero(), q, v);
   return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::make_unique<Hooks>(s_, q, v), columns_, s_.duration);

@@ -42,6 +42,7 @@ MechanismModel<Planar> describe(const Params& p) {
     d.constraints.push_back(std::make_shared<PointContact<Planar>>(
         BodyRef::link(int(2 * i + 1)), Planar::Pos(f.links[1].length, 0.0), BodyRef::payload(0), f.contact, f.normal, p.mu));
   }
+  d.forces = p.forces;
   // Bullet: fingers as one multibody from the world, the object on guide links, point-to-point grips.
   d.bullet.solver_iterations = 50;
   return d;

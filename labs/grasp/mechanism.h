@@ -43,6 +43,7 @@ struct Params {
   JointProperties joint;                   // every finger joint's friction (viscous, Coulomb); the controller does not know it
   double mu = 0.6;
   Eigen::Vector2d gravity{0.0, -9.81};     // world, m/s²
+  std::vector<ExternalForcePtr<Planar>> forces;  // external forces (the lab's push on the object)
 };
 
 // The description both engines are built from.

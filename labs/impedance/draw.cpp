@@ -52,8 +52,17 @@ void ImpedanceLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, S
     const Eigen::Vector2d x(tr.at(r, "x"), tr.at(r, "y")), xr(tr.at(r, "x_ref"), tr.at(r, "y_ref"));
     return Eigen::Vector2d(x - kRestLength * u - g * (x - xr));
   };
-  for (std::size_t r = 0; r < tr.rows(); r += std::max<std::size_t>(1, tr.rows() / 100))
-    extend({tr.at(r, "x"), tr.at(r, "y")}), extend(anchorAt(r));
+  // The force arrow on the tip (below) is framed too: its head stays in the picture.
+  const auto arrowAt = [&](std::size_t r) {
+    const Eigen::Vector2d F(tr.at(r, "F_ext_x"), tr.at(r, "F_ext_y"));
+    return F.norm() > 1e-6 ? Eigen::Vector2d(std::min(0.3, 0.01 * F.norm()) * F.normalized()) : Eigen::Vector2d::Zero();
+  };
+  for (std::size_t r = 0; r < tr.rows(); r += std::max<std::size_t>(1, tr.rows() / 100)) {
+    const Eigen::Vector2d x(tr.at(r, "x"), tr.at(r, "y"));
+    extend(x), extend(anchorAt(r));
+    const Eigen::Vector3d head = at(Eigen::Vector2d(x + arrowAt(r)));  // the arrow's head, a small margin round it
+    s.framing.bounds.extend(head - Eigen::Vector3d(0.03, 0.03, 0.03)), s.framing.bounds.extend(head + Eigen::Vector3d(0.03, 0.03, 0.03));
+  }
   s.boxes.push_back({{0, -0.03, -0.03}, {0.05, 0.03, 0.02}, Eigen::Matrix3d::Identity(), kWall});
   if (s_.wall.enabled) {
     const Eigen::Vector2d tip = ref.back();
@@ -76,8 +85,7 @@ void ImpedanceLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, S
   s.capsules.push_back({at(tip - 0.018 * side - 0.5 * d, 0.04), at(tip - 0.018 * side, 0.04), 0.004, kJoint});
   s.capsules.push_back({at(tip - 0.022 * side, 0.04), at(tip + 0.022 * side, 0.04), 0.005, kSpring});
   // The force on the tip (environment and wall), 0.01 m per newton, at most 0.3 m.
-  const Eigen::Vector2d F(tr.at(row, "F_ext_x"), tr.at(row, "F_ext_y"));
-  if (F.norm() > 1e-6) s.arrows.push_back({at(tip, 0.05), at(std::min(0.3, 0.01 * F.norm()) * F.normalized()), 0.008, kForce});
+  if (arrowAt(row).norm() > 0) s.arrows.push_back({at(tip, 0.05), at(arrowAt(row)), 0.008, kForce});
 }
 
 Eigen::Vector2d ImpedanceLab::pushDirection() const {

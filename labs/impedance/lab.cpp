@@ -1,9 +1,12 @@
 // Impedance lab: parses impedance.json, runs the motion-control arm (its mechanism description,
-// reused) on the hand-written model or on Bullet, with the tip force applied as the generalised
-// force J_tipᵀ F_ext in both engines and the wall as a planar PlaneContact, and measures the runs.
+// reused) on the hand-written model or on Bullet, with the tip force an external force of the
+// description (physics/forces.h push: each engine evaluates J_tipᵀ F_ext inside its step, at every RK4
+// stage for the hand engine, while the controller's τ is held over its period) and the wall as a
+// planar PlaneContact, and measures the runs.
 #include "labs/impedance/lab.h"
 
 #include <cmath>
+#include <functional>
 #include <map>
 #include <random>
 
@@ -12,6 +15,7 @@
 #include "labs/numbers.h"
 #include "labs/settings.h"
 #include "physics/constraints/plane_contact.h"
+#include "physics/forces.h"
 
 namespace dyn::impedance {
 namespace {
@@ -24,9 +28,14 @@ Eigen::Vector3d parse3(const JsonView& j, double lo, double hi, double scale = 1
   return {j.at(0).inRange(lo, hi) * scale, j.at(1).inRange(lo, hi) * scale, j.at(2).inRange(lo, hi) * scale};
 }
 
-// The arm with the wall (if any) as a unilateral plane contact on the tip ball.
+// The arm with the push on the tip (an external force, if any) and the wall (if any) as a unilateral
+// plane contact on the tip ball.
 MechanismModel<Planar> describeWithWall(const Settings& s) {
   MechanismModel<Planar> d = motion_control::describe(s.plant);
+  const Planar::Pos tip(s.plant.links[2].length, 0.0);
+  if (s.force.value != Eigen::Vector2d::Zero())
+    d.forces.push_back(std::make_shared<PushForce<Planar>>(BodyRef::link(2), tip, Planar::Vec(0.0, s.force.value.x(), s.force.value.y()),
+                                                            s.force.profile()));
   if (!s.wall.enabled) return d;
   PlaneContactParams c;
   c.radius = s.wall.radius;
@@ -51,6 +60,8 @@ void taskJacobian(Mech& m, const Params& p, const VecN& q, const VecN& v, Eigen:
 // The lab's controller: the chosen realisation of the target impedance on measured F.
 class Hooks final : public StepHooks {
  public:
+  // The x impulse (N·s) the hand engine's last step gave the tip at a rigid wall (unset: none).
+  std::function<double()> impulse;
   explicit Hooks(const Settings& s)
       : s_(s), model_(motion_control::describeRigid(s.model)), plant_(motion_control::describeRigid(s.plant)),
         inner_(s.inner, s.model), hold_(std::max(1L, std::lround(s.period / s.step.dt))), rng_(12345),
@@ -60,25 +71,22 @@ class Hooks final : public StepHooks {
     tau_ = Eigen::Vector3d::Zero();
   }
   VecN torque(double t, const VecN& q, const VecN& v) override {
-    // The environment's force at the tip as a generalised force (both engines alike).
-    const Eigen::Vector2d F = s_.force.at(t);
-    Eigen::Matrix3d J;
-    Eigen::Vector3d Jdv;
-    taskJacobian(plant_, s_.plant, q, v, J, Jdv);
-    f_applied_ = F;
+    // The controller, sampled; the push at the tip is the mechanism's (describeWithWall), here only for
+    // the trace row and the sensor.
+    f_applied_ = s_.force.at(t);
     if (k_++ % hold_ == 0) tau_ = control(t, q, v);
-    const Eigen::Vector3d ext = J.topRows<2>().transpose() * F;
-    return VecN(tau_ + ext);
+    return VecN(tau_);
   }
   void row(const StepRecord& r, std::vector<double>& out) override {
     const Eigen::Vector3d x = tipPose(s_.plant, r.q.head<3>());
     Eigen::Vector2d f = f_applied_;
     // The wall's push on the tip (plane on body: the constraint's force is body on world).
     if (s_.wall.enabled && !r.forces.empty() && r.forces[0].size() >= 3) f += Eigen::Vector2d(r.forces[0][1], r.forces[0][2]);
-    // A rigid wall's plastic impact: the hand engine jumps θ' at the step's start (eq. (2) for
-    // impulses), and the contact force it reports after that leaves the impulse out; the row carries
-    // it as P/dt, the step's mean force, as Bullet's impulse-based contact reports it.
-    if (s_.wall.enabled && s_.wall.stiffness == 0 && r.engine == Engine::Hand) f.x() -= impactImpulse(r.q, r.v) / s_.step.dt;
+    // A rigid wall's plastic impact: the hand engine jumps θ' at the touchdown it locates inside the
+    // step (eq. (2) for impulses), and the contact force it reports at the step's start leaves the
+    // impulse out; the row carries it as P/dt, the step's mean force, as Bullet's impulse-based contact
+    // reports it (the engine's own record: ConstrainedMechanism::impactImpulse).
+    if (impulse && r.engine == Engine::Hand) f.x() += impulse() / s_.step.dt;
     f_total_ = f;
     out.clear();
     out.push_back(r.t);
@@ -111,20 +119,6 @@ class Hooks final : public StepHooks {
   }
 
  private:
-  // The impulse P = Λ_n v_n (N·s) of a plastic impact on the wall at (q, v), as the engine's
-  // touchdown test sees it (the ball at or past the plane, moving into it); 0 otherwise.
-  // Λ_n = (J_n M⁻¹ J_nᵀ)⁻¹, J_n the tip's x row: the least-kinetic-energy jump that stops v_n.
-  double impactImpulse(const VecN& q, const VecN& v) {
-    const Eigen::Vector3d th = q.head<3>();
-    Eigen::Matrix3d J;
-    Eigen::Vector3d Jdv;
-    taskJacobian(plant_, s_.plant, q, v, J, Jdv);
-    const double vn = J.row(0).dot(v.head<3>());
-    if (vn <= 0 || tipPose(s_.plant, th)[0] + s_.wall.radius < s_.wall.x) return 0;
-    const Eigen::Matrix3d M = plant_.massMatrix(q);
-    return vn / J.row(0).dot(M.ldlt().solve(Eigen::Vector3d(J.row(0).transpose())));
-  }
-
   Eigen::Vector3d control(double t, const VecN& q, const VecN& v) {
     const Eigen::Vector3d th = q.head<3>(), thd = v.head<3>();
     const Eigen::Vector3d F(fx_.value(), fy_.value(), 0.0);
@@ -190,11 +184,7 @@ class Hooks final : public StepHooks {
 
 }  // namespace
 
-Eigen::Vector2d Force::at(double t) const {
-  if (t < start || (hold > 0 && t >= start + rise + hold)) return Eigen::Vector2d::Zero();
-  const double ramp = rise > 0 ? std::min(1.0, (t - start) / rise) : 1.0;
-  return ramp * value;
-}
+Eigen::Vector2d Force::at(double t) const { return profile().at(t) * value; }
 
 Eigen::Vector3d tipPose(const Params& p, const Eigen::Vector3d& th) {
   const auto pts = motion_control::jointPoints(p, th);
@@ -335,7 +325,10 @@ template <class M>
 std::unique_ptr<Simulation> run(const Settings& s, Engine engine, const std::vector<std::string>& columns) {
   auto mech = std::make_unique<M>(describeWithWall(s));
   VecN q = VecN(s.pose), v = VecN::Zero(3);
-  return simulateMechanism(engine, std::move(mech), s.step, q, v, std::make_unique<Hooks>(s), columns, s.duration);
+  auto hooks = std::make_unique<Hooks>(s);
+  if (engine == Engine::Hand && s.wall.enabled && s.wall.stiffness == 0)
+    hooks->impulse = [hand = mech.get()] { return hand->impactImpulse(0)[1]; };  // (τ, f_x, f_y): f_x
+  return simulateMechanism(engine, std::move(mech), s.step, q, v, std::move(hooks), columns, s.duration);
 }
 
 }  // namespace

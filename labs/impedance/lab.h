@@ -10,6 +10,7 @@
 #include "labs/lab.h"
 #include "labs/motion_control/controller.h"
 #include "labs/motion_control/mechanism.h"
+#include "physics/forces.h"
 
 namespace dyn::impedance {
 
@@ -27,6 +28,7 @@ struct Force {
   Eigen::Vector2d value = Eigen::Vector2d::Zero();
   double start = 0.2, rise = 0, hold = 0;
   Eigen::Vector2d at(double t) const;
+  ForceProfile profile() const { return {start, rise, hold}; }
 };
 
 struct Wall {

@@ -73,7 +73,7 @@ Eigen::VectorXd Controller::torque(double t, const Eigen::VectorXd& th, const Ei
       tau = model_->inverseDynamics(VecN(th), VecN(thd), VecN(a));
       for (int i = 0; i < n; ++i)
         tau[i] += fr[std::size_t(i)].viscous * thd[i] +
-                  fr[std::size_t(i)].coulomb * sat(thd[i] / std::max(model_params_.coulomb_width, 1e-12));
+                  fr[std::size_t(i)].coulomb * std::tanh(thd[i] / std::max(model_params_.coulomb_width, 1e-12));
       break;
     }
     case Kind::PdGravity:

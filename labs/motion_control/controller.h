@@ -3,7 +3,7 @@
 //                    anti-windup under the torque limit: clamping (the integrator stops while the
 //                    output saturates in the direction it pushes) or back-calculation
 //                    (u_I' = −k_I e + (τ_sat − τ)/T_t, u_I = −k_I ∫e kept in torque units)
-//   computed_torque  τ = M̂(θ)(θ_d'' − K_p e − K_d e') + Ĉθ' + Ĝ + B̂θ' + F̂_c sat(θ'/w)  (RNEA of the
+//   computed_torque  τ = M̂(θ)(θ_d'' − K_p e − K_d e') + Ĉθ' + Ĝ + B̂θ' + F̂_c tanh(θ'/w)  (RNEA of the
 //                    model at the measured state) ⇒ e'' + K_d e' + K_p e = 0 when the model is exact;
 //                    K_p = ω_n², K_d = 2ζω_n (or given directly)
 //   pd_gravity       τ = −K_p e − K_d θ' + Ĝ(θ)   (passivity: V = ½θ'ᵀMθ' + ½eᵀK_p e never increases

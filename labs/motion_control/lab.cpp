@@ -2,6 +2,8 @@
 // for 3 links) or on Bullet with the same controller, and measures the runs.
 #include "labs/motion_control/lab.h"
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <cmath>
 #include <map>
 
@@ -113,6 +115,19 @@ Eigen::VectorXd staticDeflection(const Params& p, const Eigen::VectorXd& theta) 
   return d;
 }
 
+double fastestMode(const Params& p, const Eigen::VectorXd& theta) {
+  if (!p.flexible) return 0.0;
+  const int n = p.n();
+  ArmMechanism mech(describe(p));
+  VecN q, v;
+  treeState(p, theta, Eigen::VectorXd::Zero(n), q, v);
+  const Eigen::MatrixXd M = mech.massMatrix(q);
+  Eigen::MatrixXd K = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  for (int i = 0; i < n; ++i) K(2 * i + 1, 2 * i + 1) = p.stiffness[std::size_t(i)];
+  const Eigen::GeneralizedSelfAdjointEigenSolver<Eigen::MatrixXd> eig(K, M, Eigen::EigenvaluesOnly);
+  return std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
+}
+
 Settings parseSettings(const JsonView& c) {
   Settings s;
   c.onlyKeys({"lab", "title", "description", "mechanism", "model", "trajectory", "simulation", "controller", "gains",
@@ -158,6 +173,12 @@ Settings parseSettings(const JsonView& c) {
   const SimulationSettings sim = parseSimulation(c["simulation"]);
   s.step = sim.step;
   s.duration = sim.duration;
+  // Flexible joints: the hand engine sub-steps dt so that the fastest rotor–spring mode (over the
+  // trajectory's two poses) has ω dt/substeps ≤ kResolvedOmegaDt; the trace keeps one row per dt.
+  if (s.plant.flexible) {
+    const double w = std::max(fastestMode(s.plant, T.outstretched), fastestMode(s.plant, T.folded));
+    s.step.substeps = std::max(1, int(std::ceil(w * s.step.dt / kResolvedOmegaDt)));
+  }
 
   const JsonView ctl = c["controller"];
   ctl.onlyKeys({"kind", "anti_windup", "control_period", "coulomb_compensation", "compensation_width", "tracking_time",

@@ -19,6 +19,11 @@ struct Settings {
 Settings parseSettings(const JsonView& config);
 // The static deflection of a flexible arm held at link angles θ by its motors: k_i δ_i = −G_spring,i.
 Eigen::VectorXd staticDeflection(const Params& plant, const Eigen::VectorXd& theta);
+// The fastest small-oscillation mode of a flexible arm at link angles θ (rad/s): √ of the largest
+// eigenvalue of M⁻¹K (K the springs on the deflections, motors free); 0 for a rigid arm.
+double fastestMode(const Params& plant, const Eigen::VectorXd& theta);
+// ω dt of the fastest mode that the hand engine's sub-steps keep (RK4's phase error per step ~ (ω dt)⁴/120).
+inline constexpr double kResolvedOmegaDt = 0.05;
 
 class MotionControlLab final : public Lab {
  public:

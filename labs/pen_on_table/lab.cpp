@@ -1,6 +1,6 @@
 // Pen-on-table lab: parses pen_on_table.json, runs the hand-written model (eq. (3) with the unilateral
-// plane contact, touchdown and lift-off between steps) or the Bullet reference (the tip a sphere on a
-// static plane) with the same controller, and measures the runs.
+// plane contact: lift-off between steps, touchdown located inside its step) or the Bullet reference
+// (the tip a sphere on a static plane) with the same controller, and measures the runs.
 #include "labs/pen_on_table/lab.h"
 
 #include <algorithm>
@@ -45,8 +45,8 @@ class Hooks final : public StepHooks {
   VecN torque(double t, const VecN& q, const VecN& v) override { return ctrl_.torque(t, q, v); }
   // The step's mean force along ẑ: the table's push η (the solve at the step's start; Bullet: its
   // impulses over the step / dt) plus, on the hand engine, a touchdown's impact impulse P / dt (the
-  // plastic impact is a velocity jump at the step's start, eq. (2) for impulses), as Bullet and the
-  // impedance lab's wall count it.
+  // plastic impact is a velocity jump at the touchdown located inside the step, eq. (2) for impulses),
+  // as Bullet and the impedance lab's wall count it.
   double push(const StepRecord& r) const {
     const double eta = Spatial::linear(r.forces[0]).z();
     return hand_ ? eta + Spatial::linear(hand_->impactImpulse(0)).z() / s_.step.dt : eta;
@@ -70,7 +70,7 @@ class Hooks final : public StepHooks {
   void observe(const StepRecord& r) override { ctrl_.measure(-push(r)); }
   // The lab's watchdog: an unstable force loop on a unilateral contact does not blow up, it hammers the
   // table (a bounded limit cycle of lift-offs); the run stops at max_liftoffs (4) of them after the first
-  // touchdown: a stable loop lifts off at most once (the touchdown step's impact reopens the row for a step).
+  // touchdown: a stable loop lifts off at most once (a touchdown's impact may reopen the row for a step).
   std::string stop(const StepRecord& r) override {
     const bool contact = push(r) > 0;
     if (touched_ && in_contact_ && !contact && ++liftoffs_ >= s_.max_liftoffs)

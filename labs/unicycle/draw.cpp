@@ -14,7 +14,7 @@ namespace {
 
 const Color kWheel{0.23f, 0.42f, 0.68f, 1.0f}, kTrack{0.15f, 0.15f, 0.18f, 1.0f}, kRef{0.20f, 0.65f, 0.30f, 1.0f};
 const Color kForce{0.85f, 0.45f, 0.10f, 1.0f}, kSkid{0.90f, 0.10f, 0.10f, 1.0f}, kGhost{0.55f, 0.35f, 0.75f, 0.40f};
-const Color kGround{0.90f, 0.90f, 0.86f, 1.0f}, kLeader{0.20f, 0.65f, 0.30f, 1.0f};
+const Color kGround{0.90f, 0.90f, 0.86f, 1.0f}, kLeader{0.80f, 0.10f, 0.55f, 0.75f};  // not the path's green; the wheel shows through
 
 Eigen::Vector3d on(double x, double y, double z = 0) { return {x, y, z}; }
 
@@ -48,7 +48,9 @@ void UnicycleLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Sc
   // A margin of floor round the course (the ground is drawn exactly this big, so it is framed too).
   box.extend(box.min() - Eigen::Vector3d(r + 0.15, r + 0.15, 0));
   box.extend(box.max() + Eigen::Vector3d(r + 0.15, r + 0.15, 2 * r));
-  s.framePerspective(box, Eigen::Vector3d(0, -1.2, 1.0));
+  // Seen steeply from the front: the course keeps most of its shape, so it fills a tall free area
+  // (right of the panel) as well as a wide one, and the wheel is drawn larger.
+  s.framePerspective(box, Eigen::Vector3d(0, -0.4, 1.0));
 
   // Ground, path, leader.
   const Eigen::Vector3d size = box.sizes();
@@ -57,7 +59,8 @@ void UnicycleLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Sc
   Polyline ref{{}, 2.0, kRef};
   for (const auto& p : path_.polyline()) ref.points.push_back(on(p.x(), p.y()));
   s.polylines.push_back(std::move(ref));
-  s.spheres.push_back({on(tr.at(row, "x_d"), tr.at(row, "y_d"), 0.02), 0.025, kLeader});
+  // The leader: a ball of 0.6 wheel radii standing on the path (translucent: the wheel starts on it).
+  s.spheres.push_back({on(tr.at(row, "x_d"), tr.at(row, "y_d"), 0.6 * r), 0.6 * r, kLeader});
 
   // Bullet's friction wheel, translucent, and its track.
   if (ghost && row < ghost->rows()) {

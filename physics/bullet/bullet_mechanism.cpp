@@ -14,8 +14,12 @@
 // Torques. The description's τ_i acts +τ_i on the child about the joint axis, −τ_i on the parent.
 // On a Bullet joint (which acts +u on its Bullet child): u = sign × τ_i (sign −1 when Bullet's child
 // is the description's parent). On a cut joint: link torques +τ_i on the child, −τ_i on the parent
-// (none on the world). Joint properties add −k(θ − θ_rest) − b θ' − F_c sat(θ'/w), sat = clamp(·,−1,1),
-// from the state at the start of the step.
+// (none on the world). Joint properties add −k(θ − θ_rest) − b θ' − F_c tanh(θ'/w) from the state at the
+// start of the step.
+//
+// External forces (description.forces): evaluated at the step's start (time t, the point's position and
+// velocity from Bullet's own link motion) and applied to the body's Bullet link as a force at its centre
+// of mass and the torque τ + (p − c) × f; they join link_force / link_torque like payload pushes.
 //
 // Constraint forces f (body a on body b, world axes, planar (τ, f_x, f_y) at its point):
 //   point-to-point   Bullet's A receives −λ/dt, B +λ/dt (rows world x, y), no moment;
@@ -92,6 +96,7 @@ struct BulletMechanism<Planar>::Impl {
   std::vector<double> link_torque;                // link torques applied over the last step
   std::vector<Vec2> link_force;                   // link forces (at the centre of mass) over the last step
   std::vector<Planar::Vec> force;                 // per description constraint, last step
+  Books books;                                    // work of the held forces along each step's displacement
 
   BulletWorld world;  // before what it holds: destroyed after it
   std::unique_ptr<btMultiBody> body;
@@ -289,13 +294,27 @@ struct BulletMechanism<Planar>::Impl {
     }
   }
 
-  void step(const VecN& tau_in) {
+  // An external force's body as a Bullet link, and its point in that link's frame (at the centre of mass).
+  std::pair<int, Vec2> forceLink(const ExternalForce<Planar>& f) const {
+    const BodyRef b = f.body();
+    Vec2 com = Vec2::Zero();
+    if (b.kind == BodyRef::Kind::Link) {
+      double mass;
+      Planar::massAndCom(model.tree.bodies[std::size_t(b.index)].inertia, mass, com);
+      return {plan.link_of_tree_body[std::size_t(b.index)], f.point() - com};
+    }
+    return {plan.link_of_payload[std::size_t(b.index)], f.point()};
+  }
+
+  void step(const VecN& tau_in, double t) {
     const int n = model.treeDof();
     const int k = model.payloadDof();
     if (tau_in.size() != n && tau_in.size() != n + k)
       throw std::invalid_argument("BulletMechanism::step: τ needs one value per tree joint (and optionally per payload coordinate)");
     VecN q, v;
     state(q, v);
+    VecN held = VecN::Zero(n + k), friction = VecN::Zero(n);  // generalised forces held over the step
+    held.head(tau_in.size()) = tau_in;
     std::fill(link_torque.begin(), link_torque.end(), 0.0);
     std::fill(link_force.begin(), link_force.end(), Vec2::Zero());
     // Payload forces w (ψ, x, y on the free coordinates): a torque and a force at the centre of mass.
@@ -311,12 +330,27 @@ struct BulletMechanism<Planar>::Impl {
         link_torque[std::size_t(l)] += w[0];
         link_force[std::size_t(l)] += Vec2(w[1], w[2]);
       }
+    // External forces at the step's start: a force at the link's centre of mass and its moment.
+    std::vector<std::tuple<int, Vec2, Planar::Vec, Vec2, double>> applied;  // link, point, F, p, φ
+    for (const auto& ef : model.forces) {
+      const auto [l, r_local] = forceLink(*ef);
+      const LinkMotion& m = now[std::size_t(l)];
+      const Vec2 r = rotate(m.phi, r_local), p = m.c + r;
+      const Planar::Vec V(m.omega, m.v.x() - m.omega * r.y(), m.v.y() + m.omega * r.x());
+      const Planar::Vec F = ef->force(t, p, V);
+      const double torque = F[0] + cross(r, Vec2(F[1], F[2]));
+      body->addLinkForce(l, btVector3(F[1], F[2], 0));
+      body->addLinkTorque(l, btVector3(0, 0, torque));
+      link_force[std::size_t(l)] += Vec2(F[1], F[2]);
+      link_torque[std::size_t(l)] += torque;
+      applied.emplace_back(l, r_local, F, p, m.phi);
+    }
     for (int i = 0; i < n; ++i) {
       double tau = tau_in[i];
       if (!model.joints.empty()) {  // spring, viscous and Coulomb friction from the step's start
         const JointProperties& jp = model.joints[std::size_t(i)];
-        tau -= jp.stiffness * (q[i] - jp.rest) + jp.viscous * v[i] +
-               jp.coulomb * std::clamp(v[i] / jp.coulomb_width, -1.0, 1.0);
+        friction[i] = jp.friction(v[i]);
+        tau -= jp.stiffness * (q[i] - jp.rest) + friction[i];
       }
       // Pitfall 3: applied torques are cleared after each step; apply them every step.
       const int k = joint_link[std::size_t(i)];
@@ -347,6 +381,19 @@ struct BulletMechanism<Planar>::Impl {
     std::vector<LinkMotion> start;
     planarKinematics(plan, q0, v0, &qdd, start);
     constraintForces(start);
+    // The books: the held forces along the displacement the step took.
+    VecN q1, v1;
+    state(q1, v1);
+    for (int i = 0; i < n + k; ++i) {
+      const double dq = q1[i] - q[i];
+      books.work += held[i] * dq;
+      if (i < n) books.friction -= friction[i] * dq;
+    }
+    for (const auto& [l, r_local, F, p0, phi0] : applied) {
+      const LinkMotion& m = now[std::size_t(l)];
+      const Vec2 p1 = m.c + rotate(m.phi, r_local);
+      books.work += F[1] * (p1.x() - p0.x()) + F[2] * (p1.y() - p0.y()) + F[0] * (m.phi - phi0);
+    }
   }
 
   // Force and moment constraint c applied to Bullet's B over the step (A receives the opposite), world
@@ -429,7 +476,9 @@ template <class S>
 BulletMechanism<S>::~BulletMechanism() = default;
 
 template <>
-void BulletMechanism<Planar>::step(const VecN& tau) { impl_->step(tau); }
+void BulletMechanism<Planar>::step(const VecN& tau, double t) { impl_->step(tau, t); }
+template <>
+Books BulletMechanism<Planar>::books() const { return impl_->books; }
 template <>
 void BulletMechanism<Planar>::state(VecN& q, VecN& v) const { impl_->state(q, v); }
 template <>

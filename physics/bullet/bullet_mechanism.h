@@ -9,6 +9,7 @@
 #include <memory>
 #include <string>
 
+#include "physics/integrate.h"
 #include "physics/mechanism.h"
 
 namespace dyn::bullet {
@@ -26,11 +27,16 @@ class BulletMechanism {
   BulletMechanism(const BulletMechanism&) = delete;
   BulletMechanism& operator=(const BulletMechanism&) = delete;
 
-  // One fixed step of dt with the tree-joint torques τ held (joint springs and friction of the
-  // description are added as joint torques from the state at the start of the step). τ may carry
-  // n + k values: then the last k are generalised forces on the payloads' free coordinates (ψ, x, y:
-  // a torque and a world-axes force at the centre of mass), as for ConstrainedMechanism::solve.
-  void step(const VecN& tau);
+  // One fixed step of dt from time t with the tree-joint torques τ held (joint springs and friction of
+  // the description are added as joint torques from the state at the start of the step, the external
+  // forces as link forces and torques evaluated there at t: Bullet's one step is its one substep). τ may
+  // carry n + k values: then the last k are generalised forces on the payloads' free coordinates (ψ, x,
+  // y: a torque and a world-axes force at the centre of mass), as for ConstrainedMechanism::solve.
+  void step(const VecN& tau, double t = 0);
+  // The books (integrate.h) of Bullet's run: each step's held forces times the displacement it took
+  // (τ·Δq, F·Δp + τ_F Δφ for an external force, −(b θ' + F_c tanh(θ'/w))·Δθ for friction): first order,
+  // as Bullet's own step.
+  Books books() const;
   // The state in the description's coordinates.
   void state(VecN& q, VecN& v) const;
   // The force of constraint i over the last step (body a on body b, world axes at its point). Rolling:

@@ -9,6 +9,12 @@
 //             μ, restitution 0, rigid or with the contact stiffness and damping (k_e, d_e) of the
 //             description (contact_balls.h: the shared ball-on-plane model, and what Bullet does with
 //             ρ < 1 mm, stiffness and its speculative touchdown).
+//   point_closure (loop closures, e.g. from a model file): a btMultiBodyPoint2Point when it holds
+//             translations only, a btMultiBodyFixedConstraint (the body frames kept aligned) when it
+//             holds a rotation row; Bullet then holds all 3 (or 6) rows, so rows the description
+//             leaves out must be identically satisfied there (as the model-file loader's dropped
+//             rows are: out-of-plane rows of a planar loop). Its force: B's share of the impulses
+//             / dt (point-to-point +λ, fixed −λ, rows written for A; moment rows 3..5), at the pivot.
 // Other constraint kinds, cut joints and payloads are refused (std::invalid_argument: "not yet").
 // The force reported for a ball contact is the plane's on the ball over the step (impulses / dt: the
 // normal force η n plus, when μ > 0, the friction force; n·f = η ≥ 0), with its moment about the
@@ -38,6 +44,8 @@
 // the step's start, as in the planar builder.
 #include <btBulletDynamicsCommon.h>
 #include <BulletDynamics/Featherstone/btMultiBody.h>
+#include <BulletDynamics/Featherstone/btMultiBodyFixedConstraint.h>
+#include <BulletDynamics/Featherstone/btMultiBodyPoint2Point.h>
 #include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
 #include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
@@ -53,6 +61,7 @@
 #include "physics/bullet/contact_balls.h"
 #include "physics/bullet/rolling_constraint.h"
 #include "physics/constraints/plane_contact.h"
+#include "physics/constraints/point_closure.h"
 #include "physics/constraints/rolling.h"
 
 #ifndef BT_USE_DOUBLE_PRECISION
@@ -139,8 +148,18 @@ struct BulletMechanism<Spatial>::Impl {
     btVector3 start_point{0, 0, 0};               // c − ρ n at the last step's start
   };
 
+  // A point_closure of the description: its Bullet constraint, and the sign taking B's force to the
+  // description's (a on b): −1 when the closure's a is the world (Bullet's A must be a link).
+  struct Loop {
+    int constraint = -1;
+    bool weld = false;
+    double sign = 1.0;
+    btMultiBodyConstraint* bt = nullptr;
+  };
+
   MechanismModel<Spatial> model;
   double dt;
+  std::vector<Loop> loops;
   std::vector<LinkFrame> frames;
   std::vector<Wheel> wheels;
   std::vector<Contact> contacts;
@@ -156,6 +175,7 @@ struct BulletMechanism<Spatial>::Impl {
 
   Impl(const MechanismModel<Spatial>& m, double step, const VecN& q0, const VecN& v0) : model(m), dt(step), world(bt(Spatial::linear(m.tree.gravity)), m.bullet.solver_iterations) {
     check(q0, v0);
+    if (!m.forces.empty()) throw std::invalid_argument("BulletMechanism (spatial): external forces are not modelled yet");
     frames = linkFrames(m.tree);
     force.assign(m.constraints.size(), Spatial::Vec::Zero());
     btContactSolverInfo& info = world->getSolverInfo();
@@ -199,9 +219,10 @@ struct BulletMechanism<Spatial>::Impl {
     }
     for (std::size_t c = 0; c < model.constraints.size(); ++c) {
       const Constraint<Spatial>* k = model.constraints[c].get();
-      if (!dynamic_cast<const Rolling*>(k) && !dynamic_cast<const PlaneContact<Spatial>*>(k))
+      if (!dynamic_cast<const Rolling*>(k) && !dynamic_cast<const PlaneContact<Spatial>*>(k) &&
+          !dynamic_cast<const PointClosure<Spatial>*>(k))
         throw std::invalid_argument(who + "constraint " + std::to_string(c) + " (" + k->kind() +
-                                    "): not yet (only rolling and plane_contact)");
+                                    "): not yet (only rolling, plane_contact and point_closure)");
     }
   }
 
@@ -255,6 +276,10 @@ struct BulletMechanism<Spatial>::Impl {
     const bool friction = model.bullet.rolling == RollingModel::Friction;
     std::vector<ContactBall> list;
     for (std::size_t c = 0; c < model.constraints.size(); ++c) {
+      if (dynamic_cast<const PointClosure<Spatial>*>(model.constraints[c].get())) {
+        buildLoop(int(c));
+        continue;
+      }
       if (const auto* pc = dynamic_cast<const PlaneContact<Spatial>*>(model.constraints[c].get())) {
         Contact k;
         k.constraint = int(c), k.plane = pc, k.link = pc->body().index;
@@ -291,6 +316,50 @@ struct BulletMechanism<Spatial>::Impl {
     balls.build(world, link_colliders, std::move(list), "BulletMechanism (spatial): ");
   }
 
+  // A loop closure: pivots in the Bullet link frames (the world's: world coordinates), a link as A.
+  void buildLoop(int c) {
+    Attachment<Spatial> at = model.constraints[std::size_t(c)]->attachment();
+    Loop loop;
+    loop.constraint = c;
+    for (int r = 0; r < 3; ++r) loop.weld = loop.weld || at.rows[std::size_t(r)];
+    if (at.a.isWorld()) {
+      std::swap(at.a, at.b);
+      std::swap(at.point_a, at.point_b);
+      loop.sign = -1.0;
+    }
+    static const LinkFrame world_frame;
+    const LinkFrame& la = frames[std::size_t(at.a.index)];
+    const LinkFrame& lb = at.b.isWorld() ? world_frame : frames[std::size_t(at.b.index)];
+    const btVector3 pa = bt(la.E_p * (at.point_a - la.com)), pb = bt(lb.E_p * (at.point_b - lb.com));
+    // A weld keeps the body frames aligned: each link's frame is its body's turned by E_p.
+    auto frame = [](const Mat3& E) { return btMatrix3x3(E(0, 0), E(0, 1), E(0, 2), E(1, 0), E(1, 1), E(1, 2), E(2, 0), E(2, 1), E(2, 2)); };
+    btMultiBody* b = at.b.isWorld() ? nullptr : body.get();
+    const int link_b = at.b.isWorld() ? -1 : at.b.index;
+    std::unique_ptr<btMultiBodyConstraint> k;
+    if (loop.weld)
+      k = b ? std::unique_ptr<btMultiBodyConstraint>(new btMultiBodyFixedConstraint(body.get(), at.a.index, b, link_b, pa, pb, frame(la.E_p), frame(lb.E_p)))
+            : std::unique_ptr<btMultiBodyConstraint>(new btMultiBodyFixedConstraint(body.get(), at.a.index, nullptr, pa, pb, frame(la.E_p), frame(lb.E_p)));
+    else
+      k = b ? std::unique_ptr<btMultiBodyConstraint>(new btMultiBodyPoint2Point(body.get(), at.a.index, b, link_b, pa, pb))
+            : std::unique_ptr<btMultiBodyConstraint>(new btMultiBodyPoint2Point(body.get(), at.a.index, nullptr, pa, pb));
+    k->setMaxAppliedImpulse(kImpulseCap);
+    world->addMultiBodyConstraint(k.get());
+    k->finalizeMultiDof();
+    loop.bt = k.get();
+    closures.push_back(std::move(k));
+    loops.push_back(loop);
+  }
+
+  // B's share of a loop's impulses over the step, as the description's force (a on b, world axes).
+  Spatial::Vec loopForce(const Loop& l) const {
+    Spatial::Vec f = Spatial::Vec::Zero();
+    const double s = l.sign * (l.weld ? -1.0 : 1.0) / dt;
+    for (int r = 0; r < 3; ++r) f[3 + r] = s * l.bt->getAppliedImpulse(r);
+    if (l.weld)
+      for (int r = 0; r < 3; ++r) f[r] = s * l.bt->getAppliedImpulse(3 + r);
+    return f;
+  }
+
   void summarise() {
     std::ostringstream s;
     s << "Bullet 3.24 btMultiBody (" << model.treeDof() << " links) hung from the world";
@@ -302,6 +371,10 @@ struct BulletMechanism<Spatial>::Impl {
           << ", cone)";
     }
     if (!contacts.empty()) s << ", " << contacts.size() << " plane contact(s) as a sphere on a static plane";
+    if (!loops.empty()) {
+      const auto welds = std::count_if(loops.begin(), loops.end(), [](const Loop& l) { return l.weld; });
+      s << ", " << loops.size() - std::size_t(welds) << " btMultiBodyPoint2Point and " << welds << " btMultiBodyFixedConstraint loop closure(s)";
+    }
     s << ", PGS " << model.bullet.solver_iterations << " iterations";
     summary = s.str();
   }
@@ -352,11 +425,13 @@ struct BulletMechanism<Spatial>::Impl {
     if (tau_in.size() != n) throw std::invalid_argument("BulletMechanism::step: τ needs one value per tree joint (" + std::to_string(n) + ")");
     VecN q, v;
     state(q, v);
+    VecN friction = VecN::Zero(n);
     for (int i = 0; i < n; ++i) {
       double tau = tau_in[i];
       if (!model.joints.empty()) {  // spring, viscous and Coulomb friction from the step's start
         const JointProperties& jp = model.joints[std::size_t(i)];
-        tau -= jp.stiffness * (q[i] - jp.rest) + jp.viscous * v[i] + jp.coulomb * std::clamp(v[i] / jp.coulomb_width, -1.0, 1.0);
+        friction[i] = jp.friction(v[i]);
+        tau -= jp.stiffness * (q[i] - jp.rest) + friction[i];
       }
       body->addJointTorque(i, tau);  // pitfall 3: cleared after every step
     }
@@ -365,9 +440,18 @@ struct BulletMechanism<Spatial>::Impl {
     for (Contact& k : contacts)
       k.start_point = body->localPosToWorld(k.link, k.centre) - k.plane->params().radius * bt(k.plane->normal());
     world->stepSimulation(dt, 0, dt);  // exactly one step of dt
+    for (const Loop& l : loops) force[std::size_t(l.constraint)] = loopForce(l);
     for (Wheel& w : wheels) force[std::size_t(w.constraint)] = w.noslip ? noSlipForce(w) : ballForce(w.ball, w.start_point);
     for (Contact& k : contacts) force[std::size_t(k.constraint)] = ballForce(k.ball, k.start_point);
+    // The books: the held torques along the step's displacement.
+    VecN q1, v1;
+    state(q1, v1);
+    for (int i = 0; i < n; ++i) {
+      books.work += tau_in[i] * (q1[i] - q[i]);
+      books.friction -= friction[i] * (q1[i] - q[i]);
+    }
   }
+  Books books;
 
   // The constraint's impulses over the step, at the point it was written at: no moment there.
   Spatial::Vec noSlipForce(const Wheel& w) const {
@@ -394,7 +478,12 @@ BulletMechanism<Spatial>::BulletMechanism(const MechanismModel<Spatial>& model, 
 template <>
 BulletMechanism<Spatial>::~BulletMechanism() {}
 template <>
-void BulletMechanism<Spatial>::step(const VecN& tau) { impl_->step(tau); }
+void BulletMechanism<Spatial>::step(const VecN& tau, double t) {
+  (void)t;  // no time-dependent forces: the spatial builder refuses external forces
+  impl_->step(tau);
+}
+template <>
+Books BulletMechanism<Spatial>::books() const { return impl_->books; }
 template <>
 void BulletMechanism<Spatial>::state(VecN& q, VecN& v) const { impl_->state(q, v); }
 template <>

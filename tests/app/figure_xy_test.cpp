@@ -40,7 +40,7 @@ TEST_CASE("dynlab figure --plot Y:X: x–y plots of both runs, legend and labels
   // Hand solid and Bullet dashed, each named; the x and y labels carry the lab's units.
   const std::string force = text("plot_f_Ty-vs-f_Tx.svg");
   for (const char* label : {"f_Ty vs f_Tx (hand)", "f_Ty vs f_Tx (Bullet)", "f_Tx (N)", "f_Ty (N)",
-                            "slider_crank: f_Ty vs f_Tx"})
+                            "Slider crank: f_Ty vs f_Tx"})  // the lab by its name, not its id
     CHECK_MESSAGE(has(force, label), "missing " << label);
   CHECK_FALSE(has(force, "t (s)"));
   const std::string phase = text("plot_v_c-vs-x_c.svg");

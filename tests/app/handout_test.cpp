@@ -1,10 +1,14 @@
 // dynlab handout end to end: for every registered lab the handout names every gain, rubric test,
 // scenario and metric with the JSON's own numbers (a changed threshold, bound or window in a
-// --config shows up changed); the HTML is self-contained; bad input is one line and exit 2.
+// --config shows up changed); every `dynlab ...` command it prints runs as printed (a student
+// copies them); the HTML is self-contained; bad input is one line and exit 2.
 #include <doctest/doctest.h>
 
 #include <cstdio>
+#include <iostream>
 #include <nlohmann/json.hpp>
+#include <regex>
+#include <set>
 
 #include "tests/app/cli_run.h"
 
@@ -32,6 +36,31 @@ std::vector<std::string> labNames(const TempDir& dir) {
 }
 
 bool has(const std::string& text, const std::string& what) { return text.find(what) != std::string::npos; }
+
+// The handout's example submission: its first ```json block.
+std::string exampleSubmission(const std::string& md) {
+  const std::size_t at = md.find("```json\n");
+  REQUIRE(at != std::string::npos);
+  return md.substr(at + 8, md.find("```", at + 8) - at - 8);
+}
+
+// What a test adds to a printed command so it stays quick and writes where the test looks: a short
+// run, no video or plots where the option exists, its own --out. The command itself is as printed.
+std::string quickened(const std::string& sub, int k) {
+  const std::string out = " --out o" + std::to_string(k);
+  if (sub == "run") return " --duration 0.4" + out;
+  if (sub == "figure") return " --duration 0.4 --engine hand --format svg" + out;
+  if (sub == "map") return " --duration 0.2 --out m" + std::to_string(k) + ".png";
+  if (sub == "grade" || sub == "compare") return " --no-plots" + out;
+  if (sub == "handout") return out;
+  if (sub == "ui") return " --frames 2";
+  return "";
+}
+
+bool haveXvfb() {
+  static const bool have = std::system("command -v xvfb-run >/dev/null 2>&1 && command -v xauth >/dev/null 2>&1") == 0;
+  return have;
+}
 
 }  // namespace
 
@@ -68,6 +97,60 @@ TEST_CASE("every lab's handout names every gain, test, scenario and metric with 
     for (const auto& l : config.at("rubric").value("leaderboard", json::array())) CHECK(has(md, l.at("name").get<std::string>()));
     for (const std::string& how : {"dynlab run " + lab, "dynlab ui " + lab, "dynlab grade my_gains.json --lab " + lab, "dynlab schema " + lab})
       CHECK_MESSAGE(has(md, how), how);
+  }
+}
+
+TEST_CASE("every dynlab command a handout prints runs as printed, in every lab") {
+  TempDir dir("handout_commands");
+  for (const auto& lab : labNames(dir)) {
+    INFO("lab ", lab);
+    const TempDir student("handout_commands_" + lab);  // one folder per lab: its own my_gains.json
+    REQUIRE(dynlab(dir, "handout " + lab + " --out h_" + lab + " --format md").code == 0);
+    const std::string md = readFile(dir / ("h_" + lab + "/handout.md"));
+    const std::string example = exampleSubmission(md);
+    // Every code span that is a dynlab command, once.
+    std::set<std::string> commands;
+    const std::regex span("`(dynlab [^`]+)`");
+    for (auto it = std::sregex_iterator(md.begin(), md.end(), span); it != std::sregex_iterator(); ++it) commands.insert((*it)[1]);
+    REQUIRE(commands.size() >= 8);
+    int k = 0, ran = 0;
+    for (const auto& command : commands) {
+      INFO("command: ", command);
+      std::istringstream words(command);
+      std::string word, sub, args;
+      words >> word >> sub;
+      // "`dynlab grade`" in a sentence names a command; a command has its argument.
+      if (!(words >> word) || word[0] == '-') continue;
+      args = sub;
+      do {
+        // A file it names: the repository's (labs/...: run from its root), else the student's submission.
+        if (word.size() > 5 && word.substr(word.size() - 5) == ".json") {
+          if (fs::exists(fs::path(DYNLAB_SOURCE_DIR) / word)) {
+            word = (fs::path(DYNLAB_SOURCE_DIR) / word).string();
+          } else if (!fs::exists(student / word)) {
+            fs::create_directories((student / word).parent_path());
+            writeFile(student / word, example);
+          }
+        }
+        args += " " + word;
+      } while (words >> word);
+      args += quickened(sub, ++k);
+      ++ran;
+      Result r;
+      if (sub == "ui") {
+        if (!haveXvfb()) {
+          std::cout << "note: xvfb-run not found, `" << command << "` not run\n";
+          continue;
+        }
+        r = shell(student, "xvfb-run -a -s '-screen 0 1600x900x24' " + quote(DYNLAB_BIN) + " " + args);
+      } else {
+        r = dynlab(student, args);
+      }
+      INFO("ran: dynlab ", args, "\nstdout: ", r.out, "\nstderr: ", r.err);
+      // 0, or 1 for a run the watchdog stopped (the defaults of some labs are meant to fail a scenario).
+      CHECK((r.code == 0 || (r.code == 1 && (sub == "run" || sub == "figure"))));
+    }
+    CHECK(ran >= 8);  // run, ui, grade, figure, map, schema, lessons, handout
   }
 }
 

@@ -10,35 +10,15 @@
 
 #include "app/map_plot.h"
 #include "tests/app/cli_run.h"
+#include "tests/app/png_ink.h"
 
 using namespace dyn::test::cli;
+using dyn::test::Ink;
+using dyn::test::inkOf;
 
 namespace {
 
 std::string magicOf(const fs::path& p) { return readFile(p).substr(0, 8); }
-
-// Where a PNG has ink (any pixel not white): its box, and whether any lies within `strip` pixels of
-// an edge (a label or legend cut off by the page).
-struct Ink {
-  int width = 0, height = 0, x0 = 0, y0 = 0, x1 = -1, y1 = -1;
-  bool at_edge = false;
-};
-Ink inkOf(const fs::path& png, int strip = 2) {
-  Ink ink;
-  int n = 0;
-  unsigned char* data = stbi_load(png.string().c_str(), &ink.width, &ink.height, &n, 3);
-  REQUIRE(data != nullptr);
-  ink.x0 = ink.width, ink.y0 = ink.height;
-  for (int y = 0; y < ink.height; ++y)
-    for (int x = 0; x < ink.width; ++x) {
-      const unsigned char* p = data + (std::size_t(y) * ink.width + x) * 3;
-      if (p[0] > 250 && p[1] > 250 && p[2] > 250) continue;
-      ink.x0 = std::min(ink.x0, x), ink.x1 = std::max(ink.x1, x), ink.y0 = std::min(ink.y0, y), ink.y1 = std::max(ink.y1, y);
-      ink.at_edge = ink.at_edge || x < strip || y < strip || x >= ink.width - strip || y >= ink.height - strip;
-    }
-  stbi_image_free(data);
-  return ink;
-}
 
 // A 9 × 7 map with the grasp's long axis label, stable on the left and unstable on the right.
 dyn::app::MapPicture longLabelMap(bool values) {
@@ -109,16 +89,19 @@ TEST_CASE("screening: proportional law unstable under delay once k_pf ≥ 1, sta
 }
 
 TEST_CASE("screening: integral law unstable beyond the delay margin π/(2 k_if)") {
+  // As it runs (sampled every dt = 1 ms, the sum updated after each reading): L(z) = k dt z^{−(N−1)}/(z − 1),
+  // a loop delay of N dt − dt/2 and a margin π/(2ω_c), ω_c = (2/dt) asin(k dt/2) (≈ π/(2 k_if)).
   TempDir dir("map_i");
   const Result r = dynlab(dir, "map slider_crank --x ki_f=10:200:20 --y delay=0.005:0.05:10 --out m.svg --data m.csv");
   REQUIRE_MESSAGE(r.code == 0, r.err);
   const Csv csv = readCsv(dir / "m.csv");
   REQUIRE(csv.rows.size() == 200);
   int checked = 0;
+  const double dt = 1e-3;
   for (std::size_t i = 0; i < csv.rows.size(); ++i) {
-    const double k = csv.at(i, "ki_f"), delay = csv.at(i, "delay"), margin = M_PI / (2 * k);
-    INFO("ki_f = ", k, ", delay = ", delay, ", margin = ", margin);
-    if (std::abs(delay - margin) < 0.03 * margin) continue;  // the Padé approximant's own error
+    const double k = csv.at(i, "ki_f"), delay = csv.at(i, "delay") - dt / 2, margin = M_PI / (4 / dt * std::asin(k * dt / 2));
+    INFO("ki_f = ", k, ", loop delay = ", delay, ", margin = ", margin);
+    if (std::abs(delay - margin) < 1e-3 * margin) continue;  // on the boundary
     CHECK(csv.at(i, "screen_stable") == (delay < margin ? 1 : 0));
     // The drawn boundary field: delay margin − delay of the force loop, where it binds (the motion
     // loop's own margin caps it far from the boundary).

@@ -1,11 +1,17 @@
 // Progress bars (app/progress.h): the line's format, and the real dynlab's `run --frames` and
 // `figure` drawing one on a terminal (a pseudo-terminal here) and writing nothing of it anywhere
-// else (tests, logs and pipes stay clean).
+// else (tests, logs and pipes stay clean). Where no pseudo-terminal can be opened (a chroot without
+// /dev/pts) the terminal half prints DYNLAB_TEST_SKIPPED, which ctest reports as skipped.
 #include <doctest/doctest.h>
 #include <fcntl.h>
 #include <pty.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+#include <iostream>
+#include <optional>
 
 #include "app/progress.h"
 #include "tests/app/cli_run.h"
@@ -16,10 +22,14 @@ using namespace dyn::test::cli;
 namespace {
 
 // Runs dynlab ARGS in dir with stderr on a pseudo-terminal (stdout to a file); returns what the
-// terminal received and the exit code.
-std::pair<std::string, int> onTerminal(const TempDir& dir, const std::vector<std::string>& args) {
+// terminal received and the exit code; nothing (and a skip note) where no pseudo-terminal opens.
+std::optional<std::pair<std::string, int>> onTerminal(const TempDir& dir, const std::vector<std::string>& args) {
   int master = -1, slave = -1;
-  REQUIRE(::openpty(&master, &slave, nullptr, nullptr, nullptr) == 0);
+  if (::openpty(&master, &slave, nullptr, nullptr, nullptr) != 0) {
+    std::cout << "DYNLAB_TEST_SKIPPED: openpty failed (" << std::strerror(errno)
+              << "; is /dev/pts mounted?): the progress bar on a terminal was not checked\n";
+    return std::nullopt;
+  }
   const pid_t pid = ::fork();
   REQUIRE(pid >= 0);
   if (pid == 0) {
@@ -41,7 +51,7 @@ std::pair<std::string, int> onTerminal(const TempDir& dir, const std::vector<std
   ::close(master);
   int status = 0;
   ::waitpid(pid, &status, 0);
-  return {seen, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
+  return std::pair<std::string, int>{seen, WIFEXITED(status) ? WEXITSTATUS(status) : -1};
 }
 
 }  // namespace
@@ -75,7 +85,9 @@ TEST_CASE("dynlab run --frames and figure: a bar on a terminal, nothing of it wh
   CHECK(quiet_fig.err.empty());
 
   // A terminal: the bar, redrawn in place (carriage returns), reaching its end, then erased.
-  const auto [run, run_code] = onTerminal(dir, {"run", "slider_crank", "--duration", "0.3", "--frames", "--engine", "hand", "--out", "t"});
+  const auto on_run = onTerminal(dir, {"run", "slider_crank", "--duration", "0.3", "--frames", "--engine", "hand", "--out", "t"});
+  if (!on_run) return;
+  const auto& [run, run_code] = *on_run;
   INFO(run);
   REQUIRE(run_code == 0);
   CHECK(run.find("\rframes [") != std::string::npos);
@@ -83,8 +95,10 @@ TEST_CASE("dynlab run --frames and figure: a bar on a terminal, nothing of it wh
   CHECK(run.size() >= 4);
   CHECK(run.substr(run.size() - 4) == "\r\033[K");
   CHECK(readFile(dir / "terminal.stdout").find("frames") != std::string::npos);  // the report, on stdout as before
-  const auto [fig, fig_code] =
+  const auto on_fig =
       onTerminal(dir, {"figure", "slider_crank", "--duration", "0.3", "--still", "0.1", "--plot", "x_c", "--format", "svg", "--out", "tf"});
+  REQUIRE(on_fig);
+  const auto& [fig, fig_code] = *on_fig;
   INFO(fig);
   REQUIRE(fig_code == 0);
   CHECK(fig.find("\rsimulating hand [") != std::string::npos);

@@ -1,7 +1,10 @@
-// physics/linear: roots, the Padé delay, and loop margins against closed-form answers.
+// physics/linear: roots, the Padé delay, the zero-order hold, and loop margins (continuous and sampled)
+// against closed-form answers.
 #include <doctest/doctest.h>
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
+#include <vector>
 
 #include "physics/linear.h"
 
@@ -115,4 +118,93 @@ TEST_CASE("a PI loop with k_I = 0 screens as its P loop; the plant's own integra
   LinearLoop pi = pi0;
   pi.num = {1.0, kp};
   CHECK(analyseLoop(pi).poles.size() == 2);
+}
+
+TEST_CASE("zero-order hold: 1/s, 1/(m s²) and 1/(s + p) held over T are their closed forms") {
+  const double T = 1e-3, m = 2.5, p = 40;
+  Poly n, d;
+  zeroOrderHold({1}, {0, 1}, T, n, d);  // T/(z − 1)
+  CHECK(n.size() == 2);
+  CHECK(n[0] == doctest::Approx(T).epsilon(1e-12));
+  CHECK(std::abs(n[1]) < 1e-15);
+  CHECK(d[0] == doctest::Approx(-1.0).epsilon(1e-12));
+  CHECK(d[1] == 1.0);
+  zeroOrderHold({1}, {0, 0, m}, T, n, d);  // T²(z + 1)/(2m (z − 1)²)
+  REQUIRE(n.size() == 3);
+  CHECK(n[0] == doctest::Approx(T * T / (2 * m)).epsilon(1e-10));
+  CHECK(n[1] == doctest::Approx(T * T / (2 * m)).epsilon(1e-10));
+  CHECK(std::abs(n[2]) < 1e-15);
+  CHECK(d[0] == doctest::Approx(1.0).epsilon(1e-12));
+  CHECK(d[1] == doctest::Approx(-2.0).epsilon(1e-12));
+  zeroOrderHold({1}, {p, 1}, T, n, d);  // (1 − e^{−pT}) / (p (z − e^{−pT}))
+  CHECK(n[0] == doctest::Approx((1 - std::exp(-p * T)) / p).epsilon(1e-12));
+  CHECK(d[0] == doctest::Approx(-std::exp(-p * T)).epsilon(1e-12));
+  zeroOrderHold({3}, {1}, T, n, d);  // a static gain passes unchanged
+  CHECK(n == Poly{3});
+  CHECK(d == Poly{1});
+  CHECK_THROWS(zeroOrderHold({0, 0, 1}, {0, 1}, T, n, d));  // improper: s
+}
+
+TEST_CASE("sampled PD on m s²: the poles are ln of the eigenvalues of the held closed loop, over T") {
+  // x' = v, m v' = u held over T, u_k = −(k_p x_k + k_d v_k): exactly x⁺ = x + T v + T² u/(2m),
+  // v⁺ = v + T u/m. Its matrix's eigenvalues are e^{sT} of the screened poles.
+  const double m = 2.5, kp = 4e4, kd = 300, T = 2e-3;
+  LinearLoop loop{"motion", "PD", {kp, kd}, {0, 0, m}, T / 2};
+  loop.sampled = {T, {kp, kd}, {0, 0, m}};
+  const LoopAnalysis a = analyseLoop(loop);
+  Eigen::Matrix2d Phi;
+  Phi << 1 - T * T * kp / (2 * m), T - T * T * kd / (2 * m), -T * kp / m, 1 - T * kd / m;
+  const Eigen::Vector2cd z = Phi.eigenvalues();
+  REQUIRE(a.poles.size() == 2);
+  for (int i = 0; i < 2; ++i) {
+    const std::complex<double> s = std::log(z[i]) / T;
+    bool found = false;
+    for (const auto& p : a.poles) found = found || std::abs(p - s) < 1e-8 * std::abs(s);
+    CHECK(found);
+  }
+  CHECK(a.stable);
+  // Past the sampled loop's limit (here k_d T/m ≥ 2 or so) it is unstable although the continuous one is not.
+  loop.sampled = {T, {kp, 3000}, {0, 0, m}};
+  loop.num = {kp, 3000};
+  CHECK_FALSE(analyseLoop(loop).stable);
+}
+
+TEST_CASE("sampled integral loop a z^{−N}/(z − 1): delay margin π/(2ω_c), ω_c = (2/T) asin(a/2)") {
+  // L(e^{jωT}) = a e^{−jωT(N + ½)} / (2j sin(ωT/2)): its crossover and the stated delay (N + ½)T
+  // give a margin that does not depend on N (past it, at 40 steps, the loop is unstable: the same margin).
+  const double T = 1e-3, k = 120, a = k * T, wc = 2 / T * std::asin(a / 2);
+  for (const int N : {1, 5, 10, 40}) {  // 40 steps: far past the margin
+    CAPTURE(N);
+    LinearLoop loop{"force", "integral", {k}, {0, 1}, (N + 0.5) * T};
+    loop.sampled = {T, {1}, {1}, {a}, {-1, 1}, N};
+    const LoopAnalysis an = analyseLoop(loop);
+    CHECK(an.delay_margin == doctest::Approx(M_PI / (2 * wc)).epsilon(1e-6));
+    CHECK(an.stable == (loop.delay < an.delay_margin));
+    // The slowest pole decays as the recursion f(k+1) = f(k) − a f(k − N) does.
+    std::vector<double> f(2000, 0.0);
+    f[std::size_t(N)] = 1.0;
+    for (std::size_t j = std::size_t(N); j + 1 < f.size(); ++j) f[j + 1] = f[j] - a * f[j - std::size_t(N)];
+    double peak_early = 0, peak_late = 0;
+    for (std::size_t j = 1000; j < 1300; ++j) peak_early = std::max(peak_early, std::abs(f[j]));
+    for (std::size_t j = 1700; j < 2000; ++j) peak_late = std::max(peak_late, std::abs(f[j]));
+    const double rate = std::log(peak_late / peak_early) / (700 * T);
+    CHECK(rate == doctest::Approx(an.max_real).epsilon(0.02));
+  }
+}
+
+TEST_CASE("a delay of more than kMaxSampledSteps steps is screened in continuous time (a grade's budget holds)") {
+  // dt 10 µs against a 10 ms delay is 1000 steps: 1000 discrete poles to find, seconds per screening;
+  // at such a step the sampled and the continuous loop agree, and the continuous answer is the same one.
+  const double T = 1e-5, k = 20;
+  const int N = 1000;
+  LinearLoop loop{"force", "integral", {k}, {0, 1}, (N + 0.5) * T};
+  const LoopAnalysis continuous = analyseLoop(loop);
+  loop.sampled = {T, {1}, {1}, {k * T}, {-1, 1}, N};
+  REQUIRE(N > kMaxSampledSteps);
+  const LoopAnalysis an = analyseLoop(loop);
+  CHECK(an.delay_margin == continuous.delay_margin);
+  CHECK(an.max_real == continuous.max_real);
+  CHECK(an.poles.size() == continuous.poles.size());
+  // The closed form of the continuous integral loop k e^{−sτ}/s: margin π/(2k).
+  CHECK(an.delay_margin == doctest::Approx(M_PI / (2 * k)).epsilon(1e-3));
 }

@@ -377,13 +377,13 @@ TEST_CASE("joint springs and friction in h: the damped oscillator's closed form,
     if (b == 0.0) CHECK(de < 1e-10 * e0);  // ½ k (θ − θ_r)² is in the energy
     else CHECK(de > 1e-3 * e0);            // and viscous friction really dissipates
   }
-  SUBCASE("Coulomb friction: a torque below F_c creeps at w τ / F_c inside the smoothing width") {
+  SUBCASE("Coulomb friction: a torque below F_c creeps at w atanh(τ / F_c) inside the smoothing width (F_c tanh(θ'/w))") {
     d.joints = {JointProperties{0.0, 0.0, 0.0, 2.0, 1e-2}};
     ConstrainedMechanism<Planar> mech(d);
     VecN q = VecN::Zero(1), v = VecN::Zero(1), tau(1);
     tau << 0.5;
     for (int n = 0; n < 2000; ++n) REQUIRE(step(mech, StepOptions{}, tau, q, v));
-    CHECK(std::abs(v[0] - 1e-2 * 0.5 / 2.0) < 1e-9);
+    CHECK(std::abs(v[0] - 1e-2 * std::atanh(0.5 / 2.0)) < 1e-9);
   }
 }
 

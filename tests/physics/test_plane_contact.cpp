@@ -2,6 +2,7 @@
 // open/close handling (ConstrainedMechanism::updateContacts), against closed forms:
 //  * a ball dropped from H touches down at √(2H/g) (within a step), the plastic impact removes the
 //    normal velocity and keeps the tangential one (frictionless plane), then it rests with η = m g;
+//  * located inside its step (stepLocatingContacts), the touchdown lands on the plane: no step ends past it;
 //  * pulled up harder than its weight, the contact opens and the ball rises as ½ (F/m − g) t²;
 //  * a two-link arm resting its tip on the table presses with the η of its static balance, τ = G − Jᵀ f;
 //  * a compliant plane (k_e) holds the ball at depth m g / k_e, and without damping conserves energy.
@@ -80,6 +81,43 @@ TEST_CASE("plane contact: a dropped ball touches down, stops its normal motion, 
   CHECK(std::abs(run.v[0] - vx) < 1e-12);
   CHECK(std::abs(run.q[1] - kRho) < 1e-9);
   CHECK(std::abs(eta - kM * kG) < 1e-9);
+}
+
+TEST_CASE("plane contact: the touchdown located inside its step lands on the plane at √(2H/g)") {
+  // stepLocatingContacts: the step that crosses the plane is retaken to the crossing, the contact closed
+  // there (its impact), and finished resting. No step ends past the plane; the ball's height at every
+  // step end is the closed form, free fall until √(2H/g) and ρ after; the impact stops v_y at once.
+  const double H = 0.05, vx = 0.3;
+  for (const Integrator integrator : {Integrator::RK4, Integrator::SemiImplicitEuler}) {
+    const std::string scheme = name(integrator);
+    CAPTURE(scheme);
+    Run run(ball(rigid()), integrator);
+    run.q = VecN(2);
+    run.v = VecN(2);
+    run.q << 0.0, kRho + H;
+    run.v << vx, 0.0;
+    const VecN tau = VecN::Zero(2);
+    const double dt = run.options.dt, t_fall = std::sqrt(2 * H / kG);
+    double depth = 0, worst = 0;
+    for (int k = 1; k <= 200; ++k) {
+      run.mech.updateContacts(run.q, run.v, tau);
+      REQUIRE(run.mech.stepLocatingContacts(run.options, tau, run.q, run.v));
+      const double t = k * dt;
+      depth = std::max(depth, kRho - run.q[1]);
+      if (integrator == Integrator::RK4) {
+        const double y = t < t_fall ? kRho + H - 0.5 * kG * t * t : kRho;
+        worst = std::max(worst, std::abs(run.q[1] - y));
+      }
+      if (t > t_fall + dt) {
+        CHECK(run.mech.closed(0));
+        CHECK(std::abs(run.v[1]) < 1e-12);
+      }
+    }
+    MESSAGE(scheme, ": deepest ", depth, " m; RK4's height against the closed form ", worst, " m");
+    CHECK(depth < 1e-12);
+    CHECK(worst < 1e-11);
+    CHECK(std::abs(run.v[0] - vx) < 1e-12);
+  }
 }
 
 TEST_CASE("plane contact: pulled up harder than its weight the ball lifts off") {

@@ -274,3 +274,40 @@ TEST_CASE("dynlab ui LAB runs the window (one entry point)") {
   CHECK(state["submission"]["gains"]["kp_x"] == 150.0);  // from --gains
   CHECK(state["submission"]["gains"]["kp_f"] == 0.25);    // from --set, passed through
 }
+
+TEST_CASE("every gain slider shows its whole name and its value's digits: a thin knob, names inside the panel") {
+  if (!haveXvfb()) return;
+  const fs::path dir = test::scratchDir("dynlab_ui_window", "sliders");
+  // The unicycle's long gain names (kd_heading, anti_windup) at the default window size.
+  const Result r = inXvfb(dir, DYNLAB_UI_BIN, "unicycle --frames 2 --screenshot shot.png --state state.json");
+  INFO(r.out << r.err);
+  REQUIRE(r.code == 0);
+  const json state = loadJsonFile((dir / "state.json").string());
+  const Png shot = loadPng(dir / "shot.png");
+  REQUIRE(shot.width > 0);
+  const double right = state["panel_right"];
+  REQUIRE(state["gain_sliders"].size() == state["submission"]["gains"].size());
+  for (const auto& w : state["gain_sliders"]) {
+    const std::string name = w["name"];
+    INFO("gain ", name);
+    const int x0 = int(w["frame"][0].get<double>()), y0 = int(w["frame"][1].get<double>());
+    const int x1 = int(w["frame"][2].get<double>()), y1 = int(w["frame"][3].get<double>());
+    REQUIRE((x0 >= 0 && x1 <= shot.width && y0 >= 0 && y1 <= shot.height && x1 - x0 > 40));
+    // The name ends inside the panel (not cut at its edge).
+    CHECK(w["label"][2].get<double>() <= right - 2);
+    // The knob: columns of the frame holding its blue, at most a few pixels wide; the digits: dark
+    // pixels of the text over the frame's middle.
+    int knob = 0, dark = 0;
+    for (int x = x0 + 2; x < x1 - 2; ++x) {
+      bool blue = false;
+      for (int y = y0 + 2; y < y1 - 2; ++y) {
+        const std::uint8_t* p = shot.pixel(x, y);
+        blue = blue || (p[2] > 150 && p[2] > p[0] + 60 && p[1] > 100);
+        dark += p[0] < 90 && p[1] < 90 && p[2] < 90;
+      }
+      knob += blue;
+    }
+    CHECK(knob <= 6);
+    CHECK(dark > 20);
+  }
+}

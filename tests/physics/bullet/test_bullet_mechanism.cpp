@@ -217,7 +217,7 @@ TEST_CASE("joint spring and viscous friction: damped frequency sqrt(k/I − (b/2
   CHECK(ratio == doctest::Approx(decay).epsilon(2e-3));  // explicit damping: O(b dt / I) per period
 }
 
-TEST_CASE("Coulomb friction: creeps at w τ/F_c inside the smoothing width") {
+TEST_CASE("Coulomb friction: creeps at w atanh(τ/F_c) inside the smoothing width (F_c tanh(θ'/w))") {
   MechanismModel<Planar> m = chain({{0.5, 1.0}}, 0.0);
   dyn::JointProperties jp;
   jp.coulomb = 1.0, jp.coulomb_width = 1e-2;
@@ -226,10 +226,14 @@ TEST_CASE("Coulomb friction: creeps at w τ/F_c inside the smoothing width") {
   VecN q, v;
   for (int k = 0; k < 2000; ++k) b.step(vec({0.5}));
   b.state(q, v);
-  CHECK(v[0] == doctest::Approx(0.5 * jp.coulomb_width / jp.coulomb).epsilon(1e-6));
+  CHECK(v[0] == doctest::Approx(jp.coulomb_width * std::atanh(0.5 / jp.coulomb)).epsilon(1e-6));
   for (int k = 0; k < 2000; ++k) b.step(vec({-0.25}));
   b.state(q, v);
-  CHECK(v[0] == doctest::Approx(-0.25 * jp.coulomb_width / jp.coulomb).epsilon(1e-6));
+  CHECK(v[0] == doctest::Approx(jp.coulomb_width * std::atanh(-0.25 / jp.coulomb)).epsilon(1e-6));
+  // The books: friction's work is minus what τ put in at the steady creep (E constant: no gravity).
+  const dyn::Books books = b.books();
+  CHECK(books.friction < 0.0);
+  CHECK(books.work > 0.0);
 }
 
 TEST_CASE("payloads: a free planar body falls and spins as the discrete semi-implicit step predicts") {

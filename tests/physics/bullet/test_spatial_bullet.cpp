@@ -16,6 +16,7 @@
 #include "physics/bullet/bullet_mechanism.h"
 #include "physics/constrained_mechanism.h"
 #include "physics/constraints/point_closure.h"
+#include "physics/constraints/point_contact.h"
 #include "tests/physics/bullet/unicycle_description.h"
 
 using namespace dyn;
@@ -146,10 +147,10 @@ TEST_CASE("spatial: descriptions Bullet cannot model throw std::invalid_argument
   }
   {
     auto m = u.model();
-    m.constraints.push_back(std::make_shared<PointClosure<Spatial>>(BodyRef::link(4), Pos::Zero(), BodyRef::world(),
-                                                                    Pos(0, 0, 0.1), PointClosure<Spatial>::translations()));
+    m.constraints.push_back(std::make_shared<PointContact<Spatial>>(BodyRef::link(4), Pos::Zero(), BodyRef::world(),
+                                                                    Pos(0, 0, 0.1), Pos(0, 0, 1), 0.5));
     const std::string what = thrown([&] { BulletMechanism<Spatial>(m, 1e-3, q, v); });
-    CHECK(what.find("constraint 1 (point_closure): not yet") != std::string::npos);
+    CHECK(what.find("constraint 1 (point_contact): not yet") != std::string::npos);
   }
   {
     auto m = u.model();

@@ -1,0 +1,284 @@
+// dynlab model FILE: see model.h.
+#include "app/model.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <filesystem>
+#include <random>
+#include <sstream>
+
+#include "app/output.h"
+#include "labs/trace.h"
+#include "physics/bullet/bullet_mechanism.h"
+#include "labs/utf8.h"
+#include "physics/constrained_mechanism.h"
+#include "physics/model_file/model_file.h"
+
+namespace dyn::app {
+namespace {
+
+// A name from the file as a CSV column part: letters, digits, '_', '-', '.'; anything else '_'.
+std::string columnName(const std::string& name) {
+  std::string out;
+  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ? c : '_';
+  return out.empty() ? "_" : out;
+}
+
+std::string fmt(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", x);
+  return b;
+}
+
+std::string join(const std::vector<std::string>& v, const char* sep = " ") {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
+  return s;
+}
+
+// What dynlab read, as the lines `dynlab model` prints.
+std::string describe(const model_file::LoadedModel& m) {
+  std::ostringstream o;
+  const auto& mech = m.mechanism;
+  int kept = 0, all = 0;
+  for (const auto& c : m.closures) kept += int(c.kept.size()), all += int(c.kept.size() + c.dropped.size());
+  o << m.file << ": " << m.bodies.size() << " moving bodies, " << m.joints.size() << " joints, " << m.closures.size()
+    << (m.closures.size() == 1 ? " closure (" : " closures (") << kept << " of " << all << " rows kept), " << m.dof << " degree" << (m.dof == 1 ? "" : "s")
+    << " of freedom after closure\n";
+  const Eigen::Vector3d g = mech.tree.gravity.tail<3>();
+  o << "  gravity (" << fmt(g.x()) << ", " << fmt(g.y()) << ", " << fmt(g.z()) << ") m/s²\n";
+  for (std::size_t i = 0; i < m.joints.size(); ++i) {
+    const auto& j = m.joints[i];
+    double mass = 0;
+    Eigen::Vector3d c;
+    Spatial::massAndCom(mech.tree.bodies[i].inertia, mass, c);
+    o << "  joint " << j.name << " (" << j.type << ", body " << j.body << "): q0 " << fmt(m.q0[Eigen::Index(i)]);
+    o << (mech.tree.bodies[i].massless ? ", a massless carrier" : ", carries " + fmt(mass) + " kg");
+    if (!mech.joints.empty()) {
+      const JointProperties& p = mech.joints[i];
+      if (p.stiffness != 0) o << ", spring " << fmt(p.stiffness) << " about " << fmt(p.rest);
+      if (p.viscous != 0) o << ", damping " << fmt(p.viscous);
+      if (p.coulomb != 0) o << ", friction " << fmt(p.coulomb);
+    }
+    o << "\n";
+  }
+  for (const auto& c : m.closures) {
+    o << "  closure " << c.name << ": " << c.kind << " " << c.body1 << " to " << c.body2 << ", rows " << join(c.kept) << " kept";
+    if (!c.dropped.empty()) o << ", " << join(c.dropped) << " dropped (identically dependent on the rows kept)";
+    o << "\n";
+  }
+  for (const auto& n : m.notes) o << "  note: " << n << "\n";
+  return o.str();
+}
+
+// M and the bias against MuJoCo's own at q0 and a few seeded states: the largest differences.
+std::string crossCheck(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech) {
+  model_file::MujocoReference mj(m.file);
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int n = mech.n();
+  double dM = 0, dh = 0;
+  for (int s = 0; s < 5; ++s) {
+    VecN q = m.q0, v = VecN::Zero(n);
+    for (int i = 0; s > 0 && i < n; ++i) q[i] += u(rng), v[i] = 2.0 * u(rng);
+    dM = std::max(dM, (mech.massMatrix(q) - mj.massMatrix(q)).cwiseAbs().maxCoeff());
+    dh = std::max(dh, (mech.inverseDynamics(q, v, VecN::Zero(n)) - mj.bias(q, v)).cwiseAbs().maxCoeff());
+  }
+  return "  against MuJoCo (mj_fullM, qfrc_bias; q0 and 4 seeded states): max |ΔM| " + fmt(dM) + ", max |Δh| " + fmt(dh) + "\n";
+}
+
+// The power the joints' damping and friction take out of the mechanism (≥ 0), by the description's
+// law (JointProperties::friction), for Bullet's books; the hand engine integrates its own (Books).
+double frictionPower(const MechanismModel<Spatial>& d, const VecN& v) {
+  double p = 0;
+  for (std::size_t i = 0; i < d.joints.size(); ++i) {
+    const JointProperties& j = d.joints[i];
+    const double w = v[Eigen::Index(i)];
+    p += j.friction(w) * w;
+  }
+  return p;
+}
+
+
+// One engine's passive run: the trace and what the summary reports.
+struct Run {
+  Trace trace;
+  double e0 = 0, residual = 0, balance = 0, kinetic = 0;
+  bool ok = true;
+  std::string summary;
+};
+
+Trace emptyTrace(const model_file::LoadedModel& m) {
+  Trace t;
+  t.columns.push_back("t");
+  for (const auto& j : m.joints) t.columns.push_back("q_" + columnName(j.name));
+  for (const auto& j : m.joints) t.columns.push_back("v_" + columnName(j.name));
+  t.columns.insert(t.columns.end(), {"energy", "work", "constraint_residual"});
+  for (const auto& c : m.closures)
+    for (const auto& r : c.kept) t.columns.push_back("f_" + columnName(c.name) + "_" + r);
+  return t;
+}
+
+// The row at t: state, energy, the friction's work so far, |φ|∞ (the description's, at this state)
+// and each closure's force on its kept rows; the run's extremes follow.
+void record(Run& run, ConstrainedMechanism<Spatial>& mech, double t, const VecN& q, const VecN& v, double work,
+            const std::vector<double>& forces) {
+  const double e = mech.energy(q, v), phi = mech.residual(q);
+  if (run.trace.rows() == 0) run.e0 = e;
+  std::vector<double> row{t};
+  row.insert(row.end(), q.data(), q.data() + q.size());
+  row.insert(row.end(), v.data(), v.data() + v.size());
+  row.insert(row.end(), {e, work, phi});
+  row.insert(row.end(), forces.begin(), forces.end());
+  run.trace.append(row);
+  run.residual = std::max(run.residual, phi);
+  run.balance = std::max(run.balance, std::abs(e - run.e0 - work));
+  run.kinetic = std::max(run.kinetic, mech.kineticEnergy(q, v));
+}
+
+// The hand engine from the file's pose at rest: RK4, positions and velocities projected each step;
+// forces: the solve's η at the row's state.
+Run runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, const ModelArgs& args) {
+  Run run;
+  run.trace = emptyTrace(m);
+  StepOptions o;
+  o.dt = args.dt;
+  const int steps = int(std::lround(args.duration / args.dt)), n = mech.n();
+  VecN q = m.q0, v = VecN::Zero(n);
+  const VecN tau = VecN::Zero(n);
+  // The books (friction's work) integrated with the motion, at RK4's order (integrate.h).
+  mech.setTime(0);
+  mech.books() = Books{};
+  for (int k = 0; k <= steps; ++k) {
+    const auto s = mech.solve(q, v, tau);
+    const Books b = mech.books();
+    record(run, mech, k * args.dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()));
+    if (k == steps) break;
+    if (!(run.ok = step(mech, o, tau, q, v) && q.allFinite() && v.allFinite())) break;
+  }
+  return run;
+}
+
+// Bullet from the same state; forces: each closure's over the step that starts at the row (the last
+// row repeats the last step's).
+Run runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, const ModelArgs& args) {
+  Run run;
+  run.trace = emptyTrace(m);
+  const int steps = int(std::lround(args.duration / args.dt)), n = mech.n();
+  VecN q = m.q0, v = VecN::Zero(n);
+  const VecN tau = VecN::Zero(n);
+  bullet::BulletMechanism<Spatial> bt(m.mechanism, args.dt, q, v);
+  run.summary = bt.describe();
+  static const std::map<std::string, int> kRow = {{"wx", 0}, {"wy", 1}, {"wz", 2}, {"x", 3}, {"y", 4}, {"z", 5}};
+  double work = 0, power = frictionPower(m.mechanism, v);
+  std::vector<double> forces;
+  for (int k = 0; k <= steps; ++k) {
+    VecN qn = q, vn = v;
+    if (k < steps) {
+      bt.step(tau);
+      bt.state(qn, vn);
+      forces.clear();
+      for (std::size_t c = 0; c < m.closures.size(); ++c)
+        for (const auto& r : m.closures[c].kept) forces.push_back(bt.constraintForce(int(c))[kRow.at(r)]);
+    }
+    record(run, mech, k * args.dt, q, v, work, forces);
+    if (k == steps) break;
+    if (!(run.ok = qn.allFinite() && vn.allFinite())) break;
+    const double p = frictionPower(m.mechanism, vn);
+    work -= 0.5 * (power + p) * args.dt;
+    power = p;
+    q = qn, v = vn;
+  }
+  return run;
+}
+
+std::string report(const Run& r, const std::string& engine, const model_file::LoadedModel& m, const ModelArgs& args) {
+  std::ostringstream o;
+  o << "passive run, " << engine << ", dt " << fmt(args.dt) << " s, " << fmt(args.duration) << " s from q0 at rest\n"
+    << "  closure residual max |φ|∞ " << fmt(r.residual) << "\n"
+    << "  energy E0 " << fmt(r.e0) << " J, max |E − E0 − W_friction| " << fmt(r.balance) << " J (kinetic energy up to "
+    << fmt(r.kinetic) << " J" << (m.mechanism.joints.empty() ? "" : "; W_friction by the trapezoid rule") << ")\n";
+  if (!r.ok)
+    o << "  the run stopped at t = " << fmt(double(r.trace.rows() - 1) * args.dt)
+      << " s: the projection failed or the state left the finite numbers\n";
+  return o.str();
+}
+
+}  // namespace
+
+ModelCommand::ModelCommand(CLI::App& cli) {
+  ModelArgs& a = args_;
+  command_ = cli.add_subcommand("model", "Load a mechanism from an MJCF or URDF file, print what dynlab read (bodies, joints, "
+                                         "loop closures and their rows, freedom), check M and h against MuJoCo's, run it "
+                                         "passive with the hand engine and Bullet: closure residual, energy balance, agreement, "
+                                         "OUT/trace.csv, OUT/trace_bullet.csv");
+  command_->add_option("FILE", a.file, "MJCF (.xml) or URDF file (assets/models/ has examples)")->required();
+  command_->add_option("--duration", a.duration, "Simulated time (s, default 2)")->check(CLI::Range(0.0, 600.0));
+  command_->add_option("--dt", a.dt, "Fixed step (s, default 0.001; RK4 + projection)")->check(CLI::Range(1e-5, 1e-2));
+  command_->add_option("--out", a.out, "Output directory (default: out/model/FILE's stem)");
+  command_->add_option("--engine", a.engine, "Which engine(s) to run (default: both)")->check(CLI::IsMember({"hand", "bullet", "both"}));
+  command_->add_flag("--ignore-contacts", a.ignore_contacts, "Load a file whose geoms may collide, ignoring contacts (noted)");
+}
+
+int model(const ModelArgs& args) {
+  // A trace row per step: bounded before anything runs.
+  constexpr double kMaxSteps = 2e6;
+  if (args.duration / args.dt > kMaxSteps) {
+    std::fprintf(stderr, "error: --duration %g s at --dt %g s is %.0f steps; at most %.0f (a trace row each)\n", args.duration, args.dt,
+                 std::ceil(args.duration / args.dt), kMaxSteps);
+    return 2;
+  }
+  model_file::LoadedModel m;
+  try {
+    model_file::LoadOptions options;
+    options.ignore_contacts = args.ignore_contacts;
+    m = model_file::load(args.file, options);
+  } catch (const model_file::ModelFileError& e) {
+    std::fprintf(stderr, "error: %s\n", utf8Quotable(e.what()).c_str());
+    return 2;
+  }
+  ConstrainedMechanism<Spatial> mech(m.mechanism);
+  std::string text = describe(m) + crossCheck(m, mech);
+  const bool hand = args.engine != "bullet", bullet = args.engine != "hand";
+  Run h, b;
+  if (hand) h = runHand(m, mech, args);
+  if (bullet) {
+    try {
+      b = runBullet(m, mech, args);
+    } catch (const std::exception& e) {  // a description the Bullet builder cannot model
+      std::fprintf(stderr, "error: %s: Bullet: %s\n", utf8Quotable(m.file).c_str(), utf8Quotable(e.what()).c_str());
+      return 2;
+    }
+  }
+  if (hand) text += report(h, "hand engine: RK4 + projection", m, args);
+  if (bullet) text += report(b, b.summary + ", semi-implicit Euler", m, args);
+  if (hand && bullet) {
+    double dq = 0;
+    const int n = mech.n();
+    for (std::size_t r = 0; r < std::min(h.trace.rows(), b.trace.rows()); ++r)
+      for (int i = 0; i < n; ++i) dq = std::max(dq, std::abs(h.trace.at(r, 1 + i) - b.trace.at(r, 1 + i)));
+    text += "agreement: max |q_hand − q_bullet|∞ " + fmt(dq) + " (Bullet's step is first order)\n";
+  }
+  const bool ok = (!hand || h.ok) && (!bullet || b.ok);
+  const std::filesystem::path out = args.out.empty() ? std::filesystem::path("out/model") / std::filesystem::path(args.file).stem() : std::filesystem::path(args.out);
+  text += "wrote " + out.string() + "/" + (hand ? "trace.csv " : "") + (bullet ? "trace_bullet.csv " : "") + "summary.txt\n";
+  try {
+    Staging staging(out);
+    staging.owns({"trace.csv", "trace_bullet.csv", "summary.txt"});
+    if (hand) staging.write("trace.csv", h.trace.csv());
+    if (bullet) staging.write("trace_bullet.csv", b.trace.csv());
+    staging.write("summary.txt", text);
+    staging.commit();
+  } catch (const std::exception& e) {
+    std::fputs(text.c_str(), stdout);
+    std::fprintf(stderr, "error: %s\n", utf8Quotable(e.what()).c_str());
+    return 1;
+  }
+  std::fputs(text.c_str(), stdout);
+  return ok ? 0 : 1;
+}
+
+}  // namespace dyn::app

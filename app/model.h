@@ -1,0 +1,35 @@
+// `dynlab model FILE`: a mechanism from an MJCF or URDF file (physics/model_file): loads it, prints
+// what dynlab read (bodies, joints, closures and their kept rows, the freedom left, notes), checks M
+// and the bias against MuJoCo's own, runs it passive with the hand engine (RK4 + projection) and/or
+// Bullet and reports each one's closure residual and energy balance and their agreement; writes
+// OUT/trace.csv (hand), OUT/trace_bullet.csv and OUT/summary.txt.
+// Registered on the command line by ModelCommand, so main.cpp only constructs it and asks it to run.
+#pragma once
+#include <CLI/CLI.hpp>
+#include <string>
+
+namespace dyn::app {
+
+struct ModelArgs {
+  std::string file, out, engine = "both";
+  double duration = 2.0;  // s
+  double dt = 1e-3;       // s
+  bool ignore_contacts = false;
+};
+
+// 0 ran and wrote; 1 the run failed (projection, non-finite state) or a write failed; 2 bad input
+// (one line, nothing written).
+int model(const ModelArgs& args);
+
+class ModelCommand {
+ public:
+  explicit ModelCommand(CLI::App& cli);
+  bool chosen() const { return bool(*command_); }
+  int run() const { return model(args_); }
+
+ private:
+  ModelArgs args_;
+  CLI::App* command_ = nullptr;
+};
+
+}  // namespace dyn::app

@@ -1,0 +1,422 @@
+// A model file onto the description (model_file.h): read and checked, compiled by MuJoCo, every
+// element checked against what the description can hold, then mapped at the reference pose qpos0.
+#include "physics/model_file/model_file.h"
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <random>
+#include <sstream>
+
+#include "physics/constrained_mechanism.h"
+#include "physics/constraints/point_closure.h"
+#include "physics/model_file/mujoco_call.h"
+
+namespace dyn::model_file {
+
+namespace {
+
+using Mat3 = Eigen::Matrix3d;
+using Vec3 = Eigen::Vector3d;
+using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+const char* const kRowNames[6] = {"wx", "wy", "wz", "x", "y", "z"};
+
+// Offset of the first byte that is not well-formed UTF-8 (no overlongs, surrogates or cut-off
+// sequences), or npos.
+std::size_t utf8ErrorAt(const std::string& s) {
+  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
+  const std::size_t n = s.size();
+  for (std::size_t i = 0; i < n;) {
+    const unsigned c = p[i];
+    int len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    if (len == 0 || i + std::size_t(len) > n) return i;
+    unsigned cp = len == 1 ? c : len == 2 ? (c & 0x1F) : len == 3 ? (c & 0x0F) : (c & 0x07);
+    for (int k = 1; k < len; ++k) {
+      if ((p[i + std::size_t(k)] & 0xC0) != 0x80) return i;
+      cp = (cp << 6) | (p[i + std::size_t(k)] & 0x3F);
+    }
+    const unsigned least[5] = {0, 0, 0x80, 0x800, 0x10000};
+    if (cp < least[len] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return i;
+    i += std::size_t(len);
+  }
+  return std::string::npos;
+}
+
+// The file's bytes: a regular file, at most kMaxFileBytes, well-formed UTF-8.
+std::string readChecked(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) throw ModelFileError(path + ": no such file");
+  if (!fs::is_regular_file(st)) throw ModelFileError(path + ": not a regular file (expected an MJCF or URDF file)");
+  const auto size = fs::file_size(path, ec);
+  if (ec) throw ModelFileError(path + ": cannot read its size (" + ec.message() + ")");
+  if (size > kMaxFileBytes)
+    throw ModelFileError(path + ": " + std::to_string(size) + " bytes, more than the " + std::to_string(kMaxFileBytes) +
+                         " a model file may have");
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  if (!in && !in.eof()) throw ModelFileError(path + ": cannot be read");
+  std::string s = bytes.str();
+  if (s.size() > kMaxFileBytes) throw ModelFileError(path + ": grew past " + std::to_string(kMaxFileBytes) + " bytes while read");
+  if (s.find_first_not_of(" \t\r\n") == std::string::npos) throw ModelFileError(path + ": empty (expected an MJCF or URDF file)");
+  if (const std::size_t at = utf8ErrorAt(s); at != std::string::npos) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02X", unsigned(static_cast<unsigned char>(s[at])));
+    throw ModelFileError(path + ": byte " + hex + " at offset " + std::to_string(at) + " is not valid UTF-8 (model files are UTF-8)");
+  }
+  return s;
+}
+
+struct ModelDeleter {
+  void operator()(mjModel* m) const { mj_deleteModel(m); }
+};
+struct DataDeleter {
+  void operator()(mjData* d) const { mj_deleteData(d); }
+};
+using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
+using DataPtr = std::unique_ptr<mjData, DataDeleter>;
+
+// The file compiled by MuJoCo from the bytes read (a virtual file: what was checked is what is parsed).
+ModelPtr compile(const std::string& path, std::string* warnings) {
+  const std::string bytes = readChecked(path);
+  const std::string name = std::filesystem::path(path).filename().string();
+  if (name.size() >= mjMAXVFSNAME) throw ModelFileError(path + ": file name longer than MuJoCo's " + std::to_string(mjMAXVFSNAME - 1) + " characters");
+  auto vfs = std::make_unique<mjVFS>();
+  mj_defaultVFS(vfs.get());
+  // The virtual file keeps the name alone; loading it by its path keeps the file's folder as the
+  // model's, where MuJoCo looks for includes and meshes.
+  if (mj_makeEmptyFileVFS(vfs.get(), path.c_str(), int(bytes.size())) != 0) throw ModelFileError(path + ": MuJoCo's virtual file system refused it");
+  const int at = mj_findFileVFS(vfs.get(), path.c_str());
+  if (at < 0) throw ModelFileError(path + ": MuJoCo's virtual file system lost it");
+  std::copy(bytes.begin(), bytes.end(), static_cast<char*>(vfs->filedata[at]));
+  char error[1024] = "";
+  mjModel* m = nullptr;
+  detail::MujocoGuard guard;
+  MUJOCO_CALL(path, m = mj_loadXML(path.c_str(), vfs.get(), error, sizeof error));
+  mj_deleteVFS(vfs.get());
+  if (!m) throw ModelFileError(path + ": MuJoCo's parser: " + detail::oneLine(error[0] ? error : "no model"));
+  if (warnings) *warnings = detail::oneLine(std::string(error) + " " + guard.warnings());
+  return ModelPtr(m);
+}
+
+std::string num(double x) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%g", x);
+  return b;
+}
+
+std::string nameOf(const mjModel* m, int type, int id, const char* what) {
+  const char* n = mj_id2name(m, type, id);
+  if (n && *n) return n;
+  if (type == mjOBJ_BODY && id == 0) return "world";
+  return std::string(what) + " #" + std::to_string(id);
+}
+
+// Everything in the compiled model that the description cannot hold, as one error; what it reads
+// but does not enforce, as notes.
+void checkSupported(const std::string& file, const mjModel* m, const LoadOptions& opt, std::vector<std::string>& notes) {
+  auto fail = [&](const std::string& what) { throw ModelFileError(file + ": " + what); };
+  static const char* const kJoint[4] = {"free", "ball", "slide", "hinge"};
+  for (int j = 0; j < m->njnt; ++j)
+    if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE)
+      fail("joint '" + nameOf(m, mjOBJ_JOINT, j, "joint") + "' (body '" + nameOf(m, mjOBJ_BODY, m->jnt_bodyid[j], "body") +
+           "') is a " + kJoint[m->jnt_type[j]] + " joint; dynlab reads hinge and slide joints (URDF: revolute, continuous, prismatic, fixed)");
+  if (m->nv == 0) fail("no hinge or slide joint: nothing moves (dynlab reads bodies moved by hinge and slide joints)");
+  if (m->nv > kMaxDof) fail(std::to_string(m->nv) + " joints, more than dynlab's " + std::to_string(kMaxDof));
+  for (int b = 1; b < m->nbody; ++b)
+    if (m->body_mocapid[b] >= 0) fail("body '" + nameOf(m, mjOBJ_BODY, b, "body") + "' is a mocap body; dynlab reads bodies moved by their joints only");
+  if (m->ntendon > 0) fail("tendon '" + nameOf(m, mjOBJ_TENDON, 0, "tendon") + "': dynlab reads no tendons (joints, inertias and connect/weld equalities only)");
+  for (int i = 0; i < m->nu; ++i) {
+    const std::string a = "actuator '" + nameOf(m, mjOBJ_ACTUATOR, i, "actuator") + "'";
+    if (m->actuator_dyntype[i] != mjDYN_NONE || m->actuator_gaintype[i] != mjGAIN_FIXED || m->actuator_biastype[i] != mjBIAS_NONE)
+      fail(a + " has activation dynamics, a variable gain or a bias (a servo): dynlab runs model files passive and reads plain motors only");
+    notes.push_back(a + ": a motor, read but not driven (passive run)");
+  }
+  for (int j = 0; j < m->nv; ++j)
+    if (m->dof_armature[j] != 0)
+      fail("joint '" + nameOf(m, mjOBJ_JOINT, m->dof_jntid[j], "joint") + "' has armature " + num(m->dof_armature[j]) +
+           "; the description has no rotor inertia yet (set armature=\"0\")");
+  if (m->opt.density != 0 || m->opt.viscosity != 0 || m->opt.wind[0] != 0 || m->opt.wind[1] != 0 || m->opt.wind[2] != 0)
+    fail("<option> density/viscosity/wind: dynlab has no fluid forces (leave them 0)");
+  const int flags = m->opt.disableflags;
+  if (flags & (mjDSBL_CONTACT | mjDSBL_CONSTRAINT) || opt.ignore_contacts) {
+    if (opt.ignore_contacts) notes.push_back("contacts between geoms ignored (--ignore-contacts)");
+    return;
+  }
+  if (m->npair > 0) fail("<contact><pair> '" + nameOf(m, mjOBJ_PAIR, 0, "pair") + "': dynlab has no contacts between geoms");
+  // Geoms that could touch (MuJoCo's filter: different rigid bodies, not parent and child unless one
+  // is the world, contype/conaffinity compatible, not excluded).
+  auto excluded = [&](int b1, int b2) {
+    for (int e = 0; e < m->nexclude; ++e) {
+      const int s = m->exclude_signature[e];
+      if (s == ((b1 + 1) << 16) + b2 + 1 || s == ((b2 + 1) << 16) + b1 + 1) return true;
+    }
+    return false;
+  };
+  const bool filterparent = !(flags & mjDSBL_FILTERPARENT);
+  for (int g1 = 0; g1 < m->ngeom; ++g1)
+    for (int g2 = g1 + 1; g2 < m->ngeom; ++g2) {
+      const int b1 = m->geom_bodyid[g1], b2 = m->geom_bodyid[g2];
+      const int w1 = m->body_weldid[b1], w2 = m->body_weldid[b2];
+      if (w1 == w2) continue;
+      const int p1 = m->body_weldid[m->body_parentid[w1]], p2 = m->body_weldid[m->body_parentid[w2]];
+      if (filterparent && w1 != 0 && w2 != 0 && (w1 == p2 || w2 == p1)) continue;
+      if (!(m->geom_contype[g1] & m->geom_conaffinity[g2]) && !(m->geom_contype[g2] & m->geom_conaffinity[g1])) continue;
+      if (excluded(b1, b2)) continue;
+      fail("geoms '" + nameOf(m, mjOBJ_GEOM, g1, "geom") + "' (body '" + nameOf(m, mjOBJ_BODY, b1, "body") + "') and '" +
+           nameOf(m, mjOBJ_GEOM, g2, "geom") + "' (body '" + nameOf(m, mjOBJ_BODY, b2, "body") +
+           "') may collide; dynlab has no contacts between geoms: set contype=\"0\" conaffinity=\"0\", exclude the pair, "
+           "add <option><flag contact=\"disable\"/></option>, or pass --ignore-contacts");
+    }
+}
+
+// Every number the description reads, finite and within ±kLargest: a mass of 1e308 or an infinite
+// gravity is refused here, not found as NaN mid-run.
+constexpr double kLargest = 1e9;
+void checkNumbers(const std::string& file, const mjModel* m, const mjData* d) {
+  auto check = [&](const mjtNum* x, int count, const std::string& what) {
+    for (int i = 0; i < count; ++i)
+      if (!std::isfinite(x[i]) || std::abs(x[i]) > kLargest)
+        throw ModelFileError(file + ": " + what + " is " + num(x[i]) + "; dynlab reads finite values within ±" + num(kLargest));
+  };
+  check(m->opt.gravity, 3, "<option gravity>");
+  for (int b = 1; b < m->nbody; ++b) {
+    const std::string body = "body '" + nameOf(m, mjOBJ_BODY, b, "body") + "'";
+    check(m->body_mass + b, 1, body + "'s mass");
+    check(m->body_inertia + 3 * b, 3, body + "'s inertia");
+    check(d->xipos + 3 * b, 3, body + "'s centre of mass");
+    check(d->xpos + 3 * b, 3, body + "'s position");
+  }
+  for (int j = 0; j < m->njnt; ++j) {
+    const std::string joint = "joint '" + nameOf(m, mjOBJ_JOINT, j, "joint") + "'";
+    check(d->xanchor + 3 * j, 3, joint + "'s anchor");
+    check(m->qpos0 + j, 1, joint + "'s ref");
+    check(m->qpos_spring + j, 1, joint + "'s springref");
+    check(m->jnt_stiffness + j, 1, joint + "'s stiffness");
+    check(m->dof_damping + j, 1, joint + "'s damping");
+    check(m->dof_frictionloss + j, 1, joint + "'s frictionloss");
+  }
+  for (int e = 0; e < m->neq; ++e) check(m->eq_data + mjNEQDATA * e, mjNEQDATA, "equality '" + nameOf(m, mjOBJ_EQUALITY, e, "equality") + "'s data");
+}
+
+// A MuJoCo body as the description sees it: the tree body it moves with (world: −1).
+struct Frame {
+  int link = -1;
+  Vec3 origin = Vec3::Zero();  // that tree body's frame origin, world, at qpos0
+};
+
+BodyRef ref(int link) { return link < 0 ? BodyRef::world() : BodyRef::link(link); }
+
+}  // namespace
+
+LoadedModel load(const std::string& path, const LoadOptions& options) {
+  LoadedModel out;
+  out.file = path;
+  std::string warnings;
+  const ModelPtr model = compile(path, &warnings);
+  const mjModel* m = model.get();
+  if (!warnings.empty() && warnings != " ") out.notes.push_back("MuJoCo: " + warnings);
+  checkSupported(path, m, options, out.notes);
+  // The reference pose: MuJoCo's kinematics at qpos0 (anchors, axes, centres of mass, principal axes).
+  detail::MujocoGuard guard;
+  DataPtr data;
+  MUJOCO_CALL(path, data.reset(mj_makeData(m)));
+  if (!data) throw ModelFileError(path + ": MuJoCo could not make its data");
+  mjData* d = data.get();
+  MUJOCO_CALL(path, mj_kinematics(m, d));
+  checkNumbers(path, m, d);
+  const int flags = m->opt.disableflags;
+  out.timestep = m->opt.timestep;
+  out.q0 = VecN::Zero(m->nq);
+  for (int i = 0; i < m->nq; ++i) out.q0[i] = m->qpos0[i];
+
+  // The trees: one body per joint, in MuJoCo's order (parents first), frames on the anchors.
+  MechanismModel<Spatial>& mech = out.mechanism;
+  std::vector<Frame> frame(std::size_t(m->nbody));
+  std::vector<Spatial::Mat> inertia;
+  for (int b = 1; b < m->nbody; ++b) {
+    Frame f = frame[std::size_t(m->body_parentid[b])];
+    for (int k = 0; k < m->body_jntnum[b]; ++k) {
+      const int j = m->body_jntadr[b] + k;
+      if (m->jnt_qposadr[j] != j || m->jnt_dofadr[j] != j || j != mech.tree.dof())
+        throw ModelFileError(path + ": joint '" + nameOf(m, mjOBJ_JOINT, j, "joint") + "': coordinates out of MuJoCo's usual order");
+      const Vec3 o(d->xanchor + 3 * j), a = Vec3(d->xaxis + 3 * j).normalized();
+      const bool hinge = m->jnt_type[j] == mjJNT_HINGE;
+      const double q0 = m->qpos0[m->jnt_qposadr[j]];
+      // Frames world-aligned at q0: a hinge's placement undoes its turn at q0, a slide's its travel.
+      Spatial::Transform X{Mat3::Identity(), o - f.origin, true};
+      if (hinge) X.E = Spatial::jointTransform(true, a, q0).E.transpose();
+      else X.r -= a * q0;
+      mech.tree.addBody(f.link, hinge ? JointType::Revolute : JointType::Prismatic, a, X, Spatial::Mat::Zero());
+      inertia.push_back(Spatial::Mat::Zero());
+      f = {mech.tree.dof() - 1, o};
+      Joint jt;
+      jt.name = nameOf(m, mjOBJ_JOINT, j, "joint");
+      jt.body = nameOf(m, mjOBJ_BODY, b, "body");
+      jt.type = hinge ? "hinge" : "slide";
+      jt.limited = m->jnt_limited[j] && !(flags & mjDSBL_LIMIT);
+      jt.lower = m->jnt_range[2 * j], jt.upper = m->jnt_range[2 * j + 1];
+      if (jt.limited)
+        out.notes.push_back("joint '" + jt.name + "': limit [" + num(jt.lower) + ", " + num(jt.upper) + "] " + (hinge ? "rad" : "m") + " read, not enforced");
+      out.joints.push_back(jt);
+    }
+    frame[std::size_t(b)] = f;
+    if (m->body_jntnum[b] > 0) out.bodies.push_back(nameOf(m, mjOBJ_BODY, b, "body"));
+    // The body's inertia joins the tree body it moves with (a body without joints is fused into its
+    // parent; one fused into the world never moves).
+    if (f.link < 0) continue;
+    const RowMat3 R = Eigen::Map<const RowMat3>(d->ximat + 9 * b);
+    const Mat3 Ic = R * Vec3(m->body_inertia + 3 * b).asDiagonal() * R.transpose();
+    inertia[std::size_t(f.link)] += Spatial::inertia(m->body_mass[b], Vec3(d->xipos + 3 * b) - f.origin, Ic);
+  }
+  for (int i = 0; i < mech.tree.dof(); ++i) {
+    auto& body = mech.tree.bodies[std::size_t(i)];
+    body.inertia = inertia[std::size_t(i)];
+    body.central = Spatial::central(body.inertia);
+    body.massless = Spatial::massless(body.inertia);
+  }
+  if (!(flags & mjDSBL_GRAVITY)) mech.tree.gravity.tail<3>() = Vec3(m->opt.gravity);
+
+  // Joint springs, damping and friction (MuJoCo's passive forces and frictionloss).
+  bool any = false;
+  mech.joints.resize(std::size_t(m->nv));
+  for (int j = 0; j < m->nv; ++j) {
+    JointProperties& p = mech.joints[std::size_t(j)];
+    if (!(flags & mjDSBL_PASSIVE)) {
+      p.stiffness = m->jnt_stiffness[j];
+      p.rest = m->qpos_spring[m->jnt_qposadr[j]];
+      p.viscous = m->dof_damping[j];
+    }
+    if (!(flags & (mjDSBL_FRICTIONLOSS | mjDSBL_CONSTRAINT))) p.coulomb = m->dof_frictionloss[j];
+    if (p.coulomb > 0)
+      out.notes.push_back("joint '" + out.joints[std::size_t(j)].name + "': frictionloss " + num(p.coulomb) +
+                          " read as Coulomb friction smoothed over a rate width of " + num(p.coulomb_width) + " (MuJoCo: exact stiction)");
+    any = any || p.stiffness != 0 || p.viscous != 0 || p.coulomb != 0;
+  }
+  if (!any) mech.joints.clear();
+
+  // Loop closures: connect and weld, points and rows at qpos0.
+  struct Tie {
+    int eq;
+    BodyRef a, b;
+    Vec3 pa, pb;
+    bool weld;
+  };
+  std::vector<Tie> ties;
+  const bool equalities = !(flags & (mjDSBL_EQUALITY | mjDSBL_CONSTRAINT));
+  if (!equalities && m->neq > 0) out.notes.push_back(std::to_string(m->neq) + " equalities off (<option><flag equality=\"disable\"/>)");
+  for (int e = 0; equalities && e < m->neq; ++e) {
+    const std::string name = nameOf(m, mjOBJ_EQUALITY, e, m->eq_type[e] == mjEQ_WELD ? "weld" : "connect");
+    if (m->eq_type[e] != mjEQ_CONNECT && m->eq_type[e] != mjEQ_WELD)
+      throw ModelFileError(path + ": equality '" + name + "' is a joint, tendon or distance coupling; dynlab reads <connect> and <weld>");
+    if (!m->eq_active[e]) {
+      out.notes.push_back("equality '" + name + "' is inactive in the file (active=\"false\"): not held");
+      continue;
+    }
+    const int b1 = m->eq_obj1id[e], b2 = m->eq_obj2id[e];
+    const mjtNum* data_e = m->eq_data + mjNEQDATA * e;
+    const RowMat3 R1 = Eigen::Map<const RowMat3>(d->xmat + 9 * b1), R2 = Eigen::Map<const RowMat3>(d->xmat + 9 * b2);
+    const bool weld = m->eq_type[e] == mjEQ_WELD;
+    // connect: data = (anchor in body1, anchor in body2); weld: (anchor in body2, relpose in body1: point, quaternion, torquescale).
+    const Vec3 p1 = Vec3(d->xpos + 3 * b1) + R1 * Vec3(data_e + (weld ? 3 : 0));
+    const Vec3 p2 = Vec3(d->xpos + 3 * b2) + R2 * Vec3(data_e + (weld ? 0 : 3));
+    bool rotation = weld;
+    if (weld) {
+      const Eigen::Quaterniond rel(data_e[6], data_e[7], data_e[8], data_e[9]);
+      if ((R1.transpose() * R2 - rel.normalized().toRotationMatrix()).norm() > 1e-9)
+        throw ModelFileError(path + ": weld '" + name + "' holds a relative orientation (relpose) other than the one at the reference pose; "
+                             "dynlab needs a file written in its closed pose (leave relpose out)");
+      if (data_e[10] == 0) {
+        rotation = false;
+        out.notes.push_back("weld '" + name + "' has torquescale 0: held as a connect (no rotation rows)");
+      }
+    }
+    const Frame& f1 = frame[std::size_t(b1)];
+    const Frame& f2 = frame[std::size_t(b2)];
+    if (f1.link == f2.link)
+      throw ModelFileError(path + ": equality '" + name + "' ties body '" + nameOf(m, mjOBJ_BODY, b1, "body") + "' to '" +
+                           nameOf(m, mjOBJ_BODY, b2, "body") + "', which no joint separates (they move as one body)");
+    ties.push_back({e, ref(f1.link), ref(f2.link), p1 - f1.origin, p2 - f2.origin, rotation});
+    Closure c;
+    c.name = name;
+    c.kind = weld ? "weld" : "connect";
+    c.body1 = nameOf(m, mjOBJ_BODY, b1, "body");
+    c.body2 = nameOf(m, mjOBJ_BODY, b2, "body");
+    out.closures.push_back(c);
+  }
+  auto rowsOf = [](bool weld) { return weld ? PointClosure<Spatial>::all() : PointClosure<Spatial>::translations(); };
+  for (const Tie& t : ties) mech.constraints.push_back(std::make_shared<PointClosure<Spatial>>(t.a, t.pa, t.b, t.pb, rowsOf(t.weld)));
+  if (const std::string why = mech.validate(); !why.empty()) throw ModelFileError(path + ": " + why);
+  if (ties.empty()) {
+    out.dof = m->nv;
+    return out;
+  }
+
+  // Each loop closes at qpos0 (MuJoCo places connect's second anchor there; a weld's relpose was checked).
+  const int n = m->nv;
+  ConstrainedMechanism<Spatial> full(mech);
+  for (std::size_t i = 0; i < ties.size(); ++i)
+    if (const double gap = full.residual(int(i), out.q0); !(gap <= 1e-9))
+      throw ModelFileError(path + ": equality '" + out.closures[i].name + "' does not hold at the reference pose (gap " +
+                           num(gap) + "); write the file in its closed pose");
+  // Rows identically dependent on the rows before them (a planar loop's out-of-plane rows): J at
+  // seeded configurations around q0, side by side; a row is kept when it raises the rank.
+  constexpr int kSamples = 4;
+  const int rows = full.rows();
+  Eigen::MatrixXd stacked(rows, n * kSamples);
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u(-0.5, 0.5);
+  for (int s = 0; s < kSamples; ++s) {
+    VecN q = out.q0, phi;
+    for (int i = 0; i < n; ++i) q[i] += u(rng);
+    MatN G;
+    full.constraint(q, phi, G);
+    stacked.middleCols(s * n, n) = G;
+  }
+  auto rank = [](const Eigen::MatrixXd& A) {
+    if (A.rows() == 0) return 0;
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(A);
+    lu.setThreshold(1e-9);
+    return int(lu.rank());
+  };
+  Eigen::MatrixXd kept(0, stacked.cols());
+  std::vector<std::array<bool, 6>> masks(ties.size());
+  for (std::size_t i = 0, r = 0; i < ties.size(); ++i) {
+    const auto all = rowsOf(ties[i].weld);
+    for (int k = 0; k < 6; ++k) {
+      if (!all[std::size_t(k)]) continue;
+      Eigen::MatrixXd with(kept.rows() + 1, kept.cols());
+      with << kept, stacked.row(Eigen::Index(r++));
+      const bool independent = rank(with) > kept.rows();
+      masks[i][std::size_t(k)] = independent;
+      (independent ? out.closures[i].kept : out.closures[i].dropped).push_back(kRowNames[k]);
+      if (independent) kept = with;
+    }
+  }
+  // The description keeps the independent rows (a closure left with none is noted and dropped).
+  mech.constraints.clear();
+  std::vector<Closure> closures;
+  for (std::size_t i = 0; i < ties.size(); ++i) {
+    if (out.closures[i].kept.empty()) {
+      out.notes.push_back("equality '" + out.closures[i].name + "': every row repeats other closures' rows; not held twice");
+      continue;
+    }
+    mech.constraints.push_back(std::make_shared<PointClosure<Spatial>>(ties[i].a, ties[i].pa, ties[i].b, ties[i].pb, masks[i]));
+    closures.push_back(out.closures[i]);
+  }
+  out.closures = closures;
+  // The mechanism's freedom at q0: coordinates minus the rank of the kept rows there.
+  ConstrainedMechanism<Spatial> reduced(mech);
+  VecN phi;
+  MatN G;
+  reduced.constraint(out.q0, phi, G);
+  out.dof = n - rank(Eigen::MatrixXd(G));
+  return out;
+}
+
+}  // namespace dyn::model_file

@@ -1,0 +1,85 @@
+// Mechanisms from model files: an MJCF or URDF file read by MuJoCo's own parser (Debian's
+// libmujoco-dev 2.2.2: mj_loadXML applies MuJoCo's defaults and computes inertias from geoms), its
+// compiled mjModel mapped onto the description (mechanism.h, spatial algebra):
+//   bodies       each MuJoCo body's joints in order, one tree body per joint (a body with two joints:
+//                a massless carrier, then the body); a body without joints is fused into its parent
+//   frames       every tree body's frame sits on its joint's anchor and is world-aligned at the
+//                file's reference pose qpos0, so X_tree = (R(a, q0), o_i − o_parent) for a hinge and
+//                (1, o_i − o_parent − a q0) for a slide; coordinates are MuJoCo's qpos (θ = qpos)
+//   inertias     body_mass, xipos, ximat, body_inertia at qpos0, summed over fused bodies
+//   joints       stiffness / springref, damping, frictionloss (as Coulomb smoothed over a rate width)
+//   closures     <equality> connect (3 translation rows) and weld (6 rows) as point closures, with the
+//                rows that are identically dependent on the others (a planar loop's out-of-plane
+//                rows) dropped and named
+// Anything else the description cannot represent is a one-line ModelFileError naming the file, the
+// element and what is supported. This folder is the only code that includes MuJoCo.
+#pragma once
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "physics/mechanism.h"
+#include "physics/types.h"
+
+namespace dyn::model_file {
+
+// A file larger than this is refused before it is parsed.
+inline constexpr std::size_t kMaxFileBytes = 4u << 20;
+
+// One line: "FILE: what is wrong; what is supported".
+struct ModelFileError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// A loop closure as the file names it, and which of its rows the description keeps.
+struct Closure {
+  std::string name;   // the equality's name (or "connect #i")
+  std::string kind;   // "connect" or "weld"
+  std::string body1, body2;
+  std::vector<std::string> kept, dropped;  // row names: wx wy wz x y z (world axes)
+};
+
+// A joint as the file names it (one per coordinate, in coordinate order).
+struct Joint {
+  std::string name, body, type;  // type: "hinge" or "slide"
+  bool limited = false;
+  double lower = 0, upper = 0;
+};
+
+struct LoadedModel {
+  std::string file;
+  MechanismModel<Spatial> mechanism;
+  VecN q0;                         // the file's reference pose qpos0 (closed: every loop holds there)
+  std::vector<Joint> joints;       // per coordinate
+  std::vector<std::string> bodies;  // per MuJoCo body that moves (the world and fused bodies left out)
+  std::vector<Closure> closures;   // per mechanism constraint
+  std::vector<std::string> notes;  // what is read but not enforced (limits, unused motors, ...)
+  double timestep = 0;             // the file's <option timestep>
+  int dof = 0;                     // coordinates minus independent closure rows at q0
+};
+
+struct LoadOptions {
+  bool ignore_contacts = false;  // load a file whose geoms may collide, ignoring contacts (noted)
+};
+
+// Reads FILE (MJCF or URDF). Throws ModelFileError.
+LoadedModel load(const std::string& path, const LoadOptions& options = {});
+
+// MuJoCo's own M(q) (mj_fullM) and bias C(q, v) v + G(q) (qfrc_bias) from the same file, for
+// cross-checks: the same coordinates as LoadedModel.
+class MujocoReference {
+ public:
+  explicit MujocoReference(const std::string& path);
+  ~MujocoReference();
+  MujocoReference(const MujocoReference&) = delete;
+  MujocoReference& operator=(const MujocoReference&) = delete;
+  int nv() const;
+  MatN massMatrix(const VecN& q);
+  VecN bias(const VecN& q, const VecN& v);
+
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
+}  // namespace dyn::model_file

@@ -1,0 +1,114 @@
+// MuJoCo's handlers while a guard lives (mujoco_call.h), and MuJoCo's own M and bias (model_file.h).
+#include "physics/model_file/mujoco_call.h"
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "physics/model_file/model_file.h"
+
+namespace dyn::model_file {
+namespace detail {
+namespace {
+std::string& collected() {
+  static std::string warnings;
+  return warnings;
+}
+void onError(const char* message) {
+  lastError() = oneLine(message ? message : "error");
+  if (std::jmp_buf* to = jumpTarget()) std::longjmp(*to, 1);
+  // No guarded call to return to: MuJoCo must not return from its error handler.
+  std::fprintf(stderr, "error: MuJoCo: %s\n", lastError().c_str());
+  std::_Exit(3);
+}
+void onWarning(const char* message) {
+  if (collected().size() < 4096) collected() += std::string(collected().empty() ? "" : "; ") + (message ? message : "");
+}
+}  // namespace
+
+std::jmp_buf*& jumpTarget() {
+  static std::jmp_buf* target = nullptr;
+  return target;
+}
+std::string& lastError() {
+  static std::string error;
+  return error;
+}
+
+std::string oneLine(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    const char s = static_cast<unsigned char>(c) < 0x20 ? ' ' : c;
+    if (s == ' ' && (out.empty() || out.back() == ' ')) continue;
+    out += s;
+  }
+  while (!out.empty() && out.back() == ' ') out.pop_back();
+  return out;
+}
+
+MujocoGuard::MujocoGuard() : error_(mju_user_error), warning_(mju_user_warning) {
+  collected().clear();
+  mju_user_error = onError;
+  mju_user_warning = onWarning;
+}
+MujocoGuard::~MujocoGuard() {
+  mju_user_error = error_;
+  mju_user_warning = warning_;
+}
+std::string MujocoGuard::warnings() const { return oneLine(collected()); }
+}  // namespace detail
+
+struct MujocoReference::Impl {
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  std::string file;
+  detail::MujocoGuard guard;
+  void at(const VecN& q, const VecN* v) {
+    std::copy(q.data(), q.data() + m->nq, d->qpos);
+    if (v) std::copy(v->data(), v->data() + m->nv, d->qvel);
+    else std::fill(d->qvel, d->qvel + m->nv, 0.0);
+    MUJOCO_CALL(file, mj_fwdPosition(m, d));
+    if (v) MUJOCO_CALL(file, mj_fwdVelocity(m, d));
+  }
+};
+
+MujocoReference::MujocoReference(const std::string& path) : impl_(new Impl) {
+  impl_->file = path;
+  char error[1024] = "";
+  MUJOCO_CALL(path, impl_->m = mj_loadXML(path.c_str(), nullptr, error, sizeof error));
+  if (!impl_->m) {
+    delete impl_;
+    throw ModelFileError(path + ": MuJoCo's parser: " + detail::oneLine(error));
+  }
+  MUJOCO_CALL(path, impl_->d = mj_makeData(impl_->m));
+}
+
+MujocoReference::~MujocoReference() {
+  if (impl_->d) mj_deleteData(impl_->d);
+  if (impl_->m) mj_deleteModel(impl_->m);
+  delete impl_;
+}
+
+int MujocoReference::nv() const { return impl_->m->nv; }
+
+MatN MujocoReference::massMatrix(const VecN& q) {
+  impl_->at(q, nullptr);
+  const int n = impl_->m->nv;
+  std::vector<mjtNum> M(std::size_t(n * n));
+  mj_fullM(impl_->m, M.data(), impl_->d->qM);
+  MatN out(n, n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) out(i, j) = M[std::size_t(i * n + j)];
+  return out;
+}
+
+VecN MujocoReference::bias(const VecN& q, const VecN& v) {
+  impl_->at(q, &v);
+  VecN out(impl_->m->nv);
+  for (int i = 0; i < impl_->m->nv; ++i) out[i] = impl_->d->qfrc_bias[i];
+  return out;
+}
+
+}  // namespace dyn::model_file

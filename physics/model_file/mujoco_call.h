@@ -1,0 +1,48 @@
+// MuJoCo's error and warning handlers, kept away from the process: by default mju_error prints,
+// writes MUJOCO_LOG.TXT into the working folder and exits, and mju_warning writes the same log. While
+// a MujocoGuard lives, a warning is collected and an error jumps back to the guarded call
+// (MUJOCO_CALL), which then throws one line. (MuJoCo's XML compiler installs its own handler while it
+// compiles and reports through mj_loadXML's error buffer; this guard covers the rest.)
+#pragma once
+#include <mujoco/mujoco.h>
+
+#include <csetjmp>
+#include <string>
+
+namespace dyn::model_file::detail {
+
+struct MujocoGuard {
+  MujocoGuard();
+  ~MujocoGuard();
+  MujocoGuard(const MujocoGuard&) = delete;
+  MujocoGuard& operator=(const MujocoGuard&) = delete;
+  std::string warnings() const;  // collected since the guard was made, one line
+  void (*error_)(const char*);
+  void (*warning_)(const char*);
+};
+
+// The jump target of the innermost guarded call, and the error it carries.
+std::jmp_buf*& jumpTarget();
+std::string& lastError();
+
+// One line: newlines and control characters become spaces, runs of spaces one.
+std::string oneLine(const std::string& text);
+
+}  // namespace dyn::model_file::detail
+
+// Runs the statement; a MuJoCo error inside it throws ModelFileError("<file>: MuJoCo: <message>").
+// (setjmp needs the caller's frame: a macro, not a function.)
+#define MUJOCO_CALL(file, statement)                                                              \
+  do {                                                                                           \
+    std::jmp_buf jump_;                                                                          \
+    std::jmp_buf* const outer_ = ::dyn::model_file::detail::jumpTarget();                        \
+    ::dyn::model_file::detail::jumpTarget() = &jump_;                                            \
+    if (setjmp(jump_) == 0) {                                                                    \
+      statement;                                                                                 \
+      ::dyn::model_file::detail::jumpTarget() = outer_;                                          \
+    } else {                                                                                     \
+      ::dyn::model_file::detail::jumpTarget() = outer_;                                          \
+      throw ::dyn::model_file::ModelFileError(std::string(file) + ": MuJoCo: " +                 \
+                                              ::dyn::model_file::detail::lastError());           \
+    }                                                                                            \
+  } while (0)
