@@ -103,7 +103,7 @@ py::dict LabObject::run(const std::string& engine, std::optional<double> duratio
     if (!(*duration > 0) || *duration > 3600) throw InputError(kArgument, "duration", "expected a duration in (0, 3600] s");
     config["simulation"]["duration"] = *duration;
   }
-  const auto built = buildLab(*loaded_.entry, config, source);
+  auto built = buildLab(*loaded_.entry, config, source);
   const Lab& lab = *built;
   if (lab.duration() < lab.dt())
     throw InputError(kArgument, "duration",
@@ -153,6 +153,12 @@ py::dict LabObject::run(const std::string& engine, std::optional<double> duratio
   summary["status"] = status.empty() ? "ok" : status;
   py::dict out = toPython(summary);
   out["traces"] = traces;
+  // Kept for frame() and video(): this run's lab and traces (a stopped run's too: it shows the blow-up).
+  auto last = std::make_shared<LastRun>();
+  if (hand) last->hand = std::move(hand->trace);
+  if (bullet) last->bullet = std::move(bullet->trace);
+  last->lab = std::move(built);
+  last_ = std::move(last);
   return out;
 }
 

@@ -5,8 +5,11 @@
 #include <optional>
 #include <string>
 
+#include <pybind11/numpy.h>
+
 #include "app/python/convert.h"
 #include "labs/run.h"
+#include "labs/trace.h"
 
 namespace dyn::python {
 
@@ -36,9 +39,24 @@ class LabObject {
   py::dict run(const std::string& engine, std::optional<double> duration, const std::string& scenario) const;
   // Poles and margins of the lab's linearised loops at the current gains (the grader's screening).
   py::dict screen() const;
+  // The last run drawn at time t (the lab's scene; with both engines the other one as a ghost), as
+  // an RGB array (height, width, 3) of uint8, offscreen (OSMesa: no display needed).
+  py::array frame(double t, const std::string& engine, int width, int height, bool overlay) const;
+  // The last run as an MP4 (H.264, 30 fps) at `path`, written whole or not at all; returns the path.
+  std::string video(const std::string& path, const std::string& engine, int width, int height) const;
 
  private:
+  // What frame() and video() draw: the last run's lab (its scenario and duration) and traces.
+  struct LastRun {
+    std::unique_ptr<Lab> lab;
+    std::optional<Trace> hand, bullet;
+  };
+  const LastRun& lastRun() const;
+  // The trace shown for `engine` ("hand" or "bullet") and the other engine's as its ghost (or null).
+  std::pair<const Trace*, const Trace*> shown(const std::string& engine) const;
+
   LoadedLab loaded_;
+  mutable std::shared_ptr<LastRun> last_;
 };
 
 // Runs `body` with the GIL released, asking Python for pending signals every 1024 steps through

@@ -3,6 +3,7 @@
 //   import dynlab
 //   lab = dynlab.Lab("slider_crank"); lab.set_gains(k_p=400)
 //   r = lab.run(engine="both", duration=2)   # r["traces"]["hand"]["x"], r["engines"], r["agreement"]
+//   img = lab.frame(1.0)                    # (480, 640, 3) uint8, the last run at t = 1 s
 //   dynlab.grade(lab.submission())["score"]
 // Bad input raises dynlab.InputError (a ValueError) with the CLI's one-line message
 // "<file>: <JSON path>: <what was expected>" and its parts as .file, .path, .expected.
@@ -108,6 +109,16 @@ void dyn::python::defineModule(py::module_& m) {
            "Runs the lab as `dynlab run` does: returns summary.json's fields and 'traces' "
            "(engine → column → NumPy array). Ctrl-C stops it (KeyboardInterrupt).")
       .def("screen", &LabObject::screen, "Poles and margins of the linearised loops at the current gains.")
+      .def("frame", &LabObject::frame, py::arg("t"), py::arg("engine") = "hand", py::arg("width") = 640,
+           py::arg("height") = 480, py::arg("overlay") = true,
+           "The last run at time t as an RGB array (height, width, 3), drawn as `dynlab run --frames` draws it "
+           "(with both engines run, the other one as a ghost). plt.imshow(lab.frame(1.0)) shows it.")
+      .def("video", [](const LabObject& lab, py::object path, const std::string& engine, int width, int height) {
+        std::string p;
+        if (!asPath(path, p)) throw py::type_error("video: path must be a str or os.PathLike");
+        return lab.video(p, engine, width, height);
+      }, py::arg("path"), py::arg("engine") = "hand", py::arg("width") = 640, py::arg("height") = 480,
+           "Writes the last run as an MP4 (H.264, 30 fps) at path, whole or not at all; returns its absolute path.")
       .def("grade", [](const LabObject& lab, double time_budget) {
         return grade(toPython(lab.submission()), lab.name(), lab.configFile(), time_budget);
       }, py::arg("time_budget") = 300.0, "Grades the current gains (dynlab.grade of submission()).")

@@ -159,6 +159,50 @@ class Traces(unittest.TestCase):
         self.assertEqual(lab.run(engine="hand", duration=0.1)["status"], "ok")  # still usable
 
 
+class Pictures(unittest.TestCase):
+    def test_frame_is_the_clis_frame(self):
+        # dynlab run --frames writes frame k at t = k/30 s; frame(k/30) is that image, pixel for pixel.
+        import matplotlib.image
+        out = os.path.join(TMP, "frames_slider_crank")
+        r = cli("run", "slider_crank", "--duration", "0.2", "--frames", "--out", out)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        lab = dynlab.Lab("slider_crank")
+        lab.run(duration=0.2)
+        for k in (0, 5):
+            with self.subTest(frame=k):
+                png = matplotlib.image.imread(os.path.join(out, "frames", f"{k:05d}.png"))
+                expected = np.rint(png[:, :, :3] * 255).astype(np.uint8)
+                got = lab.frame(k / 30)
+                self.assertEqual(got.shape, (480, 640, 3))
+                self.assertEqual(got.dtype, np.uint8)
+                self.assertTrue(np.array_equal(got, expected), f"frame {k} differs from the CLI's")
+        self.assertFalse(np.array_equal(lab.frame(0.0), lab.frame(0.15)))  # the mechanism moved
+        small = lab.frame(0.1, width=320, height=240, overlay=False)
+        self.assertEqual(small.shape, (240, 320, 3))
+
+    def test_video_is_written_whole(self):
+        lab = dynlab.Lab("pen_on_table")
+        with self.assertRaises(dynlab.InputError) as e:
+            lab.frame(0.0)  # nothing run yet
+        self.assertIn("run first", str(e.exception))
+        lab.run(engine="hand", duration=0.3)
+        path = lab.video(os.path.join(TMP, "pen.mp4"))
+        self.assertEqual(path, os.path.abspath(os.path.join(TMP, "pen.mp4")))
+        with open(path, "rb") as f:
+            head = f.read(12)
+        self.assertEqual(head[4:8], b"ftyp")
+        self.assertGreater(os.path.getsize(path), 1000)
+        self.assertEqual([n for n in os.listdir(TMP) if n.startswith(".dynlab-video")], [])
+        for kwargs in ({"engine": "bullet"}, {"width": 641}, {"width": 10}):
+            with self.subTest(**kwargs), self.assertRaises(dynlab.InputError):
+                lab.video(os.path.join(TMP, "bad.mp4"), **kwargs)
+        with self.assertRaises(dynlab.InputError):
+            lab.video(os.path.join(TMP, "no_such_folder", "x.mp4"))
+        with self.assertRaises(dynlab.InputError):
+            lab.frame(-1.0)
+        self.assertFalse(os.path.exists(os.path.join(TMP, "bad.mp4")))
+
+
 class Errors(unittest.TestCase):
     def cli_error(self, lab, gains):
         path = write("bad_gains.json", gains)
