@@ -87,7 +87,8 @@ int dispatch(int argc, char** argv) {
 
   RunArgs run;
   auto* r = cli.add_subcommand("run", "Run a lab with the hand-written dynamics and/or Bullet; write traces, summary, video");
-  r->add_option("LAB", run.lab, "Lab name (see `dynlab list`)")->required();
+  r->add_option("LAB", run.lab, "Lab name (see `dynlab list`), or an MJCF (.xml) / URDF (.urdf) model file: run as "
+                                "`dynlab model FILE` does")->required();
   r->add_option("--config", run.config, "Lab config JSON (default: labs/LAB/LAB.json)");
   r->add_option("--gains", run.gains, "Gains JSON: {\"gains\": {...}} as in a submission");
   r->add_option("--out", run.out, "Output directory (default: out/LAB)");
@@ -222,7 +223,7 @@ int dispatch(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   if (*list) return listLabs();
-  if (*r) return runLab(run);
+  if (*r) return isModelFile(run.lab) ? runModelFile(run) : runLab(run);
   if (*f) return figure(fig);
   if (*g) return !grade.batch.empty() ? gradeBatch(grade) : !grade.replay.empty() ? gradeReplay(grade) : gradeOne(grade);
   if (*z) return writeAutograderZip(zip_lab, zip_out);

@@ -10,6 +10,9 @@
 #include <random>
 #include <sstream>
 
+#include "app/commands.h"
+#include "app/model_scene.h"
+#include "app/movie.h"
 #include "app/output.h"
 #include "labs/trace.h"
 #include "physics/bullet/bullet_mechanism.h"
@@ -71,6 +74,7 @@ std::string describe(const model_file::LoadedModel& m) {
     o << "\n";
   }
   for (const auto& n : m.notes) o << "  note: " << n << "\n";
+  for (const auto& n : m.drawing.notes) o << "  drawing: " << n << "\n";
   return o.str();
 }
 
@@ -221,6 +225,37 @@ ModelCommand::ModelCommand(CLI::App& cli) {
   command_->add_option("--out", a.out, "Output directory (default: out/model/FILE's stem)");
   command_->add_option("--engine", a.engine, "Which engine(s) to run (default: both)")->check(CLI::IsMember({"hand", "bullet", "both"}));
   command_->add_flag("--ignore-contacts", a.ignore_contacts, "Load a file whose geoms may collide, ignoring contacts (noted)");
+  command_->add_flag("--video", a.video, "Write video.mp4 of the run drawn from the file's geoms (H.264, 30 fps; the Bullet run as a ghost)");
+  command_->add_flag("--frames", a.frames, "Write frames/NNNNN.png (30 fps)");
+}
+
+bool isModelFile(const std::string& name) {
+  std::string ext = std::filesystem::path(name).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".xml" || ext == ".urdf";
+}
+
+int runModelFile(const RunArgs& r) {
+  for (const auto& [given, option] : {std::pair{!r.config.empty(), "--config"}, {!r.gains.empty(), "--gains"}, {!r.scenario.empty(), "--scenario"}})
+    if (given) {
+      std::fprintf(stderr, "error: <command line>: %s: a model file (%s) runs passive, without a lab's config, gains or scenario\n", option,
+                   utf8Quotable(r.lab).c_str());
+      return 2;
+    }
+  ModelArgs a;
+  a.file = r.lab;
+  a.out = r.out;
+  a.engine = r.engine;
+  a.video = r.video;
+  a.frames = r.frames;
+  if (r.duration) {
+    if (!(*r.duration > 0 && *r.duration <= 600)) {
+      std::fprintf(stderr, "error: <command line>: --duration: expected a time in (0, 600] s for a model file, got %g\n", *r.duration);
+      return 2;
+    }
+    a.duration = *r.duration;
+  }
+  return model(a);
 }
 
 int model(const ModelArgs& args) {
@@ -264,13 +299,36 @@ int model(const ModelArgs& args) {
   }
   const bool ok = (!hand || h.ok) && (!bullet || b.ok);
   const std::filesystem::path out = args.out.empty() ? std::filesystem::path("out/model") / std::filesystem::path(args.file).stem() : std::filesystem::path(args.out);
-  text += "wrote " + out.string() + "/" + (hand ? "trace.csv " : "") + (bullet ? "trace_bullet.csv " : "") + "summary.txt\n";
+  text += "wrote " + out.string() + "/" + (hand ? "trace.csv " : "") + (bullet ? "trace_bullet.csv " : "") + "summary.txt";
+  if (args.video) text += " video.mp4";
+  if (args.frames) text += " frames/";
+  text += "\n";
   try {
     Staging staging(out);
-    staging.owns({"trace.csv", "trace_bullet.csv", "summary.txt"});
+    staging.owns({"trace.csv", "trace_bullet.csv", "summary.txt", "video.mp4", "frames"});
     if (hand) staging.write("trace.csv", h.trace.csv());
     if (bullet) staging.write("trace_bullet.csv", b.trace.csv());
     staging.write("summary.txt", text);
+    if (args.video || args.frames) {
+      // The hand run drawn from the file's geoms, Bullet's as a ghost; the camera framed once around
+      // the space both move through.
+      const Trace& shown = hand ? h.trace : b.trace;
+      const Trace* ghost = hand && bullet ? &b.trace : nullptr;
+      const int n = mech.n();
+      const ModelPicture picture(m);
+      const Eigen::AlignedBox3d box = runBounds(picture, n, shown, ghost);
+      const std::string title = std::filesystem::path(m.file).filename().string();
+      const std::string engines = hand ? (ghost ? "hand; Bullet ghost" : "hand") : "Bullet";
+      const DrawRow draw = [&](std::size_t row, Scene& scene, Overlay* panel) {
+        const VecN q = traceQ(shown, row, n);
+        VecN gq;
+        if (ghost && row < ghost->rows()) gq = traceQ(*ghost, row, n);
+        picture.scene(q, gq.size() ? &gq : nullptr, box, scene);
+        if (panel) modelOverlay(utf8Quotable(title), engines, shown, row, args.dt, ghost, *panel);
+      };
+      const int frames = renderFrames(draw, shown, args.dt, {640, 480, 30, args.video, args.frames}, staging.path(""));
+      text += "  " + std::to_string(frames) + " frames at 30 per second of simulated time, 640x480\n";
+    }
     staging.commit();
   } catch (const std::exception& e) {
     std::fputs(text.c_str(), stdout);
