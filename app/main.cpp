@@ -206,7 +206,8 @@ int dispatch(int argc, char** argv) {
   b->add_flag("--json", bench_args.json, "One JSON object per lab");
   b->add_option("--steps", bench_args.steps, "Steps timed per engine")->check(CLI::Range(100, 1000000));
   b->add_option("--frames", bench_args.frames, "Frames timed per output kind")->check(CLI::Range(5, 10000));
-  b->add_option("LAB", bench_args.lab, "Only this lab (default: every lab)");
+  b->add_option("LAB", bench_args.lab, "Only this lab (default: every lab), or an MJCF/URDF model file: its hand step against "
+                                      "Bullet's and MuJoCo's at equal order");
   b->add_flag("--scaling", bench_args.scaling,
               "Step cost against chain length (3 to 1,000 links): hand ABA, hand CRBA + Cholesky, Bullet; "
               "a table, OUT/scaling.csv and OUT/scaling.png");

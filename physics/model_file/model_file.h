@@ -115,4 +115,24 @@ class MujocoReference {
   Impl* impl_;
 };
 
+// MuJoCo's own simulation of the same file (mj_step), for the bench: its constraint solver and soft
+// equalities as the file sets them, at a given step and with the semi-implicit Euler integrator
+// (MuJoCo's default, first order), from a state in the same coordinates as LoadedModel.
+class MujocoSimulation {
+ public:
+  MujocoSimulation(const std::string& path, double dt);
+  ~MujocoSimulation();
+  MujocoSimulation(const MujocoSimulation&) = delete;
+  MujocoSimulation& operator=(const MujocoSimulation&) = delete;
+  void reset(const VecN& q, const VecN& v);
+  // One mj_step; false when MuJoCo warned that the state blew up (it then resets its data itself).
+  bool step();
+  void state(VecN& q, VecN& v) const;
+  std::string describe() const;  // "MuJoCo 2.2.2 mj_step, Euler, Newton solver (100 iterations)"
+
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
 }  // namespace dyn::model_file

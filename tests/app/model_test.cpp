@@ -4,6 +4,7 @@
 // same command, with its video (decoded by ffprobe) and frames drawn from the file's geoms.
 #include <doctest/doctest.h>
 
+#include <nlohmann/json.hpp>
 #include <stb_image.h>
 
 #include <cmath>
@@ -12,6 +13,7 @@
 #include "tests/app/cli_run.h"
 
 using namespace dyn::test::cli;
+using nlohmann::json;
 
 namespace {
 std::string model(const char* name) { return quote(std::string(DYNLAB_SOURCE_DIR) + "/assets/models/" + name); }
@@ -121,4 +123,26 @@ TEST_CASE("dynlab run FILE: a lab's options and a missing file are bad input (on
   checkBadInput(dir, "run " + model("fourbar.xml") + " --scenario heavy_load --out o", {"--scenario", "passive"}, dir / "o");
   checkBadInput(dir, "run missing.URDF --out o", {"missing.URDF", "no such file"}, dir / "o");
   checkBadInput(dir, "run " + model("fourbar.xml") + " --duration 0 --out o", {"--duration", "(0, 600]"}, dir / "o");
+}
+
+TEST_CASE("dynlab bench FILE: the hand step at both orders, Bullet's and MuJoCo's, each with its accuracy") {
+  TempDir dir("model_bench");
+  const Result r = dynlab(dir, "bench " + model("fivebar.xml") + " --steps 200");
+  INFO(r.out, r.err);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("4 coordinates, 2 closure rows, dt 0.001 s") != std::string::npos);
+  for (const char* row : {"\n  hand, Euler ", "\n  hand, RK4 ", "\n  Bullet ", "\n  MuJoCo ", "MuJoCo 2.2.2 mj_step, Euler", "semi-implicit Euler + Baumgarte"})
+    CHECK_MESSAGE(r.out.find(row) != std::string::npos, row);
+  // JSON: four engines, each timed and run 2 s; the RK4 run is the reference and keeps the closure.
+  const Result j = dynlab(dir, "bench " + model("fivebar.xml") + " --steps 100 --json");
+  REQUIRE(j.code == 0);
+  const json out = json::parse(j.out);
+  REQUIRE(out["engines"].size() == 4);
+  for (const json& e : out["engines"]) {
+    CHECK(e["us_per_step"].get<double>() > 0);
+    CHECK(e["complete"].get<bool>());
+  }
+  CHECK(out["engines"][1]["max_q_error_vs_hand_rk4"].get<double>() == 0.0);
+  CHECK(out["engines"][1]["max_closure_residual"].get<double>() < 1e-11);
+  checkBadInput(dir, "bench missing.xml", {"missing.xml", "no such file"}, dir / "out");
 }

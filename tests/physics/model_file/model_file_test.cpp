@@ -347,3 +347,26 @@ TEST_CASE("hostile and unsupported model files: one line naming the file and the
                               "</worldbody><equality><weld name=\"w\" body1=\"p\" body2=\"s\" relpose=\"1 0 0 0.9 0.1 0 0\"/></equality></mujoco>";
   CHECK(errorOf(writeFile("twisted.xml", twisted)).find("weld 'w' holds a relative orientation") != std::string::npos);
 }
+
+TEST_CASE("MuJoCo's own steps of the same file (the bench's fourth engine) move the same coordinates") {
+  // From rest for 20 ms, the arm3d (no loop: MuJoCo's equalities play no part) by mj_step (Euler, the
+  // same dt) and by the hand engine (RK4): the same motion to Euler's first-order error, not to zero.
+  const model_file::LoadedModel m = model_file::load(model("arm3d.xml"));
+  const int n = int(m.q0.size());
+  model_file::MujocoSimulation mj(m.file, 1e-4);
+  CHECK(mj.describe().find("mj_step, Euler") != std::string::npos);
+  mj.reset(m.q0, VecN::Zero(n));
+  ConstrainedMechanism<Spatial> mech(m.mechanism);
+  VecN q = m.q0, v = VecN::Zero(n), qm, vm;
+  StepOptions o;
+  o.dt = 1e-4;
+  for (int k = 0; k < 200; ++k) {
+    REQUIRE(mj.step());
+    REQUIRE(step(mech, o, VecN::Zero(n), q, v));
+  }
+  mj.state(qm, vm);
+  CHECK((q - m.q0).cwiseAbs().maxCoeff() > 1e-3);  // it moved
+  CHECK((qm - q).cwiseAbs().maxCoeff() < 0.02 * (q - m.q0).cwiseAbs().maxCoeff());
+  CHECK((vm - v).cwiseAbs().maxCoeff() < 0.02 * v.cwiseAbs().maxCoeff());
+  CHECK((qm - q).cwiseAbs().maxCoeff() > 0);
+}
