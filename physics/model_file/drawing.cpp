@@ -125,8 +125,11 @@ void readDrawing(const mjModel* m, const mjData* d, const std::vector<int>& link
                                    "and meshes as their bounding capsules)");
         continue;
     }
-    if (!g.rot.allFinite() || !g.pos.allFinite() || !g.size.allFinite()) {
-      out.notes.push_back(what + ": its pose or size is not finite, not drawn");
+    // Drawing only: a shape beyond what the description reads (±1e9) is left out, not refused.
+    constexpr double kLargest = 1e9;
+    if (!g.rot.allFinite() || !g.pos.allFinite() || !g.size.allFinite() || g.pos.cwiseAbs().maxCoeff() > kLargest ||
+        g.size.cwiseAbs().maxCoeff() > kLargest) {
+      out.notes.push_back(what + ": its position or size is not finite or beyond ±1e9 m, not drawn");
       continue;
     }
     drawn[std::size_t(b)] = g.shape != Geom::Shape::Plane;

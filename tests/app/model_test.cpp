@@ -114,6 +114,11 @@ TEST_CASE("dynlab run FILE.xml --engine both --video --frames: the model command
   CHECK(readFile(dir / "same/trace.csv") == readFile(dir / "out/trace.csv"));
   CHECK(readFile(dir / "same/trace_bullet.csv") == readFile(dir / "out/trace_bullet.csv"));
   CHECK_FALSE(fs::exists(dir / "same/video.mp4"));
+  // Same input, same pixels: the frames of a rerun (hand only: no ghost) twice.
+  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.2 --engine hand --frames --out f1").code == 0);
+  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.2 --engine hand --frames --out f2").code == 0);
+  CHECK(snapshot(dir / "f1/frames") == snapshot(dir / "f2/frames"));
+  CHECK(snapshot(dir / "f1/frames").size() == 7);
 }
 
 TEST_CASE("dynlab run FILE: a lab's options and a missing file are bad input (one line, exit 2)") {

@@ -79,6 +79,7 @@ TEST_CASE("meshes and ellipsoids as bounding capsules, planes as floors, hidden 
   </asset>
   <worldbody>
     <geom name="floor" type="plane" size="2 2 0.1" pos="0 0 -1"/>
+    <geom name="huge" type="box" size="1e12 1 1"/>
     <body name="arm" pos="0.2 0.1 0">
       <joint name="j" type="hinge" axis="0 1 0"/>
       <geom name="wedge" type="mesh" mesh="wedge" mass="1"/>
@@ -123,6 +124,7 @@ TEST_CASE("meshes and ellipsoids as bounding capsules, planes as floors, hidden 
   CHECK(painted.rgba[0] == doctest::Approx(0.8f));
   CHECK(has(notes, "1 geom", "groups 3"));
   CHECK(has(notes, "1 transparent", "not drawn"));
+  CHECK(has(notes, "huge", "beyond ±1e9 m, not drawn"));
 }
 
 TEST_CASE("a URDF arm without geoms is drawn as rods from each joint to the next and to its centre of mass") {
