@@ -22,6 +22,7 @@
 #include "labs/utf8.h"
 #include "physics/bullet/bullet_mechanism.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/model_file/hand_engine.h"
 #include "physics/model_file/model_file.h"
 
 namespace dyn::app {
@@ -42,7 +43,8 @@ struct Engine {
 
 // The engines from the file's pose at rest.
 struct Engines {
-  std::unique_ptr<ConstrainedMechanism<Spatial>> euler_mech, rk4_mech;
+  std::unique_ptr<ConstrainedSystem> euler_mech, rk4_mech;
+  std::string sizes;
   std::unique_ptr<bullet::BulletMechanism<Spatial>> bullet;
   std::unique_ptr<model_file::MujocoSimulation> mujoco;
   VecN q_euler, v_euler, q_rk4, v_rk4;
@@ -58,13 +60,13 @@ void build(const model_file::LoadedModel& m, double dt, Engines& e) {
   euler.drift.kind = Drift::Baumgarte;
   StepOptions rk4;
   rk4.dt = dt;
-  e.euler_mech = std::make_unique<ConstrainedMechanism<Spatial>>(m.mechanism);
-  e.rk4_mech = std::make_unique<ConstrainedMechanism<Spatial>>(m.mechanism);
+  e.euler_mech = model_file::handEngine(m.mechanism, &e.sizes);
+  e.rk4_mech = model_file::handEngine(m.mechanism);
   e.q_euler = e.q_rk4 = m.q0, e.v_euler = e.v_rk4 = zero;
-  auto hand = [&, n](const char* scheme, ConstrainedMechanism<Spatial>* mech, VecN* q, VecN* v, StepOptions o) {
+  auto hand = [&, n](const char* scheme, ConstrainedSystem* mech, VecN* q, VecN* v, StepOptions o) {
     Engine x;
     x.name = "hand";
-    x.scheme = scheme;
+    x.scheme = std::string(scheme) + " (" + e.sizes + ")";
     x.step = [=] { return step(*mech, o, VecN::Zero(n), *q, *v) && q->allFinite() && v->allFinite(); };
     x.restart = [=, q0 = m.q0] { *q = q0, *v = VecN::Zero(n), mech->setTime(0); };
     x.state = [=](VecN& qo, VecN& vo) { qo = *q, vo = *v; };

@@ -18,6 +18,7 @@
 #include "physics/bullet/bullet_mechanism.h"
 #include "labs/utf8.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/model_file/hand_engine.h"
 #include "physics/model_file/model_file.h"
 
 namespace dyn::app {
@@ -143,8 +144,9 @@ void record(Run& run, ConstrainedMechanism<Spatial>& mech, double t, const VecN&
   run.kinetic = std::max(run.kinetic, mech.kineticEnergy(q, v));
 }
 
-// The hand engine from the file's pose at rest: RK4, positions and velocities projected each step;
-// forces: the solve's η at the row's state.
+// The hand engine from the file's pose at rest: RK4, positions and velocities projected each step,
+// stepped by the sized engine the bench times (hand_engine.h); the rows' energy, residual and forces
+// (the solve's η at the row's state) from the description's mechanism.
 Run runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, const ModelArgs& args) {
   Run run;
   run.trace = emptyTrace(m);
@@ -153,15 +155,16 @@ Run runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mec
   const int steps = int(std::lround(args.duration / args.dt)), n = mech.n();
   VecN q = m.q0, v = VecN::Zero(n);
   const VecN tau = VecN::Zero(n);
+  const std::unique_ptr<ConstrainedSystem> engine = model_file::handEngine(m.mechanism, &run.summary);
   // The books (friction's work) integrated with the motion, at RK4's order (integrate.h).
-  mech.setTime(0);
-  mech.books() = Books{};
+  engine->setTime(0);
+  engine->books() = Books{};
   for (int k = 0; k <= steps; ++k) {
     const auto s = mech.solve(q, v, tau);
-    const Books b = mech.books();
+    const Books b = engine->books();
     record(run, mech, k * args.dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()));
     if (k == steps) break;
-    if (!(run.ok = step(mech, o, tau, q, v) && q.allFinite() && v.allFinite())) break;
+    if (!(run.ok = step(*engine, o, tau, q, v) && q.allFinite() && v.allFinite())) break;
   }
   return run;
 }
@@ -288,7 +291,7 @@ int model(const ModelArgs& args) {
       return 2;
     }
   }
-  if (hand) text += report(h, "hand engine: RK4 + projection", m, args);
+  if (hand) text += report(h, "hand engine (" + h.summary + "): RK4 + projection", m, args);
   if (bullet) text += report(b, b.summary + ", semi-implicit Euler", m, args);
   if (hand && bullet) {
     double dq = 0;
