@@ -85,6 +85,11 @@ ModelPicture::ModelPicture(const model_file::LoadedModel& model) : model_(model)
   joint_radius_ = std::max(1.4 * rod_radius_, 0.015 * extent);
 }
 
+bool ModelPicture::groundPivot(std::size_t i) const {
+  const auto& b = model_.mechanism.tree.bodies[i];
+  return b.parent < 0 && b.joint == JointType::Revolute;
+}
+
 void ModelPicture::place(const VecN& q) const { worldKinematics(model_.mechanism.tree, q, data_); }
 
 Vec3 ModelPicture::point(int link, const Vec3& p) const {
@@ -108,6 +113,10 @@ Box3 ModelPicture::bounds(const VecN& q) const {
   for (const auto& g : model_.drawing.geoms)
     if (g.shape != Shape::Plane) extendShape(g.link < 0 ? fixed : box, point(g.link, g.pos), rotation(g.link) * g.rot, g);
   for (const auto& b : model_.drawing.bones) extend(box, point(b.link, b.to), rod_radius_);
+  // The ground mounts (drawBodies), whatever the view: a ball of their reach under each world joint.
+  if (planar_)
+    for (std::size_t i = 0; i < data_.X_world.size(); ++i)
+      if (groundPivot(i)) extend(box, data_.X_world[i].r, 3.2 * joint_radius_);
   // What the world holds counts unless it dwarfs the mechanism (a table 100 m wide): then the
   // mechanism is framed and the rest drawn around it.
   if (!fixed.isEmpty() && (box.isEmpty() || fixed.diagonal().norm() <= 3 * box.diagonal().norm())) box.extend(fixed);
@@ -132,6 +141,17 @@ void ModelPicture::drawBodies(bool ghost, Scene& s) const {
   for (const auto& b : model_.drawing.bones)
     s.capsules.push_back({point(b.link, b.from) + back, point(b.link, b.to) + back, rod_radius_, ghost ? kGhost : kPalette[b.link % 4]});
   if (ghost) return;
+  // Side-on, a ground mount under each hinge on the world (as the planar labs draw theirs), behind
+  // the links.
+  if (planar_) {
+    const CameraBasis view = s.camera.basis();
+    Mat3 R;
+    R << view.right, view.up, view.back;
+    const double r = joint_radius_;
+    for (std::size_t i = 0; i < data_.X_world.size(); ++i)
+      if (groundPivot(i))
+        s.boxes.push_back({data_.X_world[i].r - 1.2 * r * view.up - 1.2 * r * view.back, Vec3(1.7 * r, 0.9 * r, 0.5 * r), R, kWorld});
+  }
   for (const auto& X : data_.X_world) s.spheres.push_back({X.r, joint_radius_, kJoint});
   for (const auto& c : model_.closures) s.spheres.push_back({point(c.link1, c.point1), 0.85 * joint_radius_, kClosure});
 }

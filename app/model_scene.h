@@ -34,6 +34,7 @@ class ModelPicture {
   Eigen::Vector3d point(int link, const Eigen::Vector3d& p) const;
   Eigen::Matrix3d rotation(int link) const;
   void drawBodies(bool ghost, Scene& out) const;
+  bool groundPivot(std::size_t link) const;  // a hinge on the world: drawn on a mount
 
   const model_file::LoadedModel& model_;
   mutable TreeData<Spatial> data_;
