@@ -17,6 +17,7 @@
 
 #include "app/bench.h"
 #include "app/commands.h"
+#include "app/model.h"
 #include "app/movie.h"
 #include "labs/run.h"
 #include "render/video.h"
@@ -189,6 +190,7 @@ json errorAgainst(const Lab& lab, const Trace& run, const Trace& reference) {
 }  // namespace
 
 int bench(const BenchArgs& a) {
+  if (isModelFile(a.lab)) return benchModel(a);  // a model file where a lab goes (app/bench_model.cpp)
   bool found = a.lab.empty();
   for (const auto& entry : labRegistry()) found = found || entry.name == a.lab;
   if (!found) {

@@ -10,4 +10,8 @@ double median(std::vector<double> v);
 // a sub-microsecond step is not charged the timer's own ~20–50 ns.
 double clockOverhead();
 
+struct BenchArgs;
+// dynlab bench FILE.xml|FILE.urdf: the hand step against Bullet's and MuJoCo's for a model file (app/bench_model.cpp).
+int benchModel(const BenchArgs& args);
+
 }  // namespace dyn::app

@@ -87,7 +87,8 @@ int dispatch(int argc, char** argv) {
 
   RunArgs run;
   auto* r = cli.add_subcommand("run", "Run a lab with the hand-written dynamics and/or Bullet; write traces, summary, video");
-  r->add_option("LAB", run.lab, "Lab name (see `dynlab list`)")->required();
+  r->add_option("LAB", run.lab, "Lab name (see `dynlab list`), or an MJCF (.xml) / URDF (.urdf) model file: run as "
+                                "`dynlab model FILE` does")->required();
   r->add_option("--config", run.config, "Lab config JSON (default: labs/LAB/LAB.json)");
   r->add_option("--gains", run.gains, "Gains JSON: {\"gains\": {...}} as in a submission");
   r->add_option("--out", run.out, "Output directory (default: out/LAB)");
@@ -205,7 +206,8 @@ int dispatch(int argc, char** argv) {
   b->add_flag("--json", bench_args.json, "One JSON object per lab");
   b->add_option("--steps", bench_args.steps, "Steps timed per engine")->check(CLI::Range(100, 1000000));
   b->add_option("--frames", bench_args.frames, "Frames timed per output kind")->check(CLI::Range(5, 10000));
-  b->add_option("LAB", bench_args.lab, "Only this lab (default: every lab)");
+  b->add_option("LAB", bench_args.lab, "Only this lab (default: every lab), or an MJCF/URDF model file: its hand step against "
+                                      "Bullet's and MuJoCo's at equal order");
   b->add_flag("--scaling", bench_args.scaling,
               "Step cost against chain length (3 to 1,000 links): hand ABA, hand CRBA + Cholesky, Bullet; "
               "a table, OUT/scaling.csv and OUT/scaling.png");
@@ -222,7 +224,7 @@ int dispatch(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   if (*list) return listLabs();
-  if (*r) return runLab(run);
+  if (*r) return isModelFile(run.lab) ? runModelFile(run) : runLab(run);
   if (*f) return figure(fig);
   if (*g) return !grade.batch.empty() ? gradeBatch(grade) : !grade.replay.empty() ? gradeReplay(grade) : gradeOne(grade);
   if (*z) return writeAutograderZip(zip_lab, zip_out);

@@ -10,11 +10,15 @@
 #include <random>
 #include <sstream>
 
+#include "app/commands.h"
+#include "app/model_scene.h"
+#include "app/movie.h"
 #include "app/output.h"
 #include "labs/trace.h"
 #include "physics/bullet/bullet_mechanism.h"
 #include "labs/utf8.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/model_file/hand_engine.h"
 #include "physics/model_file/model_file.h"
 
 namespace dyn::app {
@@ -71,6 +75,7 @@ std::string describe(const model_file::LoadedModel& m) {
     o << "\n";
   }
   for (const auto& n : m.notes) o << "  note: " << n << "\n";
+  for (const auto& n : m.drawing.notes) o << "  drawing: " << n << "\n";
   return o.str();
 }
 
@@ -139,8 +144,9 @@ void record(Run& run, ConstrainedMechanism<Spatial>& mech, double t, const VecN&
   run.kinetic = std::max(run.kinetic, mech.kineticEnergy(q, v));
 }
 
-// The hand engine from the file's pose at rest: RK4, positions and velocities projected each step;
-// forces: the solve's η at the row's state.
+// The hand engine from the file's pose at rest: RK4, positions and velocities projected each step,
+// stepped by the sized engine the bench times (hand_engine.h); the rows' energy, residual and forces
+// (the solve's η at the row's state) from the description's mechanism.
 Run runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, const ModelArgs& args) {
   Run run;
   run.trace = emptyTrace(m);
@@ -149,15 +155,16 @@ Run runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mec
   const int steps = int(std::lround(args.duration / args.dt)), n = mech.n();
   VecN q = m.q0, v = VecN::Zero(n);
   const VecN tau = VecN::Zero(n);
+  const std::unique_ptr<ConstrainedSystem> engine = model_file::handEngine(m.mechanism, &run.summary);
   // The books (friction's work) integrated with the motion, at RK4's order (integrate.h).
-  mech.setTime(0);
-  mech.books() = Books{};
+  engine->setTime(0);
+  engine->books() = Books{};
   for (int k = 0; k <= steps; ++k) {
     const auto s = mech.solve(q, v, tau);
-    const Books b = mech.books();
+    const Books b = engine->books();
     record(run, mech, k * args.dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()));
     if (k == steps) break;
-    if (!(run.ok = step(mech, o, tau, q, v) && q.allFinite() && v.allFinite())) break;
+    if (!(run.ok = step(*engine, o, tau, q, v) && q.allFinite() && v.allFinite())) break;
   }
   return run;
 }
@@ -221,6 +228,37 @@ ModelCommand::ModelCommand(CLI::App& cli) {
   command_->add_option("--out", a.out, "Output directory (default: out/model/FILE's stem)");
   command_->add_option("--engine", a.engine, "Which engine(s) to run (default: both)")->check(CLI::IsMember({"hand", "bullet", "both"}));
   command_->add_flag("--ignore-contacts", a.ignore_contacts, "Load a file whose geoms may collide, ignoring contacts (noted)");
+  command_->add_flag("--video", a.video, "Write video.mp4 of the run drawn from the file's geoms (H.264, 30 fps; the Bullet run as a ghost)");
+  command_->add_flag("--frames", a.frames, "Write frames/NNNNN.png (30 fps)");
+}
+
+bool isModelFile(const std::string& name) {
+  std::string ext = std::filesystem::path(name).extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".xml" || ext == ".urdf";
+}
+
+int runModelFile(const RunArgs& r) {
+  for (const auto& [given, option] : {std::pair{!r.config.empty(), "--config"}, {!r.gains.empty(), "--gains"}, {!r.scenario.empty(), "--scenario"}})
+    if (given) {
+      std::fprintf(stderr, "error: <command line>: %s: a model file (%s) runs passive, without a lab's config, gains or scenario\n", option,
+                   utf8Quotable(r.lab).c_str());
+      return 2;
+    }
+  ModelArgs a;
+  a.file = r.lab;
+  a.out = r.out;
+  a.engine = r.engine;
+  a.video = r.video;
+  a.frames = r.frames;
+  if (r.duration) {
+    if (!(*r.duration > 0 && *r.duration <= 600)) {
+      std::fprintf(stderr, "error: <command line>: --duration: expected a time in (0, 600] s for a model file, got %g\n", *r.duration);
+      return 2;
+    }
+    a.duration = *r.duration;
+  }
+  return model(a);
 }
 
 int model(const ModelArgs& args) {
@@ -253,7 +291,7 @@ int model(const ModelArgs& args) {
       return 2;
     }
   }
-  if (hand) text += report(h, "hand engine: RK4 + projection", m, args);
+  if (hand) text += report(h, "hand engine (" + h.summary + "): RK4 + projection", m, args);
   if (bullet) text += report(b, b.summary + ", semi-implicit Euler", m, args);
   if (hand && bullet) {
     double dq = 0;
@@ -264,13 +302,36 @@ int model(const ModelArgs& args) {
   }
   const bool ok = (!hand || h.ok) && (!bullet || b.ok);
   const std::filesystem::path out = args.out.empty() ? std::filesystem::path("out/model") / std::filesystem::path(args.file).stem() : std::filesystem::path(args.out);
-  text += "wrote " + out.string() + "/" + (hand ? "trace.csv " : "") + (bullet ? "trace_bullet.csv " : "") + "summary.txt\n";
+  text += "wrote " + out.string() + "/" + (hand ? "trace.csv " : "") + (bullet ? "trace_bullet.csv " : "") + "summary.txt";
+  if (args.video) text += " video.mp4";
+  if (args.frames) text += " frames/";
+  text += "\n";
   try {
     Staging staging(out);
-    staging.owns({"trace.csv", "trace_bullet.csv", "summary.txt"});
+    staging.owns({"trace.csv", "trace_bullet.csv", "summary.txt", "video.mp4", "frames"});
     if (hand) staging.write("trace.csv", h.trace.csv());
     if (bullet) staging.write("trace_bullet.csv", b.trace.csv());
     staging.write("summary.txt", text);
+    if (args.video || args.frames) {
+      // The hand run drawn from the file's geoms, Bullet's as a ghost; the camera framed once around
+      // the space both move through.
+      const Trace& shown = hand ? h.trace : b.trace;
+      const Trace* ghost = hand && bullet ? &b.trace : nullptr;
+      const int n = mech.n();
+      const ModelPicture picture(m);
+      const Eigen::AlignedBox3d box = runBounds(picture, n, shown, ghost);
+      const std::string title = std::filesystem::path(m.file).filename().string();
+      const std::string engines = hand ? (ghost ? "hand; Bullet ghost" : "hand") : "Bullet";
+      const DrawRow draw = [&](std::size_t row, Scene& scene, Overlay* panel) {
+        const VecN q = traceQ(shown, row, n);
+        VecN gq;
+        if (ghost && row < ghost->rows()) gq = traceQ(*ghost, row, n);
+        picture.scene(q, gq.size() ? &gq : nullptr, box, scene);
+        if (panel) modelOverlay(utf8Quotable(title), engines, shown, row, args.dt, ghost, *panel);
+      };
+      const int frames = renderFrames(draw, shown, args.dt, {640, 480, 30, args.video, args.frames}, staging.path(""));
+      text += "  " + std::to_string(frames) + " frames at 30 per second of simulated time, 640x480\n";
+    }
     staging.commit();
   } catch (const std::exception& e) {
     std::fputs(text.c_str(), stdout);

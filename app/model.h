@@ -2,7 +2,9 @@
 // what dynlab read (bodies, joints, closures and their kept rows, the freedom left, notes), checks M
 // and the bias against MuJoCo's own, runs it passive with the hand engine (RK4 + projection) and/or
 // Bullet and reports each one's closure residual and energy balance and their agreement; writes
-// OUT/trace.csv (hand), OUT/trace_bullet.csv and OUT/summary.txt.
+// OUT/trace.csv (hand), OUT/trace_bullet.csv and OUT/summary.txt, and with --video / --frames the run
+// drawn from the file's geoms (app/model_scene.h): OUT/video.mp4, OUT/frames/NNNNN.png.
+// `dynlab run FILE.xml|FILE.urdf` (a model file where a lab name goes) is the same command.
 // Registered on the command line by ModelCommand, so main.cpp only constructs it and asks it to run.
 #pragma once
 #include <CLI/CLI.hpp>
@@ -15,7 +17,14 @@ struct ModelArgs {
   double duration = 2.0;  // s
   double dt = 1e-3;       // s
   bool ignore_contacts = false;
+  bool video = false, frames = false;  // 30 frames per second of simulated time, 640×480
 };
+
+struct RunArgs;
+// True when `dynlab run`'s LAB names a model file (ends in .xml or .urdf, any case): no lab's name does.
+bool isModelFile(const std::string& name);
+// `dynlab run FILE`: the run's options onto `dynlab model FILE`'s (lab-only options refused: exit 2).
+int runModelFile(const RunArgs& args);
 
 // 0 ran and wrote; 1 the run failed (projection, non-finite state) or a write failed; 2 bad input
 // (one line, nothing written).

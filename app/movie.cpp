@@ -37,19 +37,22 @@ Image renderRow(Renderer& renderer, const Lab& lab, const Trace& trace, std::siz
   return renderer.render(scene, overlay ? &panel : nullptr);
 }
 
-int renderRun(const Lab& lab, const Trace& trace, const Trace* ghost, const MovieOptions& o,
-              const std::filesystem::path& dir) {
+int renderFrames(const DrawRow& draw, const Trace& trace, double dt, const MovieOptions& o,
+                 const std::filesystem::path& dir) {
   auto context = makeOffscreenContext(o.width, o.height);
   Renderer renderer(*context);
   std::unique_ptr<VideoWriter> video;
   if (o.video) video = std::make_unique<VideoWriter>((dir / "video.mp4").string(), o.width, o.height, o.fps);
   if (o.frames) std::filesystem::create_directories(dir / "frames");
   int n = 0;
-  const std::vector<std::size_t> rows = frameRows(trace, lab.dt(), o.fps);
+  const std::vector<std::size_t> rows = frameRows(trace, dt, o.fps);
   // A bar on a terminal (nothing otherwise): a 20 s run is 600 frames.
   Progress progress(o.video && o.frames ? "video and frames" : o.video ? "video" : "frames", rows.size());
   for (std::size_t row : rows) {
-    const Image image = renderRow(renderer, lab, trace, row, ghost);
+    Scene scene;
+    Overlay panel;
+    draw(row, scene, &panel);
+    const Image image = renderer.render(scene, &panel);
     if (video) video->addFrame(image);
     if (o.frames) {
       char name[32];
@@ -61,6 +64,15 @@ int renderRun(const Lab& lab, const Trace& trace, const Trace* ghost, const Movi
   }
   if (video) video->close();
   return n;
+}
+
+int renderRun(const Lab& lab, const Trace& trace, const Trace* ghost, const MovieOptions& o,
+              const std::filesystem::path& dir) {
+  const DrawRow draw = [&](std::size_t row, Scene& scene, Overlay* panel) {
+    lab.scene(trace, row, ghost, scene);
+    if (panel) lab.overlay(trace, row, *panel);
+  };
+  return renderFrames(draw, trace, lab.dt(), o, dir);
 }
 
 }  // namespace dyn::app

@@ -24,6 +24,15 @@ std::vector<std::size_t> frameRows(const Trace& trace, double dt, int fps);
 Image renderRow(Renderer& renderer, const Lab& lab, const Trace& trace, std::size_t row, const Trace* ghost,
                 bool overlay = true, const std::string& title = "");
 
+// The scene and, when overlay is not null, the panel at one trace row: what renderFrames draws.
+using DrawRow = std::function<void(std::size_t row, Scene& scene, Overlay* overlay)>;
+
+// Renders the trace's rows at options.fps frames per second of simulated time (steps of dt); writes
+// video.mp4 and/or frames/NNNNN.png (PngEncoding::Fast) into dir, with a progress bar on a terminal
+// (app/progress.h). Returns the frame count.
+int renderFrames(const DrawRow& draw, const Trace& trace, double dt, const MovieOptions& options,
+                 const std::filesystem::path& dir);
+
 // Renders the run; writes video.mp4 and/or frames/NNNNN.png (PngEncoding::Fast) into dir, with a
 // progress bar on a terminal (app/progress.h). Returns the frame count.
 int renderRun(const Lab& lab, const Trace& trace, const Trace* ghost, const MovieOptions& options,

@@ -281,6 +281,13 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     body.massless = Spatial::massless(body.inertia);
   }
   if (!(flags & mjDSBL_GRAVITY)) mech.tree.gravity.tail<3>() = Vec3(m->opt.gravity);
+  // What to draw: the geoms, each on the tree body its MuJoCo body moves with.
+  {
+    std::vector<int> link;
+    std::vector<Vec3> origin;
+    for (const Frame& f : frame) link.push_back(f.link), origin.push_back(f.origin);
+    detail::readDrawing(m, d, link, origin, out.drawing);
+  }
 
   // Joint springs, damping and friction (MuJoCo's passive forces and frictionloss).
   bool any = false;
@@ -347,6 +354,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     c.kind = weld ? "weld" : "connect";
     c.body1 = nameOf(m, mjOBJ_BODY, b1, "body");
     c.body2 = nameOf(m, mjOBJ_BODY, b2, "body");
+    c.link1 = f1.link, c.link2 = f2.link, c.point1 = p1 - f1.origin, c.point2 = p2 - f2.origin;
     out.closures.push_back(c);
   }
   auto rowsOf = [](bool weld) { return weld ? PointClosure<Spatial>::all() : PointClosure<Spatial>::translations(); };

@@ -14,6 +14,7 @@
 // Anything else the description cannot represent is a one-line ModelFileError naming the file, the
 // element and what is supported. This folder is the only code that includes MuJoCo.
 #pragma once
+#include <array>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -37,6 +38,37 @@ struct Closure {
   std::string kind;   // "connect" or "weld"
   std::string body1, body2;
   std::vector<std::string> kept, dropped;  // row names: wx wy wz x y z (world axes)
+  int link1 = -1, link2 = -1;              // the tree bodies the anchors move with (−1: the world)
+  Eigen::Vector3d point1 = Eigen::Vector3d::Zero(), point2 = Eigen::Vector3d::Zero();  // in their frames
+};
+
+// What the file draws (drawing only: the dynamics never reads it). Each shape is fixed to a tree body
+// (link −1: the world), its pose given in that body's frame (on its joint's anchor, world-aligned at q0).
+struct Geom {
+  enum class Shape { Sphere, Capsule, Cylinder, Box, Plane };
+  Shape shape = Shape::Sphere;
+  std::string name, body;
+  int link = -1;
+  Eigen::Vector3d pos = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rot = Eigen::Matrix3d::Identity();  // the shape's axes (capsule, cylinder: along z)
+  // sphere: radius; capsule, cylinder: radius, half length; box: half extents; plane: half sizes x, y
+  // (0: unbounded)
+  Eigen::Vector3d size = Eigen::Vector3d::Zero();
+  std::array<float, 4> rgba{0.5f, 0.5f, 0.5f, 1.0f};
+  bool file_color = false;  // rgba is the file's (a geom's or its material's), not MuJoCo's default grey
+};
+
+// A segment drawn for a moving body the file gives no geom: from its joint's anchor to each child's
+// anchor and to its centre of mass, in its tree body's frame.
+struct Bone {
+  int link = -1;
+  Eigen::Vector3d from = Eigen::Vector3d::Zero(), to = Eigen::Vector3d::Zero();
+};
+
+struct Drawing {
+  std::vector<Geom> geoms;
+  std::vector<Bone> bones;
+  std::vector<std::string> notes;  // what is drawn other than as written (a mesh as its bounding capsule, ...)
 };
 
 // A joint as the file names it (one per coordinate, in coordinate order).
@@ -54,6 +86,7 @@ struct LoadedModel {
   std::vector<std::string> bodies;  // per MuJoCo body that moves (the world and fused bodies left out)
   std::vector<Closure> closures;   // per mechanism constraint
   std::vector<std::string> notes;  // what is read but not enforced (limits, unused motors, ...)
+  Drawing drawing;                  // what the renderer draws (beside the description, never in it)
   double timestep = 0;             // the file's <option timestep>
   int dof = 0;                     // coordinates minus independent closure rows at q0
 };
@@ -76,6 +109,26 @@ class MujocoReference {
   int nv() const;
   MatN massMatrix(const VecN& q);
   VecN bias(const VecN& q, const VecN& v);
+
+ private:
+  struct Impl;
+  Impl* impl_;
+};
+
+// MuJoCo's own simulation of the same file (mj_step), for the bench: its constraint solver and soft
+// equalities as the file sets them, at a given step and with the semi-implicit Euler integrator
+// (MuJoCo's default, first order), from a state in the same coordinates as LoadedModel.
+class MujocoSimulation {
+ public:
+  MujocoSimulation(const std::string& path, double dt);
+  ~MujocoSimulation();
+  MujocoSimulation(const MujocoSimulation&) = delete;
+  MujocoSimulation& operator=(const MujocoSimulation&) = delete;
+  void reset(const VecN& q, const VecN& v);
+  // One mj_step; false when MuJoCo warned that the state blew up (it then resets its data itself).
+  bool step();
+  void state(VecN& q, VecN& v) const;
+  std::string describe() const;  // "MuJoCo 2.2.2 mj_step, Euler, Newton solver (100 iterations)"
 
  private:
   struct Impl;

@@ -111,4 +111,55 @@ VecN MujocoReference::bias(const VecN& q, const VecN& v) {
   return out;
 }
 
+struct MujocoSimulation::Impl {
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  std::string file;
+  detail::MujocoGuard guard;
+};
+
+MujocoSimulation::MujocoSimulation(const std::string& path, double dt) : impl_(new Impl) {
+  impl_->file = path;
+  char error[1024] = "";
+  MUJOCO_CALL(path, impl_->m = mj_loadXML(path.c_str(), nullptr, error, sizeof error));
+  if (!impl_->m) {
+    delete impl_;
+    throw ModelFileError(path + ": MuJoCo's parser: " + detail::oneLine(error));
+  }
+  impl_->m->opt.timestep = dt;
+  impl_->m->opt.integrator = mjINT_EULER;
+  MUJOCO_CALL(path, impl_->d = mj_makeData(impl_->m));
+}
+
+MujocoSimulation::~MujocoSimulation() {
+  if (impl_->d) mj_deleteData(impl_->d);
+  if (impl_->m) mj_deleteModel(impl_->m);
+  delete impl_;
+}
+
+void MujocoSimulation::reset(const VecN& q, const VecN& v) {
+  mjData* d = impl_->d;
+  MUJOCO_CALL(impl_->file, mj_resetData(impl_->m, d));
+  std::copy(q.data(), q.data() + impl_->m->nq, d->qpos);
+  std::copy(v.data(), v.data() + impl_->m->nv, d->qvel);
+}
+
+bool MujocoSimulation::step() {
+  const int bad = impl_->d->warning[mjWARN_BADQACC].number;
+  MUJOCO_CALL(impl_->file, mj_step(impl_->m, impl_->d));
+  return impl_->d->warning[mjWARN_BADQACC].number == bad;
+}
+
+void MujocoSimulation::state(VecN& q, VecN& v) const {
+  q = Eigen::Map<const VecN>(impl_->d->qpos, impl_->m->nq);
+  v = Eigen::Map<const VecN>(impl_->d->qvel, impl_->m->nv);
+}
+
+std::string MujocoSimulation::describe() const {
+  static const char* const kSolver[3] = {"PGS", "CG", "Newton"};
+  const int solver = impl_->m->opt.solver;
+  return std::string("MuJoCo ") + mj_versionString() + " mj_step, Euler, soft equalities, " +
+         (solver >= 0 && solver < 3 ? kSolver[solver] : "?") + " solver (" + std::to_string(impl_->m->opt.iterations) + " iterations)";
+}
+
 }  // namespace dyn::model_file

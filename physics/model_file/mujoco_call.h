@@ -6,8 +6,12 @@
 #pragma once
 #include <mujoco/mujoco.h>
 
+#include <Eigen/Core>
 #include <csetjmp>
 #include <string>
+#include <vector>
+
+#include "physics/model_file/model_file.h"
 
 namespace dyn::model_file::detail {
 
@@ -27,6 +31,11 @@ std::string& lastError();
 
 // One line: newlines and control characters become spaces, runs of spaces one.
 std::string oneLine(const std::string& text);
+
+// The model's geoms at qpos0 (after mj_kinematics) as drawing shapes on the tree bodies: body b moves
+// with tree body link[b] (−1: the world), whose frame origin at qpos0 is origin[b] (drawing.cpp).
+void readDrawing(const mjModel* m, const mjData* d, const std::vector<int>& link, const std::vector<Eigen::Vector3d>& origin,
+                 Drawing& out);
 
 }  // namespace dyn::model_file::detail
 

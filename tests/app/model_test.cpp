@@ -1,13 +1,19 @@
 // dynlab model FILE end to end: what it prints about the mechanism it read, the passive run's closure
 // residual and energy balance in the trace it writes, byte-identical reruns, and the bad-input contract
-// for hostile model files (exit 2, one line naming the file, nothing written).
+// for hostile model files (exit 2, one line naming the file, nothing written); `dynlab run FILE` as the
+// same command, with its video (decoded by ffprobe) and frames drawn from the file's geoms.
 #include <doctest/doctest.h>
 
+#include <nlohmann/json.hpp>
+#include <stb_image.h>
+
 #include <cmath>
+#include <cstdlib>
 
 #include "tests/app/cli_run.h"
 
 using namespace dyn::test::cli;
+using nlohmann::json;
 
 namespace {
 std::string model(const char* name) { return quote(std::string(DYNLAB_SOURCE_DIR) + "/assets/models/" + name); }
@@ -67,4 +73,81 @@ TEST_CASE("dynlab model: hostile and unsupported files get one line and exit 2, 
   checkBadInput(dir, "model ball.xml --out o", {"ball.xml", "joint 's'", "ball joint", "hinge and slide"}, dir / "o");
   checkBadInput(dir, "model missing.xml --out o", {"missing.xml", "no such file"}, dir / "o");
   checkBadInput(dir, "model " + model("fourbar.xml") + " --duration 600 --dt 1e-5 --out o", {"60000000 steps", "at most 2000000"}, dir / "o");
+}
+
+TEST_CASE("dynlab run FILE.xml --engine both --video --frames: the model command's run, drawn from the file") {
+  TempDir dir("model_video");
+  const Result r = dynlab(dir, "run " + model("fourbar.xml") + " --engine both --video --frames --duration 0.5 --out out");
+  INFO(r.out, r.err);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("1 closure (2 of 3 rows kept)") != std::string::npos);
+  // Rows 0..500 (dt 1 ms), one frame each 1/30 s of simulated time: t = 0, 1/30, ..., 0.5 s.
+  int expected = 0;
+  while (std::lround(expected * 1000.0 / 30) <= 500) ++expected;
+  CHECK(r.out.find(std::to_string(expected) + " frames at 30 per second") != std::string::npos);
+  std::size_t pngs = 0;
+  for (const auto& e : fs::directory_iterator(dir / "out/frames")) pngs += e.path().extension() == ".png";
+  CHECK(pngs == std::size_t(expected));
+  const std::string cmd = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
+                          "stream=nb_read_frames,pix_fmt,codec_name,width,height -of csv=p=0 " +
+                          quote((dir / "out/video.mp4").string()) + " > " + quote((dir / "probe.txt").string());
+  REQUIRE(std::system(cmd.c_str()) == 0);
+  std::string line = readFile(dir / "probe.txt");
+  line.erase(line.find_last_not_of(" \r\n") + 1);
+  CHECK(line == "h264,640,480,yuv420p," + std::to_string(expected));
+  // The last frame: the mechanism drawn right of the panel (the panel fills the top-left), in colour.
+  int w = 0, h = 0, n = 0;
+  char name[32];
+  std::snprintf(name, sizeof name, "%05d.png", expected - 1);
+  unsigned char* px = stbi_load((dir / "out/frames" / name).string().c_str(), &w, &h, &n, 3);
+  REQUIRE(px != nullptr);
+  int drawn = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = w / 2; x < w; ++x) {
+      const unsigned char* p = px + (std::size_t(y) * w + x) * 3;
+      drawn += std::abs(p[0] - 245) + std::abs(p[1] - 245) + std::abs(p[2] - 240) > 60;
+    }
+  stbi_image_free(px);
+  CHECK(drawn > 2000);
+  // `dynlab run FILE` is `dynlab model FILE`: the same trace, byte for byte.
+  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.5 --out same").code == 0);
+  CHECK(readFile(dir / "same/trace.csv") == readFile(dir / "out/trace.csv"));
+  CHECK(readFile(dir / "same/trace_bullet.csv") == readFile(dir / "out/trace_bullet.csv"));
+  CHECK_FALSE(fs::exists(dir / "same/video.mp4"));
+  // Same input, same pixels: the frames of a rerun (hand only: no ghost) twice.
+  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.2 --engine hand --frames --out f1").code == 0);
+  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.2 --engine hand --frames --out f2").code == 0);
+  CHECK(snapshot(dir / "f1/frames") == snapshot(dir / "f2/frames"));
+  CHECK(snapshot(dir / "f1/frames").size() == 7);
+}
+
+TEST_CASE("dynlab run FILE: a lab's options and a missing file are bad input (one line, exit 2)") {
+  TempDir dir("model_run_bad");
+  writeFile(dir / "g.json", R"({"gains": {}})");
+  checkBadInput(dir, "run " + model("fourbar.xml") + " --gains g.json --out o", {"--gains", "fourbar.xml", "passive"}, dir / "o");
+  checkBadInput(dir, "run " + model("fourbar.xml") + " --scenario heavy_load --out o", {"--scenario", "passive"}, dir / "o");
+  checkBadInput(dir, "run missing.URDF --out o", {"missing.URDF", "no such file"}, dir / "o");
+  checkBadInput(dir, "run " + model("fourbar.xml") + " --duration 0 --out o", {"--duration", "(0, 600]"}, dir / "o");
+}
+
+TEST_CASE("dynlab bench FILE: the hand step at both orders, Bullet's and MuJoCo's, each with its accuracy") {
+  TempDir dir("model_bench");
+  const Result r = dynlab(dir, "bench " + model("fivebar.xml") + " --steps 200");
+  INFO(r.out, r.err);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("4 coordinates, 2 closure rows, dt 0.001 s") != std::string::npos);
+  for (const char* row : {"\n  hand, Euler ", "\n  hand, RK4 ", "\n  Bullet ", "\n  MuJoCo ", "MuJoCo 2.2.2 mj_step, Euler", "semi-implicit Euler + Baumgarte"})
+    CHECK_MESSAGE(r.out.find(row) != std::string::npos, row);
+  // JSON: four engines, each timed and run 2 s; the RK4 run is the reference and keeps the closure.
+  const Result j = dynlab(dir, "bench " + model("fivebar.xml") + " --steps 100 --json");
+  REQUIRE(j.code == 0);
+  const json out = json::parse(j.out);
+  REQUIRE(out["engines"].size() == 4);
+  for (const json& e : out["engines"]) {
+    CHECK(e["us_per_step"].get<double>() > 0);
+    CHECK(e["complete"].get<bool>());
+  }
+  CHECK(out["engines"][1]["max_q_error_vs_hand_rk4"].get<double>() == 0.0);
+  CHECK(out["engines"][1]["max_closure_residual"].get<double>() < 1e-11);
+  checkBadInput(dir, "bench missing.xml", {"missing.xml", "no such file"}, dir / "out");
 }

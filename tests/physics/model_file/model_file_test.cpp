@@ -20,6 +20,7 @@
 #include "labs/slider_crank/mechanism.h"
 #include "physics/constrained_mechanism.h"
 #include "physics/constraints/point_closure.h"
+#include "physics/model_file/hand_engine.h"
 #include "physics/model_file/model_file.h"
 
 using namespace dyn;
@@ -346,4 +347,55 @@ TEST_CASE("hostile and unsupported model files: one line naming the file and the
                               "<body name=\"p\"><joint name=\"a\"/><geom/></body><body name=\"s\" pos=\"1 0 0\"><joint name=\"c\"/><geom/></body>"
                               "</worldbody><equality><weld name=\"w\" body1=\"p\" body2=\"s\" relpose=\"1 0 0 0.9 0.1 0 0\"/></equality></mujoco>";
   CHECK(errorOf(writeFile("twisted.xml", twisted)).find("weld 'w' holds a relative orientation") != std::string::npos);
+}
+
+TEST_CASE("MuJoCo's own steps of the same file (the bench's fourth engine) move the same coordinates") {
+  // From rest for 20 ms, the arm3d (no loop: MuJoCo's equalities play no part) by mj_step (Euler, the
+  // same dt) and by the hand engine (RK4): the same motion to Euler's first-order error, not to zero.
+  const model_file::LoadedModel m = model_file::load(model("arm3d.xml"));
+  const int n = int(m.q0.size());
+  model_file::MujocoSimulation mj(m.file, 1e-4);
+  CHECK(mj.describe().find("mj_step, Euler") != std::string::npos);
+  mj.reset(m.q0, VecN::Zero(n));
+  ConstrainedMechanism<Spatial> mech(m.mechanism);
+  VecN q = m.q0, v = VecN::Zero(n), qm, vm;
+  StepOptions o;
+  o.dt = 1e-4;
+  for (int k = 0; k < 200; ++k) {
+    REQUIRE(mj.step());
+    REQUIRE(step(mech, o, VecN::Zero(n), q, v));
+  }
+  mj.state(qm, vm);
+  CHECK((q - m.q0).cwiseAbs().maxCoeff() > 1e-3);  // it moved
+  CHECK((qm - q).cwiseAbs().maxCoeff() < 0.02 * (q - m.q0).cwiseAbs().maxCoeff());
+  CHECK((vm - v).cwiseAbs().maxCoeff() < 0.02 * v.cwiseAbs().maxCoeff());
+  CHECK((qm - q).cwiseAbs().maxCoeff() > 0);
+}
+
+TEST_CASE("the sized hand engine (hand_engine.h) steps as the dynamically sized mechanism does") {
+  // The example loops get fixed sizes; 200 steps of each scheme from the file's pose agree with the
+  // dynamic mechanism's to rounding (the same solve, loops unrolled), and an open arm stays dynamic.
+  for (const char* file : {"fourbar.xml", "fivebar.xml", "slider_crank.xml", "arm3d.xml"}) {
+    INFO(file);
+    const model_file::LoadedModel m = model_file::load(model(file));
+    std::string sizes;
+    const auto sized = model_file::handEngine(m.mechanism, &sizes);
+    CHECK(sizes.rfind(std::string(file) == "arm3d.xml" ? "dynamic" : "fixed sizes", 0) == 0);
+    for (Integrator integrator : {Integrator::RK4, Integrator::SemiImplicitEuler}) {
+      StepOptions o;
+      o.integrator = integrator;
+      if (integrator == Integrator::SemiImplicitEuler) o.drift.kind = Drift::Baumgarte;
+      ConstrainedMechanism<Spatial> dynamic(m.mechanism);
+      const auto engine = model_file::handEngine(m.mechanism);
+      const int n = int(m.q0.size());
+      VecN q1 = m.q0, v1 = VecN::Zero(n), q2 = q1, v2 = v1;
+      for (int k = 0; k < 200; ++k) {
+        REQUIRE(step(dynamic, o, VecN::Zero(n), q1, v1));
+        REQUIRE(step(*engine, o, VecN::Zero(n), q2, v2));
+      }
+      CHECK((q1 - m.q0).cwiseAbs().maxCoeff() > 1e-3);
+      CHECK((q1 - q2).cwiseAbs().maxCoeff() < 1e-12);
+      CHECK((v1 - v2).cwiseAbs().maxCoeff() < 1e-10);
+    }
+  }
 }

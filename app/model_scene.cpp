@@ -1,0 +1,246 @@
+// A loaded model as a picture: see model_scene.h.
+#include "app/model_scene.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace dyn::app {
+namespace {
+
+using Vec3 = Eigen::Vector3d;
+using Mat3 = Eigen::Matrix3d;
+using Box3 = Eigen::AlignedBox3d;
+using Shape = model_file::Geom::Shape;
+
+// Bodies whose file keeps MuJoCo's default grey get the labs' link colours, neighbours told apart.
+const Color kPalette[4] = {{0.23f, 0.42f, 0.68f, 1.0f}, {0.20f, 0.58f, 0.55f, 1.0f}, {0.52f, 0.42f, 0.72f, 1.0f}, {0.80f, 0.52f, 0.25f, 1.0f}};
+const Color kWorld{0.60f, 0.60f, 0.60f, 1.0f}, kJoint{0.15f, 0.15f, 0.18f, 1.0f}, kClosure{0.90f, 0.45f, 0.10f, 1.0f};
+const Color kGhost{0.55f, 0.35f, 0.75f, 0.35f}, kFloor{0.86f, 0.86f, 0.84f, 1.0f};
+
+Color colorOf(const model_file::Geom& g) {
+  if (g.file_color) return {g.rgba[0], g.rgba[1], g.rgba[2], g.rgba[3]};
+  return g.link < 0 ? kWorld : kPalette[g.link % 4];
+}
+
+// A round step near x: 1, 2 or 5 × 10^k.
+double niceStep(double x) {
+  const double p = std::pow(10.0, std::floor(std::log10(std::max(x, 1e-9))));
+  const double f = x / p;
+  return (f < 1.5 ? 1 : f < 3.5 ? 2 : f < 7.5 ? 5 : 10) * p;
+}
+
+void extend(Box3& box, const Vec3& p, double r) {
+  box.extend(p - Vec3::Constant(r));
+  box.extend(p + Vec3::Constant(r));
+}
+
+// The box a shape occupies (its oriented extents' world box).
+void extendShape(Box3& box, const Vec3& c, const Mat3& R, const model_file::Geom& g) {
+  Vec3 half;
+  switch (g.shape) {
+    case Shape::Sphere: half = Vec3::Constant(g.size[0]); break;
+    case Shape::Capsule: half = {g.size[0], g.size[0], g.size[1] + g.size[0]}; break;
+    case Shape::Cylinder: half = {g.size[0], g.size[0], g.size[1]}; break;
+    default: half = g.size; break;
+  }
+  const Vec3 world = R.cwiseAbs() * half;
+  box.extend(c - world);
+  box.extend(c + world);
+}
+
+}  // namespace
+
+ModelPicture::ModelPicture(const model_file::LoadedModel& model) : model_(model), data_(model.mechanism.tree) {
+  const auto& tree = model.mechanism.tree;
+  // Up against gravity (world z without it).
+  const Vec3 g = tree.gravity.tail<3>();
+  up_ = g.norm() > 1e-9 ? Vec3(-g.normalized()) : Vec3::UnitZ();
+  // Planar: every hinge about one axis, every slide across it (frames are world-aligned at q0).
+  bool found = false;
+  planar_ = true;
+  for (const auto& b : tree.bodies)
+    if (b.joint == JointType::Revolute) {
+      const Vec3 a = b.axis.normalized();
+      if (!found) axis_ = a, found = true;
+      else if (a.cross(axis_).norm() > 1e-9) planar_ = false;
+    }
+  for (const auto& b : tree.bodies)
+    if (b.joint == JointType::Prismatic && std::abs(b.axis.normalized().dot(axis_)) > 1e-9) planar_ = false;
+  planar_ = planar_ && found;
+  // Sizes of the marks: from the rods the file draws, else from the mechanism's size.
+  std::vector<double> radii;
+  for (const auto& geom : model.drawing.geoms)
+    if (geom.shape == Shape::Capsule || geom.shape == Shape::Cylinder) radii.push_back(geom.size[0]);
+  Box3 box;
+  for (const Vec3& p : anchors(model.q0)) box.extend(p);
+  place(model.q0);
+  for (const auto& geom : model.drawing.geoms)
+    if (geom.shape != Shape::Plane && geom.link >= 0) box.extend(point(geom.link, geom.pos));
+  for (const auto& b : model.drawing.bones) box.extend(point(b.link, b.to));
+  const double extent = std::max(box.isEmpty() ? 0.0 : box.diagonal().norm(), 0.05);
+  std::sort(radii.begin(), radii.end());
+  const double rod = radii.empty() ? 0.02 * extent : radii[radii.size() / 2];
+  rod_radius_ = std::clamp(rod, 0.004 * extent, 0.03 * extent);
+  joint_radius_ = std::max(1.4 * rod_radius_, 0.015 * extent);
+}
+
+bool ModelPicture::groundPivot(std::size_t i) const {
+  const auto& b = model_.mechanism.tree.bodies[i];
+  return b.parent < 0 && b.joint == JointType::Revolute;
+}
+
+void ModelPicture::place(const VecN& q) const { worldKinematics(model_.mechanism.tree, q, data_); }
+
+Vec3 ModelPicture::point(int link, const Vec3& p) const {
+  return link < 0 ? p : Vec3(Spatial::worldPoint(data_.X_world[std::size_t(link)], p));
+}
+
+Mat3 ModelPicture::rotation(int link) const {
+  return link < 0 ? Mat3::Identity() : Mat3(data_.X_world[std::size_t(link)].E.transpose());
+}
+
+std::vector<Vec3> ModelPicture::anchors(const VecN& q) const {
+  place(q);
+  std::vector<Vec3> out;
+  for (std::size_t i = 0; i < data_.X_world.size(); ++i) out.push_back(data_.X_world[i].r);
+  return out;
+}
+
+Box3 ModelPicture::bounds(const VecN& q) const {
+  Box3 box, fixed;
+  for (const Vec3& p : anchors(q)) extend(box, p, joint_radius_);  // anchors() placed the frames at q
+  for (const auto& g : model_.drawing.geoms)
+    if (g.shape != Shape::Plane) extendShape(g.link < 0 ? fixed : box, point(g.link, g.pos), rotation(g.link) * g.rot, g);
+  for (const auto& b : model_.drawing.bones) extend(box, point(b.link, b.to), rod_radius_);
+  // The ground mounts (drawBodies), whatever the view: a ball of their reach under each world joint.
+  if (planar_)
+    for (std::size_t i = 0; i < data_.X_world.size(); ++i)
+      if (groundPivot(i)) extend(box, data_.X_world[i].r, 3.2 * joint_radius_);
+  // What the world holds counts unless it dwarfs the mechanism (a table 100 m wide): then the
+  // mechanism is framed and the rest drawn around it.
+  if (!fixed.isEmpty() && (box.isEmpty() || fixed.diagonal().norm() <= 3 * box.diagonal().norm())) box.extend(fixed);
+  return box;
+}
+
+void ModelPicture::drawBodies(bool ghost, Scene& s) const {
+  // The ghost sits a little behind the mechanism when seen side-on.
+  const Vec3 back = ghost && planar_ ? Vec3(-(s.camera.eye - s.camera.target).normalized() * 3 * joint_radius_) : Vec3::Zero();
+  for (const auto& g : model_.drawing.geoms) {
+    if (g.shape == Shape::Plane || (ghost && g.link < 0)) continue;
+    const Vec3 c = point(g.link, g.pos) + back;
+    const Mat3 R = rotation(g.link) * g.rot;
+    const Color color = ghost ? kGhost : colorOf(g);
+    switch (g.shape) {
+      case Shape::Sphere: s.spheres.push_back({c, g.size[0], color}); break;
+      case Shape::Capsule: s.capsules.push_back({c - g.size[1] * R.col(2), c + g.size[1] * R.col(2), g.size[0], color}); break;
+      case Shape::Cylinder: s.cylinders.push_back({c, R, g.size[0], g.size[1], color}); break;
+      default: s.boxes.push_back({c, g.size, R, color}); break;
+    }
+  }
+  for (const auto& b : model_.drawing.bones)
+    s.capsules.push_back({point(b.link, b.from) + back, point(b.link, b.to) + back, rod_radius_, ghost ? kGhost : kPalette[b.link % 4]});
+  if (ghost) return;
+  // Side-on, a ground mount under each hinge on the world (as the planar labs draw theirs), behind
+  // the links.
+  if (planar_) {
+    const CameraBasis view = s.camera.basis();
+    Mat3 R;
+    R << view.right, view.up, view.back;
+    const double r = joint_radius_;
+    for (std::size_t i = 0; i < data_.X_world.size(); ++i)
+      if (groundPivot(i))
+        s.boxes.push_back({data_.X_world[i].r - 1.2 * r * view.up - 1.2 * r * view.back, Vec3(1.7 * r, 0.9 * r, 0.5 * r), R, kWorld});
+  }
+  for (const auto& X : data_.X_world) s.spheres.push_back({X.r, joint_radius_, kJoint});
+  for (const auto& c : model_.closures) s.spheres.push_back({point(c.link1, c.point1), 0.85 * joint_radius_, kClosure});
+}
+
+void ModelPicture::scene(const VecN& q, const VecN* ghost, const Box3& frame, Scene& s) const {
+  const Box3 box = frame.isEmpty() ? bounds(q) : frame;
+  // The camera's direction; the renderer fits the box beside the panel (Scene::framing).
+  if (planar_) {
+    Vec3 up = up_ - up_.dot(axis_) * axis_;
+    if (up.norm() < 1e-6) up = std::abs(axis_.z()) < 0.9 ? Vec3::UnitZ() : Vec3::UnitY();
+    up.normalize();
+    // Look along the axis from the side that puts world x (else y) to the right.
+    Vec3 back = axis_;
+    const Vec3 right = up.cross(back);
+    const double sense = std::abs(right.x()) > 1e-6 ? right.x() : right.y();
+    if (sense < 0) back = -back;
+    s.camera.ortho = true;
+    s.camera.up = up;
+    s.camera.target = box.isEmpty() ? Vec3(Vec3::Zero()) : Vec3(box.center());
+    s.camera.eye = s.camera.target + 5 * back;
+  } else {
+    Vec3 h = Vec3::UnitX() - up_.x() * up_;
+    if (h.norm() < 0.1) h = Vec3::UnitY() - up_.y() * up_;
+    h.normalize();
+    s.camera.ortho = false;
+    s.camera.fov_y_deg = 35;
+    s.camera.up = up_;
+    s.camera.target = box.isEmpty() ? Vec3(Vec3::Zero()) : Vec3(box.center());
+    s.camera.eye = s.camera.target + 0.9 * h - 1.1 * up_.cross(h) + 0.6 * up_;
+  }
+  s.framing.fit = true;
+  s.framing.bounds = box;
+  // Floors: under the framed box, about as large as it, slabs so a side-on view shows their edge.
+  const double reach = box.isEmpty() ? 1.0 : 0.75 * box.diagonal().norm();
+  for (const auto& g : model_.drawing.geoms) {
+    if (g.shape != Shape::Plane) continue;
+    const Mat3 R = rotation(g.link) * g.rot;
+    const Vec3 p = point(g.link, g.pos), n = R.col(2), c = box.isEmpty() ? p : Vec3(box.center());
+    Eigen::Vector2d half(g.size[0] > 0 ? std::min(g.size[0], reach) : reach, g.size[1] > 0 ? std::min(g.size[1], reach) : reach);
+    Color color = g.file_color ? Color{g.rgba[0], g.rgba[1], g.rgba[2], g.rgba[3]} : kFloor;
+    s.planes.push_back({c - n.dot(c - p) * n, R, half, color, 0.02 * reach, niceStep(reach / 4)});
+  }
+  if (ghost) {
+    place(*ghost);
+    drawBodies(true, s);
+  }
+  place(q);
+  drawBodies(false, s);
+}
+
+VecN traceQ(const Trace& trace, std::size_t row, int n) {
+  VecN q(n);
+  for (int i = 0; i < n; ++i) q[i] = trace.at(row, 1 + i);
+  return q;
+}
+
+Box3 runBounds(const ModelPicture& picture, int n, const Trace& trace, const Trace* ghost) {
+  Box3 box;
+  for (const Trace* t : {&trace, ghost}) {
+    if (!t || t->rows() == 0) continue;
+    const std::size_t stride = std::max<std::size_t>(1, t->rows() / 400);
+    for (std::size_t r = 0; r < t->rows(); r += stride) box.extend(picture.bounds(traceQ(*t, r, n)));
+    box.extend(picture.bounds(traceQ(*t, t->rows() - 1, n)));
+  }
+  return box;
+}
+
+void modelOverlay(const std::string& title, const std::string& engines, const Trace& tr, std::size_t row, double dt, const Trace* ghost, Overlay& o) {
+  auto fmt = [](const char* f, double x) {
+    char b[48];
+    std::snprintf(b, sizeof b, f, x);
+    return std::string(b);
+  };
+  const double e0 = tr.at(0, "energy");
+  auto balance = [&](std::size_t r) { return tr.at(r, "energy") - e0 - tr.at(r, "work"); };
+  o.title = title;
+  o.lines = {{"engine", engines},
+             {"t", fmt("%.3f s", tr.at(row, "t"))},
+             {"energy E", fmt("%.5f J", tr.at(row, "energy"))},
+             {"E - E0 - W", fmt("%.2e J", balance(row))},
+             {"closure |phi|", fmt("%.1e", tr.at(row, "constraint_residual"))}};
+  if (ghost && row < ghost->rows()) o.lines.push_back({"Bullet |phi|", fmt("%.1e", ghost->at(row, "constraint_residual"))});
+  // Live plots over the last two seconds, up to and including this row.
+  Series e{"E - E0 - W (mJ)", {}, {0.23f, 0.42f, 0.68f, 1.0f}}, phi{"log10 |phi|", {}, {0.90f, 0.45f, 0.10f, 1.0f}};
+  for (std::size_t r = liveWindowStart(row, 2.0, dt); r <= row; ++r) {
+    e.values.push_back(float(1e3 * balance(r)));
+    phi.values.push_back(float(std::log10(std::max(tr.at(r, "constraint_residual"), 1e-17))));
+  }
+  o.plots = {e, phi};
+}
+
+}  // namespace dyn::app

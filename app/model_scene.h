@@ -1,0 +1,57 @@
+// A loaded model (physics/model_file) as a picture: its geoms (model_file::Drawing) placed at any state
+// q by the description's own kinematics, its joints and loop closures marked, a second state (the
+// Bullet run) as a translucent ghost, framed like every lab (Scene::framing): a planar mechanism
+// side-on and orthographic, looking along its hinges' common axis; a spatial one in perspective; up
+// against gravity. And the overlay panel of a run's trace (time, energy, closure residual).
+#pragma once
+#include <Eigen/Geometry>
+#include <vector>
+
+#include "labs/scene.h"
+#include "labs/trace.h"
+#include "physics/chain.h"
+#include "physics/model_file/model_file.h"
+
+namespace dyn::app {
+
+class ModelPicture {
+ public:
+  // Keeps a reference to model: it must outlive the picture.
+  explicit ModelPicture(const model_file::LoadedModel& model);
+
+  // World positions at q of each tree body's joint anchor (one per coordinate).
+  std::vector<Eigen::Vector3d> anchors(const VecN& q) const;
+  // The box what is drawn at q occupies (floors left out).
+  Eigen::AlignedBox3d bounds(const VecN& q) const;
+  // The scene at q; ghost, when given, drawn translucent behind it; framed around `frame` (empty:
+  // bounds(q)), so a run framed around the space it moves through holds its camera still.
+  void scene(const VecN& q, const VecN* ghost, const Eigen::AlignedBox3d& frame, Scene& out) const;
+  // True when every hinge turns about one axis and every slide moves across it: drawn side-on.
+  bool planar() const { return planar_; }
+
+ private:
+  void place(const VecN& q) const;  // the tree's world frames at q
+  Eigen::Vector3d point(int link, const Eigen::Vector3d& p) const;
+  Eigen::Matrix3d rotation(int link) const;
+  void drawBodies(bool ghost, Scene& out) const;
+  bool groundPivot(std::size_t link) const;  // a hinge on the world: drawn on a mount
+
+  const model_file::LoadedModel& model_;
+  mutable TreeData<Spatial> data_;
+  bool planar_ = false;
+  Eigen::Vector3d axis_ = Eigen::Vector3d::UnitY(), up_ = Eigen::Vector3d::UnitZ();
+  double joint_radius_ = 0.01, rod_radius_ = 0.005;
+};
+
+// The coordinates q (or rates v) of a model run's trace row: columns 1..n (n..2n), as app/model.cpp writes them.
+VecN traceQ(const Trace& trace, std::size_t row, int n);
+
+// The space a run moves through: the box of what is drawn over its rows (and the ghost's), so the
+// camera holds still from frame to frame, as in every lab.
+Eigen::AlignedBox3d runBounds(const ModelPicture& picture, int n, const Trace& trace, const Trace* ghost);
+
+// The overlay panel at a row: time, energy and its balance, closure residual (and the ghost's), and
+// live plots of the energy balance and the residual over the last two seconds.
+void modelOverlay(const std::string& title, const std::string& engines, const Trace& trace, std::size_t row, double dt, const Trace* ghost, Overlay& out);
+
+}  // namespace dyn::app

@@ -1,0 +1,20 @@
+// The hand engine for a loaded model, as the integrators drive it (integrate.h ConstrainedSystem): a
+// ConstrainedMechanism whose sizes are fixed at compile time for the shapes of assets/models' loops
+// (n coordinates, r kept closure rows, no payloads: the four-bar (3, 2), the five-bar (4, 2), the
+// slider crank (4, 3)), so its loops unroll as the labs' do; any other shape the dynamically sized
+// one. The same solve either way (physics/constrained_mechanism.h): what `dynlab model` steps and
+// `dynlab bench FILE` times.
+#pragma once
+#include <memory>
+#include <string>
+
+#include "physics/integrate.h"
+#include "physics/mechanism.h"
+
+namespace dyn::model_file {
+
+// Throws std::invalid_argument as ConstrainedMechanism does. sizes, when given, says which was built
+// ("fixed sizes 4 joints, 2 rows" or "dynamic sizes").
+std::unique_ptr<ConstrainedSystem> handEngine(const MechanismModel<Spatial>& model, std::string* sizes = nullptr);
+
+}  // namespace dyn::model_file
