@@ -162,7 +162,7 @@ Fps frameRates(const Lab& lab, const Trace& trace, int frames) {
 
 // "integrator + drift" of a config's simulation block, as labs/ parses it for every lab.
 std::string schemeOf(const json& config, const std::string& file) {
-  return schemeName(parseSimulation(JsonView(config, file)["simulation"]).step);
+  return schemeName(parseSimulation(JsonView(config, file)["simulation"], IndependentForm::Yes).step);
 }
 
 // The hand engine with a reference engine's order of method (labs/settings.h firstOrderPatch),

@@ -11,7 +11,8 @@ std::unique_ptr<Lab> buildLab(const LabEntry& entry, const json& config, const s
   const JsonView view(config, file);
   checkSubmissionOptions(view);
   auto lab = entry.create(view);
-  parseSimulation(view["simulation"]);  // every lab has the shared simulation block (labs/settings.h)
+  // Every lab has the shared simulation block (labs/settings.h); its own parse refused what it cannot honour.
+  parseSimulation(view["simulation"], IndependentForm::Yes);
   return lab;
 }
 

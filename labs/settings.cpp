@@ -3,7 +3,7 @@
 
 namespace dyn {
 
-SimulationSettings parseSimulation(const JsonView& sim) {
+SimulationSettings parseSimulation(const JsonView& sim, IndependentForm form) {
   SimulationSettings s;
   sim.onlyKeys({"dt", "duration", "integrator", "drift", "baumgarte"});
   s.step.dt = sim["dt"].positive();
@@ -13,6 +13,10 @@ SimulationSettings parseSimulation(const JsonView& sim) {
     sim["duration"].fail("expected at most 2e6 steps (duration/dt); a trace of 2e6 rows is ~300 MB");
   parseIntegrator(sim["integrator"].oneOf({"semi_implicit_euler", "rk4"}), s.step.integrator);
   parseDrift(sim["drift"].oneOf({"none", "baumgarte", "projection", "independent"}), s.step.drift.kind);
+  if (s.step.drift.kind == Drift::Independent && form == IndependentForm::No)
+    sim["drift"].fail("expected none, baumgarte or projection: this lab's mechanism has no independent-coordinate form "
+                      "(\"independent\" rebuilds the dependent coordinates from the independent ones, which only the "
+                      "slider crank and the grasp can)");
   if (sim.has("baumgarte")) {
     sim["baumgarte"].onlyKeys({"zeta", "omega"});
     s.step.drift.zeta = sim["baumgarte"]["zeta"].positive(1e3);

@@ -21,8 +21,13 @@ struct SimulationSettings {
   double duration = 1;  // s
 };
 
-// The "simulation" block (pass config["simulation"]).
-SimulationSettings parseSimulation(const JsonView& simulation);
+// What a lab's mechanism can do with the shared options: drift "independent" needs a mechanism that
+// rebuilds its dependent coordinates from the independent ones (ConstrainedSystem::recoverDependent).
+enum class IndependentForm { No, Yes };
+
+// The "simulation" block (pass config["simulation"]); an option the lab cannot honour is refused here,
+// with a sentence, not at t = 0.
+SimulationSettings parseSimulation(const JsonView& simulation, IndependentForm form = IndependentForm::No);
 
 // The "gains" block: exactly the names given, each {"value", "min", "max"} with min ≤ value ≤ max
 // and optional "unit" and "doc" strings; returns name → value.

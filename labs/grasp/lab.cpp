@@ -163,7 +163,7 @@ Settings parseSettings(const JsonView& c) {
   s.pose0 = {init["psi_deg"].inRange(-180, 180) * M_PI / 180.0, init["x"].inRange(-kMaxLength, kMaxLength),
              init["y"].inRange(-kMaxLength, kMaxLength)};
 
-  const SimulationSettings sim = parseSimulation(c["simulation"]);
+  const SimulationSettings sim = parseSimulation(c["simulation"], IndependentForm::Yes);  // recoverDependent
   s.step = sim.step;
   s.duration = sim.duration;
 

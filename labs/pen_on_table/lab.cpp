@@ -170,8 +170,6 @@ Settings parseSettings(const JsonView& c) {
   }
 
   const SimulationSettings sim = parseSimulation(c["simulation"]);
-  if (sim.step.drift.kind == Drift::Independent)
-    c["simulation"]["drift"].fail("expected none, baumgarte or projection: the arm has no independent-coordinate form");
   s.step = sim.step;
   s.duration = sim.duration;
 

@@ -96,7 +96,7 @@ Settings parseSettings(const JsonView& c) {
   if (std::abs(L[0].length * std::sin(s.theta1)) > L[1].length)
     init["theta1_deg"].fail("expected a crank angle the rod can reach (|l1 sin θ1| ≤ l2)");
 
-  const SimulationSettings sim = parseSimulation(c["simulation"]);
+  const SimulationSettings sim = parseSimulation(c["simulation"], IndependentForm::Yes);  // recoverDependent from θ1
   s.step = sim.step;
   s.duration = sim.duration;
 

@@ -137,6 +137,25 @@ inline void checkEngines(const LabEntry& entry, const json& config) {
   }
 }
 
+// The shared options a lab cannot honour are refused when its config is read, naming the option, not
+// at t = 0: drift "independent" either runs on φ = 0 or is an InputError at /simulation/drift.
+inline void checkSharedOptions(const LabEntry& entry, const json& config) {
+  INFO("lab ", entry.name, ": drift independent");
+  json c = config;
+  c["simulation"]["drift"] = "independent";
+  std::unique_ptr<Lab> lab;
+  try {
+    lab = buildLab(entry, c, "config.json");
+  } catch (const InputError& e) {
+    CHECK(e.path() == "/simulation/drift");
+    CHECK(e.expected().find("independent-coordinate form") != std::string::npos);
+    return;
+  }
+  const RunResult r = runEngine(*lab, Engine::Hand, 50);
+  CHECK(r.failure.empty());
+  CHECK(finiteRows(r.trace));
+}
+
 inline void checkPassive(const LabEntry& entry, const json& config) {
   INFO("lab ", entry.name, ": passive energy");
   json passive = mergePatch(config, passivePatch());
@@ -328,6 +347,7 @@ inline void checkLab(const LabEntry& entry, const json& config, const LabCheckOp
     for (const auto& f : exampleFiles(std::string(DYNLAB_SOURCE_DIR) + "/labs/" + entry.name + "/instructor")) examples.push_back(f);
   checkConfigAndExamples(entry, config, examples);
   checkEngines(entry, config);
+  checkSharedOptions(entry, config);
   checkPassive(entry, config);
   checkColumnsAndMetrics(entry, config);
   checkGrading(entry, config_file, config, examples, dir, options.defaults_band);
