@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/model_loops.h"
 #include "app/model_scene.h"
 #include "app/movie.h"
 #include "app/output.h"
@@ -227,6 +228,7 @@ ModelCommand::ModelCommand(CLI::App& cli) {
   command_->add_option("--dt", a.dt, "Fixed step (s, default 0.001; RK4 + projection)")->check(CLI::Range(1e-5, 1e-2));
   command_->add_option("--out", a.out, "Output directory (default: out/model/FILE's stem)");
   command_->add_option("--engine", a.engine, "Which engine(s) to run (default: both)")->check(CLI::IsMember({"hand", "bullet", "both"}));
+  command_->add_option("--loops", a.loops, "Loop closures beside the file (JSON; default: STEM.loops.json beside FILE when it exists)");
   command_->add_flag("--ignore-contacts", a.ignore_contacts, "Load a file whose geoms may collide, ignoring contacts (noted)");
   command_->add_flag("--video", a.video, "Write video.mp4 of the run drawn from the file's geoms (H.264, 30 fps; the Bullet run as a ghost)");
   command_->add_flag("--frames", a.frames, "Write frames/NNNNN.png (30 fps)");
@@ -273,7 +275,7 @@ int model(const ModelArgs& args) {
   try {
     model_file::LoadOptions options;
     options.ignore_contacts = args.ignore_contacts;
-    m = model_file::load(args.file, options);
+    m = loadWithLoops(args.file, args.loops, options);
   } catch (const model_file::ModelFileError& e) {
     std::fprintf(stderr, "error: %s\n", utf8Quotable(e.what()).c_str());
     return 2;

@@ -14,6 +14,7 @@ namespace dyn::app {
 
 struct ModelArgs {
   std::string file, out, engine = "both";
+  std::string loops;  // closures beside the file (app/model_loops.h); "": STEM.loops.json when it exists
   double duration = 2.0;  // s
   double dt = 1e-3;       // s
   bool ignore_contacts = false;
