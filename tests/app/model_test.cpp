@@ -151,3 +151,51 @@ TEST_CASE("dynlab bench FILE: the hand step at both orders, Bullet's and MuJoCo'
   CHECK(out["engines"][1]["max_closure_residual"].get<double>() < 1e-11);
   checkBadInput(dir, "bench missing.xml", {"missing.xml", "no such file"}, dir / "out");
 }
+
+TEST_CASE("dynlab model FILE.urdf: loops beside it (STEM.loops.json or --loops), both engines") {
+  TempDir dir("model_urdf_loops");
+  // fourbar.loops.json is found beside fourbar.urdf: the same closure, rows and trace columns as fourbar.xml.
+  const Result r = dynlab(dir, "model " + model("fourbar.urdf") + " --duration 0.5 --out out");
+  INFO(r.out, r.err);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("1 closure (2 of 3 rows kept), 1 degree of freedom after closure") != std::string::npos);
+  CHECK(r.out.find("closure pin_C: connect coupler to rocker, rows x z kept, y dropped") != std::string::npos);
+  CHECK(r.out.find("note: loop closures from ") != std::string::npos);
+  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.5 --out xml").code == 0);
+  const Csv urdf = readCsv(dir / "out/trace.csv"), xml = readCsv(dir / "xml/trace.csv");
+  CHECK(urdf.header == xml.header);
+  REQUIRE(urdf.rows.size() == xml.rows.size());
+  double diff = 0;
+  for (std::size_t i = 0; i < urdf.rows.size(); ++i)
+    for (std::size_t c = 0; c < urdf.header.size(); ++c) diff = std::max(diff, std::abs(urdf.rows[i][c] - xml.rows[i][c]));
+  MESSAGE("fourbar.urdf + loops vs fourbar.xml, 0.5 s trace: max |difference| " << diff);
+  CHECK(diff < 1e-12);
+  CHECK(readCsv(dir / "out/trace_bullet.csv").header == urdf.header);
+  // Named loops file: a bad one is one line naming it and its JSON path; nothing written.
+  writeFile(dir / "bad.json", R"({"loops": [{"kind": "connect", "body1": "coupler", "point1": [0.4, 0, "x"], "body2": "rocker"}]})");
+  checkBadInput(dir, "model " + model("fourbar.urdf") + " --loops bad.json --out o", {"bad.json", "loops[0].point1[2]", "expected a finite number"},
+                dir / "o");
+  checkBadInput(dir, "model " + model("fourbar.urdf") + " --loops none.json --out o", {"none.json", "no such file"}, dir / "o");
+}
+
+TEST_CASE("dynlab model puma560.urdf: the 6-DoF arm runs in both engines, M and h as MuJoCo's") {
+  TempDir dir("model_puma");
+  const Result r = dynlab(dir, "model " + model("puma560.urdf") + " --duration 0.5 --out out");
+  INFO(r.out, r.err);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("6 moving bodies, 6 joints, 0 closures") != std::string::npos);
+  const Csv hand = readCsv(dir / "out/trace.csv"), bt = readCsv(dir / "out/trace_bullet.csv");
+  REQUIRE(hand.rows.size() == 501);
+  REQUIRE(bt.rows.size() == 501);
+  // Passive from rest at q = 0 (stretched out): it falls, the hand run keeps its energy to RK4's error.
+  double de = 0, fall = 0;
+  for (std::size_t i = 0; i < hand.rows.size(); ++i) {
+    de = std::max(de, std::abs(hand.at(i, "energy") - hand.at(0, "energy")));
+    fall = std::max(fall, std::abs(hand.at(i, "q_q2")));
+  }
+  MESSAGE("PUMA 560, 0.5 s passive: |E - E0| " << de << " J, |q2| up to " << fall << " rad");
+  CHECK(fall > 0.3);
+  CHECK(de < 1e-6);
+  // Bullet swings the same way at first (its step is first order: the same to a few per cent).
+  CHECK(std::abs(bt.at(100, "q_q2") - hand.at(100, "q_q2")) < 0.05 * std::abs(hand.at(100, "q_q2")));
+}
