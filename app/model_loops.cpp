@@ -1,6 +1,7 @@
 // Loop closures beside a model file: see model_loops.h.
 #include "app/model_loops.h"
 
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -99,7 +100,12 @@ std::vector<model_file::GivenClosure> readLoops(const std::string& file) {
 }
 
 std::string loopsBeside(const std::string& model) {
+  // Beside a URDF only: an MJCF file writes its loops as equalities (and fourbar.xml must not pick up
+  // fourbar.urdf's loops).
   std::filesystem::path p(model);
+  std::string ext = p.extension().string();
+  for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".urdf") return "";
   p.replace_extension(".loops.json");
   std::error_code ec;
   return std::filesystem::exists(p, ec) ? p.string() : "";

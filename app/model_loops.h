@@ -7,8 +7,8 @@
 //                  "body1": "coupler", "point1": [0.4, 0, 0.1],
 //                  "body2": "rocker",  "point2": [-0.1, 0, 0.3] } ] }      // point2 optional
 //
-// Found beside the model as STEM.loops.json (fourbar.urdf → fourbar.loops.json), or named with
-// `dynlab model FILE --loops JSON`.
+// Found beside a URDF as STEM.loops.json (fourbar.urdf → fourbar.loops.json), or named with
+// `dynlab model FILE --loops JSON` (any model file).
 #pragma once
 #include <string>
 #include <vector>
@@ -21,7 +21,8 @@ namespace dyn::app {
 // ..., got ...".
 std::vector<model_file::GivenClosure> readLoops(const std::string& json);
 
-// STEM.loops.json beside the model file when it exists (a regular file or not), else "".
+// STEM.loops.json beside a URDF file (.urdf, any case) when it exists (a regular file or not), else ""
+// (an MJCF file writes its loops as equalities: fourbar.xml does not pick up fourbar.urdf's loops).
 std::string loopsBeside(const std::string& model);
 
 // The model with its closures: LOOPS when given, else the file beside it, else the file's own only.

@@ -54,6 +54,9 @@ TEST_CASE("fourbar.urdf with fourbar.loops.json beside it equals fourbar.xml (M,
   const model_file::LoadedModel xml = model_file::load(model("fourbar.xml"));
   // Found beside the URDF without being named.
   CHECK(app::loopsBeside(model("fourbar.urdf")) == model("fourbar.loops.json"));
+  // Beside a URDF only: fourbar.xml (its loop an equality) does not pick up fourbar.urdf's.
+  CHECK(app::loopsBeside(model("fourbar.xml")).empty());
+  CHECK(app::loadWithLoops(model("fourbar.xml"), "").notes == xml.notes);
   const model_file::LoadedModel urdf = app::loadWithLoops(model("fourbar.urdf"), "");
   REQUIRE(urdf.closures.size() == 1);
   CHECK(urdf.closures[0].name == "pin_C");
