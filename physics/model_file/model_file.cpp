@@ -376,6 +376,9 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
       return b;
     };
     if (g.kind != "connect" && g.kind != "weld") throw ModelFileError(g.where + ".kind: expected \"connect\" or \"weld\", got '" + g.kind + "'");
+    // Names head the trace's force columns: one per closure.
+    for (const Closure& c : out.closures)
+      if (c.name == g.name) throw ModelFileError(g.where + ".name: '" + g.name + "' names a closure of " + path + " too (expected a new name)");
     const int b1 = body("body1", g.body1), b2 = body("body2", g.body2);
     const Vec3 p1 = Vec3(d->xpos + 3 * b1) + rotationOf(b1) * g.point1;
     const Vec3 p2 = g.has_point2 ? Vec3(Vec3(d->xpos + 3 * b2) + rotationOf(b2) * g.point2) : p1;

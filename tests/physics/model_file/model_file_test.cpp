@@ -434,6 +434,15 @@ TEST_CASE("closures given as plain data beside a URDF are held as MJCF equalitie
     what = e.what();
   }
   CHECK(what.rfind("test: loops[0].body2: expected a link of ", 0) == 0);
+  // Beside an MJCF file whose own equality has the name: refused (one force column per name).
+  options.closures[0].body2 = "rocker";
+  what.clear();
+  try {
+    model_file::load(model("fourbar.xml"), options);
+  } catch (const model_file::ModelFileError& e) {
+    what = e.what();
+  }
+  CHECK(what.rfind("test: loops[0].name: 'pin_C' names a closure of ", 0) == 0);
 }
 
 TEST_CASE("puma560.urdf: the published DH geometry and masses are what MuJoCo and dynlab read") {
