@@ -19,6 +19,7 @@
 #include "app/bench.h"
 #include "app/commands.h"
 #include "app/model.h"
+#include "app/model_loops.h"
 #include "labs/utf8.h"
 #include "physics/bullet/bullet_mechanism.h"
 #include "physics/constrained_mechanism.h"
@@ -173,6 +174,13 @@ int benchModel(const BenchArgs& a) {
     m = model_file::load(a.lab);
   } catch (const model_file::ModelFileError& e) {
     std::fprintf(stderr, "error: %s\n", utf8Quotable(e.what()).c_str());
+    return 2;
+  }
+  // Loops beside the file: MuJoCo's own run of the file would not hold them, so the engines would not
+  // run one mechanism.
+  if (const std::string loops = loopsBeside(a.lab); !loops.empty()) {
+    std::fprintf(stderr, "error: %s: its loops are beside it (%s); dynlab bench FILE times a file's own loops only (MuJoCo's run would not hold these)\n",
+                 utf8Quotable(a.lab).c_str(), utf8Quotable(loops).c_str());
     return 2;
   }
   const double dt = m.timestep;

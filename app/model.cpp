@@ -5,12 +5,14 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
 #include <filesystem>
 #include <random>
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/model_loops.h"
 #include "app/model_scene.h"
 #include "app/movie.h"
 #include "app/output.h"
@@ -147,14 +149,13 @@ void record(Run& run, ConstrainedMechanism<Spatial>& mech, double t, const VecN&
 // The hand engine from the file's pose at rest: RK4, positions and velocities projected each step,
 // stepped by the sized engine the bench times (hand_engine.h); the rows' energy, residual and forces
 // (the solve's η at the row's state) from the description's mechanism.
-Run runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, const ModelArgs& args) {
+Run runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, const ModelArgs& args, const VecN& tau) {
   Run run;
   run.trace = emptyTrace(m);
   StepOptions o;
   o.dt = args.dt;
   const int steps = int(std::lround(args.duration / args.dt)), n = mech.n();
   VecN q = m.q0, v = VecN::Zero(n);
-  const VecN tau = VecN::Zero(n);
   const std::unique_ptr<ConstrainedSystem> engine = model_file::handEngine(m.mechanism, &run.summary);
   // The books (friction's work) integrated with the motion, at RK4's order (integrate.h).
   engine->setTime(0);
@@ -171,16 +172,17 @@ Run runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mec
 
 // Bullet from the same state; forces: each closure's over the step that starts at the row (the last
 // row repeats the last step's).
-Run runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, const ModelArgs& args) {
+Run runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, const ModelArgs& args, const VecN& tau) {
   Run run;
   run.trace = emptyTrace(m);
   const int steps = int(std::lround(args.duration / args.dt)), n = mech.n();
   VecN q = m.q0, v = VecN::Zero(n);
-  const VecN tau = VecN::Zero(n);
   bullet::BulletMechanism<Spatial> bt(m.mechanism, args.dt, q, v);
   run.summary = bt.describe();
   static const std::map<std::string, int> kRow = {{"wx", 0}, {"wy", 1}, {"wz", 2}, {"x", 3}, {"y", 4}, {"z", 5}};
-  double work = 0, power = frictionPower(m.mechanism, v);
+  // The power flowing in: the torques' τ·v less what damping and friction take.
+  auto inflow = [&](const VecN& w) { return tau.dot(w) - frictionPower(m.mechanism, w); };
+  double work = 0, power = inflow(v);
   std::vector<double> forces;
   for (int k = 0; k <= steps; ++k) {
     VecN qn = q, vn = v;
@@ -194,8 +196,8 @@ Run runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& m
     record(run, mech, k * args.dt, q, v, work, forces);
     if (k == steps) break;
     if (!(run.ok = qn.allFinite() && vn.allFinite())) break;
-    const double p = frictionPower(m.mechanism, vn);
-    work -= 0.5 * (power + p) * args.dt;
+    const double p = inflow(vn);
+    work += 0.5 * (power + p) * args.dt;
     power = p;
     q = qn, v = vn;
   }
@@ -204,10 +206,13 @@ Run runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& m
 
 std::string report(const Run& r, const std::string& engine, const model_file::LoadedModel& m, const ModelArgs& args) {
   std::ostringstream o;
-  o << "passive run, " << engine << ", dt " << fmt(args.dt) << " s, " << fmt(args.duration) << " s from q0 at rest\n"
+  const bool driven = !args.torques.empty();
+  o << (driven ? "run with constant torques (" + join(args.torques, ", ") + "), " : std::string("passive run, ")) << engine << ", dt "
+    << fmt(args.dt) << " s, " << fmt(args.duration) << " s from q0 at rest\n"
     << "  closure residual max |φ|∞ " << fmt(r.residual) << "\n"
-    << "  energy E0 " << fmt(r.e0) << " J, max |E − E0 − W_friction| " << fmt(r.balance) << " J (kinetic energy up to "
-    << fmt(r.kinetic) << " J" << (m.mechanism.joints.empty() ? "" : "; W_friction by the trapezoid rule") << ")\n";
+    << "  energy E0 " << fmt(r.e0) << " J, max |E − E0 − " << (driven ? "W" : "W_friction") << "| " << fmt(r.balance)
+    << " J (kinetic energy up to " << fmt(r.kinetic) << " J" << (driven ? "; W: the torques' work and friction's" : "")
+    << (m.mechanism.joints.empty() && !driven ? "" : "; W by the trapezoid rule in Bullet's books") << ")\n";
   if (!r.ok)
     o << "  the run stopped at t = " << fmt(double(r.trace.rows() - 1) * args.dt)
       << " s: the projection failed or the state left the finite numbers\n";
@@ -227,6 +232,9 @@ ModelCommand::ModelCommand(CLI::App& cli) {
   command_->add_option("--dt", a.dt, "Fixed step (s, default 0.001; RK4 + projection)")->check(CLI::Range(1e-5, 1e-2));
   command_->add_option("--out", a.out, "Output directory (default: out/model/FILE's stem)");
   command_->add_option("--engine", a.engine, "Which engine(s) to run (default: both)")->check(CLI::IsMember({"hand", "bullet", "both"}));
+  command_->add_option("--torque", a.torques, "A constant joint torque JOINT=VALUE (N·m; N on a slide), repeatable (default: passive)")
+      ->allow_extra_args(false);
+  command_->add_option("--loops", a.loops, "Loop closures beside the file (JSON; default: STEM.loops.json beside FILE when it exists)");
   command_->add_flag("--ignore-contacts", a.ignore_contacts, "Load a file whose geoms may collide, ignoring contacts (noted)");
   command_->add_flag("--video", a.video, "Write video.mp4 of the run drawn from the file's geoms (H.264, 30 fps; the Bullet run as a ghost)");
   command_->add_flag("--frames", a.frames, "Write frames/NNNNN.png (30 fps)");
@@ -273,19 +281,40 @@ int model(const ModelArgs& args) {
   try {
     model_file::LoadOptions options;
     options.ignore_contacts = args.ignore_contacts;
-    m = model_file::load(args.file, options);
+    m = loadWithLoops(args.file, args.loops, options);
   } catch (const model_file::ModelFileError& e) {
     std::fprintf(stderr, "error: %s\n", utf8Quotable(e.what()).c_str());
     return 2;
+  }
+  // Constant torques by joint name: each "JOINT=VALUE" once, a joint of the file, a finite value.
+  VecN tau = VecN::Zero(Eigen::Index(m.joints.size()));
+  std::vector<bool> given(m.joints.size(), false);
+  for (const std::string& t : args.torques) {
+    std::vector<std::string> names;
+    for (const auto& j : m.joints) names.push_back(j.name);
+    const std::size_t eq = t.find('=');
+    const std::string joint = t.substr(0, eq);
+    const auto it = std::find(names.begin(), names.end(), joint);
+    double value = 0;
+    char* end = nullptr;
+    if (eq != std::string::npos) value = std::strtod(t.c_str() + eq + 1, &end);
+    if (eq == std::string::npos || it == names.end() || end == t.c_str() + eq + 1 || *end != '\0' || !std::isfinite(value) ||
+        std::abs(value) > 1e4 || given[std::size_t(it - names.begin())]) {
+      std::fprintf(stderr, "error: <command line>: --torque %s: expected JOINT=VALUE once per joint, JOINT one of %s's joints (%s), VALUE a finite "
+                   "N·m (N on a slide) within ±1e4\n", utf8Quotable(t).c_str(), utf8Quotable(m.file).c_str(), utf8Quotable(join(names)).c_str());
+      return 2;
+    }
+    given[std::size_t(it - names.begin())] = true;
+    tau[it - names.begin()] = value;
   }
   ConstrainedMechanism<Spatial> mech(m.mechanism);
   std::string text = describe(m) + crossCheck(m, mech);
   const bool hand = args.engine != "bullet", bullet = args.engine != "hand";
   Run h, b;
-  if (hand) h = runHand(m, mech, args);
+  if (hand) h = runHand(m, mech, args, tau);
   if (bullet) {
     try {
-      b = runBullet(m, mech, args);
+      b = runBullet(m, mech, args, tau);
     } catch (const std::exception& e) {  // a description the Bullet builder cannot model
       std::fprintf(stderr, "error: %s: Bullet: %s\n", utf8Quotable(m.file).c_str(), utf8Quotable(e.what()).c_str());
       return 2;

@@ -1,7 +1,8 @@
 // `dynlab model FILE`: a mechanism from an MJCF or URDF file (physics/model_file): loads it, prints
 // what dynlab read (bodies, joints, closures and their kept rows, the freedom left, notes), checks M
-// and the bias against MuJoCo's own, runs it passive with the hand engine (RK4 + projection) and/or
-// Bullet and reports each one's closure residual and energy balance and their agreement; writes
+// and the bias against MuJoCo's own, runs it passive (or with constant joint torques, --torque) with
+// the hand engine (RK4 + projection) and/or Bullet and reports each one's closure residual and energy
+// balance and their agreement; writes
 // OUT/trace.csv (hand), OUT/trace_bullet.csv and OUT/summary.txt, and with --video / --frames the run
 // drawn from the file's geoms (app/model_scene.h): OUT/video.mp4, OUT/frames/NNNNN.png.
 // `dynlab run FILE.xml|FILE.urdf` (a model file where a lab name goes) is the same command.
@@ -9,15 +10,18 @@
 #pragma once
 #include <CLI/CLI.hpp>
 #include <string>
+#include <vector>
 
 namespace dyn::app {
 
 struct ModelArgs {
   std::string file, out, engine = "both";
+  std::string loops;  // closures beside the file (app/model_loops.h); "": STEM.loops.json when it exists
   double duration = 2.0;  // s
   double dt = 1e-3;       // s
   bool ignore_contacts = false;
   bool video = false, frames = false;  // 30 frames per second of simulated time, 640×480
+  std::vector<std::string> torques;    // "JOINT=VALUE": constant torques (N·m; N on a slide); none: passive
 };
 
 struct RunArgs;

@@ -2,6 +2,8 @@
 // element checked against what the description can hold, then mapped at the reference pose qpos0.
 #include "physics/model_file/model_file.h"
 
+#include <algorithm>
+
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <cmath>
@@ -307,14 +309,32 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   }
   if (!any) mech.joints.clear();
 
-  // Loop closures: connect and weld, points and rows at qpos0.
+  // Loop closures: connect and weld, points and rows at qpos0: the file's equalities, then the
+  // closures given beside it. `where` starts each error about one ("FILE: equality 'pin_C'").
   struct Tie {
-    int eq;
     BodyRef a, b;
     Vec3 pa, pb;
     bool weld;
+    std::string where;
   };
   std::vector<Tie> ties;
+  // Body b1's point p1 tied to body b2's p2 (world, at qpos0).
+  auto tie = [&](const std::string& where, const std::string& name, bool weld, bool rotation, int b1, int b2, const Vec3& p1, const Vec3& p2) {
+    const Frame& f1 = frame[std::size_t(b1)];
+    const Frame& f2 = frame[std::size_t(b2)];
+    if (f1.link == f2.link)
+      throw ModelFileError(where + " ties body '" + nameOf(m, mjOBJ_BODY, b1, "body") + "' to '" + nameOf(m, mjOBJ_BODY, b2, "body") +
+                           "', which no joint separates (they move as one body)");
+    ties.push_back({ref(f1.link), ref(f2.link), p1 - f1.origin, p2 - f2.origin, rotation, where});
+    Closure c;
+    c.name = name;
+    c.kind = weld ? "weld" : "connect";
+    c.body1 = nameOf(m, mjOBJ_BODY, b1, "body");
+    c.body2 = nameOf(m, mjOBJ_BODY, b2, "body");
+    c.link1 = f1.link, c.link2 = f2.link, c.point1 = p1 - f1.origin, c.point2 = p2 - f2.origin;
+    out.closures.push_back(c);
+  };
+  auto rotationOf = [&](int b) { return Mat3(Eigen::Map<const RowMat3>(d->xmat + 9 * b)); };
   const bool equalities = !(flags & (mjDSBL_EQUALITY | mjDSBL_CONSTRAINT));
   if (!equalities && m->neq > 0) out.notes.push_back(std::to_string(m->neq) + " equalities off (<option><flag equality=\"disable\"/>)");
   for (int e = 0; equalities && e < m->neq; ++e) {
@@ -327,7 +347,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     }
     const int b1 = m->eq_obj1id[e], b2 = m->eq_obj2id[e];
     const mjtNum* data_e = m->eq_data + mjNEQDATA * e;
-    const RowMat3 R1 = Eigen::Map<const RowMat3>(d->xmat + 9 * b1), R2 = Eigen::Map<const RowMat3>(d->xmat + 9 * b2);
+    const Mat3 R1 = rotationOf(b1), R2 = rotationOf(b2);
     const bool weld = m->eq_type[e] == mjEQ_WELD;
     // connect: data = (anchor in body1, anchor in body2); weld: (anchor in body2, relpose in body1: point, quaternion, torquescale).
     const Vec3 p1 = Vec3(d->xpos + 3 * b1) + R1 * Vec3(data_e + (weld ? 3 : 0));
@@ -343,19 +363,26 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
         out.notes.push_back("weld '" + name + "' has torquescale 0: held as a connect (no rotation rows)");
       }
     }
-    const Frame& f1 = frame[std::size_t(b1)];
-    const Frame& f2 = frame[std::size_t(b2)];
-    if (f1.link == f2.link)
-      throw ModelFileError(path + ": equality '" + name + "' ties body '" + nameOf(m, mjOBJ_BODY, b1, "body") + "' to '" +
-                           nameOf(m, mjOBJ_BODY, b2, "body") + "', which no joint separates (they move as one body)");
-    ties.push_back({e, ref(f1.link), ref(f2.link), p1 - f1.origin, p2 - f2.origin, rotation});
-    Closure c;
-    c.name = name;
-    c.kind = weld ? "weld" : "connect";
-    c.body1 = nameOf(m, mjOBJ_BODY, b1, "body");
-    c.body2 = nameOf(m, mjOBJ_BODY, b2, "body");
-    c.link1 = f1.link, c.link2 = f2.link, c.point1 = p1 - f1.origin, c.point2 = p2 - f2.origin;
-    out.closures.push_back(c);
+    tie(path + ": equality '" + name + "'", name, weld, rotation, b1, b2, p1, p2);
+  }
+  // Closures given beside the file: links by name, points in their frames (a weld holds the relative
+  // orientation at qpos0, as an MJCF weld without relpose does).
+  for (const GivenClosure& g : options.closures) {
+    auto body = [&](const std::string& field, const std::string& name) {
+      const int b = name == "world" ? 0 : mj_name2id(m, mjOBJ_BODY, name.c_str());
+      if (b < 0)
+        throw ModelFileError(g.where + "." + field + ": expected a link of " + path + ", got '" + name +
+                             "' (a link fixed to its parent is fused into it by MuJoCo: name the parent, with the point in its frame)");
+      return b;
+    };
+    if (g.kind != "connect" && g.kind != "weld") throw ModelFileError(g.where + ".kind: expected \"connect\" or \"weld\", got '" + g.kind + "'");
+    // Names head the trace's force columns: one per closure.
+    for (const Closure& c : out.closures)
+      if (c.name == g.name) throw ModelFileError(g.where + ".name: '" + g.name + "' names a closure of " + path + " too (expected a new name)");
+    const int b1 = body("body1", g.body1), b2 = body("body2", g.body2);
+    const Vec3 p1 = Vec3(d->xpos + 3 * b1) + rotationOf(b1) * g.point1;
+    const Vec3 p2 = g.has_point2 ? Vec3(Vec3(d->xpos + 3 * b2) + rotationOf(b2) * g.point2) : p1;
+    tie(g.where + " ('" + g.name + "')", g.name, g.kind == "weld", g.kind == "weld", b1, b2, p1, p2);
   }
   auto rowsOf = [](bool weld) { return weld ? PointClosure<Spatial>::all() : PointClosure<Spatial>::translations(); };
   for (const Tie& t : ties) mech.constraints.push_back(std::make_shared<PointClosure<Spatial>>(t.a, t.pa, t.b, t.pb, rowsOf(t.weld)));
@@ -370,8 +397,8 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   ConstrainedMechanism<Spatial> full(mech);
   for (std::size_t i = 0; i < ties.size(); ++i)
     if (const double gap = full.residual(int(i), out.q0); !(gap <= 1e-9))
-      throw ModelFileError(path + ": equality '" + out.closures[i].name + "' does not hold at the reference pose (gap " +
-                           num(gap) + "); write the file in its closed pose");
+      throw ModelFileError(ties[i].where + " does not hold at the reference pose (gap " + num(gap) +
+                           "); write the file in its closed pose");
   // Rows identically dependent on the rows before them (a planar loop's out-of-plane rows): J at
   // seeded configurations around q0, side by side; a row is kept when it raises the rank.
   constexpr int kSamples = 4;
@@ -411,13 +438,20 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   std::vector<Closure> closures;
   for (std::size_t i = 0; i < ties.size(); ++i) {
     if (out.closures[i].kept.empty()) {
-      out.notes.push_back("equality '" + out.closures[i].name + "': every row repeats other closures' rows; not held twice");
+      out.notes.push_back("closure '" + out.closures[i].name + "': every row repeats other closures' rows; not held twice");
       continue;
     }
     mech.constraints.push_back(std::make_shared<PointClosure<Spatial>>(ties[i].a, ties[i].pa, ties[i].b, ties[i].pb, masks[i]));
     closures.push_back(out.closures[i]);
   }
   out.closures = closures;
+  // A body drawn as rods (no geom) reaches to its loop anchors too, so the drawn loop closes.
+  auto reach = [&](int link, const Vec3& point) {
+    const auto& bones = out.drawing.bones;
+    if (link >= 0 && std::any_of(bones.begin(), bones.end(), [&](const Bone& b) { return b.link == link; }))
+      out.drawing.bones.push_back({link, Vec3::Zero(), point});
+  };
+  for (const Closure& c : out.closures) reach(c.link1, c.point1), reach(c.link2, c.point2);
   // The mechanism's freedom at q0: coordinates minus the rank of the kept rows there.
   ConstrainedMechanism<Spatial> reduced(mech);
   VecN phi;

@@ -91,8 +91,20 @@ struct LoadedModel {
   int dof = 0;                     // coordinates minus independent closure rows at q0
 };
 
+// A loop closure given beside the file (plain data; app/model_loops.h reads it from the lab JSON beside
+// a URDF, which cannot express loops): held exactly as an MJCF <equality> connect or weld is.
+struct GivenClosure {
+  std::string where;              // where it was given, for errors: "FILE.loops.json: loops[0]"
+  std::string name, kind;         // kind: "connect" (3 translation rows) or "weld" (6 rows)
+  std::string body1, body2;       // link (MuJoCo body) names; "world" for the ground
+  Eigen::Vector3d point1 = Eigen::Vector3d::Zero();  // in body1's frame (a URDF link's frame)
+  bool has_point2 = false;        // false: point2 is where point1 sits at the reference pose
+  Eigen::Vector3d point2 = Eigen::Vector3d::Zero();  // in body2's frame
+};
+
 struct LoadOptions {
   bool ignore_contacts = false;  // load a file whose geoms may collide, ignoring contacts (noted)
+  std::vector<GivenClosure> closures;  // held after the file's own equalities, in this order
 };
 
 // Reads FILE (MJCF or URDF). Throws ModelFileError.

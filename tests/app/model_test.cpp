@@ -150,4 +150,95 @@ TEST_CASE("dynlab bench FILE: the hand step at both orders, Bullet's and MuJoCo'
   CHECK(out["engines"][1]["max_q_error_vs_hand_rk4"].get<double>() == 0.0);
   CHECK(out["engines"][1]["max_closure_residual"].get<double>() < 1e-11);
   checkBadInput(dir, "bench missing.xml", {"missing.xml", "no such file"}, dir / "out");
+  checkBadInput(dir, "bench " + model("fourbar.urdf"), {"fourbar.urdf", "fourbar.loops.json", "times a file's own loops only"}, dir / "out");
+}
+
+TEST_CASE("dynlab model FILE.urdf: loops beside it (STEM.loops.json or --loops), both engines") {
+  TempDir dir("model_urdf_loops");
+  // fourbar.loops.json is found beside fourbar.urdf: the same closure, rows and trace columns as fourbar.xml.
+  const Result r = dynlab(dir, "model " + model("fourbar.urdf") + " --duration 0.5 --out out");
+  INFO(r.out, r.err);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("1 closure (2 of 3 rows kept), 1 degree of freedom after closure") != std::string::npos);
+  CHECK(r.out.find("closure pin_C: connect coupler to rocker, rows x z kept, y dropped") != std::string::npos);
+  CHECK(r.out.find("note: loop closures from ") != std::string::npos);
+  // fourbar.xml beside it does not pick them up (its loop is its own equality).
+  CHECK(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.01 --out x0").out.find("loop closures from") == std::string::npos);
+  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.5 --out xml").code == 0);
+  const Csv urdf = readCsv(dir / "out/trace.csv"), xml = readCsv(dir / "xml/trace.csv");
+  CHECK(urdf.header == xml.header);
+  REQUIRE(urdf.rows.size() == xml.rows.size());
+  double diff = 0;
+  for (std::size_t i = 0; i < urdf.rows.size(); ++i)
+    for (std::size_t c = 0; c < urdf.header.size(); ++c) diff = std::max(diff, std::abs(urdf.rows[i][c] - xml.rows[i][c]));
+  MESSAGE("fourbar.urdf + loops vs fourbar.xml, 0.5 s trace: max |difference| " << diff);
+  CHECK(diff < 1e-12);
+  CHECK(readCsv(dir / "out/trace_bullet.csv").header == urdf.header);
+  // Named loops file: a bad one is one line naming it and its JSON path; nothing written.
+  writeFile(dir / "bad.json", R"({"loops": [{"kind": "connect", "body1": "coupler", "point1": [0.4, 0, "x"], "body2": "rocker"}]})");
+  checkBadInput(dir, "model " + model("fourbar.urdf") + " --loops bad.json --out o", {"bad.json", "loops[0].point1[2]", "expected a finite number"},
+                dir / "o");
+  checkBadInput(dir, "model " + model("fourbar.urdf") + " --loops none.json --out o", {"none.json", "no such file"}, dir / "o");
+}
+
+TEST_CASE("dynlab model puma560.urdf: the 6-DoF arm runs in both engines, M and h as MuJoCo's") {
+  TempDir dir("model_puma");
+  const Result r = dynlab(dir, "model " + model("puma560.urdf") + " --duration 0.5 --out out");
+  INFO(r.out, r.err);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("6 moving bodies, 6 joints, 0 closures") != std::string::npos);
+  const Csv hand = readCsv(dir / "out/trace.csv"), bt = readCsv(dir / "out/trace_bullet.csv");
+  REQUIRE(hand.rows.size() == 501);
+  REQUIRE(bt.rows.size() == 501);
+  // Passive from rest at q = 0 (stretched out): it falls, the hand run keeps its energy to RK4's error.
+  double de = 0, fall = 0;
+  for (std::size_t i = 0; i < hand.rows.size(); ++i) {
+    de = std::max(de, std::abs(hand.at(i, "energy") - hand.at(0, "energy")));
+    fall = std::max(fall, std::abs(hand.at(i, "q_q2")));
+  }
+  MESSAGE("PUMA 560, 0.5 s passive: |E - E0| " << de << " J, |q2| up to " << fall << " rad");
+  CHECK(fall > 0.3);
+  CHECK(de < 1e-6);
+  // Bullet swings the same way at first (its step is first order: the same to a few per cent).
+  CHECK(std::abs(bt.at(100, "q_q2") - hand.at(100, "q_q2")) < 0.05 * std::abs(hand.at(100, "q_q2")));
+}
+
+TEST_CASE("dynlab model --torque: constant joint torques, their work in the energy books of both engines") {
+  TempDir dir("model_torque");
+  const Result r = dynlab(dir, "model " + model("fourbar.xml") + " --torque crank=0.3 --duration 1 --out out");
+  INFO(r.out, r.err);
+  REQUIRE(r.code == 0);
+  CHECK(r.out.find("run with constant torques (crank=0.3)") != std::string::npos);
+  // The books: E − E0 = W, the torque's work ∫ τ v dt, to RK4's error (hand) and Euler's (Bullet).
+  const Csv hand = readCsv(dir / "out/trace.csv"), bt = readCsv(dir / "out/trace_bullet.csv");
+  double balance = 0, balance_bt = 0, work = 0;
+  for (std::size_t i = 0; i < hand.rows.size(); ++i) {
+    balance = std::max(balance, std::abs(hand.at(i, "energy") - hand.at(0, "energy") - hand.at(i, "work")));
+    balance_bt = std::max(balance_bt, std::abs(bt.at(i, "energy") - bt.at(0, "energy") - bt.at(i, "work")));
+    work = std::max(work, std::abs(hand.at(i, "work")));
+  }
+  // The torque's work by the crank's own rate (trapezoid rule on the trace): the same W.
+  double w = 0;
+  for (std::size_t i = 1; i < hand.rows.size(); ++i)
+    w += 0.3 * 0.5 * (hand.at(i, "v_crank") + hand.at(i - 1, "v_crank")) * (hand.at(i, "t") - hand.at(i - 1, "t"));
+  MESSAGE("four-bar, crank torque 0.3 N·m for 1 s: W " << hand.at(hand.rows.size() - 1, "work") << " J (trapezoid on the trace " << w
+                                                        << "), |E - E0 - W| hand " << balance << " J, Bullet " << balance_bt << " J");
+  CHECK(work > 0.1);
+  CHECK(std::abs(w - hand.at(hand.rows.size() - 1, "work")) < 1e-4 * work);  // the trapezoid's own h² error
+  CHECK(balance < 1e-6);
+  // Bullet's balance is its semi-implicit Euler's first-order error (measured 0.087 J at 1 ms): halving
+  // the step halves it, so its books count the torque's work right.
+  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --torque crank=0.3 --duration 1 --dt 0.0005 --engine bullet --out half").code == 0);
+  const Csv half = readCsv(dir / "half/trace_bullet.csv");
+  double balance_half = 0;
+  for (std::size_t i = 0; i < half.rows.size(); ++i)
+    balance_half = std::max(balance_half, std::abs(half.at(i, "energy") - half.at(0, "energy") - half.at(i, "work")));
+  MESSAGE("Bullet's |E - E0 - W| at dt 1 ms " << balance_bt << " J, at 0.5 ms " << balance_half << " J");
+  CHECK(balance_bt < 0.2);
+  CHECK(balance_bt / balance_half > 1.6);
+  CHECK(balance_bt / balance_half < 2.5);
+  // Bad torques: one line naming the joints, exit 2.
+  checkBadInput(dir, "model " + model("fourbar.xml") + " --torque elbow=1 --out o", {"--torque elbow=1", "crank coupler rocker"}, dir / "o");
+  checkBadInput(dir, "model " + model("fourbar.xml") + " --torque crank=nan --out o", {"--torque crank=nan", "finite"}, dir / "o");
+  checkBadInput(dir, "model " + model("fourbar.xml") + " --torque crank=1 --torque crank=2 --out o", {"--torque crank=2", "once per joint"}, dir / "o");
 }

@@ -1,13 +1,14 @@
 // Mechanisms from model files (physics/model_file) against independent references:
 //  * the slider crank as MJCF equals the slider crank lab's C++ description (M, h, φ, G = [J, −A] and
 //    the whole solve of eq. (2)) at random states, to 1e-12;
-//  * M and the bias C v + G of every example file equal MuJoCo's own (mj_fullM, qfrc_bias) from the
-//    same file, to 1e-10, at random states;
+//  * M and the bias C v + G of every model file in assets/models (the PUMA 560 among them) equal
+//    MuJoCo's own (mj_fullM, qfrc_bias) from the same file, to 1e-10, at random states;
 //  * a planar four-bar's connect keeps its 2 independent rows (y dropped), and a passive run keeps
 //    the closure at rounding level and the energy to RK4's order;
 //  * hostile and unsupported files get one-line errors naming the file and the element, fast.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <filesystem>
@@ -153,9 +154,18 @@ TEST_CASE("the slider crank as MJCF equals the lab's C++ description (M, h, φ, 
   }
 }
 
-TEST_CASE("M and the bias C v + G equal MuJoCo's own (mj_fullM, qfrc_bias) for every example file") {
-  for (const char* name : {"arm3d.xml", "fourbar.xml", "fivebar.xml", "slider_crank.xml", "planar_arm.urdf"}) {
-    CAPTURE(std::string(name));
+TEST_CASE("M and the bias C v + G equal MuJoCo's own (mj_fullM, qfrc_bias) for every model file in assets/models") {
+  // Every .xml and .urdf there, found by listing the folder (a file added later is checked too).
+  std::vector<std::string> files;
+  for (const auto& entry : fs::directory_iterator(model("")))
+    if (const std::string ext = entry.path().extension().string(); ext == ".xml" || ext == ".urdf")
+      files.push_back(entry.path().filename().string());
+  std::sort(files.begin(), files.end());
+  for (const char* expected : {"arm3d.xml", "fivebar.xml", "fourbar.urdf", "fourbar.xml", "planar_arm.urdf", "puma560.urdf", "slider_crank.xml"})
+    CHECK_MESSAGE(std::count(files.begin(), files.end(), expected) == 1, expected);
+  for (const std::string& entry : files) {
+    const char* name = entry.c_str();
+    CAPTURE(entry);
     const model_file::LoadedModel file = model_file::load(model(name));
     model_file::MujocoReference mj(model(name));
     ConstrainedMechanism<Spatial> mech(file.mechanism);
@@ -398,4 +408,67 @@ TEST_CASE("the sized hand engine (hand_engine.h) steps as the dynamically sized 
       CHECK((v1 - v2).cwiseAbs().maxCoeff() < 1e-10);
     }
   }
+}
+
+TEST_CASE("closures given as plain data beside a URDF are held as MJCF equalities are") {
+  // The four-bar's URDF tree with its pin given in C++ (app/model_loops.h reads the same from JSON).
+  model_file::LoadOptions options;
+  model_file::GivenClosure pin;
+  pin.where = "test: loops[0]";
+  pin.name = "pin_C", pin.kind = "connect", pin.body1 = "coupler", pin.body2 = "rocker";
+  pin.point1 = Eigen::Vector3d(0.4, 0, 0.1);  // point2 left out: where point1 is at q0
+  options.closures = {pin};
+  const model_file::LoadedModel urdf = model_file::load(model("fourbar.urdf"), options);
+  const model_file::LoadedModel xml = model_file::load(model("fourbar.xml"));
+  REQUIRE(urdf.closures.size() == 1);
+  CHECK(urdf.closures[0].kept == xml.closures[0].kept);
+  CHECK(urdf.closures[0].dropped == xml.closures[0].dropped);
+  CHECK((urdf.closures[0].point2 - xml.closures[0].point2).norm() < 1e-15);
+  CHECK(urdf.dof == 1);
+  // A link the file does not have: named by where the closure was given, with its field.
+  options.closures[0].body2 = "nowhere";
+  std::string what;
+  try {
+    model_file::load(model("fourbar.urdf"), options);
+  } catch (const model_file::ModelFileError& e) {
+    what = e.what();
+  }
+  CHECK(what.rfind("test: loops[0].body2: expected a link of ", 0) == 0);
+  // Beside an MJCF file whose own equality has the name: refused (one force column per name).
+  options.closures[0].body2 = "rocker";
+  what.clear();
+  try {
+    model_file::load(model("fourbar.xml"), options);
+  } catch (const model_file::ModelFileError& e) {
+    what = e.what();
+  }
+  CHECK(what.rfind("test: loops[0].name: 'pin_C' names a closure of ", 0) == 0);
+}
+
+TEST_CASE("puma560.urdf: the published DH geometry and masses are what MuJoCo and dynlab read") {
+  const model_file::LoadedModel puma = model_file::load(model("puma560.urdf"));
+  REQUIRE(puma.joints.size() == 6);
+  CHECK(puma.dof == 6);
+  ConstrainedMechanism<Spatial> mech(puma.mechanism);
+  // At q = 0 (the toolbox's qz) the wrist centre (joints 4-6 meet there) is at (a2 + a3, -d3, d4).
+  const Eigen::Vector3d wrist = mech.pointPosition(4, Eigen::Vector3d::Zero(), puma.q0);
+  CHECK((wrist - Eigen::Vector3d(0.4318 + 0.0203, -0.15005, 0.4318)).norm() < 1e-12);
+  double total = 0;
+  for (const auto& body : puma.mechanism.tree.bodies) {
+    double m = 0;
+    Eigen::Vector3d c;
+    Spatial::massAndCom(body.inertia, m, c);
+    total += m;
+  }
+  CHECK(total == doctest::Approx(1.0 + 17.4 + 4.8 + 0.82 + 0.34 + 0.09));  // link 1's 1 kg on its axis (see the file)
+  // Joint 2 holds the arm against gravity at q = 0: by the centres' reaches along x (DH a and r),
+  // |τ2| = g (m2 (a2 + r2x) + m3 (a2 + a3 + r3x) + (m4 + m5 + m6) (a2 + a3)), the wrist's masses on the
+  // wrist centre's vertical (their r have no x part at qz).
+  const VecN g = mech.inverseDynamics(puma.q0, VecN::Zero(6), VecN::Zero(6));
+  const double reach = 17.4 * (0.4318 - 0.3638) + 4.8 * (0.4318 + 0.0203 - 0.0203) + (0.82 + 0.34 + 0.09) * (0.4318 + 0.0203);
+  CHECK(std::abs(g[1]) == doctest::Approx(9.81 * reach).epsilon(1e-12));
+  // Joint 3 (on joint 2's arm end, a2 along x) holds only the wrist's offset a3 = 0.0203 m.
+  CHECK(std::abs(g[2]) == doctest::Approx(9.81 * (0.82 + 0.34 + 0.09) * 0.0203).epsilon(1e-12));
+  MESSAGE("PUMA 560 gravity torques at q = 0: " << g.transpose() << " N·m");
+  CHECK(std::abs(g[0]) < 1e-12);
 }
