@@ -1,5 +1,5 @@
-// What the unicycle lab shows: a camera that follows the wheel, in perspective from behind and
-// above, over the floor with a grid: the reference path, the leader's point, the wheel (a disk with
+// What the unicycle lab shows: a camera that follows the wheel, in perspective from behind, right
+// and above its heading, over the floor with a grid: the reference path, the leader's point, the wheel (a disk with
 // spokes, so its spin shows) and its track so far, the lateral ground force as an arrow (red once it
 // asks for more than μ f_n), Bullet's friction-contact wheel as a translucent ghost with its own track
 // (it slides where the no-slip wheel would need more friction than there is); a map of the whole
@@ -52,16 +52,27 @@ void UnicycleLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Sc
   box.extend(box.min() - Eigen::Vector3d(r + 0.15, r + 0.15, 0));
   box.extend(box.max() + Eigen::Vector3d(r + 0.15, r + 0.15, 2 * r));
 
-  // The follow camera: a square of floor centred on the wheel, as wide as the leader is ever far
-  // from it (plus room for the wheel), 3.5 to 10 wheel radii either side: the same size all run, so
-  // the camera only slides, the wheel stays large, and the leader stays in the picture.
+  // The follow camera: a disk of floor round the wheel, its radius `half` as far as the leader is
+  // ever from it (plus room for the wheel), 3.5 to 10 wheel radii: the same all run, so the wheel
+  // keeps its size on screen and the leader stays in the picture.
   double lead = 0;
   for (std::size_t k = 0; k < tr.rows(); k += stride)
     lead = std::max(lead, std::hypot(tr.at(k, "x_d") - tr.at(k, "x"), tr.at(k, "y_d") - tr.at(k, "y")));
   const double half = std::clamp(lead + 2 * r, 3.5 * r, 10 * r);
   const double x = tr.at(row, "x"), y = tr.at(row, "y"), phi = tr.at(row, "phi");
-  const Eigen::AlignedBox3d view(on(x - half, y - half), on(x + half, y + half, 2 * r));
-  s.framePerspective(view, Eigen::Vector3d(0, -0.8, 1.0));
+  // Seen from behind and to the right of the leader's heading φ_d (smooth, unlike the wheel's own
+  // when it wobbles): the wheel's face, the lateral force along its axle and the leader ahead of it
+  // all show whichever way the course turns; the map keeps the course's fixed orientation.
+  const double psi = tr.at(row, "phi_d");
+  const Eigen::Vector3d heading(std::cos(psi), std::sin(psi), 0), left(-std::sin(psi), std::cos(psi), 0);
+  const Eigen::Vector3d from = -0.75 * heading - 0.65 * left + Eigen::Vector3d(0, 0, 0.7);
+  // The framed box is axis-aligned: seen along a diagonal it looks √2 wider than square on, so
+  // it shrinks as the view turns off the axes and the wheel keeps its size (a disk of radius half
+  // round the wheel always shows).
+  const double diagonal = std::abs(from.x()) + std::abs(from.y()), square = std::hypot(from.x(), from.y());
+  const double side = half * std::sqrt(2.0) * square / diagonal;
+  const Eigen::AlignedBox3d view(on(x - side, y - side), on(x + side, y + side, 2 * r));
+  s.framePerspective(view, from);
   s.framing.clip = true;  // the floor runs on beyond the view: cut it at the free part's edge
 
   // Ground, path, leader.
@@ -71,7 +82,7 @@ void UnicycleLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Sc
   // The camera sees beyond its square near the course's edge: floor that far round it, too (the
   // same centre, so the grid lines stay where they are on the map).
   Plane floor = ground;
-  floor.half_size += Eigen::Vector2d::Constant(4 * half + 0.5);
+  floor.half_size += Eigen::Vector2d::Constant(6 * half + 0.5);
   s.planes.push_back(floor);
   Polyline ref{{}, 3.0, kRef};
   for (const auto& p : path_.polyline()) ref.points.push_back(on(p.x(), p.y()));
@@ -115,7 +126,7 @@ void UnicycleLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Sc
   m.polylines.back().width_px = 2.0;
   if (ghost && row < ghost->rows()) m.polylines.push_back(track(*ghost, row, "x_fric", "y_fric", ghost_track, 1.5));
   m.polylines.push_back(track(tr, row, "x", "y", kTrack, 1.5));
-  Polyline window{{on(x - half, y - half), on(x + half, y - half), on(x + half, y + half), on(x - half, y + half), on(x - half, y - half)}, 1.5, kWheel};
+  Polyline window{{on(x - side, y - side), on(x + side, y - side), on(x + side, y + side), on(x - side, y + side), on(x - side, y - side)}, 1.5, kWheel};
   m.polylines.push_back(window);
   const double dot = std::max(r, 0.025 * std::max(size.x(), size.y()));
   m.spheres.push_back({on(x_d, y_d, 0.3), 0.8 * dot, {kLeader.r, kLeader.g, kLeader.b, 1.0f}});
