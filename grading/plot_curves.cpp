@@ -134,8 +134,9 @@ std::vector<PlotSeries> runSeries(const std::vector<PlotCurve>& curves, const st
   std::vector<PlotSeries> out;
   const bool several = runs.size() > 1;
   // Several runs: run r is colour r in every curve; what every run shares, or some runs share, is
-  // drawn once in the colour after them (no legend entry for a line hidden under another).
-  const int shared = int(runs.size());
+  // drawn once (no legend entry for a line hidden under another), each such line in the next
+  // colour after the runs' (two of them may lie close: a model's x_des on the target x_target).
+  int shared = int(runs.size());
   int slot = 0;  // several runs: the line kinds so far (each its own pattern)
   for (std::size_t k = 0; k < curves.size(); ++k) {
     const std::string name = curvesText({curves[k]});
@@ -173,7 +174,7 @@ std::vector<PlotSeries> runSeries(const std::vector<PlotCurve>& curves, const st
     }
     // Several runs that all agree (a set point): one curve for all of them.
     if (all_same(0, true)) {
-      out.push_back({name + " (every run)", sources[0].points.x, sources[0].points.y, pattern(slot++), shared});
+      out.push_back({name + " (every run)", sources[0].points.x, sources[0].points.y, pattern(slot++), shared++});
       continue;
     }
     // Each run's lines: its engines once when they agree, else each; the hand (or agreed) line in
@@ -208,7 +209,7 @@ std::vector<PlotSeries> runSeries(const std::vector<PlotCurve>& curves, const st
       std::string label;
       for (std::size_t r : l.runs) label += runs[r].name + ", ";
       out.push_back({name + " (" + label + l.engines + ")", l.points->x, l.points->y, pattern(l.bullet ? bullet : own),
-                     l.runs.size() == 1 ? int(l.runs.front()) : shared});
+                     l.runs.size() == 1 ? int(l.runs.front()) : shared++});
     }
   }
   return out;

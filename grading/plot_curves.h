@@ -63,7 +63,7 @@ struct PlotRun {
 // Bullet line, where it differs from hand, the pattern after the curve's): "y (NAME, hand)",
 // "y (NAME, Bullet)" (or "y (NAME, hand, Bullet)"). What every run and engine gives alike (a set
 // point) is one line "y (every run)", and a line several runs give alike is one line naming them
-// ("x_target (a.json, b.json, hand)"), both in the colour after the runs': no legend entry for a
+// ("x_target (a.json, b.json, hand)"), each in a colour after the runs': no legend entry for a
 // line hidden under another.
 std::vector<PlotSeries> runSeries(const std::vector<PlotCurve>& curves, const std::vector<PlotRun>& runs);
 

@@ -186,6 +186,16 @@ TEST_CASE("runSeries, several runs with their own targets: each target in its ru
   // The target a and b share: once, in a colour no run has (a line under another has no entry).
   CHECK(s[3].style == PlotSeries::Style::Dashed);
   for (int i : {0, 1, 2}) CHECK(s[3].color != s[std::size_t(i)].color);
+  // Two shared lines (the model's x_des beside x_target, every run's): each its own colour.
+  const auto t = runSeries({{"y", "t", ""}, {"x", "t", ""}, {"m", "t", ""}}, {{"a", &a, nullptr}, {"b", &b, nullptr}});
+  REQUIRE(t.size() == 4);
+  CHECK(t[2].label == "x (every run)");
+  CHECK(t[3].label == "m (every run)");
+  CHECK(t[2].color != t[3].color);
+  for (std::size_t i : {0, 1}) {
+    CHECK(t[2].color != t[i].color);
+    CHECK(t[3].color != t[i].color);
+  }
   // No two entries of the plot draw the same line.
   for (std::size_t i = 0; i < s.size(); ++i)
     for (std::size_t j = i + 1; j < s.size(); ++j) CHECK_FALSE((s[i].style == s[j].style && s[i].y == s[j].y && s[i].x == s[j].x));
