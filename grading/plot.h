@@ -12,7 +12,8 @@ namespace dyn {
 struct PlotSeries {
   std::string label;                 // legend text
   std::vector<double> x, y;
-  enum class Style { Solid, Dashed } style = Style::Solid;
+  // Dotted and DashDot: more curves of one run told apart in its colour (runSeries, several runs).
+  enum class Style { Solid, Dashed, Dotted, DashDot } style = Style::Solid;
   int color = 0;                     // index into a fixed, colour-blind-safe palette
 };
 

@@ -119,10 +119,25 @@ bool samePoints(const CurvePoints& a, const CurvePoints& b) {
 
 }  // namespace
 
+namespace {
+
+// Several runs: the pattern of the i-th line kind of a plot (a curve, or its Bullet twin).
+PlotSeries::Style pattern(int i) {
+  constexpr PlotSeries::Style kinds[] = {PlotSeries::Style::Solid, PlotSeries::Style::Dashed, PlotSeries::Style::Dotted,
+                                         PlotSeries::Style::DashDot};
+  return kinds[i % 4];
+}
+
+}  // namespace
+
 std::vector<PlotSeries> runSeries(const std::vector<PlotCurve>& curves, const std::vector<PlotRun>& runs) {
   std::vector<PlotSeries> out;
   const bool several = runs.size() > 1;
-  int colour = 0;
+  // Several runs: run r is colour r in every curve; what every run shares, or some runs share, is
+  // drawn once (no legend entry for a line hidden under another), each such line in the next
+  // colour after the runs' (two of them may lie close: a model's x_des on the target x_target).
+  int shared = int(runs.size());
+  int slot = 0;  // several runs: the line kinds so far (each its own pattern)
   for (std::size_t k = 0; k < curves.size(); ++k) {
     const std::string name = curvesText({curves[k]});
     // Every engine's points of this curve, in run order, hand before Bullet.
@@ -146,24 +161,55 @@ std::vector<PlotSeries> runSeries(const std::vector<PlotCurve>& curves, const st
         }
       return n > 1;
     };
-    const auto style = [](bool bullet) { return bullet ? PlotSeries::Style::Dashed : PlotSeries::Style::Solid; };
-    // Several runs that all agree (a set point): one curve for all of them, dashed (drawn on top).
-    if (several && all_same(0, true)) {
-      out.push_back({name + " (every run)", sources[0].points.x, sources[0].points.y, PlotSeries::Style::Dashed, colour++});
-      continue;
-    }
-    // Each run: its engines once when they agree, else each (one colour per run and curve).
-    for (std::size_t r = 0; r < runs.size(); ++r) {
-      const std::string prefix = several ? runs[r].name + ", " : "";
-      const int c = several ? colour++ : int(k);
-      if (all_same(r, false)) {
-        const Source& s = *std::find_if(sources.begin(), sources.end(), [&](const Source& s) { return s.run == r; });
-        out.push_back({name + " (" + prefix + "hand, Bullet)", s.points.x, s.points.y, PlotSeries::Style::Solid, c});
+    if (!several) {
+      // One run: each curve a colour, its engines once when they agree, else hand solid, Bullet dashed.
+      if (all_same(0, false)) {
+        out.push_back({name + " (hand, Bullet)", sources[0].points.x, sources[0].points.y, PlotSeries::Style::Solid, int(k)});
         continue;
       }
       for (const auto& s : sources)
-        if (s.run == r)
-          out.push_back({name + " (" + prefix + (s.bullet ? "Bullet" : "hand") + ")", s.points.x, s.points.y, style(s.bullet), c});
+        out.push_back({name + " (" + (s.bullet ? "Bullet" : "hand") + ")", s.points.x, s.points.y,
+                       s.bullet ? PlotSeries::Style::Dashed : PlotSeries::Style::Solid, int(k)});
+      continue;
+    }
+    // Several runs that all agree (a set point): one curve for all of them.
+    if (all_same(0, true)) {
+      out.push_back({name + " (every run)", sources[0].points.x, sources[0].points.y, pattern(slot++), shared++});
+      continue;
+    }
+    // Each run's lines: its engines once when they agree, else each; the hand (or agreed) line in
+    // this curve's pattern, a differing Bullet line in the next one.
+    struct Line {
+      std::vector<std::size_t> runs;
+      std::string engines;
+      const CurvePoints* points;
+      bool bullet;
+    };
+    std::vector<Line> lines;
+    for (std::size_t r = 0; r < runs.size(); ++r) {
+      if (all_same(r, false)) {
+        const Source& s = *std::find_if(sources.begin(), sources.end(), [&](const Source& s) { return s.run == r; });
+        lines.push_back({{r}, "hand, Bullet", &s.points, false});
+        continue;
+      }
+      for (const auto& s : sources)
+        if (s.run == r) lines.push_back({{r}, s.bullet ? "Bullet" : "hand", &s.points, s.bullet});
+    }
+    const bool twin = std::any_of(lines.begin(), lines.end(), [](const Line& l) { return l.bullet; });
+    const int own = slot++, bullet = twin ? slot++ : own;
+    // Lines of several runs with the same points (a target two runs share): one line naming them.
+    std::vector<Line> merged;
+    for (const Line& l : lines) {
+      auto same = std::find_if(merged.begin(), merged.end(),
+                               [&](const Line& m) { return m.bullet == l.bullet && samePoints(*m.points, *l.points); });
+      if (same == merged.end()) merged.push_back(l);
+      else same->runs.push_back(l.runs.front());
+    }
+    for (const Line& l : merged) {
+      std::string label;
+      for (std::size_t r : l.runs) label += runs[r].name + ", ";
+      out.push_back({name + " (" + label + l.engines + ")", l.points->x, l.points->y, pattern(l.bullet ? bullet : own),
+                     l.runs.size() == 1 ? int(l.runs.front()) : shared++});
     }
   }
   return out;

@@ -57,9 +57,14 @@ struct PlotRun {
 
 // Every run's series of the curves, hand solid and Bullet dashed. One run: each curve a colour,
 // "y (hand)", "y (Bullet)", or once as "y (hand, Bullet)" when both engines give the same points (a
-// reference, a setpoint). Several runs (gains files overlaid): each curve of each run a colour,
-// "y (NAME, hand)", "y (NAME, Bullet)" (or "y (NAME, hand, Bullet)"), and once, dashed, as
-// "y (every run)" when every run and engine gives the same points (a set point).
+// reference, a setpoint). Several runs (gains files overlaid): run r is colour r in every curve, so a
+// run's target (x_target beside x) is its response's colour; the curves are told apart by pattern,
+// the same in every run (the first curve solid, the next dashed, then dotted, dash-dot; a curve's
+// Bullet line, where it differs from hand, the pattern after the curve's): "y (NAME, hand)",
+// "y (NAME, Bullet)" (or "y (NAME, hand, Bullet)"). What every run and engine gives alike (a set
+// point) is one line "y (every run)", and a line several runs give alike is one line naming them
+// ("x_target (a.json, b.json, hand)"), each in a colour after the runs': no legend entry for a
+// line hidden under another.
 std::vector<PlotSeries> runSeries(const std::vector<PlotCurve>& curves, const std::vector<PlotRun>& runs);
 
 // An axis label of columns with the lab's units: "x, x_d (m)" when they share one, else each its

@@ -143,7 +143,15 @@ size_t glyphs(const std::string& s) {
 PLINT seriesColour(int color, bool faint) {
   return (faint ? kFaint0 : kPalette0) + ((color % kPaletteSize) + kPaletteSize) % kPaletteSize;
 }
-PLINT seriesStyle(PlotSeries::Style s) { return s == PlotSeries::Style::Dashed ? 3 : 1; }
+// PLplot's patterns: 1 solid, 3 long dashes, 2 short dashes, 5 long and short dashes.
+PLINT seriesStyle(PlotSeries::Style s) {
+  switch (s) {
+    case PlotSeries::Style::Dashed: return 3;
+    case PlotSeries::Style::Dotted: return 2;
+    case PlotSeries::Style::DashDot: return 5;
+    default: return 1;
+  }
+}
 
 // How often a series crosses its own range: Σ|Δy| / (max − min). A smooth response over a few
 // periods scores under 10; sensor noise sampled every step, hundreds.
@@ -492,7 +500,7 @@ PlotLayout draw(const Prepared& p, int width_px, int height_px) {
   for (size_t i = 0; i < spec.series.size(); ++i)
     if (p.faint[i]) drawSeries(spec.series[i], true, budget, scale);
   for (const auto& b : spec.bands) drawBand(b, budget);
-  for (auto style : {PlotSeries::Style::Solid, PlotSeries::Style::Dashed})
+  for (auto style : {PlotSeries::Style::Solid, PlotSeries::Style::Dashed, PlotSeries::Style::Dotted, PlotSeries::Style::DashDot})
     for (size_t i = 0; i < spec.series.size(); ++i)
       if (!p.faint[i] && spec.series[i].style == style) drawSeries(spec.series[i], false, budget, scale);
   plcol0(kMarker);

@@ -137,11 +137,17 @@ struct Camera {
 // part of the frame the overlay panel leaves free (the whole frame without a panel), with `margin`
 // spare (1.08: 4 % on each side). A lab sets bounds to the space its mechanism moves through over
 // the run, so the camera holds still from frame to frame.
+// clip: the scene is cut at the edge of the part of the frame it is fitted into, so a camera that
+// follows something across a large floor (Inset below shows the whole of it) never draws under the
+// panel; without it, what lies outside bounds may spill over the rest of the frame.
 struct Framing {
   bool fit = false;
   Eigen::AlignedBox3d bounds;  // default-constructed: empty
   double margin = 1.08;
+  bool clip = false;
 };
+
+struct Inset;
 
 // Everything a frame shows. Opaque things are drawn first, then polylines, then everything with
 // alpha < 1 (back to front, each translucent shape blended once over what is behind it).
@@ -158,6 +164,7 @@ struct Scene {
   std::vector<Cone> cones;
   std::vector<Spring> springs;
   Framing framing;  // fit: the renderer chooses the camera (see Framing)
+  std::vector<Inset> insets;  // second views drawn over a corner of this one (see Inset)
 
   // A spatial lab's view: perspective, z up, looking at box from its centre + `from`, and the
   // renderer fitting box in the frame (Framing).
@@ -170,6 +177,23 @@ struct Scene {
     framing.fit = true;
     framing.bounds = box;
   }
+};
+
+// A second view over a corner of the frame: a map of the whole course beside a camera that follows
+// the wheel, or a magnified close-up. Its scene (own primitives, camera, background; its framing
+// fits it into the inset, its own insets are ignored) is drawn in a rectangle `height` of the free
+// part of the frame high (the part the main scene was fitted into: never under the panel) and
+// `aspect` times as wide (at most half the free width), `gap` pixels in from that part's `corner`,
+// inside a border of `border_px` in border colour.
+struct Inset {
+  enum class Corner { TopRight, BottomRight, BottomLeft, TopLeft };
+  Scene scene;
+  Corner corner = Corner::BottomRight;
+  double height = 0.35;  // fraction of the free part's height
+  double aspect = 1.0;   // width / height
+  double gap = 6.0;      // pixels from the free part's edges
+  double border_px = 2.0;
+  Color border{0.35f, 0.35f, 0.38f, 1.0f};
 };
 
 // ---- Pure helpers for labs (no GL) ----------------------------------------------------------

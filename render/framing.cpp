@@ -165,3 +165,19 @@ Camera fitCamera(Camera camera, const AlignedBox3d& box, int width, int height, 
 }
 
 }  // namespace dyn
+
+namespace dyn {
+
+PixelRect insetRect(const PixelRect& free, const Inset& inset) {
+  const double gap = std::max(inset.gap, 0.0);
+  double h = std::round(std::clamp(inset.height, 0.05, 1.0) * free.h);
+  double w = std::round(std::min(h * std::max(inset.aspect, 0.05), 0.5 * free.w));
+  h = std::floor(std::min(h, free.h - 2 * gap)), w = std::floor(std::min(w, free.w - 2 * gap));
+  if (!(w > 0 && h > 0)) return {};
+  const bool right = inset.corner == Inset::Corner::TopRight || inset.corner == Inset::Corner::BottomRight;
+  const bool bottom = inset.corner == Inset::Corner::BottomRight || inset.corner == Inset::Corner::BottomLeft;
+  const double x = right ? free.right() - gap - w : free.x + gap, y = bottom ? free.bottom() - gap - h : free.y + gap;
+  return {std::round(x), std::round(y), w, h};
+}
+
+}  // namespace dyn

@@ -42,4 +42,8 @@ PixelRect freeRect(int width, int height, const PixelRect& panel, const Camera& 
 Camera fitCamera(Camera camera, const Eigen::AlignedBox3d& box, int width, int height, const PixelRect& free,
                  double margin);
 
+// Where an inset goes (labs/scene.h Inset): its rectangle in `free` (the part of the frame the main
+// scene was fitted into), whole pixels, border included.
+PixelRect insetRect(const PixelRect& free, const Inset& inset);
+
 }  // namespace dyn

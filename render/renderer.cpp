@@ -43,6 +43,8 @@ struct Renderer::Impl {
   std::vector<LineVertex> line_vertices;
   Camera camera;                              // the last frame's (fitted) camera
   PixelRect panel_rect, scene_rect;           // the last frame's panel and the part left free
+  std::vector<PixelRect> inset_rects;         // the last frame's insets (inside their borders)
+  std::vector<Camera> inset_cameras;
 
   Impl(GlContext& c, RenderOptions o)
       : context(c), options(o), width(o.width > 0 ? o.width : c.width()),
@@ -125,7 +127,7 @@ struct Renderer::Impl {
 
   // Polylines as screen-space quads of width_px, one draw per polyline.
   void drawPolylines(const std::vector<Polyline>& polylines, const Eigen::Matrix4f& view_proj,
-                     bool translucent) {
+                     bool translucent, int vw, int vh) {
     line_vertices.clear();
     std::vector<std::pair<GLint, GLsizei>> ranges;
     for (const auto& pl : polylines) {
@@ -146,7 +148,7 @@ struct Renderer::Impl {
     if (line_vertices.empty()) return;
     glUseProgram(line.id);
     glUniformMatrix4fv(line.view_proj, 1, GL_FALSE, view_proj.data());
-    glUniform2f(line.viewport, float(width), float(height));
+    glUniform2f(line.viewport, float(vw), float(vh));
     glBindVertexArray(line_vao);
     glBindBuffer(GL_ARRAY_BUFFER, line_vbo);
     glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(line_vertices.size() * sizeof(LineVertex)),
@@ -163,6 +165,81 @@ struct Renderer::Impl {
     }
     glDepthFunc(GL_LESS);
     glEnable(GL_CULL_FACE);
+  }
+
+  // Limits drawing (and clears) to the whole pixels inside a rectangle of the frame.
+  void scissor(const PixelRect& r) {
+    const int x0 = int(std::ceil(r.x)), y0 = int(std::ceil(r.y));
+    const int x1 = int(std::floor(r.right())), y1 = int(std::floor(r.bottom()));
+    glEnable(GL_SCISSOR_TEST);
+    glScissor(x0, height - y1, x1 - x0, y1 - y0);
+  }
+
+  // Clears the part of `outer` outside `inner` (whole pixels) to colour c: the exact edge of a
+  // clipped view (with 4x MSAA, llvmpipe lets a scissored edge bleed into the pixel beside it).
+  void clearAround(const PixelRect& inner, const PixelRect& outer, const Color& c) {
+    const double x0 = std::ceil(inner.x), y0 = std::ceil(inner.y), x1 = std::floor(inner.right()), y1 = std::floor(inner.bottom());
+    glClearColor(c.r, c.g, c.b, c.a);
+    for (const PixelRect& r : {PixelRect{outer.x, outer.y, x0 - outer.x, outer.h},
+                               PixelRect{x1, outer.y, outer.right() - x1, outer.h},
+                               PixelRect{x0, outer.y, x1 - x0, y0 - outer.y},
+                               PixelRect{x0, y1, x1 - x0, outer.bottom() - y1}})
+      if (!r.empty()) {
+        scissor(r);
+        glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      }
+    glDisable(GL_SCISSOR_TEST);
+  }
+
+  // The scene's primitives under camera, in a viewport of vw x vh pixels: opaque meshes, the
+  // planes' grids, polylines, then translucent meshes and lines.
+  void drawContent(const Scene& scene, const Camera& camera, int vw, int vh) {
+    const CameraBasis basis = camera.basis();
+    const Eigen::Matrix4f view_proj = viewProjection(camera, vw, vh).cast<float>();
+    // Key light from the upper left, in front of the scene; moves with the camera.
+    const Vector3d light = (-0.45 * basis.right + 0.65 * basis.up + 0.75 * basis.back).normalized();
+    glUseProgram(shaded.id);
+    glUniformMatrix4fv(shaded.view_proj, 1, GL_FALSE, view_proj.data());
+    glUniform3f(shaded.light_dir, float(light.x()), float(light.y()), float(light.z()));
+    glUniform3f(shaded.view_dir, float(basis.back.x()), float(basis.back.y()), float(basis.back.z()));
+    glUniform3f(shaded.eye, float(camera.eye.x()), float(camera.eye.y()), float(camera.eye.z()));
+    glUniform1i(shaded.ortho, camera.ortho ? 1 : 0);
+
+    // Opaque meshes in scene order.
+    gl::collectDrawList(scene, camera, meshes, vw, vh, draw_list);
+    for (const auto& item : draw_list.items)
+      if (item.color.a >= 1.0f) drawItem(item);
+    // Grid lines on the planes: depth-tested but not written, so paths on a plane cover them.
+    if (!draw_list.grid_lines.empty()) {
+      glDepthMask(GL_FALSE);
+      drawPolylines(draw_list.grid_lines, view_proj, false, vw, vh);
+      glDepthMask(GL_TRUE);
+    }
+    // Opaque polylines (depth-tested, so the arm hides what is behind it).
+    drawPolylines(scene.polylines, view_proj, false, vw, vh);
+
+    // Translucent meshes: a depth-only pass first, so overlapping parts of a ghost (capsule
+    // ends, joints) blend once as one surface; then colour far to near, blended, no depth writes.
+    std::vector<const gl::DrawItem*> translucent;
+    for (const auto& item : draw_list.items)
+      if (item.color.a < 1.0f) translucent.push_back(&item);
+    std::stable_sort(translucent.begin(), translucent.end(),
+                     [](const gl::DrawItem* a, const gl::DrawItem* b) { return a->depth > b->depth; });
+    glUseProgram(shaded.id);
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    for (const gl::DrawItem* item : translucent) drawItem(*item);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glEnable(GL_BLEND);
+    glDepthMask(GL_FALSE);
+    glDepthFunc(GL_LEQUAL);
+    for (const gl::DrawItem* item : translucent) drawItem(*item);
+    glDepthFunc(GL_LESS);
+    glFrontFace(GL_CCW);
+    // Translucent lines last.
+    drawPolylines(scene.polylines, view_proj, true, vw, vh);
+    glDepthMask(GL_TRUE);
+    glDisable(GL_BLEND);
+    glBindVertexArray(0);
   }
 
   void draw(const Scene& scene, const Overlay* panel) {
@@ -199,52 +276,39 @@ struct Renderer::Impl {
       camera = fitCamera(camera, box, width, height, scene_rect, scene.framing.margin);
     }
 
-    const CameraBasis basis = camera.basis();
-    const Eigen::Matrix4f view_proj = viewProjection(camera, width, height).cast<float>();
-    // Key light from the upper left, in front of the scene; moves with the camera.
-    const Vector3d light = (-0.45 * basis.right + 0.65 * basis.up + 0.75 * basis.back).normalized();
-    glUseProgram(shaded.id);
-    glUniformMatrix4fv(shaded.view_proj, 1, GL_FALSE, view_proj.data());
-    glUniform3f(shaded.light_dir, float(light.x()), float(light.y()), float(light.z()));
-    glUniform3f(shaded.view_dir, float(basis.back.x()), float(basis.back.y()), float(basis.back.z()));
-    glUniform3f(shaded.eye, float(camera.eye.x()), float(camera.eye.y()), float(camera.eye.z()));
-    glUniform1i(shaded.ortho, camera.ortho ? 1 : 0);
-
-    // Opaque meshes in scene order.
-    gl::collectDrawList(scene, camera, meshes, width, height, draw_list);
-    for (const auto& item : draw_list.items)
-      if (item.color.a >= 1.0f) drawItem(item);
-    // Grid lines on the planes: depth-tested but not written, so paths on a plane cover them.
-    if (!draw_list.grid_lines.empty()) {
-      glDepthMask(GL_FALSE);
-      drawPolylines(draw_list.grid_lines, view_proj, false);
-      glDepthMask(GL_TRUE);
+    // The whole scene is cleared to its background; a clipped one is drawn only in its free part.
+    const bool clip = scene.framing.fit && scene.framing.clip;
+    if (clip) scissor(scene_rect);
+    drawContent(scene, camera, width, height);
+    glDisable(GL_SCISSOR_TEST);
+    if (clip) clearAround(scene_rect, {0, 0, double(width), double(height)}, bg);
+    // Insets over corners of the free part: a border, the inset's background, its scene fitted in.
+    inset_rects.clear();
+    inset_cameras.clear();
+    for (const Inset& inset : scene.insets) {
+      const PixelRect outer = insetRect(scene_rect, inset);
+      const double b = std::round(std::clamp(inset.border_px, 0.0, 0.25 * std::min(outer.w, outer.h)));
+      const PixelRect inner{outer.x + b, outer.y + b, outer.w - 2 * b, outer.h - 2 * b};
+      if (inner.empty()) continue;
+      const Color& back = inset.scene.background;
+      scissor(inner);
+      glClearColor(back.r, back.g, back.b, back.a);
+      glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+      const int iw = int(inner.w), ih = int(inner.h);
+      glViewport(int(inner.x), height - int(inner.y) - ih, iw, ih);
+      Camera view = inset.scene.camera;
+      if (inset.scene.framing.fit) {
+        const Eigen::AlignedBox3d box =
+            inset.scene.framing.bounds.isEmpty() ? sceneBounds(inset.scene) : inset.scene.framing.bounds;
+        view = fitCamera(view, box, iw, ih, {0, 0, double(iw), double(ih)}, inset.scene.framing.margin);
+      }
+      drawContent(inset.scene, view, iw, ih);
+      glDisable(GL_SCISSOR_TEST);
+      glViewport(0, 0, width, height);
+      clearAround(inner, outer, inset.border);
+      inset_rects.push_back(inner);
+      inset_cameras.push_back(view);
     }
-    // Opaque polylines (depth-tested, so the arm hides what is behind it).
-    drawPolylines(scene.polylines, view_proj, false);
-
-    // Translucent meshes: a depth-only pass first, so overlapping parts of a ghost (capsule
-    // ends, joints) blend once as one surface; then colour far to near, blended, no depth writes.
-    std::vector<const gl::DrawItem*> translucent;
-    for (const auto& item : draw_list.items)
-      if (item.color.a < 1.0f) translucent.push_back(&item);
-    std::stable_sort(translucent.begin(), translucent.end(),
-                     [](const gl::DrawItem* a, const gl::DrawItem* b) { return a->depth > b->depth; });
-    glUseProgram(shaded.id);
-    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-    for (const gl::DrawItem* item : translucent) drawItem(*item);
-    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-    glEnable(GL_BLEND);
-    glDepthMask(GL_FALSE);
-    glDepthFunc(GL_LEQUAL);
-    for (const gl::DrawItem* item : translucent) drawItem(*item);
-    glDepthFunc(GL_LESS);
-    glFrontFace(GL_CCW);
-    // Translucent lines last.
-    drawPolylines(scene.polylines, view_proj, true);
-    glDepthMask(GL_TRUE);
-    glDisable(GL_BLEND);
-    glBindVertexArray(0);
 
     // Resolve the samples into the single-sample framebuffer that read() uses.
     if (samples > 0) {
@@ -305,6 +369,10 @@ const Camera& Renderer::camera() const { return impl_->camera; }
 PixelRect Renderer::panelRect() const { return impl_->panel_rect; }
 
 PixelRect Renderer::sceneRect() const { return impl_->scene_rect; }
+
+const std::vector<PixelRect>& Renderer::insetRects() const { return impl_->inset_rects; }
+
+const std::vector<Camera>& Renderer::insetCameras() const { return impl_->inset_cameras; }
 
 int Renderer::width() const { return impl_->width; }
 

@@ -3,6 +3,7 @@
 // (Scene::framing) gets its camera placed in the part of the frame the panel leaves free.
 #pragma once
 #include <memory>
+#include <vector>
 
 #include "labs/scene.h"
 #include "render/framing.h"
@@ -46,6 +47,10 @@ class Renderer {
   // fitted into (the whole frame when the scene is not fitted).
   PixelRect panelRect() const;
   PixelRect sceneRect() const;
+  // The last frame's insets (Scene::insets, in order): the rectangle each scene was drawn in (inside
+  // its border) and its camera: project() with the rectangle's w x h, offset by its x, y.
+  const std::vector<PixelRect>& insetRects() const;
+  const std::vector<Camera>& insetCameras() const;
 
   // Waits until the GPU (llvmpipe) has finished the last draw; for timing without read().
   void finish();

@@ -160,6 +160,66 @@ TEST_CASE("runSeries, several runs: each curve of each run named by its run; one
   CHECK(pieces(k[1].y) == std::vector<std::pair<std::size_t, std::size_t>>{{1, 3}});
 }
 
+TEST_CASE("runSeries, several runs with their own targets: each target in its run's colour; a shared one drawn once") {
+  // y is the response, x its target; runs a and b share their target, c has its own.
+  const Trace a = trace({{0, 0, 1, 1}, {1, 1, 2, 1}, {2, 1, 3, 1}});
+  Trace b = a, c = a;
+  b.data[6] = 2.5;             // b's response differs
+  c.data[10] = 0.5;            // c's response and target differ
+  c.data[5] = 0.8, c.data[9] = 0.9;
+  const std::vector<PlotCurve> curves{{"y", "t", ""}, {"x", "t", ""}};
+  const auto s = runSeries(curves, {{"a", &a, nullptr}, {"b", &b, nullptr}, {"c", &c, nullptr}});
+  REQUIRE(s.size() == 5);
+  CHECK(s[0].label == "y (a, hand)");
+  CHECK(s[1].label == "y (b, hand)");
+  CHECK(s[2].label == "y (c, hand)");
+  CHECK(s[3].label == "x (a, b, hand)");
+  CHECK(s[4].label == "x (c, hand)");
+  // Every run its own colour; c's target in c's colour, dashed, its response solid.
+  CHECK(s[0].color != s[1].color);
+  CHECK(s[1].color != s[2].color);
+  CHECK(s[0].color != s[2].color);
+  CHECK(s[4].color == s[2].color);
+  CHECK(s[4].y == c.series("x"));
+  for (int i : {0, 1, 2}) CHECK(s[std::size_t(i)].style == PlotSeries::Style::Solid);
+  CHECK(s[4].style == PlotSeries::Style::Dashed);
+  // The target a and b share: once, in a colour no run has (a line under another has no entry).
+  CHECK(s[3].style == PlotSeries::Style::Dashed);
+  for (int i : {0, 1, 2}) CHECK(s[3].color != s[std::size_t(i)].color);
+  // Two shared lines (the model's x_des beside x_target, every run's): each its own colour.
+  const auto t = runSeries({{"y", "t", ""}, {"x", "t", ""}, {"m", "t", ""}}, {{"a", &a, nullptr}, {"b", &b, nullptr}});
+  REQUIRE(t.size() == 4);
+  CHECK(t[2].label == "x (every run)");
+  CHECK(t[3].label == "m (every run)");
+  CHECK(t[2].color != t[3].color);
+  for (std::size_t i : {0, 1}) {
+    CHECK(t[2].color != t[i].color);
+    CHECK(t[3].color != t[i].color);
+  }
+  // No two entries of the plot draw the same line.
+  for (std::size_t i = 0; i < s.size(); ++i)
+    for (std::size_t j = i + 1; j < s.size(); ++j) CHECK_FALSE((s[i].style == s[j].style && s[i].y == s[j].y && s[i].x == s[j].x));
+
+  // Every run its own target, both engines, responses differing between engines: the target in its
+  // run's colour, in a pattern of its own (not the Bullet line's).
+  Trace a_bullet = a, b_bullet = b, c_bullet = c;
+  a_bullet.data[10] = 7, b_bullet.data[10] = 7, c_bullet.data[10] = 8;
+  b.data[5] = 0.7, b_bullet.data[5] = 0.7;
+  const auto e = runSeries(curves, {{"a", &a, &a_bullet}, {"b", &b, &b_bullet}, {"c", &c, &c_bullet}});
+  REQUIRE(e.size() == 9);
+  for (std::size_t r = 0; r < 3; ++r) {
+    const PlotSeries &hand = e[2 * r], &bullet = e[2 * r + 1], &target = e[6 + r];
+    INFO(hand.label, " / ", bullet.label, " / ", target.label);
+    CHECK(target.label == "x (" + std::string(1, char('a' + r)) + ", hand, Bullet)");
+    CHECK(hand.color == int(r));
+    CHECK(bullet.color == int(r));
+    CHECK(target.color == int(r));
+    CHECK(hand.style == PlotSeries::Style::Solid);
+    CHECK(bullet.style == PlotSeries::Style::Dashed);
+    CHECK(target.style == PlotSeries::Style::Dotted);
+  }
+}
+
 TEST_CASE("the pen lab's ink: y_p against x_p where contact, broken exactly where the unstable gains lift off") {
   const std::string dir = std::string(DYNLAB_SOURCE_DIR) + "/labs/pen_on_table/";
   const LoadedLab loaded = loadLab("pen_on_table", "", dir + "examples/unstable.json", 2.6);

@@ -42,11 +42,32 @@ TEST_CASE("every lab's frames: the mechanism large in the frame and clear of the
         Renderer renderer(*context, o);
         renderer.render(scene, &overlay);
         const PixelRect p = renderer.panelRect(), free = renderer.sceneRect();
-        // The mechanism alone, through the camera the frame was drawn with.
+        const std::vector<PixelRect> insets = renderer.insetRects();
+        // The mechanism alone, through the camera the frame was drawn with (insets apart, checked
+        // below); a clipped scene (a camera following across a floor) only where the frame keeps it:
+        // the free part (tests/render/inset_test.cpp checks the cut).
         Scene alone = scene;
         alone.framing.fit = false;
         alone.camera = renderer.camera();
-        const PixelRect ink = inkBox(renderer.render(alone, nullptr), scene.background);
+        alone.insets.clear();
+        Image drawn = renderer.render(alone, nullptr);
+        const Color& bg = scene.background;
+        const std::uint8_t paper[3] = {std::uint8_t(std::lround(bg.r * 255)), std::uint8_t(std::lround(bg.g * 255)),
+                                       std::uint8_t(std::lround(bg.b * 255))};
+        if (scene.framing.clip)
+          for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+              if (!(x >= std::ceil(free.x) && x < std::floor(free.right()) && y >= std::ceil(free.y) && y < std::floor(free.bottom())))
+                std::copy_n(paper, 3, &drawn.rgba[(std::size_t(y) * w + x) * 4]);
+        const PixelRect ink = inkBox(drawn, scene.background);
+        // Insets: in the free part, clear of the panel.
+        for (const PixelRect& r : insets) {
+          CHECK_FALSE(r.intersects(p));
+          CHECK(r.x >= free.x);
+          CHECK(r.right() <= free.right());
+          CHECK(r.y >= free.y);
+          CHECK(r.bottom() <= free.bottom());
+        }
         INFO("lab ", entry.name, " at ", w, "x", h, (*panel ? " with the panel" : " without the panel"), " (title ",
              overlay.title, "): panel ", p.x, ",", p.y, " ", p.w, "x", p.h, "; free ", free.x, ",", free.y, " ", free.w,
              "x", free.h, "; mechanism ", ink.x, ",", ink.y, " ", ink.w, "x", ink.h);
