@@ -18,6 +18,9 @@ struct RunArgs {
   std::string lab, config, gains, out, engine = "both", scenario;
   bool video = false, frames = false;
   std::optional<double> duration;
+  // A model file's run only (dynlab model's options): constant torques JOINT=VALUE, loops beside it.
+  std::vector<std::string> torques;
+  std::string loops;
 };
 
 struct GradeArgs {

@@ -99,6 +99,9 @@ int dispatch(int argc, char** argv) {
   r->add_option("--scenario", run.scenario, "Run under one rubric scenario (heavy_load, noisy_sensor, ...) exactly as the "
                                           "grader does: its patch and the noise seed the gains file is graded with "
                                           "(default out: out/LAB/scenarios/NAME)");
+  r->add_option("--torque", run.torques, "A model file only: a constant joint torque JOINT=VALUE (N·m; N on a slide), "
+                                         "repeatable (default: passive)")->allow_extra_args(false);
+  r->add_option("--loops", run.loops, "A model file only: loop closures beside it (JSON; default: STEM.loops.json beside a .urdf)");
 
   FigureArgs fig;
   auto* f = cli.add_subcommand("figure", "Lecture figures from a lab's run: plots of trace columns (PDF/SVG/PNG) and "
@@ -224,7 +227,15 @@ int dispatch(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   if (*list) return listLabs();
-  if (*r) return isModelFile(run.lab) ? runModelFile(run) : runLab(run);
+  if (*r) {
+    if (isModelFile(run.lab)) return runModelFile(run);
+    if (!run.torques.empty() || !run.loops.empty()) {
+      std::fprintf(stderr, "error: <command line>: %s: a lab's torques come from its controller; --torque and --loops are for a model file\n",
+                   run.torques.empty() ? "--loops" : "--torque");
+      return 2;
+    }
+    return runLab(run);
+  }
   if (*f) return figure(fig);
   if (*g) return !grade.batch.empty() ? gradeBatch(grade) : !grade.replay.empty() ? gradeReplay(grade) : gradeOne(grade);
   if (*z) return writeAutograderZip(zip_lab, zip_out);

@@ -259,6 +259,8 @@ int runModelFile(const RunArgs& r) {
   a.engine = r.engine;
   a.video = r.video;
   a.frames = r.frames;
+  a.torques = r.torques;
+  a.loops = r.loops;
   if (r.duration) {
     if (!(*r.duration > 0 && *r.duration <= 600)) {
       std::fprintf(stderr, "error: <command line>: --duration: expected a time in (0, 600] s for a model file, got %g\n", *r.duration);

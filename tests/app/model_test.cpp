@@ -241,4 +241,9 @@ TEST_CASE("dynlab model --torque: constant joint torques, their work in the ener
   checkBadInput(dir, "model " + model("fourbar.xml") + " --torque elbow=1 --out o", {"--torque elbow=1", "crank coupler rocker"}, dir / "o");
   checkBadInput(dir, "model " + model("fourbar.xml") + " --torque crank=nan --out o", {"--torque crank=nan", "finite"}, dir / "o");
   checkBadInput(dir, "model " + model("fourbar.xml") + " --torque crank=1 --torque crank=2 --out o", {"--torque crank=2", "once per joint"}, dir / "o");
+  // `dynlab run FILE` takes the same torques and loops, and gives the same trace; a lab refuses them.
+  REQUIRE(dynlab(dir, "run " + model("fourbar.xml") + " --torque crank=0.3 --duration 1 --engine hand --out via_run").code == 0);
+  CHECK(readFile(dir / "via_run" / "trace.csv") == readFile(dir / "out" / "trace.csv"));
+  checkBadInput(dir, "run slider_crank --torque q1=1 --out o", {"--torque", "model file"}, dir / "o");
+  checkBadInput(dir, "run slider_crank --loops x.json --out o", {"--loops", "model file"}, dir / "o");
 }
