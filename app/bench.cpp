@@ -32,6 +32,15 @@ double median(std::vector<double> v) {
   return v.empty() ? 0 : v[v.size() / 2];
 }
 
+Ratio ratio(const std::vector<double>& slow, const std::vector<double>& fast) {
+  std::vector<double> r;
+  for (std::size_t k = 0; k < slow.size() && k < fast.size(); ++k)
+    if (fast[k] > 0) r.push_back(slow[k] / fast[k]);
+  if (r.empty()) return {};
+  std::sort(r.begin(), r.end());
+  return {r[r.size() / 2], r[r.size() / 4], r[(3 * r.size()) / 4]};
+}
+
 double clockOverhead() {
   using Micros = std::chrono::duration<double, std::micro>;
   std::vector<double> pairs(2001);
@@ -110,20 +119,6 @@ std::vector<StepTimes> stepMicros(const std::vector<TimedRun>& runs, int steps) 
     out[i].has_engine = !alone[i].empty();
   }
   return out;
-}
-
-// How many times slower `slow` is than `fast`, block by block (timed side by side): the median, and
-// the middle half of the blocks' ratios (how much the measurement itself moves).
-struct Ratio {
-  double median = 0, low = 0, high = 0;  // median, 25th and 75th percentiles
-};
-Ratio ratio(const std::vector<double>& slow, const std::vector<double>& fast) {
-  std::vector<double> r;
-  for (std::size_t k = 0; k < slow.size() && k < fast.size(); ++k)
-    if (fast[k] > 0) r.push_back(slow[k] / fast[k]);
-  if (r.empty()) return {};
-  std::sort(r.begin(), r.end());
-  return {r[r.size() / 2], r[r.size() / 4], r[(3 * r.size()) / 4]};
 }
 
 // Frames per second of draw+read (+ PNG, + video) over `frames` frames of the hand run.

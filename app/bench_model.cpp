@@ -120,18 +120,6 @@ void timeBlocks(std::vector<Engine>& engines, int steps) {
     }
 }
 
-struct Ratio {
-  double median = 0, low = 0, high = 0;
-};
-Ratio ratio(const std::vector<double>& slow, const std::vector<double>& fast) {
-  std::vector<double> r;
-  for (std::size_t k = 0; k < slow.size() && k < fast.size(); ++k)
-    if (fast[k] > 0) r.push_back(slow[k] / fast[k]);
-  if (r.empty()) return {};
-  std::sort(r.begin(), r.end());
-  return {r[r.size() / 2], r[r.size() / 4], r[(3 * r.size()) / 4]};
-}
-
 // Accuracy over `steps` steps from the file's pose: the largest |φ|∞ (the description's, at each
 // engine's state) and the largest |q − q_ref|∞ against the reference run's states.
 struct Accuracy {

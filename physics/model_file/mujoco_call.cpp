@@ -74,13 +74,26 @@ struct MujocoReference::Impl {
   }
 };
 
+namespace {
+
+// mj_loadXML with its message as a ModelFileError (nothing allocated on failure).
+mjModel* loadModel(const std::string& path) {
+  char error[1024] = "";
+  mjModel* m = nullptr;
+  MUJOCO_CALL(path, m = mj_loadXML(path.c_str(), nullptr, error, sizeof error));
+  if (!m) throw ModelFileError(path + ": MuJoCo's parser: " + detail::oneLine(error));
+  return m;
+}
+
+}  // namespace
+
 MujocoReference::MujocoReference(const std::string& path) : impl_(new Impl) {
   impl_->file = path;
-  char error[1024] = "";
-  MUJOCO_CALL(path, impl_->m = mj_loadXML(path.c_str(), nullptr, error, sizeof error));
-  if (!impl_->m) {
+  try {
+    impl_->m = loadModel(path);
+  } catch (...) {
     delete impl_;
-    throw ModelFileError(path + ": MuJoCo's parser: " + detail::oneLine(error));
+    throw;
   }
   MUJOCO_CALL(path, impl_->d = mj_makeData(impl_->m));
 }
@@ -120,11 +133,11 @@ struct MujocoSimulation::Impl {
 
 MujocoSimulation::MujocoSimulation(const std::string& path, double dt) : impl_(new Impl) {
   impl_->file = path;
-  char error[1024] = "";
-  MUJOCO_CALL(path, impl_->m = mj_loadXML(path.c_str(), nullptr, error, sizeof error));
-  if (!impl_->m) {
+  try {
+    impl_->m = loadModel(path);
+  } catch (...) {
     delete impl_;
-    throw ModelFileError(path + ": MuJoCo's parser: " + detail::oneLine(error));
+    throw;
   }
   impl_->m->opt.timestep = dt;
   impl_->m->opt.integrator = mjINT_EULER;
