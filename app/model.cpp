@@ -13,7 +13,7 @@
 
 #include "app/commands.h"
 #include "app/model_loops.h"
-#include "app/model_scene.h"
+#include "labs/model_scene.h"
 #include "app/movie.h"
 #include "app/output.h"
 #include "labs/trace.h"
@@ -25,13 +25,6 @@
 
 namespace dyn::app {
 namespace {
-
-// A name from the file as a CSV column part: letters, digits, '_', '-', '.'; anything else '_'.
-std::string columnName(const std::string& name) {
-  std::string out;
-  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ? c : '_';
-  return out.empty() ? "_" : out;
-}
 
 std::string fmt(double x) {
   char b[32];

@@ -4,7 +4,7 @@
 // the hand engine (RK4 + projection) and/or Bullet and reports each one's closure residual and energy
 // balance and their agreement; writes
 // OUT/trace.csv (hand), OUT/trace_bullet.csv and OUT/summary.txt, and with --video / --frames the run
-// drawn from the file's geoms (app/model_scene.h): OUT/video.mp4, OUT/frames/NNNNN.png.
+// drawn from the file's geoms (labs/model_scene.h): OUT/video.mp4, OUT/frames/NNNNN.png.
 // `dynlab run FILE.xml|FILE.urdf` (a model file where a lab name goes) is the same command.
 // Registered on the command line by ModelCommand, so main.cpp only constructs it and asks it to run.
 #pragma once

@@ -1,6 +1,8 @@
 // The simulation block and declared gains every lab shares; see settings.h.
 #include "labs/settings.h"
 
+#include <algorithm>
+
 namespace dyn {
 
 SimulationSettings parseSimulation(const JsonView& sim, IndependentForm form) {
@@ -27,8 +29,20 @@ SimulationSettings parseSimulation(const JsonView& sim, IndependentForm form) {
 
 std::map<std::string, double> parseGains(const JsonView& g, std::initializer_list<const char*> names) {
   g.onlyKeys(names);
+  return parseGains(g, std::vector<std::string>(names.begin(), names.end()));
+}
+
+std::map<std::string, double> parseGains(const JsonView& g, const std::vector<std::string>& names) {
+  g.requireObject();
+  for (const auto& [key, value] : g.raw().items()) {
+    (void)value;
+    if (std::find(names.begin(), names.end(), key) != names.end()) continue;
+    std::string list;
+    for (const auto& n : names) list += (list.empty() ? "" : ", ") + n;
+    g[key].fail("unknown key \"" + key + "\" (expected one of: " + list + ")");
+  }
   std::map<std::string, double> out;
-  for (const char* key : names) {
+  for (const auto& key : names) {
     const JsonView d = g[key];
     d.onlyKeys({"value", "min", "max", "unit", "doc"});
     for (const char* text : {"unit", "doc"})

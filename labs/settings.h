@@ -6,6 +6,7 @@
 #include <initializer_list>
 #include <map>
 #include <string>
+#include <vector>
 
 #include "labs/config.h"
 #include "physics/integrate.h"
@@ -32,6 +33,8 @@ SimulationSettings parseSimulation(const JsonView& simulation, IndependentForm f
 // The "gains" block: exactly the names given, each {"value", "min", "max"} with min ≤ value ≤ max
 // and optional "unit" and "doc" strings; returns name → value.
 std::map<std::string, double> parseGains(const JsonView& gains, std::initializer_list<const char*> names);
+// The same for names known only at run time (a data-defined lab's); a key not among them is refused.
+std::map<std::string, double> parseGains(const JsonView& gains, const std::vector<std::string>& names);
 
 // The simulation block's scheme in words, e.g. "rk4 + projection".
 std::string schemeName(const StepOptions& step);

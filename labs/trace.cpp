@@ -1,6 +1,7 @@
 // Trace helpers: column lookup, CSV, fingerprint.
 #include "labs/trace.h"
 
+#include <cctype>
 #include <cstdio>
 #include <stdexcept>
 
@@ -41,6 +42,12 @@ std::string Trace::csv() const {
     s += '\n';
   }
   return s;
+}
+
+std::string columnName(const std::string& name) {
+  std::string out;
+  for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ? c : '_';
+  return out.empty() ? "_" : out;
 }
 
 std::uint64_t fnv1a(const void* bytes, std::size_t n) {

@@ -10,6 +10,10 @@ namespace dyn {
 // FNV-1a 64 of n bytes: trace fingerprints, and the grader's config and submission hashes.
 std::uint64_t fnv1a(const void* bytes, std::size_t n);
 
+// A name from elsewhere (a model file's joint) as a column name part: letters, digits, '_', '-', '.';
+// anything else '_' (so it needs no quoting in CSV, JSON keys or plot labels).
+std::string columnName(const std::string& name);
+
 struct Trace {
   std::vector<std::string> columns;
   std::vector<double> data;  // row-major

@@ -1,4 +1,4 @@
-// A model file drawn (app/model_scene.h) as every lab is: the four-bar's frame at its file pose and
+// A model file drawn (labs/model_scene.h) as every lab is: the four-bar's frame at its file pose and
 // mid-swing has ink (the mechanism, not the background) where its joint anchors and its loop's pin
 // project, none in the gap between the ground pivots, nothing of it under the overlay panel, and it
 // fills the part of the frame the panel leaves free (not a speck). The spatial arm is drawn in
@@ -8,7 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 
-#include "app/model_scene.h"
+#include "labs/model_scene.h"
 #include "physics/constrained_mechanism.h"
 #include "physics/integrate.h"
 #include "render/framing.h"
@@ -50,7 +50,7 @@ void checkInkAt(const Image& image, const Scene& scene, const Renderer& r, const
 
 TEST_CASE("the four-bar from its file: ink where its joints and pin project, framed beside the panel") {
   const model_file::LoadedModel m = model_file::load(model("fourbar.xml"));
-  const app::ModelPicture picture(m);
+  const ModelPicture picture(m);
   CHECK(picture.planar());
   // A state mid-swing: 0.3 s of the passive run from the file's pose.
   ConstrainedMechanism<Spatial> mech(m.mechanism);
@@ -99,7 +99,7 @@ TEST_CASE("a spatial arm is drawn in perspective, its joints inked, and a URDF w
   for (const char* file : {"arm3d.xml", "planar_arm.urdf"}) {
     INFO(file);
     const model_file::LoadedModel m = model_file::load(model(file));
-    const app::ModelPicture picture(m);
+    const ModelPicture picture(m);
     Scene scene;
     picture.scene(m.q0, nullptr, {}, scene);
     CHECK(scene.camera.ortho == picture.planar());

@@ -12,7 +12,7 @@
 #include "physics/chain.h"
 #include "physics/model_file/model_file.h"
 
-namespace dyn::app {
+namespace dyn {
 
 class ModelPicture {
  public:
@@ -54,4 +54,4 @@ Eigen::AlignedBox3d runBounds(const ModelPicture& picture, int n, const Trace& t
 // live plots of the energy balance and the residual over the last two seconds.
 void modelOverlay(const std::string& title, const std::string& engines, const Trace& trace, std::size_t row, double dt, const Trace* ghost, Overlay& out);
 
-}  // namespace dyn::app
+}  // namespace dyn

@@ -1,11 +1,11 @@
 // A loaded model as a picture: see model_scene.h.
-#include "app/model_scene.h"
+#include "labs/model_scene.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-namespace dyn::app {
+namespace dyn {
 namespace {
 
 using Vec3 = Eigen::Vector3d;
@@ -243,4 +243,4 @@ void modelOverlay(const std::string& title, const std::string& engines, const Tr
   o.plots = {e, phi};
 }
 
-}  // namespace dyn::app
+}  // namespace dyn

@@ -1,0 +1,167 @@
+// The controller library: see controller.h.
+#include "labs/controllers/controller.h"
+
+#include <Eigen/QR>
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+namespace dyn::controllers {
+namespace {
+
+struct KindInfo {
+  const char* name;
+  Kind kind;
+  std::vector<std::string> gains;
+};
+const std::vector<KindInfo>& kinds() {
+  static const std::vector<KindInfo> k = {
+      {"none", Kind::None, {}},
+      {"constant", Kind::Constant, {}},
+      {"joint_pd_gravity", Kind::JointPdGravity, {"kp", "kd"}},
+      {"pid", Kind::Pid, {"kp", "ki", "kd"}},
+      {"computed_torque", Kind::ComputedTorque, {"omega_n", "zeta"}},
+      {"task_pd_gravity", Kind::TaskPdGravity, {"kp", "kd"}},
+      {"task_inverse_dynamics", Kind::TaskInverseDynamics, {"omega_n", "zeta"}}};
+  return k;
+}
+
+// x = J⁻¹ b for a square task Jacobian, least squares otherwise.
+VecN solveTask(const MatN& J, const VecN& b) { return J.colPivHouseholderQr().solve(b); }
+
+}  // namespace
+
+const std::vector<std::string>& kindNames() {
+  static const std::vector<std::string> names = [] {
+    std::vector<std::string> n;
+    for (const auto& k : kinds()) n.push_back(k.name);
+    return n;
+  }();
+  return names;
+}
+
+Kind kindFromName(const std::string& name) {
+  for (const auto& k : kinds())
+    if (name == k.name) return k.kind;
+  throw std::invalid_argument("unknown controller kind " + name);
+}
+
+std::vector<std::string> gainsOf(Kind kind) {
+  for (const auto& k : kinds())
+    if (k.kind == kind) return k.gains;
+  return {};
+}
+
+Controller::Controller(const Spec& spec, const MechanismModel<Spatial>& model, std::vector<int> actuated, TaskPoint task,
+                       const VecN& q0, double dt)
+    : spec_(spec), mech_(std::make_unique<Mech>(model)), chain_(*mech_, std::move(actuated)), task_(std::move(task)),
+      hold_(std::max(1L, std::lround(spec.period / dt))), dt_(dt), rng_(spec.seed), q_ik_(q0) {
+  const int m = chain_.m();
+  integral_ = VecN::Zero(m);
+  tau_u_ = VecN::Zero(m);
+  tau_ = VecN::Zero(mech_->n());
+}
+
+void Controller::taskPosition(const VecN& q, VecN& x) {
+  const Eigen::Vector3d p = mech_->pointPosition(task_.link, task_.point, q);
+  x.resize(Eigen::Index(task_.axes.size()));
+  for (std::size_t i = 0; i < task_.axes.size(); ++i) x[Eigen::Index(i)] = p[task_.axes[i] - 3];
+}
+
+// Newton on (φ(θ), x(θ) − x_d) = 0 over every coordinate, minimum-norm steps, from the last solution.
+bool Controller::inverseKinematics(const VecN& x_d, VecN& q) {
+  const int n = mech_->n(), d = int(task_.axes.size());
+  for (int it = 0; it < 30; ++it) {
+    VecN phi, x, jd;
+    MatN G, Jp;
+    mech_->constraint(q, phi, G);
+    taskPosition(q, x);
+    mech_->pointJacobian(task_.link, task_.point, q, VecN::Zero(n), Jp, jd);
+    const int r = int(phi.size());
+    VecN f(r + d);
+    MatN A(r + d, n);
+    f.head(r) = phi, A.topRows(r) = G.leftCols(n);
+    f.tail(d) = x - x_d;
+    for (int i = 0; i < d; ++i) A.row(r + i) = Jp.row(task_.axes[std::size_t(i)]);
+    if (f.cwiseAbs().maxCoeff() < 1e-12) return true;
+    q.head(n) -= Eigen::CompleteOrthogonalDecomposition<MatN>(A).solve(f);
+    if (!q.allFinite()) return false;
+  }
+  return false;
+}
+
+VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref) {
+  const int m = chain_.m();
+  const auto& act = chain_.actuated();
+  const Kind kind = spec_.kind;
+  if (kind == Kind::None) return VecN::Zero(m);
+  if (kind == Kind::Constant) return spec_.constant;
+  Eigen::Vector3d p;
+  MatN Jx;
+  VecN bias;
+  // The desired joint motion (joint laws): inverse kinematics, then rates and accelerations through J_x.
+  VecN ud, udd_d = VecN::Zero(m), ud_d = VecN::Zero(m);
+  const bool joint = kind == Kind::JointPdGravity || kind == Kind::Pid || kind == Kind::ComputedTorque;
+  if (joint) {
+    if (!inverseKinematics(ref.x, q_ik_) || !chain_.update(q_ik_, VecN::Zero(mech_->n()))) return tau_u_;
+    chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
+    ud_d = solveTask(Jx, ref.xd);
+    if (!chain_.update(q_ik_, chain_.S() * ud_d)) return tau_u_;
+    chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
+    udd_d = solveTask(Jx, ref.xdd - bias);
+    ud = VecN(m);
+    for (int j = 0; j < m; ++j) ud[j] = q_ik_[act[std::size_t(j)]];
+  }
+  if (!chain_.update(q, v)) return tau_u_;  // a singular pose: hold the last command
+  VecN u(m), w(m);
+  for (int j = 0; j < m; ++j) u[j] = q[act[std::size_t(j)]], w[j] = v[act[std::size_t(j)]];
+  const double kp = spec_.kp, kd = spec_.kd;
+  const double wn = spec_.omega_n, kp2 = wn * wn, kd2 = 2.0 * spec_.zeta * wn;
+  switch (kind) {
+    case Kind::JointPdGravity: return kp * (ud - u) + kd * (ud_d - w) + chain_.Gu();
+    case Kind::Pid: {
+      const VecN e = ud - u;
+      // Conditional integration: not while the last command sat at a limit pushing the same way.
+      for (int j = 0; j < m; ++j) {
+        const bool wound = std::abs(tau_u_[j]) >= spec_.torque_limit[j] && e[j] * tau_u_[j] > 0;
+        if (!wound) integral_[j] += e[j] * double(hold_) * dt_;
+      }
+      return kp * e + spec_.ki * integral_ + kd * (ud_d - w);
+    }
+    case Kind::ComputedTorque: return chain_.Mu() * (udd_d + kd2 * (ud_d - w) + kp2 * (ud - u)) + chain_.hu();
+    default: break;
+  }
+  chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
+  const int d = int(task_.axes.size());
+  VecN x(d);
+  for (int i = 0; i < d; ++i) x[i] = p[task_.axes[std::size_t(i)] - 3];
+  const VecN xdot = Jx * w;
+  if (kind == Kind::TaskPdGravity) return Jx.transpose() * (kp * (ref.x - x) + kd * (ref.xd - xdot)) + chain_.Gu();
+  // Task inverse dynamics: the task acceleration asked for, mapped to u'' through J_x.
+  const VecN a = ref.xdd + kd2 * (ref.xd - xdot) + kp2 * (ref.x - x);
+  return chain_.Mu() * solveTask(Jx, a - bias) + chain_.hu();
+}
+
+VecN Controller::torque(double t, const VecN& q, const VecN& v, const Reference& ref) {
+  (void)t;
+  readings_.emplace_back(q, v);
+  while (long(readings_.size()) > spec_.delay_steps + 1) readings_.pop_front();
+  if (k_++ % hold_ != 0) return tau_;
+  // What the encoders report: the reading `delay` steps old, with noise.
+  VecN qm = readings_.front().first, vm = readings_.front().second;
+  if (spec_.noise_angle > 0 || spec_.noise_rate > 0)
+    for (int i = 0; i < mech_->n(); ++i) qm[i] += spec_.noise_angle * normal_(rng_), vm[i] += spec_.noise_rate * normal_(rng_);
+  VecN u = law(qm, vm, ref);
+  saturated_ = false;
+  for (int j = 0; j < u.size(); ++j) {
+    const double lim = spec_.torque_limit[j];
+    if (!std::isfinite(u[j])) u[j] = 0.0;
+    if (std::abs(u[j]) > lim) u[j] = std::copysign(lim, u[j]), saturated_ = true;
+  }
+  tau_u_ = u;
+  tau_.setZero();
+  for (int j = 0; j < u.size(); ++j) tau_[chain_.actuated()[std::size_t(j)]] = u[j];
+  return tau_;
+}
+
+}  // namespace dyn::controllers

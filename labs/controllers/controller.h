@@ -1,0 +1,91 @@
+// The controller library of data-defined labs (labs/generic): the lecture's laws on any closed chain
+// or open tree from a model file, in its actuated coordinates u (physics/closed_chain.h: S, M_u = SᵀMS,
+// h_u, G_u, J_x, Λ; an open chain has S = I). e = x_d − x is the task error, e_u = u_d − u the joint one:
+//   none                   τ_u = 0
+//   constant               τ_u = the "constant" torques
+//   joint_pd_gravity       τ_u = K_p e_u + K_d e_u' + G_u(u)                          (kp, kd)
+//   pid                    τ_u = K_p e_u + K_i ∫e_u + K_d e_u', the integral clamped while saturated (kp, ki, kd)
+//   computed_torque        τ_u = M_u (u_d'' + K_d e_u' + K_p e_u) + h_u               (omega_n, zeta)
+//   task_pd_gravity        τ_u = J_xᵀ (K_p e + K_d e') + G_u                          (kp, kd)
+//   task_inverse_dynamics  τ_u = M_u J_x⁻¹ (x_d'' + K_d e' + K_p e − J_x' u') + h_u   (omega_n, zeta)
+// with K_p = ω_n², K_d = 2ζω_n where named so. Joint laws track the task path through inverse kinematics
+// on the controller's model (u_d, u_d' = J_x⁻¹ x_d', u_d'' = J_x⁻¹ (x_d'' − J_x' u_d')). The controller
+// samples at its period (zero-order hold), reads encoders on every joint `delay` steps late with seeded
+// Gaussian noise, knows only its own model (a payload the plant carries may be missing from it), and
+// saturates at the torque limits.
+#pragma once
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "physics/closed_chain.h"
+#include "physics/constrained_mechanism.h"
+
+namespace dyn::controllers {
+
+enum class Kind { None, Constant, JointPdGravity, Pid, ComputedTorque, TaskPdGravity, TaskInverseDynamics };
+// The kinds by name, as a lab JSON writes them, and the gains each reads.
+const std::vector<std::string>& kindNames();
+Kind kindFromName(const std::string& name);
+std::vector<std::string> gainsOf(Kind kind);
+
+struct Spec {
+  Kind kind = Kind::None;
+  double period = 1e-3;        // s, a whole number of steps
+  long delay_steps = 0;        // encoders read this many steps late
+  double noise_angle = 0, noise_rate = 0;  // rad, rad/s (standard deviations)
+  std::uint64_t seed = 1;
+  VecN constant;               // per actuated joint
+  VecN torque_limit;           // per actuated joint (> 0)
+  double kp = 0, kd = 0, ki = 0, omega_n = 0, zeta = 0;
+};
+
+// Where the task is: a point of a tree body (its frame), and the rows of its spatial velocity that the
+// task uses (3, 4, 5: x, y, z).
+struct TaskPoint {
+  int link = -1;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();
+  std::vector<int> axes;
+};
+
+// The reference at one instant, in the task's axes.
+struct Reference {
+  VecN x, xd, xdd;
+};
+
+class Controller {
+ public:
+  using Mech = ConstrainedMechanism<Spatial>;
+  // model: the controller's own description; actuated: tree coordinates it drives; q0: an assembled
+  // pose to start the inverse kinematics from.
+  Controller(const Spec& spec, const MechanismModel<Spatial>& model, std::vector<int> actuated, TaskPoint task,
+             const VecN& q0, double dt);
+  // τ for the whole tree (zeros on passive joints) at step time t from the plant's state.
+  VecN torque(double t, const VecN& q, const VecN& v, const Reference& ref);
+  // The last command per actuated joint (after saturation), and whether a limit bound.
+  const VecN& command() const { return tau_u_; }
+  bool saturated() const { return saturated_; }
+  // The task point of the plant's state, by the controller's model (what the trace shows as x).
+  void taskPosition(const VecN& q, VecN& x);
+
+ private:
+  VecN law(const VecN& q, const VecN& v, const Reference& ref);
+  bool inverseKinematics(const VecN& x, VecN& q);
+
+  Spec spec_;
+  std::unique_ptr<Mech> mech_;
+  ClosedChain<Mech> chain_;
+  TaskPoint task_;
+  long hold_, k_ = 0;
+  double dt_;
+  std::deque<std::pair<VecN, VecN>> readings_;  // (q, v) of the last delay+1 steps, newest last
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_{0.0, 1.0};
+  VecN q_ik_, integral_, tau_u_, tau_;
+  bool saturated_ = false;
+};
+
+}  // namespace dyn::controllers

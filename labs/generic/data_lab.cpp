@@ -1,0 +1,231 @@
+// The generic data-defined lab: see data_lab.h. Both engines run the plant loaded from the model file
+// (the hand engine through the generic mechanism, Bullet through its builder); the controller of the
+// library drives the actuated joints from its own model.
+#include "labs/generic/data_lab.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "labs/mechanism_simulation.h"
+#include "labs/numbers.h"
+
+namespace dyn::generic {
+namespace {
+
+namespace fs = std::filesystem;
+using Mech = ConstrainedMechanism<Spatial>;
+
+// The lab's part of a run: the reference path, the controller, the trace row.
+class Hooks final : public StepHooks {
+ public:
+  explicit Hooks(const DataSettings& s)
+      : s_(s), ctrl_(s.controller, s.model, s.actuated, s.tool, s.q0, s.step.dt), plant_(s.plant->mechanism) {}
+  VecN torque(double t, const VecN& q, const VecN& v) override {
+    s_.path->at(t, ref_.x, ref_.xd, ref_.xdd);
+    return ctrl_.torque(t, q, v, ref_);
+  }
+  void row(const StepRecord& r, std::vector<double>& out) override {
+    out.clear();
+    out.push_back(r.t);
+    out.insert(out.end(), r.q.data(), r.q.data() + r.q.size());
+    out.insert(out.end(), r.v.data(), r.v.data() + r.v.size());
+    const VecN& u = ctrl_.command();
+    out.insert(out.end(), u.data(), u.data() + u.size());
+    out.push_back(ctrl_.saturated() ? 1.0 : 0.0);
+    // The tool where the plant has it (not the controller's model: a payload changes no geometry, but
+    // the plant is the truth).
+    const Eigen::Vector3d p = plant_.pointPosition(s_.tool.link, s_.tool.point, r.q);
+    VecN x(Eigen::Index(s_.tool.axes.size()));
+    for (std::size_t i = 0; i < s_.tool.axes.size(); ++i) x[Eigen::Index(i)] = p[s_.tool.axes[i] - 3];
+    for (int i = 0; i < x.size(); ++i) out.push_back(x[i]);
+    for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i]);
+    for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i] - x[i]);
+    out.push_back(r.energy), out.push_back(r.work), out.push_back(r.residual);
+    const auto& closures = s_.plant->closures;
+    for (std::size_t c = 0; c < closures.size(); ++c)
+      for (const auto& row : closures[c].kept) out.push_back(r.forces[c][rowIndex(row)]);
+  }
+
+ private:
+  // A kept row's place in the spatial force (moment, force).
+  static int rowIndex(const std::string& row) {
+    static const char* names[] = {"wx", "wy", "wz", "x", "y", "z"};
+    for (int i = 0; i < 6; ++i)
+      if (row == names[i]) return i;
+    return 0;
+  }
+  const DataSettings& s_;
+  controllers::Controller ctrl_;
+  Mech plant_;
+  controllers::Reference ref_;
+};
+
+std::string fmt(const char* f, double x) {
+  char b[48];
+  std::snprintf(b, sizeof b, f, x);
+  return b;
+}
+
+}  // namespace
+
+DataLab::DataLab(DataSettings s) : s_(std::move(s)), picture_(*s_.plant) {}
+
+std::string DataLab::unit(const std::string& c) const {
+  auto starts = [&](const char* p) { return c.rfind(p, 0) == 0; };
+  if (c == "t") return "s";
+  if (c == "energy" || c == "work") return "J";
+  if (c == "constraint_residual") return "m";
+  if (starts("tool_") || starts("ref_") || starts("e_")) return "m";
+  if (starts("tau_") && c != "tau_sat") return "N·m";
+  if (starts("f_")) {
+    const std::string row = c.substr(c.rfind('_') + 1);
+    return row[0] == 'w' ? "N·m" : "N";
+  }
+  for (std::size_t i = 0; i < s_.plant->joints.size(); ++i) {
+    const bool slide = s_.plant->joints[i].type == "slide";
+    if (c == s_.columns[1 + i]) return slide ? "m" : "rad";
+    if (c == s_.columns[1 + s_.plant->joints.size() + i]) return slide ? "m/s" : "rad/s";
+  }
+  return {};
+}
+
+std::unique_ptr<Simulation> DataLab::simulate(Engine engine) const {
+  auto mech = std::make_unique<Mech>(s_.plant->mechanism);
+  const VecN v0 = VecN::Zero(mech->n());
+  return simulateMechanism(engine, std::move(mech), s_.step, s_.q0, v0, std::make_unique<Hooks>(s_), s_.columns, s_.duration);
+}
+
+json DataLab::metrics(const Trace& tr) const {
+  json out = json::object();
+  for (const auto& [name, spec] : s_.metrics) out[name] = evaluate(spec, tr);
+  double drift = 0, residual = 0;
+  const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
+  for (std::size_t r = 0; r < tr.rows(); ++r) {
+    drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
+    residual = std::max(residual, tr.at(r, "constraint_residual"));
+  }
+  out["energy_drift"] = drift;
+  out["max_constraint_residual"] = residual;
+  out["steps"] = tr.rows();
+  return out;
+}
+
+json DataLab::agreement(const Trace& a, const Trace& b) const {
+  const std::size_t n = std::min(a.rows(), b.rows());
+  const std::size_t joints = s_.plant->joints.size();
+  double dq = 0, dx = 0, df = 0;
+  for (std::size_t r = 0; r < n; ++r) {
+    for (std::size_t i = 0; i < joints; ++i) dq = std::max(dq, std::abs(a.at(r, int(1 + i)) - b.at(r, int(1 + i))));
+    for (const auto& ax : s_.axis_names) dx = std::max(dx, std::abs(a.at(r, "tool_" + ax) - b.at(r, "tool_" + ax)));
+    for (std::size_t c = 0; c < s_.columns.size(); ++c)
+      if (s_.columns[c].rfind("f_", 0) == 0) df = std::max(df, std::abs(a.at(r, int(c)) - b.at(r, int(c))));
+  }
+  json out = {{"rows_compared", n}, {"max_dq", dq}, {"max_dx", dx}, {"max_df", df}};
+  out.update(engineHealth(metrics(a), metrics(b)));
+  return out;
+}
+
+std::string DataLab::agreementUnit(const std::string& key) const {
+  static const std::map<std::string, std::string> units = {{"max_dq", "rad"}, {"max_dx", "m"}, {"max_df", "N, N·m"}};
+  return unitIn(units, key);
+}
+
+std::string DataLab::referenceEngine() const {
+  return bullet::BulletMechanism<Spatial>(s_.plant->mechanism, s_.step.dt, s_.q0, VecN::Zero(s_.q0.size())).describe();
+}
+
+void DataLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene& out) const {
+  const int n = int(s_.plant->joints.size());
+  // The run's bounds frame every picture of it (cached: a video asks for every row).
+  if (bounds_of_ != tr.data.data() || bounds_rows_ != tr.rows()) {
+    bounds_ = runBounds(picture_, n, tr, ghost);
+    bounds_of_ = tr.data.data(), bounds_rows_ = tr.rows();
+  }
+  const VecN q = traceQ(tr, row, n);
+  VecN gq;
+  if (ghost && row < ghost->rows()) gq = traceQ(*ghost, row, n);
+  picture_.scene(q, gq.size() ? &gq : nullptr, bounds_, out);
+  // The path: the reference so far as a thin line, the tool's target as a small ball.
+  if (s_.tool.axes.size() >= 2) {
+    Polyline path;
+    Mech plant(s_.plant->mechanism);
+    const Eigen::Vector3d p0 = plant.pointPosition(s_.tool.link, s_.tool.point, q);
+    const std::size_t stride = std::max<std::size_t>(1, tr.rows() / 400);
+    for (std::size_t r = 0; r < tr.rows(); r += stride) {
+      Eigen::Vector3d p = p0;
+      for (std::size_t i = 0; i < s_.tool.axes.size(); ++i) p[s_.tool.axes[i] - 3] = tr.at(r, "ref_" + s_.axis_names[i]);
+      path.points.push_back(p);
+    }
+    path.color = {0.85f, 0.2f, 0.2f, 0.8f};
+    out.polylines.push_back(path);
+    Eigen::Vector3d target = p0;
+    for (std::size_t i = 0; i < s_.tool.axes.size(); ++i) target[s_.tool.axes[i] - 3] = tr.at(row, "ref_" + s_.axis_names[i]);
+    out.spheres.push_back({target, 0.006, {0.85f, 0.2f, 0.2f, 1.0f}});
+  }
+}
+
+void DataLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
+  o.title = s_.title;
+  double e = 0;
+  for (const auto& a : s_.axis_names) e += std::pow(tr.at(row, "e_" + a), 2);
+  o.lines = {{"t", fmt("%.3f s", tr.at(row, "t"))}, {"tracking |e|", fmt("%.2f mm", 1e3 * std::sqrt(e))}};
+  for (const auto& a : s_.actuated_names)
+    o.lines.push_back({"tau " + a, fmt("%.2f N·m", tr.at(row, "tau_" + columnName(a)))});
+  o.lines.push_back({"closure |phi|", fmt("%.1e m", tr.at(row, "constraint_residual"))});
+  Series err{"|e| (mm)", {}, {0.85f, 0.2f, 0.2f, 1.0f}};
+  for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) {
+    double s = 0;
+    for (const auto& a : s_.axis_names) s += std::pow(tr.at(r, "e_" + a), 2);
+    err.values.push_back(float(1e3 * std::sqrt(s)));
+  }
+  o.plots = {err};
+}
+
+bool isDataLabFolder(const std::string& folder, const std::string& name) {
+  std::error_code ec;
+  if (!fs::is_regular_file(folder + "/" + name + ".json", ec)) return false;
+  for (const auto& e : fs::recursive_directory_iterator(folder, fs::directory_options::skip_permission_denied, ec)) {
+    const auto ext = e.path().extension();
+    if (ext == ".cpp" || ext == ".h") return false;
+  }
+  return !ec;
+}
+
+bool registerDataLab(const std::string& folder, std::string* why) {
+  const std::string name = fs::path(folder).filename().string();
+  if (!isDataLabFolder(folder, name)) {
+    if (why) *why = folder + ": expected a folder with " + name + ".json and no .cpp or .h";
+    return false;
+  }
+  // The summary from the JSON's title (the lab itself reports a broken JSON when it is used).
+  std::string summary = "data-defined lab (" + name + ".json)";
+  try {
+    const json j = loadJsonFile(folder + "/" + name + ".json");
+    if (j.contains("title") && j["title"].is_string()) summary = j["title"].get<std::string>();
+  } catch (const std::exception&) {
+  }
+  const bool ok = registerLab({name, summary, [name, folder](const JsonView& config) -> std::unique_ptr<Lab> {
+                                 return std::make_unique<DataLab>(parseDataSettings(config, name, folder));
+                               }});
+  if (!ok && why) *why = "a lab named " + name + " is registered already";
+  return ok;
+}
+
+int registerDataLabs(const std::string& root) {
+  std::error_code ec;
+  std::vector<std::string> folders;
+  for (const auto& e : fs::directory_iterator(root, ec))
+    if (e.is_directory(ec)) folders.push_back(e.path().string());
+  std::sort(folders.begin(), folders.end());
+  int n = 0;
+  for (const auto& f : folders)
+    if (isDataLabFolder(f, fs::path(f).filename().string())) n += registerDataLab(f) ? 1 : 0;
+  return n;
+}
+
+// Every data lab folder of the lab tree, at start-up (as the C++ labs register themselves).
+[[maybe_unused]] const int kRegistered = registerDataLabs(fs::path(defaultConfigPath("_")).parent_path().parent_path().string());
+
+}  // namespace dyn::generic

@@ -1,0 +1,85 @@
+// A lab without C++: a folder labs/<name>/ with <name>.json, handout.md, examples/ and a model file,
+// and no .cpp or .h, is served by this one generic lab class, registered once per such folder found
+// (registerDataLabs; no registration line per lab). Its JSON says, besides the blocks every lab has
+// (simulation, gains, rubric, metric_docs, figures, submission_options):
+//   "model_file": "fivebar.xml"          MJCF or URDF beside the JSON (physics/model_file)
+//   "actuated": ["left_crank", ...]      the joints the controller drives; the others are passive
+//   "torque_limit": [..]                 N·m per actuated joint
+//   "tool": {"closure": "pin_C"} | {"body": "left_link", "at": [x, y, z]}   the task point (world
+//                                        coordinates at the file's pose), "axes": ["x", "z"]
+//   "initial": {"actuated_deg": [..]}    the actuators' start; the passive joints are assembled
+//   "trajectory": {"segments": [...]}    the task path from the tool's start (labs/generic/task_path.h)
+//   "plant": {"payloads": [{"body", "at", "mass"}]}   point masses the plant carries and the
+//                                        controller's model does not (scenarios change them)
+//   "controller": {"kind", "control_period", "delay_steps", "noise": {"angle", "rate", "seed"},
+//                  "constant"}           a law of labs/controllers, gains from "gains"
+//   "metrics": {...}                     labs/generic/metric_spec.h
+//   "passive_tolerance": 1e-6            the passive energy check's |E − E0|/|E0|
+// Trace columns: t, q_<joint> (every coordinate), v_<joint>, tau_<actuated>, tau_sat, tool_<axis>,
+// ref_<axis>, e_<axis>, energy, work, constraint_residual, and f_<closure>_<row> (force, world axes, of
+// each kept closure row: rows wx wy wz are moments, x y z forces).
+#pragma once
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "labs/controllers/controller.h"
+#include "labs/generic/metric_spec.h"
+#include "labs/generic/task_path.h"
+#include "labs/lab.h"
+#include "labs/model_scene.h"
+#include "physics/model_file/model_file.h"
+
+namespace dyn::generic {
+
+struct DataSettings {
+  std::string name, folder, title;
+  std::shared_ptr<const model_file::LoadedModel> plant;  // with the payloads
+  MechanismModel<Spatial> model;                         // the controller's: without them
+  std::vector<int> actuated;
+  std::vector<std::string> actuated_names, axis_names;
+  controllers::TaskPoint tool;
+  VecN q0;  // assembled start
+  std::shared_ptr<const TaskPath> path;
+  controllers::Spec controller;
+  StepOptions step;
+  double duration = 1, passive_tolerance = 1e-6;
+  std::map<std::string, MetricSpec> metrics;
+  std::vector<std::string> columns;
+};
+
+// Parses a data lab's config (its folder: where the model file is).
+DataSettings parseDataSettings(const JsonView& config, const std::string& name, const std::string& folder);
+
+class DataLab final : public Lab {
+ public:
+  explicit DataLab(DataSettings s);
+  std::vector<std::string> columns() const override { return s_.columns; }
+  std::string unit(const std::string& column) const override;
+  double dt() const override { return s_.step.dt; }
+  double duration() const override { return s_.duration; }
+  std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  json metrics(const Trace& trace) const override;
+  json agreement(const Trace& hand, const Trace& bullet) const override;
+  std::string agreementUnit(const std::string& key) const override;
+  std::string referenceEngine() const override;
+  PassiveEnergy passiveEnergy() const override { return {s_.passive_tolerance, 0}; }
+  void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
+  void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
+
+ private:
+  DataSettings s_;
+  ModelPicture picture_;
+  mutable const double* bounds_of_ = nullptr;  // the trace whose run bounds are cached
+  mutable std::size_t bounds_rows_ = 0;
+  mutable Eigen::AlignedBox3d bounds_;
+};
+
+// True if labs/<name>/ is a data lab folder: <name>.json there, and no .cpp or .h.
+bool isDataLabFolder(const std::string& folder, const std::string& name);
+// Registers the data lab in `folder` (named by the folder); false with a sentence in *why if it cannot.
+bool registerDataLab(const std::string& folder, std::string* why = nullptr);
+// Registers every data lab folder under `labs_root`; returns how many.
+int registerDataLabs(const std::string& labs_root);
+
+}  // namespace dyn::generic

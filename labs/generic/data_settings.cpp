@@ -1,0 +1,210 @@
+// A data lab's JSON, parsed and checked against its model file: see data_lab.h.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "labs/generic/data_lab.h"
+#include "labs/settings.h"
+#include "physics/closed_chain.h"
+
+namespace dyn::generic {
+namespace {
+
+constexpr double kMaxCoordinate = 100, kMaxMass = 1e4, kMaxTorque = 1e5;
+
+Eigen::Vector3d vec3(const JsonView& j) {
+  j.size(3, 3);
+  return {j.at(0).inRange(-kMaxCoordinate, kMaxCoordinate), j.at(1).inRange(-kMaxCoordinate, kMaxCoordinate),
+          j.at(2).inRange(-kMaxCoordinate, kMaxCoordinate)};
+}
+
+std::string list(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "" : ", ") + n;
+  return s;
+}
+
+// The tree body a file body moves with: the last coordinate of its joints (−1: none).
+int linkOf(const model_file::LoadedModel& m, const std::string& body) {
+  int link = -1;
+  for (std::size_t i = 0; i < m.joints.size(); ++i)
+    if (m.joints[i].body == body) link = int(i);
+  return link;
+}
+
+std::vector<std::string> jointBodies(const model_file::LoadedModel& m) {
+  std::vector<std::string> b;
+  for (const auto& j : m.joints)
+    if (std::find(b.begin(), b.end(), j.body) == b.end()) b.push_back(j.body);
+  return b;
+}
+
+// A body and a point on it given in world coordinates at the file's pose: the tree body and the point
+// in its frame (frames are world-aligned at the file's pose, on their joint's anchor).
+std::pair<int, Eigen::Vector3d> bodyPoint(const JsonView& body, const JsonView& at, const model_file::LoadedModel& m,
+                                          ConstrainedMechanism<Spatial>& mech) {
+  const int link = linkOf(m, body.string());
+  if (link < 0) body.fail("expected a body with a joint in the model file (" + list(jointBodies(m)) + ")");
+  const Eigen::Vector3d anchor = mech.pointPosition(link, Eigen::Vector3d::Zero(), m.q0);
+  return {link, vec3(at) - anchor};
+}
+
+std::string checkedModelPath(const JsonView& j, const std::string& folder) {
+  const std::string rel = j.string();
+  const std::filesystem::path p(rel);
+  bool up = false;
+  for (const auto& part : p) up = up || part == "..";
+  if (rel.empty() || p.is_absolute() || up) j.fail("expected a model file inside the lab's folder (a relative path without \"..\")");
+  return folder + "/" + rel;
+}
+
+}  // namespace
+
+DataSettings parseDataSettings(const JsonView& c, const std::string& name, const std::string& folder) {
+  DataSettings s;
+  s.name = name, s.folder = folder;
+  c.onlyKeys({"lab", "title", "description", "model_file", "actuated", "torque_limit", "tool", "initial", "trajectory",
+              "plant", "controller", "gains", "metrics", "passive_tolerance", "simulation", "rubric", "metric_docs",
+              "figures", "submission_options", "map", "drawing"});
+  s.title = c["title"].string();
+  // The model, and the plant: the model with the payloads the controller does not know.
+  const JsonView mf = c["model_file"];
+  model_file::LoadedModel file;
+  try {
+    file = model_file::load(checkedModelPath(mf, folder));
+  } catch (const model_file::ModelFileError& e) {
+    mf.fail(std::string("a model file dynlab reads (") + e.what() + ")");
+  }
+  if (!file.mechanism.payloads.empty()) mf.fail("a model without free payload bodies");
+  s.model = file.mechanism;
+  ConstrainedMechanism<Spatial> probe(file.mechanism);
+  if (c.has("plant")) {
+    const JsonView p = c["plant"];
+    p.onlyKeys({"payloads"});
+    const JsonView loads = p["payloads"];
+    for (std::size_t i = 0, n = loads.size(0, 16); i < n; ++i) {
+      const JsonView l = loads.at(i);
+      l.onlyKeys({"body", "at", "mass"});
+      const auto [link, point] = bodyPoint(l["body"], l["at"], file, probe);
+      const double mass = l["mass"].inRange(0, kMaxMass);
+      auto& b = file.mechanism.tree.bodies[std::size_t(link)];
+      b.inertia += Spatial::inertia(mass, point, Eigen::Matrix3d::Zero());
+      b.central = Spatial::central(b.inertia);
+      b.massless = Spatial::massless(b.inertia);
+    }
+  }
+  // Actuated joints, by name.
+  const JsonView act = c["actuated"];
+  std::vector<std::string> joint_names;
+  for (const auto& j : file.joints) joint_names.push_back(j.name);
+  for (std::size_t i = 0, n = act.size(1, file.joints.size()); i < n; ++i) {
+    const std::string jn = act.at(i).string();
+    const auto it = std::find(joint_names.begin(), joint_names.end(), jn);
+    if (it == joint_names.end()) act.at(i).fail("expected a joint of the model file (" + list(joint_names) + ")");
+    const int index = int(it - joint_names.begin());
+    if (std::find(s.actuated.begin(), s.actuated.end(), index) != s.actuated.end()) act.at(i).fail("expected each joint once");
+    s.actuated.push_back(index), s.actuated_names.push_back(jn);
+  }
+  const int m = int(s.actuated.size());
+  const JsonView lim = c["torque_limit"];
+  lim.size(std::size_t(m), std::size_t(m));
+  s.controller.torque_limit.resize(m);
+  for (int j = 0; j < m; ++j) s.controller.torque_limit[j] = lim.at(std::size_t(j)).positive(kMaxTorque);
+
+  // The tool: a closure's point or a body's.
+  const JsonView tool = c["tool"];
+  tool.onlyKeys({"closure", "body", "at", "axes"});
+  if (tool.has("closure")) {
+    const std::string cn = tool["closure"].string();
+    std::vector<std::string> names;
+    for (const auto& cl : file.closures) names.push_back(cl.name);
+    const auto it = std::find(names.begin(), names.end(), cn);
+    if (it == names.end()) tool["closure"].fail("expected a closure of the model file (" + list(names) + ")");
+    const auto& cl = file.closures[std::size_t(it - names.begin())];
+    if (cl.link1 < 0) tool["closure"].fail("expected a closure whose first body moves");
+    s.tool.link = cl.link1, s.tool.point = cl.point1;
+  } else {
+    std::tie(s.tool.link, s.tool.point) = bodyPoint(tool["body"], tool["at"], file, probe);
+  }
+  const JsonView axes = tool["axes"];
+  for (std::size_t i = 0, n = axes.size(1, 3); i < n; ++i) {
+    const std::string a = axes.at(i).oneOf({"x", "y", "z"});
+    s.tool.axes.push_back(3 + (a[0] - 'x'));
+    s.axis_names.push_back(a);
+  }
+
+  // The start: the actuators placed, the loop assembled from the file's pose.
+  const JsonView init = c["initial"];
+  init.onlyKeys({"actuated_deg"});
+  init["actuated_deg"].size(std::size_t(m), std::size_t(m));
+  s.q0 = file.q0;
+  for (int j = 0; j < m; ++j) s.q0[s.actuated[std::size_t(j)]] = init["actuated_deg"].at(std::size_t(j)).inRange(-720, 720) * M_PI / 180.0;
+  ConstrainedMechanism<Spatial> plant(file.mechanism);
+  if (!assemble(plant, s.q0, s.actuated)) init["actuated_deg"].fail("actuator angles at which the loop closes");
+
+  // The path, from where the tool starts.
+  controllers::Controller probe_ctl({}, s.model, s.actuated, s.tool, s.q0, 1e-3);
+  VecN x0;
+  probe_ctl.taskPosition(s.q0, x0);
+  s.path = std::make_shared<TaskPath>(c["trajectory"], x0, kMaxCoordinate);
+
+  const SimulationSettings sim = parseSimulation(c["simulation"]);
+  s.step = sim.step, s.duration = sim.duration;
+  s.passive_tolerance = c.has("passive_tolerance") ? c["passive_tolerance"].inRange(1e-14, 1.0) : 1e-6;
+
+  // The controller: a kind of the library, the gains it reads declared in "gains".
+  const JsonView ctl = c["controller"];
+  ctl.onlyKeys({"kind", "control_period", "delay_steps", "noise", "constant"});
+  const std::string kind = ctl["kind"].string();
+  if (std::find(controllers::kindNames().begin(), controllers::kindNames().end(), kind) == controllers::kindNames().end())
+    ctl["kind"].fail("one of " + list(controllers::kindNames()));
+  auto& cs = s.controller;
+  cs.kind = controllers::kindFromName(kind);
+  cs.period = ctl["control_period"].inRange(s.step.dt, 1.0);
+  const double ratio = cs.period / s.step.dt;
+  if (std::abs(ratio - std::round(ratio)) > 1e-6) ctl["control_period"].fail("a whole multiple of the simulation step /simulation/dt");
+  cs.delay_steps = ctl.has("delay_steps") ? ctl["delay_steps"].integer(0, 1000) : 0;
+  if (ctl.has("noise")) {
+    const JsonView nz = ctl["noise"];
+    nz.onlyKeys({"angle", "rate", "seed"});
+    cs.noise_angle = nz["angle"].inRange(0, 1), cs.noise_rate = nz["rate"].inRange(0, 100);
+    cs.seed = std::uint64_t(nz["seed"].integer(0, 1L << 53));
+  }
+  cs.constant = VecN::Zero(m);
+  if (ctl.has("constant")) {
+    ctl["constant"].size(std::size_t(m), std::size_t(m));
+    for (int j = 0; j < m; ++j) cs.constant[j] = ctl["constant"].at(std::size_t(j)).inRange(-kMaxTorque, kMaxTorque);
+  }
+  std::vector<std::string> declared;
+  for (const auto& [g, _] : c["gains"].raw().items()) declared.push_back(g);
+  const auto gains = parseGains(c["gains"], declared);
+  // Every kind a submission may pick must find its gains.
+  std::vector<std::string> possible{kind};
+  if (c.has("submission_options") && c["submission_options"].has("kind"))
+    for (const auto& k : c["submission_options"]["kind"]["choices"].raw()) possible.push_back(k.get<std::string>());
+  for (const auto& k : possible) {
+    if (std::find(controllers::kindNames().begin(), controllers::kindNames().end(), k) == controllers::kindNames().end())
+      c["submission_options"]["kind"].fail("controller kinds of the library (" + list(controllers::kindNames()) + ")");
+    for (const auto& g : controllers::gainsOf(controllers::kindFromName(k)))
+      if (!gains.count(g)) c["gains"].fail("a gain \"" + g + "\" (the controller kind " + k + " reads it)");
+  }
+  auto gain = [&](const char* g) { return gains.count(g) ? gains.at(g) : 0.0; };
+  cs.kp = gain("kp"), cs.kd = gain("kd"), cs.ki = gain("ki"), cs.omega_n = gain("omega_n"), cs.zeta = gain("zeta");
+
+  // The trace's columns, then the metrics that read them.
+  s.columns = {"t"};
+  for (const auto& j : file.joints) s.columns.push_back("q_" + columnName(j.name));
+  for (const auto& j : file.joints) s.columns.push_back("v_" + columnName(j.name));
+  for (const auto& a : s.actuated_names) s.columns.push_back("tau_" + columnName(a));
+  s.columns.push_back("tau_sat");
+  for (const char* p : {"tool_", "ref_", "e_"})
+    for (const auto& a : s.axis_names) s.columns.push_back(p + a);
+  for (const char* k : {"energy", "work", "constraint_residual"}) s.columns.push_back(k);
+  for (const auto& cl : file.closures)
+    for (const auto& r : cl.kept) s.columns.push_back("f_" + columnName(cl.name) + "_" + r);
+  if (c.has("metrics")) s.metrics = parseMetrics(c["metrics"], s.columns);
+  s.plant = std::make_shared<const model_file::LoadedModel>(std::move(file));
+  return s;
+}
+
+}  // namespace dyn::generic
