@@ -1,6 +1,6 @@
 // The overlay's font draws Greek letters, math operators, arrows and sub/superscripts as themselves:
-// each renders unlike "?" (Dear ImGui's stand-in for a glyph its font lacks) and unlike the others;
-// a missing or broken font file is one line naming the file and the package.
+// each renders unlike "?" and U+FFFD (Dear ImGui's stand-ins for a glyph its font lacks) and unlike
+// the others; a missing or broken font file is one line naming the file and the package.
 #include <doctest/doctest.h>
 
 #include <cstdlib>
@@ -51,8 +51,11 @@ TEST_CASE("Greek letters, math operators, arrows and sub/superscripts are drawn 
     const Overlay overlay = panelWith(value);
     return renderer.render(scene, &overlay).rgba;
   };
-  const auto unknown = frame("?"), blank = frame(" ");
+  // A glyph the font lacks is drawn as its fallback: U+FFFD when the font has it, else "?".
+  const auto unknown = frame("?"), replacement = frame("\uFFFD"), blank = frame(" ");
   REQUIRE(unknown != blank);
+  const auto missing = frame("\u4E2D");  // 中: in no font of this atlas
+  CHECK((missing == replacement || missing == unknown));
   const std::vector<std::string> glyphs = {"θ", "τ", "ω", "Δ", "μ", "φ", "−", "·", "²", "≤", "≥", "√", "∫",
                                            "→", "₁", "ᵀ", "±", "∂", "≈", "…", "⁻"};
   std::vector<std::pair<std::vector<std::uint8_t>, std::string>> seen;  // each glyph's frame
@@ -60,6 +63,7 @@ TEST_CASE("Greek letters, math operators, arrows and sub/superscripts are drawn 
     INFO("glyph ", g);
     const auto image = frame(g);
     CHECK(image != unknown);  // the font has it
+    CHECK(image != replacement);
     CHECK(image != blank);    // and it leaves ink
     for (const auto& [other, name] : seen) CHECK_MESSAGE(image != other, g << " is drawn like " << name);
     seen.emplace_back(image, g);
