@@ -61,6 +61,12 @@ struct LessonsArgs {
   double time_budget = 300;  // s of wall time per submission
 };
 
+// dynlab check-lab LAB: the every-lab contract's checks on one lab (app/lab_check.h).
+struct CheckLabArgs {
+  std::string lab;
+  bool skip_cli = false;  // no dynlab figure/run/grade subprocesses
+};
+
 struct BenchArgs {
   bool json = false;
   int steps = 4000, frames = 60;
@@ -102,6 +108,9 @@ int benchScaling(const BenchArgs& args);
 int compare(const CompareArgs& args);
 // Prints each lesson with both scores; exit 0 when all hold, 1 when one does not, 2 on bad input.
 int lessons(const LessonsArgs& args);
+// Prints each contract check with ok/FAIL and one line, the default gains', examples' and instructor
+// answers' shares and the passive drift; exit 0 when all pass, 1 when one fails, 2 on bad input.
+int checkLab(const CheckLabArgs& args);  // app/check_lab.cpp
 // Replaces this process with dynlab-ui (next to /proc/self/exe); returns only on failure (1).
 int openUi(const UiArgs& args);
 // CPU cost of grading the lab's instructor/good.json (app/bench_grade.cpp); empty if none.

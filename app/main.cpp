@@ -204,6 +204,13 @@ int dispatch(int argc, char** argv) {
                                         "relative to its folder");
   l->add_option("--time-budget", les.time_budget, "Wall-time budget per submission (s)")->check(CLI::Range(1.0, 86400.0));
 
+  CheckLabArgs check_lab;
+  auto* cl = cli.add_subcommand("check-lab", "Check one lab against the lab contract the every-lab test holds every lab to: "
+                                             "each check with ok/FAIL and a reason, the default gains', examples' and instructor "
+                                             "answers' shares, the passive energy drift (exit 1 if a check fails)");
+  cl->add_option("LAB", check_lab.lab, "Lab name (see `dynlab list`)")->required();
+  cl->add_flag("--skip-cli", check_lab.skip_cli, "Skip running dynlab figure/run/grade on the lab as subprocesses (faster)");
+
   BenchArgs bench_args;
   auto* b = cli.add_subcommand("bench", "Benchmark: hand-written vs Bullet step time, render/PNG/video frame rates");
   b->add_flag("--json", bench_args.json, "One JSON object per lab");
@@ -244,6 +251,7 @@ int dispatch(int argc, char** argv) {
   if (*sf) return printSubmissionFile(upload_dir);
   if (*k) return compare(cmp);
   if (*l) return lessons(les);
+  if (*cl) return checkLab(check_lab);
   if (*b) return bench_args.scaling ? benchScaling(bench_args) : bench(bench_args);
   if (course.chosen()) return course.run();
   if (model_file.chosen()) return model_file.run();

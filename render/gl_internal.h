@@ -117,7 +117,7 @@ class OverlayPanel {
   void buildFrame(const Overlay& overlay);
   ::ImGuiContext* context_ = nullptr;
   PixelRect rect_;
-  float scale_ = 1.0f;  // whole multiples of the 640×480 layout, so the pixel font stays crisp
+  float scale_ = 1.0f;  // whole multiples of the 640×480 layout, so text and lines stay crisp
 };
 
 }  // namespace dyn::gl

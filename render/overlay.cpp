@@ -10,6 +10,7 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "render/fonts.h"
 #include "render/gl_internal.h"
 #include "render/plot_widget.h"
 
@@ -76,9 +77,12 @@ OverlayPanel::OverlayPanel(int width, int height) {
   // A 1080p still reads like a 480p frame: the panel grows by whole multiples of its 480p size,
   // the next one from 1.8x the height on (720p keeps the 480p panel and leaves the scene room).
   scale_ = float(std::max(1, int(std::floor(height / 480.0 + 0.2))));
-  ImFontConfig font;
-  font.SizePixels = 13.0f * scale_;
-  io.Fonts->AddFontDefault(&font);
+  try {
+    addUiFont(*io.Fonts, 13.0f * scale_);  // DejaVu Sans: Greek and the math operators too
+  } catch (...) {
+    ImGui::DestroyContext(context_);
+    throw;
+  }
   applyStyle();
   ImGui::GetStyle().ScaleAllSizes(scale_);
   if (!ImGui_ImplOpenGL3_Init("#version 330 core")) {

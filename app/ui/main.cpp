@@ -9,11 +9,11 @@
 #include <CLI/CLI.hpp>
 #include <algorithm>
 #include <cstdio>
-#include <filesystem>
 #include <fstream>
 #include <iostream>
 
 #include "app/ui/panel.h"
+#include "render/fonts.h"
 #include "render/renderer.h"
 #include "render/window_context.h"
 
@@ -50,10 +50,9 @@ void setupImGui(GLFWwindow* window) {
   ImGui::CreateContext();
   ImGuiIO& io = ImGui::GetIO();
   io.IniFilename = nullptr;  // nothing written next to the student's files
-  // DejaVu Sans when installed (Greek, ±, ≤, —, … in the notes and units); ImGui's own font otherwise.
-  const char* font = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
-  static const ImWchar ranges[] = {0x0020, 0x00FF, 0x0370, 0x03FF, 0x2010, 0x206F, 0x2190, 0x22FF, 0};
-  if (std::filesystem::exists(font)) io.Fonts->AddFontFromFileTTF(font, 15.0f, nullptr, ranges);
+  // The overlay's font (render/fonts.h): Greek, ±, ≤, −, x₁, … in the notes and units; a missing
+  // font file is a one-line error.
+  addUiFont(*io.Fonts, 15.0f);
   ImGui::StyleColorsLight();
   ImGuiStyle& style = ImGui::GetStyle();
   style.WindowRounding = 0.0f;
