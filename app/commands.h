@@ -67,6 +67,12 @@ struct CheckLabArgs {
   bool skip_cli = false;  // no dynlab figure/run/grade subprocesses
 };
 
+// dynlab new-lab NAME --from LAB: a data-defined lab copied from another (app/new_lab.cpp).
+struct NewLabArgs {
+  std::string name, from;
+  std::string labs;  // the folder of lab folders (default: the dynlab tree's labs/)
+};
+
 struct BenchArgs {
   bool json = false;
   int steps = 4000, frames = 60;
@@ -111,6 +117,7 @@ int lessons(const LessonsArgs& args);
 // Prints each contract check with ok/FAIL and one line, the default gains', examples' and instructor
 // answers' shares and the passive drift; exit 0 when all pass, 1 when one fails, 2 on bad input.
 int checkLab(const CheckLabArgs& args);  // app/check_lab.cpp
+int newLab(const NewLabArgs& args);      // app/new_lab.cpp
 // Replaces this process with dynlab-ui (next to /proc/self/exe); returns only on failure (1).
 int openUi(const UiArgs& args);
 // CPU cost of grading the lab's instructor/good.json (app/bench_grade.cpp); empty if none.

@@ -211,6 +211,13 @@ int dispatch(int argc, char** argv) {
   cl->add_option("LAB", check_lab.lab, "Lab name (see `dynlab list`)")->required();
   cl->add_flag("--skip-cli", check_lab.skip_cli, "Skip running dynlab figure/run/grade on the lab as subprocesses (faster)");
 
+  NewLabArgs new_lab;
+  auto* nl = cli.add_subcommand("new-lab", "Start a lab without C++: copy a data-defined lab's folder (JSON, model file, handout, "
+                                           "examples) under a new name, to edit its JSON; then `dynlab check-lab NAME`");
+  nl->add_option("NAME", new_lab.name, "The new lab's name (lowercase letters, digits, _)")->required();
+  nl->add_option("--from", new_lab.from, "The data-defined lab to copy, e.g. fivebar")->required();
+  nl->add_option("--labs", new_lab.labs, "The folder of lab folders to write into (default: the dynlab tree's labs/)");
+
   BenchArgs bench_args;
   auto* b = cli.add_subcommand("bench", "Benchmark: hand-written vs Bullet step time, render/PNG/video frame rates");
   b->add_flag("--json", bench_args.json, "One JSON object per lab");
@@ -252,6 +259,7 @@ int dispatch(int argc, char** argv) {
   if (*k) return compare(cmp);
   if (*l) return lessons(les);
   if (*cl) return checkLab(check_lab);
+  if (*nl) return newLab(new_lab);
   if (*b) return bench_args.scaling ? benchScaling(bench_args) : bench(bench_args);
   if (course.chosen()) return course.run();
   if (model_file.chosen()) return model_file.run();

@@ -167,13 +167,13 @@ void DataLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene&
 }
 
 void DataLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
-  o.title = s_.title;
+  o.title = s_.title.substr(0, s_.title.find(':'));  // "Five-bar: task-space control ..." → "Five-bar"
   double e = 0;
   for (const auto& a : s_.axis_names) e += std::pow(tr.at(row, "e_" + a), 2);
   o.lines = {{"t", fmt("%.3f s", tr.at(row, "t"))}, {"tracking |e|", fmt("%.2f mm", 1e3 * std::sqrt(e))}};
   for (const auto& a : s_.actuated_names)
-    o.lines.push_back({"tau " + a, fmt("%.2f N·m", tr.at(row, "tau_" + columnName(a)))});
-  o.lines.push_back({"closure |phi|", fmt("%.1e m", tr.at(row, "constraint_residual"))});
+    o.lines.push_back({"τ " + a, fmt("%.2f N·m", tr.at(row, "tau_" + columnName(a)))});
+  o.lines.push_back({"closure |φ|", fmt("%.1e m", tr.at(row, "constraint_residual"))});
   Series err{"|e| (mm)", {}, {0.85f, 0.2f, 0.2f, 1.0f}};
   for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) {
     double s = 0;

@@ -49,13 +49,20 @@ std::pair<int, Eigen::Vector3d> bodyPoint(const JsonView& body, const JsonView& 
   return {link, vec3(at) - anchor};
 }
 
+// A model file beside the JSON, or else in the dynlab tree (e.g. "assets/models/fourbar.xml", so a new
+// exercise may name one of the shipped models without copying it).
 std::string checkedModelPath(const JsonView& j, const std::string& folder) {
   const std::string rel = j.string();
   const std::filesystem::path p(rel);
   bool up = false;
   for (const auto& part : p) up = up || part == "..";
-  if (rel.empty() || p.is_absolute() || up) j.fail("expected a model file inside the lab's folder (a relative path without \"..\")");
-  return folder + "/" + rel;
+  if (rel.empty() || p.is_absolute() || up)
+    j.fail("expected a model file in the lab's folder or the dynlab tree (a relative path without \"..\")");
+  std::error_code ec;
+  if (std::filesystem::exists(folder + "/" + rel, ec)) return folder + "/" + rel;
+  const auto tree = std::filesystem::path(defaultConfigPath("_")).parent_path().parent_path().parent_path();
+  if (std::filesystem::exists(tree / rel, ec)) return (tree / rel).string();
+  j.fail("expected a model file in the lab's folder (" + folder + ") or the dynlab tree (" + tree.string() + "), not found there");
 }
 
 }  // namespace
