@@ -20,11 +20,18 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, Eigen::Ref<Eigen::M
     const int p = model.bodies[std::size_t(i)].parent;
     if (p >= 0) data.Ic_rb[p] += data.Ic_rb[i];
   }
-  M.setZero();
   for (int j = 0; j < n; ++j) {
-    // The force that moving joint j alone needs, seen by every joint on the way to the root.
+    // The force that moving joint j alone needs, seen by every joint on the way to the root (parents
+    // precede their children); the joints off that path see none. Each entry written once (M is
+    // symmetric): no zeroing pass first, which for a small M is a memset call.
     const typename S::Vec F = S::inertiaTimes(data.Ic_rb[j], data.S_w[j]);
-    for (int i = j; i >= 0; i = model.bodies[std::size_t(i)].parent) M(i, j) = M(j, i) = S::dot(data.S_w[i], F);
+    for (int r = j, i = j; r >= 0; --r)
+      if (r == i) {
+        M(i, j) = M(j, i) = S::dot(data.S_w[i], F);
+        i = model.bodies[std::size_t(i)].parent;
+      } else {
+        M(r, j) = M(j, r) = 0.0;
+      }
   }
 }
 

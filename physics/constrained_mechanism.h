@@ -32,8 +32,9 @@ class ConstrainedMechanism : public ConstrainedSystem {
   explicit ConstrainedMechanism(MechanismModel<S> model);
 
   const MechanismModel<S>& model() const { return model_; }
-  int n() const { return model_.treeDof(); }
-  int k() const { return model_.payloadDof(); }
+  // Fixed by the instantiation where it fixes them (the constructor checks the model fits).
+  int n() const { return Nj == Eigen::Dynamic ? model_.treeDof() : Nj; }
+  int k() const { return Nl == Eigen::Dynamic ? model_.payloadDof() : Nl; }
   int rows() const { return rows_; }
   // True when every constraint has a position form (no velocity-level kind such as rolling).
   bool holonomic() const {
@@ -80,7 +81,10 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // plane — the contact closed there by updateContacts (its plastic impact, then the lift-off check),
   // and the rest of the step taken from there. A step without a crossing costs one look at φ of the
   // open contacts at its end (the projection's own position stage). False if the integrator failed.
-  bool stepLocatingContacts(const StepOptions& options, const VecN& tau, VecN& q, VecN& v);
+  bool stepLocatingContacts(const StepOptions& options, const VecN& tau, VecN& q, VecN& v) {
+    // Every contact closed (or none): the plain step, inline (the usual case).
+    return anyOpenContact() ? stepToTouchdowns(options, tau, q, v) : dyn::step(*this, options, tau, q, v);
+  }
   // The impulse (N·s; as constraintForce: body a on body b, world axes at its point) that the plastic
   // impact of the last updateContacts gave constraint i: ∫ f dt over the impact, P = Λ_n v_n for one
   // contact alone; zero when that call closed nothing (or the solve was singular). A lab that reports a
@@ -115,7 +119,20 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // The projection, the trace row and the next step's first stage revisit the same configuration:
   // checked here, inline, so that a revisit costs a comparison.
   void positionStage(const VecN& q) {
-    if (!have_position_ || q != staged_q_) stagePosition(q);
+    if (!have_position_ || !same(q, staged_q_)) stagePosition(q);
+  }
+  // The state's size when the instantiation fixes it (n + k), else Dynamic.
+  static constexpr int kState = Nj == Eigen::Dynamic || Nl == Eigen::Dynamic ? Eigen::Dynamic : Nj + Nl;
+  // a == b (sizes too), entry by entry as Eigen's ==; unrolled at fixed sizes: the stages' cache checks
+  // run several times a step, and Eigen's loop over a bounded size costs more than the comparison.
+  static bool same(const VecN& a, const VecN& b) {
+    if constexpr (kState != Eigen::Dynamic)
+      if (a.size() == kState && b.size() == kState) {
+        bool equal = true;
+        for (int i = 0; i < kState; ++i) equal = equal && a[i] == b[i];
+        return equal;
+      }
+    return a.size() == b.size() && a == b;
   }
   void stagePosition(const VecN& q);
   void velocityStage(const VecN& v);
@@ -125,6 +142,14 @@ class ConstrainedMechanism : public ConstrainedSystem {
   Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd = true);
   // The deepest φ (= −gap) of the open rigid unilateral contacts at q, −∞ if none is open.
   double openDepth(const VecN& q);
+  // True while a rigid unilateral contact is open; stepLocatingContacts with one open.
+  bool anyOpenContact() const {
+    if (!any_rigid_contact_) return false;
+    for (std::size_t i = 0; i < released_.size(); ++i)
+      if (rigid_contact_[i] && released_[i]) return true;
+    return false;
+  }
+  bool stepToTouchdowns(const StepOptions& options, const VecN& tau, VecN& q, VecN& v);
   // Forget every cached stage (the released rows changed).
   void invalidate() { have_position_ = have_velocity_ = have_last_ = false; }
 
@@ -163,6 +188,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // F·V_P; and the joint friction's power.
   VecN external_bc_;
   double external_power_ = 0, friction_power_ = 0;
+  bool has_forces_ = false;  // the model has external forces (fixed at construction)
 };
 
 }  // namespace dyn

@@ -12,6 +12,31 @@
 
 namespace dyn {
 
+// m ← the zero rows × cols matrix; stores unrolled where both sizes are fixed (a lab's instantiation:
+// there a memset call costs more than the few stores).
+template <int R, int C, class Mat>
+void setZeroAt(Mat& m, int rows, int cols) {
+  m.resize(rows, cols);
+  if constexpr (R != Eigen::Dynamic && C != Eigen::Dynamic) {
+    for (int c = 0; c < C; ++c)
+      for (int r = 0; r < R; ++r) m(r, c) = 0.0;
+  } else {
+    m.setZero();
+  }
+}
+
+// dst = src, entry by entry where src has the fixed size N (unrolled), else Eigen's copy.
+template <int N>
+void setFixed(VecN& dst, const VecN& src) {
+  if constexpr (N != Eigen::Dynamic)
+    if (src.size() == N) {
+      dst.resize(N);
+      for (int i = 0; i < N; ++i) dst[i] = src[i];
+      return;
+    }
+  dst = src;
+}
+
 template <class S, int Nj, int Nr, int Nl>
 ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> model)
     : model_(std::move(model)), data_(model_.tree) {
@@ -29,9 +54,11 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
     any_rigid_contact_ = any_rigid_contact_ || rigid_contact_.back();
   }
   auto fits = [](int fixed, int actual) { return fixed == Eigen::Dynamic || fixed == actual; };
-  if (!fits(Nj, n()) || !fits(Nr, rows_) || !fits(Nl, k()))
-    throw std::invalid_argument("the mechanism's sizes (" + std::to_string(n()) + " joints, " + std::to_string(rows_) +
-                                " constraint rows, " + std::to_string(k()) + " payload coordinates) do not match this instantiation");
+  const int dof = model_.treeDof(), payload = model_.payloadDof();
+  if (!fits(Nj, dof) || !fits(Nr, rows_) || !fits(Nl, payload))
+    throw std::invalid_argument("the mechanism's sizes (" + std::to_string(dof) + " joints, " + std::to_string(rows_) +
+                                " constraint rows, " + std::to_string(payload) + " payload coordinates) do not match this instantiation");
+  has_forces_ = !model_.forces.empty();
   kin_.model = &model_;
   kin_.tree = &data_;
   kin_.payload_pose.assign(model_.payloads.size(), Eigen::Vector3d::Zero());
@@ -92,16 +119,16 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
     kin_.payload_cs[i] = p.free[0] || psi != 0.0 ? Eigen::Vector2d(std::cos(psi), std::sin(psi)) : Eigen::Vector2d(1.0, 0.0);
   }
   // Every constraint's φ, J and A rows, then eq. (2) factored at this configuration.
-  J_full_.setZero(rows_, nn);
-  A_full_.setZero(rows_, kk);
+  setZeroAt<Nr, Nj>(J_full_, rows_, nn);
+  setZeroAt<Nr, Nl>(A_full_, rows_, kk);
   for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->position(kin_, offsets_[i], phi_full_, J_full_, A_full_);
-  phi_ = phi_full_;
+  setFixed<Nr>(phi_, phi_full_);
   problem_.J = J_full_;
   problem_.A = A_full_;
   // Released rows (open or compliant contacts) are zeroed in the solve (the full rows stay for gaps
   // and compliant forces): with compliance 1, η = 0.
   if (any_released_kind_) {
-    problem_.compliance.setZero(rows_);
+    setZeroAt<Nr, 1>(problem_.compliance, rows_, 1);
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
       if (released_[i])
         for (int r = offsets_[i]; r < offsets_[i] + model_.constraints[i]->rows(); ++r) {
@@ -112,7 +139,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
         }
   }
   factored_ = factor_.factor(problem_, problem_.J, problem_.A);
-  staged_q_ = q;
+  setFixed<kState>(staged_q_, q);
   have_position_ = true;
 }
 
@@ -128,7 +155,10 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::treeStage(const VecN& q) {
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   const int nn = n();
-  const VecN qd = v.head(nn);
+  // θ' (without a payload, v itself: no copy).
+  VecN head;
+  if constexpr (Nl != 0) head = v.head(nn);
+  const VecN& qd = Nl != 0 ? head : v;
   have_last_ = false;  // the last solve was at other rates
   // Link velocities, each link's velocity-product acceleration and h = Cθ' + G, in world coordinates.
   problem_.h.resize(nn);
@@ -149,7 +179,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   // External forces at the clock's time: Q = [J, −A]ᵀ F through the point's Jacobian (h −= JᵀF on the
   // tree, b_c + G_c += AᵀF on the payloads), and their power F·V_P.
   external_power_ = 0.0;
-  if (!model_.forces.empty()) {
+  if (has_forces_) {
     const int kk = k();
     external_bc_.setZero(kk);
     MatN Jp(S::kDim, nn), Ap(S::kDim, kk);
@@ -192,7 +222,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
     }
   }
   problem_.Jdot_qd = bias;
-  staged_v_ = v;
+  setFixed<kState>(staged_v_, v);
   have_velocity_ = true;
 }
 
@@ -207,18 +237,22 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
     const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd) {
   positionStage(q);
   // The velocity stage too is kept: the trace row's solve and the step's first stage share it.
-  if (!have_velocity_ || v != staged_v_) velocityStage(v);
+  if (!have_velocity_ || !same(v, staged_v_)) velocityStage(v);
   // τ: the tree torques, optionally followed by generalised forces on the payload coordinates
   // (an external push w on the payload: M_c α_c + b_c + G_c = Aᵀ f + w).
   if (tau.size() != n() && tau.size() != n() + k())
     throw std::invalid_argument("ConstrainedMechanism: τ needs n tree torques, or n + k with payload forces");
   problem_.tau = tau.head(n());
-  if (tau.size() == n() + k()) problem_.bc_Gc = gravity_bc_ - tau.tail(k());
-  else problem_.bc_Gc = gravity_bc_;
-  if (any_compliant_ && k()) problem_.bc_Gc += compliant_bc_;
-  if (!model_.forces.empty() && k()) problem_.bc_Gc += external_bc_;
-  if (stab) problem_.stab = *stab;
-  else problem_.stab.resize(0);
+  if constexpr (Nl == 0) {
+    problem_.bc_Gc.resize(0);  // no payload
+  } else {
+    if (tau.size() == n() + k()) problem_.bc_Gc = gravity_bc_ - tau.tail(k());
+    else problem_.bc_Gc = gravity_bc_;
+    if (any_compliant_ && k()) problem_.bc_Gc += compliant_bc_;
+    if (has_forces_ && k()) problem_.bc_Gc += external_bc_;
+  }
+  if (!stab) problem_.stab.resize(0);
+  else setFixed<Nr>(problem_.stab, *stab);
   Solution s;
   if (!factored_) s = solveConstrainedBlockLU(problem_);
   else factor_.solve(problem_, s, with_qdd);
@@ -327,13 +361,8 @@ double ConstrainedMechanism<S, Nj, Nr, Nl>::openDepth(const VecN& q) {
 }
 
 template <class S, int Nj, int Nr, int Nl>
-bool ConstrainedMechanism<S, Nj, Nr, Nl>::stepLocatingContacts(const StepOptions& o, const VecN& tau, VecN& q, VecN& v) {
-  auto anyOpen = [&] {
-    for (std::size_t i = 0; i < released_.size(); ++i)
-      if (rigid_contact_[i] && released_[i]) return true;
-    return false;
-  };
-  if (!any_rigid_contact_ || !anyOpen()) return dyn::step(*this, o, tau, q, v);
+bool ConstrainedMechanism<S, Nj, Nr, Nl>::stepToTouchdowns(const StepOptions& o, const VecN& tau, VecN& q, VecN& v) {
+  auto anyOpen = [&] { return anyOpenContact(); };
   StepOptions sub = o;  // the part of the step still to take
   // At most a few touchdowns per step (a contact the impact reopens may come back at once): past
   // them the step ends as it lands, and the next step's updateContacts closes what it finds.
@@ -400,8 +429,8 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::accelerations(const VecN& q, const Vec
                                                         const VecN* stab, VecN& a) {
   // The state solve() was last asked about: the same answer (a pure function of q, v, τ). The stages
   // are still at (q, v): any restaging clears have_last_.
-  const bool known = !stab && have_last_ && have_position_ && have_velocity_ && q == staged_q_ && v == staged_v_ &&
-                     tau.size() == last_tau_.size() && tau == last_tau_;
+  const bool known = !stab && have_last_ && have_position_ && have_velocity_ && same(q, staged_q_) && same(v, staged_v_) &&
+                     same(tau, last_tau_);
   a.resize(n() + k());
   // Entry by entry, at the fixed sizes where known: θ'' was just stored 8 bytes at a time, and a block
   // copy (memcpy) reloads it 16 bytes at a time, which stalls on store forwarding.
@@ -417,7 +446,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::accelerations(const VecN& q, const Vec
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::setTime(double t) {
   // Time-dependent forces: a new time is a new velocity stage (and no remembered solve).
-  if (t != time_ && !model_.forces.empty()) have_velocity_ = have_last_ = false;
+  if (t != time_ && has_forces_) have_velocity_ = have_last_ = false;
   time_ = t;
 }
 
@@ -427,8 +456,13 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::derivatives(const VecN& q, const VecN&
   // After accelerations() the stages are at (q, v) and the clock's time: their powers are this state's.
   ConstrainedMechanism::accelerations(q, v, tau, stab, a);
   work = external_power_;
-  for (int i = 0; i < int(tau.size()); ++i) work += tau[i] * v[i];
   friction = friction_power_;
+  if constexpr (Nj != Eigen::Dynamic)
+    if (tau.size() == Nj) {  // the usual τ (n torques): the loop unrolled
+      for (int i = 0; i < Nj; ++i) work += tau[i] * v[i];
+      return;
+    }
+  for (int i = 0; i < int(tau.size()); ++i) work += tau[i] * v[i];
 }
 
 template <class S, int Nj, int Nr, int Nl>
@@ -444,10 +478,11 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::constraint(const VecN& q, VecN& phi, M
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::baumgarteTerm(const VecN& q, const VecN& v, double zeta, double omega, VecN& s) {
   positionStage(q);
-  // s = −2ζω (J θ' − A v_c) − ω² φ from the stage's own J and A (released rows are zero there).
-  const int nn = n(), kk = k();
-  s.resize(rows_);
-  for (int r = 0; r < rows_; ++r) {
+  // s = −2ζω (J θ' − A v_c) − ω² φ from the stage's own J and A (released rows are zero there); the
+  // loops unrolled at fixed sizes.
+  const int nn = Nj == Eigen::Dynamic ? n() : Nj, kk = Nl == Eigen::Dynamic ? k() : Nl, rows = Nr == Eigen::Dynamic ? rows_ : Nr;
+  s.resize(rows);
+  for (int r = 0; r < rows; ++r) {
     double gv = 0.0;
     for (int j = 0; j < nn; ++j) gv += problem_.J(r, j) * v[j];
     for (int j = 0; j < kk; ++j) gv -= problem_.A(r, j) * v[nn + j];
@@ -494,7 +529,7 @@ template <class S, int Nj, int Nr, int Nl>
 double ConstrainedMechanism<S, Nj, Nr, Nl>::kineticEnergy(const VecN& q, const VecN& v) {
   // The velocity stage at (q, v): usually the step's own (the trace row asks at the step's start).
   positionStage(q);
-  if (!have_velocity_ || v != staged_v_) velocityStage(v);
+  if (!have_velocity_ || !same(v, staged_v_)) velocityStage(v);
   double T = kineticEnergyWorld(model_.tree, data_);
   for (std::size_t i = 0, off = std::size_t(n()); i < model_.payloads.size(); ++i) {
     const Payload& p = model_.payloads[i];

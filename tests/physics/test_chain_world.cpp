@@ -5,6 +5,7 @@
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
+#include <limits>
 
 #include "physics/chain_world.h"
 #include "tests/physics/arms.h"
@@ -46,8 +47,18 @@ void checkWorldStages(TreeModel<S> t, const VecN& q, const VecN& qd) {
   const VecN h = rnea(t, body, qd, VecN::Zero(n));  // leaves body.a: the velocity-product accelerations
 
   positionKinematics(t, q, world);
-  Eigen::MatrixXd Mw(n, n);
+  // Every entry of M must be written (the branch's entries off the root paths as exact zeros): start from NaN.
+  Eigen::MatrixXd Mw = Eigen::MatrixXd::Constant(n, n, std::numeric_limits<double>::quiet_NaN());
   crbaWorld(t, world, Mw);
+  CHECK(Mw.allFinite());
+  auto onPath = [&](int i, int j) {  // i on the path from j to the root
+    for (int k = j; k >= 0; k = t.bodies[std::size_t(k)].parent)
+      if (k == i) return true;
+    return false;
+  };
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      if (!onPath(i, j) && !onPath(j, i)) CHECK(Mw(i, j) == 0.0);
   Eigen::VectorXd hw(n);
   biasForcesWorld(t, world, qd, hw);
 
