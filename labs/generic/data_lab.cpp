@@ -91,10 +91,25 @@ std::string DataLab::unit(const std::string& c) const {
   return {};
 }
 
-std::unique_ptr<Simulation> DataLab::simulate(Engine engine) const {
-  auto mech = std::make_unique<Mech>(s_.plant->mechanism);
+// A run on mechanism type M (the generic mechanism at fixed or dynamic sizes).
+template <class M>
+std::unique_ptr<Simulation> runOn(const DataSettings& s, Engine engine) {
+  auto mech = std::make_unique<M>(s.plant->mechanism);
   const VecN v0 = VecN::Zero(mech->n());
-  return simulateMechanism(engine, std::move(mech), s_.step, s_.q0, v0, std::make_unique<Hooks>(s_), s_.columns, s_.duration);
+  return simulateMechanism(engine, std::move(mech), s.step, s.q0, v0, std::make_unique<Hooks>(s), s.columns, s.duration);
+}
+
+std::unique_ptr<Simulation> DataLab::simulate(Engine engine) const {
+  // The shapes of the shipped loops at fixed sizes (instantiated in physics/model_file/hand_engine.cpp),
+  // as the C++ labs fix theirs: every loop of the step unrolled. Any other shape: dynamic sizes.
+  const auto& m = s_.plant->mechanism;
+  const int n = m.treeDof(), r = m.rows();
+  if (m.payloads.empty()) {
+    if (n == 4 && r == 2) return runOn<ConstrainedMechanism<Spatial, 4, 2, 0>>(s_, engine);
+    if (n == 3 && r == 2) return runOn<ConstrainedMechanism<Spatial, 3, 2, 0>>(s_, engine);
+    if (n == 4 && r == 3) return runOn<ConstrainedMechanism<Spatial, 4, 3, 0>>(s_, engine);
+  }
+  return runOn<Mech>(s_, engine);
 }
 
 json DataLab::metrics(const Trace& tr) const {
