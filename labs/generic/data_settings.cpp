@@ -136,6 +136,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   const JsonView axes = tool["axes"];
   for (std::size_t i = 0, n = axes.size(1, 3); i < n; ++i) {
     const std::string a = axes.at(i).oneOf({"x", "y", "z"});
+    if (std::find(s.axis_names.begin(), s.axis_names.end(), a) != s.axis_names.end()) axes.at(i).fail("each axis once");
     s.tool.axes.push_back(3 + (a[0] - 'x'));
     s.axis_names.push_back(a);
   }

@@ -169,6 +169,7 @@ TEST_CASE("a data lab's JSON: each bad field is one line naming its path") {
       {R"({"tool": {"closure": "pin_X", "axes": ["x", "z"]}})", "/tool/closure", "pin_C"},
       {R"({"tool": {"closure": null, "body": "nobody", "at": [0, 0, 0], "axes": ["x"]}})", "/tool/body", "left_crank"},
       {R"({"tool": {"closure": "pin_C", "axes": ["w"]}})", "/tool/axes/0", ""},
+      {R"({"tool": {"closure": "pin_C", "axes": ["x", "x"]}})", "/tool/axes/1", "each axis once"},
       {R"({"initial": {"actuated_deg": [1000.0, 0.0]}})", "/initial/actuated_deg/0", ""},
       {R"({"controller": {"kind": "magic"}})", "/controller/kind", "task_inverse_dynamics"},
       {R"({"controller": {"control_period": 0.0015}})", "/controller/control_period", "whole multiple"},
