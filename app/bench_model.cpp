@@ -68,7 +68,8 @@ void build(const model_file::LoadedModel& m, double dt, Engines& e) {
     Engine x;
     x.name = "hand";
     x.scheme = std::string(scheme) + " (" + e.sizes + ")";
-    x.step = [=] { return step(*mech, o, VecN::Zero(n), *q, *v) && q->allFinite() && v->allFinite(); };
+    // The zero torque made once: a step allocates nothing (as a lab's engine step).
+    x.step = [=, tau = VecN(VecN::Zero(n))] { return step(*mech, o, tau, *q, *v) && q->allFinite() && v->allFinite(); };
     x.restart = [=, q0 = m.q0] { *q = q0, *v = VecN::Zero(n), mech->setTime(0); };
     x.state = [=](VecN& qo, VecN& vo) { qo = *q, vo = *v; };
     return x;
@@ -80,8 +81,8 @@ void build(const model_file::LoadedModel& m, double dt, Engines& e) {
   b.name = "Bullet";
   b.scheme = e.bullet->describe() + ", semi-implicit Euler";
   auto* bt = &e.bullet;
-  b.step = [bt, n] {
-    (*bt)->step(VecN::Zero(n));
+  b.step = [bt, tau = VecN(VecN::Zero(n))] {
+    (*bt)->step(tau);
     return true;
   };
   b.restart = [bt, &m, dt, zero] { *bt = std::make_unique<bullet::BulletMechanism<Spatial>>(m.mechanism, dt, m.q0, zero); };
