@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <regex>
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
@@ -210,6 +211,11 @@ bool isDataLabFolder(const std::string& folder, const std::string& name) {
 
 bool registerDataLab(const std::string& folder, std::string* why) {
   const std::string name = fs::path(folder).filename().string();
+  // A lab's name goes into paths, reports and results.json: the same rule as dynlab new-lab's.
+  if (!std::regex_match(name, std::regex("[a-z][a-z0-9_]{0,39}"))) {
+    if (why) *why = folder + ": expected a lab folder named with lowercase letters, digits and _, starting with a letter (at most 40)";
+    return false;
+  }
   if (!isDataLabFolder(folder, name)) {
     if (why) *why = folder + ": expected a folder with " + name + ".json and no .cpp or .h";
     return false;

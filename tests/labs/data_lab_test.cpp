@@ -196,3 +196,42 @@ TEST_CASE("a data lab's JSON: each bad field is one line naming its path") {
   CHECK(std::find(s.columns.begin(), s.columns.end(), "f_pin_C_z") != s.columns.end());
   fs::remove_all(dir);
 }
+
+TEST_CASE("a data lab folder registers under its name, which must be a plain identifier") {
+  const fs::path root = fs::temp_directory_path() / ("dynlab_data_reg_" + std::to_string(::getpid()));
+  fs::remove_all(root);
+  auto make = [&](const std::string& name) {
+    fs::create_directories(root / name);
+    json c = fivebarConfig();
+    c["lab"] = name;
+    c["model_file"] = "assets/models/fivebar.xml";  // a shipped model, from the dynlab tree
+    std::ofstream(root / name / (name + ".json")) << c.dump();
+    return (root / name).string();
+  };
+  std::string why;
+  CHECK_FALSE(generic::registerDataLab(make("Bad Name"), &why));
+  CHECK(why.find("lowercase letters") != std::string::npos);
+  // A folder with C++ in it is a C++ lab's, not a data lab.
+  const std::string cpp = make("with_code");
+  std::ofstream(fs::path(cpp) / "lab.cpp") << "// a C++ lab\n";
+  CHECK_FALSE(generic::registerDataLab(cpp, &why));
+  CHECK(why.find("no .cpp or .h") != std::string::npos);
+  // A good one registers, builds from its JSON and runs; its name cannot be taken twice.
+  const std::string good = make("scratch_data_lab");
+  REQUIRE(generic::registerDataLab(good, &why));
+  CHECK_FALSE(generic::registerDataLab(good, &why));
+  CHECK(why.find("registered already") != std::string::npos);
+  const LabEntry* e = findLab("scratch_data_lab");
+  REQUIRE(e);
+  const json config = loadJsonFile(good + "/scratch_data_lab.json");
+  const auto lab = e->create(JsonView(config, good + "/scratch_data_lab.json"));
+  auto sim = lab->simulate(Engine::Hand);
+  std::vector<double> row;
+  for (int k = 0; k < 100; ++k) REQUIRE(sim->step(row));
+  const std::vector<std::string> columns = lab->columns();
+  const auto at = std::find(columns.begin(), columns.end(), "constraint_residual");
+  REQUIRE(at != columns.end());
+  CHECK(row[std::size_t(at - columns.begin())] <= 1e-12);
+  CHECK(unregisterLab("scratch_data_lab"));
+  fs::remove_all(root);
+}
