@@ -17,6 +17,7 @@
 #include <tuple>
 
 #include "app/commands.h"
+#include "app/model.h"
 #include "app/movie.h"
 #include "app/output.h"
 #include "app/progress.h"
@@ -222,9 +223,17 @@ int figure(const FigureArgs& a) {
     if (a.gains.size() > 1 && !a.stills.empty())
       badOption("--still", fmt("%g", a.stills.front()), "expected one --gains file with --still (a still shows one run)");
     const std::vector<std::string> gains_files = a.gains.empty() ? std::vector<std::string>{""} : a.gains;
-    for (const auto& g : gains_files) {
-      loads.push_back(loadLab(a.lab, a.config, g, a.duration));
-      applyScenario(loads.back(), a.scenario, g, a.duration);
+    if (isModelFile(a.lab)) {
+      // A model file where a lab goes: its passive run (app/model.h loadModelLab); no gains, scenario or config.
+      const std::string gains = a.gains.empty() ? "" : a.gains.front();
+      for (const auto& [option, value] : {std::pair{"--gains", gains}, {"--scenario", a.scenario}, {"--config", a.config}})
+        if (!value.empty()) badOption(option, value, "a model file runs passive: it has no gains, scenarios or lab config");
+      loads.push_back(loadModelLab(a.lab, a.duration));
+    } else {
+      for (const auto& g : gains_files) {
+        loads.push_back(loadLab(a.lab, a.config, g, a.duration));
+        applyScenario(loads.back(), a.scenario, g, a.duration);
+      }
     }
     const LoadedLab& loaded = loads.front();
     const std::vector<std::string> columns = loaded.lab->columns();

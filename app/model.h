@@ -9,8 +9,11 @@
 // Registered on the command line by ModelCommand, so main.cpp only constructs it and asks it to run.
 #pragma once
 #include <CLI/CLI.hpp>
+#include <optional>
 #include <string>
 #include <vector>
+
+#include "labs/run.h"
 
 namespace dyn::app {
 
@@ -29,6 +32,11 @@ struct RunArgs;
 bool isModelFile(const std::string& name);
 // `dynlab run FILE`: the run's options onto `dynlab model FILE`'s (lab-only options refused: exit 2).
 int runModelFile(const RunArgs& args);
+
+// A model file as a lab (`dynlab figure FILE`): the generic data lab (labs/generic/data_lab.h), passive,
+// at the file's step for `duration` s (default 2 s), with the closures beside a URDF; its figures are
+// the coordinates, the energy books and each closure's force. Throws InputError (one line) on bad input.
+LoadedLab loadModelLab(const std::string& file, std::optional<double> duration);
 
 // 0 ran and wrote; 1 the run failed (projection, non-finite state) or a write failed; 2 bad input
 // (one line, nothing written).

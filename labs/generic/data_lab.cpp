@@ -24,7 +24,7 @@ class Hooks final : public StepHooks {
   explicit Hooks(const DataSettings& s)
       : s_(s), ctrl_(s.controller, s.model, s.actuated, s.tool, s.q0, s.step.dt), plant_(s.plant->mechanism) {}
   VecN torque(double t, const VecN& q, const VecN& v) override {
-    s_.path->at(t, ref_.x, ref_.xd, ref_.xdd);
+    if (s_.path) s_.path->at(t, ref_.x, ref_.xd, ref_.xdd);
     return ctrl_.torque(t, q, v, ref_);
   }
   void row(const StepRecord& r, std::vector<double>& out) override {
@@ -37,12 +37,14 @@ class Hooks final : public StepHooks {
     out.push_back(ctrl_.saturated() ? 1.0 : 0.0);
     // The tool where the plant has it (not the controller's model: a payload changes no geometry, but
     // the plant is the truth).
-    const Eigen::Vector3d p = plant_.pointPosition(s_.tool.link, s_.tool.point, r.q);
-    VecN x(Eigen::Index(s_.tool.axes.size()));
-    for (std::size_t i = 0; i < s_.tool.axes.size(); ++i) x[Eigen::Index(i)] = p[s_.tool.axes[i] - 3];
-    for (int i = 0; i < x.size(); ++i) out.push_back(x[i]);
-    for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i]);
-    for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i] - x[i]);
+    if (!s_.tool.axes.empty()) {
+      const Eigen::Vector3d p = plant_.pointPosition(s_.tool.link, s_.tool.point, r.q);
+      VecN x(Eigen::Index(s_.tool.axes.size()));
+      for (std::size_t i = 0; i < s_.tool.axes.size(); ++i) x[Eigen::Index(i)] = p[s_.tool.axes[i] - 3];
+      for (int i = 0; i < x.size(); ++i) out.push_back(x[i]);
+      for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i]);
+      for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i] - x[i]);
+    }
     out.push_back(r.energy), out.push_back(r.work), out.push_back(r.residual);
     const auto& closures = s_.plant->closures;
     for (std::size_t c = 0; c < closures.size(); ++c)
@@ -184,6 +186,11 @@ void DataLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene&
 
 void DataLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
   o.title = s_.title.substr(0, s_.title.find(':'));  // "Five-bar: task-space control ..." → "Five-bar"
+  if (s_.axis_names.empty()) {
+    // No task: the passive model's panel (time, energy and its balance, closure), as `dynlab model` draws it.
+    modelOverlay(o.title, "passive (τ = 0)", tr, row, s_.step.dt, nullptr, o);
+    return;
+  }
   double e = 0;
   for (const auto& a : s_.axis_names) e += std::pow(tr.at(row, "e_" + a), 2);
   o.lines = {{"t", fmt("%.3f s", tr.at(row, "t"))}, {"tracking |e|", fmt("%.2f mm", 1e3 * std::sqrt(e))}};

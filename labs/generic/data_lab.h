@@ -6,7 +6,8 @@
 //   "actuated": ["left_crank", ...]      the joints the controller drives; the others are passive
 //   "torque_limit": [..]                 N·m per actuated joint
 //   "tool": {"closure": "pin_C"} | {"body": "left_link", "at": [x, y, z]}   the task point (world
-//                                        coordinates at the file's pose), "axes": ["x", "z"]
+//                                        coordinates at the file's pose), "axes": ["x", "z"]; none: no
+//                                        task and no trajectory (a passive model: `dynlab figure FILE`)
 //   "initial": {"actuated_deg": [..]}    the actuators' start; the passive joints are assembled
 //   "trajectory": {"segments": [...]}    the task path from the tool's start (labs/generic/task_path.h)
 //   "plant": {"payloads": [{"body", "at", "mass"}]}   point masses the plant carries and the
@@ -48,8 +49,9 @@ struct DataSettings {
   std::vector<std::string> columns;
 };
 
-// Parses a data lab's config (its folder: where the model file is).
-DataSettings parseDataSettings(const JsonView& config, const std::string& name, const std::string& folder);
+// Parses a data lab's config (its folder: where the model file is; options: loops given beside it).
+DataSettings parseDataSettings(const JsonView& config, const std::string& name, const std::string& folder,
+                               const model_file::LoadOptions& options = {});
 
 class DataLab final : public Lab {
  public:

@@ -67,7 +67,8 @@ std::string checkedModelPath(const JsonView& j, const std::string& folder) {
 
 }  // namespace
 
-DataSettings parseDataSettings(const JsonView& c, const std::string& name, const std::string& folder) {
+DataSettings parseDataSettings(const JsonView& c, const std::string& name, const std::string& folder,
+                               const model_file::LoadOptions& options) {
   DataSettings s;
   s.name = name, s.folder = folder;
   c.onlyKeys({"lab", "title", "description", "model_file", "actuated", "torque_limit", "tool", "initial", "trajectory",
@@ -78,7 +79,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   const JsonView mf = c["model_file"];
   model_file::LoadedModel file;
   try {
-    file = model_file::load(checkedModelPath(mf, folder));
+    file = model_file::load(checkedModelPath(mf, folder), options);
   } catch (const model_file::ModelFileError& e) {
     mf.fail(std::string("a model file dynlab reads (") + e.what() + ")");
   }
@@ -104,7 +105,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   const JsonView act = c["actuated"];
   std::vector<std::string> joint_names;
   for (const auto& j : file.joints) joint_names.push_back(j.name);
-  for (std::size_t i = 0, n = act.size(1, file.joints.size()); i < n; ++i) {
+  for (std::size_t i = 0, n = act.size(0, file.joints.size()); i < n; ++i) {
     const std::string jn = act.at(i).string();
     const auto it = std::find(joint_names.begin(), joint_names.end(), jn);
     if (it == joint_names.end()) act.at(i).fail("expected a joint of the model file (" + list(joint_names) + ")");
@@ -118,43 +119,51 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   s.controller.torque_limit.resize(m);
   for (int j = 0; j < m; ++j) s.controller.torque_limit[j] = lim.at(std::size_t(j)).positive(kMaxTorque);
 
-  // The tool: a closure's point or a body's.
-  const JsonView tool = c["tool"];
-  tool.onlyKeys({"closure", "body", "at", "axes"});
-  if (tool.has("closure")) {
-    const std::string cn = tool["closure"].string();
-    std::vector<std::string> names;
-    for (const auto& cl : file.closures) names.push_back(cl.name);
-    const auto it = std::find(names.begin(), names.end(), cn);
-    if (it == names.end()) tool["closure"].fail("expected a closure of the model file (" + list(names) + ")");
-    const auto& cl = file.closures[std::size_t(it - names.begin())];
-    if (cl.link1 < 0) tool["closure"].fail("expected a closure whose first body moves");
-    s.tool.link = cl.link1, s.tool.point = cl.point1;
-  } else {
-    std::tie(s.tool.link, s.tool.point) = bodyPoint(tool["body"], tool["at"], file, probe);
-  }
-  const JsonView axes = tool["axes"];
-  for (std::size_t i = 0, n = axes.size(1, 3); i < n; ++i) {
-    const std::string a = axes.at(i).oneOf({"x", "y", "z"});
-    if (std::find(s.axis_names.begin(), s.axis_names.end(), a) != s.axis_names.end()) axes.at(i).fail("each axis once");
-    s.tool.axes.push_back(3 + (a[0] - 'x'));
-    s.axis_names.push_back(a);
+  // The tool: a closure's point or a body's (none: a passive or open-loop lab without a task).
+  if (c.has("tool")) {
+    const JsonView tool = c["tool"];
+    tool.onlyKeys({"closure", "body", "at", "axes"});
+    if (tool.has("closure")) {
+      const std::string cn = tool["closure"].string();
+      std::vector<std::string> names;
+      for (const auto& cl : file.closures) names.push_back(cl.name);
+      const auto it = std::find(names.begin(), names.end(), cn);
+      if (it == names.end()) tool["closure"].fail("expected a closure of the model file (" + list(names) + ")");
+      const auto& cl = file.closures[std::size_t(it - names.begin())];
+      if (cl.link1 < 0) tool["closure"].fail("expected a closure whose first body moves");
+      s.tool.link = cl.link1, s.tool.point = cl.point1;
+    } else {
+      std::tie(s.tool.link, s.tool.point) = bodyPoint(tool["body"], tool["at"], file, probe);
+    }
+    const JsonView axes = tool["axes"];
+    for (std::size_t i = 0, n = axes.size(1, 3); i < n; ++i) {
+      const std::string a = axes.at(i).oneOf({"x", "y", "z"});
+      if (std::find(s.axis_names.begin(), s.axis_names.end(), a) != s.axis_names.end()) axes.at(i).fail("each axis once");
+      s.tool.axes.push_back(3 + (a[0] - 'x'));
+      s.axis_names.push_back(a);
+    }
+  } else if (c.has("trajectory")) {
+    c["trajectory"].fail("no trajectory without a \"tool\" to follow it");
   }
 
   // The start: the actuators placed, the loop assembled from the file's pose.
-  const JsonView init = c["initial"];
-  init.onlyKeys({"actuated_deg"});
-  init["actuated_deg"].size(std::size_t(m), std::size_t(m));
   s.q0 = file.q0;
-  for (int j = 0; j < m; ++j) s.q0[s.actuated[std::size_t(j)]] = init["actuated_deg"].at(std::size_t(j)).inRange(-720, 720) * M_PI / 180.0;
+  if (m > 0 || c.has("initial")) {
+    const JsonView init = c["initial"];
+    init.onlyKeys({"actuated_deg"});
+    init["actuated_deg"].size(std::size_t(m), std::size_t(m));
+    for (int j = 0; j < m; ++j) s.q0[s.actuated[std::size_t(j)]] = init["actuated_deg"].at(std::size_t(j)).inRange(-720, 720) * M_PI / 180.0;
+  }
   ConstrainedMechanism<Spatial> plant(file.mechanism);
-  if (!assemble(plant, s.q0, s.actuated)) init["actuated_deg"].fail("actuator angles at which the loop closes");
+  if (!assemble(plant, s.q0, s.actuated)) c["initial"]["actuated_deg"].fail("actuator angles at which the loop closes");
 
   // The path, from where the tool starts.
-  controllers::Controller probe_ctl({}, s.model, s.actuated, s.tool, s.q0, 1e-3);
-  VecN x0;
-  probe_ctl.taskPosition(s.q0, x0);
-  s.path = std::make_shared<TaskPath>(c["trajectory"], x0, kMaxCoordinate);
+  if (!s.tool.axes.empty()) {
+    controllers::Controller probe_ctl({}, s.model, s.actuated, s.tool, s.q0, 1e-3);
+    VecN x0;
+    probe_ctl.taskPosition(s.q0, x0);
+    s.path = std::make_shared<TaskPath>(c["trajectory"], x0, kMaxCoordinate);
+  }
 
   const SimulationSettings sim = parseSimulation(c["simulation"]);
   s.step = sim.step, s.duration = sim.duration;

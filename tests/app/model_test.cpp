@@ -121,6 +121,38 @@ TEST_CASE("dynlab run FILE.xml --engine both --video --frames: the model command
   CHECK(snapshot(dir / "f1/frames").size() == 7);
 }
 
+TEST_CASE("dynlab figure FILE: plots and stills of the file's passive run, as for a lab") {
+  TempDir dir("model_figure");
+  const Result r = dynlab(dir, "figure " + model("fourbar.xml") + " --duration 0.5 --out fig");
+  INFO(r.out, r.err);
+  REQUIRE(r.code == 0);
+  // The coordinates, the energy books and the closure's force; stills at the start, middle and end.
+  for (const char* f : {"plot_q_crank+q_coupler+q_rocker.pdf", "plot_energy+work.pdf", "plot_f_pin_C_x+f_pin_C_z.pdf",
+                        "still_0.000.png", "still_0.250.png", "still_0.500.png"}) {
+    INFO(f);
+    CHECK(fs::file_size(dir / "fig" / f) > 1000);
+  }
+  // A still draws the mechanism right of its panel, in colour.
+  int w = 0, h = 0, n = 0;
+  unsigned char* px = stbi_load((dir / "fig/still_0.500.png").string().c_str(), &w, &h, &n, 3);
+  REQUIRE(px != nullptr);
+  int drawn = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = w / 2; x < w; ++x) {
+      const unsigned char* p = px + (std::size_t(y) * w + x) * 3;
+      drawn += std::abs(p[0] - 245) + std::abs(p[1] - 245) + std::abs(p[2] - 240) > 60;
+    }
+  stbi_image_free(px);
+  CHECK(drawn > 5000);
+  // A URDF takes its loops from beside it, as dynlab model does.
+  REQUIRE(dynlab(dir, "figure " + model("fourbar.urdf") + " --plot f_pin_C_x --out urdf").code == 0);
+  CHECK(fs::exists(dir / "urdf/plot_f_pin_C_x.pdf"));
+  // Gains, scenarios and configs are a lab's: one line, exit 2, nothing written.
+  writeFile(dir / "g.json", R"({"gains": {}})");
+  checkBadInput(dir, "figure " + model("fourbar.xml") + " --gains g.json --out o", {"--gains", "g.json", "passive"}, dir / "o");
+  checkBadInput(dir, "figure missing.xml --out o", {"missing.xml", "no such file"}, dir / "o");
+}
+
 TEST_CASE("dynlab run FILE: a lab's options and a missing file are bad input (one line, exit 2)") {
   TempDir dir("model_run_bad");
   writeFile(dir / "g.json", R"({"gains": {}})");
