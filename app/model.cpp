@@ -174,7 +174,6 @@ Run runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& m
   VecN q = m.q0, v = VecN::Zero(n);
   bullet::BulletMechanism<Spatial> bt(m.mechanism, args.dt, q, v);
   run.summary = bt.describe();
-  static const std::map<std::string, int> kRow = {{"wx", 0}, {"wy", 1}, {"wz", 2}, {"x", 3}, {"y", 4}, {"z", 5}};
   // The power flowing in: the torques' τ·v less what damping and friction take.
   auto inflow = [&](const VecN& w) { return tau.dot(w) - frictionPower(m.mechanism, w); };
   double work = 0, power = inflow(v);
@@ -186,7 +185,7 @@ Run runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& m
       bt.state(qn, vn);
       forces.clear();
       for (std::size_t c = 0; c < m.closures.size(); ++c)
-        for (const auto& r : m.closures[c].kept) forces.push_back(bt.constraintForce(int(c))[kRow.at(r)]);
+        for (const auto& r : m.closures[c].kept) forces.push_back(bt.constraintForce(int(c))[model_file::rowIndex(r)]);
     }
     record(run, mech, k * args.dt, q, v, work, forces);
     if (k == steps) break;
@@ -239,8 +238,8 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration) 
   model_file::LoadOptions options;
   model_file::LoadedModel m;
   try {
-    m = loadWithLoops(file, "", options);
     if (const std::string beside = loopsBeside(file); !beside.empty()) options.closures = readLoops(beside);
+    m = model_file::load(file, options);
   } catch (const model_file::ModelFileError& e) {
     throw InputError(file, "/", std::string("a model file dynlab reads (") + e.what() + ")");
   }

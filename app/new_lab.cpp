@@ -45,7 +45,7 @@ bool renameLab(const fs::path& file, const std::string& from, const std::string&
 int newLab(const NewLabArgs& args) {
   if (!std::regex_match(args.name, std::regex("[a-z][a-z0-9_]{0,39}")))
     return fail("NAME \"" + args.name + "\": expected a lab name of lowercase letters, digits and _, starting with a letter (at most 40)");
-  const fs::path root = args.labs.empty() ? fs::path(defaultConfigPath("_")).parent_path().parent_path() : fs::path(args.labs);
+  const fs::path root = args.labs.empty() ? fs::path(labsRoot()) : fs::path(args.labs);
   const fs::path src = fs::path(defaultConfigPath(args.from)).parent_path();
   if (!generic::isDataLabFolder(src.string(), args.from)) {
     if (findLab(args.from))

@@ -129,6 +129,8 @@ bool registerLab(LabEntry entry);
 bool unregisterLab(const std::string& name);
 // The lab's default config: labs/<name>/<name>.json in the source tree, or $DYNLAB_HOME/labs/...
 std::string defaultConfigPath(const std::string& name);
+// The folder of lab folders: $DYNLAB_HOME/labs, else the source tree's labs/.
+std::string labsRoot();
 
 #define DYNLAB_REGISTER_LAB(id, summary, factory) \
   static const bool dynlab_registered_##id = ::dyn::registerLab({#id, summary, factory})

@@ -38,10 +38,12 @@ const LabEntry* findLab(const std::string& name) {
   return nullptr;
 }
 
-std::string defaultConfigPath(const std::string& name) {
+std::string labsRoot() {
   const char* home = std::getenv("DYNLAB_HOME");
-  return std::string(home && *home ? home : DYNLAB_SOURCE_DIR) + "/labs/" + name + "/" + name + ".json";
+  return std::string(home && *home ? home : DYNLAB_SOURCE_DIR) + "/labs";
 }
+
+std::string defaultConfigPath(const std::string& name) { return labsRoot() + "/" + name + "/" + name + ".json"; }
 
 std::string stoppedSentence(const std::string& failure, double t) {
   if (failure.rfind("stopped: ", 0) == 0) return failure;

@@ -22,7 +22,7 @@ using Mech = ConstrainedMechanism<Spatial>;
 class Hooks final : public StepHooks {
  public:
   explicit Hooks(const DataSettings& s)
-      : s_(s), ctrl_(s.controller, s.model, s.actuated, s.tool, s.q0, s.step.dt), plant_(s.plant->mechanism) {}
+      : s_(s), ctrl_(s.controller, s.model, s.actuated, s.tool, s.q0, s.step.dt) {}
   VecN torque(double t, const VecN& q, const VecN& v) override {
     if (s_.path) s_.path->at(t, ref_.x, ref_.xd, ref_.xdd);
     return ctrl_.torque(t, q, v, ref_);
@@ -35,12 +35,11 @@ class Hooks final : public StepHooks {
     const VecN& u = ctrl_.command();
     out.insert(out.end(), u.data(), u.data() + u.size());
     out.push_back(ctrl_.saturated() ? 1.0 : 0.0);
-    // The tool where the plant has it (not the controller's model: a payload changes no geometry, but
-    // the plant is the truth).
+    // The tool at the plant's state (the controller's model has the plant's geometry: payloads change
+    // only inertias).
     if (!s_.tool.axes.empty()) {
-      const Eigen::Vector3d p = plant_.pointPosition(s_.tool.link, s_.tool.point, r.q);
-      VecN x(Eigen::Index(s_.tool.axes.size()));
-      for (std::size_t i = 0; i < s_.tool.axes.size(); ++i) x[Eigen::Index(i)] = p[s_.tool.axes[i] - 3];
+      VecN x;
+      ctrl_.taskPosition(r.q, x);
       for (int i = 0; i < x.size(); ++i) out.push_back(x[i]);
       for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i]);
       for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i] - x[i]);
@@ -48,20 +47,12 @@ class Hooks final : public StepHooks {
     out.push_back(r.energy), out.push_back(r.work), out.push_back(r.residual);
     const auto& closures = s_.plant->closures;
     for (std::size_t c = 0; c < closures.size(); ++c)
-      for (const auto& row : closures[c].kept) out.push_back(r.forces[c][rowIndex(row)]);
+      for (const auto& row : closures[c].kept) out.push_back(r.forces[c][model_file::rowIndex(row)]);
   }
 
  private:
-  // A kept row's place in the spatial force (moment, force).
-  static int rowIndex(const std::string& row) {
-    static const char* names[] = {"wx", "wy", "wz", "x", "y", "z"};
-    for (int i = 0; i < 6; ++i)
-      if (row == names[i]) return i;
-    return 0;
-  }
   const DataSettings& s_;
   controllers::Controller ctrl_;
-  Mech plant_;
   controllers::Reference ref_;
 };
 
@@ -73,7 +64,7 @@ std::string fmt(const char* f, double x) {
 
 }  // namespace
 
-DataLab::DataLab(DataSettings s) : s_(std::move(s)), picture_(*s_.plant) {}
+DataLab::DataLab(DataSettings s) : s_(std::move(s)), picture_(*s_.plant), kinematics_(std::make_unique<Mech>(s_.plant->mechanism)) {}
 
 std::string DataLab::unit(const std::string& c) const {
   auto starts = [&](const char* p) { return c.rfind(p, 0) == 0; };
@@ -168,8 +159,7 @@ void DataLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene&
   // The path: the reference so far as a thin line, the tool's target as a small ball.
   if (s_.tool.axes.size() >= 2) {
     Polyline path;
-    Mech plant(s_.plant->mechanism);
-    const Eigen::Vector3d p0 = plant.pointPosition(s_.tool.link, s_.tool.point, q);
+    const Eigen::Vector3d p0 = kinematics_->pointPosition(s_.tool.link, s_.tool.point, q);
     const std::size_t stride = std::max<std::size_t>(1, tr.rows() / 400);
     for (std::size_t r = 0; r < tr.rows(); r += stride) {
       Eigen::Vector3d p = p0;
@@ -254,6 +244,6 @@ int registerDataLabs(const std::string& root) {
 }
 
 // Every data lab folder of the lab tree, at start-up (as the C++ labs register themselves).
-[[maybe_unused]] const int kRegistered = registerDataLabs(fs::path(defaultConfigPath("_")).parent_path().parent_path().string());
+[[maybe_unused]] const int kRegistered = registerDataLabs(labsRoot());
 
 }  // namespace dyn::generic

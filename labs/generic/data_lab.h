@@ -72,6 +72,7 @@ class DataLab final : public Lab {
  private:
   DataSettings s_;
   ModelPicture picture_;
+  std::unique_ptr<ConstrainedMechanism<Spatial>> kinematics_;  // the plant's, for the tool's place in a picture
   mutable const double* bounds_of_ = nullptr;  // the trace whose run bounds are cached
   mutable std::size_t bounds_rows_ = 0;
   mutable Eigen::AlignedBox3d bounds_;

@@ -60,7 +60,7 @@ std::string checkedModelPath(const JsonView& j, const std::string& folder) {
     j.fail("expected a model file in the lab's folder or the dynlab tree (a relative path without \"..\")");
   std::error_code ec;
   if (std::filesystem::exists(folder + "/" + rel, ec)) return folder + "/" + rel;
-  const auto tree = std::filesystem::path(defaultConfigPath("_")).parent_path().parent_path().parent_path();
+  const auto tree = std::filesystem::path(labsRoot()).parent_path();
   if (std::filesystem::exists(tree / rel, ec)) return (tree / rel).string();
   j.fail("expected a model file in the lab's folder (" + folder + ") or the dynlab tree (" + tree.string() + "), not found there");
 }
@@ -154,14 +154,14 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     init["actuated_deg"].size(std::size_t(m), std::size_t(m));
     for (int j = 0; j < m; ++j) s.q0[s.actuated[std::size_t(j)]] = init["actuated_deg"].at(std::size_t(j)).inRange(-720, 720) * M_PI / 180.0;
   }
-  ConstrainedMechanism<Spatial> plant(file.mechanism);
-  if (!assemble(plant, s.q0, s.actuated)) c["initial"]["actuated_deg"].fail("actuator angles at which the loop closes");
+  // (The probe has the file's geometry; the payloads changed only inertias.)
+  if (!assemble(probe, s.q0, s.actuated)) c["initial"]["actuated_deg"].fail("actuator angles at which the loop closes");
 
   // The path, from where the tool starts.
   if (!s.tool.axes.empty()) {
-    controllers::Controller probe_ctl({}, s.model, s.actuated, s.tool, s.q0, 1e-3);
-    VecN x0;
-    probe_ctl.taskPosition(s.q0, x0);
+    const Eigen::Vector3d p0 = probe.pointPosition(s.tool.link, s.tool.point, s.q0);
+    VecN x0(Eigen::Index(s.tool.axes.size()));
+    for (std::size_t i = 0; i < s.tool.axes.size(); ++i) x0[Eigen::Index(i)] = p0[s.tool.axes[i] - 3];
     s.path = std::make_shared<TaskPath>(c["trajectory"], x0, kMaxCoordinate);
   }
 

@@ -24,7 +24,6 @@ namespace {
 using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
 using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
-const char* const kRowNames[6] = {"wx", "wy", "wz", "x", "y", "z"};
 
 // Offset of the first byte that is not well-formed UTF-8 (no overlongs, surrogates or cut-off
 // sequences), or npos.

@@ -32,6 +32,15 @@ struct ModelFileError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A closure row's name (wx wy wz x y z, world axes) as its place in a spatial force (moment, force); −1 if
+// it names none.
+inline constexpr const char* kRowNames[6] = {"wx", "wy", "wz", "x", "y", "z"};
+inline int rowIndex(const std::string& row) {
+  for (int i = 0; i < 6; ++i)
+    if (row == kRowNames[i]) return i;
+  return -1;
+}
+
 // A loop closure as the file names it, and which of its rows the description keeps.
 struct Closure {
   std::string name;   // the equality's name (or "connect #i")

@@ -17,6 +17,22 @@ using nlohmann::json;
 
 namespace {
 std::string model(const char* name) { return quote(std::string(DYNLAB_SOURCE_DIR) + "/assets/models/" + name); }
+
+// Pixels of a frame's right half (the panel fills the top-left) that differ from the background: the
+// mechanism drawn, in colour. −1 if the PNG does not load.
+int drawnRightOfPanel(const fs::path& png) {
+  int w = 0, h = 0, n = 0;
+  unsigned char* px = stbi_load(png.string().c_str(), &w, &h, &n, 3);
+  if (!px) return -1;
+  int drawn = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = w / 2; x < w; ++x) {
+      const unsigned char* p = px + (std::size_t(y) * w + x) * 3;
+      drawn += std::abs(p[0] - 245) + std::abs(p[1] - 245) + std::abs(p[2] - 240) > 60;
+    }
+  stbi_image_free(px);
+  return drawn;
+}
 }  // namespace
 
 TEST_CASE("dynlab model: the four-bar is read, run passive, and its trace keeps closure and energy") {
@@ -96,19 +112,9 @@ TEST_CASE("dynlab run FILE.xml --engine both --video --frames: the model command
   line.erase(line.find_last_not_of(" \r\n") + 1);
   CHECK(line == "h264,640,480,yuv420p," + std::to_string(expected));
   // The last frame: the mechanism drawn right of the panel (the panel fills the top-left), in colour.
-  int w = 0, h = 0, n = 0;
   char name[32];
   std::snprintf(name, sizeof name, "%05d.png", expected - 1);
-  unsigned char* px = stbi_load((dir / "out/frames" / name).string().c_str(), &w, &h, &n, 3);
-  REQUIRE(px != nullptr);
-  int drawn = 0;
-  for (int y = 0; y < h; ++y)
-    for (int x = w / 2; x < w; ++x) {
-      const unsigned char* p = px + (std::size_t(y) * w + x) * 3;
-      drawn += std::abs(p[0] - 245) + std::abs(p[1] - 245) + std::abs(p[2] - 240) > 60;
-    }
-  stbi_image_free(px);
-  CHECK(drawn > 2000);
+  CHECK(drawnRightOfPanel(dir / "out/frames" / name) > 2000);
   // `dynlab run FILE` is `dynlab model FILE`: the same trace, byte for byte.
   REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.5 --out same").code == 0);
   CHECK(readFile(dir / "same/trace.csv") == readFile(dir / "out/trace.csv"));
@@ -133,17 +139,7 @@ TEST_CASE("dynlab figure FILE: plots and stills of the file's passive run, as fo
     CHECK(fs::file_size(dir / "fig" / f) > 1000);
   }
   // A still draws the mechanism right of its panel, in colour.
-  int w = 0, h = 0, n = 0;
-  unsigned char* px = stbi_load((dir / "fig/still_0.500.png").string().c_str(), &w, &h, &n, 3);
-  REQUIRE(px != nullptr);
-  int drawn = 0;
-  for (int y = 0; y < h; ++y)
-    for (int x = w / 2; x < w; ++x) {
-      const unsigned char* p = px + (std::size_t(y) * w + x) * 3;
-      drawn += std::abs(p[0] - 245) + std::abs(p[1] - 245) + std::abs(p[2] - 240) > 60;
-    }
-  stbi_image_free(px);
-  CHECK(drawn > 5000);
+  CHECK(drawnRightOfPanel(dir / "fig/still_0.500.png") > 5000);
   // A URDF takes its loops from beside it, as dynlab model does.
   REQUIRE(dynlab(dir, "figure " + model("fourbar.urdf") + " --plot f_pin_C_x --out urdf").code == 0);
   CHECK(fs::exists(dir / "urdf/plot_f_pin_C_x.pdf"));
