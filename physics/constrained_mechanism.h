@@ -63,6 +63,14 @@ class ConstrainedMechanism : public ConstrainedSystem {
   Vec constraintForce(int i, const Solution& s);
   // Its η rows, and the row where they start.
   int rowOffset(int i) const { return offsets_[std::size_t(i)]; }
+  // The load each tree joint carries in a solution s at (q, v): the spatial force the joint's parent
+  // applies to the subtree it carries, world axes at the world origin (spatial: (moment, force)).
+  // RNEA (chain.h) at θ'' with gravity gives the force the subtree's motion needs; the constraint
+  // forces on the subtree's links supply part of it, the joint the rest:
+  //   f_i = Σ_{k ∈ subtree(i)} (I_k a_k + v_k ×* I_k v_k − I_k a_g)  −  Σ_{constraints on the subtree} f_c
+  // Its part along the joint's axis is the joint's torque net of spring and friction; the rest is what
+  // the bearing carries. The description's external forces (model().forces) are not counted.
+  void jointLoads(const VecN& q, const VecN& v, const Solution& s, std::vector<Vec>& loads);
   // Constraint i's extra reports (Constraint::reportNames) at the state last solved.
   void constraintReport(int i, const Solution& s, double* out);
 
