@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <sstream>
@@ -63,13 +64,13 @@ Eigen::Vector3d direction(const json& v, const std::string& at, const std::strin
 
 // An array of element objects under `key`: each an object with only `keys`, with every key of
 // `required`. Returns the elements' JSON paths ("rolling[0]").
-std::vector<std::string> elements(const json& j, const char* key, const std::string& file, const std::set<std::string>& keys,
+std::vector<std::string> elements(const json& j, const char* key, const char* noun, const std::string& file, const std::set<std::string>& keys,
                                   const std::vector<const char*>& required, const std::string& hint) {
   std::vector<std::string> at;
   if (!j.contains(key)) return at;
   const json& list = j[key];
   if (!list.is_array() || list.empty() || list.size() > kMaxLoops)
-    throw ModelFileError(file + ": " + key + ": expected an array of 1 to " + std::to_string(kMaxLoops) + " elements, got " + shown(list));
+    throw ModelFileError(file + ": " + key + ": expected an array of 1 to " + std::to_string(kMaxLoops) + " " + noun + ", got " + shown(list));
   std::string expected;
   for (const auto& k : keys) expected += (expected.empty() ? "" : ", ") + k;
   for (std::size_t i = 0; i < list.size(); ++i) {
@@ -107,25 +108,26 @@ void readBeside(const std::string& file, model_file::LoadOptions& options) {
     throw ModelFileError(file + ": not JSON (" + std::string(e.what()) + ")");
   }
   if (!j.is_object() || !(j.contains("loops") || j.contains("rolling") || j.contains("contacts")))
-    throw ModelFileError(file + ": expected an object {\"loops\": [...], \"rolling\": [...], \"contacts\": [...]} (at least one), got " + shown(j));
+    throw ModelFileError(file + ": expected an object {\"loops\": [...]} (or \"rolling\", \"contacts\": at least one of the three), got " + shown(j));
   for (const auto& [key, value] : j.items())
     if (key != "loops" && key != "rolling" && key != "contacts" && key != "comment")
       throw ModelFileError(file + ": " + key + ": unknown key (expected \"loops\", \"rolling\", \"contacts\", \"comment\")");
   // Names head the trace's columns: one per closure, wheel and contact (the loader checks the file's own).
-  std::set<std::string> names;
-  auto name = [&](const json& e, const std::string& at, const std::string& fallback) {
+  std::map<std::string, std::string> names;  // name → what it names
+  auto name = [&](const json& e, const std::string& at, const std::string& fallback, const char* what) {
     const std::string n = e.contains("name") ? text(e["name"], at + ".name", file) : fallback;
-    if (!names.insert(n).second) throw ModelFileError(file + ": " + at + ".name: '" + n + "' names an earlier closure, wheel or contact too");
+    if (const auto [it, fresh] = names.emplace(n, what); !fresh)
+      throw ModelFileError(file + ": " + at + ".name: '" + n + "' names an earlier " + it->second + " too (expected a new name: it heads trace columns)");
     return n;
   };
   const std::vector<std::string> loops =
-      elements(j, "loops", file, {"name", "kind", "body1", "point1", "body2", "point2", "comment"}, {"kind", "body1", "point1", "body2"}, "");
+      elements(j, "loops", "closures", file, {"name", "kind", "body1", "point1", "body2", "point2", "comment"}, {"kind", "body1", "point1", "body2"}, "");
   for (std::size_t i = 0; i < loops.size(); ++i) {
     const std::string& at = loops[i];
     const json& l = j["loops"][i];
     model_file::GivenClosure c;
     c.where = file + ": " + at;
-    c.name = name(l, at, "loop" + std::to_string(i));
+    c.name = name(l, at, "loop" + std::to_string(i), "closure");
     c.kind = text(l["kind"], at + ".kind", file);
     if (c.kind != "connect" && c.kind != "weld")
       throw ModelFileError(file + ": " + at + ".kind: expected \"connect\" (3 translation rows) or \"weld\" (6 rows), got " + shown(l["kind"]));
@@ -136,14 +138,14 @@ void readBeside(const std::string& file, model_file::LoadOptions& options) {
     options.closures.push_back(c);
   }
   // A rolling wheel: the rolling kind rolls without slip on a horizontal ground z = height.
-  const std::vector<std::string> wheels = elements(j, "rolling", file, {"name", "body", "centre", "axle", "radius", "height", "mu", "comment"},
+  const std::vector<std::string> wheels = elements(j, "rolling", "wheels", file, {"name", "body", "centre", "axle", "radius", "height", "mu", "comment"},
                                                    {"body", "axle", "radius"}, " (the ground is the plane z = height, the wheel never slips)");
   for (std::size_t i = 0; i < wheels.size(); ++i) {
     const std::string& at = wheels[i];
     const json& w = j["rolling"][i];
     model_file::GivenRolling r;
     r.where = file + ": " + at;
-    r.name = name(w, at, "wheel" + std::to_string(i));
+    r.name = name(w, at, "wheel" + std::to_string(i), "wheel");
     r.body = text(w["body"], at + ".body", file);
     if (w.contains("centre")) r.centre = point(w["centre"], at + ".centre", file);
     r.axle = direction(w["axle"], at + ".axle", file);
@@ -154,14 +156,14 @@ void readBeside(const std::string& file, model_file::LoadOptions& options) {
   }
   // A ball against a plane: one unilateral row; the hand engine's rigid contact is plastic and frictionless.
   const std::vector<std::string> contacts = elements(
-      j, "contacts", file, {"name", "body", "point", "radius", "normal", "height", "mu", "stiffness", "damping", "comment"}, {"body", "point"},
+      j, "contacts", "contacts", file, {"name", "body", "point", "radius", "normal", "height", "mu", "stiffness", "damping", "comment"}, {"body", "point"},
       " (a rigid contact's touchdown is plastic: no restitution; mu is Coulomb friction in Bullet only)");
   for (std::size_t i = 0; i < contacts.size(); ++i) {
     const std::string& at = contacts[i];
     const json& e = j["contacts"][i];
     model_file::GivenContact c;
     c.where = file + ": " + at;
-    c.name = name(e, at, "contact" + std::to_string(i));
+    c.name = name(e, at, "contact" + std::to_string(i), "contact");
     c.body = text(e["body"], at + ".body", file);
     c.point = point(e["point"], at + ".point", file);
     if (e.contains("radius")) c.radius = number(e["radius"], at + ".radius", file, 0, 1e3, "the ball's radius in metres, in [0, 1e3]");
