@@ -11,6 +11,8 @@
 //   closures     <equality> connect (3 translation rows) and weld (6 rows) as point closures, with the
 //                rows that are identically dependent on the others (a planar loop's out-of-plane
 //                rows) dropped and named
+//   elements     dynlab's own, given beside the file (LoadOptions: GivenRolling, GivenContact): a
+//                wheel rolling without slip and a ball against a plane (unilateral), after the closures
 // Anything else the description cannot represent is a one-line ModelFileError naming the file, the
 // element and what is supported. This folder is the only code that includes MuJoCo.
 #pragma once
