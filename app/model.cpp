@@ -346,6 +346,11 @@ std::string report(const Run& r, const std::string& engine, const model_file::Lo
         o << "  contact " << c.name << ": min gap " << fmt(extreme) << " m; at the end f_normal " << fmt(t.at(last, "f_" + n + "_normal"))
           << " N, f_tangent " << fmt(t.at(last, "f_" + n + "_tangent")) << " N\n";
     }
+    for (std::size_t i = 0; i < m.contacts.size(); ++i)
+      if (m.mechanism.constraints[m.closures.size() + i]->compliant()) {
+        o << "  note: a compliant contact's spring energy and damping are not in the books (its E − E0 − W holds them)\n";
+        break;
+      }
     if (anyImpacts(m)) {
       if (engine.rfind("hand", 0) == 0)
         o << "  touchdowns (plastic impacts) took " << fmt(t.at(last, "impacts")) << " J (counted in W)\n";
