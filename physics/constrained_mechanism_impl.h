@@ -324,6 +324,8 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
       dx.tail(k()) = s.alpha_c;
       if (dx.allFinite()) {
         v -= dx;
+        const VecN dv = dx.head(n()), dvc = dx.tail(k());
+        impact_loss_ += 0.5 * (dv.dot(problem_.M * dv) + (k() ? dvc.dot(problem_.Mc * dvc) : 0.0));
         const VecN P = -s.eta;
         for (std::size_t i = 0; i < count; ++i)
           if (rigid(i) && !released_[i]) impact_[i] = model_.constraints[i]->force(kin_, P.data() + offsets_[i]);
