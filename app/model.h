@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "app/model_lab.h"
 #include "labs/run.h"
 
 namespace dyn::app {
@@ -31,15 +32,8 @@ struct ModelArgs {
 };
 
 struct RunArgs;
-// True when `dynlab run`'s LAB names a model file (ends in .xml or .urdf, any case): no lab's name does.
-bool isModelFile(const std::string& name);
 // `dynlab run FILE`: the run's options onto `dynlab model FILE`'s (lab-only options refused: exit 2).
 int runModelFile(const RunArgs& args);
-
-// A model file as a lab (`dynlab figure FILE`): the generic data lab (labs/generic/data_lab.h), passive,
-// at the file's step for `duration` s (default 2 s), with the closures beside a URDF; its figures are
-// the coordinates, the energy books and each closure's force. Throws InputError (one line) on bad input.
-LoadedLab loadModelLab(const std::string& file, std::optional<double> duration);
 
 // 0 ran and wrote; 1 the run failed (projection, non-finite state) or a write failed; 2 bad input
 // (one line, nothing written).

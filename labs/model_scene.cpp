@@ -231,11 +231,11 @@ void modelOverlay(const std::string& title, const std::string& engines, const Tr
   o.lines = {{"engine", engines},
              {"t", fmt("%.3f s", tr.at(row, "t"))},
              {"energy E", fmt("%.5f J", tr.at(row, "energy"))},
-             {"E - E0 - W", fmt("%.2e J", balance(row))},
-             {"closure |phi|", fmt("%.1e", tr.at(row, "constraint_residual"))}};
+             {"E − E0 − W", fmt("%.2e J", balance(row))},
+             {"closure |φ|", fmt("%.1e", tr.at(row, "constraint_residual"))}};
   if (ghost && row < ghost->rows()) o.lines.push_back({"Bullet |phi|", fmt("%.1e", ghost->at(row, "constraint_residual"))});
   // Live plots over the last two seconds, up to and including this row.
-  Series e{"E - E0 - W (mJ)", {}, {0.23f, 0.42f, 0.68f, 1.0f}}, phi{"log10 |phi|", {}, {0.90f, 0.45f, 0.10f, 1.0f}};
+  Series e{"E − E0 − W (mJ)", {}, {0.23f, 0.42f, 0.68f, 1.0f}}, phi{"log₁₀ |φ|", {}, {0.90f, 0.45f, 0.10f, 1.0f}};
   for (std::size_t r = liveWindowStart(row, 2.0, dt); r <= row; ++r) {
     e.values.push_back(float(1e3 * balance(r)));
     phi.values.push_back(float(std::log10(std::max(tr.at(r, "constraint_residual"), 1e-17))));

@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iostream>
 
+#include "app/model_lab.h"
 #include "app/ui/panel.h"
 #include "render/fonts.h"
 #include "render/renderer.h"
@@ -116,7 +117,12 @@ bool writeText(const std::string& path, const std::string& text) {
 
 int run(const Args& a) {
   // Everything that can be wrong with the input is checked before a window opens.
-  TuningSession session(a.lab, a.config, a.gains, a.scenario);
+  // A model file where a lab goes: its passive motion (app/model_lab.h), nothing to tune but the engines.
+  const bool model = app::isModelFile(a.lab);
+  if (model)
+    for (const auto& [given, option] : {std::pair{!a.config.empty(), "--config"}, {!a.gains.empty(), "--gains"}, {!a.scenario.empty(), "--scenario"}})
+      if (given) throw InputError("<command line>", option, "a model file runs passive, without a lab's config, gains or scenario");
+  TuningSession session = model ? TuningSession(app::loadModelLab(a.lab, std::nullopt)) : TuningSession(a.lab, a.config, a.gains, a.scenario);
   for (const auto& s : a.set) session.set(s);
   session.setEngine(parseEngineChoice(a.engine));
   session.restart();
@@ -127,7 +133,7 @@ int run(const Args& a) {
   PanelState st;
   st.playing = !a.paused;
   st.speed = a.speed;
-  st.save_path = a.save.empty() ? a.lab + "_gains.json" : a.save;
+  st.save_path = a.save.empty() ? session.labName() + "_gains.json" : a.save;
   const bool scripted = a.frames >= 0;
 
   std::unique_ptr<WindowContext> ctx;
@@ -229,7 +235,7 @@ int main(int argc, char** argv) {
   CLI::App cli{"dynlab-ui — tune a lab's controller gains interactively and watch the mechanism move.\n"
                "Space: play/pause, R: restart. \"Save gains…\" writes a submission for `dynlab grade`."};
   cli.set_version_flag("--version", std::string(DYNLAB_VERSION));
-  cli.add_option("LAB", a.lab, "Lab name (see `dynlab list`)")->required();
+  cli.add_option("LAB", a.lab, "Lab name (see `dynlab list`), or a model file (.xml, .urdf) to watch move passive")->required();
   cli.add_option("--config", a.config, "Lab config JSON (default: labs/LAB/LAB.json)");
   cli.add_option("--gains", a.gains, "Start from these gains: a submission or gains JSON");
   cli.add_option("--scenario", a.scenario, "Tune under one rubric scenario (heavy_load, noisy_sensor, ...) exactly as the grader runs it");

@@ -309,10 +309,13 @@ void drawTuningPanel(TuningSession& session, PanelState& st, float x, float widt
   runSection(session, st);
   problemSection(session);
   ImGui::Spacing();
-  gainsSection(session, st);
+  // Nothing to tune (a model file's passive run): no gains to set, save or grade.
+  const bool tunable = !session.gainSpecs().empty() || !session.optionSpecs().empty();
+  if (tunable) gainsSection(session, st);
+  else ImGui::TextWrapped("Passive: nothing to tune here. Watch the engines agree, or not.");
   plotsSection(session, st);
   metricsSection(session);
-  submissionSection(session, st);
+  if (tunable) submissionSection(session, st);
   ImGui::PopItemWidth();
   ImGui::End();
 }

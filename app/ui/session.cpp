@@ -34,21 +34,34 @@ EngineChoice parseEngineChoice(const std::string& s) {
 TuningSession::TuningSession(const std::string& lab, const std::string& config_file, const std::string& gains_file,
                              const std::string& scenario) {
   LoadedLab loaded = loadLab(lab, config_file, gains_file);
-  lab_name_ = lab;
-  entry_ = loaded.entry;
-  config_file_ = loaded.config_file;
-  source_ = gains_file.empty() ? config_file_ : gains_file;
-  file_config_ = std::move(loaded.config);
+  const std::string config_path = loaded.config_file;
   // The lab's own defaults (before any gains file), for "Lab defaults".
-  const json plain = loadJsonFile(config_file_);
+  const json plain = loadJsonFile(config_path);
   // Gains in the order the lab's JSON lists them (json objects sort their keys).
   std::vector<std::string> order;
   {
     // Read as every input is (a regular file, UTF-8): the file was checked above, not trusted since.
-    const auto ordered = nlohmann::ordered_json::parse(readTextFile(config_file_, 16u << 20), nullptr, false);
+    const auto ordered = nlohmann::ordered_json::parse(readTextFile(config_path, 16u << 20), nullptr, false);
     if (ordered.is_object() && ordered.contains("gains") && ordered["gains"].is_object())
       for (const auto& [gname, _] : ordered["gains"].items()) order.push_back(gname);
   }
+  init(lab, std::move(loaded), plain, order, gains_file.empty() ? config_path : gains_file, scenario);
+}
+
+TuningSession::TuningSession(LoadedLab loaded) {
+  // A lab built in memory (a model file's passive run): its config is its own defaults.
+  const json plain = loaded.config;
+  const std::string name = plain.value("lab", std::string("model")), source = loaded.config_file;
+  init(name, std::move(loaded), plain, {}, source, "");
+}
+
+void TuningSession::init(const std::string& lab, LoadedLab loaded, const json& plain, std::vector<std::string> order,
+                         const std::string& source, const std::string& scenario) {
+  lab_name_ = lab;
+  entry_ = loaded.entry;
+  config_file_ = loaded.config_file;
+  source_ = source;
+  file_config_ = std::move(loaded.config);
   for (const auto& [gname, _] : file_config_.at("gains").items())
     if (std::find(order.begin(), order.end(), gname) == order.end()) order.push_back(gname);
   for (const std::string& gname : order) {

@@ -11,6 +11,7 @@
 
 #include "grading/scenario.h"
 #include "labs/lab.h"
+#include "labs/run.h"
 
 namespace dyn::ui {
 
@@ -39,6 +40,8 @@ class TuningSession {
   // scenarioConfig), its noise seeded as grading submission() would seed it.
   TuningSession(const std::string& lab, const std::string& config_file = "", const std::string& gains_file = "",
                 const std::string& scenario = "");
+  // A lab already built in memory, its config its own defaults (a model file: app/model_lab.h).
+  explicit TuningSession(LoadedLab loaded);
 
   // ---- what can be tuned --------------------------------------------------------------------
   const std::string& labName() const { return lab_name_; }
@@ -105,6 +108,8 @@ class TuningSession {
     bool done = false;
   };
   bool stepRun(Run& run);
+  void init(const std::string& lab, LoadedLab loaded, const json& plain, std::vector<std::string> order,
+            const std::string& source, const std::string& scenario);
 
   std::string lab_name_, config_file_, source_;
   const LabEntry* entry_ = nullptr;

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 
+#include "app/model_lab.h"
 #include "app/ui/session.h"
 #include "grading/grade.h"
 #include "labs/run.h"
@@ -257,4 +258,23 @@ TEST_CASE("--scenario: the session runs the grader's scenario, and its saved gai
     if (graded.contains(metric)) CHECK_MESSAGE(graded[metric] == value, metric);
   // An unknown scenario is bad input, listing the rubric's.
   CHECK_THROWS_WITH_AS(TuningSession("slider_crank", "", "", "nope"), doctest::Contains("noisy_sensor"), InputError);
+}
+
+TEST_CASE("a model file in the session: its passive run, both engines, nothing to tune, the loop closed") {
+  const std::string file = std::string(DYNLAB_SOURCE_DIR) + "/assets/models/fourbar.xml";
+  ui::TuningSession s(app::loadModelLab(file, std::nullopt));
+  CHECK(s.labName() == "fourbar");
+  CHECK(s.gainSpecs().empty());
+  CHECK(s.title().find("fourbar.xml") != std::string::npos);
+  s.setEngine(ui::EngineChoice::Both);
+  s.restart();
+  CHECK(s.advance(500) == 500);
+  CHECK(s.problem().empty());
+  REQUIRE(s.ghost() != nullptr);
+  const Trace& t = s.primary();
+  CHECK(t.at(s.row(), "t") == doctest::Approx(0.5));
+  // The hand engine keeps the pin closed; the four-bar falls from rest, so it has moved.
+  for (std::size_t r = 0; r < t.rows(); ++r) CHECK(t.at(r, "constraint_residual") <= 1e-12);
+  CHECK(std::abs(t.at(s.row(), "q_crank") - t.at(0, "q_crank")) > 1e-3);
+  CHECK_THROWS_AS(s.set("kp=1"), InputError);
 }

@@ -15,6 +15,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
+#include "app/model_lab.h"
 #include "labs/run.h"
 #include "render/renderer.h"
 #include "tests/test_files.h"
@@ -273,6 +274,39 @@ TEST_CASE("dynlab ui LAB runs the window (one entry point)") {
   const json state = loadJsonFile((dir / "state.json").string());
   CHECK(state["submission"]["gains"]["kp_x"] == 150.0);  // from --gains
   CHECK(state["submission"]["gains"]["kp_f"] == 0.25);    // from --set, passed through
+}
+
+TEST_CASE("dynlab ui FILE: a model file's passive run in the window, its scene the OSMesa render of that state") {
+  const std::string file = std::string(DYNLAB_SOURCE_DIR) + "/assets/models/fourbar.xml";
+  const fs::path dir = test::scratchDir("dynlab_ui_window", "model");
+  // Lab-only options are refused before any display is needed.
+  const Result bad = noDisplay(dir, DYNLAB_UI_BIN, quote(file) + " --gains g.json");
+  CHECK(bad.code == 2);
+  CHECK(bad.err.find("--gains") != std::string::npos);
+  CHECK(std::count(bad.err.begin(), bad.err.end(), '\n') == 1);
+  if (!haveXvfb()) return;
+  const Result r = inXvfb(dir, DYNLAB_BIN, "ui " + quote(file) + " --engine both --frames 30 --screenshot shot.png --state state.json");
+  INFO(r.out << r.err);
+  REQUIRE(r.code == 0);
+  const json state = loadJsonFile((dir / "state.json").string());
+  CHECK(state["problem"] == "");
+  CHECK(state["t"].get<double>() == doctest::Approx(0.5).epsilon(0.01));
+  CHECK(state["values"]["constraint_residual"].get<double>() <= 1e-12);
+  // The scene region is the OSMesa frame of the same row of the same run.
+  const LoadedLab loaded = app::loadModelLab(file, std::nullopt);
+  const RunResult hand = runEngine(*loaded.lab, Engine::Hand), bullet = runEngine(*loaded.lab, Engine::Bullet);
+  const std::size_t row = state["row"].get<std::size_t>();
+  REQUIRE(row < hand.trace.rows());
+  CHECK(state["values"]["q_crank"].get<double>() == hand.trace.at(row, "q_crank"));
+  const Png shot = loadPng(dir / "shot.png");
+  const json& vp = state["viewport"];
+  const int vx = vp["x"], vy = vp["y"], vw = vp["width"], vh = vp["height"];
+  REQUIRE(vx + vw <= shot.width);
+  const Image same = renderOsmesa(*loaded.lab, hand.trace, &bullet.trace, row, vw, vh);
+  const Diff d = compare(shot, vx, vy, same);
+  MESSAGE("model file, window vs OSMesa: " << d.differing << " of " << vw * vh << " pixels differ");
+  CHECK(d.differing <= long(vw) * vh / 1000);
+  CHECK(compare(shot, vx, vy, renderOsmesa(*loaded.lab, hand.trace, &bullet.trace, 0, vw, vh)).differing > 500);
 }
 
 TEST_CASE("every gain slider shows its whole name and its value's digits: a thin knob, names inside the panel") {

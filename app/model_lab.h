@@ -1,0 +1,22 @@
+// A model file (MJCF or URDF, with what stands beside it: STEM.loops.json) where a lab name goes, for
+// the commands that work on a lab's run: `dynlab figure FILE` and the tuning window `dynlab ui FILE`.
+// It is the generic data lab (labs/generic/data_lab.h) with no actuated joint and no task: the file's
+// passive motion from its pose at rest, at the file's step, both engines. Shared by dynlab and
+// dynlab-ui (the library dynlab_model_lab).
+#pragma once
+#include <optional>
+#include <string>
+
+#include "labs/run.h"
+
+namespace dyn::app {
+
+// True when LAB names a model file (ends in .xml or .urdf, any case): no lab's name does.
+bool isModelFile(const std::string& name);
+
+// The model file as a lab, passive, for `duration` s (default 2 s), with the closures, wheels and
+// contacts beside it; its figures are the coordinates, the energy books and each closure's force.
+// Throws InputError (one line, naming the file) on bad input.
+LoadedLab loadModelLab(const std::string& file, std::optional<double> duration);
+
+}  // namespace dyn::app
