@@ -102,7 +102,9 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref) {
   // The desired joint motion (joint laws): inverse kinematics, then rates and accelerations through J_x.
   VecN ud, udd_d = VecN::Zero(m), ud_d = VecN::Zero(m);
   const bool joint = kind == Kind::JointPdGravity || kind == Kind::Pid || kind == Kind::ComputedTorque;
-  if (joint) {
+  if (joint && ref.joint) {
+    ud = ref.x, ud_d = ref.xd, udd_d = ref.xdd;
+  } else if (joint) {
     if (!inverseKinematics(ref.x, q_ik_) || !chain_.update(q_ik_, VecN::Zero(mech_->n()))) return tau_u_;
     chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
     ud_d = solveTask(Jx, ref.xd);
@@ -117,8 +119,10 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref) {
   for (int j = 0; j < m; ++j) u[j] = q[act[std::size_t(j)]], w[j] = v[act[std::size_t(j)]];
   const double kp = spec_.kp, kd = spec_.kd;
   const double wn = spec_.omega_n, kp2 = wn * wn, kd2 = 2.0 * spec_.zeta * wn;
+  // Joint laws' errors, each joint's scaled by its share of the gains.
+  auto scaled = [&](const VecN& e) -> VecN { return spec_.joint_scale.size() == m ? VecN(spec_.joint_scale.cwiseProduct(e)) : e; };
   switch (kind) {
-    case Kind::JointPdGravity: return kp * (ud - u) + kd * (ud_d - w) + chain_.Gu();
+    case Kind::JointPdGravity: return scaled(kp * (ud - u) + kd * (ud_d - w)) + chain_.Gu();
     case Kind::Pid: {
       const VecN e = ud - u;
       // Conditional integration: not while the last command sat at a limit pushing the same way.
@@ -126,7 +130,7 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref) {
         const bool wound = std::abs(tau_u_[j]) >= spec_.torque_limit[j] && e[j] * tau_u_[j] > 0;
         if (!wound) integral_[j] += e[j] * double(hold_) * dt_;
       }
-      return kp * e + spec_.ki * integral_ + kd * (ud_d - w);
+      return scaled(kp * e + spec_.ki * integral_ + kd * (ud_d - w));
     }
     case Kind::ComputedTorque: return chain_.Mu() * (udd_d + kd2 * (ud_d - w) + kp2 * (ud - u)) + chain_.hu();
     default: break;

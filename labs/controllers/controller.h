@@ -9,7 +9,8 @@
 //   task_pd_gravity        τ_u = J_xᵀ (K_p e + K_d e') + G_u                          (kp, kd)
 //   task_inverse_dynamics  τ_u = M_u J_x⁻¹ (x_d'' + K_d e' + K_p e − J_x' u') + h_u   (omega_n, zeta)
 // with K_p = ω_n², K_d = 2ζω_n where named so. Joint laws track the task path through inverse kinematics
-// on the controller's model (u_d, u_d' = J_x⁻¹ x_d', u_d'' = J_x⁻¹ (x_d'' − J_x' u_d')). The controller
+// on the controller's model (u_d, u_d' = J_x⁻¹ x_d', u_d'' = J_x⁻¹ (x_d'' − J_x' u_d')), or a joint path
+// directly (Reference::joint); PD and PID gains may be scaled per joint (Spec::joint_scale). The controller
 // samples at its period (zero-order hold), reads encoders on every joint `delay` steps late with seeded
 // Gaussian noise, knows only its own model (a payload the plant carries may be missing from it), and
 // saturates at the torque limits.
@@ -41,6 +42,7 @@ struct Spec {
   VecN constant;               // per actuated joint
   VecN torque_limit;           // per actuated joint (> 0)
   double kp = 0, kd = 0, ki = 0, omega_n = 0, zeta = 0;
+  VecN joint_scale;            // joint_pd_gravity, pid: joint j's gains times joint_scale[j] (empty: 1)
 };
 
 // Where the task is: a point of a tree body (its frame), and the rows of its spatial velocity that the
@@ -51,9 +53,10 @@ struct TaskPoint {
   std::vector<int> axes;
 };
 
-// The reference at one instant, in the task's axes.
+// The reference at one instant, in the task's axes (joint: in the actuated coordinates, u_d, u_d', u_d'').
 struct Reference {
   VecN x, xd, xdd;
+  bool joint = false;
 };
 
 class Controller {
