@@ -105,14 +105,16 @@ std::unique_ptr<Simulation> runOn(const DataSettings& s, Engine engine) {
 }
 
 std::unique_ptr<Simulation> DataLab::simulate(Engine engine) const {
-  // The shapes of the shipped loops at fixed sizes (instantiated in physics/model_file/hand_engine.cpp),
-  // as the C++ labs fix theirs: every loop of the step unrolled. Any other shape: dynamic sizes.
+  // The shapes of the shipped loops at fixed sizes (instantiated in physics/model_file/hand_engine.cpp)
+  // and a 6-joint open chain's (mechanism.cpp), as the C++ labs fix theirs: every loop of the step
+  // unrolled. Any other shape: dynamic sizes.
   const auto& m = s_.plant->mechanism;
   const int n = m.treeDof(), r = m.rows();
   if (m.payloads.empty()) {
     if (n == 4 && r == 2) return runOn<ConstrainedMechanism<Spatial, 4, 2, 0>>(s_, engine);
     if (n == 3 && r == 2) return runOn<ConstrainedMechanism<Spatial, 3, 2, 0>>(s_, engine);
     if (n == 4 && r == 3) return runOn<ConstrainedMechanism<Spatial, 4, 3, 0>>(s_, engine);
+    if (n == 6 && r == 0) return runOn<ConstrainedMechanism<Spatial, 6, 0, 0>>(s_, engine);  // mechanism.cpp
   }
   return runOn<Mech>(s_, engine);
 }
