@@ -1,5 +1,5 @@
 // Small number helpers every lab (and the app's panels and grading's text) share: one number
-// formatted by a printf format, and the root mean square of a series.
+// formatted by a printf format, a subscript, and the root mean square of a series.
 #pragma once
 #include <cmath>
 #include <cstdio>
@@ -13,6 +13,20 @@ inline std::string fmt(const char* format, double x) {
   char b[64];
   std::snprintf(b, sizeof b, format, x);
   return b;
+}
+
+// A whole number as Unicode subscript digits (1 → "₁", 12 → "₁₂"), for labels such as τ₁; overlay and
+// window fonts draw them (render/fonts.h).
+inline std::string subscript(int n) {
+  const std::string digits = std::to_string(n);
+  std::string out;
+  for (char c : digits) {
+    if (c == '-') { out += "₋"; continue; }
+    // U+2080 + d in UTF-8: E2 82 80+d.
+    out += "\xE2\x82";
+    out += char(0x80 + (c - '0'));
+  }
+  return out;
 }
 
 // √(Σ x² / n); 0 for an empty series.

@@ -58,6 +58,8 @@ Controller::Controller(const Spec& spec, const MechanismModel<Spatial>& model, s
       hold_(std::max(1L, std::lround(spec.period / dt))), dt_(dt), rng_(spec.seed), q_ik_(q0) {
   const int m = chain_.m();
   integral_ = VecN::Zero(m);
+  e_u_ = VecN::Zero(m);
+  if (spec_.joint_scale.size() != m) spec_.joint_scale = VecN::Ones(m);
   tau_u_ = VecN::Zero(m);
   tau_ = VecN::Zero(mech_->n());
 }
@@ -117,32 +119,38 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref) {
   if (!chain_.update(q, v)) return tau_u_;  // a singular pose: hold the last command
   VecN u(m), w(m);
   for (int j = 0; j < m; ++j) u[j] = q[act[std::size_t(j)]], w[j] = v[act[std::size_t(j)]];
-  const double kp = spec_.kp, kd = spec_.kd;
-  const double wn = spec_.omega_n, kp2 = wn * wn, kd2 = 2.0 * spec_.zeta * wn;
-  // Joint laws' errors, each joint's scaled by its share of the gains.
-  auto scaled = [&](const VecN& e) -> VecN { return spec_.joint_scale.size() == m ? VecN(spec_.joint_scale.cwiseProduct(e)) : e; };
+  // Joint laws: gains per joint (joint_scale); computed torque's set the error dynamics, the same on each.
+  const double wn = spec_.omega_n;
+  const VecN& s = spec_.joint_scale;
+  const VecN kp = spec_.kp * s, kd = spec_.kd * s, kp2 = VecN::Constant(m, wn * wn), kd2 = VecN::Constant(m, 2.0 * spec_.zeta * wn);
   switch (kind) {
-    case Kind::JointPdGravity: return scaled(kp * (ud - u) + kd * (ud_d - w)) + chain_.Gu();
+    case Kind::JointPdGravity: return laws::pdGravity(kp, VecN(ud - u), kd, VecN(ud_d - w), chain_.Gu());
     case Kind::Pid: {
-      const VecN e = ud - u;
-      // Conditional integration: not while the last command sat at a limit pushing the same way.
-      for (int j = 0; j < m; ++j) {
-        const bool wound = std::abs(tau_u_[j]) >= spec_.torque_limit[j] && e[j] * tau_u_[j] > 0;
-        if (!wound) integral_[j] += e[j] * double(hold_) * dt_;
-      }
-      return scaled(kp * e + spec_.ki * integral_ + kd * (ud_d - w));
+      // u_I advances in torque() once the clipped output is known (anti-windup reads it).
+      e_u_ = ud - u;
+      VecN tau = laws::pid(kp, e_u_, kd, VecN(ud_d - w), integral_);
+      if (spec_.coulomb_compensation)
+        for (int j = 0; j < m; ++j) {
+          const auto& joints = mech_->model().joints;
+          const std::size_t i = std::size_t(act[std::size_t(j)]);
+          const double fc = i < joints.size() ? joints[i].coulomb : 0.0;
+          tau[j] += fc * std::clamp(ud_d[j] / spec_.compensation_width, -1.0, 1.0);
+        }
+      return tau;
     }
-    case Kind::ComputedTorque: return chain_.Mu() * (udd_d + kd2 * (ud_d - w) + kp2 * (ud - u)) + chain_.hu();
+    case Kind::ComputedTorque:
+      return chain_.Mu() * laws::computedTorqueAcceleration(udd_d, kp2, VecN(ud - u), kd2, VecN(ud_d - w)) + chain_.hu();
     default: break;
   }
   chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
   const int d = int(task_.axes.size());
   VecN x(d);
   for (int i = 0; i < d; ++i) x[i] = p[task_.axes[std::size_t(i)] - 3];
-  const VecN xdot = Jx * w;
-  if (kind == Kind::TaskPdGravity) return Jx.transpose() * (kp * (ref.x - x) + kd * (ref.xd - xdot)) + chain_.Gu();
+  const VecN xdot = Jx * w, e = ref.x - x, ed = ref.xd - xdot;
+  if (kind == Kind::TaskPdGravity)
+    return laws::taskPdGravity(chain_.Gu(), Jx, VecN::Constant(d, spec_.kp), e, VecN::Constant(d, spec_.kd), ed);
   // Task inverse dynamics: the task acceleration asked for, mapped to u'' through J_x.
-  const VecN a = ref.xdd + kd2 * (ref.xd - xdot) + kp2 * (ref.x - x);
+  const VecN a = laws::computedTorqueAcceleration(ref.xdd, VecN::Constant(d, wn * wn), e, VecN::Constant(d, 2.0 * spec_.zeta * wn), ed);
   return chain_.Mu() * solveTask(Jx, a - bias) + chain_.hu();
 }
 
@@ -156,12 +164,13 @@ VecN Controller::torque(double t, const VecN& q, const VecN& v, const Reference&
   if (spec_.noise_angle > 0 || spec_.noise_rate > 0)
     for (int i = 0; i < mech_->n(); ++i) qm[i] += spec_.noise_angle * normal_(rng_), vm[i] += spec_.noise_rate * normal_(rng_);
   VecN u = law(qm, vm, ref);
-  saturated_ = false;
-  for (int j = 0; j < u.size(); ++j) {
-    const double lim = spec_.torque_limit[j];
+  for (int j = 0; j < u.size(); ++j)
     if (!std::isfinite(u[j])) u[j] = 0.0;
-    if (std::abs(u[j]) > lim) u[j] = std::copysign(lim, u[j]), saturated_ = true;
-  }
+  const VecN raw = u;
+  saturated_ = laws::saturate(u, spec_.torque_limit);
+  if (spec_.kind == Kind::Pid)
+    laws::integrate(integral_, spec_.anti_windup, VecN(spec_.ki * spec_.joint_scale), e_u_, raw, u, spec_.torque_limit,
+                    spec_.tracking_time, double(hold_) * dt_);
   tau_u_ = u;
   tau_.setZero();
   for (int j = 0; j < u.size(); ++j) tau_[chain_.actuated()[std::size_t(j)]] = u[j];

@@ -4,13 +4,15 @@
 //   none                   τ_u = 0
 //   constant               τ_u = the "constant" torques
 //   joint_pd_gravity       τ_u = K_p e_u + K_d e_u' + G_u(u)                          (kp, kd)
-//   pid                    τ_u = K_p e_u + K_i ∫e_u + K_d e_u', the integral clamped while saturated (kp, ki, kd)
+//   pid                    τ_u = K_p e_u + K_d e_u' + u_I, u_I' = K_i e_u, with anti-windup (kp, ki, kd)
 //   computed_torque        τ_u = M_u (u_d'' + K_d e_u' + K_p e_u) + h_u               (omega_n, zeta)
 //   task_pd_gravity        τ_u = J_xᵀ (K_p e + K_d e') + G_u                          (kp, kd)
 //   task_inverse_dynamics  τ_u = M_u J_x⁻¹ (x_d'' + K_d e' + K_p e − J_x' u') + h_u   (omega_n, zeta)
-// with K_p = ω_n², K_d = 2ζω_n where named so. Joint laws track the task path through inverse kinematics
-// on the controller's model (u_d, u_d' = J_x⁻¹ x_d', u_d'' = J_x⁻¹ (x_d'' − J_x' u_d')), or a joint path
-// directly (Reference::joint); PD and PID gains may be scaled per joint (Spec::joint_scale). The controller
+// with K_p = ω_n², K_d = 2ζω_n where named so; the arithmetic is laws.h's, shared with the C++ labs. The
+// joint laws' gains are scaled per joint by joint_scale (computed torque's are not: they set the error
+// dynamics), and pid may add Coulomb compensation F̂_c sat(u_d'/w) from the model's joint friction. Joint laws track the task path through inverse kinematics
+// on the controller's model (u_d, u_d' = J_x⁻¹ x_d', u_d'' = J_x⁻¹ (x_d'' − J_x' u_d')), or follow a joint
+// path directly (Reference::joint: u_d, u_d', u_d'' given, no inverse kinematics). The controller
 // samples at its period (zero-order hold), reads encoders on every joint `delay` steps late with seeded
 // Gaussian noise, knows only its own model (a payload the plant carries may be missing from it), and
 // saturates at the torque limits.
@@ -22,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "labs/controllers/laws.h"
 #include "physics/closed_chain.h"
 #include "physics/constrained_mechanism.h"
 
@@ -42,7 +45,11 @@ struct Spec {
   VecN constant;               // per actuated joint
   VecN torque_limit;           // per actuated joint (> 0)
   double kp = 0, kd = 0, ki = 0, omega_n = 0, zeta = 0;
-  VecN joint_scale;            // joint_pd_gravity, pid: joint j's gains times joint_scale[j] (empty: 1)
+  VecN joint_scale;             // per actuated joint (empty: all 1) for joint_pd_gravity and pid
+  laws::AntiWindup anti_windup = laws::AntiWindup::Clamping;  // pid's integral
+  double tracking_time = 0.05;  // s, back-calculation's T_t
+  bool coulomb_compensation = false;  // pid: add F̂_c sat(u_d'/w), F̂_c the model's Coulomb friction
+  double compensation_width = 0.05;   // rad/s: w
 };
 
 // Where the task is: a point of a tree body (its frame), and the rows of its spatial velocity that the
@@ -71,6 +78,7 @@ class Controller {
   // The last command per actuated joint (after saturation), and whether a limit bound.
   const VecN& command() const { return tau_u_; }
   bool saturated() const { return saturated_; }
+  const VecN& integral() const { return integral_; }  // pid's u_I per actuated joint (N·m)
   // The task point of the plant's state, by the controller's model (what the trace shows as x).
   void taskPosition(const VecN& q, VecN& x);
 
@@ -87,7 +95,7 @@ class Controller {
   std::deque<std::pair<VecN, VecN>> readings_;  // (q, v) of the last delay+1 steps, newest last
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_{0.0, 1.0};
-  VecN q_ik_, integral_, tau_u_, tau_;
+  VecN q_ik_, integral_, e_u_, tau_u_, tau_;  // integral_: pid's u_I (N·m); e_u_: the last joint error
   bool saturated_ = false;
 };
 

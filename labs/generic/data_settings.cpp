@@ -176,7 +176,8 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
 
   // The controller: a kind of the library, the gains it reads declared in "gains".
   const JsonView ctl = c["controller"];
-  ctl.onlyKeys({"kind", "control_period", "delay_steps", "noise", "constant", "joint_scale"});
+  ctl.onlyKeys({"kind", "control_period", "delay_steps", "noise", "constant", "joint_scale", "anti_windup", "tracking_time",
+               "coulomb_compensation", "compensation_width"});
   const std::string kind = ctl["kind"].string();
   if (std::find(controllers::kindNames().begin(), controllers::kindNames().end(), kind) == controllers::kindNames().end())
     ctl["kind"].fail("one of " + list(controllers::kindNames()));
@@ -197,11 +198,22 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     ctl["constant"].size(std::size_t(m), std::size_t(m));
     for (int j = 0; j < m; ++j) cs.constant[j] = ctl["constant"].at(std::size_t(j)).inRange(-kMaxTorque, kMaxTorque);
   }
+  // The joint laws' options (labs/controllers/laws.h): per-joint gain scale, pid's anti-windup and
+  // Coulomb compensation.
+  cs.joint_scale = VecN::Ones(m);
   if (ctl.has("joint_scale")) {
     ctl["joint_scale"].size(std::size_t(m), std::size_t(m));
-    cs.joint_scale.resize(m);
-    for (int j = 0; j < m; ++j) cs.joint_scale[j] = ctl["joint_scale"].at(std::size_t(j)).inRange(0, 1e4);
+    for (int j = 0; j < m; ++j) cs.joint_scale[j] = ctl["joint_scale"].at(std::size_t(j)).inRange(0, 1e3);
   }
+  if (ctl.has("anti_windup")) {
+    const std::string aw = ctl["anti_windup"].oneOf({"clamping", "back_calculation", "none"});
+    cs.anti_windup = aw == "clamping" ? controllers::laws::AntiWindup::Clamping
+                     : aw == "none"   ? controllers::laws::AntiWindup::None
+                                      : controllers::laws::AntiWindup::BackCalculation;
+  }
+  if (ctl.has("tracking_time")) cs.tracking_time = ctl["tracking_time"].inRange(1e-4, 100);
+  if (ctl.has("coulomb_compensation")) cs.coulomb_compensation = ctl["coulomb_compensation"].boolean();
+  if (ctl.has("compensation_width")) cs.compensation_width = ctl["compensation_width"].inRange(1e-6, 100);
   std::vector<std::string> declared;
   for (const auto& [g, _] : c["gains"].raw().items()) declared.push_back(g);
   const auto gains = parseGains(c["gains"], declared);

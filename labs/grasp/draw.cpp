@@ -133,7 +133,7 @@ void GraspLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
              {"x, y error", fmt("%.1f", 1e3 * (tr.at(row, "x_o") - tr.at(row, "x_d"))) + ", " +
                                 fmt("%.1f mm", 1e3 * (tr.at(row, "y_o") - tr.at(row, "y_d")))},
              {"f_int", fmt("%.2f N", tr.at(row, "f_int"))},
-             {"cone margin", fmt("%.2f N", tr.at(row, "cone_margin")) + fmt(" (mu = %.2f)", s_.params.mu)}};
+             {"cone margin", fmt("%.2f N", tr.at(row, "cone_margin")) + fmt(" (μ = %.2f)", s_.params.mu)}};
   // Live plots over the last two seconds: every step, up to and including this row.
   Series margin{"cone margin (N)", {}, kRef}, squeeze{"f_int (N)", {}, kForce};
   for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) {

@@ -114,11 +114,11 @@ void ImpedanceLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
   o.title = "impedance control";
   o.lines = {{"t", fmt("%.3f s", tr.at(row, "t"))},
              {"realisation", kinds[int(s_.kind)]},
-             {"x - x_ref", fmt("%.1f mm", 1e3 * (tr.at(row, "x") - tr.at(row, "x_ref")))},
-             {"y - y_ref", fmt("%.1f mm", 1e3 * (tr.at(row, "y") - tr.at(row, "y_ref")))},
+             {"x − x_ref", fmt("%.1f mm", 1e3 * (tr.at(row, "x") - tr.at(row, "x_ref")))},
+             {"y − y_ref", fmt("%.1f mm", 1e3 * (tr.at(row, "y") - tr.at(row, "y_ref")))},
              {"F_ext", fmt("(%.1f, ", tr.at(row, "F_ext_x")) + fmt("%.1f) N", tr.at(row, "F_ext_y"))},
-             {"spring glyph", fmt("stretch drawn x%g", springMagnification(tr))}};
-  Series dx{"x - x_ref (mm)", {}, {0.85f, 0.15f, 0.15f, 1}}, dy{"y - y_ref (mm)", {}, {0.23f, 0.42f, 0.68f, 1}};
+             {"spring glyph", fmt("stretch drawn ×%g", springMagnification(tr))}};
+  Series dx{"x − x_ref (mm)", {}, {0.85f, 0.15f, 0.15f, 1}}, dy{"y − y_ref (mm)", {}, {0.23f, 0.42f, 0.68f, 1}};
   for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) {
     dx.values.push_back(float(1e3 * (tr.at(r, "x") - tr.at(r, "x_ref"))));
     dy.values.push_back(float(1e3 * (tr.at(r, "y") - tr.at(r, "y_ref"))));

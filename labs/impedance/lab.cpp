@@ -10,6 +10,7 @@
 #include <map>
 #include <random>
 
+#include "labs/controllers/laws.h"
 #include "labs/delay_line.h"
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
@@ -120,6 +121,7 @@ class Hooks final : public StepHooks {
 
  private:
   Eigen::Vector3d control(double t, const VecN& q, const VecN& v) {
+    namespace laws = controllers::laws;
     const Eigen::Vector3d th = q.head<3>(), thd = v.head<3>();
     const Eigen::Vector3d F(fx_.value(), fy_.value(), 0.0);
     const Target& T = s_.law;
@@ -133,7 +135,7 @@ class Hooks final : public StepHooks {
         Eigen::Vector3d Jdv;
         taskJacobian(model_, s_.model, q, v, J, Jdv);
         const Eigen::Vector3d e = x_ref_ - tipPose(s_.model, th), ed = -J * thd;
-        tau = model_.gravityTorque(VecN(th)) + J.transpose() * (T.K.cwiseProduct(e) + T.D.cwiseProduct(ed));
+        tau = laws::taskPdGravity(Eigen::Vector3d(model_.gravityTorque(VecN(th))), J, T.K, e, T.D, ed);
         break;
       }
       case Kind::FeedbackLinearisation: {
@@ -142,7 +144,7 @@ class Hooks final : public StepHooks {
         Eigen::Vector3d Jdv;
         taskJacobian(model_, s_.model, q, v, J, Jdv);
         const Eigen::Vector3d x = tipPose(s_.model, th), xd = J * thd;
-        const Eigen::Vector3d a = (F - T.D.cwiseProduct(xd) - T.K.cwiseProduct(x - x_ref_)).cwiseQuotient(T.M);
+        const Eigen::Vector3d a = laws::impedanceAcceleration(F, T.M, T.D, T.K, x, xd, x_ref_);
         const Eigen::Vector3d qdd = J.partialPivLu().solve(a - Jdv);
         tau = model_.inverseDynamics(VecN(th), VecN(thd), VecN(qdd)) - J.transpose() * F;
         break;
@@ -152,7 +154,7 @@ class Hooks final : public StepHooks {
         // control period); inverse kinematics gives θ_des, θ_des', θ_des''; the motion-control lab's
         // joint controller (pid, computed_torque or pd_gravity) tracks them.
         const double h = s_.period;
-        a_des_ = (F - T.D.cwiseProduct(v_des_) - T.K.cwiseProduct(x_des_ - x_ref_)).cwiseQuotient(T.M);
+        a_des_ = laws::impedanceAcceleration(F, T.M, T.D, T.K, x_des_, v_des_, x_ref_);
         v_des_ += h * a_des_;
         x_des_ += h * v_des_;
         Eigen::Vector3d thd_des = th;
@@ -169,7 +171,8 @@ class Hooks final : public StepHooks {
         break;
       }
     }
-    return tau.cwiseMax(-s_.tau_max).cwiseMin(s_.tau_max);
+    laws::saturate(tau, s_.tau_max);
+    return tau;
   }
 
   const Settings& s_;

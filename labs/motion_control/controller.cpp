@@ -53,23 +53,24 @@ Eigen::VectorXd Controller::torque(double t, const Eigen::VectorXd& th, const Ei
 }
 
 Eigen::VectorXd Controller::torque(double t, const Eigen::VectorXd& th, const Eigen::VectorXd& thd, const Reference& ref) {
+  namespace laws = controllers::laws;
   const int n = int(th.size());
   const double dt = last_t_ < 0 ? 0.0 : t - last_t_;
   last_t_ = t;
-  const Eigen::VectorXd &q_d = ref.q, &qd_d = ref.qd, &qdd_d = ref.qdd;
-  const Eigen::VectorXd e = th - q_d, ed = thd - qd_d;
+  // The library's laws (labs/controllers/laws.h) take e = θ_d − θ.
+  const Eigen::VectorXd e = ref.q - th, ed = ref.qd - thd;
   Eigen::VectorXd tau = Eigen::VectorXd::Zero(n);
   const auto& fr = model_params_.friction;
   switch (c_.kind) {
     case Kind::None: break;
     case Kind::Constant: tau = c_.constant; break;
     case Kind::Pid:
-      tau = -(c_.kp.cwiseProduct(e) + c_.kd.cwiseProduct(ed)) + u_i_;
+      tau = laws::pid(c_.kp, e, c_.kd, ed, u_i_);
       if (c_.coulomb_compensation)
-        for (int i = 0; i < n; ++i) tau[i] += fr[std::size_t(i)].coulomb * sat(qd_d[i] / c_.compensation_width);
+        for (int i = 0; i < n; ++i) tau[i] += fr[std::size_t(i)].coulomb * sat(ref.qd[i] / c_.compensation_width);
       break;
     case Kind::ComputedTorque: {
-      const Eigen::VectorXd a = qdd_d - c_.kp.cwiseProduct(e) - c_.kd.cwiseProduct(ed);
+      const Eigen::VectorXd a = laws::computedTorqueAcceleration(ref.qdd, c_.kp, e, c_.kd, ed);
       tau = model_->inverseDynamics(VecN(th), VecN(thd), VecN(a));
       for (int i = 0; i < n; ++i)
         tau[i] += fr[std::size_t(i)].viscous * thd[i] +
@@ -77,27 +78,13 @@ Eigen::VectorXd Controller::torque(double t, const Eigen::VectorXd& th, const Ei
       break;
     }
     case Kind::PdGravity:
-      tau = -c_.kp.cwiseProduct(e) - c_.kd.cwiseProduct(thd) + Eigen::VectorXd(model_->gravityTorque(VecN(th)));
+      tau = laws::pdGravity(c_.kp, e, c_.kd, Eigen::VectorXd(-thd), Eigen::VectorXd(model_->gravityTorque(VecN(th))));
       break;
   }
-  // The plant interface: each joint clipped to ±τ_max.
+  // The plant interface: each joint clipped to ±τ_max; then the integral (anti-windup reads the clip).
   const Eigen::VectorXd raw = tau;
-  for (int i = 0; i < n; ++i) tau[i] = std::clamp(tau[i], -c_.tau_max[i], c_.tau_max[i]);
-  saturated_ = (raw - tau).cwiseAbs().maxCoeff() > 0;
-  // The integrator, after the output is known (anti-windup reads the saturation).
-  if (c_.kind == Kind::Pid)
-    for (int i = 0; i < n; ++i) {
-      const double push = -c_.ki[i] * e[i];  // u_I's rate without anti-windup
-      if (c_.anti_windup == AntiWindup::Clamping) {
-        const bool clipped = raw[i] != tau[i];
-        if (!(clipped && push * raw[i] > 0)) u_i_[i] += push * dt;
-        u_i_[i] = std::clamp(u_i_[i], -c_.tau_max[i], c_.tau_max[i]);
-      } else if (c_.anti_windup == AntiWindup::BackCalculation) {
-        u_i_[i] += (push + (tau[i] - raw[i]) / c_.tracking_time) * dt;
-      } else {
-        u_i_[i] += push * dt;
-      }
-    }
+  saturated_ = laws::saturate(tau, c_.tau_max);
+  if (c_.kind == Kind::Pid) laws::integrate(u_i_, c_.anti_windup, c_.ki, e, raw, tau, c_.tau_max, c_.tracking_time, dt);
   return tau;
 }
 

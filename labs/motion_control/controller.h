@@ -17,12 +17,13 @@
 
 #include <Eigen/Core>
 
+#include "labs/controllers/laws.h"
 #include "labs/motion_control/mechanism.h"
 
 namespace dyn::motion_control {
 
 enum class Kind { None, Constant, Pid, ComputedTorque, PdGravity };
-enum class AntiWindup { None, Clamping, BackCalculation };
+using AntiWindup = controllers::laws::AntiWindup;  // the library's integral (labs/controllers/laws.h)
 
 // Quintic point-to-point moves outstretched → folded → outstretched (each followed by a hold), then
 // a sine about the outstretched pose, θ_d = θ_out + a (1 − cos 2πτ/T)/2 (starts at rest).

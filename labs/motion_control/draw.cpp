@@ -80,13 +80,13 @@ void MotionControlLab::overlay(const Trace& tr, std::size_t row, Overlay& o) con
              {"control period", fmt("%.0f ms", s_.controller.period * 1e3)},
              {"torque limit", tr.at(row, "tau_sat") > 0.5 ? "SATURATED" : "within"}};
   for (int i = 0; i < n; ++i)
-    o.lines.push_back({"e" + std::to_string(i + 1) + ", tau" + std::to_string(i + 1),
+    o.lines.push_back({"e" + subscript(i + 1) + ", τ" + subscript(i + 1),
                        fmt("%.3f rad", tr.at(row, "e" + std::to_string(i + 1))) + ", " +
                            fmt("%.1f N·m", tr.at(row, "tau" + std::to_string(i + 1)))});
   static const Color palette[] = {{0.85f, 0.15f, 0.15f, 1}, {0.2f, 0.65f, 0.3f, 1}, {0.23f, 0.42f, 0.68f, 1}, {0.85f, 0.55f, 0.2f, 1}};
   std::vector<Series> errs;
   // In radians, as the trace and the rubric have them.
-  for (int i = 0; i < std::min(n, 4); ++i) errs.push_back({"e" + std::to_string(i + 1) + " (rad)", {}, palette[i]});
+  for (int i = 0; i < std::min(n, 4); ++i) errs.push_back({"e" + subscript(i + 1) + " (rad)", {}, palette[i]});
   Series sat{"saturated", {}, kSat};
   for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) {
     for (int i = 0; i < int(errs.size()); ++i) errs[std::size_t(i)].values.push_back(float(tr.at(r, "e" + std::to_string(i + 1))));

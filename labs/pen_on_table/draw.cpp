@@ -121,11 +121,11 @@ void PenOnTableLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const 
              {"controller", kind},
              {"f_z (5 ms)", fmt("%.2f N", tr.at(row, "f_z_5ms")) + fmt(" (f_zd %.2f N)", c.f_zd)},
              {"f_meas", fmt("%.2f N", tr.at(row, "f_meas"))},
-             {"z_des - z_t", fmt("%.2f mm", 1e3 * (tr.at(row, "z_des") - s_.params.table_height))},
+             {"z_des − z_t", fmt("%.2f mm", 1e3 * (tr.at(row, "z_des") - s_.params.table_height))},
              {"contact", tr.at(row, "contact") > 0.5 ? "yes" : "no (lifted)"}};
   // Live plots over the last three seconds, every step up to this row: f_z (5 ms mean), its error from f_zd (the
   // plot's zero line is the set point), and the commanded height above the table.
-  Series force{"f_z, 5 ms mean (N)", {}, kForce}, error{"f_z - f_zd (N)", {}, kRef}, height{"z_des - z_t (mm)", {}, kArm};
+  Series force{"f_z, 5 ms mean (N)", {}, kForce}, error{"f_z − f_zd (N)", {}, kRef}, height{"z_des − z_t (mm)", {}, kArm};
   for (std::size_t r = liveWindowStart(row, 3.0, s_.step.dt); r <= row; ++r) {
     force.values.push_back(float(tr.at(r, "f_z_5ms")));
     error.values.push_back(float(tr.at(r, "f_z_5ms") - tr.at(r, "f_zd")));

@@ -143,7 +143,7 @@ void UnicycleLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
              {"controller", kind},
              {"speed", fmt("%.2f", tr.at(row, "speed")) + fmt(" m/s (ref %.2f)", tr.at(row, "v_d"))},
              {"cross-track", fmt("%.1f mm", 1e3 * tr.at(row, "cross_track"))},
-             {"f_lat", fmt("%.2f N", tr.at(row, "f_lat")) + fmt(" (mu m g = %.2f N)", mu_mg)},
+             {"f_lat", fmt("%.2f N", tr.at(row, "f_lat")) + fmt(" (μmg = %.2f N)", mu_mg)},
              {"skid margin", fmt("%.2f N", tr.at(row, "skid_margin"))}};
   // Live plots over the last four seconds: every step, up to and including this row.
   Series speed{"speed (m/s)", {}, kWheel}, lateral{"f_lat (N)", {}, kForce};
