@@ -2,6 +2,7 @@
 #include "app/model.h"
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cmath>
 #include <cstdio>
@@ -22,6 +23,8 @@
 #include "physics/bullet/bullet_mechanism.h"
 #include "labs/utf8.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/constraints/plane_contact.h"
+#include "physics/constraints/rolling.h"
 #include "physics/model_file/hand_engine.h"
 #include "physics/model_file/model_file.h"
 
@@ -71,6 +74,23 @@ std::string describe(const model_file::LoadedModel& m) {
     if (!c.dropped.empty()) o << ", " << join(c.dropped) << " dropped (identically dependent on the rows kept)";
     o << "\n";
   }
+  for (std::size_t i = 0; i < m.contacts.size(); ++i) {
+    const auto& c = m.contacts[i];
+    const Constraint<Spatial>& k = *mech.constraints[m.closures.size() + i];
+    if (c.kind == "rolling") {
+      const auto& w = static_cast<const Rolling&>(k);
+      o << "  rolling " << c.name << ": body " << c.body << ", radius " << fmt(w.radius()) << " m on the ground z = " << fmt(w.groundHeight())
+        << ", 3 rows (x y: no slip, velocity-level; z: on the ground), mu " << fmt(w.mu()) << " for the skid margin\n";
+    } else {
+      const auto& p = static_cast<const PlaneContact<Spatial>&>(k);
+      const Eigen::Vector3d nn = p.normal();
+      o << "  contact " << c.name << ": a ball of radius " << fmt(p.params().radius) << " m on body " << c.body << " against the plane n·x = "
+        << fmt(p.params().height) << " m, n (" << fmt(nn.x()) << ", " << fmt(nn.y()) << ", " << fmt(nn.z()) << "), unilateral, "
+        << (p.compliant() ? "compliant (k_e " + fmt(p.params().stiffness) + " N/m, d_e " + fmt(p.params().damping) + " N·s/m)"
+                          : std::string("rigid (plastic touchdowns, lift-off)"))
+        << ", frictionless in the hand engine" << (p.params().mu > 0 ? ", mu " + fmt(p.params().mu) + " in Bullet's" : "") << "\n";
+    }
+  }
   for (const auto& n : m.notes) o << "  note: " << n << "\n";
   for (const auto& n : m.drawing.notes) o << "  drawing: " << n << "\n";
   return o.str();
@@ -113,6 +133,13 @@ struct Run {
   std::string summary;
 };
 
+// A rigid plane contact among the model's elements: its touchdowns are plastic impacts.
+bool anyImpacts(const model_file::LoadedModel& m) {
+  for (std::size_t i = 0; i < m.contacts.size(); ++i)
+    if (m.contacts[i].kind == "plane_contact" && !m.mechanism.constraints[m.closures.size() + i]->compliant()) return true;
+  return false;
+}
+
 Trace emptyTrace(const model_file::LoadedModel& m) {
   Trace t;
   t.columns.push_back("t");
@@ -121,14 +148,37 @@ Trace emptyTrace(const model_file::LoadedModel& m) {
   t.columns.insert(t.columns.end(), {"energy", "work", "constraint_residual"});
   for (const auto& c : m.closures)
     for (const auto& r : c.kept) t.columns.push_back("f_" + columnName(c.name) + "_" + r);
+  // dynlab's own elements: a wheel's ground force in wheel axes (heading, axle, up), its skid margin
+  // and slip speed; a contact's normal and tangential force and its gap; the touchdowns' energy.
+  if (anyImpacts(m)) t.columns.push_back("impacts");
+  for (const auto& c : m.contacts) {
+    const std::string n = columnName(c.name);
+    if (c.kind == "rolling")
+      t.columns.insert(t.columns.end(), {"f_" + n + "_long", "f_" + n + "_lat", "f_" + n + "_normal", "skid_margin_" + n, "slip_" + n});
+    else
+      t.columns.insert(t.columns.end(), {"f_" + n + "_normal", "f_" + n + "_tangent", "gap_" + n});
+  }
   return t;
 }
 
-// The row at t: state, energy, the friction's work so far, |φ|∞ (the description's, at this state)
-// and each closure's force on its kept rows; the run's extremes follow.
+// |φ|∞ of a model with dynlab's elements at a state: the closures' and wheels' rows, position and
+// velocity forms (a wheel's x, y rows have only the latter: its slip), and each contact's depth past
+// its plane (the description's mechanism, whose contacts stay open: their gaps are read, not held).
+double elementResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, const VecN& q, const VecN& v) {
+  double phi = desc.residual(q, v);
+  desc.stage(q);
+  for (std::size_t i = 0; i < m.contacts.size(); ++i)
+    if (const auto* pc = dynamic_cast<const PlaneContact<Spatial>*>(m.mechanism.constraints[m.closures.size() + i].get()))
+      if (!pc->compliant()) phi = std::max(phi, -pc->gap(desc.kinematics()));
+  return phi;
+}
+
+// The row at t: state, energy, the work so far (torques, friction, impacts), |φ|∞ (the description's,
+// at this state) and each closure's force on its kept rows, then the elements' columns; the run's
+// extremes follow.
 void record(Run& run, ConstrainedMechanism<Spatial>& mech, double t, const VecN& q, const VecN& v, double work,
-            const std::vector<double>& forces) {
-  const double e = mech.energy(q, v), phi = mech.residual(q);
+            const std::vector<double>& forces, double phi) {
+  const double e = mech.energy(q, v);
   if (run.trace.rows() == 0) run.e0 = e;
   std::vector<double> row{t};
   row.insert(row.end(), q.data(), q.data() + q.size());
@@ -158,9 +208,61 @@ Run runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mec
   for (int k = 0; k <= steps; ++k) {
     const auto s = mech.solve(q, v, tau);
     const Books b = engine->books();
-    record(run, mech, k * args.dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()));
+    record(run, mech, k * args.dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()), mech.residual(q));
     if (k == steps) break;
     if (!(run.ok = step(*engine, o, tau, q, v) && q.allFinite() && v.allFinite())) break;
+  }
+  return run;
+}
+
+// The hand engine with dynlab's elements, stepped as the labs step (labs/mechanism_simulation.h): at
+// each step's start the contacts close (a plastic impact on v) or open, and a touchdown inside the step
+// is located and closed there. A row's forces are the solve's at its state, plus a touchdown's impulse
+// over the step / dt (the step's mean, as impulse engines report it); its work includes the touchdowns'
+// −ΔT (the column impacts alone), so E − E0 − W stays RK4's error.
+Run runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, const ModelArgs& args, const VecN& tau) {
+  Run run;
+  run.trace = emptyTrace(m);
+  run.summary = "dynamic sizes; contacts closed and opened between steps, touchdowns located";
+  StepOptions o;
+  o.dt = args.dt;
+  const int steps = int(std::lround(args.duration / args.dt)), n = desc.n();
+  const std::size_t closures = m.closures.size();
+  int closure_rows = 0;
+  for (const auto& c : m.closures) closure_rows += int(c.kept.size());
+  const bool impacts = anyImpacts(m);
+  ConstrainedMechanism<Spatial> engine(m.mechanism);
+  engine.setTime(0);
+  engine.books() = Books{};
+  VecN q = m.q0, v = VecN::Zero(n);
+  for (int k = 0; k <= steps; ++k) {
+    engine.updateContacts(q, v, tau);
+    const auto s = engine.solve(q, v, tau);
+    std::vector<double> row(s.eta.data(), s.eta.data() + closure_rows);
+    const double loss = engine.impactLoss();
+    if (impacts) row.push_back(loss);
+    std::vector<std::array<double, 5>> report(m.contacts.size());
+    for (std::size_t i = 0; i < m.contacts.size(); ++i) engine.constraintReport(int(closures + i), s, report[i].data());
+    const Books b = engine.books();
+    const VecN q_row = q, v_row = v;
+    bool stepped = false;
+    if (k < steps) {
+      stepped = engine.stepLocatingContacts(o, tau, q, v) && q.allFinite() && v.allFinite();
+      run.ok = stepped;
+    }
+    for (std::size_t i = 0; i < m.contacts.size(); ++i) {
+      const auto& r = report[i];
+      if (m.contacts[i].kind == "rolling") {
+        row.insert(row.end(), r.begin(), r.end());
+        continue;
+      }
+      // gap, f_n; a touchdown in the step adds its impulse's normal share / dt.
+      const auto* pc = static_cast<const PlaneContact<Spatial>*>(m.mechanism.constraints[closures + i].get());
+      const double P = stepped ? pc->normal().dot(Spatial::linear(engine.impactImpulse(int(closures + i)))) : 0.0;
+      row.insert(row.end(), {r[1] + P / args.dt, 0.0, r[0]});
+    }
+    record(run, desc, k * args.dt, q_row, v_row, b.work + b.friction - loss, row, elementResidual(m, desc, q_row, v_row));
+    if (k == steps || !run.ok) break;
   }
   return run;
 }
@@ -174,6 +276,7 @@ Run runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& m
   VecN q = m.q0, v = VecN::Zero(n);
   bullet::BulletMechanism<Spatial> bt(m.mechanism, args.dt, q, v);
   run.summary = bt.describe();
+  const bool impacts = anyImpacts(m);
   // The power flowing in: the torques' τ·v less what damping and friction take.
   auto inflow = [&](const VecN& w) { return tau.dot(w) - frictionPower(m.mechanism, w); };
   double work = 0, power = inflow(v);
@@ -186,8 +289,26 @@ Run runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& m
       forces.clear();
       for (std::size_t c = 0; c < m.closures.size(); ++c)
         for (const auto& r : m.closures[c].kept) forces.push_back(bt.constraintForce(int(c))[model_file::rowIndex(r)]);
+      // Bullet's impacts are inside its contact impulses: its books hold no separate share.
+      if (impacts) forces.push_back(0.0);
+      mech.stage(q, &v);
+      for (std::size_t i = 0; i < m.contacts.size(); ++i) {
+        const int c = int(m.closures.size() + i);
+        const Spatial::Vec f = bt.constraintForce(c);
+        const Spatial::Pos f_lin = Spatial::linear(f);
+        const Constraint<Spatial>& k_c = *m.mechanism.constraints[std::size_t(c)];
+        if (m.contacts[i].kind == "rolling") {
+          double r[5];
+          k_c.report(mech.kinematics(), f_lin.data(), r);  // the rolling rows' η are the force's world components
+          forces.insert(forces.end(), r, r + 5);
+        } else {
+          const auto& pc = static_cast<const PlaneContact<Spatial>&>(k_c);
+          const double fn = pc.normal().dot(f_lin);
+          forces.insert(forces.end(), {fn, (f_lin - fn * pc.normal()).norm(), pc.gap(mech.kinematics())});
+        }
+      }
     }
-    record(run, mech, k * args.dt, q, v, work, forces);
+    record(run, mech, k * args.dt, q, v, work, forces, m.contacts.empty() ? mech.residual(q) : elementResidual(m, mech, q, v));
     if (k == steps) break;
     if (!(run.ok = qn.allFinite() && vn.allFinite())) break;
     const double p = inflow(vn);
@@ -203,10 +324,40 @@ std::string report(const Run& r, const std::string& engine, const model_file::Lo
   const bool driven = !args.torques.empty();
   o << (driven ? "run with constant torques (" + join(args.torques, ", ") + "), " : std::string("passive run, ")) << engine << ", dt "
     << fmt(args.dt) << " s, " << fmt(args.duration) << " s from q0 at rest\n"
-    << "  closure residual max |φ|∞ " << fmt(r.residual) << "\n"
-    << "  energy E0 " << fmt(r.e0) << " J, max |E − E0 − " << (driven ? "W" : "W_friction") << "| " << fmt(r.balance)
-    << " J (kinetic energy up to " << fmt(r.kinetic) << " J" << (driven ? "; W: the torques' work and friction's" : "")
+    << "  " << (m.contacts.empty() ? "closure residual" : "constraint residual (closures, no-slip rows, contact depth)") << " max |φ|∞ "
+    << fmt(r.residual) << "\n"
+    << "  energy E0 " << fmt(r.e0) << " J, max |E − E0 − " << (driven || anyImpacts(m) ? "W" : "W_friction") << "| " << fmt(r.balance)
+    << " J (kinetic energy up to " << fmt(r.kinetic) << " J"
+    << (driven ? "; W: the torques' work and friction's" : anyImpacts(m) ? "; W: friction's and, in the hand engine's books, the touchdowns'" : "")
     << (m.mechanism.joints.empty() && !driven ? "" : "; W by the trapezoid rule in Bullet's books") << ")\n";
+  // dynlab's elements: a wheel's largest slip speed, a contact's closest approach and its last force.
+  const Trace& t = r.trace;
+  if (t.rows() > 0) {
+    const std::size_t last = t.rows() - 1;
+    for (const auto& c : m.contacts) {
+      const std::string n = columnName(c.name);
+      double extreme = c.kind == "rolling" ? 0.0 : INFINITY;
+      for (std::size_t row = 0; row < t.rows(); ++row)
+        extreme = c.kind == "rolling" ? std::max(extreme, std::abs(t.at(row, "slip_" + n))) : std::min(extreme, t.at(row, "gap_" + n));
+      if (c.kind == "rolling")
+        o << "  rolling " << c.name << ": max slip speed " << fmt(extreme) << " m/s; at the end f_long " << fmt(t.at(last, "f_" + n + "_long"))
+          << ", f_lat " << fmt(t.at(last, "f_" + n + "_lat")) << ", f_normal " << fmt(t.at(last, "f_" + n + "_normal")) << " N\n";
+      else
+        o << "  contact " << c.name << ": min gap " << fmt(extreme) << " m; at the end f_normal " << fmt(t.at(last, "f_" + n + "_normal"))
+          << " N, f_tangent " << fmt(t.at(last, "f_" + n + "_tangent")) << " N\n";
+    }
+    for (std::size_t i = 0; i < m.contacts.size(); ++i)
+      if (m.mechanism.constraints[m.closures.size() + i]->compliant()) {
+        o << "  note: a compliant contact's spring energy and damping are not in the books (its E − E0 − W holds them)\n";
+        break;
+      }
+    if (anyImpacts(m)) {
+      if (engine.rfind("hand", 0) == 0)
+        o << "  touchdowns (plastic impacts) took " << fmt(t.at(last, "impacts")) << " J (counted in W)\n";
+      else
+        o << "  touchdowns: inside Bullet's contact impulses, not counted in W (its E − E0 − W holds their loss)\n";
+    }
+  }
   if (!r.ok)
     o << "  the run stopped at t = " << fmt(double(r.trace.rows() - 1) * args.dt)
       << " s: the projection failed or the state left the finite numbers\n";
@@ -238,7 +389,7 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration) 
   model_file::LoadOptions options;
   model_file::LoadedModel m;
   try {
-    if (const std::string beside = loopsBeside(file); !beside.empty()) options.closures = readLoops(beside);
+    if (const std::string beside = loopsBeside(file); !beside.empty()) readBeside(beside, options);
     m = model_file::load(file, options);
   } catch (const model_file::ModelFileError& e) {
     throw InputError(file, "/", std::string("a model file dynlab reads (") + e.what() + ")");
@@ -343,7 +494,7 @@ int model(const ModelArgs& args) {
   std::string text = describe(m) + crossCheck(m, mech);
   const bool hand = args.engine != "bullet", bullet = args.engine != "hand";
   Run h, b;
-  if (hand) h = runHand(m, mech, args, tau);
+  if (hand) h = m.contacts.empty() ? runHand(m, mech, args, tau) : runHandElements(m, mech, args, tau);
   if (bullet) {
     try {
       b = runBullet(m, mech, args, tau);

@@ -5,6 +5,9 @@
 // balance and their agreement; writes
 // OUT/trace.csv (hand), OUT/trace_bullet.csv and OUT/summary.txt, and with --video / --frames the run
 // drawn from the file's geoms (labs/model_scene.h): OUT/video.mp4, OUT/frames/NNNNN.png.
+// With dynlab's own elements beside the file (STEM.loops.json: rolling wheels, plane contacts) the hand
+// engine steps as the labs do (contacts closed and opened, touchdowns located) and the trace names each
+// element's forces (normal, tangential or wheel-axes components), gap or slip, and the touchdowns' energy.
 // `dynlab run FILE.xml|FILE.urdf` (a model file where a lab name goes) is the same command.
 // Registered on the command line by ModelCommand, so main.cpp only constructs it and asks it to run.
 #pragma once

@@ -63,6 +63,14 @@ class ConstrainedMechanism : public ConstrainedSystem {
   Vec constraintForce(int i, const Solution& s);
   // Its η rows, and the row where they start.
   int rowOffset(int i) const { return offsets_[std::size_t(i)]; }
+  // The load each tree joint carries in a solution s at (q, v): the spatial force the joint's parent
+  // applies to the subtree it carries, world axes at the world origin (spatial: (moment, force)).
+  // RNEA (chain.h) at θ'' with gravity gives the force the subtree's motion needs; the constraint
+  // forces on the subtree's links supply part of it, the joint the rest:
+  //   f_i = Σ_{k ∈ subtree(i)} (I_k a_k + v_k ×* I_k v_k − I_k a_g)  −  Σ_{constraints on the subtree} f_c
+  // Its part along the joint's axis is the joint's torque net of spring and friction; the rest is what
+  // the bearing carries. The description's external forces (model().forces) are not counted.
+  void jointLoads(const VecN& q, const VecN& v, const Solution& s, std::vector<Vec>& loads);
   // Constraint i's extra reports (Constraint::reportNames) at the state last solved.
   void constraintReport(int i, const Solution& s, double* out);
 
@@ -90,6 +98,10 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // contact alone; zero when that call closed nothing (or the solve was singular). A lab that reports a
   // step's mean contact force, as impulse-based engines do, adds P/dt to the solved force.
   const Vec& impactImpulse(int i) const { return impact_[std::size_t(i)]; }
+  // The kinetic energy every plastic impact of updateContacts has taken since construction (J, ≥ 0):
+  // ½ Δvᵀ M Δv each (v⁺ is v⁻'s M-orthogonal projection onto the closed rows, so v⁺ᵀ M Δv = 0) — what
+  // an energy book adds to E − E0 − W to balance a run with touchdowns.
+  double impactLoss() const { return impact_loss_; }
   // False while constraint i's rows are released (an open unilateral or a compliant contact).
   bool closed(int i) const { return !released_[std::size_t(i)]; }
   // Close or open a unilateral constraint by hand (initial conditions, tests).
@@ -184,6 +196,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
   VecN compliant_bc_;    // payload side: −Aᵀ η of the compliant rows
   std::vector<Vec> impact_;  // per constraint: the last updateContacts' impact impulse
   bool any_impact_ = false;
+  double impact_loss_ = 0.0;  // J, the impacts' kinetic energy taken so far
   // External forces (at the velocity stage's time): the payloads' share Aᵀ F of b_c + G_c, their power
   // F·V_P; and the joint friction's power.
   VecN external_bc_;

@@ -324,6 +324,8 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
       dx.tail(k()) = s.alpha_c;
       if (dx.allFinite()) {
         v -= dx;
+        const VecN dv = dx.head(n()), dvc = dx.tail(k());
+        impact_loss_ += 0.5 * (dv.dot(problem_.M * dv) + (k() ? dvc.dot(problem_.Mc * dvc) : 0.0));
         const VecN P = -s.eta;
         for (std::size_t i = 0; i < count; ++i)
           if (rigid(i) && !released_[i]) impact_[i] = model_.constraints[i]->force(kin_, P.data() + offsets_[i]);
@@ -518,6 +520,29 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::correction(const VecN& q, const VecN& 
 template <class S, int Nj, int Nr, int Nl>
 typename S::Vec ConstrainedMechanism<S, Nj, Nr, Nl>::constraintForce(int i, const Solution& s) {
   return model_.constraints[std::size_t(i)]->force(kin_, s.eta.data() + offsets_[std::size_t(i)]);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::jointLoads(const VecN& q, const VecN& v, const Solution& s,
+                                                     std::vector<Vec>& loads) {
+  const int nn = n();
+  // The constraint forces first, at the staged configuration: each at the world origin.
+  positionStage(q);
+  std::vector<std::pair<Attachment<S>, Vec>> applied;
+  for (std::size_t c = 0; c < model_.constraints.size(); ++c) {
+    const auto& con = *model_.constraints[c];
+    const Vec f = constraintForce(int(c), s);
+    applied.emplace_back(con.attachment(), S::forceTranspose(S::translation(con.point(kin_)), f));
+  }
+  // What each subtree needs (data_.f after RNEA: joint i's force in body i's axes), in world axes.
+  inverseDynamics(q, v, VecN(s.qdd.head(nn)));
+  loads.resize(std::size_t(nn));
+  for (int i = 0; i < nn; ++i) loads[std::size_t(i)] = S::forceTranspose(data_.X_world[std::size_t(i)], data_.f[std::size_t(i)]);
+  // Less what the constraints apply to the subtree: f_c on body b, −f_c on body a, up every joint above them.
+  for (const auto& [at, f] : applied)
+    for (const auto& [body, sign] : {std::pair{at.b, 1.0}, std::pair{at.a, -1.0}})
+      if (body.kind == BodyRef::Kind::Link)
+        for (int k = body.index; k >= 0; k = model_.tree.bodies[std::size_t(k)].parent) loads[std::size_t(k)] -= sign * f;
 }
 
 template <class S, int Nj, int Nr, int Nl>

@@ -24,6 +24,7 @@ class Hooks final : public StepHooks {
   explicit Hooks(const DataSettings& s)
       : s_(s), ctrl_(s.controller, s.model, s.actuated, s.tool, s.q0, s.step.dt) {
     if (s_.path) s_.path->at(0.0, ref_.x, ref_.xd, ref_.xdd), ref_.joint = s_.path->joint();
+    if (!s.passive.empty()) loads_mech_ = std::make_unique<Mech>(s.plant->mechanism);
   }
   VecN torque(double t, const VecN& q, const VecN& v) override {
     if (s_.path) s_.path->at(t, ref_.x, ref_.xd, ref_.xdd), ref_.joint = s_.path->joint();
@@ -56,12 +57,22 @@ class Hooks final : public StepHooks {
     const auto& closures = s_.plant->closures;
     for (std::size_t c = 0; c < closures.size(); ++c)
       for (const auto& row : closures[c].kept) out.push_back(r.forces[c][model_file::rowIndex(row)]);
+    // The force each passive joint's bearing carries (its parent on it, world axes): the plant's solve
+    // at the row's state (ConstrainedMechanism::jointLoads), for either engine's row.
+    if (loads_mech_) {
+      const auto sol = loads_mech_->solve(r.q, r.v, r.tau);
+      loads_mech_->jointLoads(r.q, r.v, sol, loads_);
+      for (const int j : s_.passive)
+        for (int a = 3; a < 6; ++a) out.push_back(loads_[std::size_t(j)][a]);
+    }
   }
 
  private:
   const DataSettings& s_;
   controllers::Controller ctrl_;
   controllers::Reference ref_;
+  std::unique_ptr<Mech> loads_mech_;  // the plant, for the passive joints' loads
+  std::vector<Spatial::Vec> loads_;
 };
 
 std::string fmt(const char* f, double x) {
@@ -83,6 +94,7 @@ std::string DataLab::unit(const std::string& c) const {
   const bool joint_path = s_.path && s_.path->joint();
   if (starts("tool_") || (!joint_path && (starts("ref_") || starts("e_")))) return "m";
   if (starts("tau_") && c != "tau_sat") return "N·m";
+  if (starts("load_")) return "N";
   if (starts("f_")) {
     const std::string row = c.substr(c.rfind('_') + 1);
     return row[0] == 'w' ? "N·m" : "N";

@@ -21,7 +21,8 @@
 // Trace columns: t, q_<joint> (every coordinate), v_<joint>, tau_<actuated>, tau_sat, tool_<axis>,
 // ref_<axis>, e_<axis> (a joint path: ref_<actuated>, e_<actuated>), energy, work, constraint_residual,
 // and f_<closure>_<row> (force, world axes, of each kept closure row: rows wx wy wz are moments, x y z
-// forces).
+// forces), then load_<joint>_x|y|z for each passive joint: the force its bearing carries (its parent on
+// it, world axes; jointLoads).
 #pragma once
 #include <memory>
 #include <string>
@@ -50,6 +51,7 @@ struct DataSettings {
   double duration = 1, passive_tolerance = 1e-6;
   std::map<std::string, MetricSpec> metrics;
   std::vector<std::string> columns;
+  std::vector<int> passive;  // the tree joints not actuated (their loads are traced)
 };
 
 // Parses a data lab's config (its folder: where the model file is; options: loops given beside it).

@@ -248,6 +248,10 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   for (const char* k : {"energy", "work", "constraint_residual"}) s.columns.push_back(k);
   for (const auto& cl : file.closures)
     for (const auto& r : cl.kept) s.columns.push_back("f_" + columnName(cl.name) + "_" + r);
+  for (int j = 0; j < int(file.joints.size()); ++j)
+    if (std::find(s.actuated.begin(), s.actuated.end(), j) == s.actuated.end()) s.passive.push_back(j);
+  for (const int j : s.passive)
+    for (const char* a : {"x", "y", "z"}) s.columns.push_back("load_" + columnName(file.joints[std::size_t(j)].name) + "_" + a);
   if (c.has("metrics")) s.metrics = parseMetrics(c["metrics"], s.columns);
   s.plant = std::make_shared<const model_file::LoadedModel>(std::move(file));
   return s;

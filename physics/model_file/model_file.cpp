@@ -386,10 +386,33 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   auto rowsOf = [](bool weld) { return weld ? PointClosure<Spatial>::all() : PointClosure<Spatial>::translations(); };
   for (const Tie& t : ties) mech.constraints.push_back(std::make_shared<PointClosure<Spatial>>(t.a, t.pa, t.b, t.pb, rowsOf(t.weld)));
   if (const std::string why = mech.validate(); !why.empty()) throw ModelFileError(path + ": " + why);
-  if (ties.empty()) {
-    out.dof = m->nv;
+  auto rank = [](const Eigen::MatrixXd& A) {
+    if (A.rows() == 0) return 0;
+    Eigen::FullPivLU<Eigen::MatrixXd> lu(A);
+    lu.setThreshold(1e-9);
+    return int(lu.rank());
+  };
+  // Last, dynlab's own elements beside the file (rolling wheels, plane contacts), and the mechanism's
+  // freedom at q0: coordinates minus the rank of the bilateral rows there (a contact's row is one-sided).
+  auto finish = [&]() {
+    {
+      std::vector<int> link;
+      std::vector<Vec3> origin;
+      for (const Frame& f : frame) link.push_back(f.link), origin.push_back(f.origin);
+      detail::addElements(path, m, d, link, origin, options, out);
+    }
+    MechanismModel<Spatial> bilateral = mech;
+    bilateral.constraints.clear();
+    for (const auto& c : mech.constraints)
+      if (!c->unilateral()) bilateral.constraints.push_back(c);
+    ConstrainedMechanism<Spatial> reduced(bilateral);
+    VecN phi;
+    MatN G;
+    reduced.constraint(out.q0, phi, G);
+    out.dof = m->nv - rank(Eigen::MatrixXd(G));
     return out;
-  }
+  };
+  if (ties.empty()) return finish();
 
   // Each loop closes at qpos0 (MuJoCo places connect's second anchor there; a weld's relpose was checked).
   const int n = m->nv;
@@ -412,12 +435,6 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     full.constraint(q, phi, G);
     stacked.middleCols(s * n, n) = G;
   }
-  auto rank = [](const Eigen::MatrixXd& A) {
-    if (A.rows() == 0) return 0;
-    Eigen::FullPivLU<Eigen::MatrixXd> lu(A);
-    lu.setThreshold(1e-9);
-    return int(lu.rank());
-  };
   Eigen::MatrixXd kept(0, stacked.cols());
   std::vector<std::array<bool, 6>> masks(ties.size());
   for (std::size_t i = 0, r = 0; i < ties.size(); ++i) {
@@ -451,13 +468,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
       out.drawing.bones.push_back({link, Vec3::Zero(), point});
   };
   for (const Closure& c : out.closures) reach(c.link1, c.point1), reach(c.link2, c.point2);
-  // The mechanism's freedom at q0: coordinates minus the rank of the kept rows there.
-  ConstrainedMechanism<Spatial> reduced(mech);
-  VecN phi;
-  MatN G;
-  reduced.constraint(out.q0, phi, G);
-  out.dof = n - rank(Eigen::MatrixXd(G));
-  return out;
+  return finish();
 }
 
 }  // namespace dyn::model_file

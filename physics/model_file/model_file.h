@@ -11,6 +11,8 @@
 //   closures     <equality> connect (3 translation rows) and weld (6 rows) as point closures, with the
 //                rows that are identically dependent on the others (a planar loop's out-of-plane
 //                rows) dropped and named
+//   elements     dynlab's own, given beside the file (LoadOptions: GivenRolling, GivenContact): a
+//                wheel rolling without slip and a ball against a plane (unilateral), after the closures
 // Anything else the description cannot represent is a one-line ModelFileError naming the file, the
 // element and what is supported. This folder is the only code that includes MuJoCo.
 #pragma once
@@ -49,6 +51,17 @@ struct Closure {
   std::vector<std::string> kept, dropped;  // row names: wx wy wz x y z (world axes)
   int link1 = -1, link2 = -1;              // the tree bodies the anchors move with (−1: the world)
   Eigen::Vector3d point1 = Eigen::Vector3d::Zero(), point2 = Eigen::Vector3d::Zero();  // in their frames
+};
+
+// dynlab's own constraint elements, given beside the file (GivenRolling, GivenContact below): a rolling
+// wheel (physics/constraints/rolling.h) or a ball against a plane (plane_contact.h, unilateral), as the
+// description holds them, after the closures.
+struct Contact {
+  std::string name;
+  std::string kind;  // "rolling" or "plane_contact"
+  std::string body;  // the MuJoCo body (URDF link) it is on
+  int link = -1;     // the tree body it moves with
+  double mu = 0;     // rolling: the skid report's μ (and Bullet's friction model); plane: Bullet's friction
 };
 
 // What the file draws (drawing only: the dynamics never reads it). Each shape is fixed to a tree body
@@ -93,11 +106,13 @@ struct LoadedModel {
   VecN q0;                         // the file's reference pose qpos0 (closed: every loop holds there)
   std::vector<Joint> joints;       // per coordinate
   std::vector<std::string> bodies;  // per MuJoCo body that moves (the world and fused bodies left out)
-  std::vector<Closure> closures;   // per mechanism constraint
+  std::vector<Closure> closures;   // per mechanism constraint, first
+  std::vector<Contact> contacts;   // per mechanism constraint after the closures (rolling, plane contacts)
   std::vector<std::string> notes;  // what is read but not enforced (limits, unused motors, ...)
   Drawing drawing;                  // what the renderer draws (beside the description, never in it)
   double timestep = 0;             // the file's <option timestep>
-  int dof = 0;                     // coordinates minus independent closure rows at q0
+  int dof = 0;                     // coordinates minus independent closure and rolling rows at q0 (contacts,
+                                   // unilateral, not counted)
 };
 
 // A loop closure given beside the file (plain data; app/model_loops.h reads it from the lab JSON beside
@@ -111,9 +126,33 @@ struct GivenClosure {
   Eigen::Vector3d point2 = Eigen::Vector3d::Zero();  // in body2's frame
 };
 
+// A wheel rolling without slip on the ground z = height (physics/constraints/rolling.h), given beside the
+// file: 3 rows, x and y velocity-level (nonholonomic), z its rim's lowest point on the ground. The file
+// is written with the wheel on the ground at the reference pose.
+struct GivenRolling {
+  std::string where;  // for errors: "FILE.loops.json: rolling[0]"
+  std::string name, body;  // body: a link (MuJoCo body) the wheel is fixed to
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  // the disk's centre, in the body's frame
+  Eigen::Vector3d axle = Eigen::Vector3d::UnitY();   // its axle, in the body's frame
+  double radius = 0, height = 0, mu = 0;  // m; the ground z = height; μ for the skid report
+};
+
+// A ball of radius ρ fixed to a body against the half-space normal·x ≥ height (plane_contact.h): one
+// unilateral row, frictionless in the hand engine (μ: Bullet's friction), rigid (stiffness 0: plastic
+// touchdowns, lift-off) or compliant. The ball may not start inside the plane.
+struct GivenContact {
+  std::string where;  // for errors: "FILE.loops.json: contacts[0]"
+  std::string name, body;
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();     // the ball's centre, in the body's frame
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   // the plane's outward normal, world
+  double radius = 0, height = 0, mu = 0, stiffness = 0, damping = 0;
+};
+
 struct LoadOptions {
   bool ignore_contacts = false;  // load a file whose geoms may collide, ignoring contacts (noted)
   std::vector<GivenClosure> closures;  // held after the file's own equalities, in this order
+  std::vector<GivenRolling> rolling;   // then these, in this order
+  std::vector<GivenContact> contacts;  // then these
 };
 
 // Reads FILE (MJCF or URDF). Throws ModelFileError.

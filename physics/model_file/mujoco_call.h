@@ -37,6 +37,11 @@ std::string oneLine(const std::string& text);
 void readDrawing(const mjModel* m, const mjData* d, const std::vector<int>& link, const std::vector<Eigen::Vector3d>& origin,
                  Drawing& out);
 
+// dynlab's own elements given beside the file (options.rolling, options.contacts) onto out's description,
+// after its closures, and into out.contacts (elements.cpp). Body b as in readDrawing.
+void addElements(const std::string& path, const mjModel* m, const mjData* d, const std::vector<int>& link,
+                 const std::vector<Eigen::Vector3d>& origin, const LoadOptions& options, LoadedModel& out);
+
 }  // namespace dyn::model_file::detail
 
 // Runs the statement; a MuJoCo error inside it throws ModelFileError("<file>: MuJoCo: <message>").

@@ -54,8 +54,11 @@ TEST_CASE("fourbar.urdf with fourbar.loops.json beside it equals fourbar.xml (M,
   const model_file::LoadedModel xml = model_file::load(model("fourbar.xml"));
   // Found beside the URDF without being named.
   CHECK(app::loopsBeside(model("fourbar.urdf")) == model("fourbar.loops.json"));
-  // Beside a URDF only: fourbar.xml (its loop an equality) does not pick up fourbar.urdf's.
+  // fourbar.xml (its loop an equality) does not pick up fourbar.urdf's; an MJCF without a URDF of its
+  // stem beside it picks up its own (dynlab's elements: unicycle.xml's wheel).
   CHECK(app::loopsBeside(model("fourbar.xml")).empty());
+  CHECK(app::loopsBeside(model("unicycle.xml")) == model("unicycle.loops.json"));
+  CHECK(app::loopsBeside(model("fivebar.xml")).empty());
   CHECK(app::loadWithLoops(model("fourbar.xml"), "").notes == xml.notes);
   const model_file::LoadedModel urdf = app::loadWithLoops(model("fourbar.urdf"), "");
   REQUIRE(urdf.closures.size() == 1);
