@@ -104,7 +104,9 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref) {
   // The desired joint motion (joint laws): inverse kinematics, then rates and accelerations through J_x.
   VecN ud, udd_d = VecN::Zero(m), ud_d = VecN::Zero(m);
   const bool joint = kind == Kind::JointPdGravity || kind == Kind::Pid || kind == Kind::ComputedTorque;
-  if (joint) {
+  if (joint && ref.joint) {
+    ud = ref.x, ud_d = ref.xd, udd_d = ref.xdd;
+  } else if (joint) {
     if (!inverseKinematics(ref.x, q_ik_) || !chain_.update(q_ik_, VecN::Zero(mech_->n()))) return tau_u_;
     chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
     ud_d = solveTask(Jx, ref.xd);

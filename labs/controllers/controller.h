@@ -11,7 +11,8 @@
 // with K_p = ω_n², K_d = 2ζω_n where named so; the arithmetic is laws.h's, shared with the C++ labs. The
 // joint laws' gains are scaled per joint by joint_scale (computed torque's are not: they set the error
 // dynamics), and pid may add Coulomb compensation F̂_c sat(u_d'/w) from the model's joint friction. Joint laws track the task path through inverse kinematics
-// on the controller's model (u_d, u_d' = J_x⁻¹ x_d', u_d'' = J_x⁻¹ (x_d'' − J_x' u_d')). The controller
+// on the controller's model (u_d, u_d' = J_x⁻¹ x_d', u_d'' = J_x⁻¹ (x_d'' − J_x' u_d')), or follow a joint
+// path directly (Reference::joint: u_d, u_d', u_d'' given, no inverse kinematics). The controller
 // samples at its period (zero-order hold), reads encoders on every joint `delay` steps late with seeded
 // Gaussian noise, knows only its own model (a payload the plant carries may be missing from it), and
 // saturates at the torque limits.
@@ -59,9 +60,10 @@ struct TaskPoint {
   std::vector<int> axes;
 };
 
-// The reference at one instant, in the task's axes.
+// The reference at one instant, in the task's axes (joint: in the actuated coordinates, u_d, u_d', u_d'').
 struct Reference {
   VecN x, xd, xdd;
+  bool joint = false;
 };
 
 class Controller {

@@ -23,10 +23,11 @@ class Hooks final : public StepHooks {
  public:
   explicit Hooks(const DataSettings& s)
       : s_(s), ctrl_(s.controller, s.model, s.actuated, s.tool, s.q0, s.step.dt) {
+    if (s_.path) s_.path->at(0.0, ref_.x, ref_.xd, ref_.xdd), ref_.joint = s_.path->joint();
     if (!s.passive.empty()) loads_mech_ = std::make_unique<Mech>(s.plant->mechanism);
   }
   VecN torque(double t, const VecN& q, const VecN& v) override {
-    if (s_.path) s_.path->at(t, ref_.x, ref_.xd, ref_.xdd);
+    if (s_.path) s_.path->at(t, ref_.x, ref_.xd, ref_.xdd), ref_.joint = s_.path->joint();
     return ctrl_.torque(t, q, v, ref_);
   }
   void row(const StepRecord& r, std::vector<double>& out) override {
@@ -39,10 +40,16 @@ class Hooks final : public StepHooks {
     out.push_back(ctrl_.saturated() ? 1.0 : 0.0);
     // The tool at the plant's state (the controller's model has the plant's geometry: payloads change
     // only inertias).
+    VecN x;
     if (!s_.tool.axes.empty()) {
-      VecN x;
       ctrl_.taskPosition(r.q, x);
       for (int i = 0; i < x.size(); ++i) out.push_back(x[i]);
+    }
+    // The errors: of the joint path in the actuated coordinates, or of the task path.
+    if (ref_.joint) {
+      for (std::size_t j = 0; j < s_.actuated.size(); ++j) out.push_back(ref_.x[Eigen::Index(j)]);
+      for (std::size_t j = 0; j < s_.actuated.size(); ++j) out.push_back(ref_.x[Eigen::Index(j)] - r.q[s_.actuated[j]]);
+    } else if (!s_.tool.axes.empty()) {
       for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i]);
       for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i] - x[i]);
     }
@@ -83,7 +90,9 @@ std::string DataLab::unit(const std::string& c) const {
   if (c == "t") return "s";
   if (c == "energy" || c == "work") return "J";
   if (c == "constraint_residual") return "m";
-  if (starts("tool_") || starts("ref_") || starts("e_")) return "m";
+  // A joint path's reference and error columns carry their joint's unit (below).
+  const bool joint_path = s_.path && s_.path->joint();
+  if (starts("tool_") || (!joint_path && (starts("ref_") || starts("e_")))) return "m";
   if (starts("tau_") && c != "tau_sat") return "N·m";
   if (starts("load_")) return "N";
   if (starts("f_")) {
@@ -92,7 +101,8 @@ std::string DataLab::unit(const std::string& c) const {
   }
   for (std::size_t i = 0; i < s_.plant->joints.size(); ++i) {
     const bool slide = s_.plant->joints[i].type == "slide";
-    if (c == s_.columns[1 + i]) return slide ? "m" : "rad";
+    const std::string j = columnName(s_.plant->joints[i].name);
+    if (c == s_.columns[1 + i] || c == "ref_" + j || c == "e_" + j) return slide ? "m" : "rad";
     if (c == s_.columns[1 + s_.plant->joints.size() + i]) return slide ? "m/s" : "rad/s";
   }
   return {};
@@ -107,14 +117,16 @@ std::unique_ptr<Simulation> runOn(const DataSettings& s, Engine engine) {
 }
 
 std::unique_ptr<Simulation> DataLab::simulate(Engine engine) const {
-  // The shapes of the shipped loops at fixed sizes (instantiated in physics/model_file/hand_engine.cpp),
-  // as the C++ labs fix theirs: every loop of the step unrolled. Any other shape: dynamic sizes.
+  // The shapes of the shipped loops at fixed sizes (instantiated in physics/model_file/hand_engine.cpp)
+  // and a 6-joint open chain's (mechanism.cpp), as the C++ labs fix theirs: every loop of the step
+  // unrolled. Any other shape: dynamic sizes.
   const auto& m = s_.plant->mechanism;
   const int n = m.treeDof(), r = m.rows();
   if (m.payloads.empty()) {
     if (n == 4 && r == 2) return runOn<ConstrainedMechanism<Spatial, 4, 2, 0>>(s_, engine);
     if (n == 3 && r == 2) return runOn<ConstrainedMechanism<Spatial, 3, 2, 0>>(s_, engine);
     if (n == 4 && r == 3) return runOn<ConstrainedMechanism<Spatial, 4, 3, 0>>(s_, engine);
+    if (n == 6 && r == 0) return runOn<ConstrainedMechanism<Spatial, 6, 0, 0>>(s_, engine);  // mechanism.cpp
   }
   return runOn<Mech>(s_, engine);
 }
@@ -169,8 +181,21 @@ void DataLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene&
   VecN gq;
   if (ghost && row < ghost->rows()) gq = traceQ(*ghost, row, n);
   picture_.scene(q, gq.size() ? &gq : nullptr, bounds_, out);
-  // The path: the reference so far as a thin line, the tool's target as a small ball.
-  if (s_.tool.axes.size() >= 2) {
+  // The path: the reference so far as a thin line, the tool's target as a small ball; a joint path's
+  // is where the tool would be at the reference angles.
+  if (s_.path && s_.path->joint() && !s_.tool.axes.empty()) {
+    auto reference = [&](std::size_t r) {
+      VecN qr = traceQ(tr, r, n);
+      for (std::size_t j = 0; j < s_.actuated.size(); ++j) qr[s_.actuated[j]] = tr.at(r, "ref_" + columnName(s_.actuated_names[j]));
+      return Eigen::Vector3d(kinematics_->pointPosition(s_.tool.link, s_.tool.point, qr));
+    };
+    Polyline path;
+    const std::size_t stride = std::max<std::size_t>(1, tr.rows() / 400);
+    for (std::size_t r = 0; r < tr.rows(); r += stride) path.points.push_back(reference(r));
+    path.color = {0.85f, 0.2f, 0.2f, 0.8f};
+    out.polylines.push_back(path);
+    out.spheres.push_back({reference(row), 0.01, {0.85f, 0.2f, 0.2f, 1.0f}});
+  } else if (s_.tool.axes.size() >= 2) {
     Polyline path;
     const Eigen::Vector3d p0 = kinematics_->pointPosition(s_.tool.link, s_.tool.point, q);
     const std::size_t stride = std::max<std::size_t>(1, tr.rows() / 400);
@@ -189,23 +214,27 @@ void DataLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene&
 
 void DataLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
   o.title = s_.title.substr(0, s_.title.find(':'));  // "Five-bar: task-space control ..." → "Five-bar"
-  if (s_.axis_names.empty()) {
+  if (s_.axis_names.empty() && !s_.path) {
     // No task: the passive model's panel (time, energy and its balance, closure), as `dynlab model` draws it.
     modelOverlay(o.title, "passive (τ = 0)", tr, row, s_.step.dt, nullptr, o);
     return;
   }
-  double e = 0;
-  for (const auto& a : s_.axis_names) e += std::pow(tr.at(row, "e_" + a), 2);
-  o.lines = {{"t", fmt("%.3f s", tr.at(row, "t"))}, {"tracking |e|", fmt("%.2f mm", 1e3 * std::sqrt(e))}};
+  // The tracking error's norm: the task's (mm) or a joint path's (mrad, over the actuated joints).
+  std::vector<std::string> errors;
+  const bool joint_path = s_.path && s_.path->joint();
+  for (const auto& a : joint_path ? s_.actuated_names : s_.axis_names) errors.push_back("e_" + (joint_path ? columnName(a) : a));
+  const char* unit = joint_path ? "mrad" : "mm";
+  auto norm = [&](std::size_t r) {
+    double e = 0;
+    for (const auto& c : errors) e += std::pow(tr.at(r, c), 2);
+    return 1e3 * std::sqrt(e);
+  };
+  o.lines = {{"t", fmt("%.3f s", tr.at(row, "t"))}, {"tracking |e|", fmt("%.2f ", norm(row)) + unit}};
   for (const auto& a : s_.actuated_names)
     o.lines.push_back({"τ " + a, fmt("%.2f N·m", tr.at(row, "tau_" + columnName(a)))});
-  o.lines.push_back({"closure |φ|", fmt("%.1e m", tr.at(row, "constraint_residual"))});
-  Series err{"|e| (mm)", {}, {0.85f, 0.2f, 0.2f, 1.0f}};
-  for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) {
-    double s = 0;
-    for (const auto& a : s_.axis_names) s += std::pow(tr.at(r, "e_" + a), 2);
-    err.values.push_back(float(1e3 * std::sqrt(s)));
-  }
+  if (!s_.plant->closures.empty()) o.lines.push_back({"closure |φ|", fmt("%.1e m", tr.at(row, "constraint_residual"))});
+  Series err{std::string("|e| (") + unit + ")", {}, {0.85f, 0.2f, 0.2f, 1.0f}};
+  for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) err.values.push_back(float(norm(r)));
   o.plots = {err};
 }
 

@@ -9,17 +9,20 @@
 //                                        coordinates at the file's pose), "axes": ["x", "z"]; none: no
 //                                        task and no trajectory (a passive model: `dynlab figure FILE`)
 //   "initial": {"actuated_deg": [..]}    the actuators' start; the passive joints are assembled
-//   "trajectory": {"segments": [...]}    the task path from the tool's start (labs/generic/task_path.h)
+//   "trajectory": {"segments": [...]}    the task path from the tool's start (labs/generic/task_path.h);
+//                                        with "space": "joint" a joint path of the actuated joints, fed
+//                                        to the joint laws without inverse kinematics (tool optional)
 //   "plant": {"payloads": [{"body", "at", "mass"}]}   point masses the plant carries and the
 //                                        controller's model does not (scenarios change them)
 //   "controller": {"kind", "control_period", "delay_steps", "noise": {"angle", "rate", "seed"},
-//                  "constant"}           a law of labs/controllers, gains from "gains"
+//                  "constant", "joint_scale"}   a law of labs/controllers, gains from "gains"
 //   "metrics": {...}                     labs/generic/metric_spec.h
 //   "passive_tolerance": 1e-6            the passive energy check's |E − E0|/|E0|
 // Trace columns: t, q_<joint> (every coordinate), v_<joint>, tau_<actuated>, tau_sat, tool_<axis>,
-// ref_<axis>, e_<axis>, energy, work, constraint_residual, and f_<closure>_<row> (force, world axes, of
-// each kept closure row: rows wx wy wz are moments, x y z forces), then load_<joint>_x|y|z for each
-// passive joint: the force its bearing carries (its parent on it, world axes; jointLoads).
+// ref_<axis>, e_<axis> (a joint path: ref_<actuated>, e_<actuated>), energy, work, constraint_residual,
+// and f_<closure>_<row> (force, world axes, of each kept closure row: rows wx wy wz are moments, x y z
+// forces), then load_<joint>_x|y|z for each passive joint: the force its bearing carries (its parent on
+// it, world axes; jointLoads).
 #pragma once
 #include <memory>
 #include <string>

@@ -142,8 +142,8 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
       s.tool.axes.push_back(3 + (a[0] - 'x'));
       s.axis_names.push_back(a);
     }
-  } else if (c.has("trajectory")) {
-    c["trajectory"].fail("no trajectory without a \"tool\" to follow it");
+  } else if (c.has("trajectory") && !TaskPath::isJointSpace(c["trajectory"])) {
+    c["trajectory"].fail("no task trajectory without a \"tool\" to follow it (or \"space\": \"joint\")");
   }
 
   // The start: the actuators placed, the loop assembled from the file's pose.
@@ -157,8 +157,13 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   // (The probe has the file's geometry; the payloads changed only inertias.)
   if (!assemble(probe, s.q0, s.actuated)) c["initial"]["actuated_deg"].fail("actuator angles at which the loop closes");
 
-  // The path, from where the tool starts.
-  if (!s.tool.axes.empty()) {
+  // The path, from where the tool starts (a joint path: from where the actuators start).
+  if (c.has("trajectory") && TaskPath::isJointSpace(c["trajectory"])) {
+    if (m == 0) c["trajectory"]["space"].fail("a task path: a joint path needs actuated joints (/actuated)");
+    VecN u0(m);
+    for (int j = 0; j < m; ++j) u0[j] = s.q0[s.actuated[std::size_t(j)]];
+    s.path = std::make_shared<TaskPath>(c["trajectory"], u0, 4 * M_PI);
+  } else if (!s.tool.axes.empty()) {
     const Eigen::Vector3d p0 = probe.pointPosition(s.tool.link, s.tool.point, s.q0);
     VecN x0(Eigen::Index(s.tool.axes.size()));
     for (std::size_t i = 0; i < s.tool.axes.size(); ++i) x0[Eigen::Index(i)] = p0[s.tool.axes[i] - 3];
@@ -221,6 +226,10 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
       c["submission_options"]["kind"].fail("controller kinds of the library (" + list(controllers::kindNames()) + ")");
     for (const auto& g : controllers::gainsOf(controllers::kindFromName(k)))
       if (!gains.count(g)) c["gains"].fail("a gain \"" + g + "\" (the controller kind " + k + " reads it)");
+    // A joint path feeds the joint laws only: the task laws need a task path.
+    const auto kk = controllers::kindFromName(k);
+    if (s.path && s.path->joint() && (kk == controllers::Kind::TaskPdGravity || kk == controllers::Kind::TaskInverseDynamics))
+      c["trajectory"]["space"].fail("\"task\" for the controller kind " + k + " (a joint path feeds joint_pd_gravity, pid and computed_torque)");
   }
   auto gain = [&](const char* g) { return gains.count(g) ? gains.at(g) : 0.0; };
   cs.kp = gain("kp"), cs.kd = gain("kd"), cs.ki = gain("ki"), cs.omega_n = gain("omega_n"), cs.zeta = gain("zeta");
@@ -231,8 +240,11 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   for (const auto& j : file.joints) s.columns.push_back("v_" + columnName(j.name));
   for (const auto& a : s.actuated_names) s.columns.push_back("tau_" + columnName(a));
   s.columns.push_back("tau_sat");
-  for (const char* p : {"tool_", "ref_", "e_"})
-    for (const auto& a : s.axis_names) s.columns.push_back(p + a);
+  // The task's columns (x, its reference, the error), or a joint path's (u_d and e_u per actuated joint).
+  const bool joint_path = s.path && s.path->joint();
+  for (const auto& a : s.axis_names) s.columns.push_back("tool_" + a);
+  for (const char* p : {"ref_", "e_"})
+    for (const auto& a : joint_path ? s.actuated_names : s.axis_names) s.columns.push_back(p + (joint_path ? columnName(a) : a));
   for (const char* k : {"energy", "work", "constraint_residual"}) s.columns.push_back(k);
   for (const auto& cl : file.closures)
     for (const auto& r : cl.kept) s.columns.push_back("f_" + columnName(cl.name) + "_" + r);

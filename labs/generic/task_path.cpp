@@ -25,8 +25,12 @@ VecN point(const JsonView& j, int dims, double max) {
 
 }  // namespace
 
-TaskPath::TaskPath(const JsonView& j, const VecN& start, double max) : start_(start) {
-  j.onlyKeys({"segments"});
+bool TaskPath::isJointSpace(const JsonView& j) {
+  return j.has("space") && j["space"].oneOf({"task", "joint"}) == "joint";
+}
+
+TaskPath::TaskPath(const JsonView& j, const VecN& start, double max) : start_(start), joint_(isJointSpace(j)) {
+  j.onlyKeys({"space", "segments"});
   const int dims = int(start.size());
   const JsonView list = j["segments"];
   const std::size_t count = list.size(1, 64);
@@ -39,10 +43,15 @@ TaskPath::TaskPath(const JsonView& j, const VecN& start, double max) : start_(st
       seg.kind = Segment::Kind::Move;
       seg.to = point(s["move"], dims, max);
       seg.T = s["time"].inRange(1e-3, 1e4);
+    } else if (joint_ && s.has("move_deg")) {
+      s.onlyKeys({"move_deg", "time"});
+      seg.kind = Segment::Kind::Move;
+      seg.to = point(s["move_deg"], dims, max * 180.0 / M_PI) * (M_PI / 180.0);
+      seg.T = s["time"].inRange(1e-3, 1e4);
     } else if (s.has("hold")) {
       s.onlyKeys({"hold"});
       seg.T = s["hold"].inRange(0, 1e4);
-    } else if (s.has("circle")) {
+    } else if (s.has("circle") && !joint_) {
       s.onlyKeys({"circle", "turns", "time"});
       if (dims != 2) s["circle"].fail("a circle needs exactly two task axes");
       seg.kind = Segment::Kind::Circle;
@@ -56,6 +65,8 @@ TaskPath::TaskPath(const JsonView& j, const VecN& start, double max) : start_(st
       // Where the circle ends.
       const double psi = seg.psi0 + seg.sweep;
       here = seg.to + seg.radius * VecN((VecN(2) << std::cos(psi), std::sin(psi)).finished());
+    } else if (joint_) {
+      s.fail("expected a joint segment {\"move_deg\": [...], \"time\": T}, {\"move\": [...], \"time\": T} or {\"hold\": T}");
     } else {
       s.fail("expected a segment {\"move\": [...], \"time\": T}, {\"hold\": T} or {\"circle\": [cx, cz], \"turns\": n, \"time\": T}");
     }

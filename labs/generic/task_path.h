@@ -7,6 +7,9 @@
 //                                       angle ψ0 + 2πn s(τ), radius = the current point's distance
 // Coordinates are the task's axes (world metres, e.g. x and z of the tool). After the last segment the
 // path holds its end point.
+// "space": "joint" makes it a joint path over the actuated coordinates instead, from their start, fed to
+// the joint laws without inverse kinematics: {"move_deg": [θ1, ...], "time": T} (degrees),
+// {"move": [...], "time": T} (the coordinates' own units: rad, m) and {"hold": T}; no circles.
 #pragma once
 #include <string>
 #include <vector>
@@ -18,11 +21,15 @@ namespace dyn::generic {
 
 class TaskPath {
  public:
-  // Parses "trajectory": {"segments": [...]} for `dims` task axes, starting at `start`.
+  // Whether "trajectory" is a joint path ("space": "joint"; default "task").
+  static bool isJointSpace(const JsonView& j);
+  // Parses "trajectory": {"segments": [...]} for `dims` task axes (or actuated coordinates), starting at
+  // `start`; every coordinate within ±max_coordinate.
   TaskPath(const JsonView& j, const VecN& start, double max_coordinate);
   // The path at t: position, velocity and acceleration.
   void at(double t, VecN& x, VecN& xd, VecN& xdd) const;
   double duration() const { return end_; }
+  bool joint() const { return joint_; }
 
  private:
   struct Segment {
@@ -34,6 +41,7 @@ class TaskPath {
   std::vector<Segment> segments_;
   VecN start_;
   double end_ = 0;
+  bool joint_ = false;
 };
 
 }  // namespace dyn::generic

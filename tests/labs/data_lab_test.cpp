@@ -4,7 +4,12 @@
 //  * metrics as data: each statistic on a trace with known values;
 //  * task-space inverse dynamics on the five-bar with the exact model: the tool's error follows the
 //    closed form of e'' + 2ζω e' + ω² e = 0, the deviation first order in the control period (its hold);
-//  * a data lab's JSON: every bad field a one-line error naming its JSON path.
+//  * a data lab's JSON: every bad field a one-line error naming its JSON path;
+//  * a joint path: quintic moves in degrees ending at rest on their targets, derivatives by differences;
+//  * on the PUMA 560 (its URDF) with joint paths fed to the joint laws: PD + gravity with the exact
+//    model converges to the reference; computed torque under a payload its model lacks settles at
+//    e = M̂⁻¹ΔG / ω_n² (the closed form of its static error);
+//  * the joint path's and joint_scale's bad fields, one line each naming the JSON path.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -23,6 +28,7 @@ namespace fs = std::filesystem;
 namespace {
 
 json fivebarConfig() { return loadJsonFile(std::string(DYNLAB_SOURCE_DIR) + "/labs/fivebar/fivebar.json"); }
+json pumaConfig() { return loadJsonFile(std::string(DYNLAB_SOURCE_DIR) + "/labs/puma_motion/puma_motion.json"); }
 
 VecN vec(std::initializer_list<double> x) {
   VecN v(Eigen::Index(x.size()));
@@ -239,4 +245,146 @@ TEST_CASE("a data lab folder registers under its name, which must be a plain ide
   CHECK(row[std::size_t(at - columns.begin())] <= 1e-12);
   CHECK(unregisterLab("scratch_data_lab"));
   fs::remove_all(root);
+}
+
+TEST_CASE("joint path: quintic moves in degrees, at rest on their targets, derivatives by differences") {
+  const json j = json::parse(R"J({"space": "joint", "segments": [{"hold": 0.2}, {"move_deg": [90.0, -45.0], "time": 0.5},
+                                 {"move": [0.0, 1.0], "time": 1.0}, {"hold": 0.3}]})J");
+  const VecN start = vec({0.1, -0.2});
+  const generic::TaskPath path(JsonView(j, "lab.json", "/trajectory"), start, 4 * M_PI);
+  CHECK(path.joint());
+  CHECK(path.duration() == doctest::Approx(2.0));
+  VecN x, xd, xdd, xp, xm, xdp, xdm, d1, d2;
+  // Each move ends on its target (degrees converted), at rest, with no acceleration.
+  path.at(0.7, x, xd, xdd);
+  CHECK((x - vec({M_PI / 2, -M_PI / 4})).norm() < 1e-12);
+  CHECK(xd.norm() < 1e-12);
+  CHECK(xdd.norm() < 1e-9);
+  path.at(1.7, x, xd, xdd);
+  CHECK((x - vec({0.0, 1.0})).norm() < 1e-12);
+  // Halfway through a quintic move: half the way, peak rate 15/8 Δ/T, no acceleration.
+  path.at(0.45, x, xd, xdd);
+  const VecN delta = vec({M_PI / 2 - 0.1, -M_PI / 4 + 0.2});
+  CHECK((x - (start + 0.5 * delta)).norm() < 1e-12);
+  CHECK((xd - 15.0 / 8.0 * delta / 0.5).norm() < 1e-12);
+  CHECK(xdd.norm() < 1e-9);
+  const double h = 1e-5;
+  for (double t : {0.33, 0.61, 0.9, 1.45}) {
+    path.at(t, x, xd, xdd);
+    path.at(t + h, xp, xdp, d1);
+    path.at(t - h, xm, xdm, d2);
+    CHECK(((xp - xm) / (2 * h) - xd).norm() < 1e-7);
+    CHECK(((xdp - xdm) / (2 * h) - xdd).norm() < 1e-5);
+  }
+  // A task path's circle is not a joint segment; "space" is task or joint.
+  const json circle = json::parse(R"({"space": "joint", "segments": [{"circle": [0.0, 0.5], "turns": 1, "time": 1}]})");
+  CHECK_THROWS_WITH_AS(generic::TaskPath(JsonView(circle, "p.json", "/trajectory"), start, 10), doctest::Contains("expected a joint segment"), InputError);
+  const json space = json::parse(R"({"space": "cartesian", "segments": [{"hold": 1}]})");
+  CHECK_THROWS_WITH_AS(generic::TaskPath(JsonView(space, "p.json", "/trajectory"), start, 10), doctest::Contains("/trajectory/space"), InputError);
+}
+
+namespace {
+
+// The PUMA 560 from its URDF, with every joint actuated, driven toward a held joint reference from the
+// stretched pose; returns the final state. `plant` may carry a payload the controller's model lacks.
+VecN runPuma(const controllers::Spec& spec, const MechanismModel<Spatial>& model, const MechanismModel<Spatial>& plant,
+             const VecN& q0, const VecN& ud, double T) {
+  const double dt = 1e-3;
+  controllers::Controller ctl(spec, model, {0, 1, 2, 3, 4, 5}, {}, q0, dt);
+  ConstrainedMechanism<Spatial> mech(plant);
+  VecN q = q0, v = VecN::Zero(6);
+  const controllers::Reference ref{ud, VecN::Zero(6), VecN::Zero(6), true};
+  StepOptions opt;
+  opt.dt = dt;
+  for (long k = 0; k < std::lround(T / dt); ++k) {
+    const VecN tau = ctl.torque(double(k) * dt, q, v, ref);
+    if (!step(mech, opt, tau, q, v)) return VecN::Constant(6, std::nan(""));  // diverged
+  }
+  return q;
+}
+
+}  // namespace
+
+TEST_CASE("the PUMA 560 on a joint reference: PD + gravity converges; computed torque's payload error is M̂⁻¹ΔG/ω²") {
+  const auto file = model_file::load(std::string(DYNLAB_SOURCE_DIR) + "/assets/models/puma560.urdf");
+  const double d = M_PI / 180;
+  const VecN q0 = vec({0, 0, -90 * d, 0, 0, 0}), ud = vec({20 * d, 10 * d, -80 * d, 10 * d, 10 * d, 10 * d});
+  controllers::Spec spec;
+  spec.torque_limit = VecN::Constant(6, 1e4);
+  // PD + gravity with the exact model: the reference is an equilibrium of the closed loop, and the
+  // damping brings the arm to it (each joint's gains scaled by its inertia at the start: ω 20, ζ 1 there).
+  spec.kind = controllers::Kind::JointPdGravity;
+  spec.kp = 400, spec.kd = 40;
+  spec.joint_scale = vec({4.26, 2.88, 0.362, 0.00164, 0.000642, 0.00004});
+  const VecN q_pd = runPuma(spec, file.mechanism, file.mechanism, q0, ud, 2.0);
+  MESSAGE("PD + gravity: |e| after 2 s " << (ud - q_pd).norm() << " rad from " << (ud - q0).norm());
+  CHECK((ud - q_pd).norm() < 1e-5);
+  // Without the scaling the light wrist (m_66 = 4e-5 kg·m²) sees kd/m_66 · dt ≫ 2 and the sampled loop
+  // diverges: the scaling is what makes one pair of gains usable on every joint.
+  spec.joint_scale.resize(0);
+  spec.kp = 40, spec.kd = 4;
+  const VecN q_raw = runPuma(spec, file.mechanism, file.mechanism, q0, ud, 0.3);
+  CHECK(!((ud - q_raw).norm() < 1e-2));
+
+  // Computed torque, a 1 kg payload at the wrist centre in the plant only: at rest τ = M̂ω²e + Ĝ must
+  // equal the plant's G, so e = M̂(θ)⁻¹ (G(θ) − Ĝ(θ)) / ω² at the pose reached.
+  auto plant = file;
+  ConstrainedMechanism<Spatial> probe(file.mechanism);
+  const Eigen::Vector3d wrist = probe.pointPosition(4, Eigen::Vector3d::Zero(), file.q0);  // joint 5's anchor: the wrist centre
+  auto& b = plant.mechanism.tree.bodies[5];
+  b.inertia += Spatial::inertia(1.0, wrist - probe.pointPosition(5, Eigen::Vector3d::Zero(), file.q0), Eigen::Matrix3d::Zero());
+  b.central = Spatial::central(b.inertia);
+  b.massless = Spatial::massless(b.inertia);
+  spec.kind = controllers::Kind::ComputedTorque;
+  spec.omega_n = 20, spec.zeta = 1;
+  const VecN q_ct = runPuma(spec, file.mechanism, plant.mechanism, q0, ud, 3.0);
+  ConstrainedMechanism<Spatial> model_mech(file.mechanism), plant_mech(plant.mechanism);
+  ClosedChain<ConstrainedMechanism<Spatial>> model_chain(model_mech, {0, 1, 2, 3, 4, 5}), plant_chain(plant_mech, {0, 1, 2, 3, 4, 5});
+  REQUIRE(model_chain.update(q_ct, VecN::Zero(6)));
+  REQUIRE(plant_chain.update(q_ct, VecN::Zero(6)));
+  const VecN predicted = model_chain.Mu().ldlt().solve(plant_chain.Gu() - model_chain.Gu()) / (20.0 * 20.0);
+  const VecN e = ud - q_ct;
+  MESSAGE("computed torque under the payload: e = " << e.transpose() << "\n  M̂⁻¹ΔG/ω² = " << predicted.transpose());
+  CHECK(e.norm() > 1e-3);  // the payload shows
+  CHECK((e - predicted).norm() < 1e-6 * e.norm() + 1e-9);
+}
+
+TEST_CASE("a joint path's JSON: each bad field is one line naming its path") {
+  struct Case {
+    const char* patch;
+    const char* path;
+    const char* says;
+  };
+  const Case cases[] = {
+      {R"({"trajectory": {"space": "cartesian"}})", "/trajectory/space", "joint"},
+      {R"({"trajectory": {"segments": [{"move_deg": [1, 2, 3], "time": 1}]}})", "/trajectory/segments/0/move_deg", ""},
+      {R"({"trajectory": {"segments": [{"move_deg": [1, 2, 3, 4, 5, 1000], "time": 1}]}})", "/trajectory/segments/0/move_deg/5", ""},
+      {R"({"trajectory": {"segments": [{"move_deg": [1, 2, 3, 4, 5, 6], "time": 0}]}})", "/trajectory/segments/0/time", ""},
+      {R"({"trajectory": {"segments": [{"circle": [0, 0], "turns": 1, "time": 1}]}})", "/trajectory/segments/0", "joint segment"},
+      {R"({"controller": {"kind": "task_pd_gravity"}})", "/trajectory/space", "task_pd_gravity"},
+      {R"({"submission_options": {"kind": {"choices": ["pid", "task_inverse_dynamics"]}}})", "/trajectory/space", "task_inverse_dynamics"},
+      {R"({"controller": {"joint_scale": [1, 2]}})", "/controller/joint_scale", ""},
+      {R"({"controller": {"joint_scale": [1, 1, 1, 1, 1, -1]}})", "/controller/joint_scale/5", ""},
+      {R"({"tool": null, "trajectory": {"space": "task"}})", "/trajectory", "tool"},
+  };
+  const std::string folder = std::string(DYNLAB_SOURCE_DIR) + "/labs/puma_motion";
+  for (const Case& c : cases) {
+    INFO(std::string(c.patch));
+    const json config = mergePatch(pumaConfig(), json::parse(c.patch));
+    try {
+      generic::parseDataSettings(JsonView(config, "puma_motion.json"), "puma_motion", folder);
+      FAIL("accepted");
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      CHECK(e.path() == c.path);
+      CHECK(what.find(c.says) != std::string::npos);
+      CHECK(what.find('\n') == std::string::npos);
+    }
+  }
+  // The shipped config parses: a joint path's reference and error per actuated joint, the tool's place.
+  const auto s = generic::parseDataSettings(JsonView(pumaConfig(), "puma_motion.json"), "puma_motion", folder);
+  for (const char* col : {"ref_q1", "e_q6", "tool_z"}) CHECK(std::find(s.columns.begin(), s.columns.end(), col) != s.columns.end());
+  CHECK(std::find(s.columns.begin(), s.columns.end(), "e_x") == s.columns.end());
+  REQUIRE(s.path);
+  CHECK(s.path->joint());
 }
