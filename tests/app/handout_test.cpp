@@ -4,6 +4,8 @@
 // copies them); the HTML is self-contained; bad input is one line and exit 2.
 #include <doctest/doctest.h>
 
+#include <cmath>
+
 #include <cstdio>
 #include <iostream>
 #include <nlohmann/json.hpp>
@@ -18,9 +20,11 @@ using nlohmann::json;
 namespace {
 
 // A JSON number as the handout prints it (integers plain, else 6 significant digits).
+// A JSON number as a reader writes it: whole numbers in full (1000000, not 1e+06), others to 6 digits.
 std::string num(double x) {
   char b[40];
-  std::snprintf(b, sizeof b, "%.6g", x);
+  if (x == std::floor(x) && std::abs(x) < 1e15) std::snprintf(b, sizeof b, "%.0f", x);
+  else std::snprintf(b, sizeof b, "%.6g", x);
   return b;
 }
 
