@@ -165,10 +165,10 @@ int benchModel(const BenchArgs& a) {
     std::fprintf(stderr, "error: %s\n", utf8Quotable(e.what()).c_str());
     return 2;
   }
-  // Loops beside the file: MuJoCo's own run of the file would not hold them, so the engines would not
-  // run one mechanism.
+  // Loops, wheels or contacts beside the file: MuJoCo's own run of the file would not hold them, so the
+  // engines would not run one mechanism.
   if (const std::string loops = loopsBeside(a.lab); !loops.empty()) {
-    std::fprintf(stderr, "error: %s: its loops are beside it (%s); dynlab bench FILE times a file's own loops only (MuJoCo's run would not hold these)\n",
+    std::fprintf(stderr, "error: %s: dynlab's elements are beside it (%s: loops, wheels or contacts); dynlab bench FILE times what the file itself holds (MuJoCo's run would not hold these); dynlab bench LAB times the unicycle and pen labs\n",
                  utf8Quotable(a.lab).c_str(), utf8Quotable(loops).c_str());
     return 2;
   }
