@@ -107,7 +107,7 @@ TEST_CASE("pen_on_table: the tree's tip is the closed form, inverse kinematics l
     CHECK(std::abs(mech.potentialEnergy(q) - potentialEnergy(p, q)) < 1e-12);
   }
   // Inverse kinematics: the tip lands on its target with the elbow above the shoulder–tip line.
-  for (const Eigen::Vector3d target : {Eigen::Vector3d(0.48, 0.0, 0.1), Eigen::Vector3d(0.32, 0.05, 0.1), Eigen::Vector3d(0.35, -0.2, 0.25)}) {
+  for (const Eigen::Vector3d& target : {Eigen::Vector3d(0.48, 0.0, 0.1), Eigen::Vector3d(0.32, 0.05, 0.1), Eigen::Vector3d(0.35, -0.2, 0.25)}) {
     Eigen::Vector3d q;
     REQUIRE(inverseKinematics(p, target, q));
     CHECK((forwardKinematics(p, q) - target).norm() < 1e-14);
