@@ -37,12 +37,6 @@ std::string fmt(double x) {
   return b;
 }
 
-std::string join(const std::vector<std::string>& v, const char* sep = " ") {
-  std::string s;
-  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
-  return s;
-}
-
 // What dynlab read, as the lines `dynlab model` prints.
 std::string describe(const model_file::LoadedModel& m) {
   std::ostringstream o;

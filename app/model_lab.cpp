@@ -11,15 +11,12 @@
 #include "physics/model_file/model_file.h"
 
 namespace dyn::app {
-namespace {
 
 std::string join(const std::vector<std::string>& v, const char* sep) {
   std::string out;
   for (std::size_t i = 0; i < v.size(); ++i) out += (i ? sep : "") + v[i];
   return out;
 }
-
-}  // namespace
 
 LoadedLab loadModelLab(const std::string& file, std::optional<double> duration) {
   model_file::LoadOptions options;

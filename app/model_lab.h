@@ -6,6 +6,7 @@
 #pragma once
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "labs/run.h"
 
@@ -18,5 +19,8 @@ bool isModelFile(const std::string& name);
 // contacts beside it; its figures are the coordinates, the energy books and each closure's force.
 // Throws InputError (one line, naming the file) on bad input.
 LoadedLab loadModelLab(const std::string& file, std::optional<double> duration);
+
+// Names joined by sep ("q_crank, q_rocker"; "x z"): a model's columns and rows in figures and summaries.
+std::string join(const std::vector<std::string>& v, const char* sep = " ");
 
 }  // namespace dyn::app

@@ -134,7 +134,7 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref) {
           const auto& joints = mech_->model().joints;
           const std::size_t i = std::size_t(act[std::size_t(j)]);
           const double fc = i < joints.size() ? joints[i].coulomb : 0.0;
-          tau[j] += fc * std::clamp(ud_d[j] / spec_.compensation_width, -1.0, 1.0);
+          tau[j] += laws::coulombCompensation(fc, ud_d[j], spec_.compensation_width);
         }
       return tau;
     }

@@ -2,7 +2,8 @@
 // controller in dynlab: the data-defined labs' library (controller.h), the motion-control lab's joint
 // controllers and the impedance lab's realisations. e = x_d − x (desired minus measured) throughout:
 //   pd_gravity         τ = K_p e + K_d ė + Ĝ                       (ė = −θ' for regulation: passive)
-//   pid                τ = K_p e + K_d ė + u_I,  u_I' = K_i e       (u_I in torque units, anti-windup below)
+//   pid                τ = K_p e + K_d ė + u_I,  u_I' = K_i e       (u_I in torque units, anti-windup below;
+//                      Coulomb compensation F̂_c sat(θ_d'/w) optional)
 //   computed torque    a = ẍ_d + K_p e + K_d ė, then τ = M̂ a + ĥ by the model's own inverse dynamics
 //   task pd_gravity    τ = Ĝ + Jᵀ(K e + D ė)
 //   target impedance   ẍ* = M_des⁻¹(F − D_des ẋ − K_des (x − x_ref))
@@ -44,6 +45,12 @@ V taskPdGravity(const V& G, const J& jac, const K& k, const W& e, const K& d, co
 template <class V>
 V impedanceAcceleration(const V& F, const V& m, const V& d, const V& k, const V& x, const V& xd, const V& x_ref) {
   return V((F - d.cwiseProduct(xd) - k.cwiseProduct(x - x_ref)).cwiseQuotient(m));
+}
+
+// Coulomb compensation feedforward F̂_c sat(θ_d'/w): the friction the desired motion will meet, its sign
+// smoothed over w so that a reference at rest asks for none.
+inline double coulombCompensation(double coulomb, double desired_rate, double width) {
+  return coulomb * std::clamp(desired_rate / width, -1.0, 1.0);
 }
 
 // Each τ_i clipped to ±τ_max,i (the plant interface); true if any clipped.

@@ -16,8 +16,6 @@ void quintic(double u, double& s, double& sd, double& sdd) {
   sdd = 60 * u * (1 - u) * (1 - 2 * u);
 }
 
-double sat(double x) { return std::clamp(x, -1.0, 1.0); }
-
 }  // namespace
 
 void Trajectory::at(double t, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen::VectorXd& qdd) const {
@@ -67,7 +65,7 @@ Eigen::VectorXd Controller::torque(double t, const Eigen::VectorXd& th, const Ei
     case Kind::Pid:
       tau = laws::pid(c_.kp, e, c_.kd, ed, u_i_);
       if (c_.coulomb_compensation)
-        for (int i = 0; i < n; ++i) tau[i] += fr[std::size_t(i)].coulomb * sat(ref.qd[i] / c_.compensation_width);
+        for (int i = 0; i < n; ++i) tau[i] += laws::coulombCompensation(fr[std::size_t(i)].coulomb, ref.qd[i], c_.compensation_width);
       break;
     case Kind::ComputedTorque: {
       const Eigen::VectorXd a = laws::computedTorqueAcceleration(ref.qdd, c_.kp, e, c_.kd, ed);

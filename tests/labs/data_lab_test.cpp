@@ -15,6 +15,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <vector>
 
 #include "labs/controllers/controller.h"
 #include "labs/generic/data_lab.h"
@@ -37,6 +38,31 @@ VecN vec(std::initializer_list<double> x) {
   return v;
 }
 
+
+// A bad field: a JSON merge patch of a lab's config, the JSON path its error must name, and a phrase it must say.
+struct Case {
+  const char* patch;
+  const char* path;
+  const char* says;
+};
+
+// Each case patched into `config` is refused with one line naming its path and saying its phrase.
+void checkRefused(const json& config, const std::vector<Case>& cases, const std::string& file, const std::string& lab,
+                  const std::string& folder) {
+  for (const Case& c : cases) {
+    INFO(std::string(c.patch));
+    const json patched = mergePatch(config, json::parse(c.patch));
+    try {
+      generic::parseDataSettings(JsonView(patched, file), lab, folder);
+      FAIL("accepted");
+    } catch (const InputError& e) {
+      const std::string what = e.what();
+      CHECK(e.path() == c.path);
+      CHECK(what.find(c.says) != std::string::npos);
+      CHECK(what.find('\n') == std::string::npos);
+    }
+  }
+}
 }  // namespace
 
 TEST_CASE("task path: smooth joins, derivatives by differences, a circle's radius and its closing") {
@@ -159,12 +185,7 @@ TEST_CASE("a data lab's JSON: each bad field is one line naming its path") {
   fs::create_directories(dir);
   fs::copy_file(std::string(DYNLAB_SOURCE_DIR) + "/labs/fivebar/fivebar.xml", dir / "fivebar.xml");
   std::ofstream(dir / "broken.xml") << "<mujoco><worldbody><body";
-  struct Case {
-    const char* patch;
-    const char* path;
-    const char* says;
-  };
-  const Case cases[] = {
+  const std::vector<Case> cases = {
       {R"({"model_file": "../fivebar.xml"})", "/model_file", "without \"..\""},
       {R"({"model_file": "/etc/passwd"})", "/model_file", "relative path"},
       {R"({"model_file": "broken.xml"})", "/model_file", "a model file dynlab reads"},
@@ -188,19 +209,7 @@ TEST_CASE("a data lab's JSON: each bad field is one line naming its path") {
       {R"({"metrics": {"e_rms": {"of": ["e_y"], "stat": "rms"}}})", "/metrics/e_rms/of", "e_y"},
       {R"({"plant": {"payloads": [{"body": "left_link", "at": [0, 0, 0.5], "mass": -1}]}})", "/plant/payloads/0/mass", ""},
   };
-  for (const Case& c : cases) {
-    INFO(std::string(c.patch));
-    const json config = mergePatch(fivebarConfig(), json::parse(c.patch));
-    try {
-      generic::parseDataSettings(JsonView(config, "fivebar.json"), "fivebar", dir.string());
-      FAIL("accepted");
-    } catch (const InputError& e) {
-      const std::string what = e.what();
-      CHECK(e.path() == c.path);
-      CHECK(what.find(c.says) != std::string::npos);
-      CHECK(what.find('\n') == std::string::npos);
-    }
-  }
+  checkRefused(fivebarConfig(), cases, "fivebar.json", "fivebar", dir.string());
   // The shipped config parses, with its columns.
   const auto s = generic::parseDataSettings(JsonView(fivebarConfig(), "fivebar.json"), "fivebar", dir.string());
   CHECK(s.columns.front() == "t");
@@ -350,12 +359,7 @@ TEST_CASE("the PUMA 560 on a joint reference: PD + gravity converges; computed t
 }
 
 TEST_CASE("a joint path's JSON: each bad field is one line naming its path") {
-  struct Case {
-    const char* patch;
-    const char* path;
-    const char* says;
-  };
-  const Case cases[] = {
+  const std::vector<Case> cases = {
       {R"({"trajectory": {"space": "cartesian"}})", "/trajectory/space", "joint"},
       {R"({"trajectory": {"segments": [{"move_deg": [1, 2, 3], "time": 1}]}})", "/trajectory/segments/0/move_deg", ""},
       {R"({"trajectory": {"segments": [{"move_deg": [1, 2, 3, 4, 5, 1000], "time": 1}]}})", "/trajectory/segments/0/move_deg/5", ""},
@@ -368,19 +372,7 @@ TEST_CASE("a joint path's JSON: each bad field is one line naming its path") {
       {R"({"tool": null, "trajectory": {"space": "task"}})", "/trajectory", "tool"},
   };
   const std::string folder = std::string(DYNLAB_SOURCE_DIR) + "/labs/puma_motion";
-  for (const Case& c : cases) {
-    INFO(std::string(c.patch));
-    const json config = mergePatch(pumaConfig(), json::parse(c.patch));
-    try {
-      generic::parseDataSettings(JsonView(config, "puma_motion.json"), "puma_motion", folder);
-      FAIL("accepted");
-    } catch (const InputError& e) {
-      const std::string what = e.what();
-      CHECK(e.path() == c.path);
-      CHECK(what.find(c.says) != std::string::npos);
-      CHECK(what.find('\n') == std::string::npos);
-    }
-  }
+  checkRefused(pumaConfig(), cases, "puma_motion.json", "puma_motion", folder);
   // The shipped config parses: a joint path's reference and error per actuated joint, the tool's place.
   const auto s = generic::parseDataSettings(JsonView(pumaConfig(), "puma_motion.json"), "puma_motion", folder);
   for (const char* col : {"ref_q1", "e_q6", "tool_z"}) CHECK(std::find(s.columns.begin(), s.columns.end(), col) != s.columns.end());

@@ -18,30 +18,19 @@
 #include "labs/unicycle/mechanism.h"
 #include "physics/constrained_mechanism.h"
 #include "physics/model_file/model_file.h"
+#include "tests/physics/model_file/fixtures.h"
 
 using namespace dyn;
+using namespace dyn::test_model_file;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string model(const char* name) { return std::string(DYNLAB_SOURCE_DIR) + "/assets/models/" + name; }
 
 nlohmann::json labJson(const char* lab) {
   std::ifstream in(std::string(DYNLAB_SOURCE_DIR) + "/labs/" + lab + "/" + lab + ".json");
   return nlohmann::json::parse(in);
 }
 
-struct Random {
-  std::mt19937_64 rng{29};
-  std::uniform_real_distribution<double> u{-1.0, 1.0};
-  VecN vec(int n, double scale) {
-    VecN v(n);
-    for (int i = 0; i < n; ++i) v[i] = scale * u(rng);
-    return v;
-  }
-};
-
-double maxAbs(const MatN& a) { return a.size() ? a.cwiseAbs().maxCoeff() : 0.0; }
 double scale(const MatN& a) { return std::max(1.0, maxAbs(a)); }
 
 // The unicycle lab's plant as it reads unicycle.json (its inertias, when not given: m r²/2, m r²/4).

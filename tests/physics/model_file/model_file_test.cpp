@@ -23,25 +23,13 @@
 #include "physics/constraints/point_closure.h"
 #include "physics/model_file/hand_engine.h"
 #include "physics/model_file/model_file.h"
+#include "tests/physics/model_file/fixtures.h"
 
 using namespace dyn;
+using namespace dyn::test_model_file;
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string model(const char* name) { return std::string(DYNLAB_SOURCE_DIR) + "/assets/models/" + name; }
-
-struct Random {
-  std::mt19937_64 rng{29};
-  std::uniform_real_distribution<double> u{-1.0, 1.0};
-  VecN vec(int n, double scale) {
-    VecN v(n);
-    for (int i = 0; i < n; ++i) v[i] = scale * u(rng);
-    return v;
-  }
-};
-
-double maxAbs(const MatN& a) { return a.size() ? a.cwiseAbs().maxCoeff() : 0.0; }
 
 // The slider crank lab's plant, read from its JSON (so the file and the lab cannot drift apart unseen).
 slider_crank::Params labParams() {
