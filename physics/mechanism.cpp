@@ -100,6 +100,18 @@ void MechanismKinematics<S>::addPointJacobian(const BodyRef& b, const Pos& p_wor
                                               const std::array<bool, S::kDim>& rows, double sign, int row,
                                               MatN& J, MatN& A) const {
   if (b.kind == BodyRef::Kind::Link) {
+    if constexpr (S::kDim == 6)
+      if (!rows[0] && !rows[1] && !rows[2]) {
+        // Spatial, linear rows only (a pin): each column's linear velocity at p, S::linearAt (the
+        // same sums as motion()'s linear half).
+        for (int j = b.index; j >= 0; j = model->tree.bodies[std::size_t(j)].parent) {
+          double u[3];
+          S::linearAt(p_world, tree->S_w[std::size_t(j)].data(), u);
+          for (int r = 3, out = row; r < 6; ++r)
+            if (rows[std::size_t(r)]) J(out++, j) += sign * u[r - 3];
+        }
+        return;
+      }
     // Column j: joint j's axis seen from the world-aligned frame at p, for every joint root → link.
     const typename S::Transform X_pw = S::translation(p_world);
     for (int j = b.index; j >= 0; j = model->tree.bodies[std::size_t(j)].parent) {
@@ -182,6 +194,22 @@ typename S::Vec MechanismKinematics<S>::pointBias(const BodyRef& b, const Pos& p
     }
   }
   return Vec::Zero();
+}
+
+template <class S>
+typename S::Pos MechanismKinematics<S>::linearBias(const BodyRef& b, const Pos& p_world) const {
+  if constexpr (S::kDim == 6)
+    if (b.kind == BodyRef::Kind::Link) {
+      // At p: a_p = (α, a − p × α), v_p = (ω, v − p × ω); the classical acceleration's linear part a_p + ω × v_p.
+      const std::size_t i = std::size_t(b.index);
+      const double* v = tree->v_w[i].data();
+      double ap[3], vp[3], wv[3];
+      S::linearAt(p_world, tree->a_w[i].data(), ap);
+      S::linearAt(p_world, v, vp);
+      S::cross3(v, vp, wv);
+      return Pos(ap[0] + wv[0], ap[1] + wv[1], ap[2] + wv[2]);
+    }
+  return S::linear(pointBias(b, p_world));
 }
 
 template <class S>

@@ -234,6 +234,8 @@ struct MechanismKinematics {
   // share of body b (velocity stage required).
   // With `velocity`, also that frame's spatial velocity (pointVelocity), computed on the way.
   Vec pointBias(const BodyRef& b, const Pos& p_world, Vec* velocity = nullptr) const;
+  // pointBias's linear rows alone (spatial links without the angular rows; the same sums).
+  Pos linearBias(const BodyRef& b, const Pos& p_world) const;
   // d · pointBias's linear rows (a classical acceleration's component along world direction d).
   double directionBias(const BodyRef& b, const Pos& p_world, const Pos& d) const;
   // The full spatial velocity of that frame (velocity stage required).

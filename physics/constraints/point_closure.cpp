@@ -10,6 +10,7 @@ template <class S>
 PointClosure<S>::PointClosure(BodyRef a, const Pos& point_a, BodyRef b, const Pos& point_b, const Rows& rows) {
   at_ = {a, b, point_a, point_b, rows};
   for (bool r : rows) count_ += int(r);
+  for (int i = 0; i < (S::kDim == 3 ? 1 : 3); ++i) turns_ = turns_ || rows[std::size_t(i)];
 }
 
 template <class S>
@@ -34,8 +35,13 @@ void PointClosure<S>::position(const MechanismKinematics<S>& k, int row, VecN& p
   if constexpr (S::kDim == 3) {
     err << std::remainder(k.angle(at_.a) - k.angle(at_.b), 2.0 * M_PI), pa - pb;  // wrapped to [−π, π]
   } else {
-    const Eigen::AngleAxisd rel(k.rotation(at_.a) * k.rotation(at_.b).transpose());
-    err << rel.angle() * rel.axis(), pa - pb;
+    // A pin holds no rotation row: no rotation vector to build (a 3×3 product and an atan2).
+    err.template head<3>().setZero();
+    if (turns_) {
+      const Eigen::AngleAxisd rel(k.rotation(at_.a) * k.rotation(at_.b).transpose());
+      err.template head<3>() = rel.angle() * rel.axis();
+    }
+    err.template tail<3>() = pa - pb;
   }
   for (int i = 0, out = row; i < S::kDim; ++i)
     if (at_.rows[std::size_t(i)]) phi[out++] = err[i];
@@ -46,6 +52,14 @@ void PointClosure<S>::position(const MechanismKinematics<S>& k, int row, VecN& p
 
 template <class S>
 void PointClosure<S>::bias(const MechanismKinematics<S>& k, int row, VecN& b) const {
+  // A spatial pin: the classical accelerations' linear parts alone (the same sums as pointBias's).
+  if constexpr (S::kDim == 6)
+    if (!turns_) {
+      const Pos d = k.linearBias(at_.a, k.position(at_.a, at_.point_a)) - k.linearBias(at_.b, k.position(at_.b, at_.point_b));
+      for (int i = 3, out = row; i < 6; ++i)
+        if (at_.rows[std::size_t(i)]) b[out++] = d[i - 3];
+      return;
+    }
   const Vec d = k.pointBias(at_.a, k.position(at_.a, at_.point_a)) - k.pointBias(at_.b, k.position(at_.b, at_.point_b));
   for (int i = 0, out = row; i < S::kDim; ++i)
     if (at_.rows[std::size_t(i)]) b[out++] = d[i];

@@ -37,6 +37,7 @@ class PointClosure final : public Constraint<S> {
  private:
   Attachment<S> at_;
   int count_ = 0;
+  bool turns_ = false;  // a rotation row is held (planar: ω; spatial: any of ωx, ωy, ωz)
 };
 
 }  // namespace dyn

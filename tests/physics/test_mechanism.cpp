@@ -338,6 +338,51 @@ TEST_CASE("passive runs conserve energy: the slider crank, and a spatial arm pin
   }
 }
 
+TEST_CASE("a spatial pin's rows are exactly a weld's translation rows (the pin's own linear-only path)") {
+  // A pin (no rotation row) skips the rotation vector and the angular rows of its Jacobian and bias;
+  // those rows must be the bits the weld computes for the same points, at random states.
+  MechanismModel<Spatial> d;
+  d.tree = test::spatialArm();
+  const Spatial::Pos pa(0.3, 0.02, -0.01), pb(0.05, 0.1, 0.15);
+  std::array<bool, 6> xz{};
+  xz[3] = xz[5] = true;
+  const PointClosure<Spatial> weld(BodyRef::link(2), pa, BodyRef::link(0), pb, PointClosure<Spatial>::all());
+  const PointClosure<Spatial> pin(BodyRef::link(2), pa, BodyRef::link(0), pb, PointClosure<Spatial>::translations());
+  const PointClosure<Spatial> pin_xz(BodyRef::link(2), pa, BodyRef::link(0), pb, xz);
+  TreeData<Spatial> data(d.tree);
+  MechanismKinematics<Spatial> k;
+  k.model = &d;
+  k.tree = &data;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    VecN q(3), v(3);
+    for (int i = 0; i < 3; ++i) q[i] = u(rng), v[i] = u(rng);
+    worldKinematics(d.tree, q, data);
+    Eigen::MatrixXd M(3, 3);
+    Eigen::VectorXd h(3);
+    crbaWorld(d.tree, data, M);
+    biasForcesWorld(d.tree, data, v, h);
+    VecN phi6 = VecN::Zero(6), phi3 = VecN::Zero(3), phi2 = VecN::Zero(2), b6(6), b3(3), b2(2);
+    MatN J6 = MatN::Zero(6, 3), J3 = MatN::Zero(3, 3), J2 = MatN::Zero(2, 3), A6(6, 0), A3(3, 0), A2(2, 0);
+    weld.position(k, 0, phi6, J6, A6);
+    pin.position(k, 0, phi3, J3, A3);
+    pin_xz.position(k, 0, phi2, J2, A2);
+    weld.bias(k, 0, b6);
+    pin.bias(k, 0, b3);
+    pin_xz.bias(k, 0, b2);
+    CHECK(phi3 == phi6.tail(3));
+    CHECK(J3 == J6.bottomRows(3));
+    CHECK(b3 == b6.tail(3));
+    CHECK(phi2 == Eigen::Vector2d(phi6[3], phi6[5]));
+    CHECK(J2.row(0) == J6.row(3));
+    CHECK(J2.row(1) == J6.row(5));
+    CHECK(b2 == Eigen::Vector2d(b6[3], b6[5]));
+    CHECK(J3.norm() > 0.1);  // the rows are not trivially zero
+    CHECK(b3.norm() > 1e-3);
+  }
+}
+
 TEST_CASE("descriptions that cannot work are refused with a sentence") {
   MechanismModel<Planar> d = sliderCrank();
   d.payloads[0].mass = 0;
