@@ -31,7 +31,7 @@ class Hooks final : public StepHooks {
     // The force sensor's truth: the push on the tool at t, in the task's axes.
     if (s_.push && !s_.tool.axes.empty()) {
       ref_.force.resize(Eigen::Index(s_.tool.axes.size()));
-      for (std::size_t i = 0; i < s_.tool.axes.size(); ++i) ref_.force[Eigen::Index(i)] = push(t)[s_.tool.axes[i] - 3];
+      for (std::size_t i = 0; i < s_.tool.axes.size(); ++i) ref_.force[Eigen::Index(i)] = push(t)[s_.tool.axes[i]];
     }
     return ctrl_.torque(t, q, v, ref_);
   }

@@ -437,6 +437,28 @@ TEST_CASE("a push on the tool as data: both engines, task PD + gravity deflects 
     CHECK(std::abs(ex - (-3.0 / 2000.0)) < tol);
     CHECK(std::abs(ez - (2.0 / 2000.0)) < tol);
   }
+  // The force sensor reads the push: impedance_inverse_dynamics programmed with the target's K, D, M
+  // makes the pin follow the target's column (to the 1 ms hold's lag), in both engines; programmed with
+  // another mass it does not.
+  auto miss = [&](double m_imp, Engine engine) {
+    json f = c;
+    f["controller"]["kind"] = "impedance_inverse_dynamics";
+    f["gains"]["k_imp"] = {{"value", 500.0}, {"min", 1.0}, {"max", 1e4}};
+    f["gains"]["d_imp"] = {{"value", 2 * 0.7 * std::sqrt(500.0)}, {"min", 0.0}, {"max", 1e4}};
+    f["gains"]["m_imp"] = {{"value", m_imp}, {"min", 0.01}, {"max", 1e4}};
+    const generic::DataLab fl(generic::parseDataSettings(JsonView(f, "fivebar.json"), "fivebar", folder));
+    auto sim = fl.simulate(engine);
+    std::vector<double> row;
+    double worst = 0;
+    while (sim->step(row)) worst = std::max(worst, std::hypot(row[std::size_t(col("dev_x"))], row[std::size_t(col("dev_z"))]));
+    return worst;
+  };
+  const double hand_miss = miss(1.0, Engine::Hand), bullet_miss = miss(1.0, Engine::Bullet), heavy_miss = miss(4.0, Engine::Hand);
+  MESSAGE("force feedback: largest |tool − target| " << hand_miss << " m (Bullet " << bullet_miss << ", programmed 4 kg " << heavy_miss
+                                                      << ") of |F|/K = " << std::hypot(3.0, 2.0) / 500);
+  CHECK(hand_miss < 0.02 * std::hypot(3.0, 2.0) / 500);
+  CHECK(bullet_miss < 0.05 * std::hypot(3.0, 2.0) / 500);
+  CHECK(heavy_miss > 0.2 * std::hypot(3.0, 2.0) / 500);
   // Bad fields: one line naming the path.
   const std::vector<Case> cases = {
       {R"({"environment": {"force": {"value": [1, 2], "start": 0}}})", "/environment/force/value", ""},
