@@ -274,6 +274,16 @@ void DataLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
     return 1e3 * std::sqrt(e);
   };
   o.lines = {{"t", fmt("%.3f s", tr.at(row, "t"))}, {"tracking |e|", fmt("%.2f ", norm(row)) + unit}};
+  // An impedance exercise: the push and the tool's distance from the target's response.
+  if (s_.push) {
+    const double F = std::sqrt(std::pow(tr.at(row, "push_x"), 2) + std::pow(tr.at(row, "push_y"), 2) + std::pow(tr.at(row, "push_z"), 2));
+    o.lines.push_back({"push |F|", fmt("%.1f N", F)});
+  }
+  if (s_.target.k > 0) {
+    double d = 0;
+    for (const auto& a : s_.axis_names) d += std::pow(tr.at(row, "dev_" + a), 2);
+    o.lines.push_back({"off target", fmt("%.2f mm", 1e3 * std::sqrt(d))});
+  }
   for (const auto& a : s_.actuated_names)
     o.lines.push_back({"τ " + a, fmt("%.2f N·m", tr.at(row, "tau_" + columnName(a)))});
   if (!s_.plant->closures.empty()) o.lines.push_back({"closure |φ|", fmt("%.1e m", tr.at(row, "constraint_residual"))});

@@ -85,7 +85,10 @@ class DataLab final : public Lab {
   json agreement(const Trace& hand, const Trace& bullet) const override;
   std::string agreementUnit(const std::string& key) const override;
   std::string referenceEngine() const override;
-  PassiveEnergy passiveEnergy() const override { return {s_.passive_tolerance, 0}; }
+  // The push does work by design: the passive check runs without it (E itself must then stay put).
+  PassiveEnergy passiveEnergy() const override {
+    return {s_.passive_tolerance, 0, s_.push ? json{{"environment", nullptr}} : json::object()};
+  }
   void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
   void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
 
