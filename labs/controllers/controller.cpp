@@ -25,7 +25,8 @@ const std::vector<KindInfo>& kinds() {
       {"task_pd_gravity", Kind::TaskPdGravity, {"kp", "kd"}},
       {"task_inverse_dynamics", Kind::TaskInverseDynamics, {"omega_n", "zeta"}},
       {"impedance_task", Kind::ImpedanceTask, {"k_imp", "d_imp"}},
-      {"impedance_inverse_dynamics", Kind::ImpedanceInverseDynamics, {"k_imp", "d_imp", "m_imp"}}};
+      {"impedance_inverse_dynamics", Kind::ImpedanceInverseDynamics, {"k_imp", "d_imp", "m_imp"}},
+      {"impedance_joint", Kind::ImpedanceJoint, {"k_imp", "d_imp", "m_imp", "omega_n", "zeta"}}};
   return k;
 }
 
@@ -121,6 +122,24 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref, const V
     ud = VecN(m);
     for (int j = 0; j < m; ++j) ud[j] = q_ik_[act[std::size_t(j)]];
   }
+  if (kind == Kind::ImpedanceJoint) {
+    // The impedance model on the measured force about the reference, then inverse kinematics.
+    const int d = int(task_.axes.size());
+    if (x_des_.size() != d) x_des_ = ref.x, v_des_ = VecN::Zero(d);
+    const VecN K = VecN::Constant(d, spec_.k_imp), D = VecN::Constant(d, spec_.d_imp), M = VecN::Constant(d, spec_.m_imp);
+    const VecN a_des = laws::impedanceAcceleration(force, M, D, K, x_des_, VecN(v_des_ - ref.xd), ref.x) + ref.xdd;
+    const double h = double(hold_) * dt_;
+    v_des_ += h * a_des;
+    x_des_ += h * v_des_;
+    if (!inverseKinematics(x_des_, q_ik_) || !chain_.update(q_ik_, VecN::Zero(mech_->n()))) return tau_u_;
+    chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
+    ud_d = Eigen::CompleteOrthogonalDecomposition<MatN>(Jx).solve(v_des_);
+    if (!chain_.update(q_ik_, chain_.S() * ud_d)) return tau_u_;
+    chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
+    udd_d = Eigen::CompleteOrthogonalDecomposition<MatN>(Jx).solve(VecN(a_des - bias));
+    ud = VecN(m);
+    for (int j = 0; j < m; ++j) ud[j] = q_ik_[act[std::size_t(j)]];
+  }
   if (!chain_.update(q, v)) return tau_u_;  // a singular pose: hold the last command
   VecN u(m), w(m);
   for (int j = 0; j < m; ++j) u[j] = q[act[std::size_t(j)]], w[j] = v[act[std::size_t(j)]];
@@ -144,6 +163,7 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref, const V
       return tau;
     }
     case Kind::ComputedTorque:
+    case Kind::ImpedanceJoint:
       return chain_.Mu() * laws::computedTorqueAcceleration(udd_d, kp2, VecN(ud - u), kd2, VecN(ud_d - w)) + chain_.hu();
     default: break;
   }

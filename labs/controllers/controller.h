@@ -16,6 +16,13 @@
 //                          τ_u = M_u J̄ (ẍ* − J_x' u') + h_u − J_xᵀ F + τ_N
 //                              = J_xᵀ (Λ (ẍ* − J_x' u') − F) + h_u + τ_N              (k_imp, d_imp, m_imp)
 //                          with force feedback: the tool's mass is M whatever Λ (exact model: x'' = ẍ*)
+//   impedance_joint        the target driven by the measured force gives x_d* (ξ'' of the line above,
+//                          semi-implicit Euler over the control period), inverse kinematics u_d*, and
+//                          computed torque tracks it: τ_u = M_u (u_d*'' + K_d e_u' + K_p e_u) + h_u,
+//                          u_d*' = J_x⁺ x_d*', u_d*'' = J_x⁺(x_d*'' − J_x' u_d*') (minimum-norm)
+//                                                                          (k_imp, d_imp, m_imp, omega_n, zeta)
+//                          the joint loop's compliance sits in series with the target: it realises it
+//                          only as far as ω_n is fast against √(K/M)
 // J̄ = M_u⁻¹ J_xᵀ Λ is the dynamically consistent inverse of J_x (Λ = (J_x M_u⁻¹ J_xᵀ)⁻¹); with more
 // actuated joints than task axes (a 6-joint arm, a 3-axis tool position) the rest is the null space,
 // held by a posture term that accelerates nothing along the task:
@@ -52,7 +59,8 @@ enum class Kind {
   TaskPdGravity,
   TaskInverseDynamics,
   ImpedanceTask,
-  ImpedanceInverseDynamics
+  ImpedanceInverseDynamics,
+  ImpedanceJoint
 };
 // The kinds by name, as a lab JSON writes them, and the gains each reads.
 const std::vector<std::string>& kindNames();
@@ -129,6 +137,7 @@ class Controller {
   std::normal_distribution<double> normal_{0.0, 1.0};
   VecN q_ik_, integral_, e_u_, tau_u_, tau_;  // integral_: pid's u_I (N·m); e_u_: the last joint error
   VecN u0_;                                     // the actuated coordinates at the start (the posture)
+  VecN x_des_, v_des_;                          // impedance_joint: the impedance model's state
   bool saturated_ = false;
 };
 

@@ -248,7 +248,8 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     // A joint path feeds the joint laws only: the task laws need a task path.
     const auto kk = controllers::kindFromName(k);
     using K = controllers::Kind;
-    const bool task = kk == K::TaskPdGravity || kk == K::TaskInverseDynamics || kk == K::ImpedanceTask || kk == K::ImpedanceInverseDynamics;
+    const bool task = kk == K::TaskPdGravity || kk == K::TaskInverseDynamics || kk == K::ImpedanceTask || kk == K::ImpedanceInverseDynamics ||
+                      kk == K::ImpedanceJoint;
     if (s.path && s.path->joint() && task)
       c["trajectory"]["space"].fail("\"task\" for the controller kind " + k + " (a joint path feeds joint_pd_gravity, pid and computed_torque)");
   }
