@@ -1,6 +1,7 @@
 // The controller library: see controller.h.
 #include "labs/controllers/controller.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
@@ -22,7 +23,10 @@ const std::vector<KindInfo>& kinds() {
       {"pid", Kind::Pid, {"kp", "ki", "kd"}},
       {"computed_torque", Kind::ComputedTorque, {"omega_n", "zeta"}},
       {"task_pd_gravity", Kind::TaskPdGravity, {"kp", "kd"}},
-      {"task_inverse_dynamics", Kind::TaskInverseDynamics, {"omega_n", "zeta"}}};
+      {"task_inverse_dynamics", Kind::TaskInverseDynamics, {"omega_n", "zeta"}},
+      {"impedance_task", Kind::ImpedanceTask, {"k_imp", "d_imp"}},
+      {"impedance_inverse_dynamics", Kind::ImpedanceInverseDynamics, {"k_imp", "d_imp", "m_imp"}},
+      {"impedance_joint", Kind::ImpedanceJoint, {"k_imp", "d_imp", "m_imp", "omega_n", "zeta"}}};
   return k;
 }
 
@@ -62,6 +66,8 @@ Controller::Controller(const Spec& spec, const MechanismModel<Spatial>& model, s
   if (spec_.joint_scale.size() != m) spec_.joint_scale = VecN::Ones(m);
   tau_u_ = VecN::Zero(m);
   tau_ = VecN::Zero(mech_->n());
+  u0_ = VecN(m);
+  for (int j = 0; j < m; ++j) u0_[j] = q0[chain_.actuated()[std::size_t(j)]];
 }
 
 void Controller::taskPosition(const VecN& q, VecN& x) {
@@ -92,7 +98,7 @@ bool Controller::inverseKinematics(const VecN& x_d, VecN& q) {
   return false;
 }
 
-VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref) {
+VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref, const VecN& force) {
   const int m = chain_.m();
   const auto& act = chain_.actuated();
   const Kind kind = spec_.kind;
@@ -113,6 +119,24 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref) {
     if (!chain_.update(q_ik_, chain_.S() * ud_d)) return tau_u_;
     chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
     udd_d = solveTask(Jx, ref.xdd - bias);
+    ud = VecN(m);
+    for (int j = 0; j < m; ++j) ud[j] = q_ik_[act[std::size_t(j)]];
+  }
+  if (kind == Kind::ImpedanceJoint) {
+    // The impedance model on the measured force about the reference, then inverse kinematics.
+    const int d = int(task_.axes.size());
+    if (x_des_.size() != d) x_des_ = ref.x, v_des_ = VecN::Zero(d);
+    const VecN K = VecN::Constant(d, spec_.k_imp), D = VecN::Constant(d, spec_.d_imp), M = VecN::Constant(d, spec_.m_imp);
+    const VecN a_des = laws::impedanceAcceleration(force, M, D, K, x_des_, VecN(v_des_ - ref.xd), ref.x) + ref.xdd;
+    const double h = double(hold_) * dt_;
+    v_des_ += h * a_des;
+    x_des_ += h * v_des_;
+    if (!inverseKinematics(x_des_, q_ik_) || !chain_.update(q_ik_, VecN::Zero(mech_->n()))) return tau_u_;
+    chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
+    ud_d = Eigen::CompleteOrthogonalDecomposition<MatN>(Jx).solve(v_des_);
+    if (!chain_.update(q_ik_, chain_.S() * ud_d)) return tau_u_;
+    chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
+    udd_d = Eigen::CompleteOrthogonalDecomposition<MatN>(Jx).solve(VecN(a_des - bias));
     ud = VecN(m);
     for (int j = 0; j < m; ++j) ud[j] = q_ik_[act[std::size_t(j)]];
   }
@@ -139,6 +163,7 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref) {
       return tau;
     }
     case Kind::ComputedTorque:
+    case Kind::ImpedanceJoint:
       return chain_.Mu() * laws::computedTorqueAcceleration(udd_d, kp2, VecN(ud - u), kd2, VecN(ud_d - w)) + chain_.hu();
     default: break;
   }
@@ -149,21 +174,48 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref) {
   const VecN xdot = Jx * w, e = ref.x - x, ed = ref.xd - xdot;
   if (kind == Kind::TaskPdGravity)
     return laws::taskPdGravity(chain_.Gu(), Jx, VecN::Constant(d, spec_.kp), e, VecN::Constant(d, spec_.kd), ed);
+  if (kind == Kind::ImpedanceTask || kind == Kind::ImpedanceInverseDynamics) return impedance(Jx, bias, x, xdot, u, w, ref, force);
   // Task inverse dynamics: the task acceleration asked for, mapped to u'' through J_x.
   const VecN a = laws::computedTorqueAcceleration(ref.xdd, VecN::Constant(d, wn * wn), e, VecN::Constant(d, 2.0 * spec_.zeta * wn), ed);
   return chain_.Mu() * solveTask(Jx, a - bias) + chain_.hu();
 }
 
+// The impedance laws (controller.h): Λ, J̄ and the null-space posture at the state of the last update.
+VecN Controller::impedance(const MatN& Jx, const VecN& bias, const VecN& x, const VecN& xdot, const VecN& u, const VecN& w,
+                           const Reference& ref, const VecN& force) {
+  const int d = int(x.size()), m = int(u.size());
+  const VecN k = VecN::Constant(d, spec_.k_imp), D = VecN::Constant(d, spec_.d_imp), M = VecN::Constant(d, spec_.m_imp);
+  const MatN Lambda = chain_.taskInertia(Jx);
+  if (Lambda.size() == 0) return tau_u_;  // a task singularity: hold the last command
+  // The posture in the null space: Nᵀ M_u a_0, Nᵀ = I − J_xᵀ J̄ᵀ, J̄ = M_u⁻¹ J_xᵀ Λ.
+  VecN tau_n = VecN::Zero(m);
+  if (spec_.posture_omega > 0) {
+    const double w0 = spec_.posture_omega;
+    const MatN Jbar = Eigen::LLT<MatN>(chain_.Mu()).solve(Jx.transpose()) * Lambda;
+    const MatN Nt = MatN::Identity(m, m) - Jx.transpose() * Jbar.transpose();
+    tau_n = Nt * (chain_.Mu() * VecN(w0 * w0 * (u0_ - u) - 2.0 * w0 * w));
+  }
+  if (spec_.kind == Kind::ImpedanceTask)
+    return laws::taskPdGravity(chain_.Gu(), Jx, k, VecN(ref.x - x), D, VecN(ref.xd - xdot)) + tau_n;
+  // Force feedback: the target's acceleration about the reference, made the tool's by M_u J̄ = J_xᵀ Λ.
+  const VecN a = laws::impedanceAcceleration(force, M, D, k, x, VecN(xdot - ref.xd), ref.x) + ref.xdd;
+  return Jx.transpose() * (Lambda * (a - bias) - force) + chain_.hu() + tau_n;
+}
+
 VecN Controller::torque(double t, const VecN& q, const VecN& v, const Reference& ref) {
   (void)t;
-  readings_.emplace_back(q, v);
+  readings_.push_back({q, v, ref.force});
   while (long(readings_.size()) > spec_.delay_steps + 1) readings_.pop_front();
   if (k_++ % hold_ != 0) return tau_;
-  // What the encoders report: the reading `delay` steps old, with noise.
-  VecN qm = readings_.front().first, vm = readings_.front().second;
+  // What the encoders (and the force sensor) report: the reading `delay` steps old, with noise.
+  VecN qm = readings_.front().q, vm = readings_.front().v;
   if (spec_.noise_angle > 0 || spec_.noise_rate > 0)
     for (int i = 0; i < mech_->n(); ++i) qm[i] += spec_.noise_angle * normal_(rng_), vm[i] += spec_.noise_rate * normal_(rng_);
-  VecN u = law(qm, vm, ref);
+  VecN fm = readings_.front().force;
+  if (fm.size() != Eigen::Index(task_.axes.size())) fm = VecN::Zero(Eigen::Index(task_.axes.size()));
+  if (spec_.noise_force > 0)
+    for (int i = 0; i < fm.size(); ++i) fm[i] += spec_.noise_force * normal_(rng_);
+  VecN u = law(qm, vm, ref, fm);
   for (int j = 0; j < u.size(); ++j)
     if (!std::isfinite(u[j])) u[j] = 0.0;
   const VecN raw = u;

@@ -28,6 +28,11 @@ class Hooks final : public StepHooks {
   }
   VecN torque(double t, const VecN& q, const VecN& v) override {
     if (s_.path) s_.path->at(t, ref_.x, ref_.xd, ref_.xdd), ref_.joint = s_.path->joint();
+    // The force sensor's truth: the push on the tool at t, in the task's axes.
+    if (s_.push && !s_.tool.axes.empty()) {
+      ref_.force.resize(Eigen::Index(s_.tool.axes.size()));
+      for (std::size_t i = 0; i < s_.tool.axes.size(); ++i) ref_.force[Eigen::Index(i)] = push(t)[s_.tool.axes[i]];
+    }
     return ctrl_.torque(t, q, v, ref_);
   }
   void row(const StepRecord& r, std::vector<double>& out) override {
@@ -53,6 +58,15 @@ class Hooks final : public StepHooks {
       for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i]);
       for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i] - x[i]);
     }
+    // The environment's push on the tool (N, world axes), as the plant feels it over this step.
+    if (s_.push)
+      for (int i = 0; i < 3; ++i) out.push_back(push(r.t)[3 + i]);
+    // The target impedance's response about the reference, and the tool's deviation from it.
+    if (s_.target.k > 0) {
+      advanceTarget(r.t);
+      for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i] + xi_[i]);
+      for (int i = 0; i < x.size(); ++i) out.push_back(x[i] - ref_.x[i] - xi_[i]);
+    }
     out.push_back(r.energy), out.push_back(r.work), out.push_back(r.residual);
     const auto& closures = s_.plant->closures;
     for (std::size_t c = 0; c < closures.size(); ++c)
@@ -68,11 +82,39 @@ class Hooks final : public StepHooks {
   }
 
  private:
+  Spatial::Vec push(double t) const { return s_.push ? Spatial::Vec(s_.push->profile().at(t) * s_.push->value()) : Spatial::Vec::Zero(); }
+  // ξ'' = (F − D ξ' − K ξ)/M per task axis, F the push along it: RK4 from the last row's time to t in
+  // four substeps (the push's profile is right-continuous, on at a step boundary as the engines see it).
+  void advanceTarget(double t) {
+    const int d = int(s_.tool.axes.size());
+    if (xi_.size() != d) xi_ = VecN::Zero(d), xid_ = VecN::Zero(d), t_target_ = t;
+    const double K = s_.target.k, M = s_.target.m, D = 2 * s_.target.zeta * std::sqrt(K * M);
+    const int sub = 4;
+    const double h = (t - t_target_) / sub;
+    for (int k = 0; k < sub && h > 0; ++k) {
+      const double t0 = t_target_ + k * h;
+      for (int i = 0; i < d; ++i) {
+        const int a = s_.tool.axes[std::size_t(i)];
+        auto acc = [&](double tt, double p, double v) { return (push(tt)[a] - D * v - K * p) / M; };
+        const double p = xi_[i], v = xid_[i];
+        const double k1p = v, k1v = acc(t0, p, v);
+        const double k2p = v + h / 2 * k1v, k2v = acc(t0 + h / 2, p + h / 2 * k1p, v + h / 2 * k1v);
+        const double k3p = v + h / 2 * k2v, k3v = acc(t0 + h / 2, p + h / 2 * k2p, v + h / 2 * k2v);
+        const double k4p = v + h * k3v, k4v = acc(t0 + h, p + h * k3p, v + h * k3v);
+        xi_[i] = p + h / 6 * (k1p + 2 * k2p + 2 * k3p + k4p);
+        xid_[i] = v + h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+      }
+    }
+    t_target_ = t;
+  }
+
   const DataSettings& s_;
   controllers::Controller ctrl_;
   controllers::Reference ref_;
   std::unique_ptr<Mech> loads_mech_;  // the plant, for the passive joints' loads
   std::vector<Spatial::Vec> loads_;
+  VecN xi_, xid_;  // the target's ξ, ξ' at t_target_
+  double t_target_ = 0;
 };
 
 std::string fmt(const char* f, double x) {
@@ -90,6 +132,8 @@ std::string DataLab::unit(const std::string& c) const {
   if (c == "t") return "s";
   if (c == "energy" || c == "work") return "J";
   if (c == "constraint_residual") return "m";
+  if (s_.push && starts("push_")) return "N";
+  if (s_.target.k > 0 && (starts("target_") || starts("dev_"))) return "m";
   // A joint path's reference and error columns carry their joint's unit (below).
   const bool joint_path = s_.path && s_.path->joint();
   if (starts("tool_") || (!joint_path && (starts("ref_") || starts("e_")))) return "m";
@@ -230,6 +274,16 @@ void DataLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
     return 1e3 * std::sqrt(e);
   };
   o.lines = {{"t", fmt("%.3f s", tr.at(row, "t"))}, {"tracking |e|", fmt("%.2f ", norm(row)) + unit}};
+  // An impedance exercise: the push and the tool's distance from the target's response.
+  if (s_.push) {
+    const double F = std::sqrt(std::pow(tr.at(row, "push_x"), 2) + std::pow(tr.at(row, "push_y"), 2) + std::pow(tr.at(row, "push_z"), 2));
+    o.lines.push_back({"push |F|", fmt("%.1f N", F)});
+  }
+  if (s_.target.k > 0) {
+    double d = 0;
+    for (const auto& a : s_.axis_names) d += std::pow(tr.at(row, "dev_" + a), 2);
+    o.lines.push_back({"off target", fmt("%.2f mm", 1e3 * std::sqrt(d))});
+  }
   for (const auto& a : s_.actuated_names)
     o.lines.push_back({"τ " + a, fmt("%.2f N·m", tr.at(row, "tau_" + columnName(a)))});
   if (!s_.plant->closures.empty()) o.lines.push_back({"closure |φ|", fmt("%.1e m", tr.at(row, "constraint_residual"))});

@@ -14,17 +14,27 @@
 //                                        to the joint laws without inverse kinematics (tool optional)
 //   "plant": {"payloads": [{"body", "at", "mass"}]}   point masses the plant carries and the
 //                                        controller's model does not (scenarios change them)
-//   "controller": {"kind", "control_period", "delay_steps", "noise": {"angle", "rate", "seed"},
-//                  "constant", "joint_scale"}   a law of labs/controllers, gains from "gains"
+//   "environment": {"force": {"value": [Fx, Fy, Fz], "start", "rise", "hold"}}   a push on the tool
+//                                        (N, world axes; physics/forces.h's profile), on the plant only:
+//                                        both engines apply J_toolᵀ F inside each step; trace push_x/y/z
+//   "controller": {"kind", "control_period", "delay_steps", "noise": {"angle", "rate", "force", "seed"},
+//                  "constant", "joint_scale", "posture_omega"}   a law of labs/controllers, gains from
+//                                        "gains"; the impedance laws' force sensor reads the push on the
+//                                        tool (in the task axes) as late as the encoders, noise "force" N
+//   "target": {"k", "m", "zeta"}         the exercise's target impedance M ξ'' + D ξ' + K ξ = F_push per
+//                                        task axis (ξ = x − x_d, D = 2ζ√(KM)): trace target_<axis> = x_d + ξ
+//                                        (RK4, four substeps a row) and dev_<axis> = tool − target
 //   "metrics": {...}                     labs/generic/metric_spec.h
 //   "passive_tolerance": 1e-6            the passive energy check's |E − E0|/|E0|
 // Trace columns: t, q_<joint> (every coordinate), v_<joint>, tau_<actuated>, tau_sat, tool_<axis>,
-// ref_<axis>, e_<axis> (a joint path: ref_<actuated>, e_<actuated>), energy, work, constraint_residual,
+// ref_<axis>, e_<axis> (a joint path: ref_<actuated>, e_<actuated>), push_x/y/z (with a push),
+// target_<axis>, dev_<axis> (with a target), energy, work, constraint_residual,
 // and f_<closure>_<row> (force, world axes, of each kept closure row: rows wx wy wz are moments, x y z
 // forces), then load_<joint>_x|y|z for each passive joint: the force its bearing carries (its parent on
 // it, world axes; jointLoads).
 #pragma once
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -33,6 +43,7 @@
 #include "labs/generic/task_path.h"
 #include "labs/lab.h"
 #include "labs/model_scene.h"
+#include "physics/forces.h"
 #include "physics/model_file/model_file.h"
 
 namespace dyn::generic {
@@ -46,6 +57,10 @@ struct DataSettings {
   controllers::TaskPoint tool;
   VecN q0;  // assembled start
   std::shared_ptr<const TaskPath> path;
+  std::optional<PushForce<Spatial>> push;  // the environment's push on the tool (the plant has it too)
+  struct Target {
+    double k = 0, m = 1, zeta = 0;  // N/m, kg, 1 (k = 0: no target)
+  } target;
   controllers::Spec controller;
   StepOptions step;
   double duration = 1, passive_tolerance = 1e-6;
@@ -70,7 +85,10 @@ class DataLab final : public Lab {
   json agreement(const Trace& hand, const Trace& bullet) const override;
   std::string agreementUnit(const std::string& key) const override;
   std::string referenceEngine() const override;
-  PassiveEnergy passiveEnergy() const override { return {s_.passive_tolerance, 0}; }
+  // The push does work by design: the passive check runs without it (E itself must then stay put).
+  PassiveEnergy passiveEnergy() const override {
+    return {s_.passive_tolerance, 0, s_.push ? json{{"environment", nullptr}} : json::object()};
+  }
   void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
   void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
 

@@ -10,7 +10,7 @@
 namespace dyn::generic {
 namespace {
 
-constexpr double kMaxCoordinate = 100, kMaxMass = 1e4, kMaxTorque = 1e5;
+constexpr double kMaxCoordinate = 100, kMaxMass = 1e4, kMaxTorque = 1e5, kMaxForce = 1e5;
 
 Eigen::Vector3d vec3(const JsonView& j) {
   j.size(3, 3);
@@ -73,7 +73,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   s.name = name, s.folder = folder;
   c.onlyKeys({"lab", "title", "description", "model_file", "actuated", "torque_limit", "tool", "initial", "trajectory",
               "plant", "controller", "gains", "metrics", "passive_tolerance", "simulation", "rubric", "metric_docs",
-              "figures", "submission_options", "map", "drawing"});
+              "figures", "submission_options", "map", "drawing", "environment", "target"});
   s.title = c["title"].string();
   // The model, and the plant: the model with the payloads the controller does not know.
   const JsonView mf = c["model_file"];
@@ -146,6 +146,23 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     c["trajectory"].fail("no task trajectory without a \"tool\" to follow it (or \"space\": \"joint\")");
   }
 
+  // The environment: a push on the tool, the plant's only (the controller's model was copied above).
+  if (c.has("environment")) {
+    const JsonView env = c["environment"];
+    env.onlyKeys({"force"});
+    const JsonView f = env["force"];
+    f.onlyKeys({"value", "start", "rise", "hold"});
+    if (s.tool.link < 0) f.fail("a \"tool\" to push on (/tool)");
+    const JsonView v = f["value"];
+    v.size(3, 3);
+    Spatial::Vec w = Spatial::Vec::Zero();
+    for (int i = 0; i < 3; ++i) w[3 + i] = v.at(std::size_t(i)).inRange(-kMaxForce, kMaxForce);
+    const ForceProfile profile{f["start"].inRange(0, 1e4), f.has("rise") ? f["rise"].inRange(0, 1e4) : 0.0,
+                               f.has("hold") ? f["hold"].inRange(0, 1e4) : 0.0};
+    s.push.emplace(BodyRef::link(s.tool.link), s.tool.point, w, profile);
+    file.mechanism.forces.push_back(std::make_shared<PushForce<Spatial>>(*s.push));
+  }
+
   // The start: the actuators placed, the loop assembled from the file's pose.
   s.q0 = file.q0;
   if (m > 0 || c.has("initial")) {
@@ -177,7 +194,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   // The controller: a kind of the library, the gains it reads declared in "gains".
   const JsonView ctl = c["controller"];
   ctl.onlyKeys({"kind", "control_period", "delay_steps", "noise", "constant", "joint_scale", "anti_windup", "tracking_time",
-               "coulomb_compensation", "compensation_width"});
+               "coulomb_compensation", "compensation_width", "posture_omega"});
   const std::string kind = ctl["kind"].string();
   if (std::find(controllers::kindNames().begin(), controllers::kindNames().end(), kind) == controllers::kindNames().end())
     ctl["kind"].fail("one of " + list(controllers::kindNames()));
@@ -189,8 +206,9 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   cs.delay_steps = ctl.has("delay_steps") ? ctl["delay_steps"].integer(0, 1000) : 0;
   if (ctl.has("noise")) {
     const JsonView nz = ctl["noise"];
-    nz.onlyKeys({"angle", "rate", "seed"});
+    nz.onlyKeys({"angle", "rate", "force", "seed"});
     cs.noise_angle = nz["angle"].inRange(0, 1), cs.noise_rate = nz["rate"].inRange(0, 100);
+    cs.noise_force = nz.has("force") ? nz["force"].inRange(0, kMaxForce) : 0.0;
     cs.seed = std::uint64_t(nz["seed"].integer(0, 1L << 53));
   }
   cs.constant = VecN::Zero(m);
@@ -214,6 +232,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   if (ctl.has("tracking_time")) cs.tracking_time = ctl["tracking_time"].inRange(1e-4, 100);
   if (ctl.has("coulomb_compensation")) cs.coulomb_compensation = ctl["coulomb_compensation"].boolean();
   if (ctl.has("compensation_width")) cs.compensation_width = ctl["compensation_width"].inRange(1e-6, 100);
+  if (ctl.has("posture_omega")) cs.posture_omega = ctl["posture_omega"].inRange(0, 1e4);
   std::vector<std::string> declared;
   for (const auto& [g, _] : c["gains"].raw().items()) declared.push_back(g);
   const auto gains = parseGains(c["gains"], declared);
@@ -228,11 +247,24 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
       if (!gains.count(g)) c["gains"].fail("a gain \"" + g + "\" (the controller kind " + k + " reads it)");
     // A joint path feeds the joint laws only: the task laws need a task path.
     const auto kk = controllers::kindFromName(k);
-    if (s.path && s.path->joint() && (kk == controllers::Kind::TaskPdGravity || kk == controllers::Kind::TaskInverseDynamics))
+    using K = controllers::Kind;
+    const bool task = kk == K::TaskPdGravity || kk == K::TaskInverseDynamics || kk == K::ImpedanceTask || kk == K::ImpedanceInverseDynamics ||
+                      kk == K::ImpedanceJoint;
+    if (s.path && s.path->joint() && task)
       c["trajectory"]["space"].fail("\"task\" for the controller kind " + k + " (a joint path feeds joint_pd_gravity, pid and computed_torque)");
   }
   auto gain = [&](const char* g) { return gains.count(g) ? gains.at(g) : 0.0; };
   cs.kp = gain("kp"), cs.kd = gain("kd"), cs.ki = gain("ki"), cs.omega_n = gain("omega_n"), cs.zeta = gain("zeta");
+  cs.k_imp = gain("k_imp"), cs.d_imp = gain("d_imp"), cs.m_imp = gains.count("m_imp") ? gains.at("m_imp") : 1.0;
+  if (!(cs.m_imp > 0)) c["gains"]["m_imp"].fail("a mass above 0 (kg): the impedance law divides by it");
+
+  // The exercise's target impedance M ξ'' + D ξ' + K ξ = F (ξ = x − x_d per task axis; D = 2ζ√(KM)).
+  if (c.has("target")) {
+    const JsonView t = c["target"];
+    t.onlyKeys({"k", "m", "zeta"});
+    if (s.tool.axes.empty() || (s.path && s.path->joint())) t.fail("a task: the target is the tool's (/tool and a task trajectory)");
+    s.target.k = t["k"].positive(1e7), s.target.m = t["m"].positive(1e5), s.target.zeta = t["zeta"].inRange(0, 100);
+  }
 
   // The trace's columns, then the metrics that read them.
   s.columns = {"t"};
@@ -245,6 +277,11 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   for (const auto& a : s.axis_names) s.columns.push_back("tool_" + a);
   for (const char* p : {"ref_", "e_"})
     for (const auto& a : joint_path ? s.actuated_names : s.axis_names) s.columns.push_back(p + (joint_path ? columnName(a) : a));
+  if (s.push)
+    for (const char* a : {"push_x", "push_y", "push_z"}) s.columns.push_back(a);
+  if (s.target.k > 0)
+    for (const char* p : {"target_", "dev_"})
+      for (const auto& a : s.axis_names) s.columns.push_back(p + a);
   for (const char* k : {"energy", "work", "constraint_residual"}) s.columns.push_back(k);
   for (const auto& cl : file.closures)
     for (const auto& r : cl.kept) s.columns.push_back("f_" + columnName(cl.name) + "_" + r);

@@ -16,6 +16,11 @@
 //             rows are: out-of-plane rows of a planar loop). Its force: B's share of the impulses
 //             / dt (point-to-point +λ, fixed −λ, rows written for A; moment rows 3..5), at the pivot.
 // Other constraint kinds, cut joints and payloads are refused (std::invalid_argument: "not yet").
+// External forces (description.forces): evaluated at the step's start (time t; the point's place p and
+// spatial velocity V from the description's kinematics at (θ, θ')) and applied to the body's Bullet link
+// as the force f at its centre of mass and the torque τ + (p − c) × f, world axes (Bullet maps them to
+// its joints as Jᵀ F inside its one step, as the hand engine does at every stage); the books add
+// (J_Pᵀ F)·Δθ, the held force along the step's first-order displacement.
 // The force reported for a ball contact is the plane's on the ball over the step (impulses / dt: the
 // normal force η n plus, when μ > 0, the friction force; n·f = η ≥ 0), with its moment about the
 // contact point at the step's start (plane_contact: c − ρ n; ~0 unless friction acts on a stand-in
@@ -165,6 +170,7 @@ struct BulletMechanism<Spatial>::Impl {
   std::vector<Contact> contacts;
   std::vector<Spatial::Vec> force;  // per description constraint, over the last step
   std::string summary;
+  std::unique_ptr<TreeData<Spatial>> kinematics;  // the external forces' points (none: no forces)
 
   BulletWorld world;  // before what it holds: destroyed after it
   std::unique_ptr<btMultiBody> body;
@@ -175,8 +181,8 @@ struct BulletMechanism<Spatial>::Impl {
 
   Impl(const MechanismModel<Spatial>& m, double step, const VecN& q0, const VecN& v0) : model(m), dt(step), world(bt(Spatial::linear(m.tree.gravity)), m.bullet.solver_iterations) {
     check(q0, v0);
-    if (!m.forces.empty()) throw std::invalid_argument("BulletMechanism (spatial): external forces are not modelled yet");
     frames = linkFrames(m.tree);
+    if (!m.forces.empty()) kinematics = std::make_unique<TreeData<Spatial>>(m.tree);
     force.assign(m.constraints.size(), Spatial::Vec::Zero());
     btContactSolverInfo& info = world->getSolverInfo();
     // Two friction directions, clipped together to the cone (without the flag Bullet keeps one).
@@ -420,11 +426,33 @@ struct BulletMechanism<Spatial>::Impl {
     }
   }
 
-  void step(const VecN& tau_in) {
+  // The external forces at the step's start as Bullet link forces and torques; returns their
+  // generalised force Σ J_Pᵀ F (for the books).
+  VecN applyForces(double t, const VecN& q, const VecN& v) {
+    VecN Q = VecN::Zero(model.treeDof());
+    if (model.forces.empty()) return Q;
+    forwardKinematics(model.tree, q, v, *kinematics);
+    MatN J;
+    for (const auto& ef : model.forces) {
+      const int i = ef->body().index;  // a link: validate() refuses the world, the builder payloads
+      const Pos p = pointPosition(*kinematics, i, ef->point());
+      pointJacobian(model.tree, *kinematics, i, ef->point(), J);
+      const Spatial::Vec F = ef->force(t, p, Spatial::Vec(J * v));
+      if (F.isZero(0.0)) continue;
+      const Pos f = F.tail<3>(), c = pointPosition(*kinematics, i, frames[std::size_t(i)].com);
+      body->addLinkForce(i, bt(f));  // world axes, at the link frame's origin: the centre of mass
+      body->addLinkTorque(i, bt(Pos(F.head<3>() + (p - c).cross(f))));
+      Q.noalias() += J.transpose() * F;
+    }
+    return Q;
+  }
+
+  void step(const VecN& tau_in, double t) {
     const int n = model.treeDof();
     if (tau_in.size() != n) throw std::invalid_argument("BulletMechanism::step: τ needs one value per tree joint (" + std::to_string(n) + ")");
     VecN q, v;
     state(q, v);
+    const VecN pushed = applyForces(t, q, v);  // pitfall 3: cleared after every step, like the torques
     VecN friction = VecN::Zero(n);
     for (int i = 0; i < n; ++i) {
       double tau = tau_in[i];
@@ -447,7 +475,7 @@ struct BulletMechanism<Spatial>::Impl {
     VecN q1, v1;
     state(q1, v1);
     for (int i = 0; i < n; ++i) {
-      books.work += tau_in[i] * (q1[i] - q[i]);
+      books.work += (tau_in[i] + pushed[i]) * (q1[i] - q[i]);
       books.friction -= friction[i] * (q1[i] - q[i]);
     }
   }
@@ -479,8 +507,7 @@ template <>
 BulletMechanism<Spatial>::~BulletMechanism() {}
 template <>
 void BulletMechanism<Spatial>::step(const VecN& tau, double t) {
-  (void)t;  // no time-dependent forces: the spatial builder refuses external forces
-  impl_->step(tau);
+  impl_->step(tau, t);
 }
 template <>
 Books BulletMechanism<Spatial>::books() const { return impl_->books; }

@@ -9,7 +9,10 @@
 //  * on the PUMA 560 (its URDF) with joint paths fed to the joint laws: PD + gravity with the exact
 //    model converges to the reference; computed torque under a payload its model lacks settles at
 //    e = M̂⁻¹ΔG / ω_n² (the closed form of its static error);
-//  * the joint path's and joint_scale's bad fields, one line each naming the JSON path.
+//  * the joint path's and joint_scale's bad fields, one line each naming the JSON path;
+//  * a push on the tool as data (environment.force): both engines deflect the five-bar's pin under task
+//    PD + gravity by the closed form F/K_p; its bad fields, the target's, the impedance laws' (posture,
+//    force noise, m_imp) name their path.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -379,4 +382,100 @@ TEST_CASE("a joint path's JSON: each bad field is one line naming its path") {
   CHECK(std::find(s.columns.begin(), s.columns.end(), "e_x") == s.columns.end());
   REQUIRE(s.path);
   CHECK(s.path->joint());
+}
+
+TEST_CASE("a push on the tool as data: both engines, task PD + gravity deflects by F/K_p") {
+  json c = fivebarConfig();
+  c["environment"] = json::parse(R"({"force": {"value": [3.0, 0.0, -2.0], "start": 0.3}})");
+  c["trajectory"] = json::parse(R"({"segments": [{"hold": 2.0}]})");
+  c["simulation"]["duration"] = 2.0;
+  c["controller"]["kind"] = "task_pd_gravity";
+  c["gains"]["kp"]["value"] = 2000.0;
+  c["gains"]["kd"]["value"] = 40.0;
+  c["target"] = json::parse(R"({"k": 500.0, "m": 1.0, "zeta": 0.7})");
+  const std::string folder = std::string(DYNLAB_SOURCE_DIR) + "/labs/fivebar";
+  const generic::DataLab lab(generic::parseDataSettings(JsonView(c, "fivebar.json"), "fivebar", folder));
+  const auto cols = lab.columns();
+  auto col = [&](const char* name) { return int(std::find(cols.begin(), cols.end(), name) - cols.begin()); };
+  REQUIRE(col("push_z") < int(cols.size()));
+  REQUIRE(col("dev_z") < int(cols.size()));
+  CHECK(lab.unit("push_x") == "N");
+  CHECK(lab.unit("target_x") == "m");
+  // The target's column is the closed-form step response of M ξ'' + D ξ' + K ξ = F about the reference
+  // (underdamped, from rest at the push's start), and dev is the tool minus it.
+  {
+    auto sim = lab.simulate(Engine::Hand);
+    std::vector<double> row;
+    const double K = 500, zeta = 0.7, wn = std::sqrt(K / 1.0), wd = wn * std::sqrt(1 - zeta * zeta);
+    double worst = 0, dev = 0;
+    while (sim->step(row)) {
+      const double t = row[0] - 0.3;
+      const double s = t < 0 ? 0.0 : 1 - std::exp(-zeta * wn * t) * (std::cos(wd * t) + zeta * wn / wd * std::sin(wd * t));
+      const double ref_x = row[std::size_t(col("ref_x"))], ref_z = row[std::size_t(col("ref_z"))];
+      worst = std::max({worst, std::abs(row[std::size_t(col("target_x"))] - (ref_x + 3.0 / K * s)),
+                        std::abs(row[std::size_t(col("target_z"))] - (ref_z - 2.0 / K * s))});
+      dev = std::max(dev, std::abs(row[std::size_t(col("dev_x"))] - (row[std::size_t(col("tool_x"))] - row[std::size_t(col("target_x"))])));
+    }
+    MESSAGE("target column against the closed form: " << worst << " m (F/K = 6e-3 m)");
+    CHECK(worst < 1e-9);
+    CHECK(dev < 1e-15);
+  }
+  // At rest J_xᵀ (K_p (x_ref − x) + F) = 0 with J_x square: x − x_ref = F / K_p, whatever the pose.
+  for (Engine engine : {Engine::Hand, Engine::Bullet}) {
+    auto sim = lab.simulate(engine);
+    std::vector<double> row, before;
+    for (int k = 0; sim->step(row); ++k)
+      if (k == 250) before = row;
+    const std::string name = engine == Engine::Hand ? "hand" : "Bullet";
+    INFO(name);
+    CHECK(before[std::size_t(col("push_x"))] == 0.0);  // not yet on at 0.25 s
+    CHECK(row[std::size_t(col("push_x"))] == 3.0);
+    CHECK(row[std::size_t(col("push_z"))] == -2.0);
+    const double ex = row[std::size_t(col("e_x"))], ez = row[std::size_t(col("e_z"))];
+    MESSAGE(name << ": e = (" << ex << ", " << ez << ") against −F/K_p = (−1.5e-3, 1e-3)");
+    const double tol = engine == Engine::Hand ? 1e-8 : 2e-5;  // Bullet: its loop closure's PGS residual
+    CHECK(std::abs(ex - (-3.0 / 2000.0)) < tol);
+    CHECK(std::abs(ez - (2.0 / 2000.0)) < tol);
+  }
+  // The force sensor reads the push: impedance_inverse_dynamics programmed with the target's K, D, M
+  // makes the pin follow the target's column (to the 1 ms hold's lag), in both engines; programmed with
+  // another mass it does not.
+  auto miss = [&](double m_imp, Engine engine) {
+    json f = c;
+    f["controller"]["kind"] = "impedance_inverse_dynamics";
+    f["gains"]["k_imp"] = {{"value", 500.0}, {"min", 1.0}, {"max", 1e4}};
+    f["gains"]["d_imp"] = {{"value", 2 * 0.7 * std::sqrt(500.0)}, {"min", 0.0}, {"max", 1e4}};
+    f["gains"]["m_imp"] = {{"value", m_imp}, {"min", 0.01}, {"max", 1e4}};
+    const generic::DataLab fl(generic::parseDataSettings(JsonView(f, "fivebar.json"), "fivebar", folder));
+    auto sim = fl.simulate(engine);
+    std::vector<double> row;
+    double worst = 0;
+    while (sim->step(row)) worst = std::max(worst, std::hypot(row[std::size_t(col("dev_x"))], row[std::size_t(col("dev_z"))]));
+    return worst;
+  };
+  const double hand_miss = miss(1.0, Engine::Hand), bullet_miss = miss(1.0, Engine::Bullet), heavy_miss = miss(4.0, Engine::Hand);
+  MESSAGE("force feedback: largest |tool − target| " << hand_miss << " m (Bullet " << bullet_miss << ", programmed 4 kg " << heavy_miss
+                                                      << ") of |F|/K = " << std::hypot(3.0, 2.0) / 500);
+  CHECK(hand_miss < 0.02 * std::hypot(3.0, 2.0) / 500);
+  CHECK(bullet_miss < 0.05 * std::hypot(3.0, 2.0) / 500);
+  CHECK(heavy_miss > 0.2 * std::hypot(3.0, 2.0) / 500);
+  // Bad fields: one line naming the path.
+  const std::vector<Case> cases = {
+      {R"({"environment": {"force": {"value": [1, 2], "start": 0}}})", "/environment/force/value", ""},
+      {R"({"environment": {"force": {"value": [1, 2, 1e9], "start": 0}}})", "/environment/force/value/2", ""},
+      {R"({"environment": {"force": {"value": [1, 2, 3], "start": -1}}})", "/environment/force/start", ""},
+      {R"({"environment": {"force": {"value": [1, 2, 3], "start": 0, "rise": "slow"}}})", "/environment/force/rise", ""},
+      {R"({"environment": {"wall": {}}})", "/environment/wall", ""},
+      {R"({"tool": null, "trajectory": null, "environment": {"force": {"value": [1, 2, 3], "start": 0}}})", "/environment/force", "tool"},
+      {R"({"target": {"k": 0, "m": 1, "zeta": 0.7}})", "/target/k", ""},
+      {R"({"target": {"k": 500, "m": 1}})", "/target", "zeta"},
+      {R"({"target": {"k": 500, "m": 1, "zeta": 0.7, "d": 3}})", "/target/d", ""},
+      {R"({"tool": null, "trajectory": null, "target": {"k": 500, "m": 1, "zeta": 0.7}})", "/target", "task"},
+      {R"({"controller": {"posture_omega": -1}})", "/controller/posture_omega", ""},
+      {R"({"controller": {"noise": {"angle": 0, "rate": 0, "seed": 1, "force": -0.5}}})", "/controller/noise/force", ""},
+      {R"({"controller": {"kind": "impedance_task"}})", "/gains", "k_imp"},
+      {R"({"controller": {"kind": "impedance_inverse_dynamics"}, "gains": {"k_imp": {"value": 1, "min": 0, "max": 2},
+          "d_imp": {"value": 1, "min": 0, "max": 2}, "m_imp": {"value": 0, "min": 0, "max": 2}}})", "/gains/m_imp", "mass"},
+  };
+  checkRefused(fivebarConfig(), cases, "fivebar.json", "fivebar", folder);
 }
