@@ -44,11 +44,11 @@ struct BodyRef {
 // energy ½ a θ'², nothing else (the rotor's own gyroscopic and cross terms are O(1/G), left out).
 struct JointProperties {
   double stiffness = 0;      // N·m/rad (N/m for prismatic)
-  double armature = 0;       // kg·m² (kg for prismatic): added to M's diagonal
   double rest = 0;           // rad (m)
   double viscous = 0;        // N·m·s/rad
   double coulomb = 0;        // N·m
   double coulomb_width = 1e-2;  // rad/s: w of F_c tanh(θ'/w)
+  double armature = 0;          // kg·m² (kg for prismatic): added to M's diagonal (last: positional initialisers keep their order)
   // The friction torque at rate θ' (opposes it: the mechanism subtracts it). tanh(x) rounds to ±1
   // for |x| ≥ 20: the call (the step's most expensive) is skipped there, bit for bit the same.
   double friction(double rate) const {
