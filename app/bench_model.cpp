@@ -6,6 +6,9 @@
 //   hand   RK4 + projection                 (dynlab model's run: the reference for accuracy)
 //   Bullet btMultiBody, semi-implicit Euler  (physics/bullet)
 //   MuJoCo mj_step, Euler                    (the same file, MuJoCo's own soft equalities)
+// With dynlab's elements beside the file (STEM.loops.json: loops, rolling wheels, plane contacts) the
+// hand engines step as the labs and `dynlab model` do (contacts closed and opened between steps,
+// touchdowns located), and MuJoCo is left out: its run of the file would not hold those elements.
 // Ratios from the blocks timed side by side (median and middle half), and each engine's accuracy over
 // a 2 s run: the largest closure residual |φ|∞ and the largest |q − q_ref|∞ against the hand RK4 run.
 #include <algorithm>
@@ -20,6 +23,7 @@
 #include "app/commands.h"
 #include "app/model.h"
 #include "app/model_loops.h"
+#include "app/model_run.h"
 #include "labs/utf8.h"
 #include "physics/bullet/bullet_mechanism.h"
 #include "physics/constrained_mechanism.h"
@@ -45,6 +49,7 @@ struct Engine {
 // The engines from the file's pose at rest.
 struct Engines {
   std::unique_ptr<ConstrainedSystem> euler_mech, rk4_mech;
+  std::unique_ptr<ConstrainedMechanism<Spatial>> euler_el, rk4_el;  // with elements beside the file
   std::string sizes;
   std::unique_ptr<bullet::BulletMechanism<Spatial>> bullet;
   std::unique_ptr<model_file::MujocoSimulation> mujoco;
@@ -52,7 +57,24 @@ struct Engines {
   std::vector<Engine> list;
 };
 
-void build(const model_file::LoadedModel& m, double dt, Engines& e) {
+// A hand engine for a file with elements beside it: contacts updated at each step's start, touchdowns
+// located (labs/mechanism_simulation.h's step); restarted as a new mechanism (its contacts open).
+Engine handWithElements(const model_file::LoadedModel& m, const char* scheme, std::unique_ptr<ConstrainedMechanism<Spatial>>* mech,
+                        VecN* q, VecN* v, StepOptions o) {
+  const int n = int(m.q0.size());
+  Engine x;
+  x.name = "hand";
+  x.scheme = std::string(scheme) + " (dynamic sizes; contacts closed and opened between steps, touchdowns located)";
+  x.step = [=, tau = VecN(VecN::Zero(n))] {
+    (*mech)->updateContacts(*q, *v, tau);
+    return (*mech)->stepLocatingContacts(o, tau, *q, *v) && q->allFinite() && v->allFinite();
+  };
+  x.restart = [=, &m] { *mech = std::make_unique<ConstrainedMechanism<Spatial>>(m.mechanism), *q = m.q0, *v = VecN::Zero(n); };
+  x.state = [=](VecN& qo, VecN& vo) { qo = *q, vo = *v; };
+  return x;
+}
+
+void build(const model_file::LoadedModel& m, double dt, bool beside, Engines& e) {
   const int n = int(m.q0.size());
   const VecN zero = VecN::Zero(n);
   StepOptions euler;
@@ -74,8 +96,13 @@ void build(const model_file::LoadedModel& m, double dt, Engines& e) {
     x.state = [=](VecN& qo, VecN& vo) { qo = *q, vo = *v; };
     return x;
   };
-  e.list.push_back(hand("semi-implicit Euler + Baumgarte", e.euler_mech.get(), &e.q_euler, &e.v_euler, euler));
-  e.list.push_back(hand("RK4 + projection", e.rk4_mech.get(), &e.q_rk4, &e.v_rk4, rk4));
+  if (m.contacts.empty()) {
+    e.list.push_back(hand("semi-implicit Euler + Baumgarte", e.euler_mech.get(), &e.q_euler, &e.v_euler, euler));
+    e.list.push_back(hand("RK4 + projection", e.rk4_mech.get(), &e.q_rk4, &e.v_rk4, rk4));
+  } else {
+    e.list.push_back(handWithElements(m, "semi-implicit Euler + Baumgarte", &e.euler_el, &e.q_euler, &e.v_euler, euler));
+    e.list.push_back(handWithElements(m, "RK4 + projection", &e.rk4_el, &e.q_rk4, &e.v_rk4, rk4));
+  }
   e.bullet = std::make_unique<bullet::BulletMechanism<Spatial>>(m.mechanism, dt, m.q0, zero);
   Engine b;
   b.name = "Bullet";
@@ -88,6 +115,7 @@ void build(const model_file::LoadedModel& m, double dt, Engines& e) {
   b.restart = [bt, &m, dt, zero] { *bt = std::make_unique<bullet::BulletMechanism<Spatial>>(m.mechanism, dt, m.q0, zero); };
   b.state = [bt](VecN& q, VecN& v) { (*bt)->state(q, v); };
   e.list.push_back(b);
+  if (beside) return;  // MuJoCo's run of the file would not hold what is beside it
   e.mujoco = std::make_unique<model_file::MujocoSimulation>(m.file, dt);
   model_file::MujocoSimulation* mj = e.mujoco.get();
   mj->reset(m.q0, zero);
@@ -127,7 +155,8 @@ struct Accuracy {
   double residual = 0, error = 0;
   bool complete = true;
 };
-std::vector<Accuracy> accuracy(std::vector<Engine>& engines, ConstrainedMechanism<Spatial>& mech, int steps, int reference) {
+std::vector<Accuracy> accuracy(std::vector<Engine>& engines, const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, int steps,
+                               int reference) {
   std::vector<std::vector<VecN>> path(engines.size());
   std::vector<Accuracy> out(engines.size());
   for (std::size_t i = 0; i < engines.size(); ++i) {
@@ -141,7 +170,7 @@ std::vector<Accuracy> accuracy(std::vector<Engine>& engines, ConstrainedMechanis
         break;
       }
       path[i].push_back(q);
-      out[i].residual = std::max(out[i].residual, mech.residual(q));
+      out[i].residual = std::max(out[i].residual, m.contacts.empty() ? mech.residual(q) : elementResidual(m, mech, q, v));
       if (k < steps && !e.step()) {
         out[i].complete = false;
         break;
@@ -158,24 +187,19 @@ std::vector<Accuracy> accuracy(std::vector<Engine>& engines, ConstrainedMechanis
 }  // namespace
 
 int benchModel(const BenchArgs& a) {
+  // Loops, wheels or contacts beside the file (STEM.loops.json) are held by the hand engine and Bullet.
+  const std::string beside = loopsBeside(a.lab);
   model_file::LoadedModel m;
   try {
-    m = model_file::load(a.lab);
+    m = loadWithLoops(a.lab, "");
   } catch (const model_file::ModelFileError& e) {
     std::fprintf(stderr, "error: %s\n", utf8Quotable(e.what()).c_str());
-    return 2;
-  }
-  // Loops, wheels or contacts beside the file: MuJoCo's own run of the file would not hold them, so the
-  // engines would not run one mechanism.
-  if (const std::string loops = loopsBeside(a.lab); !loops.empty()) {
-    std::fprintf(stderr, "error: %s: dynlab's elements are beside it (%s: loops, wheels or contacts); dynlab bench FILE times what the file itself holds (MuJoCo's run would not hold these); dynlab bench LAB times the unicycle and pen labs\n",
-                 utf8Quotable(a.lab).c_str(), utf8Quotable(loops).c_str());
     return 2;
   }
   const double dt = m.timestep;
   Engines engines;
   try {
-    build(m, dt, engines);
+    build(m, dt, !beside.empty(), engines);
   } catch (const std::exception& e) {  // a description the Bullet builder cannot model
     std::fprintf(stderr, "error: %s: %s\n", utf8Quotable(m.file).c_str(), utf8Quotable(e.what()).c_str());
     return 2;
@@ -185,12 +209,14 @@ int benchModel(const BenchArgs& a) {
   timeBlocks(list, a.steps);
   ConstrainedMechanism<Spatial> mech(m.mechanism);
   const int run_steps = int(std::lround(2.0 / dt));
-  const std::vector<Accuracy> acc = accuracy(list, mech, run_steps, 1);
+  const std::vector<Accuracy> acc = accuracy(list, m, mech, run_steps, 1);
   const Engine& euler = list[0];
   int rows = 0;
   for (const auto& c : m.closures) rows += int(c.kept.size());
+  const std::string mujoco_left_out = beside.empty() ? "" : "MuJoCo not timed: its run of the file would not hold what " + beside + " adds";
   if (a.json) {
     json out = {{"model", m.file}, {"dt", dt}, {"steps_timed", a.steps}, {"closure_rows", rows}, {"accuracy_run_s", 2.0}};
+    if (!beside.empty()) out["beside"] = {{"file", beside}, {"elements", m.contacts.size()}, {"note", mujoco_left_out}};
     for (std::size_t i = 0; i < list.size(); ++i) {
       const Ratio r = ratio(list[i].blocks, euler.blocks);
       out["engines"].push_back({{"engine", list[i].name},
@@ -205,8 +231,10 @@ int benchModel(const BenchArgs& a) {
     std::cout << out.dump() << "\n";
     return 0;
   }
-  std::printf("%s: %d coordinates, %d closure rows, dt %g s (the file's), passive from its pose at rest\n", utf8Quotable(m.file).c_str(),
-              int(m.q0.size()), rows, dt);
+  const std::string elements = beside.empty() ? "" : ", " + std::to_string(m.contacts.size()) + " wheels or contacts (" + beside + ")";
+  std::printf("%s: %d coordinates, %d closure rows%s, dt %g s (the file's), passive from its pose at rest\n", utf8Quotable(m.file).c_str(),
+              int(m.q0.size()), rows, utf8Quotable(elements).c_str(), dt);
+  if (!beside.empty()) std::printf("  %s\n", utf8Quotable(mujoco_left_out).c_str());
   std::printf("  %d steps per engine timed in blocks of %d, in turn; ratios block by block: median (middle half)\n", int(euler.all.size()), kBlock);
   std::printf("  engine             µs/step   over hand, 1st order   max |φ|∞     max |q − q_ref|∞ over 2 s (ref: hand RK4)\n");
   for (std::size_t i = 0; i < list.size(); ++i) {

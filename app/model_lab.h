@@ -1,7 +1,9 @@
 // A model file (MJCF or URDF, with what stands beside it: STEM.loops.json) where a lab name goes, for
 // the commands that work on a lab's run: `dynlab figure FILE` and the tuning window `dynlab ui FILE`.
-// It is the generic data lab (labs/generic/data_lab.h) with no actuated joint and no task: the file's
-// passive motion from its pose at rest, at the file's step, both engines. Shared by dynlab and
+// The file is read once into a lab of its own (no actuated joint, no task): its passive motion from
+// its pose at rest, at the file's step, both engines, run as `dynlab model` runs it (app/model_run.h:
+// with wheels or contacts, stepped as the labs step, the touchdowns' losses in the books), its trace
+// `dynlab model`'s columns and each joint's bearing load (load_JOINT_x|y|z). Shared by dynlab and
 // dynlab-ui (the library dynlab_model_lab).
 #pragma once
 #include <optional>
@@ -16,7 +18,8 @@ namespace dyn::app {
 bool isModelFile(const std::string& name);
 
 // The model file as a lab, passive, for `duration` s (default 2 s), with the closures, wheels and
-// contacts beside it; its figures are the coordinates, the energy books and each closure's force.
+// contacts beside it; its figures are the coordinates, the energy books (with the touchdowns' losses),
+// each closure's force and each wheel's or contact's.
 // Throws InputError (one line, naming the file) on bad input.
 LoadedLab loadModelLab(const std::string& file, std::optional<double> duration);
 

@@ -202,6 +202,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
   VecN external_bc_;
   double external_power_ = 0, friction_power_ = 0;
   bool has_forces_ = false;  // the model has external forces (fixed at construction)
+  bool has_armature_ = false;  // some joint has armature (fixed at construction): M_ii += a_i
 };
 
 }  // namespace dyn

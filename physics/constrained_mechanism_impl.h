@@ -59,6 +59,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
     throw std::invalid_argument("the mechanism's sizes (" + std::to_string(dof) + " joints, " + std::to_string(rows_) +
                                 " constraint rows, " + std::to_string(payload) + " payload coordinates) do not match this instantiation");
   has_forces_ = !model_.forces.empty();
+  for (const JointProperties& j : model_.joints) has_armature_ = has_armature_ || j.armature != 0.0;
   kin_.model = &model_;
   kin_.tree = &data_;
   kin_.payload_pose.assign(model_.payloads.size(), Eigen::Vector3d::Zero());
@@ -104,6 +105,8 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   // M from world composite inertias; the world inertias stay for the velocity stage.
   problem_.M.resize(nn, nn);
   crbaWorld(model_.tree, data_, problem_.M);
+  if (has_armature_)  // rotor inertias: M_ii += a_i
+    for (int i = 0; i < nn; ++i) problem_.M(i, i) += model_.joints[std::size_t(i)].armature;
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
   if constexpr (S::kDim == 3)
     for (int i = 0; i < nn; ++i) {
@@ -556,6 +559,8 @@ double ConstrainedMechanism<S, Nj, Nr, Nl>::kineticEnergy(const VecN& q, const V
   positionStage(q);
   if (!have_velocity_ || !same(v, staged_v_)) velocityStage(v);
   double T = kineticEnergyWorld(model_.tree, data_);
+  if (has_armature_)  // the rotors' ½ a θ'²
+    for (int i = 0; i < n(); ++i) T += 0.5 * model_.joints[std::size_t(i)].armature * v[i] * v[i];
   for (std::size_t i = 0, off = std::size_t(n()); i < model_.payloads.size(); ++i) {
     const Payload& p = model_.payloads[i];
     const double diag[3] = {p.inertia, p.mass, p.mass};
@@ -628,7 +633,10 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::pointJacobian(int link, const Pos& poi
 template <class S, int Nj, int Nr, int Nl>
 MatN ConstrainedMechanism<S, Nj, Nr, Nl>::massMatrix(const VecN& q) {
   treeStage(q);
-  return crba(model_.tree, data_);
+  MatN M = crba(model_.tree, data_);
+  if (has_armature_)
+    for (int i = 0; i < n(); ++i) M(i, i) += model_.joints[std::size_t(i)].armature;
+  return M;
 }
 
 template <class S, int Nj, int Nr, int Nl>
@@ -645,7 +653,10 @@ VecN ConstrainedMechanism<S, Nj, Nr, Nl>::inverseDynamics(const VecN& q, const V
   treeStage(q);
   have_velocity_ = false;
   velocityKinematics(model_.tree, VecN(qd.head(n())), data_);
-  return rnea(model_.tree, data_, qd, qdd);
+  VecN tau = rnea(model_.tree, data_, qd, qdd);
+  if (has_armature_)
+    for (int i = 0; i < n(); ++i) tau[i] += model_.joints[std::size_t(i)].armature * qdd[i];
+  return tau;
 }
 
 template <class S, int Nj, int Nr, int Nl>

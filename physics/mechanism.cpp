@@ -31,6 +31,9 @@ template <class S>
 std::string MechanismModel<S>::validate() const {
   const int n = tree.dof();
   if (!joints.empty() && int(joints.size()) != n) return "joint properties are given for " + std::to_string(joints.size()) + " of " + std::to_string(n) + " joints";
+  for (std::size_t i = 0; i < joints.size(); ++i)
+    if (!(joints[i].armature >= 0) || !std::isfinite(joints[i].armature))
+      return "joint " + std::to_string(i) + "'s armature must be a finite number ≥ 0";
   if constexpr (S::kDim != 3) {
     if (!payloads.empty()) return "payloads are planar: a spatial mechanism cannot carry one yet";
   }

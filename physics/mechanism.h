@@ -40,12 +40,15 @@ struct BodyRef {
 // friction F_c tanh(θ'/w): smoothed over a rate width w, C∞ so that RK4 keeps its fourth order (a
 // clamp's kinks at |θ'| = w cost it two orders). Below w it acts as a damper F_c/w; at |θ'| = w it is
 // 76 % of F_c, at 3w 99.5 %. Its power −(b θ' + F_c tanh(θ'/w)) θ' is what the books call friction.
+// Armature a is a geared rotor's reflected inertia (MuJoCo's armature, J_m G²): M_ii += a, kinetic
+// energy ½ a θ'², nothing else (the rotor's own gyroscopic and cross terms are O(1/G), left out).
 struct JointProperties {
   double stiffness = 0;      // N·m/rad (N/m for prismatic)
   double rest = 0;           // rad (m)
   double viscous = 0;        // N·m·s/rad
   double coulomb = 0;        // N·m
   double coulomb_width = 1e-2;  // rad/s: w of F_c tanh(θ'/w)
+  double armature = 0;          // kg·m² (kg for prismatic): added to M's diagonal (last: positional initialisers keep their order)
   // The friction torque at rate θ' (opposes it: the mechanism subtracts it). tanh(x) rounds to ±1
   // for |x| ≥ 20: the call (the step's most expensive) is skipped there, bit for bit the same.
   double friction(double rate) const {

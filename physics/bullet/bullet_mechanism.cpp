@@ -114,6 +114,8 @@ struct BulletMechanism<Planar>::Impl {
                                   " coordinates (tree joints, then payload free coordinates)");
     if (!m.joints.empty() && int(m.joints.size()) != m.treeDof())
       throw std::invalid_argument("BulletMechanism: joints must be empty or one per tree joint");
+    for (const JointProperties& j : m.joints)  // the planar builder has no rotor links (the spatial one has)
+      if (j.armature != 0) throw std::invalid_argument("BulletMechanism (planar): joint armature: not yet");
     if (m.bullet.solver_iterations < 1) throw std::invalid_argument("BulletMechanism: solver_iterations must be ≥ 1");
     for (int p = 0; p < int(m.payloads.size()); ++p)
       if (!(m.payloads[std::size_t(p)].mass > 0.0) || !(m.payloads[std::size_t(p)].inertia > 0.0))

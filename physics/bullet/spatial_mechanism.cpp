@@ -38,6 +38,12 @@
 //   rotParentToThis = E_p E_t E_p,parentᵀ,  pivot offset e = E_p,parent (r_t − c_parent),
 //   pivot → centre of mass d = E_p c,        joint axis E_p axis (this link's frame)
 // and Bullet's joint coordinates are the description's θ, θ' one to one (self-checked at start).
+// Armature (a joint's rotor inertia a, JointProperties): btMultiBody has none, so each such joint gets
+// a rotor link after the description's links, hung from the joint's parent at its anchor, turning
+// about its axis (a slide's: a screw), geared to it by a btMultiBodyGearConstraint θ'_r + G θ' = 0
+// with G = kRotorGear, of isotropic inertia a/G² and tiny mass: its kinetic energy ½ (a/G²)(G θ' −
+// ω_parent·k)² is ½ a θ'² up to a cross term a θ' ω_parent·k / G, which the description leaves out
+// (MuJoCo's armature is the limit G → ∞). The gear row is solved by PGS with the loops.
 // Massless bodies (the unicycle's x, y, z and heading carriers) get mass and principal inertias of
 // 1e-9 × the model's largest: Bullet needs them positive, and their effect is linear in them (the
 // tests show 1e-6 × changes nothing at their tolerances).
@@ -50,6 +56,7 @@
 #include <btBulletDynamicsCommon.h>
 #include <BulletDynamics/Featherstone/btMultiBody.h>
 #include <BulletDynamics/Featherstone/btMultiBodyFixedConstraint.h>
+#include <BulletDynamics/Featherstone/btMultiBodyGearConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBodyPoint2Point.h>
 #include <BulletDynamics/Featherstone/btMultiBodyConstraintSolver.h>
 #include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
@@ -81,6 +88,7 @@ using Mat3 = Eigen::Matrix3d;
 
 constexpr double kTiny = 1e-9;          // massless bodies: this × the model's largest mass / inertia
 constexpr double kImpulseCap = 1e12;    // pitfall 2: Bullet's default caps are 100 and 1000 N·s
+constexpr double kRotorGear = 1000.0;   // armature rotors: θ'_r = −G θ' (rad/rad; rad/m on a slide)
 
 btVector3 bt(const Pos& p) { return {p.x(), p.y(), p.z()}; }
 Pos eig(const btVector3& v) { return {v.x(), v.y(), v.z()}; }
@@ -169,6 +177,7 @@ struct BulletMechanism<Spatial>::Impl {
   std::vector<Wheel> wheels;
   std::vector<Contact> contacts;
   std::vector<Spatial::Vec> force;  // per description constraint, over the last step
+  std::vector<int> rotor_joint;     // per rotor link (Bullet link n + k): the joint it is geared to
   std::string summary;
   std::unique_ptr<TreeData<Spatial>> kinematics;  // the external forces' points (none: no forces)
 
@@ -189,6 +198,7 @@ struct BulletMechanism<Spatial>::Impl {
     info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
     info.m_solverMode &= ~SOLVER_DISABLE_IMPLICIT_CONE_FRICTION;
     buildTree();
+    buildRotors();
     buildColliders();
     buildConstraints();
     setState(q0, v0);
@@ -234,7 +244,9 @@ struct BulletMechanism<Spatial>::Impl {
 
   void buildTree() {
     const int n = model.treeDof();
-    body = std::make_unique<btMultiBody>(n, 1.0, btVector3(1, 1, 1), /*fixedBase=*/true, /*canSleep=*/false);
+    for (int i = 0; i < int(model.joints.size()); ++i)
+      if (model.joints[std::size_t(i)].armature != 0) rotor_joint.push_back(i);
+    body = std::make_unique<btMultiBody>(n + int(rotor_joint.size()), 1.0, btVector3(1, 1, 1), /*fixedBase=*/true, /*canSleep=*/false);
     body->setBaseWorldTransform(btTransform::getIdentity());
     static const LinkFrame world_frame;  // the base is the world: identity, centre at the origin
     for (int i = 0; i < n; ++i) {
@@ -249,6 +261,17 @@ struct BulletMechanism<Spatial>::Impl {
       else
         body->setupPrismatic(i, l.mass, bt(l.inertia), b.parent, rot, axis, e, d, true);
     }
+    // Rotors: the parent link's axes, the pivot on the joint's anchor, the centre on the pivot.
+    double max_mass = 0;
+    for (const LinkFrame& l : frames) max_mass = std::max(max_mass, l.mass);
+    for (std::size_t k = 0; k < rotor_joint.size(); ++k) {
+      const auto& b = model.tree.bodies[std::size_t(rotor_joint[k])];
+      const LinkFrame& p = b.parent < 0 ? world_frame : frames[std::size_t(b.parent)];
+      const double I = model.joints[std::size_t(rotor_joint[k])].armature / (kRotorGear * kRotorGear);
+      const btVector3 axis = bt(p.E_p * b.X_tree.E.transpose() * b.axis.normalized());
+      body->setupRevolute(n + int(k), kTiny * max_mass, btVector3(I, I, I), b.parent, btQuaternion::getIdentity(), axis,
+                          bt(p.E_p * (b.X_tree.r - p.com)), btVector3(0, 0, 0), true);
+    }
     body->finalizeMultiDof();
     // Pitfall 2: no damping, no velocity cap, never sleep.
     body->setLinearDamping(0.0);
@@ -261,10 +284,24 @@ struct BulletMechanism<Spatial>::Impl {
     world->addMultiBody(body.get());
   }
 
+  // Each rotor geared to its joint: rotor link A, the joint's link B, θ'_A + G θ'_B = 0 (velocity level).
+  void buildRotors() {
+    for (std::size_t k = 0; k < rotor_joint.size(); ++k) {
+      const int r = model.treeDof() + int(k);
+      auto g = std::make_unique<btMultiBodyGearConstraint>(body.get(), r, body.get(), rotor_joint[k], btVector3(0, 0, 0),
+                                                           btVector3(0, 0, 0), btMatrix3x3::getIdentity(), btMatrix3x3::getIdentity());
+      g->setGearRatio(kRotorGear);
+      g->setMaxAppliedImpulse(kImpulseCap);
+      world->addMultiBodyConstraint(g.get());
+      g->finalizeMultiDof();
+      closures.push_back(std::move(g));
+    }
+  }
+
   // Pitfall 1: every link gets a collider, with mask 0 (no contacts) unless a friction wheel's.
   void buildColliders() {
     shapes.push_back(std::make_unique<btSphereShape>(0.01));
-    for (int i = -1; i < model.treeDof(); ++i) {
+    for (int i = -1; i < body->getNumLinks(); ++i) {
       auto c = std::make_unique<btMultiBodyLinkCollider>(body.get(), i);
       c->setCollisionShape(shapes.front().get());
       c->setActivationState(DISABLE_DEACTIVATION);
@@ -377,6 +414,7 @@ struct BulletMechanism<Spatial>::Impl {
           << ", cone)";
     }
     if (!contacts.empty()) s << ", " << contacts.size() << " plane contact(s) as a sphere on a static plane";
+    if (!rotor_joint.empty()) s << ", " << rotor_joint.size() << " armature rotor(s) geared " << kRotorGear << ":1";
     if (!loops.empty()) {
       const auto welds = std::count_if(loops.begin(), loops.end(), [](const Loop& l) { return l.weld; });
       s << ", " << loops.size() - std::size_t(welds) << " btMultiBodyPoint2Point and " << welds << " btMultiBodyFixedConstraint loop closure(s)";
@@ -389,6 +427,10 @@ struct BulletMechanism<Spatial>::Impl {
     for (int i = 0; i < model.treeDof(); ++i) {
       body->setJointPos(i, q[i]);
       body->setJointVel(i, v[i]);
+    }
+    for (std::size_t k = 0; k < rotor_joint.size(); ++k) {  // each rotor turning with its gear
+      body->setJointPos(model.treeDof() + int(k), 0.0);
+      body->setJointVel(model.treeDof() + int(k), -kRotorGear * v[rotor_joint[k]]);
     }
     btAlignedObjectArray<btQuaternion> w2l;
     btAlignedObjectArray<btVector3> origin;

@@ -25,54 +25,6 @@ using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
 using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 
-// Offset of the first byte that is not well-formed UTF-8 (no overlongs, surrogates or cut-off
-// sequences), or npos.
-std::size_t utf8ErrorAt(const std::string& s) {
-  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
-  const std::size_t n = s.size();
-  for (std::size_t i = 0; i < n;) {
-    const unsigned c = p[i];
-    int len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
-    if (len == 0 || i + std::size_t(len) > n) return i;
-    unsigned cp = len == 1 ? c : len == 2 ? (c & 0x1F) : len == 3 ? (c & 0x0F) : (c & 0x07);
-    for (int k = 1; k < len; ++k) {
-      if ((p[i + std::size_t(k)] & 0xC0) != 0x80) return i;
-      cp = (cp << 6) | (p[i + std::size_t(k)] & 0x3F);
-    }
-    const unsigned least[5] = {0, 0, 0x80, 0x800, 0x10000};
-    if (cp < least[len] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return i;
-    i += std::size_t(len);
-  }
-  return std::string::npos;
-}
-
-// The file's bytes: a regular file, at most kMaxFileBytes, well-formed UTF-8.
-std::string readChecked(const std::string& path) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) throw ModelFileError(path + ": no such file");
-  if (!fs::is_regular_file(st)) throw ModelFileError(path + ": not a regular file (expected an MJCF or URDF file)");
-  const auto size = fs::file_size(path, ec);
-  if (ec) throw ModelFileError(path + ": cannot read its size (" + ec.message() + ")");
-  if (size > kMaxFileBytes)
-    throw ModelFileError(path + ": " + std::to_string(size) + " bytes, more than the " + std::to_string(kMaxFileBytes) +
-                         " a model file may have");
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  if (!in && !in.eof()) throw ModelFileError(path + ": cannot be read");
-  std::string s = bytes.str();
-  if (s.size() > kMaxFileBytes) throw ModelFileError(path + ": grew past " + std::to_string(kMaxFileBytes) + " bytes while read");
-  if (s.find_first_not_of(" \t\r\n") == std::string::npos) throw ModelFileError(path + ": empty (expected an MJCF or URDF file)");
-  if (const std::size_t at = utf8ErrorAt(s); at != std::string::npos) {
-    char hex[8];
-    std::snprintf(hex, sizeof hex, "0x%02X", unsigned(static_cast<unsigned char>(s[at])));
-    throw ModelFileError(path + ": byte " + hex + " at offset " + std::to_string(at) + " is not valid UTF-8 (model files are UTF-8)");
-  }
-  return s;
-}
-
 struct ModelDeleter {
   void operator()(mjModel* m) const { mj_deleteModel(m); }
 };
@@ -82,25 +34,35 @@ struct DataDeleter {
 using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
 using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 
-// The file compiled by MuJoCo from the bytes read (a virtual file: what was checked is what is parsed).
+// The file compiled by MuJoCo from the bytes read, beside every file it names (files.cpp): virtual
+// files all, so what was checked is what is parsed.
 ModelPtr compile(const std::string& path, std::string* warnings) {
-  const std::string bytes = readChecked(path);
+  const std::string bytes = detail::readChecked(path);
   const std::string name = std::filesystem::path(path).filename().string();
   if (name.size() >= mjMAXVFSNAME) throw ModelFileError(path + ": file name longer than MuJoCo's " + std::to_string(mjMAXVFSNAME - 1) + " characters");
   auto vfs = std::make_unique<mjVFS>();
   mj_defaultVFS(vfs.get());
+  struct Clear {
+    mjVFS* v;
+    ~Clear() { mj_deleteVFS(v); }
+  } clear{vfs.get()};
   // The virtual file keeps the name alone; loading it by its path keeps the file's folder as the
   // model's, where MuJoCo looks for includes and meshes.
-  if (mj_makeEmptyFileVFS(vfs.get(), path.c_str(), int(bytes.size())) != 0) throw ModelFileError(path + ": MuJoCo's virtual file system refused it");
-  const int at = mj_findFileVFS(vfs.get(), path.c_str());
-  if (at < 0) throw ModelFileError(path + ": MuJoCo's virtual file system lost it");
-  std::copy(bytes.begin(), bytes.end(), static_cast<char*>(vfs->filedata[at]));
+  detail::putFile(vfs.get(), path, path, bytes);
+  const std::vector<std::string> missing = detail::addReferencedFiles(path, bytes, vfs.get());
   char error[1024] = "";
   mjModel* m = nullptr;
   detail::MujocoGuard guard;
   MUJOCO_CALL(path, m = mj_loadXML(path.c_str(), vfs.get(), error, sizeof error));
-  mj_deleteVFS(vfs.get());
-  if (!m) throw ModelFileError(path + ": MuJoCo's parser: " + detail::oneLine(error[0] ? error : "no model"));
+  if (!m) {
+    std::string why = path + ": MuJoCo's parser: " + detail::oneLine(error[0] ? error : "no model");
+    if (!missing.empty()) {
+      why += " (named but not found in the model's folder:";
+      for (std::size_t i = 0; i < missing.size() && i < 3; ++i) why += " '" + detail::oneLine(missing[i]) + "'";
+      why += missing.size() > 3 ? " ...)" : ")";
+    }
+    throw ModelFileError(why);
+  }
   if (warnings) *warnings = detail::oneLine(std::string(error) + " " + guard.warnings());
   return ModelPtr(m);
 }
@@ -138,10 +100,6 @@ void checkSupported(const std::string& file, const mjModel* m, const LoadOptions
       fail(a + " has activation dynamics, a variable gain or a bias (a servo): dynlab runs model files passive and reads plain motors only");
     notes.push_back(a + ": a motor, read but not driven (passive run)");
   }
-  for (int j = 0; j < m->nv; ++j)
-    if (m->dof_armature[j] != 0)
-      fail("joint '" + nameOf(m, mjOBJ_JOINT, m->dof_jntid[j], "joint") + "' has armature " + num(m->dof_armature[j]) +
-           "; the description has no rotor inertia yet (set armature=\"0\")");
   if (m->opt.density != 0 || m->opt.viscosity != 0 || m->opt.wind[0] != 0 || m->opt.wind[1] != 0 || m->opt.wind[2] != 0)
     fail("<option> density/viscosity/wind: dynlab has no fluid forces (leave them 0)");
   const int flags = m->opt.disableflags;
@@ -201,6 +159,7 @@ void checkNumbers(const std::string& file, const mjModel* m, const mjData* d) {
     check(m->jnt_stiffness + j, 1, joint + "'s stiffness");
     check(m->dof_damping + j, 1, joint + "'s damping");
     check(m->dof_frictionloss + j, 1, joint + "'s frictionloss");
+    check(m->dof_armature + j, 1, joint + "'s armature");
   }
   for (int e = 0; e < m->neq; ++e) check(m->eq_data + mjNEQDATA * e, mjNEQDATA, "equality '" + nameOf(m, mjOBJ_EQUALITY, e, "equality") + "'s data");
 }
@@ -290,7 +249,8 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     detail::readDrawing(m, d, link, origin, out.drawing);
   }
 
-  // Joint springs, damping and friction (MuJoCo's passive forces and frictionloss).
+  // Joint springs, damping and friction (MuJoCo's passive forces and frictionloss), and armature
+  // (MuJoCo adds it to M's diagonal whatever the flags).
   bool any = false;
   mech.joints.resize(std::size_t(m->nv));
   for (int j = 0; j < m->nv; ++j) {
@@ -301,10 +261,11 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
       p.viscous = m->dof_damping[j];
     }
     if (!(flags & (mjDSBL_FRICTIONLOSS | mjDSBL_CONSTRAINT))) p.coulomb = m->dof_frictionloss[j];
+    p.armature = m->dof_armature[j];
     if (p.coulomb > 0)
       out.notes.push_back("joint '" + out.joints[std::size_t(j)].name + "': frictionloss " + num(p.coulomb) +
                           " read as Coulomb friction smoothed over a rate width of " + num(p.coulomb_width) + " (MuJoCo: exact stiction)");
-    any = any || p.stiffness != 0 || p.viscous != 0 || p.coulomb != 0;
+    any = any || p.stiffness != 0 || p.viscous != 0 || p.coulomb != 0 || p.armature != 0;
   }
   if (!any) mech.joints.clear();
 

@@ -26,8 +26,14 @@
 
 namespace dyn::model_file {
 
-// A file larger than this is refused before it is parsed.
+// A file larger than this is refused before it is parsed (an included model file too).
 inline constexpr std::size_t kMaxFileBytes = 4u << 20;
+// What a model file may name (meshes, textures, height fields, includes): each file at most
+// kMaxAssetBytes, at most kMaxAssetFiles names, at most kMaxAssetsBytes in all; only regular files
+// inside the model file's folder (resolved through links). Checked before MuJoCo parses.
+inline constexpr std::size_t kMaxAssetBytes = 16u << 20;
+inline constexpr std::size_t kMaxAssetsBytes = 64u << 20;
+inline constexpr int kMaxAssetFiles = 256;
 
 // One line: "FILE: what is wrong; what is supported".
 struct ModelFileError : std::runtime_error {

@@ -32,6 +32,19 @@ std::string& lastError();
 // One line: newlines and control characters become spaces, runs of spaces one.
 std::string oneLine(const std::string& text);
 
+// The model file's bytes: a regular file of at most kMaxFileBytes, not blank, well-formed UTF-8
+// (files.cpp). Throws ModelFileError.
+std::string readChecked(const std::string& path);
+
+// bytes as the virtual file `name` (MuJoCo keeps its last part); errors name `path`.
+void putFile(mjVFS* vfs, const std::string& path, const std::string& name, const std::string& bytes);
+
+// Every file the model's text names (includes, meshes, textures, height fields, skins; URDF's mesh
+// filename), checked (a regular file inside the model's folder, within kMaxAssetBytes, kMaxAssetFiles
+// and kMaxAssetsBytes; an included .xml or .urdf as the model file is, and scanned in turn) and put
+// into vfs under its name; a name with no such file gets a one-byte stand-in. Returns those names.
+std::vector<std::string> addReferencedFiles(const std::string& path, const std::string& bytes, mjVFS* vfs);
+
 // The model's geoms at qpos0 (after mj_kinematics) as drawing shapes on the tree bodies: body b moves
 // with tree body link[b] (−1: the world), whose frame origin at qpos0 is origin[b] (drawing.cpp).
 void readDrawing(const mjModel* m, const mjData* d, const std::vector<int>& link, const std::vector<Eigen::Vector3d>& origin,

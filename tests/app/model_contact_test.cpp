@@ -6,11 +6,15 @@
 //  * pen_drop.xml, a pen dropped flat-ish on a table: it lands (plastic touchdowns: their energy in the
 //    books), comes to rest flat, and the table carries m g, half at each end;
 //  * pen.xml (the pen-on-table lab's arm) falls onto its table: the contact never pulls or sinks;
-//  * a bad element in the JSON is one line naming the file and the JSON path, exit 2, nothing written.
+//  * a bad element in the JSON is one line naming the file and the JSON path, exit 2, nothing written;
+//  * `dynlab figure pen_drop.xml` plots the contacts' forces and books the touchdowns (the model file's
+//    lab, read once: it runs after the file is gone), and `dynlab bench` times files with elements.
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <nlohmann/json.hpp>
 
+#include "app/model_lab.h"
 #include "tests/app/cli_run.h"
 
 using namespace dyn::test::cli;
@@ -136,4 +140,49 @@ TEST_CASE("dynlab model: a bad wheel or contact beside the file is one line nami
   checkBadInput(dir, "model " + model("unicycle.xml") + " --loops body.json --out o", {"body.json", "rolling[0].body", "got 'hub'"}, dir / "o");
   writeFile(dir / "text.json", "rolling: yes");
   checkBadInput(dir, "model " + model("unicycle.xml") + " --loops text.json --out o", {"text.json", "not JSON"}, dir / "o");
+}
+
+TEST_CASE("dynlab figure pen_drop.xml: the contacts' forces plotted, the touchdowns in the energy books, the file read once") {
+  TempDir dir("model_pen_figure");
+  const Result r = dynlab(dir, "figure " + model("pen_drop.xml") + " --duration 1 --out fig");
+  INFO(r.out, r.err);
+  REQUIRE(r.code == 0);
+  for (const char* f : {"plot_f_tip_normal+f_cap_normal.pdf", "plot_energy+work+impacts.pdf", "still_1.000.png"}) {
+    INFO(f);
+    CHECK(fs::file_size(dir / "fig" / f) > 1000);
+  }
+  // In-process, from a copy of the file that is then removed: the lab holds the model it read.
+  for (const char* f : {"pen_drop.xml", "pen_drop.loops.json"}) fs::copy_file(fs::path(DYNLAB_SOURCE_DIR) / "assets/models" / f, dir / f);
+  const dyn::LoadedLab loaded = dyn::app::loadModelLab((dir / "pen_drop.xml").string(), 1.0);
+  fs::remove(dir / "pen_drop.xml");
+  const auto lab = loaded.entry->create(dyn::JsonView(loaded.config, "config"));
+  const dyn::RunResult hand = dyn::runEngine(*lab, dyn::Engine::Hand);
+  REQUIRE(hand.failure.empty());
+  const dyn::Trace& t = hand.trace;
+  const std::size_t last = t.rows() - 1;
+  // At rest the table carries m g; the touchdowns' losses are in W, so E − E0 − W stays at RK4's error
+  // although they took most of the drop's energy.
+  CHECK(std::abs(t.at(last, "f_tip_normal") + t.at(last, "f_cap_normal") - 0.02 * 9.81) < 1e-9);
+  double balance = 0;
+  for (std::size_t i = 0; i < t.rows(); ++i) balance = std::max(balance, std::abs(t.at(i, "energy") - t.at(0, "energy") - t.at(i, "work")));
+  MESSAGE("figure's run: touchdowns took " << t.at(last, "impacts") << " J, max |E - E0 - W| " << balance << " J");
+  CHECK(t.at(last, "impacts") > 0.01);
+  CHECK(balance < 1e-9);
+  CHECK(lab->metrics(t)["energy_drift"].get<double>() < 1e-9);
+}
+
+TEST_CASE("dynlab bench FILE with wheels or contacts beside it: the hand step against Bullet's at equal order") {
+  TempDir dir("model_bench_elements");
+  for (const char* file : {"pen_drop.xml", "unicycle.xml"}) {
+    const Result r = dynlab(dir, "bench " + model(file) + " --steps 200 --json");
+    INFO(file, r.out, r.err);
+    REQUIRE(r.code == 0);
+    const auto out = nlohmann::json::parse(r.out);
+    // Hand (Euler, RK4) and Bullet; MuJoCo left out (its run would not hold the elements), and said so.
+    REQUIRE(out["engines"].size() == 3);
+    CHECK(out["engines"][2]["engine"] == "Bullet");
+    CHECK(out["beside"]["note"].get<std::string>().find("MuJoCo not timed") != std::string::npos);
+    for (const auto& e : out["engines"]) CHECK(e["complete"].get<bool>());
+    CHECK(out["engines"][1]["max_q_error_vs_hand_rk4"].get<double>() == 0.0);
+  }
 }

@@ -7,6 +7,9 @@
 #include <nlohmann/json.hpp>
 #include <stb_image.h>
 
+#include <sys/stat.h>
+
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 
@@ -88,6 +91,17 @@ TEST_CASE("dynlab model: hostile and unsupported files get one line and exit 2, 
                               "<geom size=\"0.1\"/></body></worldbody></mujoco>");
   checkBadInput(dir, "model ball.xml --out o", {"ball.xml", "joint 's'", "ball joint", "hinge and slide"}, dir / "o");
   checkBadInput(dir, "model missing.xml --out o", {"missing.xml", "no such file"}, dir / "o");
+  // A mesh that is a FIFO (MuJoCo would block opening it) and one linked to /dev/zero: refused before
+  // MuJoCo reads anything, within a second.
+  REQUIRE(::mkfifo((dir / "pipe.stl").c_str(), 0600) == 0);
+  fs::create_symlink("/dev/zero", dir / "zero.stl");
+  for (const char* mesh : {"pipe.stl", "zero.stl"}) {
+    writeFile(dir / "mesh.xml", std::string("<mujoco><asset><mesh name=\"m\" file=\"") + mesh + "\"/></asset><worldbody><body><joint/>"
+                                "<geom type=\"mesh\" mesh=\"m\" contype=\"0\" conaffinity=\"0\"/></body></worldbody></mujoco>");
+    const auto t0 = std::chrono::steady_clock::now();
+    checkBadInput(dir, "model mesh.xml --out o", {"mesh.xml", mesh}, dir / "o");
+    CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < 1.0);
+  }
   checkBadInput(dir, "model " + model("fourbar.xml") + " --duration 600 --dt 1e-5 --out o", {"60000000 steps", "at most 2000000"}, dir / "o");
 }
 
@@ -178,7 +192,12 @@ TEST_CASE("dynlab bench FILE: the hand step at both orders, Bullet's and MuJoCo'
   CHECK(out["engines"][1]["max_q_error_vs_hand_rk4"].get<double>() == 0.0);
   CHECK(out["engines"][1]["max_closure_residual"].get<double>() < 1e-11);
   checkBadInput(dir, "bench missing.xml", {"missing.xml", "no such file"}, dir / "out");
-  checkBadInput(dir, "bench " + model("fourbar.urdf"), {"fourbar.urdf", "fourbar.loops.json", "times what the file itself holds"}, dir / "out");
+  // A URDF with its loops beside it: timed too, MuJoCo left out (its run of the URDF has no loops).
+  const Result u = dynlab(dir, "bench " + model("fourbar.urdf") + " --steps 100");
+  INFO(u.out, u.err);
+  REQUIRE(u.code == 0);
+  CHECK(u.out.find("MuJoCo not timed") != std::string::npos);
+  CHECK(u.out.find("\n  MuJoCo  ") == std::string::npos);  // no engine row
 }
 
 TEST_CASE("dynlab model FILE.urdf: loops beside it (STEM.loops.json or --loops), both engines") {

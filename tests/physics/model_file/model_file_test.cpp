@@ -5,6 +5,8 @@
 //    MuJoCo's own (mj_fullM, qfrc_bias) from the same file, to 1e-10, at random states;
 //  * a planar four-bar's connect keeps its 2 independent rows (y dropped), and a passive run keeps
 //    the closure at rounding level and the energy to RK4's order;
+//  * a joint's armature is MuJoCo's (M_ii += a to mj_fullM's rounding), in the energy, and a passive
+//    run keeps that energy to RK4's order;
 //  * hostile and unsupported files get one-line errors naming the file and the element, fast.
 #include <doctest/doctest.h>
 
@@ -149,7 +151,8 @@ TEST_CASE("M and the bias C v + G equal MuJoCo's own (mj_fullM, qfrc_bias) for e
     if (const std::string ext = entry.path().extension().string(); ext == ".xml" || ext == ".urdf")
       files.push_back(entry.path().filename().string());
   std::sort(files.begin(), files.end());
-  for (const char* expected : {"arm3d.xml", "fivebar.xml", "fourbar.urdf", "fourbar.xml", "planar_arm.urdf", "puma560.urdf", "slider_crank.xml"})
+  for (const char* expected : {"arm3d.xml", "fivebar.xml", "fourbar.urdf", "fourbar.xml", "geared_arm.xml", "planar_arm.urdf", "puma560.urdf",
+                               "slider_crank.xml"})
     CHECK_MESSAGE(std::count(files.begin(), files.end(), expected) == 1, expected);
   for (const std::string& entry : files) {
     const char* name = entry.c_str();
@@ -231,6 +234,57 @@ TEST_CASE("four-bar: the connect's dependent row is dropped; a passive run keeps
   CHECK(phi2 < 1e-12);
   CHECK(de2 < 1e-6);
   CHECK(de1 / de2 > 8.0);
+}
+
+TEST_CASE("armature: M_ii += a as MuJoCo's mj_fullM, ½ a θ'² in the energy, kept by a passive run") {
+  // A one-joint file (once refused): read, and its M is MuJoCo's to rounding.
+  const std::string one = writeFile("armature.xml", mjcf("<joint name=\"j\" armature=\"0.1\"/>"));
+  const model_file::LoadedModel single = model_file::load(one);
+  REQUIRE(single.mechanism.joints.size() == 1);
+  CHECK(single.mechanism.joints[0].armature == 0.1);
+  model_file::MujocoReference mj_one(one);
+  ConstrainedMechanism<Spatial> mech_one(single.mechanism);
+  CHECK(maxAbs(mech_one.massMatrix(single.q0) - mj_one.massMatrix(single.q0)) < 1e-12);
+  // geared_arm.xml: two hinges (the elbow's parent moves) and a slide, each with its armature. The
+  // difference to the same description without armature is exactly diag(a), and M equals MuJoCo's.
+  const model_file::LoadedModel file = model_file::load(model("geared_arm.xml"));
+  REQUIRE(file.mechanism.joints.size() == 3);
+  const VecN a = Eigen::Vector3d(0.32, 0.09, 1.97);
+  for (int i = 0; i < 3; ++i) CHECK(file.mechanism.joints[std::size_t(i)].armature == a[i]);
+  MechanismModel<Spatial> bare = file.mechanism;
+  for (JointProperties& j : bare.joints) j.armature = 0;
+  ConstrainedMechanism<Spatial> mech(file.mechanism), without(bare);
+  model_file::MujocoReference mj(model("geared_arm.xml"));
+  Random r;
+  double worst = 0, worst_diag = 0, worst_id = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    const VecN q = file.q0 + r.vec(3, 1.5), v = r.vec(3, 3.0), qdd = r.vec(3, 5.0);
+    worst = std::max(worst, maxAbs(mech.massMatrix(q) - mj.massMatrix(q)));
+    worst_diag = std::max(worst_diag, maxAbs(mech.massMatrix(q) - without.massMatrix(q) - MatN(a.asDiagonal())));
+    // Inverse dynamics carries the rotors' a θ'' too; the kinetic energy their ½ a θ'².
+    worst_id = std::max(worst_id, maxAbs(mech.inverseDynamics(q, v, qdd) - mech.massMatrix(q) * qdd - mech.inverseDynamics(q, v, VecN::Zero(3))));
+    CHECK(mech.kineticEnergy(q, v) == doctest::Approx(0.5 * v.dot(mech.massMatrix(q) * v)).epsilon(1e-12));
+  }
+  MESSAGE("geared arm: |M - M_mujoco| " << worst << ", |M - M_bare - diag(a)| " << worst_diag << ", |ID - M qdd - h| " << worst_id);
+  CHECK(worst < 1e-10);
+  CHECK(worst_diag < 1e-12);
+  CHECK(worst_id < 1e-10);
+  // Passive swing from rest, 2 s: the energy to RK4's order (halving dt: ~1/16), and the rotors
+  // matter: without them the arm is elsewhere by far more than that.
+  const auto [de1, phi1] = passiveRun(mech, file.q0, 2.0, 2e-3);
+  const auto [de2, phi2] = passiveRun(mech, file.q0, 2.0, 1e-3);
+  MESSAGE("geared arm: |E - E0| " << de1 << " J (dt 2 ms), " << de2 << " J (dt 1 ms)");
+  CHECK(de2 < 1e-6);
+  CHECK(de1 / de2 > 8.0);
+  StepOptions o;
+  o.dt = 1e-3;
+  VecN q1 = file.q0, v1 = VecN::Zero(3), q2 = file.q0, v2 = VecN::Zero(3);
+  for (int k = 0; k < 500; ++k) {
+    REQUIRE(step(mech, o, VecN::Zero(3), q1, v1));
+    REQUIRE(step(without, o, VecN::Zero(3), q2, v2));
+  }
+  MESSAGE("geared arm: |q(armature) - q(none)| after 0.5 s " << (q1 - q2).lpNorm<Eigen::Infinity>());
+  CHECK((q1 - q2).lpNorm<Eigen::Infinity>() > 0.05);
 }
 
 TEST_CASE("four-bar: the pin's force satisfies the rocker's Newton–Euler balance about its pivot") {
@@ -325,7 +379,6 @@ TEST_CASE("hostile and unsupported model files: one line naming the file and the
   const std::string ball = errorOf(writeFile("ball.xml", mjcf("<joint name=\"shoulder\" type=\"ball\"/>")));
   CHECK(ball.find("joint 'shoulder' (body 'b') is a ball joint; dynlab reads hinge and slide") != std::string::npos);
   CHECK(errorOf(writeFile("free.xml", mjcf("<freejoint name=\"fly\"/>"))).find("'fly' (body 'b') is a free joint") != std::string::npos);
-  CHECK(errorOf(writeFile("armature.xml", mjcf("<joint name=\"j\" armature=\"0.1\"/>"))).find("joint 'j' has armature") != std::string::npos);
   const std::string servo = mjcf("<joint name=\"j\"/>", "<actuator><position name=\"servo\" joint=\"j\" kp=\"10\"/></actuator>");
   CHECK(errorOf(writeFile("servo.xml", servo)).find("actuator 'servo'") != std::string::npos);
   const std::string tendon = mjcf("<joint name=\"j\"/>", "<tendon><fixed name=\"t\"><joint joint=\"j\" coef=\"1\"/></fixed></tendon>");

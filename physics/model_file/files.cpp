@@ -1,0 +1,252 @@
+// What MuJoCo may read: the model file and every file it names, checked and read here, then handed to
+// MuJoCo's virtual file system (mjVFS), so that what was checked is what is parsed. MuJoCo 2.2.2 looks
+// a file up there by its name alone (no folder, any case) and reads the disk only when it is missing:
+// every name the text gives a file (an attribute file, filename or file*, as <include>, <mesh>,
+// <hfield>, <texture>, <skin> and URDF's <mesh filename> write them) is put there, either as the
+// checked bytes of a regular file inside the model's folder or, when no such file exists, as a
+// one-byte stand-in that MuJoCo then reports as unreadable: MuJoCo never opens a FIFO, a device, a
+// link out of the folder or a file past the limits. The names are found by scanning the text for
+// attribute values (a lexical scan, not a parse: a name in a comment is checked too, harmlessly).
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <set>
+
+#include "physics/model_file/mujoco_call.h"
+
+namespace dyn::model_file::detail {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Offset of the first byte that is not well-formed UTF-8 (no overlongs, surrogates or cut-off
+// sequences), or npos.
+std::size_t utf8ErrorAt(const std::string& s) {
+  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
+  const std::size_t n = s.size();
+  for (std::size_t i = 0; i < n;) {
+    const unsigned c = p[i];
+    int len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
+    if (len == 0 || i + std::size_t(len) > n) return i;
+    unsigned cp = len == 1 ? c : len == 2 ? (c & 0x1F) : len == 3 ? (c & 0x0F) : (c & 0x07);
+    for (int k = 1; k < len; ++k) {
+      if ((p[i + std::size_t(k)] & 0xC0) != 0x80) return i;
+      cp = (cp << 6) | (p[i + std::size_t(k)] & 0x3F);
+    }
+    const unsigned least[5] = {0, 0, 0x80, 0x800, 0x10000};
+    if (cp < least[len] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return i;
+    i += std::size_t(len);
+  }
+  return std::string::npos;
+}
+
+// A regular file's bytes, at most `limit`: opened without blocking (a FIFO swapped in after the check
+// opens and is refused), its type and size taken from the open file. `who` starts each error.
+std::string readRegular(const std::string& path, std::size_t limit, const std::string& who, const std::string& expected) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw ModelFileError(who + ": cannot be opened");
+  struct stat st {};
+  std::string bytes;
+  try {
+    if (::fstat(fd, &st) != 0) throw ModelFileError(who + ": cannot read its size");
+    if (!S_ISREG(st.st_mode)) throw ModelFileError(who + ": not a regular file (expected " + expected + ")");
+    if (std::size_t(st.st_size) > limit)
+      throw ModelFileError(who + ": " + std::to_string(st.st_size) + " bytes, more than the " + std::to_string(limit) + " " + expected + " may have");
+    bytes.resize(std::size_t(st.st_size) + 1);
+    std::size_t got = 0;
+    while (got < bytes.size()) {
+      const ssize_t r = ::read(fd, bytes.data() + got, bytes.size() - got);
+      if (r < 0) throw ModelFileError(who + ": cannot be read");
+      if (r == 0) break;
+      got += std::size_t(r);
+    }
+    if (got > limit) throw ModelFileError(who + ": grew past " + std::to_string(limit) + " bytes while read");
+    bytes.resize(got);
+  } catch (...) {
+    ::close(fd);
+    throw;
+  }
+  ::close(fd);
+  return bytes;
+}
+
+// A model text's bytes checked: not blank, well-formed UTF-8.
+void checkText(const std::string& s, const std::string& who, const std::string& expected) {
+  if (s.find_first_not_of(" \t\r\n") == std::string::npos) throw ModelFileError(who + ": empty (expected " + expected + ")");
+  if (const std::size_t at = utf8ErrorAt(s); at != std::string::npos) {
+    char hex[8];
+    std::snprintf(hex, sizeof hex, "0x%02X", unsigned(static_cast<unsigned char>(s[at])));
+    throw ModelFileError(who + ": byte " + hex + " at offset " + std::to_string(at) + " is not valid UTF-8 (model files are UTF-8)");
+  }
+}
+
+// An attribute value with XML's character references and predefined entities replaced (as the parser
+// will); false if it holds another entity.
+bool unescape(const std::string& in, std::string& out) {
+  out.clear();
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    if (in[i] != '&') {
+      out += in[i];
+      continue;
+    }
+    const std::size_t end = in.find(';', i);
+    if (end == std::string::npos) return false;
+    const std::string e = in.substr(i + 1, end - i - 1);
+    static const std::map<std::string, char> named{{"lt", '<'}, {"gt", '>'}, {"amp", '&'}, {"quot", '"'}, {"apos", '\''}};
+    if (const auto it = named.find(e); it != named.end()) {
+      out += it->second;
+    } else if (e.size() > 1 && e[0] == '#') {
+      const bool hex = e[1] == 'x' || e[1] == 'X';
+      const std::string digits = e.substr(hex ? 2 : 1);
+      if (digits.empty() || digits.size() > 8 || digits.find_first_not_of(hex ? "0123456789abcdefABCDEF" : "0123456789") != std::string::npos)
+        return false;
+      const unsigned long cp = std::stoul(digits, nullptr, hex ? 16 : 10);
+      if (cp == 0 || cp > 0x10FFFF) return false;
+      // UTF-8 of the code point (a name's byte at last).
+      if (cp < 0x80) out += char(cp);
+      else if (cp < 0x800) out += char(0xC0 | (cp >> 6)), out += char(0x80 | (cp & 0x3F));
+      else if (cp < 0x10000) out += char(0xE0 | (cp >> 12)), out += char(0x80 | ((cp >> 6) & 0x3F)), out += char(0x80 | (cp & 0x3F));
+      else out += char(0xF0 | (cp >> 18)), out += char(0x80 | ((cp >> 12) & 0x3F)), out += char(0x80 | ((cp >> 6) & 0x3F)), out += char(0x80 | (cp & 0x3F));
+    } else {
+      return false;
+    }
+    i = end;
+  }
+  return true;
+}
+
+bool isNameChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == ':' || c == '.'; }
+
+// Every `name = "value"` (or '…') in the text whose name starts with "file" (files) or is meshdir,
+// texturedir or assetdir (folders), values unescaped. One pass over the text.
+void scanNames(const std::string& text, const std::string& who, std::vector<std::string>& files, std::vector<std::string>& dirs) {
+  for (std::size_t eq = text.find('='); eq != std::string::npos; eq = text.find('=', eq + 1)) {
+    std::size_t e = eq;
+    while (e > 0 && std::isspace(static_cast<unsigned char>(text[e - 1]))) --e;
+    std::size_t b = e;
+    while (b > 0 && isNameChar(text[b - 1])) --b;
+    if (b == e) continue;
+    const std::string name = text.substr(b, e - b);
+    const bool file = name.rfind("file", 0) == 0, dir = name == "meshdir" || name == "texturedir" || name == "assetdir";
+    if (!file && !dir) continue;
+    std::size_t v = eq + 1;
+    while (v < text.size() && std::isspace(static_cast<unsigned char>(text[v]))) ++v;
+    if (v >= text.size() || (text[v] != '"' && text[v] != '\'')) continue;
+    const std::size_t close = text.find(text[v], v + 1);
+    if (close == std::string::npos) continue;
+    std::string value;
+    if (!unescape(text.substr(v + 1, close - v - 1), value))
+      throw ModelFileError(who + ": " + name + "=\"" + oneLine(text.substr(v + 1, std::min<std::size_t>(close - v - 1, 80))) +
+                           "\" holds an entity dynlab does not expand (write the file's name plainly)");
+    if (!value.empty()) (file ? files : dirs).push_back(value);
+  }
+}
+
+// MuJoCo's name for a file in its virtual file system: the name without its folder, any case.
+std::string vfsKey(const std::string& name) {
+  const std::size_t slash = name.find_last_of("/\\");
+  std::string key = slash == std::string::npos ? name : name.substr(slash + 1);
+  std::transform(key.begin(), key.end(), key.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return key;
+}
+
+bool inside(const fs::path& folder, const fs::path& p) {
+  const auto [f, q] = std::mismatch(folder.begin(), folder.end(), p.begin(), p.end());
+  return f == folder.end();
+}
+
+}  // namespace
+
+std::string readChecked(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) throw ModelFileError(path + ": no such file");
+  if (!fs::is_regular_file(st)) throw ModelFileError(path + ": not a regular file (expected an MJCF or URDF file)");
+  std::string s = readRegular(path, kMaxFileBytes, path, "a model file");
+  checkText(s, path, "an MJCF or URDF file");
+  return s;
+}
+
+void putFile(mjVFS* vfs, const std::string& path, const std::string& name, const std::string& bytes) {
+  if (mj_makeEmptyFileVFS(vfs, name.c_str(), int(bytes.size())) != 0) throw ModelFileError(path + ": MuJoCo's virtual file system refused '" + name + "'");
+  const int at = mj_findFileVFS(vfs, name.c_str());
+  if (at < 0) throw ModelFileError(path + ": MuJoCo's virtual file system lost '" + name + "'");
+  std::copy(bytes.begin(), bytes.end(), static_cast<char*>(vfs->filedata[at]));
+}
+
+std::vector<std::string> addReferencedFiles(const std::string& path, const std::string& bytes, mjVFS* vfs) {
+  std::error_code ec;
+  const fs::path main = fs::canonical(path, ec);
+  if (ec) throw ModelFileError(path + ": cannot resolve its folder (" + ec.message() + ")");
+  const fs::path folder = main.parent_path();
+  // The texts to scan (the model, then each include found), every name found, and the folders named.
+  std::vector<std::pair<std::string, std::string>> texts{{path, bytes}};  // (who, text)
+  std::vector<std::string> dirs{""};
+  std::map<std::string, fs::path> taken{{vfsKey(main.filename().string()), main}};  // VFS name → the file put there
+  std::set<std::string> seen;  // names already handled
+  std::vector<std::string> missing;
+  std::size_t total = 0;
+  for (std::size_t t = 0; t < texts.size(); ++t) {
+    std::vector<std::string> files;
+    std::vector<std::string> more_dirs;
+    scanNames(texts[t].second, texts[t].first, files, more_dirs);
+    for (const std::string& d : more_dirs)
+      if (std::find(dirs.begin(), dirs.end(), d) == dirs.end()) dirs.push_back(d);
+    for (const std::string& name : files) {
+      if (!seen.insert(name).second) continue;
+      if (seen.size() > std::size_t(kMaxAssetFiles))
+        throw ModelFileError(path + ": names more than " + std::to_string(kMaxAssetFiles) + " files (meshes, textures, includes)");
+      const std::string who = path + ": file '" + oneLine(name) + "'";
+      // Where MuJoCo may look: the name as written, or its last part, under the model's folder and
+      // under each folder the file names (meshdir, texturedir, assetdir); the first that exists.
+      fs::path found;
+      for (const std::string& d : dirs) {
+        const fs::path base = fs::path(d).is_absolute() ? fs::path(d) : folder / d;
+        for (const fs::path& c : {fs::path(name).is_absolute() ? fs::path(name) : base / name, base / fs::path(name).filename()})
+          if (found.empty() && fs::exists(fs::symlink_status(c, ec))) found = c;
+      }
+      const std::string key = vfsKey(name);
+      if (found.empty()) {
+        // None: a stand-in under its name, so that MuJoCo cannot read it from elsewhere.
+        if (!taken.count(key)) {
+          putFile(vfs, path, key, "\n");
+          taken[key] = fs::path();
+          missing.push_back(name);
+        }
+        continue;
+      }
+      const fs::path real = fs::canonical(found, ec);
+      if (ec) throw ModelFileError(who + " is a link that leads nowhere (" + found.string() + ")");
+      if (!inside(folder, real))
+        throw ModelFileError(who + " resolves to " + real.string() + ", outside the model's folder " + folder.string() +
+                             " (dynlab reads the files a model names from its own folder)");
+      if (const auto it = taken.find(key); it != taken.end()) {
+        if (it->second == real) continue;  // the same file, already there
+        throw ModelFileError(who + ": another file named '" + key + "' is named too (MuJoCo finds files by name alone: rename one)");
+      }
+      const bool xml = [&] {
+        const std::string ext = vfsKey(real.extension().string());
+        return ext == ".xml" || ext == ".urdf";
+      }();
+      std::string data = readRegular(real.string(), xml ? kMaxFileBytes : kMaxAssetBytes, who, xml ? "an included model file" : "a mesh, texture or height field");
+      total += data.size();
+      if (total > kMaxAssetsBytes)
+        throw ModelFileError(who + ": the files the model names pass " + std::to_string(kMaxAssetsBytes) + " bytes in all");
+      if (xml) {
+        checkText(data, who, "an included MJCF file");
+        texts.emplace_back(who, data);
+      }
+      putFile(vfs, path, key, data);
+      taken[key] = real;
+    }
+  }
+  return missing;
+}
+
+}  // namespace dyn::model_file::detail

@@ -1,0 +1,139 @@
+// What a model file names (physics/model_file/files.cpp): a mesh in a meshdir is read (its mass and
+// centre follow the tetrahedron written, so MuJoCo had its bytes), and every hostile name (a
+// FIFO, a link to /dev/zero, a file outside the folder, an absolute or escaped path, a huge file, two
+// files of one name, a missing include) is one line naming the file, within a second, before MuJoCo
+// opens anything.
+#include <doctest/doctest.h>
+#include <sys/stat.h>
+
+#include <chrono>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "physics/model_file/model_file.h"
+
+using namespace dyn;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A fresh folder for this process's files.
+fs::path folder() {
+  static const fs::path dir = [] {
+    const fs::path d = fs::temp_directory_path() / ("dynlab_model_files_" + std::to_string(::getpid()));
+    fs::remove_all(d);
+    fs::create_directories(d / "model");
+    return d;
+  }();
+  return dir;
+}
+
+fs::path write(const std::string& name, const std::string& text) {
+  const fs::path p = folder() / name;
+  fs::create_directories(p.parent_path());
+  std::ofstream(p, std::ios::binary) << text;
+  return p;
+}
+
+// A binary STL of the tetrahedron (0, s e_x, s e_y, s e_z), faces outward.
+std::string tetrahedron(float s) {
+  const float O[3] = {0, 0, 0}, X[3] = {s, 0, 0}, Y[3] = {0, s, 0}, Z[3] = {0, 0, s};
+  const float* faces[4][3] = {{O, Y, X}, {O, X, Z}, {O, Z, Y}, {X, Y, Z}};
+  std::string b(80, ' ');
+  const std::uint32_t count = 4;
+  b.append(reinterpret_cast<const char*>(&count), 4);
+  for (const auto& f : faces) {
+    const float normal[3] = {0, 0, 0};
+    b.append(reinterpret_cast<const char*>(normal), 12);
+    for (const float* v : f) b.append(reinterpret_cast<const char*>(v), 12);
+    b.append(2, '\0');
+  }
+  return b;
+}
+
+// A one-joint model naming assets (a mesh geom when mesh is given) and an extra top-level section.
+std::string mjcf(const std::string& assets, const std::string& mesh = "", const std::string& extra = "") {
+  return "<mujoco><compiler meshdir=\"meshes\"/><asset>" + assets + "</asset><worldbody><body name=\"b\"><joint name=\"j\"/>" +
+         (mesh.empty() ? "<geom size=\"0.1\" contype=\"0\" conaffinity=\"0\"/>"
+                       : "<geom type=\"mesh\" mesh=\"" + mesh + "\" density=\"1000\" contype=\"0\" conaffinity=\"0\"/>") +
+         "</body></worldbody>" + extra + "</mujoco>";
+}
+
+std::string errorOf(const fs::path& file, double* seconds = nullptr) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string what;
+  try {
+    model_file::load(file.string());
+  } catch (const model_file::ModelFileError& e) {
+    what = e.what();
+  }
+  const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (seconds) *seconds = s;
+  CHECK(s < 1.0);
+  CHECK(what.find('\n') == std::string::npos);
+  CHECK(what.rfind(file.string() + ": ", 0) == 0);
+  return what;
+}
+
+}  // namespace
+
+TEST_CASE("a mesh in the file's meshdir is read through the checked copy: its mass and centre follow its bytes") {
+  // Two tetrahedra, edges 0.3 and 0.15 m: MuJoCo's mass from the mesh scales as the volume (8:1) and the
+  // centre of mass sits at s/4 along each axis, so what it read is the bytes written.
+  double mass[2] = {0, 0};
+  const float sizes[2] = {0.3f, 0.15f};
+  for (int k = 0; k < 2; ++k) {
+    const std::string stl = "tet" + std::to_string(k) + ".stl";
+    write("model/meshes/" + stl, tetrahedron(sizes[k]));
+    const fs::path file = write("model/mesh" + std::to_string(k) + ".xml", mjcf("<mesh name=\"tet\" file=\"" + stl + "\"/>", "tet"));
+    const model_file::LoadedModel m = model_file::load(file.string());
+    Eigen::Vector3d com;
+    Spatial::massAndCom(m.mechanism.tree.bodies[0].inertia, mass[k], com);
+    CHECK((com - Eigen::Vector3d::Constant(sizes[k] / 4.0)).norm() < 1e-6);
+  }
+  CHECK(mass[1] > 0);
+  CHECK(mass[0] / mass[1] == doctest::Approx(8.0).epsilon(1e-6));
+}
+
+TEST_CASE("what a model file names: hostile files get one line naming the file, within a second") {
+  // A FIFO as a mesh: MuJoCo would block opening it for ever.
+  const fs::path fifo = folder() / "model/meshes/pipe.stl";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  CHECK(errorOf(write("model/fifo.xml", mjcf("<mesh name=\"m\" file=\"pipe.stl\"/>", "m"))).find("file 'pipe.stl': not a regular file") !=
+        std::string::npos);
+  // A link in the folder to /dev/zero, /dev/zero by its path, and escaped: all outside the folder.
+  fs::create_symlink("/dev/zero", folder() / "model/meshes/zero.stl");
+  CHECK(errorOf(write("model/zero.xml", mjcf("<mesh name=\"m\" file=\"zero.stl\"/>", "m"))).find("resolves to /dev/zero, outside the model's folder") !=
+        std::string::npos);
+  CHECK(errorOf(write("model/abs.xml", mjcf("<mesh name=\"m\" file=\"/dev/zero\"/>", "m"))).find("outside the model's folder") != std::string::npos);
+  CHECK(errorOf(write("model/escaped.xml", mjcf("<mesh name=\"m\" file=\"&#47;dev&#x2F;zero\"/>", "m"))).find("file '/dev/zero'") !=
+        std::string::npos);
+  CHECK(errorOf(write("model/entity.xml", mjcf("<mesh name=\"m\" file=\"&zero;\"/>", "m"))).find("holds an entity dynlab does not expand") !=
+        std::string::npos);
+  // An include from outside the folder.
+  write("outside.xml", "<mujoco/>");
+  CHECK(errorOf(write("model/up.xml", "<mujoco><include file=\"../outside.xml\"/></mujoco>")).find("outside the model's folder") != std::string::npos);
+  // 100 MB (sparse): refused by its size before it is read; an included file as a model file is.
+  const fs::path big = write("model/meshes/big.stl", "solid");
+  fs::resize_file(big, 100u << 20);
+  CHECK(errorOf(write("model/big.xml", mjcf("<mesh name=\"m\" file=\"big.stl\"/>", "m"))).find("104857600 bytes, more than the 16777216") !=
+        std::string::npos);
+  fs::remove(big);
+  write("model/latin1_part.xml", "<mujoco model=\"caf\xE9\"/>");
+  CHECK(errorOf(write("model/latin1_main.xml", "<mujoco><include file=\"latin1_part.xml\"/></mujoco>")).find("not valid UTF-8") != std::string::npos);
+  // Two files of one name: MuJoCo would read the first for both.
+  write("model/meshes/a/tet.stl", tetrahedron(0.1f));
+  write("model/meshes/b/tet.stl", tetrahedron(0.2f));
+  CHECK(errorOf(write("model/twins.xml", mjcf("<mesh name=\"m1\" file=\"a/tet.stl\"/><mesh name=\"m2\" file=\"b/tet.stl\"/>", "m1")))
+            .find("another file named 'tet.stl'") != std::string::npos);
+  // Named but missing: MuJoCo's own error, with the name it did not find (never the disk's elsewhere).
+  CHECK(errorOf(write("model/missing.xml", "<mujoco><include file=\"nothere.xml\"/></mujoco>")).find("not found in the model's folder: 'nothere.xml'") !=
+        std::string::npos);
+  // A file naming more files than allowed.
+  std::string many;
+  for (int i = 0; i <= model_file::kMaxAssetFiles; ++i) many += "<mesh name=\"m" + std::to_string(i) + "\" file=\"m" + std::to_string(i) + ".stl\"/>";
+  CHECK(errorOf(write("model/many.xml", mjcf(many))).find("names more than 256 files") != std::string::npos);
+  fs::remove_all(folder());
+}
