@@ -221,13 +221,9 @@ double MechanismKinematics<S>::directionBias(const BodyRef& b, const Pos& p_worl
     // pointBias's link case, only its linear rows along d.
     const std::size_t i = std::size_t(b.index);
     if constexpr (S::kDim == 6) {
-      // As above: at p, a_p = (α, a − p × α) and v_p = (ω, v − p × ω); d·(a_p + ω × v_p).
-      const double* v = tree->v_w[i].data();
-      double ap[3], vp[3], wv[3];
-      S::linearAt(p_world, tree->a_w[i].data(), ap);
-      S::linearAt(p_world, v, vp);
-      S::cross3(v, vp, wv);
-      return d[0] * (ap[0] + wv[0]) + (d[1] * (ap[1] + wv[1]) + d[2] * (ap[2] + wv[2]));
+      // linearBias's a_p + ω × v_p, along d.
+      const Pos a = linearBias(b, p_world);
+      return d[0] * a[0] + (d[1] * a[1] + d[2] * a[2]);
     }
     const typename S::Transform X_pw = S::translation(p_world);
     return d.dot(S::linear(S::classicalAcceleration(S::motion(X_pw, tree->a_w[i]), S::motion(X_pw, tree->v_w[i]))));

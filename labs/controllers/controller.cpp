@@ -98,6 +98,28 @@ bool Controller::inverseKinematics(const VecN& x_d, VecN& q) {
   return false;
 }
 
+// The joint motion that makes the task point move as (x, x', x''): inverse kinematics on the
+// controller's model, then u_d' = J_x⁻¹ x', u_d'' = J_x⁻¹ (x'' − J_x' u_d') (minimum-norm solutions when
+// `min_norm`: more joints than task axes); false where the pose is out of reach or singular.
+bool Controller::jointMotion(const VecN& x, const VecN& xd, const VecN& xdd, bool min_norm, VecN& ud, VecN& ud_d, VecN& udd_d) {
+  auto solve = [min_norm](const MatN& J, const VecN& b) {
+    return min_norm ? VecN(Eigen::CompleteOrthogonalDecomposition<MatN>(J).solve(b)) : solveTask(J, b);
+  };
+  Eigen::Vector3d p;
+  MatN Jx;
+  VecN bias;
+  if (!inverseKinematics(x, q_ik_) || !chain_.update(q_ik_, VecN::Zero(mech_->n()))) return false;
+  chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
+  ud_d = solve(Jx, xd);
+  if (!chain_.update(q_ik_, chain_.S() * ud_d)) return false;
+  chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
+  udd_d = solve(Jx, VecN(xdd - bias));
+  const auto& act = chain_.actuated();
+  ud = VecN(chain_.m());
+  for (int j = 0; j < chain_.m(); ++j) ud[j] = q_ik_[act[std::size_t(j)]];
+  return true;
+}
+
 VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref, const VecN& force) {
   const int m = chain_.m();
   const auto& act = chain_.actuated();
@@ -112,15 +134,8 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref, const V
   const bool joint = kind == Kind::JointPdGravity || kind == Kind::Pid || kind == Kind::ComputedTorque;
   if (joint && ref.joint) {
     ud = ref.x, ud_d = ref.xd, udd_d = ref.xdd;
-  } else if (joint) {
-    if (!inverseKinematics(ref.x, q_ik_) || !chain_.update(q_ik_, VecN::Zero(mech_->n()))) return tau_u_;
-    chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
-    ud_d = solveTask(Jx, ref.xd);
-    if (!chain_.update(q_ik_, chain_.S() * ud_d)) return tau_u_;
-    chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
-    udd_d = solveTask(Jx, ref.xdd - bias);
-    ud = VecN(m);
-    for (int j = 0; j < m; ++j) ud[j] = q_ik_[act[std::size_t(j)]];
+  } else if (joint && !jointMotion(ref.x, ref.xd, ref.xdd, false, ud, ud_d, udd_d)) {
+    return tau_u_;
   }
   if (kind == Kind::ImpedanceJoint) {
     // The impedance model on the measured force about the reference, then inverse kinematics.
@@ -131,14 +146,7 @@ VecN Controller::law(const VecN& q, const VecN& v, const Reference& ref, const V
     const double h = double(hold_) * dt_;
     v_des_ += h * a_des;
     x_des_ += h * v_des_;
-    if (!inverseKinematics(x_des_, q_ik_) || !chain_.update(q_ik_, VecN::Zero(mech_->n()))) return tau_u_;
-    chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
-    ud_d = Eigen::CompleteOrthogonalDecomposition<MatN>(Jx).solve(v_des_);
-    if (!chain_.update(q_ik_, chain_.S() * ud_d)) return tau_u_;
-    chain_.task(task_.link, task_.point, task_.axes, p, Jx, bias);
-    udd_d = Eigen::CompleteOrthogonalDecomposition<MatN>(Jx).solve(VecN(a_des - bias));
-    ud = VecN(m);
-    for (int j = 0; j < m; ++j) ud[j] = q_ik_[act[std::size_t(j)]];
+    if (!jointMotion(x_des_, v_des_, a_des, true, ud, ud_d, udd_d)) return tau_u_;
   }
   if (!chain_.update(q, v)) return tau_u_;  // a singular pose: hold the last command
   VecN u(m), w(m);

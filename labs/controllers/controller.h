@@ -98,7 +98,7 @@ struct TaskPoint {
 struct Reference {
   VecN x, xd, xdd;
   bool joint = false;
-  VecN force;  // the environment's force on the tool in the task axes (N), what a sensor reads (empty: 0)
+  VecN force = VecN();  // the environment's force on the tool in the task axes (N), what a sensor reads (empty: 0)
 };
 
 class Controller {
@@ -122,6 +122,7 @@ class Controller {
   VecN impedance(const MatN& Jx, const VecN& bias, const VecN& x, const VecN& xdot, const VecN& u, const VecN& w,
                  const Reference& ref, const VecN& force);
   bool inverseKinematics(const VecN& x, VecN& q);
+  bool jointMotion(const VecN& x, const VecN& xd, const VecN& xdd, bool min_norm, VecN& ud, VecN& ud_d, VecN& udd_d);
 
   Spec spec_;
   std::unique_ptr<Mech> mech_;
