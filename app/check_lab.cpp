@@ -65,6 +65,7 @@ int checkLab(const CheckLabArgs& args) {
   const ScratchDir dir(entry->name);
   LabCheckOptions options;
   options.work_dir = dir.path.string();
+  options.config_file = defaultConfigPath(entry->name);
   if (!args.skip_cli) {
     std::error_code ec;
     options.dynlab_binary = fs::read_symlink("/proc/self/exe", ec).string();

@@ -2,8 +2,6 @@
 // wrong (or, when all holds, what it measured) as one line; an exception is that check's failure.
 #include "app/lab_check.h"
 
-#include <sys/wait.h>
-
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -12,6 +10,7 @@
 #include <functional>
 #include <sstream>
 
+#include "app/process.h"
 #include "grading/grade.h"
 #include "grading/lessons.h"
 #include "grading/metric_doc.h"
@@ -132,16 +131,22 @@ GradeOutcome graded(Step& s, const std::string& file, const GradeOptions& o) {
   return g;
 }
 
-// A shell command in dir: its exit code and the last line it wrote to stderr.
-std::pair<int, std::string> shell(const fs::path& dir, const std::string& command) {
+// dynlab (the binary at `bin`) run with args in dir, no shell: its exit code and the last line it wrote
+// to stderr. A file name among args is one argument, whatever it holds.
+std::pair<int, std::string> runDynlab(const fs::path& dir, const std::string& bin, const std::vector<std::string>& args) {
   const fs::path err = dir / ".check_stderr";
-  const std::string cmd = "cd '" + dir.string() + "' && " + command + " >/dev/null 2>'" + err.string() + "'";
-  const int status = std::system(cmd.c_str());
+  std::vector<std::string> argv = {bin};
+  argv.insert(argv.end(), args.begin(), args.end());
+  ProcessOptions o;
+  o.cwd = dir.string();
+  o.stderr_file = err.string();
+  const ProcessResult r = runProgram(argv, o);
+  if (!r.started()) return {r.code, r.error};
   std::ifstream in(err);
   std::string line, last;
   while (std::getline(in, line))
     if (!line.empty()) last = line;
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), last};
+  return {r.code, last};
 }
 
 }  // namespace
@@ -162,8 +167,11 @@ std::vector<std::string> jsonFiles(const std::string& dir) {
 LabCheckReport checkLab(const LabEntry& entry, const json& config, const LabCheckOptions& options) {
   LabCheckReport report;
   const fs::path dir = options.work_dir;
-  const std::string config_file = (dir / "config.json").string();
-  writeFile(config_file, config.dump(2));
+  // The file the checks name and the grader reads: the lab's own when given, else a scratch copy.
+  const std::string config_file = options.config_file.empty() ? (dir / "config.json").string() : options.config_file;
+  if (options.config_file.empty()) writeFile(config_file, config.dump(2));
+  const std::string shown = options.config_file.empty() ? "config.json" : options.config_file;
+  const std::string passive_name = shown + " (passive: τ = 0)";
   const std::string lab_dir =
       options.lab_dir.empty() ? fs::path(defaultConfigPath(entry.name)).parent_path().string() : options.lab_dir;
   std::vector<std::string> examples = jsonFiles(options.examples_dir.empty() ? lab_dir + "/examples" : options.examples_dir);
@@ -176,8 +184,8 @@ LabCheckReport checkLab(const LabEntry& entry, const json& config, const LabChec
   o.config_file = config_file;
 
   run(report, "config", [&](Step& s) {
-    buildLab(entry, config, "config.json");
-    parseSimulation(JsonView(config, "config.json")["simulation"]);
+    buildLab(entry, config, shown);
+    parseSimulation(JsonView(config, shown)["simulation"]);
     s.detail = "builds; the simulation block parses";
   });
 
@@ -208,7 +216,7 @@ LabCheckReport checkLab(const LabEntry& entry, const json& config, const LabChec
   });
 
   run(report, "engines", [&](Step& s) {
-    const auto lab = buildLab(entry, config, "config.json");
+    const auto lab = buildLab(entry, config, shown);
     const long expected = std::min(200L, std::lround(lab->duration() / lab->dt()));
     for (const Engine e : {Engine::Hand, Engine::Bullet}) {
       const RunResult r = runEngine(*lab, e, 200);
@@ -228,7 +236,7 @@ LabCheckReport checkLab(const LabEntry& entry, const json& config, const LabChec
     c["simulation"]["drift"] = "independent";
     std::unique_ptr<Lab> lab;
     try {
-      lab = buildLab(entry, c, "config.json");
+      lab = buildLab(entry, c, shown);
     } catch (const InputError& e) {
       s.expect(e.path() == "/simulation/drift", "refused at " + e.path() + ", not at /simulation/drift");
       s.expect(e.expected().find("independent-coordinate form") != std::string::npos,
@@ -244,10 +252,10 @@ LabCheckReport checkLab(const LabEntry& entry, const json& config, const LabChec
 
   run(report, "passive energy", [&](Step& s) {
     json passive = mergePatch(config, passivePatch());
-    const Lab::PassiveEnergy stated = buildLab(entry, passive, "passive.json")->passiveEnergy();
+    const Lab::PassiveEnergy stated = buildLab(entry, passive, passive_name)->passiveEnergy();
     passive = mergePatch(passive, stated.conservative);
     if (stated.duration > 0) passive["simulation"]["duration"] = stated.duration;
-    const auto lab = buildLab(entry, passive, "passive.json");
+    const auto lab = buildLab(entry, passive, passive_name);
     const RunResult r = runEngine(*lab, Engine::Hand);
     s.expect(r.failure.empty(), r.failure);
     if (!s.expect(r.trace.rows() > 1, "the passive run has fewer than 2 rows")) return;
@@ -267,14 +275,14 @@ LabCheckReport checkLab(const LabEntry& entry, const json& config, const LabChec
   // Every metric the rubric's tests and leaderboard read exists for every option choice: the lab's
   // metrics of a short run and the screening of its loops.
   run(report, "metrics", [&](Step& s) {
-    const Rubric rubric = parseRubric(JsonView(config, "config.json"));
+    const Rubric rubric = parseRubric(JsonView(config, shown));
     const std::vector<json> subs = optionSubmissions(name, config);
     for (const json& sub : subs) {
       const std::string which = "submission " + sub.dump() + ": ";
       const json applied = applySubmission(config, JsonView(sub, "submission.json"), name, true);
-      const auto lab = buildLab(entry, applied, "submission.json");
+      const auto lab = buildLab(entry, applied, shown);
       try {
-        checkColumns(rubric, lab->columns(), "config.json");
+        checkColumns(rubric, lab->columns(), shown);
       } catch (const std::exception& e) {
         s.fail(which + e.what());
       }
@@ -388,7 +396,7 @@ LabCheckReport checkLab(const LabEntry& entry, const json& config, const LabChec
   }
 
   run(report, "render", [&](Step& s) {
-      const auto lab = buildLab(entry, config, "config.json");
+      const auto lab = buildLab(entry, config, shown);
       const RunResult r = runEngine(*lab, Engine::Hand, 50);
       if (!s.expect(r.trace.rows() > 0, "no trace row to draw")) return;
       Scene scene;
@@ -413,20 +421,20 @@ LabCheckReport checkLab(const LabEntry& entry, const json& config, const LabChec
 
   if (!options.dynlab_binary.empty())
     run(report, "cli", [&](Step& s) {
-      const auto lab = buildLab(entry, config, "config.json");
+      const auto lab = buildLab(entry, config, shown);
       const std::vector<std::string> columns = lab->columns();
       if (!s.expect(columns.size() >= 3, "fewer than 3 trace columns")) return;
-      const std::string bin = "'" + options.dynlab_binary + "' ";
+      const std::string& bin = options.dynlab_binary;
       const std::string plot = columns[1] + "," + columns[2];
-      auto [code, err] = shell(dir, bin + "figure " + name + " --plot " + plot + " --duration 0.2 --format png --out figures");
+      auto [code, err] = runDynlab(dir, bin, {"figure", name, "--plot", plot, "--duration", "0.2", "--format", "png", "--out", "figures"});
       s.expect(code == 0, "dynlab figure exit " + std::to_string(code) + ": " + err);
       s.expect(fs::exists(dir / "figures" / ("plot_" + columns[1] + "+" + columns[2] + ".png")), "dynlab figure wrote no plot");
       // What scripts/demo runs: the default config, both engines, its whole duration, under the
       // rubric's watchdog (which both engines must pass with the shipped gains).
-      std::tie(code, err) = shell(dir, bin + "run " + name + " --out run");
+      std::tie(code, err) = runDynlab(dir, bin, {"run", name, "--out", "run"});
       s.expect(code == 0, "dynlab run exit " + std::to_string(code) + ": " + err);
       if (!s.expect(!examples.empty(), "no example to grade")) return;
-      std::tie(code, err) = shell(dir, bin + "grade '" + examples.front() + "' --out grade");
+      std::tie(code, err) = runDynlab(dir, bin, {"grade", examples.front(), "--out", "grade"});
       s.expect(code == 0, "dynlab grade exit " + std::to_string(code) + ": " + err);
       s.expect(fs::exists(dir / "grade" / "results.json"), "dynlab grade wrote no results.json");
       s.detail = "dynlab figure, run (both engines, whole run) and grade exit 0";

@@ -33,6 +33,8 @@ struct LabCheck {
 
 struct LabCheckOptions {
   std::string work_dir;      // an existing folder for the submissions, plots and runs written
+  std::string config_file;   // the file config was read from: the checks name it, the grader reads it
+                             // (empty: a scratch config.json in work_dir, named "config.json")
   std::string examples_dir;  // default: <lab_dir>/examples, then <lab_dir>/instructor's answers too
   std::string lab_dir;       // where the lessons' paths start (default: the default config's folder)
   std::string instructor_dir;  // the full-credit answers (default: <lab_dir>/instructor; "-": none)
