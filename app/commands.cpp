@@ -79,7 +79,7 @@ void applyScenario(LoadedLab& loaded, const std::string& scenario, const std::st
   // The grader's seed: from the submission's hash, so the noise is the one this file is graded with.
   const json sub = gains_file.empty() ? defaultsSubmission(loaded.config, loaded.entry->name) : loadJsonFile(gains_file, 1u << 20);
   json cfg = scenarioConfig(loaded.config, rubric, sc, submissionHash(sub), loaded.config_file);
-  if (duration) cfg["simulation"]["duration"] = *duration;
+  if (duration) setRunDuration(cfg, *duration);
   loaded.lab = buildLab(*loaded.entry, cfg, loaded.config_file + " (scenario " + sc.name + ")");
   loaded.config = std::move(cfg);
 }

@@ -172,7 +172,7 @@ GradeOutcome gradeSubmission(const json& sub, const std::string& file, const Gra
     }
     for (const auto& l : rubric.leaderboard) {
       const ScenarioRun& run = runs.at(l.scenario);
-      if (run.metrics.contains(l.metric))
+      if (run.metrics.contains(l.metric) && std::isfinite(run.metrics[l.metric].get<double>()))
         rep.leaderboard.push_back({{"name", l.name}, {"value", run.metrics[l.metric].get<double>() * l.scale}, {"order", l.order}});
     }
 

@@ -38,7 +38,7 @@ LoadedLab loadLab(const std::string& name, const std::string& config_file, const
   if (duration) {
     if (!(*duration > 0) || *duration > 3600)
       throw InputError("<command line>", "--duration", "expected a duration in (0, 3600] s");
-    out.config["simulation"]["duration"] = *duration;
+    setRunDuration(out.config, *duration);
   }
   out.lab = buildLab(*out.entry, out.config, source);
   return out;

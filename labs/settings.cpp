@@ -7,12 +7,13 @@ namespace dyn {
 
 SimulationSettings parseSimulation(const JsonView& sim, IndependentForm form) {
   SimulationSettings s;
-  sim.onlyKeys({"dt", "duration", "integrator", "drift", "baumgarte"});
+  sim.onlyKeys({"dt", "duration", "integrator", "drift", "baumgarte", "exercise_duration"});
   s.step.dt = sim["dt"].positive();
   if (s.step.dt > kMaxDt || s.step.dt < kMinDt) sim["dt"].inRange(kMinDt, kMaxDt);
   s.duration = sim["duration"].positive();
   if (s.duration / s.step.dt > kMaxSteps)
     sim["duration"].fail("expected at most 2e6 steps (duration/dt); a trace of 2e6 rows is ~300 MB");
+  s.exercise_duration = sim.has("exercise_duration") ? sim["exercise_duration"].positive(1e6) : s.duration;
   parseIntegrator(sim["integrator"].oneOf({"semi_implicit_euler", "rk4"}), s.step.integrator);
   parseDrift(sim["drift"].oneOf({"none", "baumgarte", "projection", "independent"}), s.step.drift.kind);
   if (s.step.drift.kind == Drift::Independent && form == IndependentForm::No)
@@ -25,6 +26,12 @@ SimulationSettings parseSimulation(const JsonView& sim, IndependentForm form) {
     s.step.drift.omega = sim["baumgarte"]["omega"].positive(1e6);
   }
   return s;
+}
+
+void setRunDuration(json& config, double duration) {
+  json& sim = config["simulation"];
+  if (sim.is_object() && !sim.contains("exercise_duration") && sim.contains("duration")) sim["exercise_duration"] = sim["duration"];
+  sim["duration"] = duration;
 }
 
 std::map<std::string, double> parseGains(const JsonView& g, std::initializer_list<const char*> names) {

@@ -1,5 +1,5 @@
 // What every lab's JSON shares, parsed once here for all labs:
-//   "simulation": {"dt", "duration", "integrator", "drift", "baumgarte": {"zeta", "omega"}}
+//   "simulation": {"dt", "duration", "integrator", "drift", "baumgarte": {"zeta", "omega"}, "exercise_duration"}
 //   "gains":      {"<name>": {"value", "min", "max", "unit", "doc"}, ...}
 // (submission options: labs/submission.h). Errors are InputErrors naming file and JSON path.
 #pragma once
@@ -19,8 +19,14 @@ inline constexpr double kMaxGain = 1e9;                  // |min|, |max| of a de
 
 struct SimulationSettings {
   StepOptions step;
-  double duration = 1;  // s
+  double duration = 1;           // s: the run's
+  double exercise_duration = 1;  // s: the exercise's own, when a run is made shorter or longer (setRunDuration)
 };
+
+// config's run made `duration` s long (--duration, Python's duration=, check-lab's short runs): the
+// exercise's own duration is kept as "simulation/exercise_duration", so what is checked against the
+// exercise (a metric's window) is not refused because one run is shorter.
+void setRunDuration(json& config, double duration);
 
 // What a lab's mechanism can do with the shared options: drift "independent" needs a mechanism that
 // rebuilds its dependent coordinates from the independent ones (ConstrainedSystem::recoverDependent).

@@ -101,7 +101,7 @@ py::dict LabObject::run(const std::string& engine, std::optional<double> duratio
   }
   if (duration) {
     if (!(*duration > 0) || *duration > 3600) throw InputError(kArgument, "duration", "expected a duration in (0, 3600] s");
-    config["simulation"]["duration"] = *duration;
+    setRunDuration(config, *duration);
   }
   auto built = buildLab(*loaded_.entry, config, source);
   const Lab& lab = *built;

@@ -289,7 +289,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     if (std::find(s.actuated.begin(), s.actuated.end(), j) == s.actuated.end()) s.passive.push_back(j);
   for (const int j : s.passive)
     for (const char* a : {"x", "y", "z"}) s.columns.push_back("load_" + columnName(file.joints[std::size_t(j)].name) + "_" + a);
-  if (c.has("metrics")) s.metrics = parseMetrics(c["metrics"], s.columns);
+  if (c.has("metrics")) s.metrics = parseMetrics(c["metrics"], s.columns, sim.exercise_duration, s.step.dt);
   s.plant = std::make_shared<const model_file::LoadedModel>(std::move(file));
   return s;
 }

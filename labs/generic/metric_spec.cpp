@@ -3,10 +3,44 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace dyn::generic {
 
-std::map<std::string, MetricSpec> parseMetrics(const JsonView& j, const std::vector<std::string>& columns) {
+namespace {
+
+// A number in seconds, shortest digits that read back the same ("2.7", not "2.700000").
+std::string seconds(double t) {
+  char b[32];
+  for (int digits = 1; digits <= 17; ++digits) {
+    std::snprintf(b, sizeof b, "%.*g", digits, t);
+    if (std::strtod(b, nullptr) == t) break;
+  }
+  return b;
+}
+
+// The window [from, to] inside the run [0, duration] sampled every dt, holding at least one sample:
+// from ≤ duration − dt, and a given to in [from + dt, duration].
+void readWindow(const JsonView& m, double duration, double dt, MetricSpec& s) {
+  const std::string run = "the run lasts " + seconds(duration) + " s, sampled every " + seconds(dt) + " s";
+  if (m.has("from")) {
+    s.from = m["from"].number();
+    if (!(s.from >= 0 && s.from <= duration - dt))
+      m["from"].fail("expected a start in [0, " + seconds(duration - dt) + "] s (" + run + "), got " + seconds(s.from));
+  }
+  if (m.has("to")) {
+    s.to = m["to"].number();
+    if (!(s.to >= s.from + dt && s.to <= duration * (1 + 1e-12)))
+      m["to"].fail("expected an end in [" + seconds(s.from + dt) + ", " + seconds(duration) + "] s (from + one sample, " + run +
+                   "), got " + seconds(s.to));
+  }
+}
+
+}  // namespace
+
+std::map<std::string, MetricSpec> parseMetrics(const JsonView& j, const std::vector<std::string>& columns, double duration,
+                                               double dt) {
   j.requireObject();
   std::map<std::string, MetricSpec> out;
   for (const auto& [name, value] : j.raw().items()) {
@@ -24,8 +58,7 @@ std::map<std::string, MetricSpec> parseMetrics(const JsonView& j, const std::vec
     using St = MetricSpec::Stat;
     s.stat = stat == "rms" ? St::Rms : stat == "mean" ? St::Mean : stat == "max" ? St::Max : stat == "min" ? St::Min
              : stat == "max_abs" ? St::MaxAbs : stat == "final" ? St::Final : stat == "settling" ? St::Settling : St::Variation;
-    s.from = m.has("from") ? m["from"].inRange(0, 1e6) : 0.0;
-    s.to = m.has("to") ? m["to"].inRange(s.from, 1e6) : 1e300;
+    readWindow(m, duration, dt, s);
     if (s.stat == St::Settling) s.band = m["band"].positive(1e9);
     else if (m.has("band")) m["band"].fail("expected no band: only \"settling\" takes one");
     out[name] = s;
@@ -73,7 +106,7 @@ double evaluate(const MetricSpec& m, const Trace& tr) {
     prev = r;
     ++count;
   }
-  if (count == 0) return 0.0;
+  if (count == 0) return NAN;  // no sample: a value no threshold credits
   switch (m.stat) {
     case St::Rms: return std::sqrt(acc / double(count));
     case St::Mean: return acc / double(count);

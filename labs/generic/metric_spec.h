@@ -25,10 +25,13 @@ struct MetricSpec {
   double from = 0, to = 1e300, band = 0;
 };
 
-// Parses the "metrics" object; every column must be in `columns` (the lab's trace).
-std::map<std::string, MetricSpec> parseMetrics(const JsonView& j, const std::vector<std::string>& columns);
+// Parses the "metrics" object; every column must be in `columns` (the lab's trace), every window inside
+// the run [0, duration] sampled every dt with at least one sample in it (refused at its JSON path).
+std::map<std::string, MetricSpec> parseMetrics(const JsonView& j, const std::vector<std::string>& columns, double duration,
+                                               double dt);
 
-// The metric over a trace (0 for an empty window).
+// The metric over a trace (NaN for a window without a sample, as a run stopped early leaves: no
+// threshold credits it).
 double evaluate(const MetricSpec& m, const Trace& trace);
 
 }  // namespace dyn::generic
