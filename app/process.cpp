@@ -1,4 +1,5 @@
-// Another program started with an argument vector (app/process.h): fork, set up the child, execvp.
+// Another program started with an argument vector (app/process.h): fork, set up the child, execvp;
+// the parent waits for it, then or later (startProgram / waitProgram).
 #include "app/process.h"
 
 #include <fcntl.h>
@@ -77,20 +78,19 @@ void redirect(int target, const char* path, bool write, bool append, int report)
   childFail(report);
 }
 
-// Waits for pid; past the deadline (timeout_s > 0) kills it. Returns the wait status.
-int waitFor(pid_t pid, double timeout_s, bool& timed_out) {
+// Waits for pid; past the deadline (when one is set) kills it. Returns the wait status.
+int waitFor(pid_t pid, std::chrono::steady_clock::time_point deadline, bool& timed_out) {
   int status = 0;
-  if (timeout_s <= 0) {
+  if (deadline == std::chrono::steady_clock::time_point{}) {
     while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
     }
     return status;
   }
-  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
   auto pause = std::chrono::milliseconds(1);
   for (;;) {
     const pid_t r = ::waitpid(pid, &status, WNOHANG);
     if (r == pid || (r < 0 && errno != EINTR)) return status;
-    if (std::chrono::steady_clock::now() >= until) {
+    if (std::chrono::steady_clock::now() >= deadline) {
       timed_out = true;
       ::kill(pid, SIGKILL);
       while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
@@ -104,24 +104,25 @@ int waitFor(pid_t pid, double timeout_s, bool& timed_out) {
 
 }  // namespace
 
-ProcessResult runProgram(const std::vector<std::string>& args, const ProcessOptions& options) {
-  ProcessResult result;
+StartedProgram startProgram(const std::vector<std::string>& args, const ProcessOptions& options) {
+  StartedProgram program;
+  ProcessResult& result = program.result;
   if (args.empty() || args.front().empty()) {
     result.error = "no program to run";
-    return result;
+    return program;
   }
   std::vector<std::string> arg_strings = args, env_strings = childEnvironment(options);
   const std::vector<char*> argv = pointers(arg_strings), envp = pointers(env_strings);
   int report[2];  // the child's errno if it fails before exec; closed by a successful exec
   if (::pipe2(report, O_CLOEXEC) != 0) {
     result.error = std::string("cannot open a pipe: ") + std::strerror(errno);
-    return result;
+    return program;
   }
   const pid_t pid = ::fork();
   if (pid < 0) {
     result.error = std::string("cannot start ") + args.front() + ": " + std::strerror(errno);
     ::close(report[0]), ::close(report[1]);
-    return result;
+    return program;
   }
   if (pid == 0) child(options, argv.data(), envp.data(), report[1]);
   ::close(report[1]);
@@ -130,19 +131,38 @@ ProcessResult runProgram(const std::vector<std::string>& args, const ProcessOpti
   while ((got = ::read(report[0], &child_errno, sizeof child_errno)) < 0 && errno == EINTR) {
   }
   ::close(report[0]);
-  const int status = waitFor(pid, options.timeout_s, result.timed_out);
-  if (got == ssize_t(sizeof child_errno)) {
+  if (options.timeout_s > 0)
+    program.deadline = std::chrono::steady_clock::now() +
+                       std::chrono::duration_cast<std::chrono::steady_clock::duration>(std::chrono::duration<double>(options.timeout_s));
+  if (got == ssize_t(sizeof child_errno)) {  // it exits 127 at once: reaped here
+    bool timed_out = false;
+    waitFor(pid, {}, timed_out);
     result.error = "cannot run " + args.front() + ": " + std::strerror(child_errno);
     result.code = 127;
-    return result;
+    return program;
   }
+  program.pid = pid;
+  return program;
+}
+
+ProcessResult waitProgram(StartedProgram& program) {
+  if (program.pid < 0) return program.result;
+  ProcessResult result;
+  const int status = waitFor(program.pid, program.deadline, result.timed_out);
+  program.pid = -1;
   if (WIFSIGNALED(status)) {
     result.signal = WTERMSIG(status);
     result.code = 128 + result.signal;
   } else {
     result.code = WEXITSTATUS(status);
   }
+  program.result = result;
   return result;
+}
+
+ProcessResult runProgram(const std::vector<std::string>& args, const ProcessOptions& options) {
+  StartedProgram program = startProgram(args, options);
+  return waitProgram(program);
 }
 
 }  // namespace dyn

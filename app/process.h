@@ -3,9 +3,12 @@
 // Used where dynlab runs itself or a tool (check-lab runs grade/figure/run) and by the tests.
 //   runProgram(argv, options)   fork, then in the child: chdir, redirect 0/1/2, set limits and the
 //                               environment, execvp; the parent waits (with an optional deadline)
+//   startProgram / waitProgram  the same in two halves, for a caller with work to do meanwhile (two
+//                               programs at once, a reader on the child's pipe, a kill)
 // The child does only async-signal-safe work between fork and exec (everything it needs is built
 // before fork), so it is safe from a threaded process (Python, the batch grader).
 #pragma once
+#include <chrono>
 #include <string>
 #include <utility>
 #include <vector>
@@ -35,5 +38,17 @@ struct ProcessResult {
 
 // Runs argv[0] (looked up in PATH when it has no '/') with argv as its arguments and waits for it.
 ProcessResult runProgram(const std::vector<std::string>& argv, const ProcessOptions& options = {});
+
+// A program started and not yet waited for (startProgram), to be waited for once (waitProgram).
+struct StartedProgram {
+  int pid = -1;           // the child, for a signal of the caller's; -1: none to wait for
+  ProcessResult result;   // what waitProgram returns when there is no child (it did not start: error)
+  std::chrono::steady_clock::time_point deadline{};  // options.timeout_s after the start (none: epoch)
+};
+
+// runProgram's first half: returns once argv[0] has been exec'd (or could not be).
+StartedProgram startProgram(const std::vector<std::string>& argv, const ProcessOptions& options = {});
+// runProgram's second half: waits for the child (killed at its deadline) and reaps it.
+ProcessResult waitProgram(StartedProgram& program);
 
 }  // namespace dyn

@@ -23,22 +23,23 @@ std::vector<std::string> checkLines(const std::string& out, const std::string& s
   return lines;
 }
 
-// A copy of the slider crank's folder under DYNLAB_HOME=dir/home, its config changed by edit.
+// A copy of the slider crank's folder under DYNLAB_HOME=dir/home, its config changed by edit; the
+// options that run dynlab with that DYNLAB_HOME.
 template <class Edit>
-std::string homeWith(const TempDir& dir, Edit edit) {
+ProcessOptions homeWith(const TempDir& dir, Edit edit) {
   const fs::path home = dir / "home";
   fs::create_directories(home / "labs");
   fs::copy(fs::path(DYNLAB_SOURCE_DIR) / "labs/slider_crank", home / "labs/slider_crank", fs::copy_options::recursive);
   const fs::path config = home / "labs/slider_crank/slider_crank.json";
   writeFile(config, edit(readFile(config)));
-  return "DYNLAB_HOME=" + quote(home.string()) + " ";
+  return withEnv({{"DYNLAB_HOME", home.string()}});
 }
 
 }  // namespace
 
 TEST_CASE("check-lab: every check of a shipped lab passes, with its shares and passive drift") {
   const TempDir dir("check_lab_ok");
-  const Result r = dynlab(dir, "check-lab slider_crank");
+  const Result r = dynlab(dir, {"check-lab", "slider_crank"});
   INFO(r.out, r.err);
   CHECK(r.code == 0);
   CHECK(r.err.empty());
@@ -58,7 +59,7 @@ TEST_CASE("check-lab: every check of a shipped lab passes, with its shares and p
   CHECK(std::regex_search(r.out, std::regex("\npassive drift: +max \\|E − E0\\| = \\S+ over 4 s, relative \\S+ \\(tolerance 1e-06\\)\n")));
   CHECK(r.out.find("\nslider_crank: " + std::to_string(ok.size()) + " of " + std::to_string(ok.size()) + " checks pass (") != std::string::npos);
   // --skip-cli leaves out only the subprocesses.
-  const Result quick = dynlab(dir, "check-lab slider_crank --skip-cli");
+  const Result quick = dynlab(dir, {"check-lab", "slider_crank", "--skip-cli"});
   CHECK(quick.code == 0);
   CHECK(checkLines(quick.out, "ok").size() == ok.size() - 1);
   CHECK(quick.out.find("  ok    cli ") == std::string::npos);
@@ -67,13 +68,13 @@ TEST_CASE("check-lab: every check of a shipped lab passes, with its shares and p
 TEST_CASE("check-lab: default gains that already earn the points fail the defaults check (exit 1), the rest still run") {
   const TempDir dir("check_lab_fail");
   // The instructor's answer as the shipped defaults: no exercise left to the student.
-  const std::string env = homeWith(dir, [](const std::string& text) {
+  const ProcessOptions env = homeWith(dir, [](const std::string& text) {
     json config = json::parse(text);
     const json good = json::parse(readFile(fs::path(DYNLAB_SOURCE_DIR) / "labs/slider_crank/instructor/good.json"));
     for (const auto& [gain, value] : good.at("gains").items()) config["gains"][gain]["value"] = value;
     return config.dump(2);
   });
-  const Result r = shell(dir, env + quote(DYNLAB_BIN) + " check-lab slider_crank --skip-cli");
+  const Result r = dynlab(dir, {"check-lab", "slider_crank", "--skip-cli"}, env);
   INFO(r.out, r.err);
   CHECK(r.code == 1);
   const std::vector<std::string> failed = checkLines(r.out, "FAIL");
@@ -87,18 +88,18 @@ TEST_CASE("check-lab: default gains that already earn the points fail the defaul
 
 TEST_CASE("check-lab: an unknown lab, a missing name or an unreadable config is bad input (exit 2, one line)") {
   const TempDir dir("check_lab_bad");
-  Result r = dynlab(dir, "check-lab no_such_lab");
+  Result r = dynlab(dir, {"check-lab", "no_such_lab"});
   CHECK(r.code == 2);
   CHECK(r.out.empty());
   CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
   CHECK(r.err.rfind("error: <command line>: LAB: unknown lab \"no_such_lab\" (known labs: ", 0) == 0);
   for (const char* lab : {"slider_crank", "grasp", "unicycle", "pen_on_table", "motion_control", "impedance"})
     CHECK_MESSAGE(r.err.find(lab) != std::string::npos, "not listed: " << lab);
-  r = dynlab(dir, "check-lab");
+  r = dynlab(dir, {"check-lab"});
   CHECK(r.code == 2);
   CHECK(r.out.empty());
-  const std::string env = homeWith(dir, [](const std::string& text) { return text.substr(0, text.size() / 2); });
-  r = shell(dir, env + quote(DYNLAB_BIN) + " check-lab slider_crank");
+  const ProcessOptions env = homeWith(dir, [](const std::string& text) { return text.substr(0, text.size() / 2); });
+  r = dynlab(dir, {"check-lab", "slider_crank"}, env);
   INFO(r.err);
   CHECK(r.code == 2);
   CHECK(r.out.empty());

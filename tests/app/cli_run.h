@@ -1,9 +1,9 @@
-// Running the real dynlab binary (DYNLAB_BIN) from a test: a scratch directory per test case, the
-// exit code and captured stdout/stderr, snapshots of what a command wrote, the trace CSVs, and the
-// bad-input contract (exit 2, one line naming what was given, nothing written).
+// Running the real dynlab binary (DYNLAB_BIN) from a test, and any other program, always as an
+// argument vector (app/process.h: no shell, so no command line is ever built): a scratch directory
+// per test case, the exit code and captured stdout/stderr, snapshots of what a command wrote, the
+// trace CSVs, and the bad-input contract (exit 2, one line naming what was given, nothing written).
 #pragma once
 #include <doctest/doctest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,9 +13,15 @@
 #include <map>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
 
+#include "app/process.h"
+
 namespace dyn::test::cli {
+
+using dyn::ProcessOptions;
+using dyn::runProgram;
 
 namespace fs = std::filesystem;
 
@@ -27,8 +33,6 @@ inline std::string readFile(const fs::path& p) {
 }
 
 inline void writeFile(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
-
-inline std::string quote(const std::string& s) { return "'" + s + "'"; }
 
 // A fresh directory per test case, unique to this process; removed at the end.
 struct TempDir {
@@ -46,27 +50,76 @@ struct TempDir {
 };
 
 struct Result {
-  int code = -1;
+  int code = -1;           // the exit status, or 128 + the signal that ended it
+  bool timed_out = false;  // killed at options.timeout_s
   std::string out, err;
 };
 
-// Runs a shell command in dir (stdout/stderr captured to files there).
-inline Result shell(const TempDir& dir, const std::string& command) {
-  const fs::path out = dir / ".stdout", err = dir / ".stderr";
-  const std::string cmd = "cd " + quote(dir.path.string()) + " && " + command + " >" + quote(out.string()) + " 2>" +
-                          quote(err.string());
-  const int status = std::system(cmd.c_str());
+// Runs argv (no shell: each element is one argument) in cwd, with stdout and stderr captured to
+// files there unless o names its own. A program that cannot be started is exit 127, the reason on err.
+inline Result run(const fs::path& cwd, const std::vector<std::string>& argv, ProcessOptions o = {}) {
+  const fs::path out = cwd / ".stdout", err = cwd / ".stderr";
+  const bool capture_out = o.stdout_file.empty(), capture_err = o.stderr_file.empty();
+  if (capture_out) o.stdout_file = out.string();
+  if (capture_err) o.stderr_file = err.string();
+  if (o.cwd.empty()) o.cwd = cwd.string();
+  const ProcessResult p = runProgram(argv, o);
   Result r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  r.out = readFile(out);
-  r.err = readFile(err);
-  fs::remove(out);
-  fs::remove(err);
+  r.code = p.code;
+  r.timed_out = p.timed_out;
+  if (capture_out) r.out = readFile(out), fs::remove(out);
+  if (capture_err) r.err = readFile(err), fs::remove(err);
+  if (!p.started()) r.err += p.error + "\n";
   return r;
 }
+inline Result run(const TempDir& dir, const std::vector<std::string>& argv, const ProcessOptions& o = {}) {
+  return run(dir.path, argv, o);
+}
 
-// Runs `dynlab ARGS` in dir.
-inline Result dynlab(const TempDir& dir, const std::string& args) { return shell(dir, quote(DYNLAB_BIN) + " " + args); }
+// Runs `dynlab ARGS...` in dir.
+inline Result dynlab(const TempDir& dir, std::vector<std::string> args, const ProcessOptions& o = {}) {
+  args.insert(args.begin(), DYNLAB_BIN);
+  return run(dir, args, o);
+}
+
+// Argument lists joined: cat(base, {"--out", "x"}).
+inline std::vector<std::string> cat(std::vector<std::string> a, const std::vector<std::string>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+// An argument list as one line, for messages (each argument as it is, separated by spaces).
+inline std::string shown(const std::vector<std::string>& argv) {
+  std::string s;
+  for (const auto& a : argv) s += (s.empty() ? "" : " ") + a;
+  return s;
+}
+
+// Options that set environment variables (NAME, VALUE) for the child.
+inline ProcessOptions withEnv(std::vector<std::pair<std::string, std::string>> vars) {
+  ProcessOptions o;
+  o.set_env = std::move(vars);
+  return o;
+}
+
+// Whether `program` is an executable file in a folder of PATH (what the shell's `command -v` finds).
+inline bool onPath(const std::string& program) {
+  const char* path = std::getenv("PATH");
+  std::istringstream dirs(path ? path : "/usr/bin:/bin");
+  for (std::string d; std::getline(dirs, d, ':');) {
+    const fs::path p = fs::path(d.empty() ? "." : d) / program;
+    std::error_code ec;
+    if (fs::is_regular_file(p, ec) && ::access(p.c_str(), X_OK) == 0) return true;
+  }
+  return false;
+}
+
+// A virtual X display for windows (xvfb-run, which needs xauth too): available here?
+inline bool haveXvfb() { return onPath("xvfb-run") && onPath("xauth"); }
+// argv run in a fresh virtual X display of that screen size (24-bit).
+inline std::vector<std::string> inXvfb(const std::vector<std::string>& argv, const std::string& screen = "1600x1000") {
+  return cat({"xvfb-run", "-a", "-s", "-screen 0 " + screen + "x24"}, argv);
+}
 
 // Every regular file under dir (relative name → bytes).
 inline std::map<std::string, std::string> snapshot(const fs::path& dir) {
@@ -108,10 +161,10 @@ inline Csv readCsv(const fs::path& p) {
 }
 
 // Bad input: exit code 2, one line on stderr naming what is given, nothing written at all.
-inline void checkBadInput(const TempDir& dir, const std::string& args, const std::vector<std::string>& names,
-                   const fs::path& out) {
+inline void checkBadInput(const TempDir& dir, const std::vector<std::string>& args, const std::vector<std::string>& names,
+                          const fs::path& out) {
   const Result r = dynlab(dir, args);
-  INFO("dynlab ", args, "\nstderr: ", r.err);
+  INFO("dynlab ", shown(args), "\nstderr: ", r.err);
   CHECK(r.code == 2);
   CHECK(r.out.empty());
   CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);

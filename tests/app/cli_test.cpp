@@ -1,4 +1,4 @@
-// The dynlab command line end to end: the real binary (DYNLAB_BIN) run through the shell, its exit
+// The dynlab command line end to end: the real binary (DYNLAB_BIN) run with an argument vector, its exit
 // code, stdout/stderr and the files it writes. Every test works in its own directory under the
 // build tree, removed afterwards.
 //   exit codes: 0 success, 1 a run or write failed, 2 bad input (nothing written).
@@ -15,30 +15,35 @@ using namespace dyn::test::cli;
 
 TEST_CASE("dynlab list and --help") {
   TempDir dir("help");
-  const Result list = dynlab(dir, "list");
+  const Result list = dynlab(dir, {"list"});
   CHECK(list.code == 0);
   CHECK((list.out.rfind("slider_crank ", 0) == 0 || list.out.find("\nslider_crank ") != std::string::npos));
   CHECK((list.out.rfind("grasp ", 0) == 0 || list.out.find("\ngrasp ") != std::string::npos));
-  for (const char* args : {"--help", "run --help", "figure --help", "grade --help", "bench --help", "schema --help",
-                           "list --help"}) {
-    INFO("dynlab ", args);
+  for (const std::vector<std::string>& args : std::vector<std::vector<std::string>>{{"--help"},
+                                                                                   {"run", "--help"},
+                                                                                   {"figure", "--help"},
+                                                                                   {"grade", "--help"},
+                                                                                   {"bench", "--help"},
+                                                                                   {"schema", "--help"},
+                                                                                   {"list", "--help"}}) {
+    INFO("dynlab ", shown(args));
     const Result r = dynlab(dir, args);
     CHECK(r.code == 0);
     CHECK(r.out.find("Usage:") != std::string::npos);
     CHECK(r.err.empty());
   }
-  CHECK(dynlab(dir, "run --help").out.find("--duration") != std::string::npos);
+  CHECK(dynlab(dir, {"run", "--help"}).out.find("--duration") != std::string::npos);
   // No subcommand, an unknown one, or an unknown option: a usage error (2), not a crash.
-  CHECK(dynlab(dir, "").code == 2);
-  CHECK(dynlab(dir, "frobnicate").code == 2);
-  CHECK(dynlab(dir, "run slider_crank --no-such-option").code == 2);
-  CHECK(dynlab(dir, "run slider_crank --engine warp").code == 2);
+  CHECK(dynlab(dir, {}).code == 2);
+  CHECK(dynlab(dir, {"frobnicate"}).code == 2);
+  CHECK(dynlab(dir, {"run", "slider_crank", "--no-such-option"}).code == 2);
+  CHECK(dynlab(dir, {"run", "slider_crank", "--engine", "warp"}).code == 2);
   CHECK(snapshot(dir.path).empty());  // none of these wrote anything
 }
 
 TEST_CASE("dynlab run writes both traces and a summary that agrees with them") {
   TempDir dir("run");
-  const Result r = dynlab(dir, "run slider_crank --out out --duration 0.5");
+  const Result r = dynlab(dir, {"run", "slider_crank", "--out", "out", "--duration", "0.5"});
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   REQUIRE(r.code == 0);
   const fs::path out = dir / "out";
@@ -109,7 +114,7 @@ TEST_CASE("dynlab run writes both traces and a summary that agrees with them") {
 
 TEST_CASE("dynlab run --engine hand writes only the hand trace") {
   TempDir dir("engine");
-  const Result r = dynlab(dir, "run slider_crank --out out --duration 0.2 --engine hand");
+  const Result r = dynlab(dir, {"run", "slider_crank", "--out", "out", "--duration", "0.2", "--engine", "hand"});
   INFO("stderr: ", r.err);
   REQUIRE(r.code == 0);
   CHECK(fs::exists(dir / "out/trace_hand.csv"));
@@ -124,7 +129,7 @@ TEST_CASE("dynlab run --engine hand writes only the hand trace") {
 TEST_CASE("dynlab run --frames --video: 30 frames per second of simulated time, H.264 yuv420p") {
   TempDir dir("video");
   const double duration = 0.5;
-  const Result r = dynlab(dir, "run slider_crank --out out --duration 0.5 --frames --video");
+  const Result r = dynlab(dir, {"run", "slider_crank", "--out", "out", "--duration", "0.5", "--frames", "--video"});
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   REQUIRE(r.code == 0);
   const int expected = int(std::lround(30 * duration));
@@ -148,11 +153,10 @@ TEST_CASE("dynlab run --frames --video: 30 frames per second of simulated time, 
   CHECK(be32(16) == 640u);
   CHECK(be32(20) == 480u);
   // Decode the whole video with ffprobe: every frame is read, not just the header's count.
-  const std::string cmd = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
-                          "stream=nb_read_frames,pix_fmt,codec_name -of csv=p=0 " +
-                          quote((dir / "out/video.mp4").string()) + " > " + quote((dir / "probe.txt").string());
-  REQUIRE(std::system(cmd.c_str()) == 0);
-  std::string line = readFile(dir / "probe.txt");
+  const Result probe = run(dir, {"ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                                 "stream=nb_read_frames,pix_fmt,codec_name", "-of", "csv=p=0", "out/video.mp4"});
+  REQUIRE_MESSAGE(probe.code == 0, probe.err);
+  std::string line = probe.out;
   line.erase(line.find_last_not_of(" \r\n") + 1);
   CHECK(line == "h264,yuv420p," + std::to_string(expected));
   CHECK(r.out.find(std::to_string(expected) + " frames)") != std::string::npos);
@@ -161,13 +165,14 @@ TEST_CASE("dynlab run --frames --video: 30 frames per second of simulated time, 
 TEST_CASE("bad input through the CLI: exit 2, one line naming file and JSON path, nothing written") {
   TempDir dir("bad");
   const fs::path out = dir / "out";
-  const std::string run = "run slider_crank --out out --duration 0.2 ";
+  const std::vector<std::string> run = {"run", "slider_crank", "--out", "out", "--duration", "0.2"};
 
   SUBCASE("config with a negative mass") {
     json c = json::parse(defaultConfigText());
     c["mechanism"]["links"][0]["mass"] = -1.0;
     writeFile(dir / "negative_mass.json", c.dump(2));
-    checkBadInput(dir, run + "--config negative_mass.json", {"negative_mass.json", "/mechanism/links/0/mass", "positive"}, out);
+    checkBadInput(dir, cat(run, {"--config", "negative_mass.json"}),
+                  {"negative_mass.json", "/mechanism/links/0/mass", "positive"}, out);
   }
   SUBCASE("config with a number that overflows a double (1e999)") {
     std::string text = defaultConfigText();
@@ -175,37 +180,35 @@ TEST_CASE("bad input through the CLI: exit 2, one line naming file and JSON path
     REQUIRE(text.find(key) != std::string::npos);
     text.replace(text.find(key), key.size(), "\"load_mass\": 1e999");
     writeFile(dir / "overflow.json", text);
-    checkBadInput(dir, run + "--config overflow.json", {"overflow.json", "1e999"}, out);
+    checkBadInput(dir, cat(run, {"--config", "overflow.json"}), {"overflow.json", "1e999"}, out);
   }
   SUBCASE("malformed and empty config files") {
     writeFile(dir / "malformed.json", "{\"lab\": \"slider_crank\",,}");
-    checkBadInput(dir, run + "--config malformed.json", {"malformed.json", "expected valid JSON", "line 1"}, out);
+    checkBadInput(dir, cat(run, {"--config", "malformed.json"}), {"malformed.json", "expected valid JSON", "line 1"}, out);
     writeFile(dir / "empty.json", "");
-    checkBadInput(dir, run + "--config empty.json", {"empty.json", "empty"}, out);
+    checkBadInput(dir, cat(run, {"--config", "empty.json"}), {"empty.json", "empty"}, out);
   }
   SUBCASE("missing config file") {
-    checkBadInput(dir, run + "--config no_such_config.json", {"no_such_config.json", "cannot open"}, out);
+    checkBadInput(dir, cat(run, {"--config", "no_such_config.json"}), {"no_such_config.json", "cannot open"}, out);
   }
   SUBCASE("gains out of bounds, unknown gain, wrong type") {
     writeFile(dir / "gains_big.json", R"({"gains": {"kp_x": 1e9}})");
-    checkBadInput(dir, run + "--gains gains_big.json", {"gains_big.json", "/gains/kp_x", "[0, 20000]"}, out);
+    checkBadInput(dir, cat(run, {"--gains", "gains_big.json"}), {"gains_big.json", "/gains/kp_x", "[0, 20000]"}, out);
     writeFile(dir / "gains_unknown.json", R"({"gains": {"kp_z": 1}})");
-    checkBadInput(dir, run + "--gains gains_unknown.json", {"gains_unknown.json", "/gains/kp_z", "unknown gain"}, out);
+    checkBadInput(dir, cat(run, {"--gains", "gains_unknown.json"}), {"gains_unknown.json", "/gains/kp_z", "unknown gain"}, out);
     writeFile(dir / "gains_type.json", R"({"gains": {"ki_f": "NaN"}})");
-    checkBadInput(dir, run + "--gains gains_type.json", {"gains_type.json", "/gains/ki_f", "expected a number"}, out);
+    checkBadInput(dir, cat(run, {"--gains", "gains_type.json"}), {"gains_type.json", "/gains/ki_f", "expected a number"}, out);
   }
   SUBCASE("unknown lab") {
-    checkBadInput(dir, "run no_such_lab --out out", {"unknown lab \"no_such_lab\"", "LAB", "slider_crank"}, out);
+    checkBadInput(dir, {"run", "no_such_lab", "--out", "out"}, {"unknown lab \"no_such_lab\"", "LAB", "slider_crank"}, out);
   }
-  SUBCASE("bad duration") {
-    checkBadInput(dir, "run slider_crank --out out --duration 0", {"--duration"}, out);
-  }
+  SUBCASE("bad duration") { checkBadInput(dir, {"run", "slider_crank", "--out", "out", "--duration", "0"}, {"--duration"}, out); }
   SUBCASE("a failing run keeps the results of an earlier good run intact") {
     REQUIRE(dynlab(dir, run).code == 0);
     const auto before = snapshot(out);
     REQUIRE(before.size() == 3);
     writeFile(dir / "gains_big.json", R"({"gains": {"kd_x": -5}})");
-    const Result r = dynlab(dir, run + "--gains gains_big.json");
+    const Result r = dynlab(dir, cat(run, {"--gains", "gains_big.json"}));
     INFO("stderr: ", r.err);
     CHECK(r.code == 2);
     CHECK(r.err.find("/gains/kd_x") != std::string::npos);
@@ -216,7 +219,7 @@ TEST_CASE("bad input through the CLI: exit 2, one line naming file and JSON path
 
 TEST_CASE("the same command twice gives byte-identical traces and summary") {
   TempDir dir("repeat");
-  const std::string cmd = "run slider_crank --out out --duration 0.3";
+  const std::vector<std::string> cmd = {"run", "slider_crank", "--out", "out", "--duration", "0.3"};
   REQUIRE(dynlab(dir, cmd).code == 0);
   const auto first = snapshot(dir / "out");
   REQUIRE(dynlab(dir, cmd).code == 0);
@@ -229,17 +232,17 @@ TEST_CASE("the same command twice gives byte-identical traces and summary") {
     CHECK(second.at(name) == bytes);
   }
   // And the bytes do depend on the input: a different duration gives a different summary.
-  REQUIRE(dynlab(dir, "run slider_crank --out out2 --duration 0.2").code == 0);
+  REQUIRE(dynlab(dir, {"run", "slider_crank", "--out", "out2", "--duration", "0.2"}).code == 0);
   CHECK(readFile(dir / "out2/summary.json") != first.at("summary.json"));
 }
 
 TEST_CASE("a rerun into the same directory leaves no stale output of the earlier run") {
   TempDir dir("rerun");
-  REQUIRE(dynlab(dir, "run slider_crank --out out --duration 0.2 --video --frames").code == 0);
+  REQUIRE(dynlab(dir, {"run", "slider_crank", "--out", "out", "--duration", "0.2", "--video", "--frames"}).code == 0);
   REQUIRE(fs::exists(dir / "out/video.mp4"));
   REQUIRE(fs::exists(dir / "out/frames"));
   std::ofstream(dir / "out/notes.txt") << "mine";  // the user's own file stays
-  REQUIRE(dynlab(dir, "run slider_crank --out out --duration 0.2 --engine hand").code == 0);
+  REQUIRE(dynlab(dir, {"run", "slider_crank", "--out", "out", "--duration", "0.2", "--engine", "hand"}).code == 0);
   CHECK_FALSE(fs::exists(dir / "out/video.mp4"));
   CHECK_FALSE(fs::exists(dir / "out/frames"));
   CHECK_FALSE(fs::exists(dir / "out/trace_bullet.csv"));
@@ -249,7 +252,7 @@ TEST_CASE("a rerun into the same directory leaves no stale output of the earlier
 
 TEST_CASE("dynlab bench --json: the fields of every lab, and speed with accuracy (no speed asserted)") {
   TempDir dir("bench");
-  const Result r = dynlab(dir, "bench --json --steps 200 --frames 5");
+  const Result r = dynlab(dir, {"bench", "--json", "--steps", "200", "--frames", "5"});
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   REQUIRE(r.code == 0);
   std::istringstream lines(r.out);

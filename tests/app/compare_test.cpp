@@ -53,11 +53,11 @@ TEST_CASE("compare: both graded as dynlab grade grades them, side by side, one p
   const TempDir dir("compare");
   // Two of the students' examples (the integral and the proportional law); no instructor file needed.
   const std::string a = kLab + "examples/mediocre.json", b = kLab + "examples/proportional.json";
-  REQUIRE(dynlab(dir, "grade " + quote(a) + " --no-plots --out ga").code == 0);
-  REQUIRE(dynlab(dir, "grade " + quote(b) + " --no-plots --out gb").code == 0);
+  REQUIRE(dynlab(dir, {"grade", a, "--no-plots", "--out", "ga"}).code == 0);
+  REQUIRE(dynlab(dir, {"grade", b, "--no-plots", "--out", "gb"}).code == 0);
   const json ra = json::parse(readFile(dir / "ga/results.json")), rb = json::parse(readFile(dir / "gb/results.json"));
 
-  const Result r = dynlab(dir, "compare " + quote(a) + " " + quote(b) + " --out cmp");
+  const Result r = dynlab(dir, {"compare", a, b, "--out", "cmp"});
   INFO(r.err);
   REQUIRE(r.code == 0);
   const std::string md = readFile(dir / "cmp/comparison.md");
@@ -97,15 +97,15 @@ TEST_CASE("compare: both graded as dynlab grade grades them, side by side, one p
     CHECK(md.find(std::string("](plots/") + prefix) != std::string::npos);
   }
   // Both responses are on each plot: comparing A with itself draws other pictures.
-  REQUIRE(dynlab(dir, "compare " + quote(a) + " " + quote(a) + " --out same").code == 0);
+  REQUIRE(dynlab(dir, {"compare", a, a, "--out", "same"}).code == 0);
   CHECK(plotCount(dir / "same/plots") == sim.size());
   for (const auto& e : fs::directory_iterator(dir / "cmp/plots"))
     CHECK(readFile(e.path()) != readFile(dir / "same/plots" / e.path().filename()));
   // The same command twice: the same bytes.
-  REQUIRE(dynlab(dir, "compare " + quote(a) + " " + quote(b) + " --out again").code == 0);
+  REQUIRE(dynlab(dir, {"compare", a, b, "--out", "again"}).code == 0);
   CHECK(snapshot(dir / "again") == snapshot(dir / "cmp"));
   // --no-plots: the comparison alone.
-  REQUIRE(dynlab(dir, "compare " + quote(a) + " " + quote(b) + " --no-plots --out bare").code == 0);
+  REQUIRE(dynlab(dir, {"compare", a, b, "--no-plots", "--out", "bare"}).code == 0);
   CHECK_FALSE(fs::exists(dir / "bare/plots"));
 }
 
@@ -113,7 +113,7 @@ TEST_CASE("compare: a hostile file name is text in the terminal, the Markdown an
   const TempDir dir("compare_hostile");
   const std::string hostile = "<img src=x onerror=alert(1)> *b* | [l](javascript:x) #h `c`\n\x1b[31m\xff.json";
   writeFile(dir / hostile, readFile(kLab + "examples/mediocre.json"));
-  const Result r = dynlab(dir, "compare " + quote(hostile) + " " + quote(kLab + "examples/proportional.json") + " --out cmp");
+  const Result r = dynlab(dir, {"compare", hostile, kLab + "examples/proportional.json", "--out", "cmp"});
   INFO(r.err);
   REQUIRE(r.code == 0);
   // The terminal: control characters and bad bytes as visible escapes.
@@ -139,16 +139,16 @@ TEST_CASE("compare: a hostile file name is text in the terminal, the Markdown an
 
 TEST_CASE("compare: bad input exits 2 with one line and writes nothing; OUT's own files are kept") {
   const TempDir dir("compare_bad");
-  const std::string good = quote(kLab + "examples/mediocre.json");
+  const std::string good = kLab + "examples/mediocre.json";
   writeFile(dir / "broken.json", "{\"lab\": \"slider_crank\", \"gains\": {\"kp_x\": }");
-  checkBadInput(dir, "compare " + good + " broken.json --out cmp", {"broken.json"}, dir / "cmp");
-  checkBadInput(dir, "compare broken.json " + good + " --out cmp", {"broken.json"}, dir / "cmp");
-  checkBadInput(dir, "compare " + good + " missing.json --out cmp", {"missing.json"}, dir / "cmp");
-  checkBadInput(dir, "compare " + good + " " + good + " --lab nope --out cmp", {"/lab", "nope"}, dir / "cmp");
+  checkBadInput(dir, {"compare", good, "broken.json", "--out", "cmp"}, {"broken.json"}, dir / "cmp");
+  checkBadInput(dir, {"compare", "broken.json", good, "--out", "cmp"}, {"broken.json"}, dir / "cmp");
+  checkBadInput(dir, {"compare", good, "missing.json", "--out", "cmp"}, {"missing.json"}, dir / "cmp");
+  checkBadInput(dir, {"compare", good, good, "--lab", "nope", "--out", "cmp"}, {"/lab", "nope"}, dir / "cmp");
   // A plots/ folder of the user's in OUT: nothing is removed, exit 2.
   fs::create_directories(dir / "mine/plots");
   writeFile(dir / "mine/plots/notes.txt", "mine");
-  const Result r = dynlab(dir, "compare " + good + " " + good + " --out mine");
+  const Result r = dynlab(dir, {"compare", good, good, "--out", "mine"});
   CHECK(r.code == 2);
   CHECK(r.err.find("notes.txt") != std::string::npos);
   CHECK(readFile(dir / "mine/plots/notes.txt") == "mine");

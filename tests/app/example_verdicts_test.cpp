@@ -25,7 +25,7 @@ TEST_CASE("every example named for a verdict gets that verdict") {
     if (!unstable && !slipping && !skidding && !mediocre) continue;
     INFO(file.string());
     const std::string out = "g" + std::to_string(++checked);
-    const Result r = dynlab(dir, "grade " + quote(file.string()) + " --no-plots --out " + out);
+    const Result r = dynlab(dir, {"grade", file.string(), "--no-plots", "--out", out});
     REQUIRE_MESSAGE(r.code == 0, r.err);
     const json res = json::parse(readFile(dir / out / "results.json"));
     std::string stopped;

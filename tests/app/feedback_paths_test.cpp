@@ -39,7 +39,7 @@ TEST_CASE("an invalid submission graded by its absolute path: the feedback names
   const fs::path bad = dir / "ta/course/subs/alice.json";
   writeFile(bad, R"({"lab": "slider_crank", "gains": {"kp_x": 1e9}})");
   const fs::path out = dir / "ta/out";
-  const Result r = dynlab(dir, "grade " + quote(bad.string()) + " --out " + quote(out.string()));
+  const Result r = dynlab(dir, {"grade", bad.string(), "--out", out.string()});
   REQUIRE(r.code == 2);
   // The staff's terminal keeps the whole path; the student's text has the name and what to fix.
   CHECK(r.err.find(bad.string()) != std::string::npos);
@@ -49,7 +49,7 @@ TEST_CASE("an invalid submission graded by its absolute path: the feedback names
   checkNoPaths(dir, readFile(out / "report.md"), "report.md");
   checkNoPaths(dir, readFile(out / "report.html"), "report.html");
   // A graded one: Gradescope's text has no path either.
-  const Result g = dynlab(dir, "grade " + quote(kMediocre) + " --no-plots --out " + quote((dir / "ta/graded").string()));
+  const Result g = dynlab(dir, {"grade", kMediocre, "--no-plots", "--out", (dir / "ta/graded").string()});
   REQUIRE(g.code == 0);
   checkNoPaths(dir, studentText(dir / "ta/graded/results.json"), "graded results.json");
 }
@@ -61,8 +61,8 @@ TEST_CASE("a batch: every student's feedback is free of the TA's paths; gradeboo
   writeFile(dir / "subs/alice/submission.json", readFile(kMediocre));
   writeFile(dir / "subs/bob/submission.json", R"({"lab": "slider_crank", "gains": {"kp_x": 1e9}})");
   writeFile(dir / "subs/carol.json", "{\"lab\": \"slider_crank\", \"gains\": {\"kp_x\": \xE9}}");  // Latin-1, not UTF-8
-  const Result r = dynlab(dir, "grade --batch " + quote((dir / "subs").string()) + " --no-plots --jobs 2 --out " +
-                                   quote((dir / "book").string()));
+  const Result r =
+      dynlab(dir, {"grade", "--batch", (dir / "subs").string(), "--no-plots", "--jobs", "2", "--out", (dir / "book").string()});
   INFO(r.out, r.err);
   for (const std::string student : {"alice", "bob", "carol"}) {
     INFO("student ", student);

@@ -30,8 +30,8 @@ TEST_CASE("dynlab figure --gains A --gains B: each run's curves on one plot, nam
   TempDir dir("figure_runs");
   writeFile(dir / "a.json", readFile(kSlider + "mediocre.json"));
   writeFile(dir / "b.json", readFile(kSlider + "proportional.json"));
-  const std::string cmd = "figure slider_crank --gains a.json --gains b.json --out out --duration 0.3 "
-                          "--plot f_Ty,f_des --format svg";
+  const std::vector<std::string> cmd = {"figure", "slider_crank", "--gains", "a.json", "--gains",    "b.json",   "--out",
+                                        "out",    "--duration",   "0.3",     "--plot", "f_Ty,f_des", "--format", "svg"};
   const Result r = dynlab(dir, cmd);
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   REQUIRE(r.code == 0);
@@ -47,10 +47,14 @@ TEST_CASE("dynlab figure --gains A --gains B: each run's curves on one plot, nam
   CHECK(snapshot(dir / "out") == first);
 
   // The lab's own set with two runs: its plots, overlaid; no stills.
-  REQUIRE(dynlab(dir, "figure slider_crank --gains a.json --gains b.json --out own --duration 0.3 --engine hand --format svg").code == 0);
+  REQUIRE(dynlab(dir, {"figure", "slider_crank", "--gains", "a.json", "--gains", "b.json", "--out", "own", "--duration", "0.3",
+                       "--engine", "hand", "--format", "svg"})
+              .code == 0);
   for (const auto& n : names(dir / "own")) CHECK_MESSAGE(n.rfind("plot_", 0) == 0, n);
   // One --gains: the legend as before (engines only).
-  REQUIRE(dynlab(dir, "figure slider_crank --gains a.json --out one --duration 0.3 --plot f_Ty,f_des --format svg").code == 0);
+  REQUIRE(dynlab(dir, {"figure", "slider_crank", "--gains", "a.json", "--out", "one", "--duration", "0.3", "--plot", "f_Ty,f_des",
+                       "--format", "svg"})
+              .code == 0);
   const std::string one = test::svgText(readFile(dir / "one/plot_f_Ty+f_des.svg"));
   CHECK(has(one, "f_Ty (hand)"));
   CHECK_FALSE(has(one, "a.json"));
@@ -58,8 +62,8 @@ TEST_CASE("dynlab figure --gains A --gains B: each run's curves on one plot, nam
 
 TEST_CASE("dynlab figure --plot Y:X@M: the pen's ink where contact, named; the lab's own set has it") {
   TempDir dir("figure_mask");
-  const Result r = dynlab(dir, "figure pen_on_table --gains " + quote(kPen + "unstable.json") +
-                                   " --engine hand --duration 2.6 --out out --format svg --plot 'y_p:x_p@contact, y_d:x_d'");
+  const Result r = dynlab(dir, {"figure", "pen_on_table", "--gains", kPen + "unstable.json", "--engine", "hand", "--duration",
+                                "2.6", "--out", "out", "--format", "svg", "--plot", "y_p:x_p@contact, y_d:x_d"});
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   REQUIRE(r.code == 1);  // the watchdog stops the unstable run; the figure is still written
   CHECK(has(r.out, "the pen bounced"));
@@ -69,15 +73,15 @@ TEST_CASE("dynlab figure --plot Y:X@M: the pen's ink where contact, named; the l
   CHECK(has(svg, "x (m)"));  // the lab's labels for exactly these curves (its "figures")
   CHECK_FALSE(has(svg, "x_p, x_d (m)"));
   // Before touchdown the mask is 0 throughout: nothing drawn, and said so (the other plot is written).
-  const Result early = dynlab(dir, "figure pen_on_table --engine hand --duration 0.05 --out early --format svg "
-                                   "--plot 'y_p:x_p@contact' --plot z_p");
+  const Result early = dynlab(dir, {"figure", "pen_on_table", "--engine", "hand", "--duration", "0.05", "--out", "early",
+                                    "--format", "svg", "--plot", "y_p:x_p@contact", "--plot", "z_p"});
   INFO("stdout: ", early.out, "\nstderr: ", early.err);
   CHECK(early.code == 0);
   CHECK(names(dir / "early") == std::vector<std::string>{"plot_z_p.svg"});
   CHECK(has(early.out, "not written: plot_y_p-vs-x_p-where-contact.svg (y_p vs x_p where contact: nothing to draw"));
     // The lab's own set, two runs (so no stills): the ink is one of its figures, each run's named.
-  const Result two = dynlab(dir, "figure pen_on_table --gains " + quote(kPen + "mediocre.json") + " --gains " +
-                                     quote(kPen + "spring.json") + " --engine hand --duration 0.5 --out two --format svg");
+  const Result two = dynlab(dir, {"figure", "pen_on_table", "--gains", kPen + "mediocre.json", "--gains", kPen + "spring.json",
+                                  "--engine", "hand", "--duration", "0.5", "--out", "two", "--format", "svg"});
   INFO("stdout: ", two.out, "\nstderr: ", two.err);
   REQUIRE(two.code == 0);
   const std::string both = test::svgText(readFile(dir / "two/plot_y_p-vs-x_p-where-contact+y_d-vs-x_d.svg"));
@@ -91,13 +95,13 @@ TEST_CASE("dynlab figure --gains: repeated, missing or bad files and --still wit
   writeFile(dir / "a.json", readFile(kSlider + "mediocre.json"));
   writeFile(dir / "bad.json", "{\"gains\": {\"kp_x\": \"fast\"}}");
   const fs::path out = dir / "out";
-  const std::string fig = "figure slider_crank --out out --duration 0.3 --plot f_Ty ";
-  checkBadInput(dir, fig + "--gains a.json --gains a.json", {"--gains a.json", "each gains file once"}, out);
-  checkBadInput(dir, fig + "--gains a.json --gains ./a.json", {"--gains ./a.json", "each gains file once"}, out);
-  checkBadInput(dir, fig + "--gains a.json --gains missing.json", {"missing.json"}, out);
-  checkBadInput(dir, fig + "--gains bad.json --gains a.json", {"bad.json"}, out);
-  checkBadInput(dir, fig + "--gains a.json --gains " + quote(kSlider + "proportional.json") + " --still 0.1",
+  const std::vector<std::string> fig = {"figure", "slider_crank", "--out", "out", "--duration", "0.3", "--plot", "f_Ty"};
+  checkBadInput(dir, cat(fig, {"--gains", "a.json", "--gains", "a.json"}), {"--gains a.json", "each gains file once"}, out);
+  checkBadInput(dir, cat(fig, {"--gains", "a.json", "--gains", "./a.json"}), {"--gains ./a.json", "each gains file once"}, out);
+  checkBadInput(dir, cat(fig, {"--gains", "a.json", "--gains", "missing.json"}), {"missing.json"}, out);
+  checkBadInput(dir, cat(fig, {"--gains", "bad.json", "--gains", "a.json"}), {"bad.json"}, out);
+  checkBadInput(dir, cat(fig, {"--gains", "a.json", "--gains", kSlider + "proportional.json", "--still", "0.1"}),
                 {"--still 0.1", "one --gains file"}, out);
-  checkBadInput(dir, fig + "--plot 'q2:q1@'", {"--plot q2:q1@", "empty column name"}, out);
-  checkBadInput(dir, fig + "--plot 'q2:q1@x_c@x_d'", {"has two '@'"}, out);
+  checkBadInput(dir, cat(fig, {"--plot", "q2:q1@"}), {"--plot q2:q1@", "empty column name"}, out);
+  checkBadInput(dir, cat(fig, {"--plot", "q2:q1@x_c@x_d"}), {"has two '@'"}, out);
 }

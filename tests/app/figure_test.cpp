@@ -71,7 +71,8 @@ TEST_CASE("dynlab figure --plot: valid PDF, SVG and PNG files, legend per column
   TempDir dir("figure_plot");
   for (const std::string format : {"pdf", "svg", "png"}) {
     INFO("format ", format);
-    const std::string cmd = "figure slider_crank --out out --duration 0.3 --plot f_Ty,f_des --plot x_c --format " + format;
+    const std::vector<std::string> cmd = {"figure", "slider_crank", "--out",  "out", "--duration", "0.3",
+                                          "--plot", "f_Ty,f_des",   "--plot", "x_c", "--format",   format};
     const Result r = dynlab(dir, cmd);
     INFO("stdout: ", r.out, "\nstderr: ", r.err);
     REQUIRE(r.code == 0);
@@ -105,7 +106,9 @@ TEST_CASE("dynlab figure --plot: valid PDF, SVG and PNG files, legend per column
   }
   // One engine: no Bullet series; and the bytes depend on what was asked.
   const std::string svg = test::svgText(readFile(dir / "out/plot_x_c.svg"));
-  REQUIRE(dynlab(dir, "figure slider_crank --out hand --duration 0.3 --plot x_c --format svg --engine hand").code == 0);
+  REQUIRE(dynlab(dir, {"figure", "slider_crank", "--out", "hand", "--duration", "0.3", "--plot", "x_c", "--format", "svg",
+                       "--engine", "hand"})
+              .code == 0);
   const std::string hand = test::svgText(readFile(dir / "hand/plot_x_c.svg"));
   CHECK(hand.find("x_c (hand)") != std::string::npos);
   CHECK(hand.find("Bullet") == std::string::npos);
@@ -122,39 +125,41 @@ int largestFont(const std::string& svg) {
 
 TEST_CASE("dynlab figure: plots are --size big (PNG pixels, PDF and SVG page), text --font-scale, y --y-scale") {
   TempDir dir("figure_plot_size");
-  const std::string fig = "figure slider_crank --duration 0.3 --plot x_c ";
-  REQUIRE(dynlab(dir, fig + "--out a --format png --size 1280x720").code == 0);
+  const std::vector<std::string> fig = {"figure", "slider_crank", "--duration", "0.3", "--plot", "x_c"};
+  REQUIRE(dynlab(dir, cat(fig, {"--out", "a", "--format", "png", "--size", "1280x720"})).code == 0);
   CHECK(pngSize(readFile(dir / "a/plot_x_c.png")) == std::pair<int, int>(1280, 720));
-  REQUIRE(dynlab(dir, fig + "--out b --format pdf --size 1024x768").code == 0);
+  REQUIRE(dynlab(dir, cat(fig, {"--out", "b", "--format", "pdf", "--size", "1024x768"})).code == 0);
   CHECK(readFile(dir / "b/plot_x_c.pdf").find("/MediaBox [ 0 0 1024 768 ]") != std::string::npos);
-  REQUIRE(dynlab(dir, fig + "--out c --format svg --size 640x360").code == 0);
+  REQUIRE(dynlab(dir, cat(fig, {"--out", "c", "--format", "svg", "--size", "640x360"})).code == 0);
   const std::string small = readFile(dir / "c/plot_x_c.svg");
   CHECK(small.find("width=\"640px\"") != std::string::npos);
   CHECK(small.find("height=\"360px\"") != std::string::npos);
   // Without --size a plot is 800x450 (a still 1920x1080).
-  REQUIRE(dynlab(dir, fig + "--out d --format pdf").code == 0);
+  REQUIRE(dynlab(dir, cat(fig, {"--out", "d", "--format", "pdf"})).code == 0);
   CHECK(readFile(dir / "d/plot_x_c.pdf").find("/MediaBox [ 0 0 800 450 ]") != std::string::npos);
   // --font-scale: the same page, bigger text.
-  REQUIRE(dynlab(dir, fig + "--out e --format svg --size 640x360 --font-scale 2").code == 0);
+  REQUIRE(dynlab(dir, cat(fig, {"--out", "e", "--format", "svg", "--size", "640x360", "--font-scale", "2"})).code == 0);
   const std::string big = readFile(dir / "e/plot_x_c.svg");
   CHECK(largestFont(big) >= 1.8 * largestFont(small));
   CHECK(big.find("width=\"640px\"") != std::string::npos);
   // --y-scale log: tick labels are powers of ten ("10" with a superscript exponent); linear: none.
-  const std::string residual = "figure slider_crank --duration 0.3 --plot constraint_residual --engine bullet --format svg ";
-  REQUIRE(dynlab(dir, residual + "--out f --y-scale log").code == 0);
+  const std::vector<std::string> residual = {"figure",   "slider_crank", "--duration", "0.3", "--plot", "constraint_residual",
+                                             "--engine", "bullet",       "--format",   "svg"};
+  REQUIRE(dynlab(dir, cat(residual, {"--out", "f", "--y-scale", "log"})).code == 0);
   CHECK(test::svgText(readFile(dir / "f/plot_constraint_residual.svg")).find(">10<tspan") != std::string::npos);
-  REQUIRE(dynlab(dir, residual + "--out h --y-scale linear").code == 0);
+  REQUIRE(dynlab(dir, cat(residual, {"--out", "h", "--y-scale", "linear"})).code == 0);
   CHECK(test::svgText(readFile(dir / "h/plot_constraint_residual.svg")).find(">10<tspan") == std::string::npos);
   // A plot needs room for its labels; a bad scale is named.
-  checkBadInput(dir, fig + "--out g --size 80x60", {"--size 80x60", "at least 100x100"}, dir / "g");
-  CHECK(dynlab(dir, fig + "--out g --y-scale cubic").code == 2);
-  CHECK(dynlab(dir, fig + "--out g --font-scale 0").code == 2);
+  checkBadInput(dir, cat(fig, {"--out", "g", "--size", "80x60"}), {"--size 80x60", "at least 100x100"}, dir / "g");
+  CHECK(dynlab(dir, cat(fig, {"--out", "g", "--y-scale", "cubic"})).code == 2);
+  CHECK(dynlab(dir, cat(fig, {"--out", "g", "--font-scale", "0"})).code == 2);
 }
 
 TEST_CASE("dynlab figure --still: the requested size, the arm and slider where the trace puts them at t") {
   TempDir dir("figure_still");
   const double t = 1.0;  // half the reference period: the slider has moved its full stroke
-  const Result r = dynlab(dir, "figure slider_crank --out out --duration 1.5 --engine hand --still 1 --size 960x540 --no-overlay");
+  const Result r = dynlab(dir, {"figure", "slider_crank", "--out", "out", "--duration", "1.5", "--engine", "hand", "--still", "1",
+                                "--size", "960x540", "--no-overlay"});
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   REQUIRE(r.code == 0);
   CHECK(names(dir / "out") == std::vector<std::string>{"still_1.000.png"});
@@ -199,7 +204,9 @@ TEST_CASE("dynlab figure --still: the requested size, the arm and slider where t
 
   // With the overlay panel (default) the top-left corner shows the panel, and the scene is fitted
   // into the rest of the frame: the slider where that camera puts it.
-  REQUIRE(dynlab(dir, "figure slider_crank --out panel --duration 1.5 --engine hand --still 1 --size 960x540").code == 0);
+  REQUIRE(dynlab(dir, {"figure", "slider_crank", "--out", "panel", "--duration", "1.5", "--engine", "hand", "--still", "1",
+                       "--size", "960x540"})
+              .code == 0);
   const Png panel = loadPng(dir / "panel/still_1.000.png");
   REQUIRE(panel.width == 960);
   long differing = 0;
@@ -212,7 +219,7 @@ TEST_CASE("dynlab figure --still: the requested size, the arm and slider where t
 
 TEST_CASE("dynlab figure with neither --plot nor --still: the lab's plots and stills at start, middle and end") {
   TempDir dir("figure_default");
-  const Result r = dynlab(dir, "figure slider_crank --out out --duration 0.4");
+  const Result r = dynlab(dir, {"figure", "slider_crank", "--out", "out", "--duration", "0.4"});
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   REQUIRE(r.code == 0);
   // The rubric's plots (response with reference, duplicates once) and three stills at 1920x1080.
@@ -233,11 +240,14 @@ TEST_CASE("dynlab figure with neither --plot nor --still: the lab's plots and st
 
 TEST_CASE("dynlab figure: a rerun replaces the figures of the earlier one and keeps other files") {
   TempDir dir("figure_rerun");
-  REQUIRE(dynlab(dir, "figure slider_crank --out out --duration 0.2 --plot x_c --still 0.1 --size 160x120").code == 0);
+  REQUIRE(dynlab(dir, {"figure", "slider_crank", "--out", "out", "--duration", "0.2", "--plot", "x_c", "--still", "0.1", "--size",
+                       "160x120"})
+              .code == 0);
   REQUIRE(names(dir / "out") == std::vector<std::string>{"plot_x_c.pdf", "still_0.100.png"});
   writeFile(dir / "out/notes.txt", "mine");
-  REQUIRE(dynlab(dir, "run slider_crank --out out --duration 0.2 --engine hand").code == 0);
-  const Result r = dynlab(dir, "figure slider_crank --out out --duration 0.2 --plot f_Ty --format svg");
+  REQUIRE(dynlab(dir, {"run", "slider_crank", "--out", "out", "--duration", "0.2", "--engine", "hand"}).code == 0);
+  const Result r =
+      dynlab(dir, {"figure", "slider_crank", "--out", "out", "--duration", "0.2", "--plot", "f_Ty", "--format", "svg"});
   REQUIRE(r.code == 0);
   // The earlier figures are gone, and the command says which; the user's file and dynlab run's
   // outputs are not the figure's.
@@ -249,31 +259,32 @@ TEST_CASE("dynlab figure: a rerun replaces the figures of the earlier one and ke
 TEST_CASE("dynlab figure: bad input exits 2 with one line naming it, and writes nothing") {
   TempDir dir("figure_bad");
   const fs::path out = dir / "out";
-  const std::string fig = "figure slider_crank --out out --duration 1 ";
+  const std::vector<std::string> fig = {"figure", "slider_crank", "--out", "out", "--duration", "1"};
   SUBCASE("unknown column: the error lists the available ones") {
-    checkBadInput(dir, fig + "--plot f_Ty --plot f_Ty,f_Tz", {"--plot f_Ty,f_Tz", "unknown column \"f_Tz\"", "t, q1, q2", "f_des"}, out);
-    checkBadInput(dir, fig + "--plot x_c,", {"--plot x_c,", "empty column name"}, out);
+    checkBadInput(dir, cat(fig, {"--plot", "f_Ty", "--plot", "f_Ty,f_Tz"}),
+                  {"--plot f_Ty,f_Tz", "unknown column \"f_Tz\"", "t, q1, q2", "f_des"}, out);
+    checkBadInput(dir, cat(fig, {"--plot", "x_c,"}), {"--plot x_c,", "empty column name"}, out);
   }
   SUBCASE("a time outside the run") {
-    checkBadInput(dir, fig + "--still 0.5 --still 1.5", {"--still 1.5", "[0, 1] s"}, out);
-    checkBadInput(dir, fig + "--still -0.1", {"--still -0.1", "[0, 1] s"}, out);
+    checkBadInput(dir, cat(fig, {"--still", "0.5", "--still", "1.5"}), {"--still 1.5", "[0, 1] s"}, out);
+    checkBadInput(dir, cat(fig, {"--still", "-0.1"}), {"--still -0.1", "[0, 1] s"}, out);
   }
   SUBCASE("bad size or format") {
     for (const char* size : {"100", "0x0", "640x480x", "x480", "99999x100", "640X480"})
-      checkBadInput(dir, fig + "--still 0 --size " + size, {std::string("--size ") + size, "WIDTHxHEIGHT"}, out);
-    checkBadInput(dir, fig + "--plot x_c --format jpg", {"--format jpg", "pdf, svg or png"}, out);
+      checkBadInput(dir, cat(fig, {"--still", "0", "--size", size}), {std::string("--size ") + size, "WIDTHxHEIGHT"}, out);
+    checkBadInput(dir, cat(fig, {"--plot", "x_c", "--format", "jpg"}), {"--format jpg", "pdf, svg or png"}, out);
   }
   SUBCASE("malformed config, bad gains") {
     writeFile(dir / "malformed.json", "{\"lab\": \"slider_crank\",,}");
-    checkBadInput(dir, fig + "--config malformed.json", {"malformed.json", "expected valid JSON"}, out);
+    checkBadInput(dir, cat(fig, {"--config", "malformed.json"}), {"malformed.json", "expected valid JSON"}, out);
     writeFile(dir / "gains_big.json", R"({"gains": {"kp_x": 1e9}})");
-    checkBadInput(dir, fig + "--gains gains_big.json", {"gains_big.json", "/gains/kp_x"}, out);
-    checkBadInput(dir, "figure no_such_lab --out out", {"unknown lab \"no_such_lab\""}, out);
+    checkBadInput(dir, cat(fig, {"--gains", "gains_big.json"}), {"gains_big.json", "/gains/kp_x"}, out);
+    checkBadInput(dir, {"figure", "no_such_lab", "--out", "out"}, {"unknown lab \"no_such_lab\""}, out);
   }
   SUBCASE("bad input leaves an earlier figure run intact") {
-    REQUIRE(dynlab(dir, fig + "--plot x_c").code == 0);
+    REQUIRE(dynlab(dir, cat(fig, {"--plot", "x_c"})).code == 0);
     const auto before = snapshot(out);
-    const Result r = dynlab(dir, fig + "--plot q9");
+    const Result r = dynlab(dir, cat(fig, {"--plot", "q9"}));
     CHECK(r.code == 2);
     CHECK(snapshot(out) == before);
   }

@@ -50,8 +50,8 @@ TEST_CASE("every title of a lab's figure set stays on the page, at every size") 
   // The stiff-wall scenario: the longest titles ("Impedance control (stiff_wall): push response: ...").
   for (const auto& [w, h] : {std::pair{320, 240}, std::pair{640, 480}, std::pair{800, 450}, std::pair{1920, 1080}}) {
     const std::string size = std::to_string(w) + "x" + std::to_string(h), out = "f_" + size;
-    const Result r = dynlab(dir, "figure impedance --scenario stiff_wall --duration 0.3 --engine hand --format png --size " +
-                                     size + " --out " + out);
+    const Result r = dynlab(dir, {"figure", "impedance", "--scenario", "stiff_wall", "--duration", "0.3", "--engine", "hand",
+                                  "--format", "png", "--size", size, "--out", out});
     REQUIRE_MESSAGE(r.code == 0, r.err);
     const auto plots = plotsIn(dir / out, ".png");
     REQUIRE(plots.size() >= 5);
@@ -68,26 +68,29 @@ TEST_CASE("every title of a lab's figure set stays on the page, at every size") 
 
 TEST_CASE("plot titles use the lab's display name, not its id") {
   TempDir dir("figure_title_name");
-  const Result r = dynlab(dir, "figure slider_crank --plot x_c --duration 0.3 --engine hand --format svg --out f");
+  const Result r = dynlab(
+      dir, {"figure", "slider_crank", "--plot", "x_c", "--duration", "0.3", "--engine", "hand", "--format", "svg", "--out", "f"});
   REQUIRE_MESSAGE(r.code == 0, r.err);
   const std::string svg = svgText(readFile(dir / "f/plot_x_c.svg"));
   CHECK(svg.find("Slider crank") != std::string::npos);
   CHECK(svg.find("slider_crank") == std::string::npos);
-  const Result s = dynlab(dir, "figure impedance --scenario stiff_wall --plot F_ext_x --duration 0.3 --engine hand --format svg --out g");
+  const Result s = dynlab(dir, {"figure", "impedance", "--scenario", "stiff_wall", "--plot", "F_ext_x", "--duration", "0.3",
+                                "--engine", "hand", "--format", "svg", "--out", "g"});
   REQUIRE_MESSAGE(s.code == 0, s.err);
   CHECK(svgText(readFile(dir / "g/plot_F_ext_x.svg")).find("Impedance control (stiff_wall)") != std::string::npos);
 }
 
 TEST_CASE("a figure's levels: the stiff wall is drawn where the scenario puts it, and only there") {
   TempDir dir("figure_levels");
-  const std::string plot = " --plot 'x, x_target' --duration 0.3 --engine hand --format svg";
-  REQUIRE(dynlab(dir, "figure impedance --scenario stiff_wall" + plot + " --out w").code == 0);
-  REQUIRE(dynlab(dir, "figure impedance" + plot + " --out n").code == 0);
+  const std::vector<std::string> plot = {"--plot", "x, x_target", "--duration", "0.3", "--engine", "hand", "--format", "svg"};
+  REQUIRE(dynlab(dir, cat(cat({"figure", "impedance", "--scenario", "stiff_wall"}, plot), {"--out", "w"})).code == 0);
+  REQUIRE(dynlab(dir, cat(cat({"figure", "impedance"}, plot), {"--out", "n"})).code == 0);
   CHECK(svgText(readFile(dir / "w/plot_x+x_target.svg")).find("wall (the tip touches it)") != std::string::npos);
   CHECK(svgText(readFile(dir / "n/plot_x+x_target.svg")).find("wall") == std::string::npos);  // no wall in the nominal run
   // A level that points nowhere: one line naming the file and its JSON path, exit 2.
   json config = json::parse(readFile(fs::path(DYNLAB_SOURCE_DIR) / "labs/impedance/impedance.json"));
   config["figures"][0]["levels"][0]["at"] = "/environment/no_such";
   writeFile(dir / "bad.json", config.dump());
-  checkBadInput(dir, "figure impedance --config bad.json --out b", {"bad.json", "/figures/0/levels/0/at"}, dir / "b");
+  checkBadInput(dir, {"figure", "impedance", "--config", "bad.json", "--out", "b"}, {"bad.json", "/figures/0/levels/0/at"},
+                dir / "b");
 }

@@ -26,9 +26,9 @@ bool has(const std::string& s, const std::string& part) { return s.find(part) !=
 
 TEST_CASE("dynlab figure --plot Y:X: x–y plots of both runs, legend and labels with units, same bytes twice") {
   TempDir dir("figure_xy");
-  const std::string cmd =
-      "figure slider_crank --out out --duration 0.3 --plot f_Ty:f_Tx --plot 'v_c : x_c' "
-      "--plot 'q2:q1, q3:q1, q2:q1' --plot 'f_des:x_d' --format svg";
+  const std::vector<std::string> cmd = {"figure", "slider_crank", "--out",    "out",       "--duration", "0.3",
+                                        "--plot", "f_Ty:f_Tx",    "--plot",   "v_c : x_c", "--plot",     "q2:q1, q3:q1, q2:q1",
+                                        "--plot", "f_des:x_d",    "--format", "svg"};
   const Result r = dynlab(dir, cmd);
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   REQUIRE(r.code == 0);
@@ -58,12 +58,15 @@ TEST_CASE("dynlab figure --plot Y:X: x–y plots of both runs, legend and labels
   CHECK(snapshot(dir / "out") == first);
 
   // One engine, PNG at the asked size; PDF's page too.
-  REQUIRE(dynlab(dir, "figure slider_crank --out png --duration 0.3 --engine hand --plot f_Ty:f_Tx --format png "
-                      "--size 640x640").code == 0);
+  REQUIRE(dynlab(dir, {"figure", "slider_crank", "--out", "png", "--duration", "0.3", "--engine", "hand", "--plot", "f_Ty:f_Tx",
+                       "--format", "png", "--size", "640x640"})
+              .code == 0);
   const std::string png = readFile(dir / "png/plot_f_Ty-vs-f_Tx.png");
   REQUIRE(png.compare(0, 8, "\x89PNG\r\n\x1a\n") == 0);
   CHECK(png.substr(16, 8) == std::string("\0\0\x02\x80\0\0\x02\x80", 8));  // IHDR: 640 x 640
-  REQUIRE(dynlab(dir, "figure slider_crank --out pdf --duration 0.3 --plot f_Ty:f_Tx --size 1024x768").code == 0);
+  REQUIRE(
+      dynlab(dir, {"figure", "slider_crank", "--out", "pdf", "--duration", "0.3", "--plot", "f_Ty:f_Tx", "--size", "1024x768"})
+          .code == 0);
   CHECK(has(readFile(dir / "pdf/plot_f_Ty-vs-f_Tx.pdf"), "/MediaBox [ 0 0 1024 768 ]"));
 }
 
@@ -75,7 +78,8 @@ TEST_CASE("dynlab figure: a rubric test's x–y plot is one of the lab's default
   REQUIRE(at != std::string::npos);
   config.replace(at, config.find('}', at) + 1 - at, R"("plot": {"x": "f_Tx", "columns": ["f_Ty"], "reference": "f_des"})");
   writeFile(dir / "cfg.json", config);
-  const Result r = dynlab(dir, "figure slider_crank --config cfg.json --out out --duration 0.3 --format svg --size 320x240");
+  const Result r = dynlab(dir, {"figure", "slider_crank", "--config", "cfg.json", "--out", "out", "--duration", "0.3", "--format",
+                                "svg", "--size", "320x240"});
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   REQUIRE(r.code == 0);
   const auto files = names(dir / "out");
@@ -89,12 +93,12 @@ TEST_CASE("dynlab figure: a rubric test's x–y plot is one of the lab's default
 TEST_CASE("dynlab figure --plot Y:X: bad specs exit 2 with one line naming them, and write nothing") {
   TempDir dir("figure_xy_bad");
   const fs::path out = dir / "out";
-  const std::string fig = "figure slider_crank --out out --duration 0.3 ";
-  checkBadInput(dir, fig + "--plot 'x_c, f_Ty:f_Tx'",
+  const std::vector<std::string> fig = {"figure", "slider_crank", "--out", "out", "--duration", "0.3"};
+  checkBadInput(dir, cat(fig, {"--plot", "x_c, f_Ty:f_Tx"}),
                 {"--plot x_c, f_Ty:f_Tx", "against t or every one against a column", "\"x_c\" is against t"}, out);
-  checkBadInput(dir, fig + "--plot f_Ty:f_Tz", {"--plot f_Ty:f_Tz", "unknown column \"f_Tz\"", "Y:X", "t, q1, q2"}, out);
-  checkBadInput(dir, fig + "--plot f_Ty:", {"--plot f_Ty:", "empty column name"}, out);
-  checkBadInput(dir, fig + "--plot q3:q2:q1", {"--plot q3:q2:q1", "has two ':'"}, out);
+  checkBadInput(dir, cat(fig, {"--plot", "f_Ty:f_Tz"}), {"--plot f_Ty:f_Tz", "unknown column \"f_Tz\"", "Y:X", "t, q1, q2"}, out);
+  checkBadInput(dir, cat(fig, {"--plot", "f_Ty:"}), {"--plot f_Ty:", "empty column name"}, out);
+  checkBadInput(dir, cat(fig, {"--plot", "q3:q2:q1"}), {"--plot q3:q2:q1", "has two ':'"}, out);
   // A bad spec among good ones: still nothing written.
-  checkBadInput(dir, fig + "--plot f_Ty:f_Tx --plot x_c:", {"--plot x_c:", "empty column name"}, out);
+  checkBadInput(dir, cat(fig, {"--plot", "f_Ty:f_Tx", "--plot", "x_c:"}), {"--plot x_c:", "empty column name"}, out);
 }

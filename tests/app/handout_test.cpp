@@ -29,7 +29,7 @@ std::string num(double x) {
 }
 
 std::vector<std::string> labNames(const TempDir& dir) {
-  const Result r = dynlab(dir, "list");
+  const Result r = dynlab(dir, {"list"});
   REQUIRE(r.code == 0);
   std::vector<std::string> names;
   std::istringstream in(r.out);
@@ -41,6 +41,31 @@ std::vector<std::string> labNames(const TempDir& dir) {
 
 bool has(const std::string& text, const std::string& what) { return text.find(what) != std::string::npos; }
 
+// A command line split into words as a POSIX shell splits one with no expansions in it: at spaces,
+// a '...' or "..." part kept whole without its quotes.
+std::vector<std::string> shellWords(const std::string& command) {
+  std::vector<std::string> words;
+  std::string word;
+  bool in_word = false;
+  char quote = 0;
+  for (const char c : command) {
+    if (quote) {
+      if (c == quote) quote = 0;
+      else word += c;
+    } else if (c == ' ' || c == '\t' || c == '\n') {
+      if (in_word) words.push_back(word);
+      word.clear();
+      in_word = false;
+    } else {
+      in_word = true;
+      if (c == '\'' || c == '"') quote = c;
+      else word += c;
+    }
+  }
+  if (in_word) words.push_back(word);
+  return words;
+}
+
 // The handout's example submission: its first ```json block.
 std::string exampleSubmission(const std::string& md) {
   const std::size_t at = md.find("```json\n");
@@ -50,20 +75,15 @@ std::string exampleSubmission(const std::string& md) {
 
 // What a test adds to a printed command so it stays quick and writes where the test looks: a short
 // run, no video or plots where the option exists, its own --out. The command itself is as printed.
-std::string quickened(const std::string& sub, int k) {
-  const std::string out = " --out o" + std::to_string(k);
-  if (sub == "run") return " --duration 0.4" + out;
-  if (sub == "figure") return " --duration 0.4 --engine hand --format svg" + out;
-  if (sub == "map") return " --duration 0.2 --out m" + std::to_string(k) + ".png";
-  if (sub == "grade" || sub == "compare") return " --no-plots" + out;
+std::vector<std::string> quickened(const std::string& sub, int k) {
+  const std::vector<std::string> out = {"--out", "o" + std::to_string(k)};
+  if (sub == "run") return cat({"--duration", "0.4"}, out);
+  if (sub == "figure") return cat({"--duration", "0.4", "--engine", "hand", "--format", "svg"}, out);
+  if (sub == "map") return {"--duration", "0.2", "--out", "m" + std::to_string(k) + ".png"};
+  if (sub == "grade" || sub == "compare") return cat({"--no-plots"}, out);
   if (sub == "handout") return out;
-  if (sub == "ui") return " --frames 2";
-  return "";
-}
-
-bool haveXvfb() {
-  static const bool have = std::system("command -v xvfb-run >/dev/null 2>&1 && command -v xauth >/dev/null 2>&1") == 0;
-  return have;
+  if (sub == "ui") return {"--frames", "2"};
+  return {};
 }
 
 }  // namespace
@@ -72,7 +92,7 @@ TEST_CASE("every lab's handout names every gain, test, scenario and metric with 
   TempDir dir("handout_every");
   for (const auto& lab : labNames(dir)) {
     INFO("lab ", lab);
-    const Result r = dynlab(dir, "handout " + lab + " --out h_" + lab);
+    const Result r = dynlab(dir, {"handout", lab, "--out", "h_" + lab});
     REQUIRE_MESSAGE(r.code == 0, r.err);
     const std::string md = readFile(dir / ("h_" + lab + "/handout.md"));
     const std::string html = readFile(dir / ("h_" + lab + "/handout.html"));
@@ -109,7 +129,7 @@ TEST_CASE("every dynlab command a handout prints runs as printed, in every lab")
   for (const auto& lab : labNames(dir)) {
     INFO("lab ", lab);
     const TempDir student("handout_commands_" + lab);  // one folder per lab: its own my_gains.json
-    REQUIRE(dynlab(dir, "handout " + lab + " --out h_" + lab + " --format md").code == 0);
+    REQUIRE(dynlab(dir, {"handout", lab, "--out", "h_" + lab, "--format", "md"}).code == 0);
     const std::string md = readFile(dir / ("h_" + lab + "/handout.md"));
     const std::string example = exampleSubmission(md);
     // Every code span that is a dynlab command, once.
@@ -120,13 +140,14 @@ TEST_CASE("every dynlab command a handout prints runs as printed, in every lab")
     int k = 0, ran = 0;
     for (const auto& command : commands) {
       INFO("command: ", command);
-      std::istringstream words(command);
-      std::string word, sub, args;
-      words >> word >> sub;
+      // The words a student's shell makes of it: nothing in it is expanded, quotes group words.
+      CHECK_MESSAGE(command.find_first_of("$`\\|&;<>()*?[]{}~!") == std::string::npos, "a shell would expand part of it");
+      const std::vector<std::string> words = shellWords(command);
       // "`dynlab grade`" in a sentence names a command; a command has its argument.
-      if (!(words >> word) || word[0] == '-') continue;
-      args = sub;
-      do {
+      if (words.size() < 3 || words[2][0] == '-') continue;
+      const std::string sub = words[1];
+      std::vector<std::string> args = {sub};
+      for (std::string word : std::vector<std::string>(words.begin() + 2, words.end())) {
         // A file it names: the repository's (labs/...: run from its root), else the student's submission.
         if (word.size() > 5 && word.substr(word.size() - 5) == ".json") {
           if (fs::exists(fs::path(DYNLAB_SOURCE_DIR) / word)) {
@@ -136,9 +157,9 @@ TEST_CASE("every dynlab command a handout prints runs as printed, in every lab")
             writeFile(student / word, example);
           }
         }
-        args += " " + word;
-      } while (words >> word);
-      args += quickened(sub, ++k);
+        args.push_back(word);
+      }
+      args = cat(args, quickened(sub, ++k));
       ++ran;
       Result r;
       if (sub == "ui") {
@@ -146,11 +167,11 @@ TEST_CASE("every dynlab command a handout prints runs as printed, in every lab")
           std::cout << "note: xvfb-run not found, `" << command << "` not run\n";
           continue;
         }
-        r = shell(student, "xvfb-run -a -s '-screen 0 1600x900x24' " + quote(DYNLAB_BIN) + " " + args);
+        r = run(student, inXvfb(cat({DYNLAB_BIN}, args), "1600x900"));
       } else {
         r = dynlab(student, args);
       }
-      INFO("ran: dynlab ", args, "\nstdout: ", r.out, "\nstderr: ", r.err);
+      INFO("ran: dynlab ", shown(args), "\nstdout: ", r.out, "\nstderr: ", r.err);
       // 0, or 1 for a run the watchdog stopped (the defaults of some labs are meant to fail a scenario).
       CHECK((r.code == 0 || (r.code == 1 && (sub == "run" || sub == "figure"))));
     }
@@ -166,8 +187,8 @@ TEST_CASE("the handout follows the config: a changed threshold, bound and window
   config["gains"]["kp_x"]["max"] = 12345;
   config["metrics"]["settle_time"] = 0.75;
   writeFile(dir / "changed.json", config.dump());
-  REQUIRE(dynlab(dir, "handout slider_crank --out a").code == 0);
-  const Result r = dynlab(dir, "handout slider_crank --config changed.json --out b --format md");
+  REQUIRE(dynlab(dir, {"handout", "slider_crank", "--out", "a"}).code == 0);
+  const Result r = dynlab(dir, {"handout", "slider_crank", "--config", "changed.json", "--out", "b", "--format", "md"});
   REQUIRE_MESSAGE(r.code == 0, r.err);
   const std::string before = readFile(dir / "a/handout.md"), after = readFile(dir / "b/handout.md");
   CHECK_FALSE(has(before, "0.0042"));
@@ -180,14 +201,14 @@ TEST_CASE("the handout follows the config: a changed threshold, bound and window
   CHECK(has(after, "**" + num(15 - 3 + 7) + "**"));  // the total follows
   CHECK_FALSE(fs::exists(dir / "b/handout.html"));  // only the format asked for
   // The same inputs give the same bytes.
-  REQUIRE(dynlab(dir, "handout slider_crank --out c").code == 0);
+  REQUIRE(dynlab(dir, {"handout", "slider_crank", "--out", "c"}).code == 0);
   CHECK(readFile(dir / "c/handout.md") == before);
   CHECK(readFile(dir / "c/handout.html") == readFile(dir / "a/handout.html"));
 }
 
 TEST_CASE("the HTML handout is self-contained: no external reference of any kind") {
   TempDir dir("handout_html");
-  REQUIRE(dynlab(dir, "handout slider_crank --out h --format html").code == 0);
+  REQUIRE(dynlab(dir, {"handout", "slider_crank", "--out", "h", "--format", "html"}).code == 0);
   const std::string html = readFile(dir / "h/handout.html");
   CHECK(html.rfind("<!doctype html>", 0) == 0);
   CHECK(has(html, "<table>"));
@@ -197,13 +218,15 @@ TEST_CASE("the HTML handout is self-contained: no external reference of any kind
 
 TEST_CASE("bad LAB, --out or --format: one line, exit 2, nothing written") {
   TempDir dir("handout_bad");
-  checkBadInput(dir, "handout no_such_lab --out h", {"no_such_lab"}, dir / "h");
+  checkBadInput(dir, {"handout", "no_such_lab", "--out", "h"}, {"no_such_lab"}, dir / "h");
   writeFile(dir / "a_file", "x");
-  checkBadInput(dir, "handout slider_crank --out a_file/h", {"a_file"}, dir / "a_file/h");
-  checkBadInput(dir, "handout slider_crank --out h --format pdf", {"pdf", "print it to PDF from a browser"}, dir / "h");
-  checkBadInput(dir, "handout slider_crank --out h --format docx", {"docx"}, dir / "h");
+  checkBadInput(dir, {"handout", "slider_crank", "--out", "a_file/h"}, {"a_file"}, dir / "a_file/h");
+  checkBadInput(dir, {"handout", "slider_crank", "--out", "h", "--format", "pdf"}, {"pdf", "print it to PDF from a browser"},
+                dir / "h");
+  checkBadInput(dir, {"handout", "slider_crank", "--out", "h", "--format", "docx"}, {"docx"}, dir / "h");
   json config = json::parse(defaultConfigText());
   config["metric_docs"]["f_rms"]["window"] = "from t = {/metrics/no_such} s on";
   writeFile(dir / "bad.json", config.dump());
-  checkBadInput(dir, "handout slider_crank --config bad.json --out h", {"bad.json", "/metric_docs/f_rms/window", "/metrics/no_such"}, dir / "h");
+  checkBadInput(dir, {"handout", "slider_crank", "--config", "bad.json", "--out", "h"},
+                {"bad.json", "/metric_docs/f_rms/window", "/metrics/no_such"}, dir / "h");
 }

@@ -1,7 +1,7 @@
 // Hostile input through the real binary: a corpus built per test (UTF-16, Latin-1, cut UTF-8, a
 // NUL, duplicate keys, a FIFO, a directory, a symlink to /etc/passwd, 20 MB, deep nesting, an empty
 // file, odd file names) given to grade, grade --replay, run --gains/--config and figure --gains.
-// Every case runs under `timeout 20` (a hang is exit 124, a failure here), and must give exit 2,
+// Every case runs under a 20 s timeout (a hang is a kill, a failure here), and must give exit 2,
 // one line of valid UTF-8 on stderr naming the file and what was wrong, nothing written by
 // run/figure, and for grade a results.json that `dynlab check-results` accepts with score 0.
 // Then diverging gains through `dynlab run`, a grade cut short by its time budget, and an
@@ -24,9 +24,10 @@ const std::string kExamples = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_cra
 // A valid, stable submission that students have too (the full-credit one stays in instructor/).
 const std::string kStable = kExamples + "mediocre.json";
 
-// dynlab ARGS in dir, killed after 20 s: a blocking open() shows up as exit 124.
-Result timedDynlab(const TempDir& dir, const std::string& args) {
-  return shell(dir, "timeout 20 " + quote(DYNLAB_BIN) + " " + args);
+// dynlab ARGS in dir, killed after 20 s: a blocking open() shows up as a kill (exit 137, timed_out).
+Result timedDynlab(const TempDir& dir, const std::vector<std::string>& args, ProcessOptions o = {}) {
+  o.timeout_s = 20;
+  return dynlab(dir, args, o);
 }
 
 // One hostile file: its name in the test dir, how the message shows that name, and words the
@@ -110,10 +111,11 @@ void checkMessage(const Result& r, const Hostile& h, const std::string& file_sho
 TEST_CASE("hostile files given to run --gains/--config and figure --gains: exit 2, one line, nothing written") {
   TempDir dir("hostile_run");
   for (const Hostile& h : buildCorpus(dir)) {
-    for (const std::string cmd : {"run slider_crank --duration 0.2 --gains=", "run slider_crank --duration 0.2 --config=",
-                                  "figure slider_crank --duration 0.2 --gains="}) {
-      INFO("dynlab ", cmd, h.shown);
-      const Result r = timedDynlab(dir, cmd + quote(h.name) + " --out out");
+    // (command, option): the file name joined to the option, one argument
+    for (const auto& c :
+         std::vector<std::pair<std::string, std::string>>{{"run", "--gains="}, {"run", "--config="}, {"figure", "--gains="}}) {
+      INFO("dynlab ", c.first, " slider_crank --duration 0.2 ", c.second, h.shown);
+      const Result r = timedDynlab(dir, {c.first, "slider_crank", "--duration", "0.2", c.second + h.name, "--out", "out"});
       checkMessage(r, h, h.shown);
       CHECK(r.out.empty());
       CHECK_FALSE(fs::exists(dir / "out"));
@@ -125,13 +127,13 @@ TEST_CASE("hostile submissions graded: exit 2, a valid results.json with score 0
   TempDir dir("hostile_grade");
   for (const Hostile& h : buildCorpus(dir)) {
     INFO("dynlab grade ", h.shown);
-    const Result r = timedDynlab(dir, "grade --out out --no-plots -- " + quote(h.name));
+    const Result r = timedDynlab(dir, {"grade", "--out", "out", "--no-plots", "--", h.name});
     checkMessage(r, h, h.shown);
     // The results set, and nothing else; Gradescope's shape checked by the binary itself.
     const auto written = snapshot(dir / "out");
     CHECK(written.size() == 3);
     CHECK(written.count("results.json") == 1);
-    const Result check = timedDynlab(dir, "check-results out/results.json");
+    const Result check = timedDynlab(dir, {"check-results", "out/results.json"});
     CHECK_MESSAGE(check.code == 0, check.err);
     const json results = json::parse(readFile(dir / "out/results.json"));
     CHECK(results.at("score") == 0.0);
@@ -142,14 +144,14 @@ TEST_CASE("hostile submissions graded: exit 2, a valid results.json with score 0
     for (const auto& [name, text] : written) CHECK(text.find(passwdStart()) == std::string::npos);
 
     // --replay re-grades the same failure to the same results: no abort (was exit 134), exit 0.
-    const Result replay = timedDynlab(dir, "grade --replay out/results.json -- " + quote(h.name));
+    const Result replay = timedDynlab(dir, {"grade", "--replay", "out/results.json", "--", h.name});
     INFO("replay: ", replay.out, replay.err);
     CHECK(replay.code == 0);
     CHECK(replay.out.find("replay: match") != std::string::npos);
     fs::remove_all(dir / "out");
 
     // The same file as the results to replay against: an input error about it.
-    const Result as_results = timedDynlab(dir, "grade " + quote(kStable) + " --replay=" + quote(h.name));
+    const Result as_results = timedDynlab(dir, {"grade", kStable, "--replay=" + h.name});
     checkMessage(as_results, h, h.shown);
   }
 }
@@ -157,16 +159,16 @@ TEST_CASE("hostile submissions graded: exit 2, a valid results.json with score 0
 TEST_CASE("a UTF-8 byte order mark is accepted everywhere; a lone surrogate or overlong form is not UTF-8") {
   TempDir dir("hostile_bom");
   writeFile(dir / "bom.json", "\xEF\xBB\xBF" + readFile(kStable));
-  const Result g = timedDynlab(dir, "grade bom.json --out out --no-plots");
+  const Result g = timedDynlab(dir, {"grade", "bom.json", "--out", "out", "--no-plots"});
   INFO(g.err);
   CHECK(g.code == 0);
   CHECK(json::parse(readFile(dir / "out/results.json")).at("score").get<double>() > 0);
-  CHECK(timedDynlab(dir, "run slider_crank --duration 0.1 --gains bom.json --out run").code == 0);
+  CHECK(timedDynlab(dir, {"run", "slider_crank", "--duration", "0.1", "--gains", "bom.json", "--out", "run"}).code == 0);
   // Encoded surrogate (ED A0 80) and overlong "/" (C0 AF): well-formed UTF-8 forbids both.
   for (const std::string bad : {"\xED\xA0\x80", "\xC0\xAF"}) {
     const std::string text = R"({"lab": "slider_crank", "note": ")" + bad + "\"}";
     writeFile(dir / "bad.json", text);
-    const Result r = timedDynlab(dir, "run slider_crank --gains bad.json --out out2");
+    const Result r = timedDynlab(dir, {"run", "slider_crank", "--gains", "bad.json", "--out", "out2"});
     CHECK(r.code == 2);
     CHECK(r.err.find("at offset " + offsetOf(text, bad) + " is not valid UTF-8") != std::string::npos);
   }
@@ -176,8 +178,8 @@ TEST_CASE("a UTF-8 byte order mark is accepted everywhere; a lone surrogate or o
 
 TEST_CASE("dynlab run with diverging gains: the grader's watchdog sentence, truthful statuses, exit 1") {
   TempDir dir("hostile_unstable");
-  const std::string gains = quote(kExamples + "unstable_integral.json");
-  const Result r = timedDynlab(dir, "run slider_crank --gains " + gains + " --out out");
+  const std::string gains = kExamples + "unstable_integral.json";
+  const Result r = timedDynlab(dir, {"run", "slider_crank", "--gains", gains, "--out", "out"});
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   CHECK(r.code == 1);
   const std::string sentence = "unstable: the rail force left its safe range [-500, 500] at t = ";
@@ -197,13 +199,13 @@ TEST_CASE("dynlab run with diverging gains: the grader's watchdog sentence, trut
     CHECK(trace.rows.back()[std::size_t(trace.col("t"))] == doctest::Approx(e.at("stopped_at").get<double>()));
   }
   // The exact sentence the grader gives the same gains in its nominal scenario.
-  const Result g = timedDynlab(dir, "grade " + gains + " --out grade --no-plots");
+  const Result g = timedDynlab(dir, {"grade", gains, "--out", "grade", "--no-plots"});
   CHECK(g.code == 0);
   const json results = json::parse(readFile(dir / "grade/results.json"));
   CHECK(summary["engines"]["hand"]["status"] == results["extra_data"]["scenarios"]["nominal"]["status"]);
 
   // Stable gains: both engines complete, with metrics and their agreement.
-  const Result ok = timedDynlab(dir, "run slider_crank --duration 0.5 --gains " + quote(kStable) + " --out good");
+  const Result ok = timedDynlab(dir, {"run", "slider_crank", "--duration", "0.5", "--gains", kStable, "--out", "good"});
   CHECK(ok.code == 0);
   const json fine = json::parse(readFile(dir / "good/summary.json"));
   CHECK(fine.at("status") == "ok");
@@ -222,11 +224,12 @@ TEST_CASE("a grade cut short by the time budget exits 4 with a valid results.jso
   config["simulation"]["duration"] = 15.0;
   config["rubric"]["watchdog"]["max_steps"] = 3000000;
   writeFile(dir / "slow.json", config.dump());
-  const Result r = timedDynlab(dir, "grade " + quote(kStable) + " --config slow.json --time-budget 1 --no-plots --out out");
+  const Result r =
+      timedDynlab(dir, {"grade", kStable, "--config", "slow.json", "--time-budget", "1", "--no-plots", "--out", "out"});
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   CHECK(r.code == 4);
   CHECK(r.err.find("time budget of 1 s ran out") != std::string::npos);
-  CHECK(timedDynlab(dir, "check-results out/results.json").code == 0);
+  CHECK(timedDynlab(dir, {"check-results", "out/results.json"}).code == 0);
   const json results = json::parse(readFile(dir / "out/results.json"));
   CHECK(results.dump().find("not graded: the grading time budget ran out") != std::string::npos);
 }
@@ -234,7 +237,7 @@ TEST_CASE("a grade cut short by the time budget exits 4 with a valid results.jso
 TEST_CASE("an exception that escapes a command: one line 'error: internal: ...', exit 3, no abort") {
   TempDir dir("hostile_internal");
   writeFile(dir / "boom.json", readFile(kStable));
-  const Result r = shell(dir, "DYNLAB_FAULT_INJECTION=throw:boom timeout 20 " + quote(DYNLAB_BIN) + " grade boom.json --out out");
+  const Result r = timedDynlab(dir, {"grade", "boom.json", "--out", "out"}, withEnv({{"DYNLAB_FAULT_INJECTION", "throw:boom"}}));
   INFO("stderr: ", r.err);
   CHECK(r.code == 3);
   CHECK(r.err == "error: internal: injected fault for boom\n");

@@ -30,7 +30,7 @@ std::vector<fs::path> jsonFiles(const fs::path& dir) {
 
 // Score and max score of `dynlab grade FILE`.
 std::pair<double, double> grade(const TempDir& dir, const fs::path& file) {
-  const Result r = dynlab(dir, "grade " + quote(file.string()) + " --no-plots --out g");
+  const Result r = dynlab(dir, {"grade", file.string(), "--no-plots", "--out", "g"});
   INFO(file, "\n", r.err);
   REQUIRE((r.code == 0 || r.code == 2));
   const json res = json::parse(readFile(dir / "g/results.json"));
@@ -89,7 +89,7 @@ TEST_CASE("the slider crank's instructor/good.json scores full marks" * doctest:
 
 TEST_CASE("the Gradescope bundle has the students' examples and no instructor folder") {
   const TempDir dir("instructor_bundle");
-  REQUIRE(dynlab(dir, "autograder slider_crank --out ag.zip").code == 0);
+  REQUIRE(dynlab(dir, {"autograder", "slider_crank", "--out", "ag.zip"}).code == 0);
   const std::map<std::string, std::string> zip = readZip(dir / "ag.zip");
   REQUIRE(zip.count("run_autograder") == 1);
   CHECK(zip.count("source/labs/slider_crank/examples/mediocre.json") == 1);
@@ -102,12 +102,13 @@ TEST_CASE("the Gradescope bundle has the students' examples and no instructor fo
 
 TEST_CASE("a student copy made with git archive leaves instructor/ out (export-ignore)") {
   const TempDir dir("instructor_git");
-  const std::string git = "git -C " + quote(DYNLAB_SOURCE_DIR);
-  if (shell(dir, git + " rev-parse --is-inside-work-tree").code != 0) {
+  const std::vector<std::string> git = {"git", "-C", DYNLAB_SOURCE_DIR};
+  if (run(dir, cat(git, {"rev-parse", "--is-inside-work-tree"})).code != 0) {
     MESSAGE("not a git checkout: nothing to check");
     return;
   }
-  const Result r = shell(dir, git + " check-attr export-ignore -- labs/slider_crank/instructor/good.json labs/slider_crank/examples/mediocre.json");
+  const Result r = run(dir, cat(git, {"check-attr", "export-ignore", "--", "labs/slider_crank/instructor/good.json",
+                                      "labs/slider_crank/examples/mediocre.json"}));
   REQUIRE(r.code == 0);
   CHECK(r.out.find("instructor/good.json: export-ignore: set") != std::string::npos);
   CHECK(r.out.find("mediocre.json: export-ignore: unspecified") != std::string::npos);
@@ -116,7 +117,7 @@ TEST_CASE("a student copy made with git archive leaves instructor/ out (export-i
 TEST_CASE("the instructor cases are skipped only in a student copy: files git tracks are on disk") {
   // A staff checkout that lost its instructor folders would skip those cases silently: not here.
   const TempDir dir("instructor_present");
-  const Result r = shell(dir, "git -C " + quote(DYNLAB_SOURCE_DIR) + " ls-files -- 'labs/*/instructor/*'");
+  const Result r = run(dir, {"git", "-C", DYNLAB_SOURCE_DIR, "ls-files", "--", "labs/*/instructor/*"});
   if (r.code != 0) {
     MESSAGE("not a git checkout (a student copy): nothing to check");
     return;

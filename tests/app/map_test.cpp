@@ -45,12 +45,12 @@ dyn::app::MapPicture longLabelMap(bool values) {
 
 TEST_CASE("a 5 × 4 screening map: PNG, SVG and PDF, the same bytes on a rerun") {
   TempDir dir("map_files");
-  const std::string grid = "map slider_crank --x kp_f=0:2:5 --y delay=0:0.04:4";
+  const std::vector<std::string> grid = {"map", "slider_crank", "--x", "kp_f=0:2:5", "--y", "delay=0:0.04:4"};
   for (const std::string ext : {"png", "svg", "pdf"}) {
     INFO(ext);
-    const Result a = dynlab(dir, grid + " --out a." + ext);
+    const Result a = dynlab(dir, cat(grid, {"--out", "a." + ext}));
     REQUIRE_MESSAGE(a.code == 0, a.err);
-    REQUIRE(dynlab(dir, grid + " --out b." + ext).code == 0);
+    REQUIRE(dynlab(dir, cat(grid, {"--out", "b." + ext})).code == 0);
     const std::string bytes = readFile(dir / ("a." + ext));
     if (ext == "png") CHECK(magicOf(dir / "a.png") == "\x89PNG\r\n\x1a\n");
     if (ext == "svg") CHECK(bytes.find("<svg") != std::string::npos);
@@ -62,10 +62,11 @@ TEST_CASE("a 5 × 4 screening map: PNG, SVG and PDF, the same bytes on a rerun")
 
 TEST_CASE("--sim: the simulated map is the same with one thread or two") {
   TempDir dir("map_sim");
-  const std::string grid = "map slider_crank --x kp_f=0.5:1.5:3 --y delay=0.01:0.03:2 --sim --duration 0.4 --metric f_rms";
-  const Result one = dynlab(dir, grid + " --jobs 1 --out one.png --data one.csv");
+  const std::vector<std::string> grid = {"map",   "slider_crank", "--x", "kp_f=0.5:1.5:3", "--y",  "delay=0.01:0.03:2",
+                                         "--sim", "--duration",   "0.4", "--metric",       "f_rms"};
+  const Result one = dynlab(dir, cat(grid, {"--jobs", "1", "--out", "one.png", "--data", "one.csv"}));
   REQUIRE_MESSAGE(one.code == 0, one.err);
-  REQUIRE(dynlab(dir, grid + " --jobs 2 --out two.png --data two.csv").code == 0);
+  REQUIRE(dynlab(dir, cat(grid, {"--jobs", "2", "--out", "two.png", "--data", "two.csv"})).code == 0);
   CHECK(readFile(dir / "one.csv") == readFile(dir / "two.csv"));
   CHECK(readFile(dir / "one.png") == readFile(dir / "two.png"));
   // Every point was simulated (sim_stable 0 or 1, never -1).
@@ -76,7 +77,8 @@ TEST_CASE("--sim: the simulated map is the same with one thread or two") {
 
 TEST_CASE("screening: proportional law unstable under delay once k_pf ≥ 1, stable below") {
   TempDir dir("map_p");
-  const Result r = dynlab(dir, "map slider_crank --x kp_f=0:2:9 --y delay=0.005:0.05:4 --out m.png --data m.csv");
+  const Result r =
+      dynlab(dir, {"map", "slider_crank", "--x", "kp_f=0:2:9", "--y", "delay=0.005:0.05:4", "--out", "m.png", "--data", "m.csv"});
   REQUIRE_MESSAGE(r.code == 0, r.err);
   const Csv csv = readCsv(dir / "m.csv");
   REQUIRE(csv.rows.size() == 36);
@@ -92,7 +94,8 @@ TEST_CASE("screening: integral law unstable beyond the delay margin π/(2 k_if)"
   // As it runs (sampled every dt = 1 ms, the sum updated after each reading): L(z) = k dt z^{−(N−1)}/(z − 1),
   // a loop delay of N dt − dt/2 and a margin π/(2ω_c), ω_c = (2/dt) asin(k dt/2) (≈ π/(2 k_if)).
   TempDir dir("map_i");
-  const Result r = dynlab(dir, "map slider_crank --x ki_f=10:200:20 --y delay=0.005:0.05:10 --out m.svg --data m.csv");
+  const Result r = dynlab(
+      dir, {"map", "slider_crank", "--x", "ki_f=10:200:20", "--y", "delay=0.005:0.05:10", "--out", "m.svg", "--data", "m.csv"});
   REQUIRE_MESSAGE(r.code == 0, r.err);
   const Csv csv = readCsv(dir / "m.csv");
   REQUIRE(csv.rows.size() == 200);
@@ -115,19 +118,22 @@ TEST_CASE("screening: integral law unstable beyond the delay margin π/(2 k_if)"
 TEST_CASE("bad axis specs and metrics: one line, exit 2, nothing written") {
   TempDir dir("map_bad");
   const fs::path out = dir / "m.png";
-  const std::string y = " --y delay=0:0.05:4 --out m.png";
-  checkBadInput(dir, "map slider_crank --x kq_f=0:2:5" + y, {"--x", "kq_f"}, out);
-  checkBadInput(dir, "map slider_crank --x kp_f=0:2" + y, {"--x", "kp_f=0:2"}, out);
-  checkBadInput(dir, "map slider_crank --x kp_f=0:2:5:1" + y, {"--x", "kp_f=0:2:5:1"}, out);
-  checkBadInput(dir, "map slider_crank --x kp_f=zero:2:5" + y, {"--x", "kp_f=zero:2:5"}, out);
-  checkBadInput(dir, "map slider_crank --x kp_f=0:2:201" + y, {"--x", "201"}, out);
-  checkBadInput(dir, "map slider_crank --x kp_f=0:2:1" + y, {"--x", "1"}, out);
-  checkBadInput(dir, "map slider_crank --x kp_f=0:20:5" + y, {"--x", "20", "kp_f"}, out);
-  checkBadInput(dir, "map slider_crank --x kp_f=0:2:5 --y /controller/nope=0:1:3 --out m.png", {"--y", "/controller/nope"}, out);
-  checkBadInput(dir, "map slider_crank --x kp_f=0:2:5 --metric f_rms" + y, {"--metric", "f_rms", "--sim"}, out);
-  checkBadInput(dir, "map slider_crank --x kp_f=0:2:5 --metric nope" + y, {"--metric", "nope"}, out);
-  checkBadInput(dir, "map no_lab --x kp_f=0:2:5" + y, {"no_lab"}, out);
-  checkBadInput(dir, "map slider_crank --x kp_f=0:2:5 --y delay=0:0.05:4 --out m.gif", {"--out", "m.gif"}, dir / "m.gif");
+  const std::vector<std::string> y = {"--y", "delay=0:0.05:4", "--out", "m.png"};
+  checkBadInput(dir, cat({"map", "slider_crank", "--x", "kq_f=0:2:5"}, y), {"--x", "kq_f"}, out);
+  checkBadInput(dir, cat({"map", "slider_crank", "--x", "kp_f=0:2"}, y), {"--x", "kp_f=0:2"}, out);
+  checkBadInput(dir, cat({"map", "slider_crank", "--x", "kp_f=0:2:5:1"}, y), {"--x", "kp_f=0:2:5:1"}, out);
+  checkBadInput(dir, cat({"map", "slider_crank", "--x", "kp_f=zero:2:5"}, y), {"--x", "kp_f=zero:2:5"}, out);
+  checkBadInput(dir, cat({"map", "slider_crank", "--x", "kp_f=0:2:201"}, y), {"--x", "201"}, out);
+  checkBadInput(dir, cat({"map", "slider_crank", "--x", "kp_f=0:2:1"}, y), {"--x", "1"}, out);
+  checkBadInput(dir, cat({"map", "slider_crank", "--x", "kp_f=0:20:5"}, y), {"--x", "20", "kp_f"}, out);
+  checkBadInput(dir, {"map", "slider_crank", "--x", "kp_f=0:2:5", "--y", "/controller/nope=0:1:3", "--out", "m.png"},
+                {"--y", "/controller/nope"}, out);
+  checkBadInput(dir, cat({"map", "slider_crank", "--x", "kp_f=0:2:5", "--metric", "f_rms"}, y), {"--metric", "f_rms", "--sim"},
+                out);
+  checkBadInput(dir, cat({"map", "slider_crank", "--x", "kp_f=0:2:5", "--metric", "nope"}, y), {"--metric", "nope"}, out);
+  checkBadInput(dir, cat({"map", "no_lab", "--x", "kp_f=0:2:5"}, y), {"no_lab"}, out);
+  checkBadInput(dir, {"map", "slider_crank", "--x", "kp_f=0:2:5", "--y", "delay=0:0.05:4", "--out", "m.gif"}, {"--out", "m.gif"},
+                dir / "m.gif");
 }
 
 TEST_CASE("nothing of a map reaches the page's edge: long labels, legend and colour bar, at every size") {
@@ -149,7 +155,7 @@ TEST_CASE("nothing of a map reaches the page's edge: long labels, legend and col
 
 TEST_CASE("dynlab map: the grasp's long axis label stays on the page") {
   TempDir dir("map_cli_edges");
-  const Result r = dynlab(dir, "map grasp --x f_squeeze=1:6:6 --y mu=0.2:1:5 --out m.png");
+  const Result r = dynlab(dir, {"map", "grasp", "--x", "f_squeeze=1:6:6", "--y", "mu=0.2:1:5", "--out", "m.png"});
   REQUIRE_MESSAGE(r.code == 0, r.err);
   CHECK_FALSE(inkOf(dir / "m.png").at_edge);
 }

@@ -20,7 +20,7 @@
 using namespace dyn::test::cli;
 
 namespace {
-std::string model(const char* name) { return quote(std::string(DYNLAB_SOURCE_DIR) + "/assets/models/" + name); }
+std::string model(const char* name) { return std::string(DYNLAB_SOURCE_DIR) + "/assets/models/" + name; }
 
 double maxAbsColumn(const Csv& csv, const std::string& c) {
   double m = 0;
@@ -31,7 +31,8 @@ double maxAbsColumn(const Csv& csv, const std::string& c) {
 
 TEST_CASE("dynlab model unicycle.xml: the wheel beside the file rolls without slip, m v φ' sideways, in both engines") {
   TempDir dir("model_unicycle");
-  const Result r = dynlab(dir, "model " + model("unicycle.xml") + " --duration 2 --torque spin=0.05 --torque heading=0.002 --out out");
+  const Result r = dynlab(dir, {"model", model("unicycle.xml"), "--duration", "2", "--torque", "spin=0.05", "--torque",
+                                "heading=0.002", "--out", "out"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   CHECK(r.out.find("5 joints, 0 closures (0 of 0 rows kept), 2 degrees of freedom after closure") != std::string::npos);
@@ -76,7 +77,7 @@ TEST_CASE("dynlab model unicycle.xml: the wheel beside the file rolls without sl
 
 TEST_CASE("dynlab model pen_drop.xml: the pen lands on the table and at rest the table carries m g, half at each end") {
   TempDir dir("model_pen_drop");
-  const Result r = dynlab(dir, "model " + model("pen_drop.xml") + " --duration 1 --out out");
+  const Result r = dynlab(dir, {"model", model("pen_drop.xml"), "--duration", "1", "--out", "out"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   CHECK(r.out.find("contact tip: a ball of radius 0.006 m on body pen against the plane n·x = 0 m") != std::string::npos);
@@ -110,7 +111,7 @@ TEST_CASE("dynlab model pen_drop.xml: the pen lands on the table and at rest the
 
 TEST_CASE("dynlab model pen.xml: the pen-on-table arm falls onto its table, the contact pressing, never pulling or sinking") {
   TempDir dir("model_pen");
-  const Result r = dynlab(dir, "model " + model("pen.xml") + " --duration 1.5 --engine hand --out out");
+  const Result r = dynlab(dir, {"model", model("pen.xml"), "--duration", "1.5", "--engine", "hand", "--out", "out"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   const Csv hand = readCsv(dir / "out/trace.csv");
@@ -129,22 +130,25 @@ TEST_CASE("dynlab model pen.xml: the pen-on-table arm falls onto its table, the 
 TEST_CASE("dynlab model: a bad wheel or contact beside the file is one line naming the JSON path, exit 2, nothing written") {
   TempDir dir("model_contact_bad");
   writeFile(dir / "radius.json", R"({"rolling": [{"body": "wheel", "axle": [0, 1, 0], "radius": -0.1}]})");
-  checkBadInput(dir, "model " + model("unicycle.xml") + " --loops radius.json --out o", {"radius.json", "rolling[0].radius", "expected the wheel's radius"},
-                dir / "o");
+  checkBadInput(dir, {"model", model("unicycle.xml"), "--loops", "radius.json", "--out", "o"},
+                {"radius.json", "rolling[0].radius", "expected the wheel's radius"}, dir / "o");
   writeFile(dir / "bounce.json", R"({"contacts": [{"body": "pen", "point": [0, 0, 0], "restitution": 0.5}]})");
-  checkBadInput(dir, "model " + model("pen_drop.xml") + " --loops bounce.json --out o", {"bounce.json", "contacts[0].restitution", "unknown key", "no restitution"},
-                dir / "o");
+  checkBadInput(dir, {"model", model("pen_drop.xml"), "--loops", "bounce.json", "--out", "o"},
+                {"bounce.json", "contacts[0].restitution", "unknown key", "no restitution"}, dir / "o");
   writeFile(dir / "normal.json", R"({"contacts": [{"body": "pen", "point": [0, 0, 0], "normal": [0, 0, "up"]}]})");
-  checkBadInput(dir, "model " + model("pen_drop.xml") + " --loops normal.json --out o", {"normal.json", "contacts[0].normal[2]"}, dir / "o");
+  checkBadInput(dir, {"model", model("pen_drop.xml"), "--loops", "normal.json", "--out", "o"},
+                {"normal.json", "contacts[0].normal[2]"}, dir / "o");
   writeFile(dir / "body.json", R"({"rolling": [{"body": "hub", "axle": [0, 1, 0], "radius": 0.1}]})");
-  checkBadInput(dir, "model " + model("unicycle.xml") + " --loops body.json --out o", {"body.json", "rolling[0].body", "got 'hub'"}, dir / "o");
+  checkBadInput(dir, {"model", model("unicycle.xml"), "--loops", "body.json", "--out", "o"},
+                {"body.json", "rolling[0].body", "got 'hub'"}, dir / "o");
   writeFile(dir / "text.json", "rolling: yes");
-  checkBadInput(dir, "model " + model("unicycle.xml") + " --loops text.json --out o", {"text.json", "not JSON"}, dir / "o");
+  checkBadInput(dir, {"model", model("unicycle.xml"), "--loops", "text.json", "--out", "o"}, {"text.json", "not JSON"},
+                dir / "o");
 }
 
 TEST_CASE("dynlab figure pen_drop.xml: the contacts' forces plotted, the touchdowns in the energy books, the file read once") {
   TempDir dir("model_pen_figure");
-  const Result r = dynlab(dir, "figure " + model("pen_drop.xml") + " --duration 1 --out fig");
+  const Result r = dynlab(dir, {"figure", model("pen_drop.xml"), "--duration", "1", "--out", "fig"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   for (const char* f : {"plot_f_tip_normal+f_cap_normal.pdf", "plot_energy+work+impacts.pdf", "still_1.000.png"}) {
@@ -174,7 +178,7 @@ TEST_CASE("dynlab figure pen_drop.xml: the contacts' forces plotted, the touchdo
 TEST_CASE("dynlab bench FILE with wheels or contacts beside it: the hand step against Bullet's at equal order") {
   TempDir dir("model_bench_elements");
   for (const char* file : {"pen_drop.xml", "unicycle.xml"}) {
-    const Result r = dynlab(dir, "bench " + model(file) + " --steps 200 --json");
+    const Result r = dynlab(dir, {"bench", model(file), "--steps", "200", "--json"});
     INFO(file, r.out, r.err);
     REQUIRE(r.code == 0);
     const auto out = nlohmann::json::parse(r.out);

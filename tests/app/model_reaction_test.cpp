@@ -107,7 +107,7 @@ TEST_CASE("the pin force in dynlab model's trace balances the coupler, with acce
   // so in the extrapolated residual whole; bounding that by 1e-5 of the largest |f| times |C − B|
   // bounds the reported force's error by 1e-5 of its size.
   TempDir dir("model_reaction");
-  const Result r = dynlab(dir, "model " + quote(kFile) + " --engine hand --duration 1 --out out");
+  const Result r = dynlab(dir, {"model", kFile, "--engine", "hand", "--duration", "1", "--out", "out"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   const Csv csv = readCsv(dir / "out/trace.csv");

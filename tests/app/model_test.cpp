@@ -19,7 +19,7 @@ using namespace dyn::test::cli;
 using nlohmann::json;
 
 namespace {
-std::string model(const char* name) { return quote(std::string(DYNLAB_SOURCE_DIR) + "/assets/models/" + name); }
+std::string model(const char* name) { return std::string(DYNLAB_SOURCE_DIR) + "/assets/models/" + name; }
 
 // Pixels of a frame's right half (the panel fills the top-left) that differ from the background: the
 // mechanism drawn, in colour. −1 if the PNG does not load.
@@ -40,7 +40,7 @@ int drawnRightOfPanel(const fs::path& png) {
 
 TEST_CASE("dynlab model: the four-bar is read, run passive, and its trace keeps closure and energy") {
   TempDir dir("model_fourbar");
-  const Result r = dynlab(dir, "model " + model("fourbar.xml") + " --duration 1 --out out");
+  const Result r = dynlab(dir, {"model", model("fourbar.xml"), "--duration", "1", "--out", "out"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   CHECK(r.out.find("1 closure (2 of 3 rows kept), 1 degree of freedom after closure") != std::string::npos);
@@ -74,11 +74,11 @@ TEST_CASE("dynlab model: the four-bar is read, run passive, and its trace keeps 
   CHECK(r.out.find("agreement: max |q_hand − q_bullet|∞") != std::string::npos);
   // Same input, same bytes.
   const std::string first = readFile(dir / "out/trace.csv"), first_bt = readFile(dir / "out/trace_bullet.csv");
-  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 1 --out out").code == 0);
+  REQUIRE(dynlab(dir, {"model", model("fourbar.xml"), "--duration", "1", "--out", "out"}).code == 0);
   CHECK(readFile(dir / "out/trace.csv") == first);
   CHECK(readFile(dir / "out/trace_bullet.csv") == first_bt);
   // One engine: only its trace.
-  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.1 --engine hand --out hand_only").code == 0);
+  REQUIRE(dynlab(dir, {"model", model("fourbar.xml"), "--duration", "0.1", "--engine", "hand", "--out", "hand_only"}).code == 0);
   CHECK(fs::exists(dir / "hand_only/trace.csv"));
   CHECK_FALSE(fs::exists(dir / "hand_only/trace_bullet.csv"));
 }
@@ -86,11 +86,11 @@ TEST_CASE("dynlab model: the four-bar is read, run passive, and its trace keeps 
 TEST_CASE("dynlab model: hostile and unsupported files get one line and exit 2, nothing written") {
   TempDir dir("model_bad");
   writeFile(dir / "latin1.xml", "<mujoco model=\"caf\xE9\"/>");
-  checkBadInput(dir, "model latin1.xml --out o", {"latin1.xml", "not valid UTF-8"}, dir / "o");
+  checkBadInput(dir, {"model", "latin1.xml", "--out", "o"}, {"latin1.xml", "not valid UTF-8"}, dir / "o");
   writeFile(dir / "ball.xml", "<mujoco><worldbody><body name=\"b\"><joint name=\"s\" type=\"ball\"/>"
                               "<geom size=\"0.1\"/></body></worldbody></mujoco>");
-  checkBadInput(dir, "model ball.xml --out o", {"ball.xml", "joint 's'", "ball joint", "hinge and slide"}, dir / "o");
-  checkBadInput(dir, "model missing.xml --out o", {"missing.xml", "no such file"}, dir / "o");
+  checkBadInput(dir, {"model", "ball.xml", "--out", "o"}, {"ball.xml", "joint 's'", "ball joint", "hinge and slide"}, dir / "o");
+  checkBadInput(dir, {"model", "missing.xml", "--out", "o"}, {"missing.xml", "no such file"}, dir / "o");
   // A mesh that is a FIFO (MuJoCo would block opening it) and one linked to /dev/zero: refused before
   // MuJoCo reads anything, within a second.
   REQUIRE(::mkfifo((dir / "pipe.stl").c_str(), 0600) == 0);
@@ -99,15 +99,17 @@ TEST_CASE("dynlab model: hostile and unsupported files get one line and exit 2, 
     writeFile(dir / "mesh.xml", std::string("<mujoco><asset><mesh name=\"m\" file=\"") + mesh + "\"/></asset><worldbody><body><joint/>"
                                 "<geom type=\"mesh\" mesh=\"m\" contype=\"0\" conaffinity=\"0\"/></body></worldbody></mujoco>");
     const auto t0 = std::chrono::steady_clock::now();
-    checkBadInput(dir, "model mesh.xml --out o", {"mesh.xml", mesh}, dir / "o");
+    checkBadInput(dir, {"model", "mesh.xml", "--out", "o"}, {"mesh.xml", mesh}, dir / "o");
     CHECK(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < 1.0);
   }
-  checkBadInput(dir, "model " + model("fourbar.xml") + " --duration 600 --dt 1e-5 --out o", {"60000000 steps", "at most 2000000"}, dir / "o");
+  checkBadInput(dir, {"model", model("fourbar.xml"), "--duration", "600", "--dt", "1e-5", "--out", "o"},
+                {"60000000 steps", "at most 2000000"}, dir / "o");
 }
 
 TEST_CASE("dynlab run FILE.xml --engine both --video --frames: the model command's run, drawn from the file") {
   TempDir dir("model_video");
-  const Result r = dynlab(dir, "run " + model("fourbar.xml") + " --engine both --video --frames --duration 0.5 --out out");
+  const Result r =
+      dynlab(dir, {"run", model("fourbar.xml"), "--engine", "both", "--video", "--frames", "--duration", "0.5", "--out", "out"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   CHECK(r.out.find("1 closure (2 of 3 rows kept)") != std::string::npos);
@@ -118,11 +120,10 @@ TEST_CASE("dynlab run FILE.xml --engine both --video --frames: the model command
   std::size_t pngs = 0;
   for (const auto& e : fs::directory_iterator(dir / "out/frames")) pngs += e.path().extension() == ".png";
   CHECK(pngs == std::size_t(expected));
-  const std::string cmd = "ffprobe -v error -count_frames -select_streams v:0 -show_entries "
-                          "stream=nb_read_frames,pix_fmt,codec_name,width,height -of csv=p=0 " +
-                          quote((dir / "out/video.mp4").string()) + " > " + quote((dir / "probe.txt").string());
-  REQUIRE(std::system(cmd.c_str()) == 0);
-  std::string line = readFile(dir / "probe.txt");
+  const Result probe = run(dir, {"ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                                 "stream=nb_read_frames,pix_fmt,codec_name,width,height", "-of", "csv=p=0", "out/video.mp4"});
+  REQUIRE_MESSAGE(probe.code == 0, probe.err);
+  std::string line = probe.out;
   line.erase(line.find_last_not_of(" \r\n") + 1);
   CHECK(line == "h264,640,480,yuv420p," + std::to_string(expected));
   // The last frame: the mechanism drawn right of the panel (the panel fills the top-left), in colour.
@@ -130,20 +131,22 @@ TEST_CASE("dynlab run FILE.xml --engine both --video --frames: the model command
   std::snprintf(name, sizeof name, "%05d.png", expected - 1);
   CHECK(drawnRightOfPanel(dir / "out/frames" / name) > 2000);
   // `dynlab run FILE` is `dynlab model FILE`: the same trace, byte for byte.
-  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.5 --out same").code == 0);
+  REQUIRE(dynlab(dir, {"model", model("fourbar.xml"), "--duration", "0.5", "--out", "same"}).code == 0);
   CHECK(readFile(dir / "same/trace.csv") == readFile(dir / "out/trace.csv"));
   CHECK(readFile(dir / "same/trace_bullet.csv") == readFile(dir / "out/trace_bullet.csv"));
   CHECK_FALSE(fs::exists(dir / "same/video.mp4"));
   // Same input, same pixels: the frames of a rerun (hand only: no ghost) twice.
-  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.2 --engine hand --frames --out f1").code == 0);
-  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.2 --engine hand --frames --out f2").code == 0);
+  REQUIRE(dynlab(dir, {"model", model("fourbar.xml"), "--duration", "0.2", "--engine", "hand", "--frames", "--out", "f1"}).code ==
+          0);
+  REQUIRE(dynlab(dir, {"model", model("fourbar.xml"), "--duration", "0.2", "--engine", "hand", "--frames", "--out", "f2"}).code ==
+          0);
   CHECK(snapshot(dir / "f1/frames") == snapshot(dir / "f2/frames"));
   CHECK(snapshot(dir / "f1/frames").size() == 7);
 }
 
 TEST_CASE("dynlab figure FILE: plots and stills of the file's passive run, as for a lab") {
   TempDir dir("model_figure");
-  const Result r = dynlab(dir, "figure " + model("fourbar.xml") + " --duration 0.5 --out fig");
+  const Result r = dynlab(dir, {"figure", model("fourbar.xml"), "--duration", "0.5", "--out", "fig"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   // The coordinates, the energy books and the closure's force; stills at the start, middle and end.
@@ -155,33 +158,36 @@ TEST_CASE("dynlab figure FILE: plots and stills of the file's passive run, as fo
   // A still draws the mechanism right of its panel, in colour.
   CHECK(drawnRightOfPanel(dir / "fig/still_0.500.png") > 5000);
   // A URDF takes its loops from beside it, as dynlab model does.
-  REQUIRE(dynlab(dir, "figure " + model("fourbar.urdf") + " --plot f_pin_C_x --out urdf").code == 0);
+  REQUIRE(dynlab(dir, {"figure", model("fourbar.urdf"), "--plot", "f_pin_C_x", "--out", "urdf"}).code == 0);
   CHECK(fs::exists(dir / "urdf/plot_f_pin_C_x.pdf"));
   // Gains, scenarios and configs are a lab's: one line, exit 2, nothing written.
   writeFile(dir / "g.json", R"({"gains": {}})");
-  checkBadInput(dir, "figure " + model("fourbar.xml") + " --gains g.json --out o", {"--gains", "g.json", "passive"}, dir / "o");
-  checkBadInput(dir, "figure missing.xml --out o", {"missing.xml", "no such file"}, dir / "o");
+  checkBadInput(dir, {"figure", model("fourbar.xml"), "--gains", "g.json", "--out", "o"}, {"--gains", "g.json", "passive"},
+                dir / "o");
+  checkBadInput(dir, {"figure", "missing.xml", "--out", "o"}, {"missing.xml", "no such file"}, dir / "o");
 }
 
 TEST_CASE("dynlab run FILE: a lab's options and a missing file are bad input (one line, exit 2)") {
   TempDir dir("model_run_bad");
   writeFile(dir / "g.json", R"({"gains": {}})");
-  checkBadInput(dir, "run " + model("fourbar.xml") + " --gains g.json --out o", {"--gains", "fourbar.xml", "passive"}, dir / "o");
-  checkBadInput(dir, "run " + model("fourbar.xml") + " --scenario heavy_load --out o", {"--scenario", "passive"}, dir / "o");
-  checkBadInput(dir, "run missing.URDF --out o", {"missing.URDF", "no such file"}, dir / "o");
-  checkBadInput(dir, "run " + model("fourbar.xml") + " --duration 0 --out o", {"--duration", "(0, 600]"}, dir / "o");
+  checkBadInput(dir, {"run", model("fourbar.xml"), "--gains", "g.json", "--out", "o"}, {"--gains", "fourbar.xml", "passive"},
+                dir / "o");
+  checkBadInput(dir, {"run", model("fourbar.xml"), "--scenario", "heavy_load", "--out", "o"}, {"--scenario", "passive"},
+                dir / "o");
+  checkBadInput(dir, {"run", "missing.URDF", "--out", "o"}, {"missing.URDF", "no such file"}, dir / "o");
+  checkBadInput(dir, {"run", model("fourbar.xml"), "--duration", "0", "--out", "o"}, {"--duration", "(0, 600]"}, dir / "o");
 }
 
 TEST_CASE("dynlab bench FILE: the hand step at both orders, Bullet's and MuJoCo's, each with its accuracy") {
   TempDir dir("model_bench");
-  const Result r = dynlab(dir, "bench " + model("fivebar.xml") + " --steps 200");
+  const Result r = dynlab(dir, {"bench", model("fivebar.xml"), "--steps", "200"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   CHECK(r.out.find("4 coordinates, 2 closure rows, dt 0.001 s") != std::string::npos);
   for (const char* row : {"\n  hand, Euler ", "\n  hand, RK4 ", "\n  Bullet ", "\n  MuJoCo ", "MuJoCo 2.2.2 mj_step, Euler", "semi-implicit Euler + Baumgarte"})
     CHECK_MESSAGE(r.out.find(row) != std::string::npos, row);
   // JSON: four engines, each timed and run 2 s; the RK4 run is the reference and keeps the closure.
-  const Result j = dynlab(dir, "bench " + model("fivebar.xml") + " --steps 100 --json");
+  const Result j = dynlab(dir, {"bench", model("fivebar.xml"), "--steps", "100", "--json"});
   REQUIRE(j.code == 0);
   const json out = json::parse(j.out);
   REQUIRE(out["engines"].size() == 4);
@@ -191,9 +197,9 @@ TEST_CASE("dynlab bench FILE: the hand step at both orders, Bullet's and MuJoCo'
   }
   CHECK(out["engines"][1]["max_q_error_vs_hand_rk4"].get<double>() == 0.0);
   CHECK(out["engines"][1]["max_closure_residual"].get<double>() < 1e-11);
-  checkBadInput(dir, "bench missing.xml", {"missing.xml", "no such file"}, dir / "out");
+  checkBadInput(dir, {"bench", "missing.xml"}, {"missing.xml", "no such file"}, dir / "out");
   // A URDF with its loops beside it: timed too, MuJoCo left out (its run of the URDF has no loops).
-  const Result u = dynlab(dir, "bench " + model("fourbar.urdf") + " --steps 100");
+  const Result u = dynlab(dir, {"bench", model("fourbar.urdf"), "--steps", "100"});
   INFO(u.out, u.err);
   REQUIRE(u.code == 0);
   CHECK(u.out.find("MuJoCo not timed") != std::string::npos);
@@ -203,15 +209,16 @@ TEST_CASE("dynlab bench FILE: the hand step at both orders, Bullet's and MuJoCo'
 TEST_CASE("dynlab model FILE.urdf: loops beside it (STEM.loops.json or --loops), both engines") {
   TempDir dir("model_urdf_loops");
   // fourbar.loops.json is found beside fourbar.urdf: the same closure, rows and trace columns as fourbar.xml.
-  const Result r = dynlab(dir, "model " + model("fourbar.urdf") + " --duration 0.5 --out out");
+  const Result r = dynlab(dir, {"model", model("fourbar.urdf"), "--duration", "0.5", "--out", "out"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   CHECK(r.out.find("1 closure (2 of 3 rows kept), 1 degree of freedom after closure") != std::string::npos);
   CHECK(r.out.find("closure pin_C: connect coupler to rocker, rows x z kept, y dropped") != std::string::npos);
   CHECK(r.out.find("note: loop closures from ") != std::string::npos);
   // fourbar.xml beside it does not pick them up (its loop is its own equality).
-  CHECK(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.01 --out x0").out.find("loop closures from") == std::string::npos);
-  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --duration 0.5 --out xml").code == 0);
+  CHECK(dynlab(dir, {"model", model("fourbar.xml"), "--duration", "0.01", "--out", "x0"}).out.find("loop closures from") ==
+        std::string::npos);
+  REQUIRE(dynlab(dir, {"model", model("fourbar.xml"), "--duration", "0.5", "--out", "xml"}).code == 0);
   const Csv urdf = readCsv(dir / "out/trace.csv"), xml = readCsv(dir / "xml/trace.csv");
   CHECK(urdf.header == xml.header);
   REQUIRE(urdf.rows.size() == xml.rows.size());
@@ -223,14 +230,15 @@ TEST_CASE("dynlab model FILE.urdf: loops beside it (STEM.loops.json or --loops),
   CHECK(readCsv(dir / "out/trace_bullet.csv").header == urdf.header);
   // Named loops file: a bad one is one line naming it and its JSON path; nothing written.
   writeFile(dir / "bad.json", R"({"loops": [{"kind": "connect", "body1": "coupler", "point1": [0.4, 0, "x"], "body2": "rocker"}]})");
-  checkBadInput(dir, "model " + model("fourbar.urdf") + " --loops bad.json --out o", {"bad.json", "loops[0].point1[2]", "expected a finite number"},
+  checkBadInput(dir, {"model", model("fourbar.urdf"), "--loops", "bad.json", "--out", "o"},
+                {"bad.json", "loops[0].point1[2]", "expected a finite number"}, dir / "o");
+  checkBadInput(dir, {"model", model("fourbar.urdf"), "--loops", "none.json", "--out", "o"}, {"none.json", "no such file"},
                 dir / "o");
-  checkBadInput(dir, "model " + model("fourbar.urdf") + " --loops none.json --out o", {"none.json", "no such file"}, dir / "o");
 }
 
 TEST_CASE("dynlab model puma560.urdf: the 6-DoF arm runs in both engines, M and h as MuJoCo's") {
   TempDir dir("model_puma");
-  const Result r = dynlab(dir, "model " + model("puma560.urdf") + " --duration 0.5 --out out");
+  const Result r = dynlab(dir, {"model", model("puma560.urdf"), "--duration", "0.5", "--out", "out"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   CHECK(r.out.find("6 moving bodies, 6 joints, 0 closures") != std::string::npos);
@@ -252,7 +260,7 @@ TEST_CASE("dynlab model puma560.urdf: the 6-DoF arm runs in both engines, M and 
 
 TEST_CASE("dynlab model --torque: constant joint torques, their work in the energy books of both engines") {
   TempDir dir("model_torque");
-  const Result r = dynlab(dir, "model " + model("fourbar.xml") + " --torque crank=0.3 --duration 1 --out out");
+  const Result r = dynlab(dir, {"model", model("fourbar.xml"), "--torque", "crank=0.3", "--duration", "1", "--out", "out"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   CHECK(r.out.find("run with constant torques (crank=0.3)") != std::string::npos);
@@ -275,7 +283,9 @@ TEST_CASE("dynlab model --torque: constant joint torques, their work in the ener
   CHECK(balance < 1e-6);
   // Bullet's balance is its semi-implicit Euler's first-order error (measured 0.087 J at 1 ms): halving
   // the step halves it, so its books count the torque's work right.
-  REQUIRE(dynlab(dir, "model " + model("fourbar.xml") + " --torque crank=0.3 --duration 1 --dt 0.0005 --engine bullet --out half").code == 0);
+  REQUIRE(dynlab(dir, {"model", model("fourbar.xml"), "--torque", "crank=0.3", "--duration", "1", "--dt", "0.0005", "--engine",
+                       "bullet", "--out", "half"})
+              .code == 0);
   const Csv half = readCsv(dir / "half/trace_bullet.csv");
   double balance_half = 0;
   for (std::size_t i = 0; i < half.rows.size(); ++i)
@@ -285,12 +295,17 @@ TEST_CASE("dynlab model --torque: constant joint torques, their work in the ener
   CHECK(balance_bt / balance_half > 1.6);
   CHECK(balance_bt / balance_half < 2.5);
   // Bad torques: one line naming the joints, exit 2.
-  checkBadInput(dir, "model " + model("fourbar.xml") + " --torque elbow=1 --out o", {"--torque elbow=1", "crank coupler rocker"}, dir / "o");
-  checkBadInput(dir, "model " + model("fourbar.xml") + " --torque crank=nan --out o", {"--torque crank=nan", "finite"}, dir / "o");
-  checkBadInput(dir, "model " + model("fourbar.xml") + " --torque crank=1 --torque crank=2 --out o", {"--torque crank=2", "once per joint"}, dir / "o");
+  checkBadInput(dir, {"model", model("fourbar.xml"), "--torque", "elbow=1", "--out", "o"},
+                {"--torque elbow=1", "crank coupler rocker"}, dir / "o");
+  checkBadInput(dir, {"model", model("fourbar.xml"), "--torque", "crank=nan", "--out", "o"}, {"--torque crank=nan", "finite"},
+                dir / "o");
+  checkBadInput(dir, {"model", model("fourbar.xml"), "--torque", "crank=1", "--torque", "crank=2", "--out", "o"},
+                {"--torque crank=2", "once per joint"}, dir / "o");
   // `dynlab run FILE` takes the same torques and loops, and gives the same trace; a lab refuses them.
-  REQUIRE(dynlab(dir, "run " + model("fourbar.xml") + " --torque crank=0.3 --duration 1 --engine hand --out via_run").code == 0);
+  REQUIRE(dynlab(dir, {"run", model("fourbar.xml"), "--torque", "crank=0.3", "--duration", "1", "--engine", "hand", "--out",
+                       "via_run"})
+              .code == 0);
   CHECK(readFile(dir / "via_run" / "trace.csv") == readFile(dir / "out" / "trace.csv"));
-  checkBadInput(dir, "run slider_crank --torque q1=1 --out o", {"--torque", "model file"}, dir / "o");
-  checkBadInput(dir, "run slider_crank --loops x.json --out o", {"--loops", "model file"}, dir / "o");
+  checkBadInput(dir, {"run", "slider_crank", "--torque", "q1=1", "--out", "o"}, {"--torque", "model file"}, dir / "o");
+  checkBadInput(dir, {"run", "slider_crank", "--loops", "x.json", "--out", "o"}, {"--loops", "model file"}, dir / "o");
 }

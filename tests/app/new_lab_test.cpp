@@ -55,9 +55,9 @@ TEST_CASE("new-lab: a four-bar exercise from the five-bar by editing JSON only")
   fs::create_directories(home / "labs");
   fs::create_directories(home / "assets/models");
   fs::copy_file(fs::path(DYNLAB_SOURCE_DIR) / "assets/models/fourbar.xml", home / "assets/models/fourbar.xml");
-  const std::string env = "DYNLAB_HOME=" + quote(home.string()) + " ";
+  const ProcessOptions env = withEnv({{"DYNLAB_HOME", home.string()}});
 
-  Result r = dynlab(dir, "new-lab fourbar_lab --from fivebar --labs " + quote((home / "labs").string()));
+  Result r = dynlab(dir, {"new-lab", "fourbar_lab", "--from", "fivebar", "--labs", (home / "labs").string()});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   const fs::path lab = home / "labs/fourbar_lab";
@@ -77,11 +77,11 @@ TEST_CASE("new-lab: a four-bar exercise from the five-bar by editing JSON only")
   writeFile(lab / "fourbar_lab.json", d.dump(1));
   fs::remove(lab / "fivebar.xml");
 
-  r = shell(dir, env + quote(DYNLAB_BIN) + " list");
+  r = dynlab(dir, {"list"}, env);
   CHECK(r.out.find("fourbar_lab      Four-bar: move the rocker's pin with the crank") != std::string::npos);
 
   // Both engines, the whole run; the hand engine keeps the loop closed to rounding level.
-  r = shell(dir, env + quote(DYNLAB_BIN) + " run fourbar_lab --out run");
+  r = dynlab(dir, {"run", "fourbar_lab", "--out", "run"}, env);
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   const json summary = json::parse(readFile(dir / "run/summary.json"));
@@ -93,7 +93,7 @@ TEST_CASE("new-lab: a four-bar exercise from the five-bar by editing JSON only")
   CHECK(std::find(trace.header.begin(), trace.header.end(), "f_pin_C_x") != trace.header.end());
 
   // The instructor's answer (task-space inverse dynamics) grades, and tracks the pin's path.
-  r = shell(dir, env + quote(DYNLAB_BIN) + " grade " + quote((lab / "instructor/good.json").string()) + " --out grade --no-plots");
+  r = dynlab(dir, {"grade", (lab / "instructor/good.json").string(), "--out", "grade", "--no-plots"}, env);
   REQUIRE(r.code == 0);
   const json results = json::parse(readFile(dir / "grade/results.json"));
   double max = 0;
@@ -102,7 +102,7 @@ TEST_CASE("new-lab: a four-bar exercise from the five-bar by editing JSON only")
   CHECK(results.at("score").get<double>() > 0.9 * max);
 
   // The contract's mechanical checks hold on it (the rubric's tuning checks are the lecturer's next step).
-  r = shell(dir, env + quote(DYNLAB_BIN) + " check-lab fourbar_lab --skip-cli");
+  r = dynlab(dir, {"check-lab", "fourbar_lab", "--skip-cli"}, env);
   for (const char* check : {"config ", "examples ", "engines ", "passive energy ", "metrics ", "grading ", "render "}) {
     INFO("check ", check, "\n", r.out);
     CHECK(r.out.find("  ok    " + std::string(check)) != std::string::npos);
@@ -112,15 +112,19 @@ TEST_CASE("new-lab: a four-bar exercise from the five-bar by editing JSON only")
 TEST_CASE("new-lab: bad uses get one line and exit 2, and write nothing") {
   const TempDir dir("new_lab_bad");
   fs::create_directories(dir / "labs");
-  const std::string to = " --labs " + quote((dir / "labs").string());
+  const std::vector<std::string> to = {"--labs", (dir / "labs").string()};
   struct Case {
-    std::string args, says;
+    std::vector<std::string> args;
+    std::string says;
   };
-  for (const Case& c : {Case{"new-lab copy --from slider_crank" + to, "a C++ lab"}, Case{"new-lab Bad --from fivebar" + to, "expected a lab name"},
-                        Case{"new-lab '../up' --from fivebar" + to, "expected a lab name"}, Case{"new-lab copy --from no_such_lab" + to, "no lab folder"},
-                        Case{"new-lab fivebar --from fivebar" + to, "a lab of that name exists"},
-                        Case{"new-lab copy --from fivebar --labs " + quote((dir / "missing").string()), "expected an existing folder"}}) {
-    INFO(c.args);
+  for (const Case& c :
+       {Case{cat({"new-lab", "copy", "--from", "slider_crank"}, to), "a C++ lab"},
+        Case{cat({"new-lab", "Bad", "--from", "fivebar"}, to), "expected a lab name"},
+        Case{cat({"new-lab", "../up", "--from", "fivebar"}, to), "expected a lab name"},
+        Case{cat({"new-lab", "copy", "--from", "no_such_lab"}, to), "no lab folder"},
+        Case{cat({"new-lab", "fivebar", "--from", "fivebar"}, to), "a lab of that name exists"},
+        Case{{"new-lab", "copy", "--from", "fivebar", "--labs", (dir / "missing").string()}, "expected an existing folder"}}) {
+    INFO(shown(c.args));
     const Result r = dynlab(dir, c.args);
     CHECK(r.code == 2);
     CHECK(r.err.find(c.says) != std::string::npos);
@@ -130,7 +134,7 @@ TEST_CASE("new-lab: bad uses get one line and exit 2, and write nothing") {
   // An existing folder is never overwritten.
   fs::create_directories(dir / "labs/copy");
   writeFile(dir / "labs/copy/keep.txt", "mine");
-  const Result r = dynlab(dir, "new-lab copy --from fivebar" + to);
+  const Result r = dynlab(dir, cat({"new-lab", "copy", "--from", "fivebar"}, to));
   CHECK(r.code == 2);
   CHECK(readFile(dir / "labs/copy/keep.txt") == "mine");
   CHECK_FALSE(fs::exists(dir / "labs/copy/copy.json"));

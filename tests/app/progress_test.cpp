@@ -76,11 +76,12 @@ TEST_CASE("a Progress that is not enabled writes nothing") {
 TEST_CASE("dynlab run --frames and figure: a bar on a terminal, nothing of it when stderr is a file") {
   TempDir dir("progress");
   // Not a terminal: stderr stays empty, stdout is the usual report.
-  const Result quiet = shell(dir, quote(DYNLAB_BIN) + " run slider_crank --duration 0.3 --frames --engine hand --out q");
+  const Result quiet = dynlab(dir, {"run", "slider_crank", "--duration", "0.3", "--frames", "--engine", "hand", "--out", "q"});
   INFO(quiet.out, quiet.err);
   REQUIRE(quiet.code == 0);
   CHECK(quiet.err.empty());
-  const Result quiet_fig = shell(dir, quote(DYNLAB_BIN) + " figure slider_crank --duration 0.3 --still 0.1 --plot x_c --format svg --out qf");
+  const Result quiet_fig = dynlab(
+      dir, {"figure", "slider_crank", "--duration", "0.3", "--still", "0.1", "--plot", "x_c", "--format", "svg", "--out", "qf"});
   REQUIRE(quiet_fig.code == 0);
   CHECK(quiet_fig.err.empty());
 

@@ -47,8 +47,10 @@ std::pair<int, double> sensorShift(const Csv& tr) {
 }
 
 Csv runScenario(const TempDir& dir, const std::string& scenario, const std::string& out) {
-  const std::string opt = scenario.empty() ? "" : " --scenario " + scenario;
-  const Result r = dynlab(dir, "run slider_crank --engine hand --gains " + quote(kExamples + "mediocre.json") + opt + " --out " + out);
+  std::vector<std::string> args = {"run", "slider_crank", "--engine", "hand", "--gains", kExamples + "mediocre.json", "--out",
+                                   out};
+  if (!scenario.empty()) args = cat(args, {"--scenario", scenario});
+  const Result r = dynlab(dir, args);
   INFO(r.err);
   REQUIRE(r.code == 0);
   if (!scenario.empty()) CHECK(r.out.find("under scenario " + scenario) != std::string::npos);
@@ -82,7 +84,7 @@ TEST_CASE("run --scenario: each trace shows its scenario's patch, read from the 
   const auto [d2, e2] = sensorShift(noisy);
   CHECK(e2 == doctest::Approx(sc["noisy_sensor"]["patch"]["controller"]["noise_std"].get<double>()).epsilon(0.05));
   // The default output of a scenario run is its own folder, beside (not over) the nominal run.
-  const Result r = dynlab(dir, "run slider_crank --engine hand --duration 0.1 --scenario light_load");
+  const Result r = dynlab(dir, {"run", "slider_crank", "--engine", "hand", "--duration", "0.1", "--scenario", "light_load"});
   REQUIRE(r.code == 0);
   CHECK(fs::exists(dir / "out/slider_crank/scenarios/light_load/trace_hand.csv"));
   CHECK(json::parse(readFile(dir / "out/slider_crank/scenarios/light_load/summary.json"))["scenario"] == "light_load");
@@ -91,12 +93,12 @@ TEST_CASE("run --scenario: each trace shows its scenario's patch, read from the 
 
 TEST_CASE("run --scenario is the grader's run of the same file: same trace hash, same metrics") {
   const TempDir dir("scenario_grade");
-  const std::string sub = quote(kExamples + "proportional.json");
-  REQUIRE(dynlab(dir, "grade " + sub + " --no-plots --out graded").code == 0);
+  const std::string sub = kExamples + "proportional.json";
+  REQUIRE(dynlab(dir, {"grade", sub, "--no-plots", "--out", "graded"}).code == 0);
   const json results = json::parse(readFile(dir / "graded/results.json"));
   for (const auto& [name, graded] : results["extra_data"]["scenarios"].items()) {
     CAPTURE(name);
-    const Result r = dynlab(dir, "run slider_crank --engine hand --gains " + sub + " --scenario " + name + " --out " + name);
+    const Result r = dynlab(dir, {"run", "slider_crank", "--engine", "hand", "--gains", sub, "--scenario", name, "--out", name});
     REQUIRE(r.code == 0);
     const json summary = json::parse(readFile(dir / name / "summary.json"));
     const json& hand = summary["engines"]["hand"];
@@ -113,15 +115,18 @@ TEST_CASE("run --scenario is the grader's run of the same file: same trace hash,
   other.erase("force_law");
   writeFile(dir / "other.json", other.dump());
   for (const std::string name : {"nominal", "noisy_sensor"})
-    REQUIRE(dynlab(dir, "run slider_crank --engine hand --gains other.json --scenario " + name + " --out other_" + name).code == 0);
+    REQUIRE(dynlab(dir, {"run", "slider_crank", "--engine", "hand", "--gains", "other.json", "--scenario", name, "--out",
+                         "other_" + name})
+                .code == 0);
   CHECK(readFile(dir / "other_nominal/trace_hand.csv") == readFile(dir / "nominal/trace_hand.csv"));
   CHECK(readFile(dir / "other_noisy_sensor/trace_hand.csv") != readFile(dir / "noisy_sensor/trace_hand.csv"));
 }
 
 TEST_CASE("figure --scenario: the scenario's run, in its own folder, named in the title") {
   const TempDir dir("scenario_figure");
-  const std::string args = "figure slider_crank --engine hand --duration 0.5 --plot f_Tx --format svg";
-  REQUIRE(dynlab(dir, args + " --scenario heavy_load").code == 0);
+  const std::vector<std::string> args = {"figure", "slider_crank", "--engine", "hand",     "--duration",
+                                         "0.5",    "--plot",       "f_Tx",     "--format", "svg"};
+  REQUIRE(dynlab(dir, cat(args, {"--scenario", "heavy_load"})).code == 0);
   REQUIRE(dynlab(dir, args).code == 0);
   const std::string heavy = dyn::test::svgText(readFile(dir / "out/slider_crank/scenarios/heavy_load/figures/plot_f_Tx.svg"));
   const std::string nominal = dyn::test::svgText(readFile(dir / "out/slider_crank/figures/plot_f_Tx.svg"));
@@ -135,15 +140,16 @@ TEST_CASE("an unknown scenario: one line listing the rubric's scenarios, exit 2,
   const TempDir dir("scenario_bad");
   std::vector<std::string> names = {"--scenario", "\"nope\""};
   for (const auto& [name, _] : labConfig()["rubric"]["scenarios"].items()) names.push_back(name);
-  checkBadInput(dir, "run slider_crank --scenario nope", names, dir / "out");
-  checkBadInput(dir, "figure slider_crank --scenario nope", names, dir / "out");
+  checkBadInput(dir, {"run", "slider_crank", "--scenario", "nope"}, names, dir / "out");
+  checkBadInput(dir, {"figure", "slider_crank", "--scenario", "nope"}, names, dir / "out");
   // A config without a rubric has no scenarios to run.
   json cfg = labConfig();
   cfg.erase("rubric");
   writeFile(dir / "plain.json", cfg.dump());
-  checkBadInput(dir, "run slider_crank --config plain.json --scenario nominal", {"--scenario", "rubric"}, dir / "out");
+  checkBadInput(dir, {"run", "slider_crank", "--config", "plain.json", "--scenario", "nominal"}, {"--scenario", "rubric"},
+                dir / "out");
 #ifdef DYNLAB_UI_BIN
   // The window checks it before opening: no display needed.
-  checkBadInput(dir, "ui slider_crank --scenario nope", names, dir / "out");
+  checkBadInput(dir, {"ui", "slider_crank", "--scenario", "nope"}, names, dir / "out");
 #endif
 }

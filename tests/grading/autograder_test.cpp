@@ -6,9 +6,9 @@
 
 #include <doctest/doctest.h>
 
+#include "app/process.h"
 #include "tests/test_files.h"
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <zip.h>
 
 #include <algorithm>
@@ -82,26 +82,21 @@ struct Ran {
   std::string out, err;
 };
 
-// A path in single quotes for the shell (the scratch paths hold no quote).
-std::string quoted(const std::string& s) {
-  std::string q = "'";
-  q += s;
-  q += '\'';
-  return q;
-}
-
-// Runs a shell command with stdout and stderr captured (in files of a scratch folder of their own).
-Ran shell(const std::string& cmd) {
+// Runs argv (no shell) with stdout and stderr captured (in files of a scratch folder of their own),
+// killed after timeout_s (> 0).
+Ran captured(const std::vector<std::string>& argv, double timeout_s = 0) {
   static const fs::path dir = scratch("capture");
   const fs::path out = dir / "stdout.txt", err = dir / "stderr.txt";
-  const int status = std::system((cmd + " >" + quoted(out.string()) + " 2>" + quoted(err.string())).c_str());
-  return {WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status), readBytes(out), readBytes(err)};
+  dyn::ProcessOptions o;
+  o.stdout_file = out.string();
+  o.stderr_file = err.string();
+  o.timeout_s = timeout_s;
+  const dyn::ProcessResult r = dyn::runProgram(argv, o);
+  return {r.code, readBytes(out), readBytes(err) + r.error};
 }
 
 // The real `dynlab check-results FILE` (under a timeout, so a hang fails instead of blocking the suite).
-Ran checkResults(const fs::path& file) {
-  return shell("timeout 20 " + quoted(DYNLAB_BIN) + " check-results " + quoted(file.string()));
-}
+Ran checkResults(const fs::path& file) { return captured({DYNLAB_BIN, "check-results", file.string()}, 20); }
 
 std::string thrown(const std::function<void()>& f) {
   try {
@@ -259,13 +254,19 @@ struct Sandbox {
     fakeDynlab("out=\"${@: -1}\"; cp '" + (dir / "fake_results.json").string() + "' \"$out/results.json\"; exit 0");
   }
   std::string log() const { return readBytes(dir / "log.txt"); }
-  // Runs the script (under a timeout); returns results.json parsed. It must parse, and the real
-  // check-results must accept it.
-  nlohmann::json run(const std::string& env = "") {
-    const std::string cmd = "env DYNLAB_BIN='" + dynlab.string() + "' DYNLAB_SUBMISSION_DIR='" + submission.string() +
-                            "' DYNLAB_RESULTS_DIR='" + results.string() + "' " + env + " timeout 60 bash '" +
-                            script.string() + "' > '" + (dir / "log.txt").string() + "' 2>&1";
-    CHECK(std::system(cmd.c_str()) == 0);
+  // Runs the script (under a timeout, with env added to its environment; its output in log.txt);
+  // returns results.json parsed. It must parse, and the real check-results must accept it.
+  nlohmann::json run(const std::vector<std::pair<std::string, std::string>>& env = {}) {
+    dyn::ProcessOptions o;
+    o.set_env = {{"DYNLAB_BIN", dynlab.string()},
+                 {"DYNLAB_SUBMISSION_DIR", submission.string()},
+                 {"DYNLAB_RESULTS_DIR", results.string()}};
+    o.set_env.insert(o.set_env.end(), env.begin(), env.end());
+    o.timeout_s = 60;
+    fs::remove(dir / "log.txt");
+    o.stdout_file = o.stderr_file = (dir / "log.txt").string();
+    o.append = true;  // both into one file (2>&1)
+    CHECK(dyn::runProgram({"bash", script.string()}, o).code == 0);
     INFO(log());
     REQUIRE(fs::is_regular_file(results / "results.json"));
     const Ran check = checkResults(results / "results.json");
@@ -311,7 +312,7 @@ TEST_CASE("run_autograder: garbage, timeouts, a missing binary and missing files
     Sandbox box("slow");
     writeText(box.submission / "submission.json", "{}");
     box.fakeDynlab("sleep 30");
-    const auto r = box.run("DYNLAB_TIME_LIMIT=1");
+    const auto r = box.run({{"DYNLAB_TIME_LIMIT", "1"}});
     CHECK(r.at("score").get<double>() == 0.0);
     CHECK(r.at("output").get<std::string>().find("longer than 1 seconds") != std::string::npos);
   }
@@ -422,7 +423,7 @@ TEST_CASE("dynlab check-results: a valid results.json passes, and so do dynlab g
   for (const std::string& sub : {src + "/labs/slider_crank/examples/mediocre.json", (dir / "bad_gains.json").string()}) {
     INFO(sub);
     const fs::path out = dir / fs::path(sub).stem();
-    shell(quoted(bin) + " grade " + quoted(sub) + " --no-plots --out " + quoted(out.string()));
+    captured({bin, "grade", sub, "--no-plots", "--out", out.string()});
     const Ran own = checkResults(out / "results.json");
     CHECK_MESSAGE(own.code == 0, own.err);
   }
@@ -465,7 +466,7 @@ TEST_CASE("dynlab check-results: not UTF-8, not JSON, or not a regular file") {
   checkRejected(checkResults(dir / "folder.json"), {"folder.json: expected a regular file, got a directory"});
   checkRejected(checkResults("/dev/null"), {"/dev/null: expected a regular file, got a device"});
   checkRejected(checkResults(dir / "missing.json"), {"missing.json: expected a readable file, got no such file"});
-  CHECK(shell(quoted(DYNLAB_BIN) + " check-results").code == 2);  // FILE is required
+  CHECK(captured({DYNLAB_BIN, "check-results"}).code == 2);  // FILE is required
 }
 
 TEST_CASE("run_autograder: dynlab's results.json of the wrong shape is replaced by a valid one naming the path") {
@@ -524,8 +525,8 @@ fs::path pathWithoutPython(const fs::path& dir) {
 TEST_CASE("run_autograder: with no python3 on PATH, results.json is still checked for real") {
   Sandbox box("nopython");
   const fs::path bin = pathWithoutPython(box.dir);
-  const std::string env = "PATH='" + bin.string() + "'";
-  CHECK(shell("env " + env + " bash -c 'command -v python3 || command -v python'").code != 0);
+  const std::vector<std::pair<std::string, std::string>> env = {{"PATH", bin.string()}};
+  for (const char* python : {"python3", "python"}) CHECK_FALSE(fs::exists(bin / python));  // `command -v` finds neither
   writeText(box.submission / "submission.json", "{}");
 
   box.fakeResults(R"({"score": "lots", "tests": 5})");  // starts with '{': the old fallback took it
@@ -538,12 +539,12 @@ TEST_CASE("run_autograder: with no python3 on PATH, results.json is still checke
 }
 
 TEST_CASE("run_autograder: DYNLAB_TIME_LIMIT must be whole seconds from 1 to 86400, else the default is used") {
-  for (const std::string bad : {"0", "000", "abc", "10m", "-5", "1.5", "86401", "99999999999999999999", "' '"}) {
+  for (const std::string bad : {"0", "000", "abc", "10m", "-5", "1.5", "86401", "99999999999999999999", " "}) {
     INFO("DYNLAB_TIME_LIMIT=" << bad);
     Sandbox box("limit");
     writeText(box.submission / "submission.json", "{}");
     box.fakeResults(R"({"score": 3})");
-    CHECK(box.run("DYNLAB_TIME_LIMIT=" + bad).at("score").get<double>() == 3.0);  // graded, under the default
+    CHECK(box.run({{"DYNLAB_TIME_LIMIT", bad}}).at("score").get<double>() == 3.0);  // graded, under the default
     CHECK(box.log().find("expected whole seconds from 1 to 86400; using the default, 540") != std::string::npos);
   }
   for (const std::string good : {"", "1", "007", "86400"}) {
@@ -551,14 +552,14 @@ TEST_CASE("run_autograder: DYNLAB_TIME_LIMIT must be whole seconds from 1 to 864
     Sandbox box("limit_ok");
     writeText(box.submission / "submission.json", "{}");
     box.fakeResults(R"({"score": 3})");
-    CHECK(box.run("DYNLAB_TIME_LIMIT=" + good).at("score").get<double>() == 3.0);
+    CHECK(box.run({{"DYNLAB_TIME_LIMIT", good}}).at("score").get<double>() == 3.0);
     CHECK(box.log().find("DYNLAB_TIME_LIMIT") == std::string::npos);
   }
   // 0 no longer turns the limit off: a hanging grader is still stopped (here after a limit of 2 s).
   Sandbox box("limit_applies");
   writeText(box.submission / "submission.json", "{}");
   box.fakeDynlab("sleep 30");
-  const auto r = box.run("DYNLAB_TIME_LIMIT=02");
+  const auto r = box.run({{"DYNLAB_TIME_LIMIT", "02"}});
   CHECK(r.at("output").get<std::string>().find("longer than 2 seconds") != std::string::npos);
 }
 
@@ -644,7 +645,7 @@ TEST_CASE("run_autograder: a grader killed by a signal before the limit is a cra
   Sandbox box("killed");
   writeText(box.submission / "submission.json", "{}");
   box.fakeDynlab("kill -KILL $$");
-  const std::string out = box.run("DYNLAB_TIME_LIMIT=100").at("output").get<std::string>();
+  const std::string out = box.run({{"DYNLAB_TIME_LIMIT", "100"}}).at("output").get<std::string>();
   CHECK(out.find("exit status 137") != std::string::npos);
   CHECK(out.find("longer than") == std::string::npos);
 }

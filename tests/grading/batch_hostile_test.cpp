@@ -1,6 +1,6 @@
 // dynlab grade --batch against hostile file names, stale results, a kill -9, a second batch on the
 // same OUT, a Gradescope export and graders that fail: always through the real binary (DYNLAB_BIN),
-// every command under `timeout` so a hang fails the test instead of blocking the suite.
+// every command under a timeout so a hang fails the test instead of blocking the suite.
 #include <doctest/doctest.h>
 
 #include <cstdio>
@@ -110,8 +110,9 @@ std::string aloneScore(const std::string& example) {
   static std::map<std::string, std::string> cells;
   if (const auto it = cells.find(example); it != cells.end()) return it->second;
   const TempDir dir("batch_alone_" + example);
-  const Result r = shell(dir, "timeout 60 " + quote(DYNLAB_BIN) + " grade " + quote((kExamples / (example + ".json")).string()) +
-                                  " --no-plots --out out");
+  ProcessOptions o;
+  o.timeout_s = 60;
+  const Result r = dynlab(dir, {"grade", (kExamples / (example + ".json")).string(), "--no-plots", "--out", "out"}, o);
   REQUIRE_MESSAGE(r.code == 0, r.err);
   char cell[32];
   std::snprintf(cell, sizeof cell, "%.4g", json::parse(readFile(dir / "out/results.json")).at("score").get<double>());
@@ -125,25 +126,30 @@ std::string budget() {
   return b && *b ? b : "1";
 }
 
-// `dynlab grade --batch IN --out OUT` in dir, with a time limit and optional fault injection.
-Result batch(const TempDir& dir, const std::string& in, const std::string& out, const std::string& faults = "",
-             const std::string& extra = "--jobs 2") {
-  const std::string env = faults.empty() ? "" : "DYNLAB_FAULT_INJECTION=" + faults + " ";
-  return shell(dir, env + "timeout 300 " + quote(DYNLAB_BIN) + " grade --batch " + quote(in) + " --out " + quote(out) +
-                        " --lab slider_crank --no-plots --time-budget " + budget() + " " + extra);
+// The batch's arguments: `grade --batch IN --out OUT` of the slider crank, each grader under budget().
+std::vector<std::string> batchArgs(const std::string& in, const std::string& out, const std::string& jobs) {
+  return {"grade", "--batch", in, "--out", out, "--lab", "slider_crank", "--no-plots", "--time-budget", budget(), "--jobs", jobs};
 }
 
-// Starts the same batch in the background (its own pid, via exec); the caller waits for it.
-pid_t batchInBackground(const TempDir& dir, const std::string& in, const std::string& out, const std::string& faults) {
-  const std::string cmd = "cd " + quote(dir.path.string()) + " && exec env DYNLAB_FAULT_INJECTION=" + faults + " " +
-                          quote(DYNLAB_BIN) + " grade --batch " + quote(in) + " --out " + quote(out) +
-                          " --lab slider_crank --no-plots --time-budget " + budget() + " --jobs 1 >" + quote(out + ".log") + " 2>&1";
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  return pid;
+// `dynlab grade --batch IN --out OUT` in dir, with a time limit and optional fault injection.
+Result batch(const TempDir& dir, const std::string& in, const std::string& out, const std::string& faults = "",
+             const std::string& jobs = "2") {
+  ProcessOptions o;
+  o.timeout_s = 300;
+  if (!faults.empty()) o.set_env = {{"DYNLAB_FAULT_INJECTION", faults}};
+  return dynlab(dir, batchArgs(in, out, jobs), o);
+}
+
+// Starts the same batch (one job) in the background, its output in OUT.log; the caller waits for it.
+dyn::StartedProgram batchInBackground(const TempDir& dir, const std::string& in, const std::string& out,
+                                      const std::string& faults) {
+  ProcessOptions o;
+  o.cwd = dir.path.string();
+  o.set_env = {{"DYNLAB_FAULT_INJECTION", faults}};
+  fs::remove(dir / (out + ".log"));
+  o.stdout_file = o.stderr_file = (dir / (out + ".log")).string();
+  o.append = true;  // both into one file (2>&1)
+  return dyn::startProgram(cat({DYNLAB_BIN}, batchArgs(in, out, "1")), o);
 }
 
 // Waits (up to 60 s) until a path exists.
@@ -301,19 +307,17 @@ TEST_CASE("a rerun grades afresh: a stale results.json never counts, a failing g
 TEST_CASE("a batch killed with SIGKILL and rerun gives the gradebook of an uninterrupted one" * doctest::timeout(300)) {
   TempDir dir("batch_kill");
   standardBatch(dir);
-  REQUIRE(batch(dir, "in", "clean", kFaults, "--jobs 1").code == 0);
+  REQUIRE(batch(dir, "in", "clean", kFaults, "1").code == 0);
   const std::string clean = readFile(dir / "clean" / "gradebook.csv");
 
   // Killed while the hanging submission is being graded (crashes and fine are done by then).
-  const pid_t pid = batchInBackground(dir, "in", "out", kFaults);
-  REQUIRE(pid > 0);
+  dyn::StartedProgram killed = batchInBackground(dir, "in", "out", kFaults);
+  REQUIRE(killed.pid > 0);
   REQUIRE(waitFor(dir / "out" / "hangs" / "grade.log"));
   std::this_thread::sleep_for(std::chrono::milliseconds(300));
   REQUIRE(processIn(dir.path));  // the batch and its graders are seen working there
-  REQUIRE(::kill(pid, SIGKILL) == 0);
-  int status = 0;
-  REQUIRE(::waitpid(pid, &status, 0) == pid);
-  CHECK(WIFSIGNALED(status));
+  REQUIRE(::kill(killed.pid, SIGKILL) == 0);
+  CHECK(dyn::waitProgram(killed).signal == SIGKILL);
   CHECK(!fs::exists(dir / "out" / "gradebook.csv"));
   CHECK(fs::exists(dir / "out" / "fine" / "results.json"));
   // Its graders died with it: none is left writing into OUT.
@@ -322,7 +326,7 @@ TEST_CASE("a batch killed with SIGKILL and rerun gives the gradebook of an unint
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   CHECK(gone);
 
-  REQUIRE(batch(dir, "in", "out", kFaults, "--jobs 1").code == 0);
+  REQUIRE(batch(dir, "in", "out", kFaults, "1").code == 0);
   CHECK(readFile(dir / "out" / "gradebook.csv") == clean);
   for (const char* n : {"fine", "mediocre", "malformed", "crashes", "hangs"}) {
     CAPTURE(n);
@@ -336,8 +340,8 @@ TEST_CASE("a batch killed with SIGKILL and rerun gives the gradebook of an unint
 TEST_CASE("a second batch into the same OUT refuses at once; the first finishes intact" * doctest::timeout(300)) {
   TempDir dir("batch_lock");
   standardBatch(dir);
-  const pid_t first = batchInBackground(dir, "in", "out", kFaults);
-  REQUIRE(first > 0);
+  dyn::StartedProgram first = batchInBackground(dir, "in", "out", kFaults);
+  REQUIRE(first.pid > 0);
   REQUIRE(waitFor(dir / "out" / "crashes" / "grade.log"));
 
   const auto started = std::chrono::steady_clock::now();
@@ -349,9 +353,8 @@ TEST_CASE("a second batch into the same OUT refuses at once; the first finishes 
   CHECK(std::count(second.err.begin(), second.err.end(), '\n') == 1);
   CHECK(second.err.rfind("error: out: another dynlab grade --batch is writing into this folder", 0) == 0);
 
-  int status = 0;
-  REQUIRE(::waitpid(first, &status, 0) == first);
-  CHECK((WIFEXITED(status) && WEXITSTATUS(status) == 0));
+  const dyn::ProcessResult done = dyn::waitProgram(first);
+  CHECK((done.signal == 0 && done.code == 0));
   const auto book = readBook(dir / "out" / "gradebook.csv");
   CHECK(book.size() == 6);
   CHECK(book.at("fine.json").at("score") == aloneScore("proportional"));
@@ -437,7 +440,9 @@ TEST_CASE("a broken lab config is an internal error in every row, not the studen
   json config = json::parse(defaultConfigText());
   config["rubric"]["tests"][0]["points"] = "lots";
   put(dir / "broken.json", config.dump());
-  const Result r = shell(dir, "timeout 120 " + quote(DYNLAB_BIN) + " grade --batch in --out out --config broken.json --no-plots");
+  ProcessOptions o;
+  o.timeout_s = 120;
+  const Result r = dynlab(dir, {"grade", "--batch", "in", "--out", "out", "--config", "broken.json", "--no-plots"}, o);
   REQUIRE(r.code == 0);
   const auto row = readBook(dir / "out" / "gradebook.csv").at("fine.json");
   CHECK(row.at("status") == "internal error");

@@ -15,6 +15,7 @@
 #include <string>
 #include <vector>
 
+#include "app/process.h"
 #include "tests/test_files.h"
 
 namespace fs = std::filesystem;
@@ -83,9 +84,12 @@ TEST_CASE("gradebook.md: counts, statistics, histogram and failure reasons as th
   const std::string hostile = "*evil*<b>|x| [a](j:x).json";
   put(in / hostile, R"({"lab": "slider_crank", "gains": {"kp_x": "<b>"}})");
 
-  const std::string cmd = std::string(DYNLAB_BIN) + " grade --batch " + in.string() + " --jobs 2 --no-plots --out " +
-                          (dir / "out").string() + " > " + (dir / "log").string() + " 2>&1";
-  REQUIRE(std::system(cmd.c_str()) == 0);
+  dyn::ProcessOptions to_log;
+  to_log.stdout_file = to_log.stderr_file = (dir / "log").string();
+  to_log.append = true;  // both into one file (2>&1); dir is fresh
+  REQUIRE(dyn::runProgram(
+              {DYNLAB_BIN, "grade", "--batch", in.string(), "--jobs", "2", "--no-plots", "--out", (dir / "out").string()}, to_log)
+              .code == 0);
   const std::string md = readBytes(dir / "out/gradebook.md");
   REQUIRE_FALSE(md.empty());
   CHECK(readBytes(dir / "log").find("gradebook.md") != std::string::npos);
@@ -158,8 +162,8 @@ TEST_CASE("gradebook.md: counts, statistics, histogram and failure reasons as th
   CHECK(listed.find("\\|x\\|") != std::string::npos);
   CHECK(listed.find("| invalid submission |") != std::string::npos);
   // The same batch again gives the same summary.
-  const std::string again = std::string(DYNLAB_BIN) + " grade --batch " + in.string() + " --jobs 1 --no-plots --out " +
-                            (dir / "out2").string() + " > /dev/null 2>&1";
-  REQUIRE(std::system(again.c_str()) == 0);
+  REQUIRE(dyn::runProgram(
+              {DYNLAB_BIN, "grade", "--batch", in.string(), "--jobs", "1", "--no-plots", "--out", (dir / "out2").string()})
+              .code == 0);  // stdout and stderr to /dev/null
   CHECK(readBytes(dir / "out2/gradebook.md") == md);
 }

@@ -3,6 +3,7 @@
 // exactly as alone, whatever --jobs is.
 #include <doctest/doctest.h>
 
+#include "app/process.h"
 #include "tests/test_files.h"
 
 #include <cstdio>
@@ -41,11 +42,17 @@ fs::path makeBatch() {
   return dir;
 }
 
+// The batch with a hanging and a crashing grader; its exit code, its stdout and stderr in OUT.log.
 int runBatch(const fs::path& dir, const std::string& out, int jobs) {
-  const std::string cmd = "DYNLAB_FAULT_INJECTION=hang:hangs,crash:crashes " + std::string(DYNLAB_BIN) + " grade --batch " +
-                          (dir / "in").string() + " --jobs " + std::to_string(jobs) + " --time-budget 2 --no-plots --out " +
-                          (dir / out).string() + " > " + (dir / (out + ".log")).string() + " 2>&1";
-  return std::system(cmd.c_str());
+  dyn::ProcessOptions o;
+  o.set_env = {{"DYNLAB_FAULT_INJECTION", "hang:hangs,crash:crashes"}};
+  fs::remove(dir / (out + ".log"));
+  o.stdout_file = o.stderr_file = (dir / (out + ".log")).string();
+  o.append = true;  // both into one file (2>&1)
+  return dyn::runProgram({DYNLAB_BIN, "grade", "--batch", (dir / "in").string(), "--jobs", std::to_string(jobs), "--time-budget",
+                          "2", "--no-plots", "--out", (dir / out).string()},
+                         o)
+      .code;
 }
 
 }  // namespace

@@ -299,15 +299,16 @@ TEST_CASE("dynlab grade: the replay hints run as printed, from any folder, and r
   fs::create_directories(odd);
   write(odd / "my gains.json", readBytes(kMediocre));
   write(odd / "lab config.json", readBytes(kLabDir + "slider_crank.json"));
-  const Result r = dynlab(dir, "grade " + shellWord((odd / "my gains.json").string()) + " --config " +
-                                   shellWord((odd / "lab config.json").string()) + " --lab slider_crank --out " +
-                                   shellWord((odd / "out put").string()) + " --inline-plots");
+  const Result r = dynlab(dir, {"grade", (odd / "my gains.json").string(), "--config", (odd / "lab config.json").string(),
+                                "--lab", "slider_crank", "--out", (odd / "out put").string(), "--inline-plots"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   // results.json with inline plots passes Gradescope's shape check.
-  const Result check = dynlab(dir, "check-results " + shellWord((odd / "out put/results.json").string()));
+  const Result check = dynlab(dir, {"check-results", (odd / "out put/results.json").string()});
   CHECK_MESSAGE(check.code == 0, check.err);
-  // The terminal's hint and report.md's, each run by /bin/sh from another folder.
+  // The terminal's hint and report.md's, each run by a POSIX shell (sh) from another folder.
+  ProcessOptions from_root;
+  from_root.cwd = "/";
   std::smatch m;
   REQUIRE(std::regex_search(r.out, m, std::regex("replay:  ([^\n]*)\n")));
   const std::string terminal_hint = m[1];
@@ -317,7 +318,8 @@ TEST_CASE("dynlab grade: the replay hints run as printed, from any folder, and r
   CHECK(report_hint == terminal_hint);
   CHECK(report_hint.find("--config") != std::string::npos);
   for (const std::string& hint : {terminal_hint, report_hint}) {
-    const Result replay = shell(dir, "cd / && " + hint);
+    const Result replay =
+        run(dir, {"sh", "-c", hint}, from_root);  // a user's shell: the test checks the command line printed for pasting
     INFO(hint, "\n", replay.out, replay.err);
     CHECK(replay.code == 0);
     CHECK(replay.out.find("replay: match") != std::string::npos);
@@ -327,7 +329,8 @@ TEST_CASE("dynlab grade: the replay hints run as printed, from any folder, and r
   results["tests"][0]["extra_data"]["value"] = 0.02;
   results["tests"][0]["score"] = 2.5;
   write(odd / "out put/results.json", results.dump());
-  const Result changed = shell(dir, "cd / && " + terminal_hint);
+  const Result changed =
+      run(dir, {"sh", "-c", terminal_hint}, from_root);  // a user's shell: the test checks the command line printed for pasting
   CHECK(changed.code == 1);
   CHECK(changed.out.find("metric x_rms of test 1 (Slider tracks x_d(t)): was 0.02 → now 0.0116") != std::string::npos);
   CHECK(changed.out.find("score was 2.5 → now 2.03") != std::string::npos);

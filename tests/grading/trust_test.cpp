@@ -4,7 +4,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include <fcntl.h>
+#include <poll.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cmath>
+#include <csignal>
 
 #include "tests/app/cli_run.h"
 
@@ -15,6 +21,36 @@ namespace {
 const fs::path kLabs = fs::path(DYNLAB_SOURCE_DIR) / "labs";
 const fs::path kGood = kLabs / "grasp/examples/mediocre.json", kOther = kLabs / "slider_crank/examples/mediocre.json";
 json results(const fs::path& p) { return json::parse(readFile(p)); }
+// Options that run a program in dir with its stdout and stderr both in the file `log` there (2>&1).
+ProcessOptions logTo(const TempDir& dir, const std::string& log) {
+  ProcessOptions o;
+  o.cwd = dir.path.string();
+  fs::remove(dir / log);
+  o.stdout_file = o.stderr_file = (dir / log).string();
+  o.append = true;  // one file, two descriptors: appending, neither overwrites the other
+  return o;
+}
+// Runs argv in dir with stdout and stderr on a FIFO whose reader takes one byte and closes it (as
+// `2>&1 | head -c 1` would); returns what it read, once the program has ended.
+std::string readOneByte(const TempDir& dir, const std::vector<std::string>& argv) {
+  const fs::path fifo = dir / "pipe";
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  // The reader opens first (without blocking), so the program's open for writing does not block.
+  const int reader = ::open(fifo.c_str(), O_RDONLY | O_NONBLOCK);
+  REQUIRE(reader >= 0);
+  ProcessOptions o;
+  o.cwd = dir.path.string();
+  o.stdout_file = o.stderr_file = fifo.string();
+  dyn::StartedProgram program = dyn::startProgram(argv, o);
+  pollfd ready{reader, POLLIN, 0};
+  char byte = 0;
+  std::string got;
+  if (::poll(&ready, 1, 60000) > 0 && ::read(reader, &byte, 1) == 1) got.assign(1, byte);
+  ::close(reader);
+  dyn::waitProgram(program);
+  fs::remove(fifo);
+  return got;
+}
 // gradebook.csv's data rows as text fields (RFC 4180 quotes; the header dropped).
 std::vector<std::vector<std::string>> gradebook(const fs::path& p) {
   std::vector<std::vector<std::string>> rows(1, std::vector<std::string>(1));
@@ -37,10 +73,11 @@ std::vector<std::vector<std::string>> gradebook(const fs::path& p) {
 TEST_CASE("staging: two concurrent grades into one --out both finish and leave one whole set, never a mix") {
   TempDir dir("trust_concurrent");
   for (int trial = 0; trial < 3; ++trial) {
-    shell(dir, "( (" + quote(DYNLAB_BIN) + " grade " + quote(kGood.string()) + " --out out > a.log 2>&1; echo $? > a.rc) & (" +
-                                    quote(DYNLAB_BIN) + " grade " + quote(kOther.string()) + " --out out > b.log 2>&1; echo $? > b.rc) & wait )");
-    CHECK(readFile(dir / "a.rc") == "0\n");
-    CHECK(readFile(dir / "b.rc") == "0\n");
+    dyn::StartedProgram a = dyn::startProgram({DYNLAB_BIN, "grade", kGood.string(), "--out", "out"}, logTo(dir, "a.log"));
+    dyn::StartedProgram b = dyn::startProgram({DYNLAB_BIN, "grade", kOther.string(), "--out", "out"}, logTo(dir, "b.log"));
+    const dyn::ProcessResult ra = dyn::waitProgram(a), rb = dyn::waitProgram(b);
+    CHECK_MESSAGE(ra.code == 0, readFile(dir / "a.log"));
+    CHECK_MESSAGE(rb.code == 0, readFile(dir / "b.log"));
     // The set that stands is one student's: results.json, report.md and the plots agree on the lab.
     const std::string md = readFile(dir / "out/report.md");
     const bool grasp = md.find("grasp") != std::string::npos, crank = md.find("slider") != std::string::npos;
@@ -60,7 +97,7 @@ TEST_CASE("staff errors: a broken --config or a rubric naming an unknown metric 
   writeFile(dir / "unknown_metric.json", cfg.dump());
   for (const std::string config : {"broken.json", "unknown_metric.json"}) {
     const fs::path full = fs::absolute(dir / config);
-    const Result r = dynlab(dir, "grade " + quote(kGood.string()) + " --no-plots --out out --config " + quote(full.string()));
+    const Result r = dynlab(dir, {"grade", kGood.string(), "--no-plots", "--out", "out", "--config", full.string()});
     CHECK(r.code == 3);
     const json res = results(dir / "out/results.json");
     CHECK(res["extra_data"]["status"] == "internal_error");
@@ -75,7 +112,7 @@ TEST_CASE("batch: the lab is fixed before it starts; a submission for another la
   fs::create_directories(dir / "subs");
   fs::copy_file(kGood, dir / "subs/a.json");
   fs::copy_file(kOther, dir / "subs/b.json");
-  const Result r = dynlab(dir, "grade --batch subs --out out --no-plots");
+  const Result r = dynlab(dir, {"grade", "--batch", "subs", "--out", "out", "--no-plots"});
   CHECK(r.code == 0);
   CHECK(r.out.find("lab: grasp (from the first submission naming a lab, a)") != std::string::npos);
   CHECK(readFile(dir / "out/gradebook.md").find("Lab: grasp") != std::string::npos);
@@ -104,21 +141,24 @@ TEST_CASE("one submission rule: run_autograder and the batch read the same file,
   fs::create_symlink("../../staff.json", dir / "subs/link_out/submission.json");
   fs::copy_file(kGood, dir / "subs/link_in/mine.json");
   fs::create_symlink("mine.json", dir / "subs/link_in/submission.json");
-  REQUIRE(shell(dir, "mkfifo subs/fifo/submission.json").code == 0);
+  REQUIRE(::mkfifo((dir / "subs/fifo/submission.json").c_str(), 0644) == 0);
   fs::copy_file(kGood, dir / "subs/two/a.json");
   fs::copy_file(kGood, dir / "subs/two/b.json");
-  const Result batch = dynlab(dir, "grade --batch subs --out out --no-plots --lab grasp");
+  const Result batch = dynlab(dir, {"grade", "--batch", "subs", "--out", "out", "--no-plots", "--lab", "grasp"});
   REQUIRE(batch.code == 0);
   std::map<std::string, std::string> batch_scores;
   for (const auto& row : gradebook(dir / "out/gradebook.csv")) batch_scores[row[0].substr(0, row[0].find('/'))] = row[1];
   // run_autograder from the bundle, over each folder as its upload.
-  REQUIRE(dynlab(dir, "autograder grasp --out bundle.zip").code == 0);
-  REQUIRE(shell(dir, "mkdir bundle && cd bundle && unzip -q ../bundle.zip").code == 0);
+  REQUIRE(dynlab(dir, {"autograder", "grasp", "--out", "bundle.zip"}).code == 0);
+  REQUIRE(fs::create_directory(dir / "bundle"));
+  ProcessOptions in_bundle;
+  in_bundle.cwd = (dir / "bundle").string();
+  REQUIRE(run(dir, {"unzip", "-q", "../bundle.zip"}, in_bundle).code == 0);
   for (const auto& c : cases) {
     CAPTURE(c);
     const std::string res = "res_" + c;
-    shell(dir, "env DYNLAB_BIN=" + quote(DYNLAB_BIN) + " DYNLAB_SUBMISSION_DIR=subs/" + c + " DYNLAB_RESULTS_DIR=" + res +
-                   " bash bundle/run_autograder");
+    run(dir, {"bash", "bundle/run_autograder"},
+        withEnv({{"DYNLAB_BIN", DYNLAB_BIN}, {"DYNLAB_SUBMISSION_DIR", "subs/" + c}, {"DYNLAB_RESULTS_DIR", res}}));
     const double score = results(dir / res / "results.json")["score"];
     REQUIRE(batch_scores.count(c));
     CHECK(std::abs(std::stod(batch_scores[c]) - score) < 1e-3);  // the gradebook shows 3 decimals
@@ -129,13 +169,13 @@ TEST_CASE("one submission rule: run_autograder and the batch read the same file,
 
 TEST_CASE("limits: NaN and infinite options, runs shorter than a step, clipped echoes, full stdout, pipes") {
   TempDir dir("trust_limits");
-  for (const std::string opt : {"--time-budget nan", "--time-budget inf", "--time-budget -inf"}) {
-    const Result r = dynlab(dir, "grade " + quote(kGood.string()) + " " + opt);
+  for (const std::string budget : {"nan", "inf", "-inf"}) {
+    const Result r = dynlab(dir, {"grade", kGood.string(), "--time-budget", budget});
     CHECK(r.code == 2);
-    if (opt == "--time-budget nan") CHECK(r.err.find("finite") != std::string::npos);
+    if (budget == "nan") CHECK(r.err.find("finite") != std::string::npos);
   }
-  CHECK(dynlab(dir, "run grasp --duration nan").code == 2);
-  const Result short_run = dynlab(dir, "run grasp --duration 1e-9 --out run");
+  CHECK(dynlab(dir, {"run", "grasp", "--duration", "nan"}).code == 2);
+  const Result short_run = dynlab(dir, {"run", "grasp", "--duration", "1e-9", "--out", "run"});
   CHECK(short_run.code == 2);
   CHECK(short_run.err.find("at least one step") != std::string::npos);
   CHECK_FALSE(fs::exists(dir / "run"));
@@ -143,35 +183,43 @@ TEST_CASE("limits: NaN and infinite options, runs shorter than a step, clipped e
   json sub = json::parse(readFile(kGood));
   sub["gains"][std::string(900000, 'k')] = 1;
   writeFile(dir / "big.json", sub.dump());
-  const Result big = dynlab(dir, "grade big.json --no-plots --out big");
+  const Result big = dynlab(dir, {"grade", "big.json", "--no-plots", "--out", "big"});
   CHECK(big.code == 2);
   CHECK(big.err.size() < 4000);
   CHECK(fs::file_size(dir / "big/results.json") < 20000);
   CHECK(readFile(dir / "big/report.md").size() < 20000);
   // ...nor in a message a lab builds (run and compare parse the gains with the lab's own parser).
-  for (const std::string cmd : {std::string("run grasp --gains big.json --duration 0.1 --out runbig"),
-                                "compare big.json " + quote(kGood.string()) + " --out cmpbig"}) {
+  for (const std::vector<std::string>& cmd :
+       {std::vector<std::string>{"run", "grasp", "--gains", "big.json", "--duration", "0.1", "--out", "runbig"},
+        {"compare", "big.json", kGood.string(), "--out", "cmpbig"}}) {
     const Result r = dynlab(dir, cmd);
-    INFO(cmd);
+    INFO(shown(cmd));
     CHECK(r.code == 2);
     CHECK(r.err.size() < 4000);
     CHECK(r.err.find("bytes left out") != std::string::npos);
   }
   // Standard output that cannot be written is an error, not a silent success.
-  for (const std::string cmd : {std::string("schema grasp"), std::string("list"), "grade " + quote(kGood.string()) + " --no-plots --out full"}) {
-    const Result r = shell(dir, quote(DYNLAB_BIN) + " " + cmd + " >/dev/full 2>full.err; echo $? > full.rc");
-    CHECK(readFile(dir / "full.rc") != "0\n");
-    CHECK(readFile(dir / "full.err").find("cannot write standard output") != std::string::npos);
+  for (const std::vector<std::string>& cmd :
+       {std::vector<std::string>{"schema", "grasp"}, {"list"}, {"grade", kGood.string(), "--no-plots", "--out", "full"}}) {
+    INFO(shown(cmd));
+    ProcessOptions to_full;
+    to_full.stdout_file = "/dev/full";
+    const Result r = dynlab(dir, cmd, to_full);
+    CHECK(r.code != 0);
+    CHECK(r.err.find("cannot write standard output") != std::string::npos);
   }
   // A batch piped into a reader that stops early still writes its gradebook.
   fs::create_directories(dir / "subs");
   for (int i = 0; i < 4; ++i) fs::copy_file(kGood, dir / "subs" / ("s" + std::to_string(i) + ".json"));
-  shell(dir, quote(DYNLAB_BIN) + " grade --batch subs --out pb --no-plots 2>&1 | head -c 1");
+  CHECK(readOneByte(dir, {DYNLAB_BIN, "grade", "--batch", "subs", "--out", "pb", "--no-plots"}).size() == 1);
   CHECK(fs::exists(dir / "pb/gradebook.csv"));
   // Past `ulimit -f` a grade ends with an error line and a non-zero exit, not SIGXFSZ.
-  const Result fsize = shell(dir, "(ulimit -f 8; " + quote(DYNLAB_BIN) + " grade " + quote(kGood.string()) + " --out fs; echo rc=$? >&2)");
-  CHECK(fsize.err.find("rc=0") == std::string::npos);
-  CHECK(fsize.err.find("rc=153") == std::string::npos);  // 128 + SIGXFSZ
+  ProcessOptions small_files;
+  small_files.file_size = 8 * 512;  // `ulimit -f 8` (blocks of 512 bytes)
+  const Result fsize = dynlab(dir, {"grade", kGood.string(), "--out", "fs"}, small_files);
+  INFO(fsize.err);
+  CHECK(fsize.code != 0);
+  CHECK(fsize.code != 128 + SIGXFSZ);
   CHECK(fsize.err.find("error:") != std::string::npos);
 }
 
@@ -181,7 +229,8 @@ TEST_CASE("a grade cut by its time budget has its own status, not \"graded\"") {
   json cfg = json::parse(readFile(kLabs / "grasp/grasp.json"));
   cfg["simulation"]["duration"] = cfg["simulation"]["duration"].get<double>() * 40;
   writeFile(dir / "long.json", cfg.dump());
-  const Result r = dynlab(dir, "grade " + quote(kGood.string()) + " --config long.json --no-plots --out o --time-budget 1");
+  const Result r =
+      dynlab(dir, {"grade", kGood.string(), "--config", "long.json", "--no-plots", "--out", "o", "--time-budget", "1"});
   CHECK(r.code == 4);
   CHECK(results(dir / "o/results.json")["extra_data"]["status"] == "out_of_time");
 }
@@ -189,7 +238,7 @@ TEST_CASE("a grade cut by its time budget has its own status, not \"graded\"") {
 TEST_CASE("Markdown output: a URL or an email in reflected text is no link (GFM autolinks on)") {
   TempDir dir("trust_autolink");
   writeFile(dir / "sub.json", R"({"lab": "see https://evil.example/x, www.evil.example or mail me@evil.example", "gains": {}})");
-  const Result r = dynlab(dir, "grade sub.json --no-plots --out o");
+  const Result r = dynlab(dir, {"grade", "sub.json", "--no-plots", "--out", "o"});
   CHECK(r.code == 2);
   const std::string html = readFile(dir / "o/report.html"), md = readFile(dir / "o/report.md");
   CHECK(md.find("evil") != std::string::npos);  // the text is there, shown as text
@@ -203,7 +252,9 @@ TEST_CASE("Markdown output: a URL or an email in reflected text is no link (GFM 
 TEST_CASE("A plotting library that dies under a memory limit costs the plots, not the grade") {
   // Under `ulimit -v` GLib traps when pango cannot start a thread: that used to kill the whole grade.
   TempDir dir("trust_low_memory");
-  const Result r = shell(dir, "ulimit -v 400000 && " + quote(DYNLAB_BIN) + " grade " + quote(kGood.string()) + " --out o");
+  ProcessOptions low_memory;
+  low_memory.address_space = 400000LL * 1024;  // `ulimit -v 400000` (KiB)
+  const Result r = dynlab(dir, {"grade", kGood.string(), "--out", "o"}, low_memory);
   INFO(r.out, r.err);
   // Never a signal death: graded (with its plots, or none and why), or, if the grade itself ran out
   // of memory first, an internal error (exit 3) with its one line.

@@ -8,7 +8,6 @@
 #pragma once
 #include <doctest/doctest.h>
 
-#include <cstdlib>
 #include <iostream>
 #include <string>
 #include <utility>
@@ -52,14 +51,13 @@ inline void checkLab(const LabEntry& entry, const json& config, const LabCheckOp
 // `dynlab ui LAB --frames 3` in a virtual X display; false (and DYNLAB_TEST_SKIPPED printed, so
 // ctest reports the test skipped) when xvfb-run is missing.
 inline bool checkWindow(const LabEntry& entry) {
-  if (std::system("command -v xvfb-run >/dev/null 2>&1 && command -v xauth >/dev/null 2>&1") != 0) {
+  if (!cli::haveXvfb()) {
     std::cout << "DYNLAB_TEST_SKIPPED: xvfb-run (packages xvfb, xauth) not found; the window checks did not run\n";
     return false;
   }
   INFO("lab ", entry.name, ": dynlab ui");
   const cli::TempDir dir("every_lab_ui_" + entry.name);
-  const cli::Result r = cli::shell(dir, "xvfb-run -a -s '-screen 0 1600x1000x24' " + cli::quote(DYNLAB_BIN) + " ui " +
-                                            entry.name + " --frames 3");
+  const cli::Result r = cli::run(dir, cli::inXvfb({DYNLAB_BIN, "ui", entry.name, "--frames", "3"}));
   INFO(r.out, r.err);
   CHECK(r.code == 0);
   return true;

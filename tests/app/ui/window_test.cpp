@@ -5,11 +5,8 @@
 // window cases print DYNLAB_TEST_SKIPPED, which ctest reports as skipped.
 #include <doctest/doctest.h>
 #include <stb_image.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -18,6 +15,7 @@
 #include "app/model_lab.h"
 #include "labs/run.h"
 #include "render/renderer.h"
+#include "tests/app/cli_run.h"
 #include "tests/test_files.h"
 
 namespace fs = std::filesystem;
@@ -25,41 +23,25 @@ using namespace dyn;
 
 namespace {
 
-std::string quote(const std::string& s) { return "'" + s + "'"; }
-
-struct Result {
-  int code = -1;
-  std::string out, err;
-};
-
-// Runs a shell command in dir, capturing stdout and stderr.
-Result shell(const fs::path& dir, const std::string& cmd) {
-  const fs::path out = dir / ".stdout", err = dir / ".stderr";
-  const std::string full = "cd " + quote(dir.string()) + " && " + cmd + " >" + quote(out.string()) + " 2>" + quote(err.string());
-  const int status = std::system(full.c_str());
-  Result r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  r.out = test::readBytes(out);
-  r.err = test::readBytes(err);
-  fs::remove(out);
-  fs::remove(err);
-  return r;
-}
+using test::cli::cat;
+using test::cli::Result;
 
 // Without a display at all: what must work before (or instead of) a window.
-Result noDisplay(const fs::path& dir, const std::string& bin, const std::string& args) {
-  return shell(dir, "env -u DISPLAY -u WAYLAND_DISPLAY " + quote(bin) + " " + args);
+Result noDisplay(const fs::path& dir, const std::string& bin, const std::vector<std::string>& args) {
+  ProcessOptions o;
+  o.unset_env = {"DISPLAY", "WAYLAND_DISPLAY"};
+  return test::cli::run(dir, cat({bin}, args), o);
 }
 
 bool haveXvfb() {
-  static const bool have = std::system("command -v xvfb-run >/dev/null 2>&1 && command -v xauth >/dev/null 2>&1") == 0;
+  static const bool have = test::cli::haveXvfb();
   if (!have) std::cout << "DYNLAB_TEST_SKIPPED: xvfb-run (packages xvfb, xauth) not found; the window tests did not run\n";
   return have;
 }
 
 // bin ARGS in a fresh virtual X display (24-bit, larger than the window).
-Result inXvfb(const fs::path& dir, const std::string& bin, const std::string& args) {
-  return shell(dir, "xvfb-run -a -s '-screen 0 1600x1000x24' " + quote(bin) + " " + args);
+Result inXvfb(const fs::path& dir, const std::string& bin, const std::vector<std::string>& args) {
+  return test::cli::run(dir, test::cli::inXvfb(cat({bin}, args), "1600x1000"));
 }
 
 struct Png {
@@ -119,7 +101,7 @@ Image renderOsmesa(const Lab& lab, const Trace& full, const Trace* full_ghost, s
 
 // Grades a submission with the real dynlab; returns results.json.
 json grade(const fs::path& dir, const std::string& file, const std::string& out) {
-  const Result r = shell(dir, quote(DYNLAB_BIN) + " grade " + quote(file) + " --out " + quote(out) + " --no-plots");
+  const Result r = test::cli::run(dir, {DYNLAB_BIN, "grade", file, "--out", out, "--no-plots"});
   INFO("dynlab grade " << file << ": " << r.out << r.err);
   CHECK(r.code == 0);
   return loadJsonFile((dir / out / "results.json").string());
@@ -131,30 +113,30 @@ const std::string kExamples = std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_cra
 
 TEST_CASE("dynlab-ui: --help and bad input need no display, and bad input exits 2 before a window opens") {
   const fs::path dir = test::scratchDir("dynlab_ui_window", "no_display");
-  Result r = noDisplay(dir, DYNLAB_UI_BIN, "--help");
+  Result r = noDisplay(dir, DYNLAB_UI_BIN, {"--help"});
   CHECK(r.code == 0);
   CHECK(r.out.find("--frames") != std::string::npos);
   CHECK(r.out.find("--set") != std::string::npos);
-  r = noDisplay(dir, DYNLAB_UI_BIN, "slider_crank --set kp_x=1e9 --frames 1");
+  r = noDisplay(dir, DYNLAB_UI_BIN, {"slider_crank", "--set", "kp_x=1e9", "--frames", "1"});
   CHECK(r.code == 2);
   CHECK(r.err == "error: <command line>: --set kp_x=1e9: expected a number in [0, 2e+04] N/m, got 1e+09\n");
-  r = noDisplay(dir, DYNLAB_UI_BIN, "slider_crank --set force_law=bang_bang");
+  r = noDisplay(dir, DYNLAB_UI_BIN, {"slider_crank", "--set", "force_law=bang_bang"});
   CHECK(r.code == 2);
   CHECK(r.err.find("expected one of open_loop, proportional, integral") != std::string::npos);
-  r = noDisplay(dir, DYNLAB_UI_BIN, "no_such_lab");
+  r = noDisplay(dir, DYNLAB_UI_BIN, {"no_such_lab"});
   CHECK(r.code == 2);
   CHECK(r.err.find("unknown lab \"no_such_lab\"") != std::string::npos);
-  r = noDisplay(dir, DYNLAB_UI_BIN, "slider_crank --screenshot x.png");
+  r = noDisplay(dir, DYNLAB_UI_BIN, {"slider_crank", "--screenshot", "x.png"});
   CHECK(r.code == 2);  // --screenshot needs --frames
   // With good input and no display: a clear error, not a crash.
-  r = noDisplay(dir, DYNLAB_UI_BIN, "slider_crank --frames 1");
+  r = noDisplay(dir, DYNLAB_UI_BIN, {"slider_crank", "--frames", "1"});
   CHECK(r.code == 1);
   CHECK(r.err.find("error: cannot open a window") == 0);
   // The one entry point: dynlab ui execs dynlab-ui with its arguments and exit code.
-  r = noDisplay(dir, DYNLAB_BIN, "ui --help");
+  r = noDisplay(dir, DYNLAB_BIN, {"ui", "--help"});
   CHECK(r.code == 0);
   CHECK(r.out.find("dynlab-ui") != std::string::npos);
-  r = noDisplay(dir, DYNLAB_BIN, "ui slider_crank --set kd_x=-3 --frames 1");
+  r = noDisplay(dir, DYNLAB_BIN, {"ui", "slider_crank", "--set", "kd_x=-3", "--frames", "1"});
   CHECK(r.code == 2);
   CHECK(r.err.find("--set kd_x=-3: expected a number in [0, 2000]") != std::string::npos);
 }
@@ -163,8 +145,8 @@ TEST_CASE("the window's scene is the OSMesa render of the state it shows, with t
   if (!haveXvfb()) return;
   const fs::path dir = test::scratchDir("dynlab_ui_window", "screenshot");
   const Result r = inXvfb(dir, DYNLAB_UI_BIN,
-                          "slider_crank --set kp_x=500 --engine both --frames 60 --screenshot shot.png --state state.json "
-                          "--save gains.json");
+                          {"slider_crank", "--set", "kp_x=500", "--engine", "both", "--frames", "60", "--screenshot", "shot.png",
+                           "--state", "state.json", "--save", "gains.json"});
   INFO(r.out << r.err);
   REQUIRE(r.code == 0);
   const json state = loadJsonFile((dir / "state.json").string());
@@ -228,8 +210,8 @@ TEST_CASE("gains saved by the window grade exactly like the same gains written b
   if (!haveXvfb()) return;
   const fs::path dir = test::scratchDir("dynlab_ui_window", "grade");
   const Result r = inXvfb(dir, DYNLAB_UI_BIN,
-                          "slider_crank --set kp_x=300 --set kd_x=12 --set ki_f=10 --set force_law=integral --frames 3 "
-                          "--save mine.json");
+                          {"slider_crank", "--set", "kp_x=300", "--set", "kd_x=12", "--set", "ki_f=10", "--set",
+                           "force_law=integral", "--frames", "3", "--save", "mine.json"});
   INFO(r.out << r.err);
   REQUIRE(r.code == 0);
   const json saved = loadJsonFile((dir / "mine.json").string());
@@ -249,7 +231,9 @@ TEST_CASE("unstable gains: the window says why in the grader's words, and does n
   if (!haveXvfb()) return;
   const fs::path dir = test::scratchDir("dynlab_ui_window", "unstable");
   const std::string gains = kExamples + "unstable_integral.json";
-  const Result r = inXvfb(dir, DYNLAB_UI_BIN, "slider_crank --gains " + quote(gains) + " --frames 20 --state state.json --screenshot shot.png");
+  const Result r =
+      inXvfb(dir, DYNLAB_UI_BIN,
+             {"slider_crank", "--gains", gains, "--frames", "20", "--state", "state.json", "--screenshot", "shot.png"});
   INFO(r.out << r.err);
   REQUIRE(r.code == 0);
   const json state = loadJsonFile((dir / "state.json").string());
@@ -267,8 +251,9 @@ TEST_CASE("unstable gains: the window says why in the grader's words, and does n
 TEST_CASE("dynlab ui LAB runs the window (one entry point)") {
   if (!haveXvfb()) return;
   const fs::path dir = test::scratchDir("dynlab_ui_window", "entry");
-  const Result r = inXvfb(dir, DYNLAB_BIN, "ui slider_crank --gains " + quote(kExamples + "mediocre.json") +
-                                               " --set kp_f=0.25 --frames 2 --state state.json");
+  const Result r = inXvfb(dir, DYNLAB_BIN,
+                          {"ui", "slider_crank", "--gains", kExamples + "mediocre.json", "--set", "kp_f=0.25", "--frames", "2",
+                           "--state", "state.json"});
   INFO(r.out << r.err);
   REQUIRE(r.code == 0);
   const json state = loadJsonFile((dir / "state.json").string());
@@ -280,12 +265,13 @@ TEST_CASE("dynlab ui FILE: a model file's passive run in the window, its scene t
   const std::string file = std::string(DYNLAB_SOURCE_DIR) + "/assets/models/fourbar.xml";
   const fs::path dir = test::scratchDir("dynlab_ui_window", "model");
   // Lab-only options are refused before any display is needed.
-  const Result bad = noDisplay(dir, DYNLAB_UI_BIN, quote(file) + " --gains g.json");
+  const Result bad = noDisplay(dir, DYNLAB_UI_BIN, {file, "--gains", "g.json"});
   CHECK(bad.code == 2);
   CHECK(bad.err.find("--gains") != std::string::npos);
   CHECK(std::count(bad.err.begin(), bad.err.end(), '\n') == 1);
   if (!haveXvfb()) return;
-  const Result r = inXvfb(dir, DYNLAB_BIN, "ui " + quote(file) + " --engine both --frames 30 --screenshot shot.png --state state.json");
+  const Result r = inXvfb(
+      dir, DYNLAB_BIN, {"ui", file, "--engine", "both", "--frames", "30", "--screenshot", "shot.png", "--state", "state.json"});
   INFO(r.out << r.err);
   REQUIRE(r.code == 0);
   const json state = loadJsonFile((dir / "state.json").string());
@@ -313,7 +299,7 @@ TEST_CASE("every gain slider shows its whole name and its value's digits: a thin
   if (!haveXvfb()) return;
   const fs::path dir = test::scratchDir("dynlab_ui_window", "sliders");
   // The unicycle's long gain names (kd_heading, anti_windup) at the default window size.
-  const Result r = inXvfb(dir, DYNLAB_UI_BIN, "unicycle --frames 2 --screenshot shot.png --state state.json");
+  const Result r = inXvfb(dir, DYNLAB_UI_BIN, {"unicycle", "--frames", "2", "--screenshot", "shot.png", "--state", "state.json"});
   INFO(r.out << r.err);
   REQUIRE(r.code == 0);
   const json state = loadJsonFile((dir / "state.json").string());
