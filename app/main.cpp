@@ -8,11 +8,13 @@
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <new>
 #include <string>
 
 #include "app/check_results.h"
 #include "app/commands.h"
 #include "app/course.h"
+#include "app/isolated_draw.h"
 #include "app/model.h"
 #include "app/submission_file.h"
 #include "labs/utf8.h"
@@ -32,6 +34,12 @@ int internalError(const std::string& what) {
   std::fprintf(stderr, "error: internal: %s\n", line.c_str());
   return kInternalError;
 }
+
+// Out of memory is the machine's limit, not dynlab's error: one line and exit 1 (a run or write failed).
+int outOfMemory() {
+  std::fprintf(stderr, "error: out of memory: the command needed more memory than it could get%s\n", dyn::app::memoryLimitText().c_str());
+  return 1;
+}
 }  // namespace
 
 // Standard output that could not be written (a full disk, /dev/full, a closed pipe): one line on
@@ -45,7 +53,7 @@ static int checkStdout(int code) {
   return code == 0 ? 1 : code;
 }
 
-// Whatever escapes a command is reported on one line and exits 3: never an abort. A write past
+// Whatever escapes a command is reported on one line and exits 3 (out of memory: 1): never an abort. A write past
 // `ulimit -f` (SIGXFSZ) or into a closed pipe (SIGPIPE, `| head`) fails with an error the command
 // reports instead of killing it, so a batch still writes its gradebook.
 int main(int argc, char** argv) {
@@ -54,6 +62,8 @@ int main(int argc, char** argv) {
   int code;
   try {
     code = dispatch(argc, argv);
+  } catch (const std::bad_alloc&) {
+    code = outOfMemory();
   } catch (const std::exception& e) {
     code = internalError(e.what());
   } catch (...) {

@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <exception>
 #include <cmath>
 #include <stdexcept>
 
@@ -71,6 +72,12 @@ struct Renderer::Impl {
   }
 
   ~Impl() {
+    // While an exception unwinds (out of memory while drawing) the context may be half-built: its GL
+    // objects and ImGui's are left to the process's end, as the context is (osmesa_context.cpp).
+    if (std::uncaught_exceptions() > 0) {
+      (void)overlay.release();
+      return;
+    }
     overlay.reset();
     meshes.destroy();
     glDeleteBuffers(1, &line_vbo);
