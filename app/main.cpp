@@ -36,9 +36,20 @@ int internalError(const std::string& what) {
 }
 
 // Out of memory is the machine's limit, not dynlab's error: one line and exit 1 (a run or write failed).
-int outOfMemory() {
-  std::fprintf(stderr, "error: out of memory: the command needed more memory than it could get%s\n", dyn::app::memoryLimitText().c_str());
+// what: the library's own words, when it said so (one line, valid UTF-8).
+int outOfMemory(const std::string& what = "the command needed more memory than it could get") {
+  std::string line = dyn::utf8Quotable(what);
+  for (char& c : line)
+    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+  std::fprintf(stderr, "error: out of memory: %s%s\n", line.c_str(), dyn::app::memoryLimitText().c_str());
   return 1;
+}
+
+// A library's own words for a failed allocation, in what escaped (MuJoCo's "Could not allocate memory").
+bool saysOutOfMemory(const std::string& what) {
+  for (const char* words : {"Could not allocate memory", "Cannot allocate memory", "out of memory"})
+    if (what.find(words) != std::string::npos) return true;
+  return false;
 }
 }  // namespace
 
@@ -65,7 +76,7 @@ int main(int argc, char** argv) {
   } catch (const std::bad_alloc&) {
     code = outOfMemory();
   } catch (const std::exception& e) {
-    code = internalError(e.what());
+    code = saysOutOfMemory(e.what()) ? outOfMemory(e.what()) : internalError(e.what());
   } catch (...) {
     code = internalError("an exception that is not a std::exception");
   }
