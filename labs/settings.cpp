@@ -44,7 +44,7 @@ std::string runBoundProblem(double dt, double duration, std::size_t columns, con
 }
 
 std::string frameBoundProblem(double duration, double fps) {
-  const double frames = std::floor(duration * fps) + 1;
+  const double frames = std::floor(duration * fps + 1e-6) + 1;  // a trace's duration, (rows − 1)·dt, may fall short by an ulp
   if (frames <= kMaxFrames) return "";
   return fmt("%g", duration) + " s at " + fmt("%g", fps) + " frames a second is " + fmt("%g", frames) + " frames, more than the " +
          fmt("%g", kMaxFrames) + " a run may draw";
