@@ -12,10 +12,11 @@ namespace dyn::app {
 // " under the address-space limit of 450 MB (ulimit -v)" when this process has one; "" otherwise.
 std::string memoryLimitText();
 
-// Runs draw() in a child process with its standard error silenced. Returns when it finished; throws
-// std::runtime_error with one line otherwise: draw()'s own exception's message, or, when the child
-// ran out of memory or was ended by a signal under an address-space limit,
-// "out of memory: drawing WHAT stopped (...) under the address-space limit of N MB (ulimit -v)".
+// Runs draw() in a child process, its standard error kept in memory (not shown). Returns when it
+// finished; throws std::runtime_error with one line otherwise: draw()'s own exception's message, or,
+// when the child ran out of memory (std::bad_alloc; a signal, or a library's words for a failed
+// allocation on its stderr, under an address-space limit), "out of memory: drawing WHAT ... under the
+// address-space limit of N MiB (ulimit -v)".
 void drawIsolated(const std::string& what, const std::function<void()>& draw);
 
 }  // namespace dyn::app

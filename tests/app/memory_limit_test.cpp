@@ -3,8 +3,9 @@
 // from GLib under PLplot's cairo driver, SIGABRT from llvmpipe's LLVM) run here under an address-space
 // limit set in the child (setrlimit, as ulimit -v does). Where memory runs out depends on the machine
 // (llvmpipe's thread count, the address layout), so each may also succeed; what it may never do is end
-// by a signal, print more than one line, or exit 3. The limits are the two where every one of the three
-// crashed before (400 and 425 MiB); each command fails or finishes in a second or two.
+// by a signal, print more than one line, or exit 3. The limits are two where the binary before the fix
+// died by SIGSEGV (run --video at 400, figure at 425 MiB) and SIGTRAP (figure at 400) or said only
+// "error: std::bad_alloc" (model --video); each command fails or finishes in a second or two.
 #include <doctest/doctest.h>
 
 #include "tests/app/cli_run.h"
