@@ -35,6 +35,7 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 constexpr int kBlock = 50;
+constexpr double kAccuracyRun = 2.0;  // s: each engine's run from the file's pose, against the hand RK4 run
 
 // One engine as the bench drives it: a step from its own state, back to the start, and its state.
 struct Engine {
@@ -197,6 +198,12 @@ int benchModel(const BenchArgs& a) {
     return 2;
   }
   const double dt = m.timestep;
+  // Its accuracy run (2 s at the file's step, each of 3 engines' q kept per step) has the bound every
+  // run has (labs/settings.h).
+  if (const std::string problem = runBoundProblem(dt, kAccuracyRun, 3 * std::size_t(m.q0.size()), "timestep"); !problem.empty()) {
+    std::fprintf(stderr, "error: %s: <option timestep>: %s\n", utf8Quotable(m.file).c_str(), problem.c_str());
+    return 2;
+  }
   Engines engines;
   try {
     build(m, dt, !beside.empty(), engines);
@@ -208,14 +215,14 @@ int benchModel(const BenchArgs& a) {
   for (Engine& e : list) e.restart();
   timeBlocks(list, a.steps);
   ConstrainedMechanism<Spatial> mech(m.mechanism);
-  const int run_steps = int(std::lround(2.0 / dt));
+  const int run_steps = int(std::lround(kAccuracyRun / dt));
   const std::vector<Accuracy> acc = accuracy(list, m, mech, run_steps, 1);
   const Engine& euler = list[0];
   int rows = 0;
   for (const auto& c : m.closures) rows += int(c.kept.size());
   const std::string mujoco_left_out = beside.empty() ? "" : "MuJoCo not timed: its run of the file would not hold what " + beside + " adds";
   if (a.json) {
-    json out = {{"model", m.file}, {"dt", dt}, {"steps_timed", a.steps}, {"closure_rows", rows}, {"accuracy_run_s", 2.0}};
+    json out = {{"model", m.file}, {"dt", dt}, {"steps_timed", a.steps}, {"closure_rows", rows}, {"accuracy_run_s", kAccuracyRun}};
     if (!beside.empty()) out["beside"] = {{"file", beside}, {"elements", m.contacts.size()}, {"note", mujoco_left_out}};
     for (std::size_t i = 0; i < list.size(); ++i) {
       const Ratio r = ratio(list[i].blocks, euler.blocks);

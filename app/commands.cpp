@@ -13,6 +13,7 @@
 #include <stdexcept>
 
 #include "app/autograder.h"
+#include "app/isolated_draw.h"
 #include "app/movie.h"
 #include "app/output.h"
 #include "grading/escape.h"
@@ -122,6 +123,9 @@ int runLab(const RunArgs& a) {
       std::snprintf(what, sizeof what, "expected at least one step (dt = %g s), got %g s", loaded.lab->dt(), loaded.lab->duration());
       throw InputError("<command line>", "--duration", what);
     }
+    if (a.video || a.frames)  // the frames drawn of the run are bounded too (labs/settings.h), before it runs
+      if (const std::string problem = frameBoundProblem(loaded.lab->duration(), 30); !problem.empty())
+        throw InputError("<command line>", a.video ? "--video" : "--frames", problem);
   } catch (const InputError& e) {
     std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
     return 2;
@@ -172,7 +176,10 @@ int runLab(const RunArgs& a) {
     if (a.video || a.frames) {
       const Trace& shown = hand ? hand->trace : bullet->trace;
       const Trace* ghost = hand && bullet ? &bullet->trace : nullptr;
-      frames = renderRun(lab, shown, ghost, {640, 480, 30, a.video, a.frames}, staging.path(""));
+      // Drawn in a child (app/isolated_draw.h): llvmpipe ends the process when memory runs out.
+      frames = int(frameRows(shown, lab.dt(), 30).size());
+      drawIsolated(a.video ? "video.mp4" : "the frames",
+                   [&] { renderRun(lab, shown, ghost, {640, 480, 30, a.video, a.frames}, staging.path("")); });
     }
     staging.commit();
 
@@ -192,6 +199,8 @@ int runLab(const RunArgs& a) {
     if (a.frames) std::printf("  frames          %s/ (%d PNG)\n", (out / "frames").c_str(), frames);
     if (summary.contains("agreement")) std::printf("  hand vs Bullet: %s\n", describeAgreement(lab, summary["agreement"]).c_str());
     return status == "ok" ? 0 : 1;
+  } catch (const std::bad_alloc&) {
+    throw;  // main's one line for it (app/main.cpp)
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;

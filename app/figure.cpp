@@ -17,6 +17,7 @@
 #include <tuple>
 
 #include "app/commands.h"
+#include "app/isolated_draw.h"
 #include "app/model.h"
 #include "app/movie.h"
 #include "app/output.h"
@@ -241,6 +242,9 @@ int figure(const FigureArgs& a) {
     const double duration = loaded.lab->duration();
     if (duration < loaded.lab->dt())  // a figure of a run needs at least one step of it
       badOption("--duration", fmt("%g", duration), "expected at least one step (dt = " + fmt("%g", loaded.lab->dt()) + " s)");
+    if (double(stills.size()) > kMaxFrames)  // the frames a run may draw (labs/settings.h)
+      badOption("--still", fmt("%g", stills.back()), std::to_string(stills.size()) + " stills are more than the " +
+                                                         fmt("%g", kMaxFrames) + " frames a run may draw");
     for (double t : stills)
       if (!(t >= 0 && t <= duration))
         badOption("--still", fmt("%g", t), "expected a time in [0, " + fmt("%g", duration) + "] s (the run's duration)");
@@ -317,24 +321,31 @@ int figure(const FigureArgs& a) {
         skipped.push_back(name + " (" + curvesText(p.curves) + ": nothing to draw, its masks are 0 throughout)");
         continue;
       }
-      writePlot(staging.path(name).string(), spec, plot_size.first, plot_size.second);
+      // PLplot's cairo driver (GLib, pango) ends the process when memory runs out: drawn in a child.
+      drawIsolated(name, [&] { writePlot(staging.path(name).string(), spec, plot_size.first, plot_size.second); });
       written.push_back(name);
     }
     if (!stills.empty()) {
-      auto context = makeOffscreenContext(size.first, size.second);
-      RenderOptions options;
-      options.show_overlay = a.overlay;
-      Renderer renderer(*context, options);
-      const Trace* ghost = hand && bullet ? &bullet->trace : nullptr;
-      for (double t : stills) {
-        const std::string name = "still_" + fmt("%.3f", t + 0.0) + ".png";  // + 0.0: no "-0.000"
-        bar.set(made++);
-        if (!names.insert(name).second) continue;
-        const std::size_t row = rowAt(shown.trace, lab.dt(), t);
-        const Image image = renderRow(renderer, lab, shown.trace, row, ghost, a.overlay, a.title);
-        if (std::string why; !writePng(staging.path(name).string(), image, &why)) throw std::runtime_error(why);
-        written.push_back(name);
-      }
+      // Each still's name once; drawn in a child (OSMesa's llvmpipe aborts when memory runs out).
+      std::vector<std::pair<double, std::string>> todo;
+      for (double t : stills)
+        if (const std::string name = "still_" + fmt("%.3f", t + 0.0) + ".png"; names.insert(name).second)  // + 0.0: no "-0.000"
+          todo.push_back({t, name});
+      drawIsolated(todo.size() == 1 ? todo.front().second : "the stills", [&] {
+        auto context = makeOffscreenContext(size.first, size.second);
+        RenderOptions options;
+        options.show_overlay = a.overlay;
+        Renderer renderer(*context, options);
+        const Trace* ghost = hand && bullet ? &bullet->trace : nullptr;
+        for (std::size_t i = 0; i < todo.size(); ++i) {
+          bar.set(made + i);
+          const std::size_t row = rowAt(shown.trace, lab.dt(), todo[i].first);
+          const Image image = renderRow(renderer, lab, shown.trace, row, ghost, a.overlay, a.title);
+          if (std::string why; !writePng(staging.path(todo[i].second).string(), image, &why)) throw std::runtime_error(why);
+        }
+      });
+      made += stills.size();
+      for (const auto& still : todo) written.push_back(still.second);
     }
     bar.set(made);
     bar.done();
@@ -357,6 +368,8 @@ int figure(const FigureArgs& a) {
     if (!removed.empty())
       std::printf("  removed the earlier figure run's %s (use another --out to keep figures side by side)\n", termText(removed).c_str());
     return status == "ok" ? 0 : 1;
+  } catch (const std::bad_alloc&) {
+    throw;  // main's one line for it (app/main.cpp)
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
     return 1;

@@ -8,11 +8,13 @@
 #include <cstdlib>
 #include <cstring>
 #include <iostream>
+#include <new>
 #include <string>
 
 #include "app/check_results.h"
 #include "app/commands.h"
 #include "app/course.h"
+#include "app/isolated_draw.h"
 #include "app/model.h"
 #include "app/submission_file.h"
 #include "labs/utf8.h"
@@ -32,6 +34,23 @@ int internalError(const std::string& what) {
   std::fprintf(stderr, "error: internal: %s\n", line.c_str());
   return kInternalError;
 }
+
+// Out of memory is the machine's limit, not dynlab's error: one line and exit 1 (a run or write failed).
+// what: the library's own words, when it said so (one line, valid UTF-8).
+int outOfMemory(const std::string& what = "the command needed more memory than it could get") {
+  std::string line = dyn::utf8Quotable(what);
+  for (char& c : line)
+    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
+  std::fprintf(stderr, "error: out of memory: %s%s\n", line.c_str(), dyn::app::memoryLimitText().c_str());
+  return 1;
+}
+
+// A library's own words for a failed allocation, in what escaped (MuJoCo's "Could not allocate memory").
+bool saysOutOfMemory(const std::string& what) {
+  for (const char* words : {"Could not allocate memory", "Cannot allocate memory", "out of memory"})
+    if (what.find(words) != std::string::npos) return true;
+  return false;
+}
 }  // namespace
 
 // Standard output that could not be written (a full disk, /dev/full, a closed pipe): one line on
@@ -45,7 +64,7 @@ static int checkStdout(int code) {
   return code == 0 ? 1 : code;
 }
 
-// Whatever escapes a command is reported on one line and exits 3: never an abort. A write past
+// Whatever escapes a command is reported on one line and exits 3 (out of memory: 1): never an abort. A write past
 // `ulimit -f` (SIGXFSZ) or into a closed pipe (SIGPIPE, `| head`) fails with an error the command
 // reports instead of killing it, so a batch still writes its gradebook.
 int main(int argc, char** argv) {
@@ -54,8 +73,10 @@ int main(int argc, char** argv) {
   int code;
   try {
     code = dispatch(argc, argv);
+  } catch (const std::bad_alloc&) {
+    code = outOfMemory();
   } catch (const std::exception& e) {
-    code = internalError(e.what());
+    code = saysOutOfMemory(e.what()) ? outOfMemory(e.what()) : internalError(e.what());
   } catch (...) {
     code = internalError("an exception that is not a std::exception");
   }

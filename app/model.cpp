@@ -14,6 +14,7 @@
 #include <sstream>
 
 #include "app/commands.h"
+#include "app/isolated_draw.h"
 #include "app/model_loops.h"
 #include "app/model_run.h"
 #include "labs/generic/data_lab.h"
@@ -200,13 +201,15 @@ int runModelFile(const RunArgs& r) {
 }
 
 int model(const ModelArgs& args) {
-  // A trace row per step: bounded before anything runs.
-  constexpr double kMaxSteps = 2e6;
-  if (args.duration / args.dt > kMaxSteps) {
-    std::fprintf(stderr, "error: --duration %g s at --dt %g s is %.0f steps; at most %.0f (a trace row each)\n", args.duration, args.dt,
-                 std::ceil(args.duration / args.dt), kMaxSteps);
+  // A trace row per step and the frames drawn: the bound every run has (labs/settings.h), before anything runs.
+  const auto refuse = [](const char* option, const std::string& problem) {
+    std::fprintf(stderr, "error: <command line>: %s: %s\n", option, problem.c_str());
     return 2;
-  }
+  };
+  if (const std::string problem = runBoundProblem(args.dt, args.duration); !problem.empty()) return refuse("--duration", problem);
+  if (args.video || args.frames)
+    if (const std::string problem = frameBoundProblem(args.duration, 30); !problem.empty())
+      return refuse(args.video ? "--video" : "--frames", problem);
   model_file::LoadedModel m;
   try {
     model_file::LoadOptions options;
@@ -216,6 +219,8 @@ int model(const ModelArgs& args) {
     std::fprintf(stderr, "error: %s\n", utf8Quotable(e.what()).c_str());
     return 2;
   }
+  if (const std::string problem = runBoundProblem(args.dt, args.duration, modelColumns(m).columns.size()); !problem.empty())
+    return refuse("--duration", problem);
   // Constant torques by joint name: each "JOINT=VALUE" once, a joint of the file, a finite value.
   VecN tau = VecN::Zero(Eigen::Index(m.joints.size()));
   std::vector<bool> given(m.joints.size(), false);
@@ -288,10 +293,15 @@ int model(const ModelArgs& args) {
         picture.scene(q, gq.size() ? &gq : nullptr, box, scene);
         if (panel) modelOverlay(utf8Quotable(title), engines, shown, row, args.dt, ghost, *panel);
       };
-      const int frames = renderFrames(draw, shown, args.dt, {640, 480, 30, args.video, args.frames}, staging.path(""));
+      // Drawn in a child (app/isolated_draw.h): llvmpipe ends the process when memory runs out.
+      const int frames = int(frameRows(shown, args.dt, 30).size());
+      drawIsolated(args.video ? "video.mp4" : "the frames",
+                   [&] { renderFrames(draw, shown, args.dt, {640, 480, 30, args.video, args.frames}, staging.path("")); });
       text += "  " + std::to_string(frames) + " frames at 30 per second of simulated time, 640x480\n";
     }
     staging.commit();
+  } catch (const std::bad_alloc&) {
+    throw;  // main's one line for it (app/main.cpp)
   } catch (const std::exception& e) {
     std::fputs(text.c_str(), stdout);
     std::fprintf(stderr, "error: %s\n", utf8Quotable(e.what()).c_str());

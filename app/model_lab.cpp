@@ -158,6 +158,14 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration) 
   const std::filesystem::path path(file);
   const std::string stem = path.stem().string();
   const double dt = m->timestep > 0 ? m->timestep : 1e-3;
+  // The run at the file's step is bounded (labs/settings.h), before anything runs; a refusal names the
+  // --duration given, else the file's timestep.
+  const std::string step = duration ? path.filename().string() + "'s timestep" : "timestep";
+  const auto refuse = [&](const std::string& problem) {
+    if (duration) throw InputError("<command line>", "--duration", problem);
+    throw InputError(file, "<option timestep>", problem);
+  };
+  if (const std::string problem = runBoundProblem(dt, duration.value_or(2.0), 0, step); !problem.empty()) refuse(problem);
   // Its figures: the coordinates, the energy books, each closure's force, each wheel's and contact's.
   std::vector<std::string> q, f, c;
   for (const auto& j : m->joints) q.push_back("q_" + columnName(j.name));
@@ -191,6 +199,9 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration) 
   out.config = config;
   out.config_file = file;
   out.lab = out.entry->create(JsonView(out.config, file));
+  // Its trace: a row of the lab's columns per step (many joints make wide rows).
+  if (const std::string problem = runBoundProblem(dt, out.lab->duration(), out.lab->columns().size(), step); !problem.empty())
+    refuse(problem);
   return out;
 }
 

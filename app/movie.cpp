@@ -39,6 +39,9 @@ Image renderRow(Renderer& renderer, const Lab& lab, const Trace& trace, std::siz
 
 int renderFrames(const DrawRow& draw, const Trace& trace, double dt, const MovieOptions& o,
                  const std::filesystem::path& dir) {
+  // Never more frames than a run may draw (labs/settings.h): the commands refuse before they run, Python here.
+  if (const std::string problem = frameBoundProblem(double(trace.rows() ? trace.rows() - 1 : 0) * dt, o.fps); !problem.empty())
+    throw InputError("<frames>", o.video ? "video" : "frames", problem);
   auto context = makeOffscreenContext(o.width, o.height);
   Renderer renderer(*context);
   std::unique_ptr<VideoWriter> video;

@@ -32,11 +32,18 @@ inline std::string progressLine(const std::string& what, std::size_t done, std::
   return s;
 }
 
+// Where progress lines go: standard error, or in a drawing child (app/isolated_draw.h, its stderr
+// silenced) a copy of the terminal it had.
+inline int& progressFd() {
+  static int fd = STDERR_FILENO;
+  return fd;
+}
+
 // A progress line for `total` units of work; set() as they are done. Silent unless enabled
 // (default: stderr is a terminal). The line is erased by done() or the destructor.
 class Progress {
  public:
-  explicit Progress(std::string what, std::size_t total, bool enabled = ::isatty(STDERR_FILENO) == 1)
+  explicit Progress(std::string what, std::size_t total, bool enabled = ::isatty(progressFd()) == 1)
       : what_(std::move(what)), total_(total), enabled_(enabled), start_(Clock::now()) {
     set(0);
   }
@@ -52,18 +59,25 @@ class Progress {
     last_ = now;
     drawn_ = true;
     const std::string line = progressLine(what_, done, total_, std::chrono::duration<double>(now - start_).count());
-    std::fprintf(stderr, "\r%s\033[K", line.c_str());
-    std::fflush(stderr);
+    put("\r" + line + "\033[K");
   }
   // Erases the line.
   void done() {
     if (!enabled_ || finished_) return;
     finished_ = true;
-    if (drawn_) std::fprintf(stderr, "\r\033[K"), std::fflush(stderr);
+    if (drawn_) put("\r\033[K");
   }
 
  private:
   using Clock = std::chrono::steady_clock;
+  static void put(const std::string& s) {
+    std::fflush(stderr);  // whatever the command wrote there first
+    for (std::size_t done = 0; done < s.size();) {
+      const ssize_t n = ::write(progressFd(), s.data() + done, s.size() - done);
+      if (n <= 0) return;
+      done += std::size_t(n);
+    }
+  }
   std::string what_;
   std::size_t total_;
   bool enabled_, drawn_ = false, finished_ = false;

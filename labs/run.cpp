@@ -13,6 +13,9 @@ std::unique_ptr<Lab> buildLab(const LabEntry& entry, const json& config, const s
   auto lab = entry.create(view);
   // Every lab has the shared simulation block (labs/settings.h); its own parse refused what it cannot honour.
   parseSimulation(view["simulation"], IndependentForm::Yes);
+  // The run's trace too (a row of the lab's columns per step): the bound every path shares (settings.h).
+  if (const std::string problem = runBoundProblem(lab->dt(), lab->duration(), lab->columns().size()); !problem.empty())
+    view["simulation"].fail(problem);
   return lab;
 }
 
@@ -38,6 +41,10 @@ LoadedLab loadLab(const std::string& name, const std::string& config_file, const
   if (duration) {
     if (!(*duration > 0) || *duration > 3600)
       throw InputError("<command line>", "--duration", "expected a duration in (0, 3600] s");
+    // The steps it makes at the lab's dt, named as the option's (buildLab below names the trace's memory).
+    const json& dt = out.config["simulation"]["dt"];
+    if (const std::string problem = runBoundProblem(dt.is_number() ? dt.get<double>() : 0.0, *duration); !problem.empty())
+      throw InputError("<command line>", "--duration", problem);
     setRunDuration(out.config, *duration);
   }
   out.lab = buildLab(*out.entry, out.config, source);
@@ -45,6 +52,10 @@ LoadedLab loadLab(const std::string& name, const std::string& config_file, const
 }
 
 RunResult runEngine(const Lab& lab, Engine engine, long max_steps, const std::function<void(long)>& on_steps) {
+  // Held again here, for a lab built some other way than buildLab: never a trace past the bound.
+  if (max_steps < 0 || double(max_steps) > kMaxSteps)
+    if (const std::string problem = runBoundProblem(lab.dt(), lab.duration(), lab.columns().size()); !problem.empty())
+      throw InputError("<run>", "/simulation", problem);
   RunResult r;
   r.trace.columns = lab.columns();
   auto sim = lab.simulate(engine);

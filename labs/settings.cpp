@@ -2,6 +2,9 @@
 #include "labs/settings.h"
 
 #include <algorithm>
+#include <cmath>
+
+#include "labs/numbers.h"
 
 namespace dyn {
 
@@ -11,8 +14,7 @@ SimulationSettings parseSimulation(const JsonView& sim, IndependentForm form) {
   s.step.dt = sim["dt"].positive();
   if (s.step.dt > kMaxDt || s.step.dt < kMinDt) sim["dt"].inRange(kMinDt, kMaxDt);
   s.duration = sim["duration"].positive();
-  if (s.duration / s.step.dt > kMaxSteps)
-    sim["duration"].fail("expected at most 2e6 steps (duration/dt); a trace of 2e6 rows is ~300 MB");
+  if (const std::string problem = runBoundProblem(s.step.dt, s.duration); !problem.empty()) sim["duration"].fail(problem);
   s.exercise_duration = sim.has("exercise_duration") ? sim["exercise_duration"].positive(1e6) : s.duration;
   parseIntegrator(sim["integrator"].oneOf({"semi_implicit_euler", "rk4"}), s.step.integrator);
   parseDrift(sim["drift"].oneOf({"none", "baumgarte", "projection", "independent"}), s.step.drift.kind);
@@ -32,6 +34,27 @@ void setRunDuration(json& config, double duration) {
   json& sim = config["simulation"];
   if (sim.is_object() && !sim.contains("exercise_duration") && sim.contains("duration")) sim["exercise_duration"] = sim["duration"];
   sim["duration"] = duration;
+}
+
+std::string runBoundProblem(double dt, double duration, std::size_t columns, const std::string& step) {
+  if (!(dt > 0) || !std::isfinite(dt)) return step + " " + fmt("%g", dt) + " s is not a positive step";
+  const double steps = duration / dt;
+  if (!(steps <= kMaxSteps))  // NaN too
+    return step + " " + fmt("%g", dt) + " s over " + fmt("%g", duration) + " s is " + fmt("%g", steps) + " steps, more than the " +
+           fmt("%g", kMaxSteps) + " a run may take";
+  const double rows = std::floor(steps) + 1, bytes = rows * double(columns) * sizeof(double);
+  if (bytes > kMaxTraceBytes)
+    return "a trace of " + fmt("%g", rows) + " rows × " + std::to_string(columns) + " columns is " + fmt("%.3g", bytes / 1e6) +
+           " MB, more than the " + fmt("%g", kMaxTraceBytes / 1e6) + " MB a run's trace may hold (" + step + " " + fmt("%g", dt) +
+           " s over " + fmt("%g", duration) + " s)";
+  return "";
+}
+
+std::string frameBoundProblem(double duration, double fps) {
+  const double frames = std::floor(duration * fps + 1e-6) + 1;  // a trace's duration, (rows − 1)·dt, may fall short by an ulp
+  if (frames <= kMaxFrames) return "";
+  return fmt("%g", duration) + " s at " + fmt("%g", fps) + " frames a second is " + fmt("%g", frames) + " frames, more than the " +
+         fmt("%g", kMaxFrames) + " a run may draw";
 }
 
 std::map<std::string, double> parseGains(const JsonView& g, std::initializer_list<const char*> names) {

@@ -3,6 +3,7 @@
 //   "gains":      {"<name>": {"value", "min", "max", "unit", "doc"}, ...}
 // (submission options: labs/submission.h). Errors are InputErrors naming file and JSON path.
 #pragma once
+#include <cstddef>
 #include <initializer_list>
 #include <map>
 #include <string>
@@ -14,8 +15,23 @@
 namespace dyn {
 
 inline constexpr double kMinDt = 1e-6, kMaxDt = 0.05;  // s
-inline constexpr double kMaxSteps = 2e6;                 // duration/dt: a trace of 2e6 rows is ~300 MB
 inline constexpr double kMaxGain = 1e9;                  // |min|, |max| of a declared gain
+
+// The one bound on a run's work, however the run is asked for (a lab's JSON, a model file's
+// <option timestep>, --duration or --dt on any command, Python's arguments): its steps (duration / dt),
+// its trace's memory (a row of doubles per step) and the frames drawn of it. Commands check it before
+// they simulate; buildLab, runEngine and the frame writer (app/movie.h) hold it again.
+inline constexpr double kMaxSteps = 2e6;         // steps of one run
+inline constexpr double kMaxTraceBytes = 512e6;  // one run's trace: (steps + 1) rows × columns × 8 bytes
+inline constexpr double kMaxFrames = 36000;      // frames drawn of one run: 20 minutes at 30 a second
+
+// Why a run of `duration` s at step dt (called `step` in the sentence: "dt", "timestep") with a trace
+// of `columns` columns is over the bound, naming it: "timestep 1e-09 s over 2 s is 2e+09 steps, more
+// than the 2e+06 a run may take", or "a trace of 2e+06 rows × 300 columns is 4.8 GB, more than the
+// 512 MB a run's trace may hold"; "" when it fits (columns 0: the steps alone).
+std::string runBoundProblem(double dt, double duration, std::size_t columns = 0, const std::string& step = "dt");
+// The same for the frames drawn at `fps` a second of simulated time over `duration` s.
+std::string frameBoundProblem(double duration, double fps);
 
 struct SimulationSettings {
   StepOptions step;

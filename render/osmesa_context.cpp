@@ -2,6 +2,7 @@
 // client-memory RGBA buffer; no display, no GPU needed.
 #include <GL/osmesa.h>
 
+#include <exception>
 #include <stdexcept>
 #include <vector>
 
@@ -31,7 +32,7 @@ class OsmesaContext final : public GlContext {
     context_ = OSMesaCreateContextAttribs(attribs, nullptr);
     if (!context_)
       throw std::runtime_error("OSMesa: could not create an OpenGL 3.3 core context");
-    buffer_.resize(std::size_t(width) * height * 4);
+    buffer_.resize(std::size_t(width) * height * 4);  // std::bad_alloc: the context left to the process's end, as below
     if (!OSMesaMakeCurrent(context_, buffer_.data(), GL_UNSIGNED_BYTE, width, height)) {
       OSMesaDestroyContext(context_);
       throw std::runtime_error("OSMesa: could not make the context current");
@@ -43,7 +44,12 @@ class OsmesaContext final : public GlContext {
     };
     description_ = "OSMesa " + str(GL_VERSION) + ", " + str(GL_RENDERER);
   }
-  ~OsmesaContext() override { OSMesaDestroyContext(context_); }
+  // Destroyed while an exception unwinds (an allocation failed while drawing, out of memory), llvmpipe's
+  // state may be half-built, and tearing it down crashed (SIGSEGV) instead of letting the error reach
+  // its one line: then the context is left to the process's end.
+  ~OsmesaContext() override {
+    if (std::uncaught_exceptions() == 0) OSMesaDestroyContext(context_);
+  }
 
   int width() const override { return width_; }
   int height() const override { return height_; }

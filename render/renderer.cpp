@@ -8,6 +8,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <exception>
 #include <cmath>
 #include <stdexcept>
 
@@ -71,6 +72,12 @@ struct Renderer::Impl {
   }
 
   ~Impl() {
+    // While an exception unwinds (out of memory while drawing) the context may be half-built: its GL
+    // objects and ImGui's are left to the process's end, as the context is (osmesa_context.cpp).
+    if (std::uncaught_exceptions() > 0) {
+      (void)overlay.release();
+      return;
+    }
     overlay.reset();
     meshes.destroy();
     glDeleteBuffers(1, &line_vbo);
@@ -99,10 +106,12 @@ struct Renderer::Impl {
       glBindRenderbuffer(GL_RENDERBUFFER, depth);
       glRenderbufferStorageMultisample(GL_RENDERBUFFER, n, GL_DEPTH_COMPONENT24, width, height);
       glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth);
-      if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
-        throw std::runtime_error("render: framebuffer incomplete (" + std::to_string(n) +
-                                 " samples, " + std::to_string(width) + "x" +
-                                 std::to_string(height) + ")");
+      if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE) {
+        // Its formats (RGBA8, DEPTH24) are ones every GL 3.3 has: incomplete, its storage was not
+        // allocated (llvmpipe under a memory limit, with or without GL_OUT_OF_MEMORY).
+        throw std::runtime_error("out of memory: the renderer could not allocate its framebuffer (" + std::to_string(width) + "x" +
+                                 std::to_string(height) + ", " + std::to_string(n) + " samples: incomplete)");
+      }
     };
     makeTarget(0, resolve_fbo, resolve_color, resolve_depth);
     if (samples > 0) makeTarget(samples, msaa_fbo, msaa_color, msaa_depth);

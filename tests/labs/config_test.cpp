@@ -372,5 +372,5 @@ TEST_CASE("a run cut short by max_steps reserves only what it needs") {
   CHECK(r.trace.rows() == 5);
   CHECK(r.trace.data.capacity() <= 6 * r.trace.columns.size());
   checkNames(buildError({{"simulation", {{"dt", 1e-6}, {"duration", 10.0}}}}), "bad_config.json",
-             "/simulation/duration", "expected at most 2e6 steps");
+             "/simulation/duration", "dt 1e-06 s over 10 s is 1e+07 steps, more than the 2e+06 a run may take");
 }
