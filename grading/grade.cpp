@@ -81,8 +81,8 @@ GradeOutcome failedOutcome(const std::string& full_message, const InputError* e)
 
 std::string timeBudgetProblem(double seconds) {
   if (seconds >= kMinTimeBudget && seconds <= kMaxTimeBudget) return "";  // NaN fails both
-  return "expected a time budget in [" + exactNumber(kMinTimeBudget) + ", " + exactNumber(kMaxTimeBudget) + "] s, got " +
-         exactNumber(seconds);
+  return std::string("expected a ") + (std::isfinite(seconds) ? "" : "finite ") + "time budget in [" + exactNumber(kMinTimeBudget) +
+         ", " + exactNumber(kMaxTimeBudget) + "] s, got " + exactNumber(seconds);
 }
 
 GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {

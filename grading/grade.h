@@ -58,7 +58,7 @@ struct GradeOutcome {
 
 // The wall-time budgets a grade takes, in s: what `--time-budget` and dynlab.grade(time_budget=)
 // accept, refused by both with timeBudgetProblem's text ("expected a time budget in [1, 86400] s,
-// got 0"; empty for a budget in range).
+// got 0", "expected a finite time budget …, got nan"; empty for a budget in range).
 inline constexpr double kMinTimeBudget = 1, kMaxTimeBudget = 86400;
 std::string timeBudgetProblem(double seconds);
 
