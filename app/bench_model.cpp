@@ -194,7 +194,7 @@ int benchModel(const BenchArgs& a) {
   try {
     m = loadWithLoops(a.lab, "");
   } catch (const model_file::ModelFileError& e) {
-    std::fprintf(stderr, "error: %s\n", utf8Quotable(e.what()).c_str());
+    std::fprintf(stderr, "error: %s\n", termName(e.what(), 1000).c_str());
     return 2;
   }
   const double dt = m.timestep;
@@ -208,7 +208,7 @@ int benchModel(const BenchArgs& a) {
   try {
     build(m, dt, !beside.empty(), engines);
   } catch (const std::exception& e) {  // a description the Bullet builder cannot model
-    std::fprintf(stderr, "error: %s: %s\n", utf8Quotable(m.file).c_str(), utf8Quotable(e.what()).c_str());
+    std::fprintf(stderr, "error: %s: %s\n", termName(m.file).c_str(), termName(e.what(), 1000).c_str());
     return 2;
   }
   std::vector<Engine>& list = engines.list;
@@ -239,9 +239,9 @@ int benchModel(const BenchArgs& a) {
     return 0;
   }
   const std::string elements = beside.empty() ? "" : ", " + std::to_string(m.contacts.size()) + " wheels or contacts (" + beside + ")";
-  std::printf("%s: %d coordinates, %d closure rows%s, dt %g s (the file's), passive from its pose at rest\n", utf8Quotable(m.file).c_str(),
-              int(m.q0.size()), rows, utf8Quotable(elements).c_str(), dt);
-  if (!beside.empty()) std::printf("  %s\n", utf8Quotable(mujoco_left_out).c_str());
+  std::printf("%s: %d coordinates, %d closure rows%s, dt %g s (the file's), passive from its pose at rest\n", termName(m.file).c_str(),
+              int(m.q0.size()), rows, termText(elements).c_str(), dt);
+  if (!beside.empty()) std::printf("  %s\n", termName(mujoco_left_out, 1000).c_str());
   std::printf("  %d steps per engine timed in blocks of %d, in turn; ratios block by block: median (middle half)\n", int(euler.all.size()), kBlock);
   std::printf("  engine             µs/step   over hand, 1st order   max |φ|∞     max |q − q_ref|∞ over 2 s (ref: hand RK4)\n");
   for (std::size_t i = 0; i < list.size(); ++i) {

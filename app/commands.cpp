@@ -23,6 +23,7 @@
 #include "grading/scenario.h"
 #include "labs/run.h"
 #include "labs/submission.h"
+#include "labs/numbers.h"
 #include "labs/utf8.h"
 
 namespace fs = std::filesystem;
@@ -30,7 +31,8 @@ namespace fs = std::filesystem;
 namespace dyn::app {
 
 int listLabs() {
-  for (const auto& e : labRegistry()) std::printf("%-16s %s\n", e.name.c_str(), e.summary.c_str());
+  // A data-defined lab's summary is its JSON's title: escaped and clipped like every name from a file.
+  for (const auto& e : labRegistry()) std::printf("%-16s %s\n", e.name.c_str(), termName(e.summary).c_str());
   return 0;
 }
 
@@ -119,9 +121,8 @@ int runLab(const RunArgs& a) {
     watchdog = runWatchdog(loaded);
     // A run must hold at least one step: a shorter one would report "ok" over an empty trace.
     if (loaded.lab->duration() < loaded.lab->dt()) {
-      char what[96];
-      std::snprintf(what, sizeof what, "expected at least one step (dt = %g s), got %g s", loaded.lab->dt(), loaded.lab->duration());
-      throw InputError("<command line>", "--duration", what);
+      throw InputError("<command line>", "--duration", "expected at least one step (dt = " + fmt("%g", loaded.lab->dt()) +
+                                                           " s), got " + exactNumber(loaded.lab->duration()) + " s");
     }
     if (a.video || a.frames)  // the frames drawn of the run are bounded too (labs/settings.h), before it runs
       if (const std::string problem = frameBoundProblem(loaded.lab->duration(), 30); !problem.empty())

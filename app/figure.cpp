@@ -241,13 +241,13 @@ int figure(const FigureArgs& a) {
     for (const auto& spec : a.plots) requested.push_back(parsePlotCurves(spec, columns, "<command line>", "--plot " + spec));
     const double duration = loaded.lab->duration();
     if (duration < loaded.lab->dt())  // a figure of a run needs at least one step of it
-      badOption("--duration", fmt("%g", duration), "expected at least one step (dt = " + fmt("%g", loaded.lab->dt()) + " s)");
+      badOption("--duration", exactNumber(duration), "expected at least one step (dt = " + fmt("%g", loaded.lab->dt()) + " s)");
     if (double(stills.size()) > kMaxFrames)  // the frames a run may draw (labs/settings.h)
       badOption("--still", fmt("%g", stills.back()), std::to_string(stills.size()) + " stills are more than the " +
                                                          fmt("%g", kMaxFrames) + " frames a run may draw");
     for (double t : stills)
       if (!(t >= 0 && t <= duration))
-        badOption("--still", fmt("%g", t), "expected a time in [0, " + fmt("%g", duration) + "] s (the run's duration)");
+        badOption("--still", exactNumber(t), "expected a time in [0, " + fmt("%g", duration) + "] s (the run's duration)");
     rubric_plots = rubricPlots(loaded);
     declared = declaredPlots(loaded);
     std::vector<FigurePlot> known = declared;  // a declared figure's labels first: they are for figures

@@ -17,6 +17,7 @@
 #include "app/isolated_draw.h"
 #include "app/model.h"
 #include "app/submission_file.h"
+#include "grading/grade.h"
 #include "labs/utf8.h"
 
 namespace {
@@ -26,12 +27,10 @@ int dispatch(int argc, char** argv);
 // failed) and 2 (bad input), so a batch or the autograder can tell them apart.
 constexpr int kInternalError = 3;
 
-// What escaped every command, as one line of valid UTF-8 on stderr.
+// What escaped every command, as one line of valid UTF-8 on stderr: a name or path it quotes
+// (a model file's, say) escaped and clipped (termName), never a raw control character.
 int internalError(const std::string& what) {
-  std::string line = dyn::utf8Quotable(what);
-  for (char& c : line)
-    if (static_cast<unsigned char>(c) < 0x20) c = ' ';
-  std::fprintf(stderr, "error: internal: %s\n", line.c_str());
+  std::fprintf(stderr, "error: internal: %s\n", dyn::termName(what, 1000).c_str());
   return kInternalError;
 }
 
@@ -84,6 +83,18 @@ int main(int argc, char** argv) {
 }
 
 namespace {
+// --time-budget: the grader's own check and message (grading/grade.h), which dynlab.grade gives too.
+CLI::Validator timeBudget() {
+  return CLI::Validator(
+      [](std::string& text) {
+        char* end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (end == text.c_str() || *end != '\0') return std::string();  // not a number: CLI11's conversion says so
+        return dyn::timeBudgetProblem(v);
+      },
+      "SECONDS");
+}
+
 // Every floating-point option of every command (CLI11 names their type FLOAT) refuses NaN and the
 // infinities: a range check passes NaN (every comparison is false), and inf overflows what uses it.
 void requireFinite(CLI::App& app) {
@@ -166,7 +177,7 @@ int dispatch(int argc, char** argv) {
   g->add_option("--out", grade.out, "Output directory: results.json, report.md/html, plots/ (default: out/grade)");
   g->add_option("--lab", grade.lab, "The assignment's lab: a submission naming another lab scores 0");
   g->add_option("--config", grade.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
-  g->add_option("--time-budget", grade.time_budget, "Wall-time budget per submission (s)")->check(CLI::Range(1.0, 86400.0));
+  g->add_option("--time-budget", grade.time_budget, "Wall-time budget per submission (s)")->check(timeBudget());
   g->add_flag("!--no-plots", grade.plots, "Skip the response plots (faster)");
   g->add_flag("--inline-plots", grade.inline_plots, "Put each test's plot in results.json as an inline PNG (Gradescope shows "
                                                     "it to the student; 30-100 KB a plot, at most 600 KB in all)");
@@ -214,7 +225,7 @@ int dispatch(int argc, char** argv) {
   k->add_option("--out", cmp.out, "Output directory: comparison.md, plots/ (default: out/compare)");
   k->add_option("--lab", cmp.lab, "The lab both must name (default: the lab A names)");
   k->add_option("--config", cmp.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
-  k->add_option("--time-budget", cmp.time_budget, "Wall-time budget per submission (s)")->check(CLI::Range(1.0, 86400.0));
+  k->add_option("--time-budget", cmp.time_budget, "Wall-time budget per submission (s)")->check(timeBudget());
   k->add_flag("!--no-plots", cmp.plots, "Skip the plots (faster)");
 
   LessonsArgs les;
@@ -223,7 +234,7 @@ int dispatch(int argc, char** argv) {
   l->add_option("LAB", les.lab, "Lab name (see `dynlab list`)")->required();
   l->add_option("--config", les.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json); the pairs' paths are "
                                         "relative to its folder");
-  l->add_option("--time-budget", les.time_budget, "Wall-time budget per submission (s)")->check(CLI::Range(1.0, 86400.0));
+  l->add_option("--time-budget", les.time_budget, "Wall-time budget per submission (s)")->check(timeBudget());
 
   CheckLabArgs check_lab;
   auto* cl = cli.add_subcommand("check-lab", "Check one lab against the lab contract the every-lab test holds every lab to: "

@@ -23,6 +23,7 @@
 #include "app/output.h"
 #include "labs/trace.h"
 #include "physics/bullet/bullet_mechanism.h"
+#include "labs/numbers.h"
 #include "labs/utf8.h"
 #include "physics/constrained_mechanism.h"
 #include "physics/constraints/plane_contact.h"
@@ -39,13 +40,19 @@ std::string fmt(double x) {
   return b;
 }
 
-// What dynlab read, as the lines `dynlab model` prints.
+// A name or path from the file (or the command line) as `dynlab model` prints it: escaped and clipped.
+std::string nameShown(const std::string& s) { return termName(s); }
+
+// A note or an error that quotes names: one line, escaped, at most a few names long.
+std::string shownLine(const std::string& s) { return termName(s, 1000); }
+
+// What dynlab read, as the lines `dynlab model` prints (every name from the file escaped and clipped).
 std::string describe(const model_file::LoadedModel& m) {
   std::ostringstream o;
   const auto& mech = m.mechanism;
   int kept = 0, all = 0;
   for (const auto& c : m.closures) kept += int(c.kept.size()), all += int(c.kept.size() + c.dropped.size());
-  o << m.file << ": " << m.bodies.size() << " moving bodies, " << m.joints.size() << " joints, " << m.closures.size()
+  o << nameShown(m.file) << ": " << m.bodies.size() << " moving bodies, " << m.joints.size() << " joints, " << m.closures.size()
     << (m.closures.size() == 1 ? " closure (" : " closures (") << kept << " of " << all << " rows kept), " << m.dof << " degree" << (m.dof == 1 ? "" : "s")
     << " of freedom after closure\n";
   const Eigen::Vector3d g = mech.tree.gravity.tail<3>();
@@ -55,7 +62,7 @@ std::string describe(const model_file::LoadedModel& m) {
     double mass = 0;
     Eigen::Vector3d c;
     Spatial::massAndCom(mech.tree.bodies[i].inertia, mass, c);
-    o << "  joint " << j.name << " (" << j.type << ", body " << j.body << "): q0 " << fmt(m.q0[Eigen::Index(i)]);
+    o << "  joint " << nameShown(j.name) << " (" << nameShown(j.type) << ", body " << nameShown(j.body) << "): q0 " << fmt(m.q0[Eigen::Index(i)]);
     o << (mech.tree.bodies[i].massless ? ", a massless carrier" : ", carries " + fmt(mass) + " kg");
     if (!mech.joints.empty()) {
       const JointProperties& p = mech.joints[i];
@@ -67,7 +74,7 @@ std::string describe(const model_file::LoadedModel& m) {
     o << "\n";
   }
   for (const auto& c : m.closures) {
-    o << "  closure " << c.name << ": " << c.kind << " " << c.body1 << " to " << c.body2 << ", rows " << join(c.kept) << " kept";
+    o << "  closure " << nameShown(c.name) << ": " << nameShown(c.kind) << " " << nameShown(c.body1) << " to " << nameShown(c.body2) << ", rows " << join(c.kept) << " kept";
     if (!c.dropped.empty()) o << ", " << join(c.dropped) << " dropped (identically dependent on the rows kept)";
     o << "\n";
   }
@@ -76,20 +83,20 @@ std::string describe(const model_file::LoadedModel& m) {
     const Constraint<Spatial>& k = *mech.constraints[m.closures.size() + i];
     if (c.kind == "rolling") {
       const auto& w = static_cast<const Rolling&>(k);
-      o << "  rolling " << c.name << ": body " << c.body << ", radius " << fmt(w.radius()) << " m on the ground z = " << fmt(w.groundHeight())
+      o << "  rolling " << nameShown(c.name) << ": body " << nameShown(c.body) << ", radius " << fmt(w.radius()) << " m on the ground z = " << fmt(w.groundHeight())
         << ", 3 rows (x y: no slip, velocity-level; z: on the ground), mu " << fmt(w.mu()) << " for the skid margin\n";
     } else {
       const auto& p = static_cast<const PlaneContact<Spatial>&>(k);
       const Eigen::Vector3d nn = p.normal();
-      o << "  contact " << c.name << ": a ball of radius " << fmt(p.params().radius) << " m on body " << c.body << " against the plane n·x = "
+      o << "  contact " << nameShown(c.name) << ": a ball of radius " << fmt(p.params().radius) << " m on body " << nameShown(c.body) << " against the plane n·x = "
         << fmt(p.params().height) << " m, n (" << fmt(nn.x()) << ", " << fmt(nn.y()) << ", " << fmt(nn.z()) << "), unilateral, "
         << (p.compliant() ? "compliant (k_e " + fmt(p.params().stiffness) + " N/m, d_e " + fmt(p.params().damping) + " N·s/m)"
                           : std::string("rigid (plastic touchdowns, lift-off)"))
         << ", frictionless in the hand engine" << (p.params().mu > 0 ? ", mu " + fmt(p.params().mu) + " in Bullet's" : "") << "\n";
     }
   }
-  for (const auto& n : m.notes) o << "  note: " << n << "\n";
-  for (const auto& n : m.drawing.notes) o << "  drawing: " << n << "\n";
+  for (const auto& n : m.notes) o << "  note: " << shownLine(n) << "\n";
+  for (const auto& n : m.drawing.notes) o << "  drawing: " << shownLine(n) << "\n";
   return o.str();
 }
 
@@ -112,7 +119,7 @@ std::string crossCheck(const model_file::LoadedModel& m, ConstrainedMechanism<Sp
 std::string report(const ModelRun& r, const std::string& engine, const model_file::LoadedModel& m, const ModelArgs& args) {
   std::ostringstream o;
   const bool driven = !args.torques.empty();
-  o << (driven ? "run with constant torques (" + join(args.torques, ", ") + "), " : std::string("passive run, ")) << engine << ", dt "
+  o << (driven ? "run with constant torques (" + shownLine(join(args.torques, ", ")) + "), " : std::string("passive run, ")) << engine << ", dt "
     << fmt(args.dt) << " s, " << fmt(args.duration) << " s from q0 at rest\n"
     << "  " << (m.contacts.empty() ? "closure residual" : "constraint residual (closures, no-slip rows, contact depth)") << " max |φ|∞ "
     << fmt(r.residual) << "\n"
@@ -130,10 +137,10 @@ std::string report(const ModelRun& r, const std::string& engine, const model_fil
       for (std::size_t row = 0; row < t.rows(); ++row)
         extreme = c.kind == "rolling" ? std::max(extreme, std::abs(t.at(row, "slip_" + n))) : std::min(extreme, t.at(row, "gap_" + n));
       if (c.kind == "rolling")
-        o << "  rolling " << c.name << ": max slip speed " << fmt(extreme) << " m/s; at the end f_long " << fmt(t.at(last, "f_" + n + "_long"))
+        o << "  rolling " << nameShown(c.name) << ": max slip speed " << fmt(extreme) << " m/s; at the end f_long " << fmt(t.at(last, "f_" + n + "_long"))
           << ", f_lat " << fmt(t.at(last, "f_" + n + "_lat")) << ", f_normal " << fmt(t.at(last, "f_" + n + "_normal")) << " N\n";
       else
-        o << "  contact " << c.name << ": min gap " << fmt(extreme) << " m; at the end f_normal " << fmt(t.at(last, "f_" + n + "_normal"))
+        o << "  contact " << nameShown(c.name) << ": min gap " << fmt(extreme) << " m; at the end f_normal " << fmt(t.at(last, "f_" + n + "_normal"))
           << " N, f_tangent " << fmt(t.at(last, "f_" + n + "_tangent")) << " N\n";
     }
     for (std::size_t i = 0; i < m.contacts.size(); ++i)
@@ -179,7 +186,7 @@ int runModelFile(const RunArgs& r) {
   for (const auto& [given, option] : {std::pair{!r.config.empty(), "--config"}, {!r.gains.empty(), "--gains"}, {!r.scenario.empty(), "--scenario"}})
     if (given) {
       std::fprintf(stderr, "error: <command line>: %s: a model file (%s) runs passive, without a lab's config, gains or scenario\n", option,
-                   utf8Quotable(r.lab).c_str());
+                   nameShown(r.lab).c_str());
       return 2;
     }
   ModelArgs a;
@@ -192,7 +199,7 @@ int runModelFile(const RunArgs& r) {
   a.loops = r.loops;
   if (r.duration) {
     if (!(*r.duration > 0 && *r.duration <= 600)) {
-      std::fprintf(stderr, "error: <command line>: --duration: expected a time in (0, 600] s for a model file, got %g\n", *r.duration);
+      std::fprintf(stderr, "error: <command line>: --duration: expected a time in (0, 600] s for a model file, got %s\n", exactNumber(*r.duration).c_str());
       return 2;
     }
     a.duration = *r.duration;
@@ -216,7 +223,7 @@ int model(const ModelArgs& args) {
     options.ignore_contacts = args.ignore_contacts;
     m = loadWithLoops(args.file, args.loops, options);
   } catch (const model_file::ModelFileError& e) {
-    std::fprintf(stderr, "error: %s\n", utf8Quotable(e.what()).c_str());
+    std::fprintf(stderr, "error: %s\n", shownLine(e.what()).c_str());
     return 2;
   }
   if (const std::string problem = runBoundProblem(args.dt, args.duration, modelColumns(m).columns.size()); !problem.empty())
@@ -236,7 +243,7 @@ int model(const ModelArgs& args) {
     if (eq == std::string::npos || it == names.end() || end == t.c_str() + eq + 1 || *end != '\0' || !std::isfinite(value) ||
         std::abs(value) > 1e4 || given[std::size_t(it - names.begin())]) {
       std::fprintf(stderr, "error: <command line>: --torque %s: expected JOINT=VALUE once per joint, JOINT one of %s's joints (%s), VALUE a finite "
-                   "N·m (N on a slide) within ±1e4\n", utf8Quotable(t).c_str(), utf8Quotable(m.file).c_str(), utf8Quotable(join(names)).c_str());
+                   "N·m (N on a slide) within ±1e4\n", nameShown(t).c_str(), nameShown(m.file).c_str(), shownLine(join(names)).c_str());
       return 2;
     }
     given[std::size_t(it - names.begin())] = true;
@@ -251,7 +258,7 @@ int model(const ModelArgs& args) {
     try {
       b = runBullet(m, mech, args.dt, args.duration, tau);
     } catch (const std::exception& e) {  // a description the Bullet builder cannot model
-      std::fprintf(stderr, "error: %s: Bullet: %s\n", utf8Quotable(m.file).c_str(), utf8Quotable(e.what()).c_str());
+      std::fprintf(stderr, "error: %s: Bullet: %s\n", nameShown(m.file).c_str(), shownLine(e.what()).c_str());
       return 2;
     }
   }
@@ -266,7 +273,7 @@ int model(const ModelArgs& args) {
   }
   const bool ok = (!hand || h.ok) && (!bullet || b.ok);
   const std::filesystem::path out = args.out.empty() ? std::filesystem::path("out/model") / std::filesystem::path(args.file).stem() : std::filesystem::path(args.out);
-  text += "wrote " + out.string() + "/" + (hand ? "trace.csv " : "") + (bullet ? "trace_bullet.csv " : "") + "summary.txt";
+  text += "wrote " + nameShown(out.string()) + "/" + (hand ? "trace.csv " : "") + (bullet ? "trace_bullet.csv " : "") + "summary.txt";
   if (args.video) text += " video.mp4";
   if (args.frames) text += " frames/";
   text += "\n";
@@ -291,7 +298,7 @@ int model(const ModelArgs& args) {
         VecN gq;
         if (ghost && row < ghost->rows()) gq = traceQ(*ghost, row, n);
         picture.scene(q, gq.size() ? &gq : nullptr, box, scene);
-        if (panel) modelOverlay(utf8Quotable(title), engines, shown, row, args.dt, ghost, *panel);
+        if (panel) modelOverlay(termName(title), engines, shown, row, args.dt, ghost, *panel);
       };
       // Drawn in a child (app/isolated_draw.h): llvmpipe ends the process when memory runs out.
       const int frames = int(frameRows(shown, args.dt, 30).size());
@@ -304,7 +311,7 @@ int model(const ModelArgs& args) {
     throw;  // main's one line for it (app/main.cpp)
   } catch (const std::exception& e) {
     std::fputs(text.c_str(), stdout);
-    std::fprintf(stderr, "error: %s\n", utf8Quotable(e.what()).c_str());
+    std::fprintf(stderr, "error: %s\n", shownLine(e.what()).c_str());
     return 1;
   }
   std::fputs(text.c_str(), stdout);

@@ -11,14 +11,16 @@
 
 #include "app/commands.h"
 #include "labs/generic/data_lab.h"
+#include "labs/utf8.h"
 
 namespace dyn::app {
 namespace {
 
 namespace fs = std::filesystem;
 
+// One line on stderr, whatever a name or path given holds (a newline, an ESC): escaped and clipped.
 int fail(const std::string& what) {
-  std::fprintf(stderr, "error: dynlab new-lab: %s\n", what.c_str());
+  std::fprintf(stderr, "error: dynlab new-lab: %s\n", termName(what, 1000).c_str());
   return 2;
 }
 
@@ -87,14 +89,14 @@ int newLab(const NewLabArgs& args) {
     fs::rename(stage, dest);
   } catch (const std::exception& e) {
     fs::remove_all(stage, ec);
-    std::fprintf(stderr, "error: dynlab new-lab: %s: %s (nothing written)\n", dest.string().c_str(), e.what());
+    std::fprintf(stderr, "error: dynlab new-lab: %s: %s (nothing written)\n", termName(dest.string()).c_str(), termName(e.what(), 1000).c_str());
     return 1;
   }
-  std::printf("dynlab new-lab: %s, a copy of %s\n", dest.string().c_str(), args.from.c_str());
-  for (const auto& s : skipped) std::printf("  not copied (a link or special file): %s\n", s.c_str());
+  std::printf("dynlab new-lab: %s, a copy of %s\n", termName(dest.string()).c_str(), termName(args.from).c_str());
+  for (const auto& s : skipped) std::printf("  not copied (a link or special file): %s\n", termName(s).c_str());
   std::printf("  next: edit %s (model_file, actuated, tool, trajectory, metrics, rubric) and handout.md,\n"
               "        then `dynlab check-lab %s` until every check passes\n",
-              (dest / (args.name + ".json")).string().c_str(), args.name.c_str());
+              termName((dest / (args.name + ".json")).string()).c_str(), args.name.c_str());
   return 0;
 }
 

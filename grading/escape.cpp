@@ -5,39 +5,18 @@
 
 #include <algorithm>
 #include <cctype>
-#include <cstdio>
 
 namespace dyn {
 namespace {
 
 constexpr std::string_view kReplacement = "\xEF\xBF\xBD";  // U+FFFD
 
-// The length of the well-formed UTF-8 sequence starting at s[i] (0 if there is none) and its code point.
-std::size_t utf8At(std::string_view s, std::size_t i, char32_t& cp) {
-  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(s[k]); };
-  const unsigned char b = byte(i);
-  if (b < 0x80) return cp = b, 1;
-  std::size_t n;
-  char32_t min;
-  if (b >= 0xC2 && b <= 0xDF) n = 2, cp = b & 0x1F, min = 0x80;
-  else if (b >= 0xE0 && b <= 0xEF) n = 3, cp = b & 0x0F, min = 0x800;
-  else if (b >= 0xF0 && b <= 0xF4) n = 4, cp = b & 0x07, min = 0x10000;
-  else return 0;
-  if (i + n > s.size()) return 0;
-  for (std::size_t k = 1; k < n; ++k) {
-    if ((byte(i + k) & 0xC0) != 0x80) return 0;
-    cp = (cp << 6) | (byte(i + k) & 0x3F);
-  }
-  if (cp < min || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return 0;
-  return n;
-}
-
 // Calls each(cp, bytes) per well-formed character and bad(byte) per byte that is not part of one.
 template <class Each, class Bad>
 void forEachChar(std::string_view s, Each each, Bad bad) {
   for (std::size_t i = 0; i < s.size();) {
     char32_t cp = 0;
-    if (const std::size_t n = utf8At(s, i, cp)) {
+    if (const std::size_t n = utf8CharAt(s, i, cp)) {
       each(cp, s.substr(i, n));
       i += n;
     } else {
@@ -45,50 +24,6 @@ void forEachChar(std::string_view s, Each each, Bad bad) {
       ++i;
     }
   }
-}
-
-std::string hexByte(unsigned b) {
-  char buf[8];
-  std::snprintf(buf, sizeof buf, "\\x%02X", b);
-  return buf;
-}
-
-// \n, \r, \t or \xNN for a C0 control or DEL; empty for any other character.
-std::string controlEscape(char32_t cp) {
-  if (cp == '\n') return "\\n";
-  if (cp == '\r') return "\\r";
-  if (cp == '\t') return "\\t";
-  if (cp < 0x20 || cp == 0x7F) return hexByte(unsigned(cp));
-  return {};
-}
-
-// Characters that move or hide text on a terminal or in a page: C1 controls, line/paragraph
-// separators, bidi embeddings, overrides and isolates.
-bool isInvisibleControl(char32_t cp) {
-  return (cp >= 0x80 && cp <= 0x9F) || cp == 0x2028 || cp == 0x2029 || (cp >= 0x202A && cp <= 0x202E) ||
-         (cp >= 0x2066 && cp <= 0x2069) || cp == 0x200E || cp == 0x200F || cp == 0x061C;
-}
-
-std::string codePointEscape(char32_t cp) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "\\u{%04X}", unsigned(cp));
-  return buf;
-}
-
-// s as valid UTF-8 on one line: controls and invisible controls as escapes, bad bytes as U+FFFD
-// (bad_as_hex false) or \xNN (true).
-std::string visibleLine(std::string_view s, bool bad_as_hex) {
-  std::string out;
-  out.reserve(s.size());
-  forEachChar(
-      s,
-      [&](char32_t cp, std::string_view bytes) {
-        if (std::string e = controlEscape(cp); !e.empty()) out += e;
-        else if (isInvisibleControl(cp)) out += codePointEscape(cp);
-        else out += bytes;
-      },
-      [&](unsigned char b) { out += bad_as_hex ? hexByte(b) : std::string(kReplacement); });
-  return out;
 }
 
 bool isAsciiPunct(char c) {
@@ -190,8 +125,6 @@ std::string htmlText(std::string_view s) {
   return out;
 }
 
-std::string termText(std::string_view s) { return visibleLine(s, true); }
-
 std::string shellWord(std::string_view s) {
   const std::string text = jsonText(s);
   const bool plain = !text.empty() && text.find_first_not_of(
@@ -201,27 +134,5 @@ std::string shellWord(std::string_view s) {
   for (char c : text) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return out + "'";
 }
-
-std::string csvField(const std::string& raw) {
-  // Line breaks and tabs stay (quoted below); other controls (ESC, OSC, bidi overrides) as escapes.
-  std::string s;
-  forEachChar(
-      raw,
-      [&](char32_t cp, std::string_view bytes) {
-        if (cp == '\n' || cp == '\r' || cp == '\t') s += bytes;
-        else if (std::string e = controlEscape(cp); !e.empty()) s += e;
-        else if (isInvisibleControl(cp)) s += codePointEscape(cp);
-        else s += bytes;
-      },
-      [&](unsigned char) { s += kReplacement; });
-  if (!s.empty() && (s[0] == '=' || s[0] == '+' || s[0] == '-' || s[0] == '@' || s[0] == '\t' || s[0] == '\r'))
-    s.insert(s.begin(), '\'');
-  const bool quote = s.find_first_of(",\"\r\n") != std::string::npos || (!s.empty() && (s.front() == ' ' || s.back() == ' '));
-  if (!quote) return s;
-  std::string out = "\"";
-  for (char c : s) out += c == '"' ? std::string("\"\"") : std::string(1, c);
-  return out + "\"";
-}
-
 
 }  // namespace dyn

@@ -46,18 +46,13 @@ std::string mdCode(std::string_view s);
 // Text for HTML element content or a quoted attribute value.
 std::string htmlText(std::string_view s);
 
-// One line for a terminal: control characters (C0, DEL, C1), U+2028/U+2029 and bidi controls as
-// \n, \t, \xNN or \u{XXXX}; invalid UTF-8 bytes as \xNN.
-std::string termText(std::string_view s);
+// termText (one line for a terminal) and termName (a name from a file, escaped and clipped):
+// labs/utf8.h, so that labs/ and render/ use the same function.
 
 // A word for a POSIX shell command line shown to a user: as it is when plain, else '...' quoted.
 std::string shellWord(std::string_view s);
 
-// One CSV field: control characters other than line breaks and tabs (ESC, OSC, C1) and bidi
-// controls shown as escapes (\x1b, \u{202E}), a leading = + - @ tab or CR gets a ' prefix (no
-// spreadsheet formula), then the field is quoted when it holds , " CR or LF or starts/ends with a space ("" inside). Pass numbers
-// you format yourself directly; this is for text.
-std::string csvField(const std::string& s);
+// csvField (one CSV field, no formula, controls as escapes): labs/utf8.h.
 
 // clipText (text echoed from input, at most so many bytes): labs/utf8.h.
 

@@ -13,6 +13,7 @@
 #include "grading/scenario.h"
 #include "grading/test_plot.h"
 #include "labs/run.h"
+#include "labs/numbers.h"
 #include "labs/submission.h"
 #include "labs/utf8.h"
 
@@ -77,6 +78,12 @@ GradeOutcome failedOutcome(const std::string& full_message, const InputError* e)
 }
 
 }  // namespace
+
+std::string timeBudgetProblem(double seconds) {
+  if (seconds >= kMinTimeBudget && seconds <= kMaxTimeBudget) return "";  // NaN fails both
+  return std::string("expected a ") + (std::isfinite(seconds) ? "" : "finite ") + "time budget in [" + exactNumber(kMinTimeBudget) +
+         ", " + exactNumber(kMaxTimeBudget) + "] s, got " + exactNumber(seconds);
+}
 
 GradeOutcome gradeSubmission(const std::string& file, const GradeOptions& opt) {
   json sub;

@@ -56,6 +56,12 @@ struct GradeOutcome {
   }
 };
 
+// The wall-time budgets a grade takes, in s: what `--time-budget` and dynlab.grade(time_budget=)
+// accept, refused by both with timeBudgetProblem's text ("expected a time budget in [1, 86400] s,
+// got 0", "expected a finite time budget …, got nan"; empty for a budget in range).
+inline constexpr double kMinTimeBudget = 1, kMaxTimeBudget = 86400;
+std::string timeBudgetProblem(double seconds);
+
 GradeOutcome gradeSubmission(const std::string& submission_file, const GradeOptions& options);
 // A submission already in memory (the Python module's dict): graded exactly as the same JSON in a
 // file; `file` names it in messages and reports.

@@ -13,24 +13,6 @@
 namespace dyn {
 
 namespace {
-// The message is one line whatever the input held: control characters (a newline in a key, a
-// scenario name, a file name) are written as escapes.
-std::string oneLine(const std::string& s) {
-  std::string out;
-  out.reserve(s.size());
-  for (const char c : s) {
-    if (c == '\n') out += "\\n";
-    else if (c == '\r') out += "\\r";
-    else if (c == '\t') out += "\\t";
-    else if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) {
-      char b[8];
-      std::snprintf(b, sizeof b, "\\x%02x", static_cast<unsigned char>(c));
-      out += b;
-    } else out += c;
-  }
-  return out;
-}
-
 // A key as a JSON Pointer token (RFC 6901): "~" is written "~0" and "/" is written "~1".
 std::string pointerToken(const std::string& key) {
   std::string out;
@@ -44,8 +26,10 @@ std::string pointerToken(const std::string& key) {
 }  // namespace
 
 InputError::InputError(std::string file, std::string path, const std::string& expected)
-    : std::runtime_error(oneLine(utf8Quotable(clipText(file) + ": " + (path.empty() ? "/" : clipText(path)) + ": " +
-                                              clipText(expected, 600)))),
+    // The message is one line of text a terminal shows as it is, whatever the input held: control
+    // characters (a newline or an ESC in a key, a scenario name, a file name), C1 and bidi controls
+    // and invalid bytes written as escapes (termText).
+    : std::runtime_error(termText(clipText(file) + ": " + (path.empty() ? "/" : clipText(path)) + ": " + clipText(expected, 600))),
       file_(utf8Quotable(clipText(file))), path_(utf8Quotable(clipText(path))), expected_(utf8Quotable(clipText(expected, 600))) {}
 
 namespace {

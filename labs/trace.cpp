@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "labs/utf8.h"
+
 namespace dyn {
 
 int Trace::column(const std::string& name) const {
@@ -30,7 +32,8 @@ std::vector<double> Trace::series(const std::string& name) const {
 
 std::string Trace::csv() const {
   std::string s;
-  for (std::size_t i = 0; i < columns.size(); ++i) s += (i ? "," : "") + columns[i];
+  // A name from a lab's JSON may hold anything: each header one CSV field (quoted, no formula, no ESC).
+  for (std::size_t i = 0; i < columns.size(); ++i) s += (i ? "," : "") + csvField(columns[i]);
   s += '\n';
   char buf[32];
   for (std::size_t r = 0; r < rows(); ++r) {
@@ -47,6 +50,13 @@ std::string Trace::csv() const {
 std::string columnName(const std::string& name) {
   std::string out;
   for (char c : name) out += std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == '.' ? c : '_';
+  // A long name (a model file may name a joint with 200,000 characters) keeps its start and a hash
+  // of the whole: a header of a few dozen characters, still one per name.
+  if (out.size() > kMaxColumnName) {
+    char hash[24];
+    std::snprintf(hash, sizeof hash, "_%016llx", static_cast<unsigned long long>(fnv1a(name.data(), name.size())));
+    out = out.substr(0, kMaxColumnName - 17) + hash;
+  }
   return out.empty() ? "_" : out;
 }
 

@@ -11,7 +11,9 @@ namespace dyn {
 std::uint64_t fnv1a(const void* bytes, std::size_t n);
 
 // A name from elsewhere (a model file's joint) as a column name part: letters, digits, '_', '-', '.';
-// anything else '_' (so it needs no quoting in CSV, JSON keys or plot labels).
+// anything else '_' (so it needs no quoting in CSV, JSON keys or plot labels); one longer than
+// kMaxColumnName is cut to its start and a hash of the whole name, kMaxColumnName characters in all.
+constexpr std::size_t kMaxColumnName = 64;
 std::string columnName(const std::string& name);
 
 struct Trace {

@@ -9,7 +9,11 @@
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
 
+#include "labs/utf8.h"
 #include "render/fonts.h"
 #include "render/gl_internal.h"
 #include "render/plot_widget.h"
@@ -106,14 +110,18 @@ void OverlayPanel::buildFrame(const Overlay& overlay) {
   ImGui_ImplOpenGL3_NewFrame();
   ImGui::NewFrame();
 
+  // Text from a file (a lab's title, a model file's name) shown escaped and clipped (termName):
+  // no control character reaches ImGui and no 200 kB name is measured.
+  std::vector<std::pair<std::string, std::string>> lines;
+  for (const auto& [label, value] : overlay.lines) lines.emplace_back(termName(label), termName(value));
   // Column layout from the text itself: labels left, values aligned after the widest label.
   float label_w = 0, value_w = 0;
-  for (const auto& [label, value] : overlay.lines) {
+  for (const auto& [label, value] : lines) {
     label_w = std::max(label_w, ImGui::CalcTextSize(label.c_str()).x);
     value_w = std::max(value_w, ImGui::CalcTextSize(value.c_str()).x);
   }
   const float gap = 16.0f * scale_;
-  const std::string title = overlay.title.empty() ? std::string("dynlab") : overlay.title;
+  const std::string title = overlay.title.empty() ? std::string("dynlab") : termName(overlay.title);
   const float title_w = ImGui::CalcTextSize(title.c_str()).x + 8.0f * scale_;
   const float plot_w = 240.0f * scale_, plot_h = 48.0f * scale_;
   float content_w = std::max(label_w + gap + value_w, 160.0f * scale_);
@@ -146,7 +154,7 @@ void OverlayPanel::buildFrame(const Overlay& overlay) {
 
   // Label/value lines.
   const ImVec4 muted(0.38f, 0.42f, 0.48f, 1.0f);
-  for (const auto& [label, value] : overlay.lines) {
+  for (const auto& [label, value] : lines) {
     ImGui::TextColored(muted, "%s", label.c_str());
     ImGui::SameLine(ImGui::GetStyle().WindowPadding.x + label_w + gap);
     ImGui::TextUnformatted(value.c_str());
@@ -161,7 +169,7 @@ void OverlayPanel::buildFrame(const Overlay& overlay) {
     const Series& s = overlay.plots[i];
     ImVec4 color = toImVec4(s.color);
     color.w = 1.0f;
-    ImGui::TextColored(color, "%s", s.name.c_str());
+    ImGui::TextColored(color, "%s", termName(s.name).c_str());
     if (!s.values.empty()) {
       char latest[32];
       std::snprintf(latest, sizeof latest, "%.4g", double(s.values.back()));

@@ -7,11 +7,16 @@
 #include "grading/grade.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
+#include "labs/numbers.h"
 #include "labs/submission.h"
 
 namespace dyn::python {
 
-LabObject::LabObject(const std::string& name, const std::string& config_file) { loaded_ = loadLab(name, config_file); }
+LabObject::LabObject(const std::string& name, const std::string& config_file) {
+  // open() would stop at a NUL and read another file.
+  if (config_file.find('\0') != std::string::npos) throw InputError(config_file, "", "expected a path without a NUL byte");
+  loaded_ = loadLab(name, config_file);
+}
 
 py::dict LabObject::gains() const {
   py::dict out;
@@ -47,7 +52,7 @@ void LabObject::apply(py::handle object, const std::string& source) {
   std::string file = source;
   json sub;
   if (asPath(object, file)) sub = loadJsonFile(file, 1u << 20);
-  else sub = toJson(object);
+  else sub = toJson(object, source);
   // Validated in full before anything changes: a bad gain leaves the lab as it was.
   json config = applySubmission(loaded_.config, JsonView(sub, file), name(), false);
   auto lab = buildLab(*loaded_.entry, config, file);
@@ -107,7 +112,7 @@ py::dict LabObject::run(const std::string& engine, std::optional<double> duratio
   const Lab& lab = *built;
   if (lab.duration() < lab.dt())
     throw InputError(kArgument, "duration",
-                     "expected at least one step (dt = " + fmtNumber(lab.dt()) + " s), got " + fmtNumber(lab.duration()) + " s");
+                     "expected at least one step (dt = " + fmtNumber(lab.dt()) + " s), got " + exactNumber(lab.duration()) + " s");
   // `dynlab run`'s watchdog: the rubric's limits, no step budget.
   Watchdog watchdog;
   if (rubric) {
@@ -119,12 +124,14 @@ py::dict LabObject::run(const std::string& engine, std::optional<double> duratio
   // The runs, without the GIL; Ctrl-C is heard every 1024 steps.
   std::optional<WatchedRun> hand, bullet;
   Interruptible interrupted;
+  // Without the GIL only what this call owns: the lab it built, its watchdog, a copy of the config's name.
+  const std::string config_file = loaded_.config_file;
   {
     py::gil_scoped_release release;
     const StopRequest stop = [&] { return interrupted(); };
-    if (engine != "bullet") hand = runWatched(lab, Engine::Hand, watchdog, Deadline::max(), loaded_.config_file, stop);
+    if (engine != "bullet") hand = runWatched(lab, Engine::Hand, watchdog, Deadline::max(), config_file, stop);
     if (engine != "hand" && !(hand && hand->interrupted))
-      bullet = runWatched(lab, Engine::Bullet, watchdog, Deadline::max(), loaded_.config_file, stop);
+      bullet = runWatched(lab, Engine::Bullet, watchdog, Deadline::max(), config_file, stop);
   }
   interrupted.rethrow();
 

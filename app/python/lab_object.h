@@ -1,5 +1,9 @@
 // dynlab.Lab: one lab with its config and the gains set so far. Each object owns its config and
 // its built lab; nothing is shared between two Lab objects but the registry (read only).
+// Safe from several Python threads: what changes (the config, the last run) changes only with the
+// GIL held; what runs without it (a run, a frame, a video) works on its own copy: run() on the lab
+// it built, frame() and video() on the last run they took (a run() meanwhile replaces the object's
+// last run, not theirs); drawing is one at a time in the process (Dear ImGui has one current context).
 #pragma once
 #include <memory>
 #include <optional>
@@ -12,9 +16,6 @@
 #include "labs/trace.h"
 
 namespace dyn::python {
-
-// What `source` names inputs from Python in messages, where the CLI names a file.
-inline const std::string kGainsSource = "<gains>", kSubmissionSource = "<submission>", kArgument = "<python>";
 
 class LabObject {
  public:
@@ -51,12 +52,13 @@ class LabObject {
     std::unique_ptr<Lab> lab;
     std::optional<Trace> hand, bullet;
   };
-  const LastRun& lastRun() const;
-  // The trace shown for `engine` ("hand" or "bullet") and the other engine's as its ghost (or null).
-  std::pair<const Trace*, const Trace*> shown(const std::string& engine) const;
+  // The last run, shared with the caller (which keeps it alive while it draws without the GIL).
+  std::shared_ptr<const LastRun> lastRun() const;
+  // The trace of `run` shown for `engine` ("hand" or "bullet") and the other engine's as its ghost (or null).
+  static std::pair<const Trace*, const Trace*> shown(const LastRun& run, const std::string& engine);
 
   LoadedLab loaded_;
-  mutable std::shared_ptr<LastRun> last_;
+  mutable std::shared_ptr<const LastRun> last_;  // replaced (with the GIL held) by each run()
 };
 
 // Runs `body` with the GIL released, asking Python for pending signals every 1024 steps through

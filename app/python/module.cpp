@@ -23,13 +23,16 @@ namespace {
 // dynlab.grade: a submission dict or file → results.json as a dict, as `dynlab grade` writes it
 // (no plots). A submission the grader refuses raises InputError with `dynlab grade`'s message.
 py::dict grade(py::handle submission, const std::string& lab, const std::string& config, double time_budget) {
+  // `dynlab grade --time-budget`'s check and message (NaN, inf, 0, -1, 1e300 are refused, not graded as out of time).
+  if (const std::string problem = timeBudgetProblem(time_budget); !problem.empty())
+    throw InputError(kArgument, "time_budget", problem);
   GradeOptions o;
   o.expected_lab = lab;
   o.config_file = config;
   o.time_budget = time_budget;
   std::string file;
   const bool is_file = asPath(submission, file);
-  const json sub = is_file ? json() : toJson(submission);
+  const json sub = is_file ? json() : toJson(submission, kSubmissionSource);
   Interruptible interrupted;
   o.stop = [&] { return interrupted(); };
   GradeOutcome g;

@@ -2,24 +2,25 @@
 // overlay panel, the other engine's run as a ghost), offscreen through OSMesa, without the GIL.
 #include <cstring>
 #include <filesystem>
+#include <mutex>
 #include <system_error>
 
 #include "app/movie.h"
 #include "app/python/lab_object.h"
 #include "grading/scenario.h"
+#include "labs/numbers.h"
 #include "render/gl_context.h"
 
 namespace dyn::python {
 
 namespace fs = std::filesystem;
 
-const LabObject::LastRun& LabObject::lastRun() const {
+std::shared_ptr<const LabObject::LastRun> LabObject::lastRun() const {
   if (!last_) throw InputError(kArgument, "run", "expected a run first: lab.run() and then frame() or video()");
-  return *last_;
+  return last_;
 }
 
-std::pair<const Trace*, const Trace*> LabObject::shown(const std::string& engine) const {
-  const LastRun& r = lastRun();
+std::pair<const Trace*, const Trace*> LabObject::shown(const LastRun& r, const std::string& engine) {
   if (engine != "hand" && engine != "bullet")
     throw InputError(kArgument, "engine", "expected \"hand\" or \"bullet\", got \"" + engine + "\"");
   const auto& main = engine == "hand" ? r.hand : r.bullet;
@@ -29,6 +30,13 @@ std::pair<const Trace*, const Trace*> LabObject::shown(const std::string& engine
 }
 
 namespace {
+
+// Drawing is one at a time in the process: the overlay's Dear ImGui context is made current
+// globally. Taken with the GIL released (a thread waiting for it lets Python run).
+std::mutex& drawing() {
+  static std::mutex m;
+  return m;
+}
 
 // The frame sizes the CLI accepts (render/image.h parseFrameSize: up to 8192 a side).
 void checkSize(int width, int height) {
@@ -41,13 +49,16 @@ void checkSize(int width, int height) {
 
 py::array LabObject::frame(double t, const std::string& engine, int width, int height, bool overlay) const {
   checkSize(width, height);
-  const auto [trace, ghost] = shown(engine);
-  const Lab& lab = *last_->lab;
+  // This call's own reference to the last run: a run() in another thread meanwhile replaces last_, not it.
+  const std::shared_ptr<const LastRun> run = lastRun();
+  const auto [trace, ghost] = shown(*run, engine);
+  const Lab& lab = *run->lab;
   if (!(t >= 0) || t > lab.duration() + lab.dt())
-    throw InputError(kArgument, "t", "expected a time in [0, " + fmtNumber(lab.duration()) + "] s, got " + fmtNumber(t));
+    throw InputError(kArgument, "t", "expected a time in [0, " + fmtNumber(lab.duration()) + "] s, got " + exactNumber(t));
   Image image;
   {
     py::gil_scoped_release release;
+    const std::lock_guard<std::mutex> one_at_a_time(drawing());
     auto context = makeOffscreenContext(width, height);
     Renderer renderer(*context);
     image = app::renderRow(renderer, lab, *trace, app::rowAt(*trace, lab.dt(), t), ghost, overlay);
@@ -64,8 +75,9 @@ py::array LabObject::frame(double t, const std::string& engine, int width, int h
 std::string LabObject::video(const std::string& path, const std::string& engine, int width, int height) const {
   checkSize(width, height);
   if ((width | height) & 1) throw InputError(kArgument, "width, height", "expected even sides (H.264 4:2:0)");
-  const auto [trace, ghost] = shown(engine);
-  const Lab& lab = *last_->lab;
+  const std::shared_ptr<const LastRun> run = lastRun();  // as in frame(): this call's own
+  const auto [trace, ghost] = shown(*run, engine);
+  const Lab& lab = *run->lab;
   const fs::path target = fs::absolute(path);
   if (target.filename().empty() || fs::is_directory(target))
     throw InputError(path, "", "expected a file name for the video (e.g. run.mp4), not a folder");
@@ -81,6 +93,7 @@ std::string LabObject::video(const std::string& path, const std::string& engine,
   }
   try {
     py::gil_scoped_release release;
+    const std::lock_guard<std::mutex> one_at_a_time(drawing());
     app::renderRun(lab, *trace, ghost, {width, height, 30, true, false}, scratch);
     fs::rename(scratch / "video.mp4", target);
   } catch (...) {

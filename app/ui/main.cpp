@@ -14,6 +14,7 @@
 
 #include "app/model_lab.h"
 #include "app/ui/panel.h"
+#include "labs/utf8.h"
 #include "render/fonts.h"
 #include "render/renderer.h"
 #include "render/window_context.h"
@@ -138,9 +139,9 @@ int run(const Args& a) {
 
   std::unique_ptr<WindowContext> ctx;
   try {
-    ctx = makeWindowContext({win_w, win_h, "dynlab — " + session.title(), !scripted});
+    ctx = makeWindowContext({win_w, win_h, "dynlab — " + termName(session.title()), !scripted});
   } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
+    std::cerr << "error: " << termName(e.what(), 1000) << "\n";
     return 1;
   }
   setupImGui(ctx->window());
@@ -214,12 +215,12 @@ int run(const Args& a) {
       if (!a.save.empty()) {
         saveGains(session, st);
         if (st.status_is_error) {
-          std::cerr << "error: " << st.status << "\n";
+          std::cerr << "error: " << termName(st.status, 1000) << "\n";
           code = 1;
         }
       }
       std::printf("dynlab-ui: %ld frames, t = %.3f s (row %zu)%s%s\n", a.frames, session.time(), session.row(),
-                  session.problem().empty() ? "" : "; stopped: ", session.problem().c_str());
+                  session.problem().empty() ? "" : "; stopped: ", termName(session.problem(), 1000).c_str());
     }
     ctx->swap();
   }
@@ -261,7 +262,7 @@ int main(int argc, char** argv) {
     std::cerr << "error: " << e.what() << "\n";
     return 2;
   } catch (const std::exception& e) {
-    std::cerr << "error: " << e.what() << "\n";
+    std::cerr << "error: " << termName(e.what(), 1000) << "\n";
     return 1;
   }
 }

@@ -9,6 +9,7 @@
 #include <cstdio>
 
 #include "labs/numbers.h"
+#include "labs/utf8.h"
 #include "render/plot_widget.h"
 
 namespace dyn::ui {
@@ -25,6 +26,11 @@ std::string shellWord(const std::string& s) {
   for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return q + "'";
 }
+
+// Text from the lab's files or the model file (its title, gain and option names, trace columns,
+// messages quoting them) as the panel shows it: control and bidi characters as escapes, and a long
+// one clipped (termName), so no name is measured or drawn 200,000 characters long.
+std::string shown(const std::string& s, std::size_t max_bytes = 200) { return termName(s, max_bytes); }
 
 void tooltip(const std::string& text) {
   if (!ImGui::IsItemHovered()) return;
@@ -99,14 +105,14 @@ void problemSection(const TuningSession& session) {
   if (!session.problem().empty()) {
     ImGui::Separator();
     ImGui::PushStyleColor(ImGuiCol_Text, kError);
-    ImGui::TextWrapped("The run stopped: %s", session.problem().c_str());
+    ImGui::TextWrapped("The run stopped: %s", shown(session.problem(), 1000).c_str());
     ImGui::PopStyleColor();
     ImGui::TextWrapped("These gains would score 0 in this scenario. Lower them (see the screening below) or "
                        "choose another option, then Restart.");
   }
   if (!session.ghostProblem().empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, kWarn);
-    ImGui::TextWrapped("%s", session.ghostProblem().c_str());
+    ImGui::TextWrapped("%s", shown(session.ghostProblem(), 1000).c_str());
     ImGui::PopStyleColor();
   }
 }
@@ -118,7 +124,7 @@ void gainsSection(TuningSession& session, PanelState& st) {
     std::string format = g.unit.empty() || g.unit == "1" ? "%.4g" : "%.4g " + g.unit;  // "1": dimensionless
     for (std::size_t p = format.find('%', 1); p != std::string::npos; p = format.find('%', p + 2)) format.insert(p, "%");
     ImGui::SetNextItemWidth(-label_room);
-    if (ImGui::SliderScalar(g.name.c_str(), ImGuiDataType_Double, &v, &g.min, &g.max, format.c_str(),
+    if (ImGui::SliderScalar(shown(g.name).c_str(), ImGuiDataType_Double, &v, &g.min, &g.max, format.c_str(),
                             ImGuiSliderFlags_Logarithmic | ImGuiSliderFlags_AlwaysClamp))
       session.setGain(g.name, std::clamp(v, g.min, g.max));
     {
@@ -127,31 +133,31 @@ void gainsSection(TuningSession& session, PanelState& st) {
       PanelState::Widget w;
       w.name = g.name;
       const float lx = frame_right + ImGui::GetStyle().ItemInnerSpacing.x;
-      const float fr[4] = {a.x, a.y, frame_right, b.y}, lb[4] = {lx, a.y, lx + ImGui::CalcTextSize(g.name.c_str()).x, b.y};
+      const float fr[4] = {a.x, a.y, frame_right, b.y}, lb[4] = {lx, a.y, lx + ImGui::CalcTextSize(shown(g.name).c_str()).x, b.y};
       std::copy(fr, fr + 4, w.frame), std::copy(lb, lb + 4, w.label);
       st.widgets.push_back(w);
     }
     if (ImGui::IsItemDeactivatedAfterEdit()) changed(session, st);
-    tooltip(g.doc + "\nunit: " + g.unit + "\nrange [" + fmt("%.4g", g.min) + ", " + fmt("%.4g", g.max) +
+    tooltip(shown(g.doc, 1000) + "\nunit: " + shown(g.unit) + "\nrange [" + fmt("%.4g", g.min) + ", " + fmt("%.4g", g.max) +
             "], lab default " + fmt("%.4g", g.lab_default) + "\nCtrl+click to type a value.");
   }
   for (const OptionSpec& o : session.optionSpecs()) {
     const std::string current = session.option(o.name);
     ImGui::SetNextItemWidth(-label_room);
-    if (ImGui::BeginCombo(o.name.c_str(), current.c_str())) {
+    if (ImGui::BeginCombo(shown(o.name).c_str(), shown(current).c_str())) {
       for (const auto& c : o.choices) {
-        if (ImGui::Selectable(c.c_str(), c == current) && c != current) {
+        if (ImGui::Selectable(shown(c).c_str(), c == current) && c != current) {
           session.setOption(o.name, c);
           changed(session, st);
         }
       }
       ImGui::EndCombo();
     }
-    tooltip(o.doc + "\nchoices: " + [&] {
+    tooltip(shown(o.doc, 1000) + "\nchoices: " + [&] {
       std::string l;
       for (const auto& c : o.choices) l += (l.empty() ? "" : ", ") + c;
-      return l;
-    }() + "\nlab default: " + o.lab_default);
+      return shown(l, 1000);
+    }() + "\nlab default: " + shown(o.lab_default));
   }
   if (ImGui::Button("Lab defaults")) {
     session.resetToLabDefaults();
@@ -182,7 +188,7 @@ void plotsSection(const TuningSession& session, PanelState& st) {
   for (const Series& s : plots) gutter = std::max(gutter, plotGutter(s.values));
   for (std::size_t i = 0; i < plots.size(); ++i) {
     const Series& s = plots[i];
-    ImGui::TextColored(ImVec4(s.color.r, s.color.g, s.color.b, 1.0f), "%s", s.name.c_str());
+    ImGui::TextColored(ImVec4(s.color.r, s.color.g, s.color.b, 1.0f), "%s", shown(s.name).c_str());
     if (!s.values.empty()) {
       ImGui::SameLine();
       ImGui::Text("%.4g", double(s.values.back()));
@@ -193,11 +199,14 @@ void plotsSection(const TuningSession& session, PanelState& st) {
   }
   // Any column of the trace over the last two seconds.
   ImGui::SetNextItemWidth(-label_room);
-  const char* chosen = st.plot_column >= 0 && st.plot_column < int(tr.columns.size()) ? tr.columns[st.plot_column].c_str() : "(none)";
-  if (ImGui::BeginCombo("column", chosen)) {
+  const std::string chosen = st.plot_column >= 0 && st.plot_column < int(tr.columns.size()) ? shown(tr.columns[st.plot_column]) : "(none)";
+  if (ImGui::BeginCombo("column", chosen.c_str())) {
     if (ImGui::Selectable("(none)", st.plot_column < 0)) st.plot_column = -1;
-    for (int c = 0; c < int(tr.columns.size()); ++c)
-      if (ImGui::Selectable(tr.columns[c].c_str(), c == st.plot_column)) st.plot_column = c;
+    for (int c = 0; c < int(tr.columns.size()); ++c) {
+      ImGui::PushID(c);  // two columns may show alike once clipped
+      if (ImGui::Selectable(shown(tr.columns[c]).c_str(), c == st.plot_column)) st.plot_column = c;
+      ImGui::PopID();
+    }
     ImGui::EndCombo();
   }
   tooltip("plot any column of the trace (the same columns as trace_hand.csv)");
@@ -215,7 +224,7 @@ void metricsSection(TuningSession& session) {
     for (const auto& [key, value] : metrics.items()) {
       ImGui::TableNextRow();
       ImGui::TableSetColumnIndex(0);
-      ImGui::TextUnformatted(key.c_str());
+      ImGui::TextUnformatted(shown(key).c_str());
       ImGui::TableSetColumnIndex(1);
       const std::string text = value.is_number() ? fmt("%.4g", value.get<double>()) : value.dump();
       ImGui::TextUnformatted(text.c_str());
@@ -227,7 +236,7 @@ void metricsSection(TuningSession& session) {
     for (const std::string& note : session.screening()) {
       const bool bad = note.find("unstable") != std::string::npos || note.find("destabilises") != std::string::npos;
       ImGui::PushStyleColor(ImGuiCol_Text, bad ? kError : ImGui::GetStyleColorVec4(ImGuiCol_Text));
-      ImGui::TextWrapped("%s", note.c_str());
+      ImGui::TextWrapped("%s", shown(note, 1000).c_str());
       ImGui::PopStyleColor();
     }
   }
@@ -252,10 +261,10 @@ void submissionSection(TuningSession& session, PanelState& st) {
     ImGui::EndPopup();
   }
   ImGui::SameLine();
-  ImGui::TextColored(kMuted, "%s", st.save_path.c_str());
+  ImGui::TextColored(kMuted, "%s", shown(st.save_path).c_str());
   if (!st.status.empty()) {
     ImGui::PushStyleColor(ImGuiCol_Text, st.status_is_error ? kError : kOk);
-    ImGui::TextWrapped("%s", st.status.c_str());
+    ImGui::TextWrapped("%s", shown(st.status, 1000).c_str());
     ImGui::PopStyleColor();
   }
   // The grade hint: the exact command for the saved (or about to be saved) file.
@@ -263,7 +272,7 @@ void submissionSection(TuningSession& session, PanelState& st) {
   const std::string command = "dynlab grade " + shellWord(file);
   ImGui::TextColored(kMuted, st.saved_path.empty() ? "Grade, once saved:" : "Grade:");
   ImGui::SameLine();
-  ImGui::TextUnformatted(command.c_str());
+  ImGui::TextUnformatted(shown(command, 1000).c_str());
   ImGui::SameLine();
   if (ImGui::SmallButton("Copy")) ImGui::SetClipboardText(command.c_str());
   tooltip("copy the command; it writes results.json and report.html into out/grade");
@@ -296,12 +305,12 @@ void drawTuningPanel(TuningSession& session, PanelState& st, float x, float widt
                                  ImGuiWindowFlags_NoSavedSettings | ImGuiWindowFlags_NoBringToFrontOnFocus;
   // The window's title is the lab's name ("Impedance control", not the whole sentence after it),
   // which fits the panel; the full title is the OS window's.
-  const std::string full = session.title(), title = full.substr(0, full.find(": ")) + "###tuning";
+  const std::string full = session.title(), title = shown(full.substr(0, full.find(": "))) + "###tuning";
   ImGui::Begin(title.c_str(), nullptr, flags);
   // Every name right of its slider in full: the widest one sets the column.
   float widest = ImGui::CalcTextSize("speed").x;
-  for (const GainSpec& g : session.gainSpecs()) widest = std::max(widest, ImGui::CalcTextSize(g.name.c_str()).x);
-  for (const OptionSpec& o : session.optionSpecs()) widest = std::max(widest, ImGui::CalcTextSize(o.name.c_str()).x);
+  for (const GainSpec& g : session.gainSpecs()) widest = std::max(widest, ImGui::CalcTextSize(shown(g.name).c_str()).x);
+  for (const OptionSpec& o : session.optionSpecs()) widest = std::max(widest, ImGui::CalcTextSize(shown(o.name).c_str()).x);
   label_room = std::min(widest + 2 * ImGui::GetStyle().ItemInnerSpacing.x, 0.45f * width);
   st.widgets.clear();
   st.window_right = x + width;

@@ -13,6 +13,7 @@
 #include <fstream>
 
 #include "grading/grade.h"
+#include "labs/numbers.h"
 #include "grading/rubric.h"
 #include "labs/run.h"
 #include "labs/submission.h"
@@ -115,7 +116,7 @@ void TuningSession::setGain(const std::string& gname, double value) {
     if (!std::isfinite(value) || value < g.min || value > g.max)
       throw InputError("<tuning>", "/gains/" + gname,
                        "expected a number in [" + fmtNumber(g.min) + ", " + fmtNumber(g.max) + "] " + g.unit +
-                           ", got " + fmtNumber(value));
+                           ", got " + exactNumber(value));
     gains_[gname] = value;
     return;
   }

@@ -158,6 +158,25 @@ TEST_CASE("terminal text: control characters, separators and bad bytes made visi
   }
 }
 
+TEST_CASE("names from files: escaped, and a long one clipped between characters with what was left out") {
+  CHECK(termName("crank\x1b]0;x\x07") == "crank\\x1B]0;x\\x07");
+  CHECK(termName(std::string(200, 'a')) == std::string(200, 'a'));
+  // 200,000 characters: the head and the tail, and how many bytes are not shown.
+  const std::string clipped = termName("j" + std::string(200000, 'a') + "z");
+  CHECK(clipped.size() < 260);
+  CHECK(clipped.rfind("ja", 0) == 0);
+  CHECK(clipped.back() == 'z');
+  CHECK(clipped.find(" bytes left out) … ") != std::string::npos);
+  // Never cut inside an escape: every backslash still starts a whole \xNN or \u{XXXX}.
+  for (const std::string& s : {std::string(300, '\x1b'), std::string(100, 'a') + std::string(120, '\x9b') + "\xe2\x80\xae"}) {
+    const std::string t = termName(s, 200);
+    CHECK(t.size() < 260);
+    for (std::size_t i = t.find('\\'); i != std::string::npos; i = t.find('\\', i + 1))
+      CHECK_MESSAGE((t.compare(i, 4, "\\x1B") == 0 || t.compare(i, 4, "\\x9B") == 0 || t.compare(i, 9, "\\u{202E}") == 0), t);
+    CHECK(isValidUtf8(t));
+  }
+}
+
 TEST_CASE("CSV fields: quoted when needed, formulas neutralised") {
   CHECK(csvField("plain") == "plain");
   CHECK(csvField("a,b") == "\"a,b\"");

@@ -216,7 +216,9 @@ class Errors(unittest.TestCase):
         lab = dynlab.Lab("slider_crank")
         name, info = next(iter(lab.gain_info.items()))
         before = lab.gains
-        for gains in ({"no_such_gain": 1.0}, {name: info["max"] * 10 + 1}, {name: "fast"}, {name: [1]}):
+        # 2**80: an int past 64 bits is read as the CLI reads it from the file (a double), not "Unable to cast".
+        for gains in ({"no_such_gain": 1.0}, {name: info["max"] * 10 + 1}, {name: "fast"}, {name: [1]}, {name: 2**80},
+                      {name: -2**80}, {name: 2**64 - 1}):
             with self.subTest(gains=gains):
                 path, message = self.cli_error("slider_crank", {"gains": gains})
                 with self.assertRaises(dynlab.InputError) as e:
@@ -248,6 +250,109 @@ class Errors(unittest.TestCase):
                 lab.run(**kwargs)
         with self.assertRaises(TypeError):
             lab.set_gains({"kp_x": {1, 2}})
+
+
+def python(code):
+    """Runs code in a fresh interpreter, so that a crash fails the test instead of this process."""
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, encoding="utf-8", errors="replace", cwd=TMP,
+                          timeout=900)
+
+
+class Hostile(unittest.TestCase):
+    """Python input as hostile as a file: never a crash, always the CLI's checks as ValueError or TypeError."""
+
+    def test_self_referencing_data_is_a_value_error(self):
+        r = python("""
+import dynlab
+lab = dynlab.Lab("slider_crank")
+g = {}
+g["kp_x"] = g
+s = {"lab": "slider_crank"}
+s["gains"] = s
+l = []
+l.append(l)
+for call in (lambda: lab.set_gains(g), lambda: lab.apply(s), lambda: dynlab.grade(s), lambda: lab.set_gains(kp_x=l)):
+    try:
+        call()
+        print("no error")
+    except ValueError as e:
+        print("ValueError", str(e)[-50:])
+""")
+        self.assertEqual(r.returncode, 0, r.stderr[-2000:])  # today: SIGSEGV (-11)
+        lines = r.stdout.splitlines()
+        self.assertEqual(len(lines), 4, r.stdout)
+        for line in lines:
+            self.assertTrue(line.startswith("ValueError "), line)
+            self.assertTrue(line.endswith("expected JSON nested at most 64 levels deep"), line)
+
+    def test_one_lab_from_two_threads(self):
+        # One thread draws the last run (video and frames) while the other replaces it with new runs.
+        r = python(f"""
+import os, threading, dynlab
+lab = dynlab.Lab("slider_crank")
+lab.run(engine="both", duration=0.4)
+failed = []
+def guard(f):
+    def body():
+        try:
+            f()
+        except Exception as e:
+            failed.append(repr(e))
+    return body
+def draw():
+    for i in range(3):
+        lab.video(os.path.join({TMP!r}, f"thread_{{i}}.mp4"))
+        lab.frame(0.3)
+def run():
+    for i in range(8):
+        lab.run(engine="both", duration=0.4)
+        lab.set_gains(kp_x=100 + i)
+threads = [threading.Thread(target=guard(f)) for f in (draw, run, draw)]
+for t in threads:
+    t.start()
+for t in threads:
+    t.join()
+print("failed:", failed)
+""")
+        self.assertEqual(r.returncode, 0, r.stderr[-2000:])  # today: SIGSEGV every time
+        self.assertEqual(r.stdout.strip(), "failed: []")
+
+    def test_time_budget_is_checked_like_the_clis(self):
+        sub = examples("slider_crank")[0]
+        lab = dynlab.Lab("slider_crank")
+        for value, text in ((float("nan"), "nan"), (-1.0, "-1"), (0.0, "0"), (float("inf"), "inf"), (1e300, "1e300"),
+                            (86400.5, "86400.5")):
+            with self.subTest(time_budget=value):
+                with self.assertRaises(dynlab.InputError) as e:  # today: graded, 1/15 marked out_of_time
+                    dynlab.grade(sub, time_budget=value)
+                self.assertIsInstance(e.exception, ValueError)
+                self.assertEqual(e.exception.path, "time_budget")
+                with self.assertRaises(dynlab.InputError):
+                    lab.grade(time_budget=value)
+                r = cli("grade", sub, "--time-budget=" + text, "--out", os.path.join(TMP, "budget"))
+                self.assertEqual(r.returncode, 2)
+                self.assertIn("--time-budget: " + e.exception.expected, r.stderr)
+        with self.assertRaises(TypeError):
+            dynlab.grade(sub, time_budget="10")
+
+    def test_numbers_and_text_no_json_holds(self):
+        lab = dynlab.Lab("slider_crank")
+        for gains in ({"kp_x": 10**400}, {"kp_x": -(10**400)}, {"kp_x": "\ud800"}, {"\udcff": 1.0}):
+            with self.subTest(gains=repr(gains)), self.assertRaises(ValueError) as e:  # today: RuntimeError / OverflowError
+                lab.set_gains(gains)
+            self.assertNotIsInstance(e.exception, RuntimeError)
+        with self.assertRaises(dynlab.InputError) as e:
+            lab.set_gains(kp_x=2**80)  # keywords too
+        self.assertIn("/gains/kp_x: expected a number in [", str(e.exception))
+        self.assertIn("got 1.2089258196146292e+24", str(e.exception))
+        with self.assertRaises(dynlab.InputError) as e:  # more data than a submission file may hold, refused as it is read
+            lab.set_gains({"kp_x": ["x" * 1000] * 2000})
+        self.assertIn("expected at most 1048576 bytes of JSON data", str(e.exception))
+        with open(os.path.join(TMP, "gains.json"), "w", encoding="utf-8") as f:
+            json.dump({"gains": {"kp_x": 100}}, f)
+        with self.assertRaises(dynlab.InputError) as e:  # not gains.json: open() would stop at the NUL
+            lab.set_gains(os.path.join(TMP, "gains.json\0.txt"))
+        self.assertIn("expected a path without a NUL byte", str(e.exception))
 
 
 if __name__ == "__main__":

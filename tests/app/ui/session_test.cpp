@@ -74,6 +74,8 @@ TEST_CASE("--set NAME=VALUE: gains within bounds, declared options, one clear li
   CHECK(s.option("force_law") == "proportional");
   CHECK(inputError(s, "kp_x=1e9").find("--set kp_x=1e9: expected a number in [0, 2e+04] N/m") != std::string::npos);
   CHECK(inputError(s, "kp_x=-1").find("expected a number in") != std::string::npos);
+  // The value refused with the digits that show why (%g would print "got 2e+04", inside [0, 2e+04]).
+  CHECK(inputError(s, "kp_x=20000.000000000004").find("expected a number in [0, 2e+04] N/m, got 20000.000000000004") != std::string::npos);
   CHECK(inputError(s, "kp_x=abc").find("expected a number, got \"abc\"") != std::string::npos);
   CHECK(inputError(s, "kp_x=nan").find("expected a number") != std::string::npos);
   CHECK(inputError(s, "force_law=bang_bang").find("expected one of open_loop, proportional, integral") != std::string::npos);
