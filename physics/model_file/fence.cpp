@@ -52,9 +52,11 @@ std::size_t addressSpace() {
   // faulthandler) would report it as the caller's.
   for (int sig : {SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT, SIGTRAP, SIGXCPU, SIGPIPE}) ::signal(sig, SIG_DFL);
   // Memory: what the caller had plus the budget (a fixed total would starve a large caller).
-  const std::size_t now = addressSpace();
-  const rlimit as{rlim_t(now + limits.memory_bytes), rlim_t(now + limits.memory_bytes)};
-  ::setrlimit(RLIMIT_AS, &as);
+  // (Unknown: no limit rather than one below what the caller already holds.)
+  if (const std::size_t now = addressSpace(); now > 0) {
+    const rlimit as{rlim_t(now + limits.memory_bytes), rlim_t(now + limits.memory_bytes)};
+    ::setrlimit(RLIMIT_AS, &as);
+  }
   // CPU time: SIGXCPU a second past the deadline, SIGKILL a second later (the caller kills it first).
   const rlim_t cpu = rlim_t(std::ceil(limits.seconds)) + 1;
   const rlimit c{cpu, cpu + 1};
