@@ -2,6 +2,7 @@
 #include "physics/model_file/fence.h"
 
 #include <fcntl.h>
+#include <malloc.h>
 #include <poll.h>
 #include <signal.h>
 #include <sys/resource.h>
@@ -62,6 +63,8 @@ std::size_t addressSpace() {
   const rlimit c{cpu, cpu + 1};
   ::setrlimit(RLIMIT_CPU, &c);
   std::set_new_handler(outOfMemory);
+  // Large blocks from fresh pages, not from the caller's heap (each reused page would be copied).
+  ::mallopt(M_MMAP_THRESHOLD, 128 * 1024);
   std::string reply;
   char tag = kReply;
   try {
@@ -94,6 +97,9 @@ void fenceOutOfMemory() { outOfMemory(); }
 
 std::string fenced(const std::string& file, const std::string& who, const FenceLimits& limits, const std::function<std::string()>& work) {
   const std::string head = file + ": " + who;
+  // Free heap pages go back to the system first: the child would copy each one it reuses (a page
+  // shared after fork is copied on its first write), the caller fault on each after.
+  ::malloc_trim(0);
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw ModelFileError(head + " could not be started (no pipe: " + std::strerror(errno) + ")");
   const pid_t pid = ::fork();
