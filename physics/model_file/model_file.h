@@ -14,7 +14,10 @@
 //   elements     dynlab's own, given beside the file (LoadOptions: GivenRolling, GivenContact): a
 //                wheel rolling without slip and a ball against a plane (unilateral), after the closures
 // Anything else the description cannot represent is a one-line ModelFileError naming the file, the
-// element and what is supported. This folder is the only code that includes MuJoCo.
+// element and what is supported. The file is parsed once, from the checked files, in a child process
+// with time and memory limits (compile.cpp, fence.h), after its size is counted (sizes.cpp); the
+// compiled model is kept (LoadedModel::compiled) for MuJoCo's own cross-check and simulation. This
+// folder is the only code that includes MuJoCo.
 #pragma once
 #include <array>
 #include <memory>
