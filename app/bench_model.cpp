@@ -117,7 +117,7 @@ void build(const model_file::LoadedModel& m, double dt, bool beside, Engines& e)
   b.state = [bt](VecN& q, VecN& v) { (*bt)->state(q, v); };
   e.list.push_back(b);
   if (beside) return;  // MuJoCo's run of the file would not hold what is beside it
-  e.mujoco = std::make_unique<model_file::MujocoSimulation>(m.file, dt);
+  e.mujoco = std::make_unique<model_file::MujocoSimulation>(m, dt);
   model_file::MujocoSimulation* mj = e.mujoco.get();
   mj->reset(m.q0, zero);
   Engine u;

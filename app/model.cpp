@@ -102,7 +102,7 @@ std::string describe(const model_file::LoadedModel& m) {
 
 // M and the bias against MuJoCo's own at q0 and a few seeded states: the largest differences.
 std::string crossCheck(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech) {
-  model_file::MujocoReference mj(m.file);
+  model_file::MujocoReference mj(m);
   std::mt19937_64 rng(29);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const int n = mech.n();

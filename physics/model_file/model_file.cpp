@@ -1,5 +1,6 @@
-// A model file onto the description (model_file.h): read and checked, compiled by MuJoCo, every
-// element checked against what the description can hold, then mapped at the reference pose qpos0.
+// A model file onto the description (model_file.h): read, checked and compiled by MuJoCo in the
+// fence (compile.cpp), every element checked against what the description can hold, then mapped at
+// the reference pose qpos0.
 #include "physics/model_file/model_file.h"
 
 #include <algorithm>
@@ -12,6 +13,7 @@
 #include <memory>
 #include <random>
 #include <sstream>
+#include <unordered_set>
 
 #include "physics/constrained_mechanism.h"
 #include "physics/constraints/point_closure.h"
@@ -25,47 +27,10 @@ using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
 using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 
-struct ModelDeleter {
-  void operator()(mjModel* m) const { mj_deleteModel(m); }
-};
 struct DataDeleter {
   void operator()(mjData* d) const { mj_deleteData(d); }
 };
-using ModelPtr = std::unique_ptr<mjModel, ModelDeleter>;
 using DataPtr = std::unique_ptr<mjData, DataDeleter>;
-
-// The file compiled by MuJoCo from the bytes read, beside every file it names (files.cpp): virtual
-// files all, so what was checked is what is parsed.
-ModelPtr compile(const std::string& path, std::string* warnings) {
-  const std::string bytes = detail::readChecked(path);
-  const std::string name = std::filesystem::path(path).filename().string();
-  if (name.size() >= mjMAXVFSNAME) throw ModelFileError(path + ": file name longer than MuJoCo's " + std::to_string(mjMAXVFSNAME - 1) + " characters");
-  auto vfs = std::make_unique<mjVFS>();
-  mj_defaultVFS(vfs.get());
-  struct Clear {
-    mjVFS* v;
-    ~Clear() { mj_deleteVFS(v); }
-  } clear{vfs.get()};
-  // The virtual file keeps the name alone; loading it by its path keeps the file's folder as the
-  // model's, where MuJoCo looks for includes and meshes.
-  detail::putFile(vfs.get(), path, path, bytes);
-  const std::vector<std::string> missing = detail::addReferencedFiles(path, bytes, vfs.get());
-  char error[1024] = "";
-  mjModel* m = nullptr;
-  detail::MujocoGuard guard;
-  MUJOCO_CALL(path, m = mj_loadXML(path.c_str(), vfs.get(), error, sizeof error));
-  if (!m) {
-    std::string why = path + ": MuJoCo's parser: " + detail::oneLine(error[0] ? error : "no model");
-    if (!missing.empty()) {
-      why += " (named but not found in the model's folder:";
-      for (std::size_t i = 0; i < missing.size() && i < 3; ++i) why += " '" + detail::oneLine(missing[i]) + "'";
-      why += missing.size() > 3 ? " ...)" : ")";
-    }
-    throw ModelFileError(why);
-  }
-  if (warnings) *warnings = detail::oneLine(std::string(error) + " " + guard.warnings());
-  return ModelPtr(m);
-}
 
 std::string num(double x) {
   char b[32];
@@ -110,12 +75,9 @@ void checkSupported(const std::string& file, const mjModel* m, const LoadOptions
   if (m->npair > 0) fail("<contact><pair> '" + nameOf(m, mjOBJ_PAIR, 0, "pair") + "': dynlab has no contacts between geoms");
   // Geoms that could touch (MuJoCo's filter: different rigid bodies, not parent and child unless one
   // is the world, contype/conaffinity compatible, not excluded).
+  const std::unordered_set<int> exclusions(m->exclude_signature, m->exclude_signature + m->nexclude);
   auto excluded = [&](int b1, int b2) {
-    for (int e = 0; e < m->nexclude; ++e) {
-      const int s = m->exclude_signature[e];
-      if (s == ((b1 + 1) << 16) + b2 + 1 || s == ((b2 + 1) << 16) + b1 + 1) return true;
-    }
-    return false;
+    return exclusions.count(((b1 + 1) << 16) + b2 + 1) > 0 || exclusions.count(((b2 + 1) << 16) + b1 + 1) > 0;
   };
   const bool filterparent = !(flags & mjDSBL_FILTERPARENT);
   for (int g1 = 0; g1 < m->ngeom; ++g1)
@@ -178,8 +140,8 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   LoadedModel out;
   out.file = path;
   std::string warnings;
-  const ModelPtr model = compile(path, &warnings);
-  const mjModel* m = model.get();
+  out.compiled = detail::compile(path, &warnings);
+  const mjModel* m = out.compiled->m;
   if (!warnings.empty() && warnings != " ") out.notes.push_back("MuJoCo: " + warnings);
   checkSupported(path, m, options, out.notes);
   // The reference pose: MuJoCo's kinematics at qpos0 (anchors, axes, centres of mass, principal axes).

@@ -14,9 +14,13 @@
 //   elements     dynlab's own, given beside the file (LoadOptions: GivenRolling, GivenContact): a
 //                wheel rolling without slip and a ball against a plane (unilateral), after the closures
 // Anything else the description cannot represent is a one-line ModelFileError naming the file, the
-// element and what is supported. This folder is the only code that includes MuJoCo.
+// element and what is supported. The file is parsed once, from the checked files, in a child process
+// with time and memory limits (compile.cpp, fence.h), after its size is counted (sizes.cpp); the
+// compiled model is kept (LoadedModel::compiled) for MuJoCo's own cross-check and simulation. This
+// folder is the only code that includes MuJoCo.
 #pragma once
 #include <array>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -34,6 +38,23 @@ inline constexpr std::size_t kMaxFileBytes = 4u << 20;
 inline constexpr std::size_t kMaxAssetBytes = 16u << 20;
 inline constexpr std::size_t kMaxAssetsBytes = 64u << 20;
 inline constexpr int kMaxAssetFiles = 256;
+// What a model file may write, its includes expanded, counted before MuJoCo compiles it (sizes.cpp):
+// far past any real model (MuJoCo Menagerie's arms and humanoids have tens of bodies and joints and
+// at most a few hundred geoms; a loop mechanism a handful of equalities; dynlab moves at most kMaxDof
+// coordinates), far below what makes MuJoCo's parser slow or crash (47,000 bodies crash MuJoCo
+// 2.2.2's parser after 11 s; 100,000 take 92 s and 1.7 GB). See assets/models/README.md.
+inline constexpr int kMaxBodies = 1000;     // MJCF bodies, URDF links
+inline constexpr int kMaxJoints = 1000;
+inline constexpr int kMaxGeoms = 5000;      // MJCF geoms, URDF visual and collision shapes
+inline constexpr int kMaxEqualities = 200;  // MJCF equality constraints (≤ 6 rows each)
+inline constexpr int kMaxElements = 1000000;  // XML elements visited while counting
+inline constexpr int kMaxIncludeDepth = 8;
+// MuJoCo's parser runs in a child process (fence.h): at most this long (wall clock and CPU time)
+// and this much memory past the caller's; a crash, a timeout or running out is a one-line refusal.
+inline constexpr double kParseSeconds = 20;
+inline constexpr std::size_t kParseMemoryBytes = std::size_t(1) << 30;
+// MuJoCo's data for a model (mjData: nstack numbers and its buffer) at most this large.
+inline constexpr std::size_t kMaxDataBytes = std::size_t(256) << 20;
 
 // One line: "FILE: what is wrong; what is supported".
 struct ModelFileError : std::runtime_error {
@@ -106,8 +127,15 @@ struct Joint {
   double lower = 0, upper = 0;
 };
 
+namespace detail {
+struct Compiled;  // MuJoCo's compiled model (mujoco_call.h)
+}
+
 struct LoadedModel {
   std::string file;
+  // The model MuJoCo compiled from the checked files, in the fence, once: MujocoReference and
+  // MujocoSimulation start from it (nothing parses the file again).
+  std::shared_ptr<const detail::Compiled> compiled;
   MechanismModel<Spatial> mechanism;
   VecN q0;                         // the file's reference pose qpos0 (closed: every loop holds there)
   std::vector<Joint> joints;       // per coordinate
@@ -164,11 +192,11 @@ struct LoadOptions {
 // Reads FILE (MJCF or URDF). Throws ModelFileError.
 LoadedModel load(const std::string& path, const LoadOptions& options = {});
 
-// MuJoCo's own M(q) (mj_fullM) and bias C(q, v) v + G(q) (qfrc_bias) from the same file, for
-// cross-checks: the same coordinates as LoadedModel.
+// MuJoCo's own M(q) (mj_fullM) and bias C(q, v) v + G(q) (qfrc_bias) from the same compiled model,
+// for cross-checks: the same coordinates as LoadedModel.
 class MujocoReference {
  public:
-  explicit MujocoReference(const std::string& path);
+  explicit MujocoReference(const LoadedModel& model);
   ~MujocoReference();
   MujocoReference(const MujocoReference&) = delete;
   MujocoReference& operator=(const MujocoReference&) = delete;
@@ -181,12 +209,12 @@ class MujocoReference {
   Impl* impl_;
 };
 
-// MuJoCo's own simulation of the same file (mj_step), for the bench: its constraint solver and soft
+// MuJoCo's own simulation of the same compiled model (mj_step), for the bench: its constraint solver and soft
 // equalities as the file sets them, at a given step and with the semi-implicit Euler integrator
 // (MuJoCo's default, first order), from a state in the same coordinates as LoadedModel.
 class MujocoSimulation {
  public:
-  MujocoSimulation(const std::string& path, double dt);
+  MujocoSimulation(const LoadedModel& model, double dt);
   ~MujocoSimulation();
   MujocoSimulation(const MujocoSimulation&) = delete;
   MujocoSimulation& operator=(const MujocoSimulation&) = delete;

@@ -76,26 +76,28 @@ struct MujocoReference::Impl {
 
 namespace {
 
-// mj_loadXML with its message as a ModelFileError (nothing allocated on failure).
-mjModel* loadModel(const std::string& path) {
-  char error[1024] = "";
+// A copy of the model compiled at load (the cross-check and the bench each own one).
+mjModel* copyOf(const LoadedModel& model) {
+  if (!model.compiled || !model.compiled->m) throw ModelFileError(model.file + ": no compiled model (load the file first)");
   mjModel* m = nullptr;
-  MUJOCO_CALL(path, m = mj_loadXML(path.c_str(), nullptr, error, sizeof error));
-  if (!m) throw ModelFileError(path + ": MuJoCo's parser: " + detail::oneLine(error));
+  MUJOCO_CALL(model.file, m = mj_copyModel(nullptr, model.compiled->m));
+  if (!m) throw ModelFileError(model.file + ": MuJoCo could not copy its model");
   return m;
 }
 
 }  // namespace
 
-MujocoReference::MujocoReference(const std::string& path) : impl_(new Impl) {
-  impl_->file = path;
+MujocoReference::MujocoReference(const LoadedModel& model) : impl_(new Impl) {
+  impl_->file = model.file;
   try {
-    impl_->m = loadModel(path);
+    impl_->m = copyOf(model);
+    MUJOCO_CALL(model.file, impl_->d = mj_makeData(impl_->m));
+    if (!impl_->d) throw ModelFileError(model.file + ": MuJoCo could not make its data");
   } catch (...) {
+    if (impl_->m) mj_deleteModel(impl_->m);
     delete impl_;
     throw;
   }
-  MUJOCO_CALL(path, impl_->d = mj_makeData(impl_->m));
 }
 
 MujocoReference::~MujocoReference() {
@@ -131,17 +133,19 @@ struct MujocoSimulation::Impl {
   detail::MujocoGuard guard;
 };
 
-MujocoSimulation::MujocoSimulation(const std::string& path, double dt) : impl_(new Impl) {
-  impl_->file = path;
+MujocoSimulation::MujocoSimulation(const LoadedModel& model, double dt) : impl_(new Impl) {
+  impl_->file = model.file;
   try {
-    impl_->m = loadModel(path);
+    impl_->m = copyOf(model);
+    impl_->m->opt.timestep = dt;
+    impl_->m->opt.integrator = mjINT_EULER;
+    MUJOCO_CALL(model.file, impl_->d = mj_makeData(impl_->m));
+    if (!impl_->d) throw ModelFileError(model.file + ": MuJoCo could not make its data");
   } catch (...) {
+    if (impl_->m) mj_deleteModel(impl_->m);
     delete impl_;
     throw;
   }
-  impl_->m->opt.timestep = dt;
-  impl_->m->opt.integrator = mjINT_EULER;
-  MUJOCO_CALL(path, impl_->d = mj_makeData(impl_->m));
 }
 
 MujocoSimulation::~MujocoSimulation() {

@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <csetjmp>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,23 @@ std::string& lastError();
 
 // One line: newlines and control characters become spaces, runs of spaces one.
 std::string oneLine(const std::string& text);
+
+// A model compiled by MuJoCo (LoadedModel::compiled): owned, read only once made.
+struct Compiled {
+  mjModel* m = nullptr;
+  Compiled() = default;
+  ~Compiled();
+  Compiled(const Compiled&) = delete;
+  Compiled& operator=(const Compiled&) = delete;
+};
+
+// FILE compiled by MuJoCo from the checked files, in the fence (compile.cpp); MuJoCo's warnings into
+// *warnings. Throws ModelFileError.
+std::shared_ptr<const Compiled> compile(const std::string& path, std::string* warnings);
+
+// The model's text and its includes (in vfs) within kMaxBodies, kMaxJoints, kMaxGeoms and
+// kMaxEqualities, no <composite>, includes nested at most kMaxIncludeDepth (sizes.cpp).
+void checkSizes(const std::string& path, const std::string& text, const mjVFS* vfs);
 
 // The model file's bytes: a regular file of at most kMaxFileBytes, not blank, well-formed UTF-8
 // (files.cpp). Throws ModelFileError.

@@ -158,7 +158,7 @@ TEST_CASE("M and the bias C v + G equal MuJoCo's own (mj_fullM, qfrc_bias) for e
     const char* name = entry.c_str();
     CAPTURE(entry);
     const model_file::LoadedModel file = model_file::load(model(name));
-    model_file::MujocoReference mj(model(name));
+    model_file::MujocoReference mj(file);
     ConstrainedMechanism<Spatial> mech(file.mechanism);
     const int n = mech.n();
     REQUIRE(mj.nv() == n);
@@ -242,7 +242,7 @@ TEST_CASE("armature: M_ii += a as MuJoCo's mj_fullM, ½ a θ'² in the energy, k
   const model_file::LoadedModel single = model_file::load(one);
   REQUIRE(single.mechanism.joints.size() == 1);
   CHECK(single.mechanism.joints[0].armature == 0.1);
-  model_file::MujocoReference mj_one(one);
+  model_file::MujocoReference mj_one(single);
   ConstrainedMechanism<Spatial> mech_one(single.mechanism);
   CHECK(maxAbs(mech_one.massMatrix(single.q0) - mj_one.massMatrix(single.q0)) < 1e-12);
   // geared_arm.xml: two hinges (the elbow's parent moves) and a slide, each with its armature. The
@@ -254,7 +254,7 @@ TEST_CASE("armature: M_ii += a as MuJoCo's mj_fullM, ½ a θ'² in the energy, k
   MechanismModel<Spatial> bare = file.mechanism;
   for (JointProperties& j : bare.joints) j.armature = 0;
   ConstrainedMechanism<Spatial> mech(file.mechanism), without(bare);
-  model_file::MujocoReference mj(model("geared_arm.xml"));
+  model_file::MujocoReference mj(file);
   Random r;
   double worst = 0, worst_diag = 0, worst_id = 0;
   for (int trial = 0; trial < 20; ++trial) {
@@ -405,7 +405,7 @@ TEST_CASE("MuJoCo's own steps of the same file (the bench's fourth engine) move 
   // same dt) and by the hand engine (RK4): the same motion to Euler's first-order error, not to zero.
   const model_file::LoadedModel m = model_file::load(model("arm3d.xml"));
   const int n = int(m.q0.size());
-  model_file::MujocoSimulation mj(m.file, 1e-4);
+  model_file::MujocoSimulation mj(m, 1e-4);
   CHECK(mj.describe().find("mj_step, Euler") != std::string::npos);
   mj.reset(m.q0, VecN::Zero(n));
   ConstrainedMechanism<Spatial> mech(m.mechanism);

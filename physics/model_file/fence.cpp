@@ -1,0 +1,163 @@
+// The fence (fence.h): fork, limits in the child, a pipe back, a deadline in the caller.
+#include "physics/model_file/fence.h"
+
+#include <fcntl.h>
+#include <malloc.h>
+#include <poll.h>
+#include <signal.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <new>
+
+#include "physics/model_file/model_file.h"
+
+namespace dyn::model_file::detail {
+namespace {
+
+// How the child ends: its reply follows a tag byte on the pipe.
+constexpr char kReply = 'R', kRefused = 'E';
+constexpr int kOutOfMemory = 97;
+
+void writeAll(int fd, const char* data, std::size_t size) {
+  for (std::size_t done = 0; done < size;) {
+    const ssize_t n = ::write(fd, data + done, size - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return;
+    done += std::size_t(n);
+  }
+}
+
+[[noreturn]] void outOfMemory() { ::_exit(kOutOfMemory); }
+
+// The caller's address space now (bytes), from /proc/self/statm; 0 if unknown.
+std::size_t addressSpace() {
+  std::FILE* f = std::fopen("/proc/self/statm", "r");
+  if (!f) return 0;
+  unsigned long pages = 0;
+  const int got = std::fscanf(f, "%lu", &pages);
+  std::fclose(f);
+  return got == 1 ? std::size_t(pages) * std::size_t(::sysconf(_SC_PAGESIZE)) : 0;
+}
+
+// The child: limits, the work, its reply; never returns.
+[[noreturn]] void child(int fd, const FenceLimits& limits, const std::function<std::string()>& work) {
+  // A crash is the child's own: the caller's crash handlers (a test framework's, Python's
+  // faulthandler) would report it as the caller's.
+  for (int sig : {SIGSEGV, SIGBUS, SIGILL, SIGFPE, SIGABRT, SIGTRAP, SIGXCPU, SIGPIPE}) ::signal(sig, SIG_DFL);
+  // Memory: what the caller had plus the budget (a fixed total would starve a large caller).
+  // (Unknown: no limit rather than one below what the caller already holds.)
+  if (const std::size_t now = addressSpace(); now > 0) {
+    const rlimit as{rlim_t(now + limits.memory_bytes), rlim_t(now + limits.memory_bytes)};
+    ::setrlimit(RLIMIT_AS, &as);
+  }
+  // CPU time: SIGXCPU a second past the deadline, SIGKILL a second later (the caller kills it first).
+  const rlim_t cpu = rlim_t(std::ceil(limits.seconds)) + 1;
+  const rlimit c{cpu, cpu + 1};
+  ::setrlimit(RLIMIT_CPU, &c);
+  std::set_new_handler(outOfMemory);
+  // Large blocks from fresh pages, not from the caller's heap (each reused page would be copied).
+  ::mallopt(M_MMAP_THRESHOLD, 128 * 1024);
+  std::string reply;
+  char tag = kReply;
+  try {
+    reply = work();
+  } catch (const std::bad_alloc&) {
+    outOfMemory();
+  } catch (const ModelFileError& e) {
+    tag = kRefused;
+    reply = e.what();
+  } catch (const std::exception& e) {
+    tag = kRefused;
+    reply = std::string("unexpected error: ") + e.what();
+  } catch (...) {
+    tag = kRefused;
+    reply = "unexpected error";
+  }
+  writeAll(fd, &tag, 1);
+  writeAll(fd, reply.data(), reply.size());
+  ::_exit(0);
+}
+
+std::string signalName(int sig) {
+  const char* a = ::sigabbrev_np(sig);
+  return std::to_string(sig) + (a ? std::string(", SIG") + a : std::string());
+}
+
+}  // namespace
+
+void fenceOutOfMemory() { outOfMemory(); }
+
+std::string fenced(const std::string& file, const std::string& who, const FenceLimits& limits, const std::function<std::string()>& work) {
+  const std::string head = file + ": " + who;
+  // Free heap pages go back to the system first: the child would copy each one it reuses (a page
+  // shared after fork is copied on its first write), the caller fault on each after.
+  ::malloc_trim(0);
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) throw ModelFileError(head + " could not be started (no pipe: " + std::strerror(errno) + ")");
+  const pid_t pid = ::fork();
+  if (pid < 0) {
+    const int e = errno;
+    ::close(fds[0]), ::close(fds[1]);
+    throw ModelFileError(head + " could not be started (" + std::strerror(e) + ")");
+  }
+  if (pid == 0) {
+    ::close(fds[0]);
+    child(fds[1], limits, work);
+  }
+  ::close(fds[1]);
+  // Read until the child closes the pipe, the reply passes its bound or the time is up.
+  std::string bytes;
+  bool late = false, large = false;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(limits.seconds);
+  for (;;) {
+    const double left = std::chrono::duration<double>(until - std::chrono::steady_clock::now()).count();
+    if (left <= 0) {
+      late = true;
+      break;
+    }
+    pollfd p{fds[0], POLLIN, 0};
+    const int ready = ::poll(&p, 1, int(std::min(left, 3600.0) * 1000) + 1);
+    if (ready <= 0) continue;  // EINTR or time: the clock above decides
+    char buf[65536];
+    const ssize_t n = ::read(fds[0], buf, sizeof buf);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) break;
+    if (bytes.size() + std::size_t(n) > limits.max_reply + 1) {
+      large = true;
+      break;
+    }
+    bytes.append(buf, std::size_t(n));
+  }
+  ::close(fds[0]);
+  if (late || large) ::kill(pid, SIGKILL);
+  int status = 0;
+  pid_t waited = 0;
+  while ((waited = ::waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
+  }
+  char seconds[32];
+  std::snprintf(seconds, sizeof seconds, "%g", limits.seconds);
+  if (late) throw ModelFileError(head + " took longer than " + seconds + " s on this file");
+  if (large) throw ModelFileError(head + " answered with more than " + std::to_string(limits.max_reply >> 20) + " MiB");
+  // waitpid fails only when the caller reaps children itself (SIGCHLD ignored): the reply then speaks.
+  const bool clean = waited < 0 || (WIFEXITED(status) && WEXITSTATUS(status) == 0);
+  if (clean && !bytes.empty() && bytes[0] == kReply) return bytes.substr(1);
+  if (clean && !bytes.empty() && bytes[0] == kRefused) throw ModelFileError(bytes.substr(1));
+  if (waited >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == kOutOfMemory)
+    throw ModelFileError(head + " ran out of memory on this file (limit " + std::to_string(limits.memory_bytes >> 20) + " MiB)");
+  if (waited >= 0 && WIFSIGNALED(status)) {
+    const int sig = WTERMSIG(status);
+    if (sig == SIGXCPU) throw ModelFileError(head + " took longer than " + seconds + " s of CPU time on this file");
+    throw ModelFileError(head + " crashed on this file (signal " + signalName(sig) + ")");
+  }
+  throw ModelFileError(head + " ended without an answer (exit status " + std::to_string(waited >= 0 && WIFEXITED(status) ? WEXITSTATUS(status) : -1) + ")");
+}
+
+}  // namespace dyn::model_file::detail
