@@ -1,6 +1,8 @@
 // Python ↔ JSON and traces; see convert.h.
 #include "app/python/convert.h"
 
+#include <cmath>
+
 #include <pybind11/numpy.h>
 
 namespace dyn::python {
@@ -112,7 +114,10 @@ py::object toPython(const json& v) {
     case json::value_t::boolean: return py::bool_(v.get<bool>());
     case json::value_t::number_integer: return py::int_(v.get<long long>());
     case json::value_t::number_unsigned: return py::int_(v.get<unsigned long long>());
-    case json::value_t::number_float: return py::float_(v.get<double>());
+    case json::value_t::number_float: {  // NaN, ±inf as None: what the same value is in a JSON file (null)
+      const double x = v.get<double>();
+      return std::isfinite(x) ? py::object(py::float_(x)) : py::object(py::none());
+    }
     case json::value_t::string: return py::str(v.get<std::string>());
     case json::value_t::array: {
       py::list out;

@@ -25,6 +25,7 @@ inline constexpr std::size_t kMaxPythonJsonBytes = 1u << 20;
 // JSON text, an int no double holds, text UTF-8 cannot encode. Any other type is a TypeError
 // naming the path. An int past 64 bits becomes a double, as nlohmann reads 1208925819614629174706176.
 json toJson(py::handle object, const std::string& source);
+// A JSON value as Python data; a non-finite number is None, as a JSON file holds it (null).
 py::object toPython(const json& value);
 // A trace as {column: 1-D float64 array}, in the trace's column order.
 py::dict traceArrays(const Trace& trace);

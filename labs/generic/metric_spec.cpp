@@ -3,37 +3,27 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
+
+#include "labs/numbers.h"
 
 namespace dyn::generic {
 
 namespace {
 
-// A number in seconds, shortest digits that read back the same ("2.7", not "2.700000").
-std::string seconds(double t) {
-  char b[32];
-  for (int digits = 1; digits <= 17; ++digits) {
-    std::snprintf(b, sizeof b, "%.*g", digits, t);
-    if (std::strtod(b, nullptr) == t) break;
-  }
-  return b;
-}
-
 // The window [from, to] inside the run [0, duration] sampled every dt, holding at least one sample:
 // from ≤ duration − dt, and a given to in [from + dt, duration].
 void readWindow(const JsonView& m, double duration, double dt, MetricSpec& s) {
-  const std::string run = "the run lasts " + seconds(duration) + " s, sampled every " + seconds(dt) + " s";
+  const std::string run = "the run lasts " + fmt("%.6g", duration) + " s, sampled every " + fmt("%.6g", dt) + " s";
   if (m.has("from")) {
     s.from = m["from"].number();
     if (!(s.from >= 0 && s.from <= duration - dt))
-      m["from"].fail("expected a start in [0, " + seconds(duration - dt) + "] s (" + run + "), got " + seconds(s.from));
+      m["from"].fail("expected a start in [0, " + fmt("%.6g", duration - dt) + "] s (" + run + "), got " + exactNumber(s.from));
   }
   if (m.has("to")) {
     s.to = m["to"].number();
     if (!(s.to >= s.from + dt && s.to <= duration * (1 + 1e-12)))
-      m["to"].fail("expected an end in [" + seconds(s.from + dt) + ", " + seconds(duration) + "] s (from + one sample, " + run +
-                   "), got " + seconds(s.to));
+      m["to"].fail("expected an end in [" + fmt("%.6g", s.from + dt) + ", " + fmt("%.6g", duration) + "] s (from + one sample, " + run +
+                   "), got " + exactNumber(s.to));
   }
 }
 

@@ -100,6 +100,11 @@ std::string fenced(const std::string& file, const std::string& who, const FenceL
   // Free heap pages go back to the system first: the child would copy each one it reuses (a page
   // shared after fork is copied on its first write), the caller fault on each after.
   ::malloc_trim(0);
+  // The caller's own address-space limit (ulimit -v) below what the child would get: a child that
+  // then runs out of memory (or dies of a failed allocation) met the machine's limit, not the file's.
+  rlimit own{};
+  const bool capped = ::getrlimit(RLIMIT_AS, &own) == 0 && own.rlim_cur != RLIM_INFINITY &&
+                      own.rlim_cur < addressSpace() + limits.memory_bytes;
   int fds[2];
   if (::pipe2(fds, O_CLOEXEC) != 0) throw ModelFileError(head + " could not be started (no pipe: " + std::strerror(errno) + ")");
   const pid_t pid = ::fork();
@@ -150,6 +155,9 @@ std::string fenced(const std::string& file, const std::string& who, const FenceL
   const bool clean = waited < 0 || (WIFEXITED(status) && WEXITSTATUS(status) == 0);
   if (clean && !bytes.empty() && bytes[0] == kReply) return bytes.substr(1);
   if (clean && !bytes.empty() && bytes[0] == kRefused) throw ModelFileError(bytes.substr(1));
+  const bool starved = waited >= 0 && ((WIFEXITED(status) && WEXITSTATUS(status) == kOutOfMemory) ||
+                                       (WIFSIGNALED(status) && WTERMSIG(status) != SIGXCPU));
+  if (capped && starved) throw std::bad_alloc();  // the caller reports its own limit (exit 1)
   if (waited >= 0 && WIFEXITED(status) && WEXITSTATUS(status) == kOutOfMemory)
     throw ModelFileError(head + " ran out of memory on this file (limit " + std::to_string(limits.memory_bytes >> 20) + " MiB)");
   if (waited >= 0 && WIFSIGNALED(status)) {

@@ -2,7 +2,7 @@
 // may grow by at most FenceLimits::memory_bytes past the caller's), a CPU-time limit and a wall-clock
 // deadline (the child is killed at it), whose only way back is the bytes it returns up a pipe.
 // Whatever the work does — crash, hang, run out of memory, call exit — the caller gets its bytes or
-// one line (a ModelFileError naming the file), never a signal, a hang or bad_alloc. The child only
+// one line (a ModelFileError naming the file), never a signal or a hang. The child only
 // works, writes and _exit()s: no atexit handler, no flushed stdio buffer, nothing else of the
 // caller's (safe to fork from a threaded process such as the Python module or the window).
 // (grading/isolated.h does the same for work that may abort while drawing; physics may not use it.)
@@ -23,6 +23,9 @@ struct FenceLimits {
 // with its message. Otherwise one line, `file + ": " + who + ...`:
 //   " crashed on this file (signal 11, SIGSEGV)", " took longer than 20 s on this file",
 //   " ran out of memory on this file (limit 1024 MiB)", " ended without an answer (exit status N)".
+// Except: when the caller's own address-space limit (ulimit -v) is below what the child would be
+// given, a child that runs out of memory or dies by a signal met the machine's limit, not the file's,
+// and fenced throws std::bad_alloc (the command's "out of memory", exit 1).
 std::string fenced(const std::string& file, const std::string& who, const FenceLimits& limits, const std::function<std::string()>& work);
 
 // For the work: ends the child as out of memory (a library's failed allocation, not operator new's).

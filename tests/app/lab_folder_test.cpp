@@ -14,20 +14,12 @@ using namespace dyn::test::cli;
 
 namespace {
 
-// dynlab argv in dir with DYNLAB_HOME = home (no shell).
-// (home empty: the tree's labs, no DYNLAB_HOME.)
-Result dynlabIn(const TempDir& dir, const fs::path& home, const std::vector<std::string>& args, double timeout_s = 600) {
-  std::vector<std::string> argv = {DYNLAB_BIN};
-  argv.insert(argv.end(), args.begin(), args.end());
+// dynlab args in dir (no shell), with DYNLAB_HOME = home (empty: the tree's labs).
+Result dynlabIn(const TempDir& dir, const fs::path& home, const std::vector<std::string>& args) {
   dyn::ProcessOptions o;
-  o.cwd = dir.path.string();
-  o.stdout_file = (dir / ".out").string();
-  o.stderr_file = (dir / ".err").string();
   if (!home.empty()) o.set_env = {{"DYNLAB_HOME", home.string()}};
-  o.timeout_s = timeout_s;
-  const dyn::ProcessResult p = dyn::runProgram(argv, o);
-  REQUIRE_MESSAGE(p.started(), p.error);
-  return {p.code, readFile(dir / ".out"), readFile(dir / ".err")};
+  o.timeout_s = 600;
+  return dynlab(dir, args, o);
 }
 
 // A copy of the five-bar lab as `name` in home/labs (new-lab), its JSON path returned.

@@ -21,32 +21,6 @@ using namespace dyn::test::cli;
 
 namespace {
 
-// Runs DYNLAB_BIN with args in dir: no shell, stdout and stderr captured to files there.
-Result run(const TempDir& dir, const std::vector<std::string>& args) {
-  const fs::path out = dir / ".names_stdout", err = dir / ".names_stderr";
-  std::vector<char*> argv;
-  std::string program = DYNLAB_BIN;
-  argv.push_back(program.data());
-  std::vector<std::string> copy = args;
-  for (std::string& a : copy) argv.push_back(a.data());
-  argv.push_back(nullptr);
-  const pid_t pid = ::fork();
-  REQUIRE(pid >= 0);
-  if (pid == 0) {
-    const int o = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644), e = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    if (o < 0 || e < 0 || ::chdir(dir.path.c_str()) != 0 || ::dup2(o, 1) < 0 || ::dup2(e, 2) < 0) ::_exit(127);
-    ::execv(argv[0], argv.data());
-    ::_exit(127);
-  }
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  Result r;
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-  r.out = readFile(out);
-  r.err = readFile(err);
-  return r;
-}
-
 // The bytes a terminal acts on: C0 controls other than a line's newline (ESC, BEL, CR), DEL, a C1
 // control written in UTF-8 (U+0080–U+009F: C2 80–C2 9F) and the bidi overrides U+202A–U+202E.
 bool hasControl(const std::string& s) {
@@ -101,7 +75,7 @@ const std::string kHostile = "x\x1b]0;pwned\x07y\xe2\x80\xae" "z\xc2\x9b" "31m";
 TEST_CASE("dynlab model: joint, body and closure names with ESC, BEL, U+202E, U+009B are printed escaped, also in summary.txt") {
   const TempDir dir("names_hostile");
   writeFile(dir / "hostile.xml", fourbar("crank" + kHostile, "coupler" + kHostile, "pin" + kHostile));
-  const Result r = run(dir, {"model", "hostile.xml", "--duration", "0.01", "--out", "out"});
+  const Result r = dynlab(dir, {"model", "hostile.xml", "--duration", "0.01", "--out", "out"});
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   CHECK_FALSE(hasControl(r.out));
@@ -122,7 +96,7 @@ TEST_CASE("dynlab model: a 200,000-character joint name is clipped on the termin
   const TempDir dir("names_long");
   const std::string name = "j" + std::string(200000, 'a');
   writeFile(dir / "long.xml", fourbar(name, "coupler", "pin_C"));
-  const Result r = run(dir, {"model", "long.xml", "--duration", "0.01", "--out", "out"});
+  const Result r = dynlab(dir, {"model", "long.xml", "--duration", "0.01", "--out", "out"});
   INFO(r.err);
   REQUIRE(r.code == 0);
   CHECK(r.out.size() < 20000);  // today: the name in full, 200 kB
@@ -143,7 +117,7 @@ TEST_CASE("dynlab model: a broken model file named with an OSC sequence or a new
     writeFile(dir / file, "<mujoco><worldbody><body name=\"b\"><joint name=\"j\" type=\"hinge\"/>");  // cut short
     for (const std::vector<std::string>& args : {std::vector<std::string>{"model", file, "--out", "out"}, {"run", file, "--out", "out"},
                                                 {"figure", file, "--out", "out"}, {"bench", file}}) {
-      const Result r = run(dir, args);
+      const Result r = dynlab(dir, args);
       INFO(args[0], " ", file, "\nstderr: ", r.err);
       CHECK(r.code == 2);
       CHECK(r.err.rfind("error: ", 0) == 0);
@@ -152,7 +126,7 @@ TEST_CASE("dynlab model: a broken model file named with an OSC sequence or a new
       CHECK_FALSE(hasControl(r.out));
     }
     // Also a file that does not exist.
-    const Result r = run(dir, {"model", "missing" + file});
+    const Result r = dynlab(dir, {"model", "missing" + file});
     INFO(r.err);
     CHECK(r.code == 2);
     CHECK(lines(r.err) == 1);
@@ -164,7 +138,7 @@ TEST_CASE("dynlab new-lab: a name with a newline or an ESC gets one escaped line
   const TempDir dir("names_new_lab");
   fs::create_directories(dir / "labs");
   for (const std::string& name : {std::string("a\nb"), std::string("a\x1b[2Jb"), std::string("lab\xe2\x80\xae")}) {
-    const Result r = run(dir, {"new-lab", name, "--from", "fivebar", "--labs", (dir / "labs").string()});
+    const Result r = dynlab(dir, {"new-lab", name, "--from", "fivebar", "--labs", (dir / "labs").string()});
     INFO(r.err);
     CHECK(r.code == 2);
     CHECK(lines(r.err) == 1);
@@ -178,13 +152,13 @@ TEST_CASE("bound messages print the refused value with the digits that show why 
   // A time budget: the grader's own check and text (dynlab.grade gives the same).
   writeFile(dir / "sub.json", R"({"lab": "slider_crank", "gains": {}})");
   for (const auto& [given, shown] : {std::pair{"0", "got 0"}, {"86400.00000000001", "got 86400.00000000001"}, {"-1", "got -1"}}) {
-    const Result r = run(dir, {"grade", "sub.json", "--time-budget", given});
+    const Result r = dynlab(dir, {"grade", "sub.json", "--time-budget", given});
     INFO(r.err);
     CHECK(r.code == 2);
     CHECK(r.err.find("--time-budget: expected a time budget in [1, 86400] s, " + std::string(shown)) != std::string::npos);
   }
   // A model file's duration.
-  const Result r = run(dir, {"run", std::string(DYNLAB_SOURCE_DIR) + "/assets/models/fourbar.xml", "--duration", "600.0000000000001"});
+  const Result r = dynlab(dir, {"run", std::string(DYNLAB_SOURCE_DIR) + "/assets/models/fourbar.xml", "--duration", "600.0000000000001"});
   INFO(r.err);
   CHECK(r.code == 2);
   CHECK(r.err.find("got 600.0000000000001") != std::string::npos);

@@ -24,6 +24,7 @@
 #include "labs/generic/data_lab.h"
 #include "labs/generic/metric_spec.h"
 #include "labs/generic/task_path.h"
+#include "labs/settings.h"
 #include "physics/model_file/model_file.h"
 
 using namespace dyn;
@@ -123,7 +124,7 @@ TEST_CASE("metrics as data: each statistic on a trace with known values") {
     "max_abs": {"of": "a", "stat": "max_abs"}, "final": {"of": "a", "stat": "final", "to": 0.25},
     "mean": {"of": "a", "stat": "mean", "from": 0.15}, "variation": {"of": ["a", "b"], "stat": "variation"},
     "settling": {"of": "a", "stat": "settling", "band": 0.6}})");
-  const auto m = generic::parseMetrics(JsonView(spec, "lab.json", "/metrics"), tr.columns);
+  const auto m = generic::parseMetrics(JsonView(spec, "lab.json", "/metrics"), tr.columns, 0.5, 0.1);  // 5 rows of 0.1 s
   auto value = [&](const char* k) { return generic::evaluate(m.at(k), tr); };
   CHECK(value("rms") == doctest::Approx(std::sqrt((9 + 16 + 0.25 + 0.04 + 0.01) / 5.0)));
   CHECK(value("norm_max") == doctest::Approx(5.0));  // |(3, 4)| = |(−4, 3)| = 5
@@ -135,9 +136,21 @@ TEST_CASE("metrics as data: each statistic on a trace with known values") {
   CHECK(value("settling") == doctest::Approx(0.2));  // within ±0.6 from t = 0.2 on
   // A column the trace lacks, and a band where none belongs.
   const json bad = json::parse(R"({"e": {"of": ["a", "zz"], "stat": "rms"}})");
-  CHECK_THROWS_WITH_AS(generic::parseMetrics(JsonView(bad, "lab.json", "/metrics"), tr.columns), doctest::Contains("/metrics/e/of"), InputError);
+  CHECK_THROWS_WITH_AS(generic::parseMetrics(JsonView(bad, "lab.json", "/metrics"), tr.columns, 0.5, 0.1), doctest::Contains("/metrics/e/of"), InputError);
   const json band = json::parse(R"({"e": {"of": "a", "stat": "rms", "band": 1}})");
-  CHECK_THROWS_WITH_AS(generic::parseMetrics(JsonView(band, "lab.json", "/metrics"), tr.columns), doctest::Contains("/metrics/e/band"), InputError);
+  CHECK_THROWS_WITH_AS(generic::parseMetrics(JsonView(band, "lab.json", "/metrics"), tr.columns, 0.5, 0.1), doctest::Contains("/metrics/e/band"), InputError);
+  // A window must hold a sample of the run: a start past its last row, an end past its end, an empty one.
+  for (const char* window : {R"("from": 0.45)", R"("from": -0.1)", R"("to": 0.6)", R"("from": 0.2, "to": 0.25)"}) {
+    CAPTURE(window);
+    const json w = json::parse(std::string(R"({"e": {"of": "a", "stat": "rms", )") + window + "}}");
+    CHECK_THROWS_WITH_AS(generic::parseMetrics(JsonView(w, "lab.json", "/metrics"), tr.columns, 0.5, 0.1), doctest::Contains("the run lasts 0.5 s"),
+                         InputError);
+  }
+  // A run stopped early leaves a window without a sample: NaN, which no threshold credits (was 0: full marks for an RMS).
+  Trace early;
+  early.columns = tr.columns;
+  early.append({0.0, 3, 4});
+  CHECK(std::isnan(generic::evaluate(m.at("mean"), early)));
 }
 
 TEST_CASE("task inverse dynamics on the five-bar: the error follows e'' + 2ζω e' + ω² e = 0") {
@@ -388,7 +401,7 @@ TEST_CASE("a push on the tool as data: both engines, task PD + gravity deflects 
   json c = fivebarConfig();
   c["environment"] = json::parse(R"({"force": {"value": [3.0, 0.0, -2.0], "start": 0.3}})");
   c["trajectory"] = json::parse(R"({"segments": [{"hold": 2.0}]})");
-  c["simulation"]["duration"] = 2.0;
+  setRunDuration(c, 2.0);  // a shorter run than the exercise's (its metric windows are the exercise's)
   c["controller"]["kind"] = "task_pd_gravity";
   c["gains"]["kp"]["value"] = 2000.0;
   c["gains"]["kd"]["value"] = 40.0;
