@@ -72,16 +72,14 @@ json defaultsSubmission(const json& config, const std::string& lab) {
   return sub;
 }
 
-void applyScenario(LoadedLab& loaded, const std::string& scenario, const std::string& gains_file,
-                   std::optional<double> duration) {
+void applyScenario(LoadedLab& loaded, const std::string& scenario, std::optional<double> duration) {
   if (scenario.empty()) return;
   if (!loaded.config.contains("rubric"))
     throw InputError("<command line>", "--scenario", "expected a lab with a rubric; " + loaded.config_file + " has none");
   const Rubric rubric = parseRubric(JsonView(loaded.config, loaded.config_file));
   const Scenario& sc = findScenario(rubric, scenario);
-  // The grader's seed: from the submission's hash, so the noise is the one this file is graded with.
-  const json sub = gains_file.empty() ? defaultsSubmission(loaded.config, loaded.entry->name) : loadJsonFile(gains_file, 1u << 20);
-  json cfg = scenarioConfig(loaded.config, rubric, sc, submissionHash(sub), loaded.config_file);
+  // The grader's seed (the lab's and the scenario's): the noise every submission is graded with.
+  json cfg = scenarioConfig(loaded.config, rubric, sc, loaded.entry->name, loaded.config_file);
   if (duration) setRunDuration(cfg, *duration);
   loaded.lab = buildLab(*loaded.entry, cfg, loaded.config_file + " (scenario " + sc.name + ")");
   loaded.config = std::move(cfg);
@@ -117,7 +115,7 @@ int runLab(const RunArgs& a) {
   Watchdog watchdog;
   try {
     loaded = loadLab(a.lab, a.config, a.gains, a.duration);
-    applyScenario(loaded, a.scenario, a.gains, a.duration);
+    applyScenario(loaded, a.scenario, a.duration);
     watchdog = runWatchdog(loaded);
     // A run must hold at least one step: a shorter one would report "ok" over an empty trace.
     if (loaded.lab->duration() < loaded.lab->dt()) {

@@ -82,12 +82,10 @@ struct BenchArgs {
 };
 
 // --scenario NAME (run, figure): rebuilds the loaded lab under the rubric scenario's patch and noise
-// seed exactly as the grader does (grading/scenario.h scenarioConfig). The seed is the one grading
-// gains_file as a submission gives; without one, the lab's defaults as a submission (what the tuning
-// window saves). --duration still wins. Nothing happens for an empty name; throws InputError (an
+// seed exactly as the grader does (grading/scenario.h scenarioConfig: the lab's and the scenario's,
+// the same for every submission). --duration still wins. Nothing happens for an empty name; throws InputError (an
 // unknown name lists the rubric's).
-void applyScenario(LoadedLab& loaded, const std::string& scenario, const std::string& gains_file,
-                   std::optional<double> duration);
+void applyScenario(LoadedLab& loaded, const std::string& scenario, std::optional<double> duration);
 // {"lab", <options as the config sets them>, "gains": {every gain's value}}: the lab's defaults as a submission.
 json defaultsSubmission(const json& config, const std::string& lab);
 // The lab's name for people: its JSON "title" up to the first ": " ("Impedance control"), else its id.

@@ -233,7 +233,7 @@ int figure(const FigureArgs& a) {
     } else {
       for (const auto& g : gains_files) {
         loads.push_back(loadLab(a.lab, a.config, g, a.duration));
-        applyScenario(loads.back(), a.scenario, g, a.duration);
+        applyScenario(loads.back(), a.scenario, a.duration);
       }
     }
     const LoadedLab& loaded = loads.front();

@@ -140,7 +140,7 @@ GradeOutcome gradeSubmission(const json& sub, const std::string& file, const Gra
       for (const auto& t : rubric.tests) used = used || t.scenario == sc.name;
       for (const auto& l : rubric.leaderboard) used = used || l.scenario == sc.name;
       if (!used) continue;
-      const json cfg = scenarioConfig(applied, rubric, sc, rep.fingerprint["submission_hash"], config_file);
+      const json cfg = scenarioConfig(applied, rubric, sc, lab_name, config_file);
       const auto lab = buildLab(*entry, cfg, config_file + " (scenario " + sc.name + ")");
       ScenarioRun run = runScenario(*lab, rubric.watchdog, deadline, config_file, opt.stop);
       trajectories += hashHex(std::to_string(run.trace.hash()));

@@ -157,11 +157,11 @@ WatchedRun runWatched(const Lab& lab, Engine engine, const Watchdog& wd, Deadlin
   return out;
 }
 
-json scenarioConfig(const json& applied, const Rubric& rubric, const Scenario& sc, const std::string& submission_hash,
+json scenarioConfig(const json& applied, const Rubric& rubric, const Scenario& sc, const std::string& lab,
                     const std::string& config_file) {
   json cfg = mergePatch(applied, sc.patch);
-  // The seed: fixed per submission and scenario, so noise is the same every time it is graded.
-  const std::uint64_t seed = std::stoull(hashHex(submission_hash + "/" + sc.name), nullptr, 16) & ((1ull << 53) - 1);
+  // The seed: fixed per lab and scenario, never the submission's, so the noise cannot be shopped for.
+  const std::uint64_t seed = std::stoull(hashHex("noise/" + lab + "/" + sc.name), nullptr, 16) & ((1ull << 53) - 1);
   writeSeed(cfg, rubric, seed, config_file, sc.name);
   return cfg;
 }

@@ -74,11 +74,13 @@ ScenarioRun runScenario(const Lab& lab, const Watchdog& watchdog, Deadline deadl
 
 // The config one rubric scenario runs on, exactly as the grader builds it: the submission's config
 // (its gains applied) merged with the scenario's patch (RFC 7386), and the scenario's noise seed,
-// derived from the submission's hash (grade.h submissionHash) and the scenario's name, written at
-// the rubric's seed_target. Used by the grader, `dynlab run/figure --scenario` and the tuning window,
-// so a scenario run locally is the graded one. Throws InputError (naming config_file) on a bad seed_target.
-json scenarioConfig(const json& applied, const Rubric& rubric, const Scenario& scenario,
-                    const std::string& submission_hash, const std::string& config_file);
+// derived from the lab's and the scenario's names alone, written at the rubric's seed_target: every
+// submission meets the same noise, so none can be re-rolled by changing a gain (read or not) or the
+// way the file is written. Used by the grader, `dynlab run/figure --scenario`, Python and the tuning
+// window, so a scenario run locally is the graded one. Throws InputError (naming config_file) on a bad
+// seed_target.
+json scenarioConfig(const json& applied, const Rubric& rubric, const Scenario& scenario, const std::string& lab,
+                    const std::string& config_file);
 
 // The rubric's scenario NAME; else InputError("<command line>", option, the names it knows).
 const Scenario& findScenario(const Rubric& rubric, const std::string& name, const std::string& option = "--scenario");

@@ -101,7 +101,7 @@ py::dict LabObject::run(const std::string& engine, std::optional<double> duratio
   if (!scenario.empty()) {
     if (!rubric) throw InputError(kArgument, "scenario", "expected a lab with a rubric; " + loaded_.config_file + " has none");
     const Scenario& sc = findScenario(*rubric, scenario, "scenario");
-    config = scenarioConfig(config, *rubric, sc, submissionHash(submission()), loaded_.config_file);
+    config = scenarioConfig(config, *rubric, sc, loaded_.entry->name, loaded_.config_file);
     source = loaded_.config_file + " (scenario " + sc.name + ")";
   }
   if (duration) {

@@ -222,9 +222,9 @@ void TuningSession::restart() {
   try {
     const json sub = submission();
     effective_config_ = applySubmission(file_config_, JsonView(sub, source_), lab_name_, true);
-    // Under a scenario: its patch and the seed grading this submission (once saved) would use.
+    // Under a scenario: its patch and the seed grading uses (the lab's and the scenario's).
     if (!scenario_.empty())
-      effective_config_ = scenarioConfig(effective_config_, rubric_, *rubric_.scenario(scenario_), submissionHash(sub), config_file_);
+      effective_config_ = scenarioConfig(effective_config_, rubric_, *rubric_.scenario(scenario_), lab_name_, config_file_);
     lab_ = buildLab(*entry_, effective_config_, source_);
     watch_ = std::make_unique<RowWatch>(watchdog_, lab_->columns(), config_file_);
     const ScreenResult screen = screenLoops(*lab_);
