@@ -106,6 +106,10 @@ py::dict LabObject::run(const std::string& engine, std::optional<double> duratio
   }
   if (duration) {
     if (!(*duration > 0) || *duration > 3600) throw InputError(kArgument, "duration", "expected a duration in (0, 3600] s");
+    // The steps at the lab's dt, named as the argument (as run's --duration is).
+    const json& dt = config["simulation"]["dt"];
+    if (const std::string problem = runBoundProblem(dt.is_number() ? dt.get<double>() : 0.0, *duration); !problem.empty())
+      throw InputError(kArgument, "duration", problem);
     setRunDuration(config, *duration);
   }
   auto built = buildLab(*loaded_.entry, config, source);

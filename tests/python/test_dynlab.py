@@ -250,6 +250,12 @@ class Errors(unittest.TestCase):
                 lab.run(**kwargs)
         with self.assertRaises(TypeError):
             lab.set_gains({"kp_x": {1, 2}})
+        # Past the steps a run may take: refused at the argument, with the bound named, before any work.
+        with self.assertRaises(dynlab.InputError) as e:
+            lab.run(duration=3000)
+        self.assertIn("duration", str(e.exception))
+        self.assertIn("more than the 2e+06 a run may take", str(e.exception))
+        self.assertNotIn("slider_crank.json", str(e.exception))
 
 
 def python(code):
