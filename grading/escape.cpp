@@ -9,23 +9,6 @@
 namespace dyn {
 namespace {
 
-constexpr std::string_view kReplacement = "\xEF\xBF\xBD";  // U+FFFD
-
-// Calls each(cp, bytes) per well-formed character and bad(byte) per byte that is not part of one.
-template <class Each, class Bad>
-void forEachChar(std::string_view s, Each each, Bad bad) {
-  for (std::size_t i = 0; i < s.size();) {
-    char32_t cp = 0;
-    if (const std::size_t n = utf8CharAt(s, i, cp)) {
-      each(cp, s.substr(i, n));
-      i += n;
-    } else {
-      bad(static_cast<unsigned char>(s[i]));
-      ++i;
-    }
-  }
-}
-
 bool isAsciiPunct(char c) {
   return (c >= '!' && c <= '/') || (c >= ':' && c <= '@') || (c >= '[' && c <= '`') || (c >= '{' && c <= '~');
 }
@@ -37,7 +20,7 @@ bool isValidUtf8(std::string_view bytes) { return utf8ErrorAt(bytes) == std::str
 std::string jsonText(std::string_view bytes) {
   if (isValidUtf8(bytes)) return std::string(bytes);
   std::string out;
-  forEachChar(bytes, [&](char32_t, std::string_view c) { out += c; }, [&](unsigned char) { out += kReplacement; });
+  forEachChar(bytes, [&](char32_t, std::string_view c) { out += c; }, [&](unsigned char) { out += kReplacementChar; });
   return out;
 }
 

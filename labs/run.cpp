@@ -38,15 +38,7 @@ LoadedLab loadLab(const std::string& name, const std::string& config_file, const
     out.config = applySubmission(out.config, JsonView(gains, gains_file), name, false);
     source = gains_file;
   }
-  if (duration) {
-    if (!(*duration > 0) || *duration > 3600)
-      throw InputError("<command line>", "--duration", "expected a duration in (0, 3600] s");
-    // The steps it makes at the lab's dt, named as the option's (buildLab below names the trace's memory).
-    const json& dt = out.config["simulation"]["dt"];
-    if (const std::string problem = runBoundProblem(dt.is_number() ? dt.get<double>() : 0.0, *duration); !problem.empty())
-      throw InputError("<command line>", "--duration", problem);
-    setRunDuration(out.config, *duration);
-  }
+  if (duration) requestRunDuration(out.config, *duration, "<command line>", "--duration");
   out.lab = buildLab(*out.entry, out.config, source);
   return out;
 }

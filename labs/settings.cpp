@@ -36,6 +36,15 @@ void setRunDuration(json& config, double duration) {
   sim["duration"] = duration;
 }
 
+void requestRunDuration(json& config, double duration, const std::string& who, const std::string& option) {
+  if (!(duration > 0) || duration > 3600) throw InputError(who, option, "expected a duration in (0, 3600] s");
+  // The steps it makes at the lab's dt, named as the option's (buildLab names the trace's memory).
+  const json& dt = config["simulation"]["dt"];
+  if (const std::string problem = runBoundProblem(dt.is_number() ? dt.get<double>() : 0.0, duration); !problem.empty())
+    throw InputError(who, option, problem);
+  setRunDuration(config, duration);
+}
+
 std::string runBoundProblem(double dt, double duration, std::size_t columns, const std::string& step) {
   if (!(dt > 0) || !std::isfinite(dt)) return step + " " + fmt("%g", dt) + " s is not a positive step";
   const double steps = duration / dt;

@@ -44,6 +44,10 @@ struct SimulationSettings {
 // exercise (a metric's window) is not refused because one run is shorter.
 void setRunDuration(json& config, double duration);
 
+// setRunDuration for a duration someone asked for (--duration, Python's duration=): in (0, 3600] s and
+// within the run bound at the config's dt, else InputError(who, option, ...) naming the option.
+void requestRunDuration(json& config, double duration, const std::string& who, const std::string& option);
+
 // What a lab's mechanism can do with the shared options: drift "independent" needs a mechanism that
 // rebuilds its dependent coordinates from the independent ones (ConstrainedSystem::recoverDependent).
 enum class IndependentForm { No, Yes };

@@ -40,23 +40,6 @@ std::size_t utf8CharAt(std::string_view s, std::size_t i, char32_t& cp) {
 
 namespace {
 
-constexpr std::string_view kReplacement = "\xEF\xBF\xBD";  // U+FFFD
-
-// Calls each(cp, bytes) per well-formed character and bad(byte) per byte that is not part of one.
-template <class Each, class Bad>
-void forEachChar(std::string_view s, Each each, Bad bad) {
-  for (std::size_t i = 0; i < s.size();) {
-    char32_t cp = 0;
-    if (const std::size_t n = utf8CharAt(s, i, cp)) {
-      each(cp, s.substr(i, n));
-      i += n;
-    } else {
-      bad(static_cast<unsigned char>(s[i]));
-      ++i;
-    }
-  }
-}
-
 std::string hexByte(unsigned b) {
   char buf[8];
   std::snprintf(buf, sizeof buf, "\\x%02X", b);
@@ -97,7 +80,7 @@ std::string visibleLine(std::string_view s, bool bad_as_hex) {
         else if (isInvisibleControl(cp)) out += codePointEscape(cp);
         else out += bytes;
       },
-      [&](unsigned char b) { out += bad_as_hex ? hexByte(b) : std::string(kReplacement); });
+      [&](unsigned char b) { out += bad_as_hex ? hexByte(b) : std::string(kReplacementChar); });
   return out;
 }
 
@@ -142,7 +125,7 @@ std::string csvField(const std::string& raw) {
         else if (isInvisibleControl(cp)) s += codePointEscape(cp);
         else s += bytes;
       },
-      [&](unsigned char) { s += kReplacement; });
+      [&](unsigned char) { s += kReplacementChar; });
   if (!s.empty() && (s[0] == '=' || s[0] == '+' || s[0] == '-' || s[0] == '@' || s[0] == '\t' || s[0] == '\r'))
     s.insert(s.begin(), '\'');
   const bool quote = s.find_first_of(",\"\r\n") != std::string::npos || (!s.empty() && (s.front() == ' ' || s.back() == ' '));

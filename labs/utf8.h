@@ -26,6 +26,24 @@ std::string clipText(std::string_view s, std::size_t max_bytes = 300);
 // cp, its code point.
 std::size_t utf8CharAt(std::string_view s, std::size_t i, char32_t& cp);
 
+// U+FFFD, what an ill-formed byte becomes where text must stay valid UTF-8.
+inline constexpr std::string_view kReplacementChar = "\xEF\xBF\xBD";
+
+// Calls each(cp, bytes) per well-formed character of s and bad(byte) per byte that is not part of one.
+template <class Each, class Bad>
+void forEachChar(std::string_view s, Each each, Bad bad) {
+  for (std::size_t i = 0; i < s.size();) {
+    char32_t cp = 0;
+    if (const std::size_t n = utf8CharAt(s, i, cp)) {
+      each(cp, s.substr(i, n));
+      i += n;
+    } else {
+      bad(static_cast<unsigned char>(s[i]));
+      ++i;
+    }
+  }
+}
+
 // s as valid UTF-8 on one line: C0 controls and DEL as \n, \r, \t or \xNN, C1 controls, U+2028/
 // U+2029 and bidi controls as \u{XXXX}; a byte that is not part of a well-formed character as \xNN
 // (bad_as_hex) or U+FFFD.

@@ -104,14 +104,7 @@ py::dict LabObject::run(const std::string& engine, std::optional<double> duratio
     config = scenarioConfig(config, *rubric, sc, loaded_.entry->name, loaded_.config_file);
     source = loaded_.config_file + " (scenario " + sc.name + ")";
   }
-  if (duration) {
-    if (!(*duration > 0) || *duration > 3600) throw InputError(kArgument, "duration", "expected a duration in (0, 3600] s");
-    // The steps at the lab's dt, named as the argument (as run's --duration is).
-    const json& dt = config["simulation"]["dt"];
-    if (const std::string problem = runBoundProblem(dt.is_number() ? dt.get<double>() : 0.0, *duration); !problem.empty())
-      throw InputError(kArgument, "duration", problem);
-    setRunDuration(config, *duration);
-  }
+  if (duration) requestRunDuration(config, *duration, kArgument, "duration");
   auto built = buildLab(*loaded_.entry, config, source);
   const Lab& lab = *built;
   if (lab.duration() < lab.dt())

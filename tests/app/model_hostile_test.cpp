@@ -3,12 +3,11 @@
 // model reached through a link in another folder, its <include> beside the link's target, is read
 // once from the checked files by the load, the M/h cross-check and bench's MuJoCo engine alike (no
 // "Include error", no hang on a FIFO beside the link). The files are made here, at run time. The
-// binary runs from an argument vector (posix_spawn, no shell) with a deadline: a hang fails the
+// binary runs from an argument vector (app/process.h, no shell) with a deadline: a hang fails the
 // test instead of stalling it.
 #include <doctest/doctest.h>
 #include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -21,6 +20,8 @@
 #include <string>
 #include <thread>
 #include <vector>
+
+#include "app/process.h"
 
 namespace {
 
@@ -39,41 +40,19 @@ std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-// dynlab with these arguments in folder dir, killed after `limit` seconds.
+// dynlab with these arguments in folder dir, killed after `limit` seconds (app/process.h: no shell).
 Run dynlab(const fs::path& dir, const std::vector<std::string>& args, double limit) {
   const fs::path out = dir / ".stdout", err = dir / ".stderr";
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&fa, 1, out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&fa, 2, err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addchdir_np(&fa, dir.c_str());
-  std::vector<std::string> all{DYNLAB_BIN};
-  all.insert(all.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (std::string& a : all) argv.push_back(a.data());
-  argv.push_back(nullptr);
+  std::vector<std::string> argv{DYNLAB_BIN};
+  argv.insert(argv.end(), args.begin(), args.end());
+  dyn::ProcessOptions o;
+  o.cwd = dir.string(), o.stdout_file = out.string(), o.stderr_file = err.string(), o.timeout_s = limit;
   const auto t0 = std::chrono::steady_clock::now();
-  pid_t pid = -1;
+  const dyn::ProcessResult p = dyn::runProgram(argv, o);
+  REQUIRE_MESSAGE(p.started(), p.error);
   Run r;
-  const int spawned = posix_spawn(&pid, DYNLAB_BIN, &fa, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&fa);
-  REQUIRE(spawned == 0);
-  int status = 0;
-  for (;;) {
-    const pid_t w = ::waitpid(pid, &status, WNOHANG);
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (w == pid) {
-      r.code = WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
-      break;
-    }
-    if (r.seconds > limit) {
-      ::kill(pid, SIGKILL);
-      ::waitpid(pid, &status, 0);
-      break;
-    }
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  r.code = p.timed_out ? -1 : p.code;
   r.out = slurp(out), r.err = slurp(err);
   fs::remove(out), fs::remove(err);
   return r;

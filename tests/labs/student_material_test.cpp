@@ -81,9 +81,10 @@ int gainsNamed(const Answer& a, const std::string& line) {
   for (const auto& [gain, value] : a.gains) {
     bool found = false;
     for (const std::string& name : spellings(gain)) {
-      const std::string number = std::regex_replace(dyn::exactNumber(value), std::regex("\\."), "\\.");
-      // name, then "=", ":", a space or a quote, then the number not followed by more digits
-      const std::regex re("(^|[^A-Za-z0-9_])" + std::regex_replace(name, std::regex("[_]"), "_") + "[\"']?\\s*[=:]?\\s*" + number +
+      const std::string number = std::regex_replace(dyn::exactNumber(value), std::regex("[.+]"), "\\$&");  // 62.6, 1e+09 as a pattern
+      // name (letters, '_', Greek: nothing a regex reads), then "=", ":", a space or a quote, then the
+      // number not followed by more digits
+      const std::regex re("(^|[^A-Za-z0-9_])" + name + "[\"']?\\s*[=:]?\\s*" + number +
                           "(?![0-9.]*[0-9])");
       found = found || std::regex_search(line, re);
     }

@@ -13,29 +13,24 @@
 #include <fstream>
 
 #include "physics/model_file/model_file.h"
+#include "tests/physics/model_file/fixtures.h"
 
 using namespace dyn;
 namespace fs = std::filesystem;
 
 namespace {
 
-// A fresh folder for this process's files.
+// A fresh folder for this process's files (model files go in its "model" folder).
 fs::path folder() {
   static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("dynlab_model_files_" + std::to_string(::getpid()));
-    fs::remove_all(d);
+    const fs::path d = test_model_file::scratchFolder("model_files");
     fs::create_directories(d / "model");
     return d;
   }();
   return dir;
 }
 
-fs::path write(const std::string& name, const std::string& text) {
-  const fs::path p = folder() / name;
-  fs::create_directories(p.parent_path());
-  std::ofstream(p, std::ios::binary) << text;
-  return p;
-}
+fs::path write(const std::string& name, const std::string& text) { return test_model_file::writeFile(folder(), name, text); }
 
 // A binary STL of the tetrahedron (0, s e_x, s e_y, s e_z), faces outward.
 std::string tetrahedron(float s) {

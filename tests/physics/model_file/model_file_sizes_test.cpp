@@ -11,6 +11,7 @@
 #include <string>
 
 #include "physics/model_file/model_file.h"
+#include "tests/physics/model_file/fixtures.h"
 
 using namespace dyn;
 namespace fs = std::filesystem;
@@ -18,20 +19,11 @@ namespace fs = std::filesystem;
 namespace {
 
 fs::path folder() {
-  static const fs::path dir = [] {
-    const fs::path d = fs::temp_directory_path() / ("dynlab_model_sizes_" + std::to_string(::getpid()));
-    fs::remove_all(d);
-    fs::create_directories(d);
-    return d;
-  }();
+  static const fs::path dir = test_model_file::scratchFolder("model_sizes");
   return dir;
 }
 
-fs::path write(const std::string& name, const std::string& text) {
-  const fs::path p = folder() / name;
-  std::ofstream(p, std::ios::binary) << text;
-  return p;
-}
+fs::path write(const std::string& name, const std::string& text) { return test_model_file::writeFile(folder(), name, text); }
 
 // One hinged body holding the geoms given, then `rest` inside <worldbody>, `top` beside it.
 std::string model(const std::string& rest, const std::string& top = "") {
