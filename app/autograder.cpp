@@ -7,6 +7,7 @@
 #include <zip.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cctype>
 #include <cerrno>
 #include <cstdio>
@@ -114,7 +115,9 @@ std::string runScript(const std::string& lab) {
   return replaceAll(replaceAll(R"SH(#!/usr/bin/env bash
 # Gradescope runs this once per submission: grade the student's JSON for the lab @LAB@ with dynlab,
 # and always leave a valid /autograder/results/results.json, also when grading itself fails.
-# To try it locally, override DYNLAB_BIN, DYNLAB_SUBMISSION_DIR, DYNLAB_RESULTS_DIR, DYNLAB_TIME_LIMIT.
+# To try it locally, override DYNLAB_BIN, DYNLAB_SUBMISSION_DIR, DYNLAB_RESULTS_DIR, DYNLAB_TIME_LIMIT
+# (and DYNLAB_SECRET_FILE, the zip's course_secret, and DYNLAB_METADATA, the submission_metadata.json,
+# for a lab with a plant per student).
 set -uo pipefail
 
 lab="@LAB@"
@@ -173,7 +176,16 @@ budget=$((time_limit * 3 / 4))
 ((budget >= 1)) || budget=1
 ((budget <= 300)) || budget=300
 started=$SECONDS
-timeout --kill-after=10 "$time_limit" "$dynlab" grade "$file" --time-budget "$budget" --lab "$lab" --inline-plots --out "$results_dir"
+# A lab with a plant per student: the course secret (staff-only, in this zip) and the submitter's ID
+# from Gradescope's metadata (dynlab reads it: their Student ID, else their e-mail).
+student=()
+secret_file="${DYNLAB_SECRET_FILE:-/autograder/source/course_secret}"
+if [ -f "$secret_file" ]; then
+  DYNLAB_COURSE_SECRET="$(cat -- "$secret_file")"
+  export DYNLAB_COURSE_SECRET
+  student=(--student-from "${DYNLAB_METADATA:-/autograder/submission_metadata.json}")
+fi
+timeout --kill-after=10 "$time_limit" "$dynlab" grade "$file" --time-budget "$budget" --lab "$lab" "${student[@]}" --inline-plots --out "$results_dir"
 status=$?
 elapsed=$((SECONDS - started))
 # Its results.json stands only if Gradescope would accept it, checked by dynlab check-results.
@@ -345,6 +357,15 @@ void writeAutograder(const std::string& lab, const std::string& source_dir, cons
   std::vector<Entry> entries = {{"setup.sh", setupScript(), 0755u},
                                 {"run_autograder", runScript(lab), 0755u},
                                 {"README.md", readme(lab, config), 0644u}};
+  // A lab with a plant per student (labs/variants.h): the course secret rides in the staff-only zip,
+  // and run_autograder grades each submission on its submitter's plant.
+  if (config.contains("variants")) {
+    const char* secret = std::getenv("DYNLAB_COURSE_SECRET");
+    if (!secret || !*secret)
+      fail(zip_path, lab + " gives each student their own plant: set DYNLAB_COURSE_SECRET (the secret the students' keys "
+                           "were made with) when writing its autograder");
+    entries.push_back({"course_secret", secret, 0600u});
+  }
   addSourceTree(source_dir, zip_path, entries);
   // The zip being written may sit inside the tree: never pack it (or its temp file) into itself.
   const fs::path out = fs::weakly_canonical(zip_path);

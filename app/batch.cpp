@@ -14,6 +14,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <thread>
@@ -26,6 +27,7 @@
 #include "grading/escape.h"
 #include "grading/plot.h"
 #include "labs/utf8.h"
+#include "labs/variants.h"
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
@@ -94,6 +96,7 @@ pid_t spawnGrade(const GradeArgs& a, const Job& job, int log_fd) {
   one.time_budget = a.time_budget;
   one.lab = a.lab;
   one.config = a.config;
+  one.student = job.sub.student;
   one.plots = a.plots;
   const pid_t parent = ::getpid();
   std::fflush(nullptr);  // nothing the batch has buffered is written again by the child
@@ -204,6 +207,22 @@ int gradeBatch(const GradeArgs& a) {
     } catch (const std::exception&) {
       // Not valid: the next one decides.
     }
+  }
+  // A lab with variants grades each submission on its student's plant: the IDs come first.
+  try {
+    if (!args.lab.empty() && declaresVariants(args.config.empty() ? defaultConfigPath(args.lab) : args.config)) {
+      const char* secret = std::getenv("DYNLAB_COURSE_SECRET");
+      if (!secret || !*secret)
+        throw InputError("<command line>", "--batch", "expected DYNLAB_COURSE_SECRET to be set: " + args.lab +
+                                                      " gives each student their own plant, drawn from the course secret");
+      batch::assignStudents(found.submissions, a.roster);
+    } else if (!a.roster.empty()) {
+      throw InputError("<command line>", "--roster", "expected a lab with variants (a plant per student); " + args.lab + " has none");
+    }
+  } catch (const InputError& e) {
+    ::close(lock_fd);
+    std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
+    return 2;
   }
   const std::string lab_line = args.lab.empty() ? "lab: none (no submission names a known lab)"
                                                  : "lab: " + args.lab + " (from " + lab_source + ")";

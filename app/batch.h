@@ -16,7 +16,15 @@ struct Submission {
   std::filesystem::path file;  // what the grader reads (empty when `problem` says why there is none)
   std::string problem;         // set when it cannot be graded at all (no file, several, not a regular file)
   std::string folder;          // its output folder's name inside OUT: safe, unique, never OUT's own files
+  std::string student;         // whose plant it is graded on (a lab with variants; else empty)
 };
+
+// Each submission's student when the lab gives each student their own plant (labs/variants.h): the
+// roster's ID for its name (a CSV of lines FILE_OR_FOLDER,STUDENT_ID; a first line
+// "submission,student" is a header), else its folder's name or its file's stem. A name that is not a
+// student ID (grading/student.h) makes it a problem, naming the roster. Throws InputError for a
+// roster that cannot be read (naming the file and line).
+void assignStudents(std::vector<Submission>& subs, const std::string& roster);
 
 // What a batch directory holds. `error` is set (and nothing is listed) when it holds no submission.
 struct Found {

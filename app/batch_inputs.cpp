@@ -9,6 +9,8 @@
 #include "app/batch.h"
 #include "app/submission_file.h"
 #include "grading/grade.h"
+#include "grading/student.h"
+#include "labs/config.h"
 
 namespace fs = std::filesystem;
 
@@ -120,6 +122,56 @@ void assignFolders(std::vector<Submission>& subs, const fs::path& out) {
       folder = folder == clean ? hashed : hashed + "-" + std::to_string(n);
     taken.insert(lower(folder));
     s.folder = folder;
+  }
+}
+
+namespace {
+
+// The roster: name → student ID, one "NAME,ID" a line (split at the last comma, so a name may hold one).
+std::map<std::string, std::string> readRoster(const std::string& file) {
+  std::map<std::string, std::string> out;
+  const std::string text = readTextFile(file, 4u << 20);
+  std::size_t line_no = 0, at = 0;
+  while (at < text.size()) {
+    std::size_t end = text.find('\n', at);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(at, end - at);
+    at = end + 1;
+    ++line_no;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || (line_no == 1 && line == "submission,student")) continue;
+    const std::string where = "line " + std::to_string(line_no);
+    const std::size_t comma = line.rfind(',');
+    if (comma == std::string::npos || comma == 0)
+      throw InputError(file, where, "expected FILE_OR_FOLDER,STUDENT_ID");
+    const std::string name = line.substr(0, comma), id = line.substr(comma + 1);
+    if (const std::string problem = studentIdProblem(id); !problem.empty()) throw InputError(file, where, problem);
+    if (!out.emplace(name, id).second) throw InputError(file, where, "expected each submission once, got \"" + name + "\" again");
+  }
+  return out;
+}
+
+}  // namespace
+
+void assignStudents(std::vector<Submission>& subs, const std::string& roster) {
+  const std::map<std::string, std::string> ids = roster.empty() ? std::map<std::string, std::string>{} : readRoster(roster);
+  for (Submission& s : subs) {
+    // The top name: a student's folder, or a file at the top ("alice.json" → alice).
+    std::string name = s.name.substr(0, s.name.find('/'));
+    if (const auto it = ids.find(name); it != ids.end()) {
+      s.student = it->second;
+      continue;
+    }
+    if (!roster.empty()) {
+      if (s.problem.empty()) s.problem = "not in the roster " + roster + ": no student to grade it as";
+      continue;
+    }
+    if (s.name.find('/') == std::string::npos && endsWithJson(name)) name = name.substr(0, name.size() - 5);
+    if (const std::string problem = studentIdProblem(name); !problem.empty()) {
+      if (s.problem.empty()) s.problem = "its name is not a student ID (" + problem + "): give the batch a --roster";
+      continue;
+    }
+    s.student = name;
   }
 }
 

@@ -21,6 +21,7 @@
 #include "grading/report.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
+#include "grading/student.h"
 #include "labs/run.h"
 #include "labs/submission.h"
 #include "labs/numbers.h"
@@ -114,7 +115,7 @@ int runLab(const RunArgs& a) {
   LoadedLab loaded;
   Watchdog watchdog;
   try {
-    loaded = loadLab(a.lab, a.config, a.gains, a.duration);
+    loaded = loadLab(a.lab, a.config, a.gains, a.duration, studentPlant(a.student));
     applyScenario(loaded, a.scenario, a.duration);
     watchdog = runWatchdog(loaded);
     // A run must hold at least one step: a shorter one would report "ok" over an empty trace.
@@ -242,6 +243,7 @@ static GradeOptions gradeOptions(const GradeArgs& a, const std::string& out_dir)
   GradeOptions o;
   o.expected_lab = a.lab;
   o.config_file = a.config;
+  o.plant = studentPlant(a.student);
   o.time_budget = a.time_budget;
   if (a.plots) o.out_dir = out_dir;
   o.inline_plots = a.inline_plots && a.plots;
@@ -250,12 +252,22 @@ static GradeOptions gradeOptions(const GradeArgs& a, const std::string& out_dir)
 
 int gradeOne(const GradeArgs& a) {
   injectFault(a.submission);
+  GradeArgs args = a;
+  try {
+    // Gradescope's submitter, for a lab that gives each student their own plant (else not needed).
+    if (!a.student_from.empty() && !a.lab.empty() && declaresVariants(a.config.empty() ? defaultConfigPath(a.lab) : a.config))
+      args.student = gradescopeStudent(a.student_from);
+    studentPlant(args.student);  // a bad --student, or no key to draw the plant with: nothing is graded
+  } catch (const InputError& e) {
+    std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
+    return 2;
+  }
   GradeOutcome g;
   try {
     // Everything lands in OUT/.staging first; a failure never leaves a half-written results set.
     Staging staging(a.out);
     staging.owns({"results.json", "report.md", "report.html", "plots"});
-    GradeOptions o = gradeOptions(a, staging.path("").string());
+    GradeOptions o = gradeOptions(args, staging.path("").string());
     o.replay_program = dynlabProgram();
     o.results_file = (fs::path(a.out) / "results.json").string();
     g = gradeSubmission(a.submission, o);
@@ -280,7 +292,7 @@ int gradeOne(const GradeArgs& a) {
               termText((fs::path(a.out) / "report.html").string()).c_str());
   if (!g.input_error && !g.internal_error)
     std::printf("replay:  %s\n", termText(replayCommand(dynlabProgram(), (fs::path(a.out) / "results.json").string(),
-                                                         a.submission, gradeOptions(a, ""))).c_str());
+                                                         a.submission, gradeOptions(args, ""))).c_str());
   // A grade the time budget cut short is written (score 0 for what it stopped) but is not a grade.
   if (g.out_of_time) std::fprintf(stderr, "error: %s: the grading time budget of %g s ran out; the grade is incomplete\n",
                                   utf8Quotable(a.submission).c_str(), a.time_budget);
@@ -383,6 +395,7 @@ int openUi(const UiArgs& a) {
   if (!a.config.empty()) args.insert(args.end(), {"--config", a.config});
   if (!a.gains.empty()) args.insert(args.end(), {"--gains", a.gains});
   if (!a.scenario.empty()) args.insert(args.end(), {"--scenario", a.scenario});
+  if (!a.student.empty()) args.insert(args.end(), {"--student", a.student});
   args.insert(args.end(), a.extra.begin(), a.extra.end());
   std::vector<char*> argv;
   for (auto& s : args) argv.push_back(s.data());

@@ -16,6 +16,7 @@ namespace dyn::app {
 
 struct RunArgs {
   std::string lab, config, gains, out, engine = "both", scenario;
+  std::string student;  // whose plant (labs/variants.h; empty: the nominal one)
   bool video = false, frames = false;
   std::optional<double> duration;
   // A model file's run only (dynlab model's options): constant torques JOINT=VALUE, loops beside it.
@@ -25,6 +26,9 @@ struct RunArgs {
 
 struct GradeArgs {
   std::string submission, out = "out/grade", lab, config, replay, batch;
+  std::string student;  // whose plant (grading/student.h); --batch: each submission's own ID instead
+  std::string roster;   // --batch: a CSV of file or folder name → student ID
+  std::string student_from;  // Gradescope's submission_metadata.json: its submitter is the student
   double time_budget = 300;  // s of wall time per submission
   bool plots = true;
   bool inline_plots = false;  // each test's plot inline in results.json (the Gradescope autograder)
@@ -32,12 +36,12 @@ struct GradeArgs {
 };
 
 struct UiArgs {
-  std::string lab, config, gains, scenario;
+  std::string lab, config, gains, scenario, student;
   std::vector<std::string> extra;  // passed on to dynlab-ui as they are
 };
 
 struct FigureArgs {
-  std::string lab, config, out, engine = "both", format = "pdf", title, scenario;
+  std::string lab, config, out, engine = "both", format = "pdf", title, scenario, student;
   std::vector<std::string> gains;  // none or one: one run; several: each a run, overlaid on every plot
   std::string size;              // WxH of stills and plots (empty: 1920x1080 stills, 800x450 plots)
   std::string y_scale = "auto";  // plots: auto (log when the data span decades), linear or log

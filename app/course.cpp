@@ -11,6 +11,8 @@ CourseCommands::CourseCommands(CLI::App& cli) {
   handout_->add_option("LAB", h.lab, "Lab name (see `dynlab list`)")->required();
   handout_->add_option("--out", h.out, "Output directory (default: out/LAB/handout)");
   handout_->add_option("--config", h.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
+  handout_->add_option("--student", h.student, "Write this student's handout: their plant's numbers and their key (the lab's "
+                                               "variants; needs DYNLAB_COURSE_SECRET, or DYNLAB_STUDENT_KEY)");
   handout_->add_option("--format", h.format, "Comma-separated formats: md, html (default: md,html); for a PDF, open the HTML in a browser and print it (Save as PDF)");
 
   MapArgs& m = map_args_;

@@ -9,7 +9,7 @@
 namespace dyn::app {
 
 struct HandoutArgs {
-  std::string lab, out, config, format = "md,html";
+  std::string lab, out, config, format = "md,html", student;
 };
 
 struct MapArgs {

@@ -26,6 +26,7 @@
 #include "grading/plot.h"
 #include "grading/plot_curves.h"
 #include "grading/rubric.h"
+#include "grading/student.h"
 #include "labs/numbers.h"
 #include "labs/run.h"
 #include "render/renderer.h"
@@ -232,7 +233,7 @@ int figure(const FigureArgs& a) {
       loads.push_back(loadModelLab(a.lab, a.duration));
     } else {
       for (const auto& g : gains_files) {
-        loads.push_back(loadLab(a.lab, a.config, g, a.duration));
+        loads.push_back(loadLab(a.lab, a.config, g, a.duration, studentPlant(a.student)));
         applyScenario(loads.back(), a.scenario, a.duration);
       }
     }

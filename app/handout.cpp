@@ -16,6 +16,7 @@
 #include "grading/metric_doc.h"
 #include "grading/report.h"
 #include "grading/rubric.h"
+#include "grading/student.h"
 #include "labs/run.h"
 #include "labs/submission.h"
 
@@ -93,9 +94,11 @@ std::string join(const std::vector<std::string>& parts, const std::string& sep) 
 
 struct Handout {
   std::string lab, config_file;
-  json config;
+  json config;  // on the student's plant
   const LabEntry* entry;
   Rubric rubric;
+  PlantChoice student;             // whose handout (nominal: everyone's)
+  std::vector<PlantValue> nominal;  // the varied parameters at the nominal plant's values
 
   // The lab built with a scenario's patch: its loops name the screening metrics.
   std::vector<LinearLoop> loops(const Scenario& s) const {
@@ -118,6 +121,32 @@ struct Handout {
             cell(unit == "1" ? "1 (dimensionless)" : unit) + " | " + cell(g.value("doc", "")) + " |\n";
     }
     return md + "\n";
+  }
+
+  // The plant per student (labs/variants.h): the ranges, and on a student's handout their values and key.
+  std::string plant() const {
+    if (nominal.empty()) return {};
+    std::string md = "## Your plant\n\n";
+    if (student.nominal()) {
+      md += "Each student's plant differs in the parameters below, drawn from these ranges by the student's key; you are "
+            "graded on yours. Your own handout, which the course staff make for you with your student ID, shows your "
+            "values and your key.\n\n| parameter | nominal | range | unit | what it is |\n|---|---|---|---|---|\n";
+      for (const PlantValue& v : nominal)
+        md += "| " + cell(v.parameter.name) + " | " + num(v.value) + " | " + num(v.parameter.min) + " … " +
+              num(v.parameter.max) + " | " + cell(v.parameter.unit) + " | " + cell(v.parameter.doc) + " |\n";
+      return md + "\n";
+    }
+    const std::vector<PlantValue> mine = drawPlant(JsonView(config, config_file), PlantChoice{}, lab);
+    md += "This is the handout of student " + code(student.student) + ": every number in it is of your plant, and you are "
+          "graded on it. Your plant's varied parameters:\n\n| parameter | yours | range | unit | what it is |\n|---|---|---|---|---|\n";
+    for (const PlantValue& v : mine)
+      md += "| " + cell(v.parameter.name) + " | " + num(v.value) + " | " + num(v.parameter.min) + " … " +
+            num(v.parameter.max) + " | " + cell(v.parameter.unit) + " | " + cell(v.parameter.doc) + " |\n";
+    md += "\nYour key is " + code(student.key) + ". To run, tune and grade on your plant, set `DYNLAB_STUDENT_KEY=" +
+          student.key + "` and add `--student " + student.student + "` to `dynlab run`, `ui`, `figure` and `grade` "
+          "(Python: `dynlab.Lab(\"" + lab + "\", student=\"" + student.student + "\")`). Gains tuned on another "
+          "student's plant are graded on yours.\n\n";
+    return md;
   }
 
   std::string submission() const {
@@ -287,7 +316,7 @@ struct Handout {
                      "print it (Save as PDF).*\n\n" + config.value("description", "") + "\n\n";
     md += "## The mechanism\n\n" + prose.sections.at("Mechanism") + "\n";
     md += "## The exercise\n\n" + prose.sections.at("Exercise") + "\n";
-    md += gains() + submission();
+    md += plant() + gains() + submission();
     md += "## How you are graded\n\nThe grader runs your gains on the hand-written engine in each scenario below "
           "(dt = " + num(config.at("simulation").at("dt")) + " s, " + num(config.at("simulation").at("duration")) +
           " s per run) and screens them on the linearised loops first. " + num(rubric.maxScore()) + " points in all.\n\n";
@@ -322,8 +351,11 @@ int handout(const HandoutArgs& a) {
       formats.push_back(f);
     }
     if (formats.empty()) throw InputError("<command line>", "--format", "expected at least one of md, html");
-    LoadedLab loaded = loadLab(a.lab, a.config);
-    Handout h{a.lab, loaded.config_file, loaded.config, loaded.entry, parseRubric(JsonView(loaded.config, loaded.config_file))};
+    const PlantChoice student = studentPlant(a.student);
+    LoadedLab loaded = loadLab(a.lab, a.config, "", std::nullopt, student);
+    const json written = loadJsonFile(loaded.config_file);
+    Handout h{a.lab, loaded.config_file, loaded.config, loaded.entry, parseRubric(JsonView(loaded.config, loaded.config_file)),
+              student, drawPlant(JsonView(written, loaded.config_file), PlantChoice{}, a.lab)};
     const Prose prose = readProse(fs::path(defaultConfigPath(a.lab)).parent_path() / "handout.md",
                                   JsonView(loaded.config, loaded.config_file));
     md = h.markdown(prose);

@@ -366,6 +366,33 @@ LabCheckReport checkLab(const LabEntry& entry, const json& config, const LabChec
     });
   }
 
+  // A plant per student (labs/variants.h): every lesson holds on each corner of the ranges and on a
+  // few drawn plants, not only on the nominal one.
+  run(report, "plants per student", [&](Step& s) {
+    const Rubric rubric = parseRubric(JsonView(config, config_file));
+    const std::size_t n = parseVariants(JsonView(config, config_file)).size();
+    if (n == 0) {
+      s.detail = "no variants: one plant for every student";
+      return;
+    }
+    std::vector<PlantChoice> plants = {{"", "", PlantChoice::Corner::Min}, {"", "", PlantChoice::Corner::Max}};
+    for (int i = 1; i <= 3; ++i) plants.push_back({"sample-" + std::to_string(i), hashHex("check-lab/" + std::to_string(i))});
+    int held = 0;
+    for (const PlantChoice& plant : plants) {
+      GradeOptions on = o;
+      on.plant = plant;
+      for (const LessonCheck& c : checkLessons(rubric, lab_dir, on)) {
+        const std::string pair = fs::path(c.lesson.better).stem().string() + " ahead of " + fs::path(c.lesson.worse).stem().string();
+        if (!s.expect(c.error.empty(), plant.label() + ": " + pair + ": " + c.error)) return;
+        s.expect(c.holds(), plant.label() + ": lesson " + pair + " fails, " + fmt(c.better) + " vs " + fmt(c.worse) + ": " +
+                                c.lesson.about);
+        held += c.holds();
+      }
+    }
+    s.detail = std::to_string(held) + " lesson checks hold on " + std::to_string(plants.size()) + " plants (" +
+               std::to_string(n) + " varied parameters: both corners of the ranges and 3 drawn)";
+  });
+
   // Doing nothing: every gain at its declared minimum, the options as the config sets them.
   run(report, "doing nothing", [&](Step& s) {
     json nothing = defaultSubmission(name, config);

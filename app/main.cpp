@@ -27,6 +27,11 @@ int dispatch(int argc, char** argv);
 // failed) and 2 (bad input), so a batch or the autograder can tell them apart.
 constexpr int kInternalError = 3;
 
+// --student on every command that runs or grades a lab's plant (labs/variants.h, grading/student.h).
+constexpr const char* kStudentHelp =
+    "Use this student's plant (the lab's variants, drawn from the student's key: DYNLAB_STUDENT_KEY, the key on "
+    "their handout, or for staff DYNLAB_COURSE_SECRET); default: the nominal plant";
+
 // What escaped every command, as one line of valid UTF-8 on stderr: a name or path it quotes
 // (a model file's, say) escaped and clipped (termName), never a raw control character.
 int internalError(const std::string& what) {
@@ -128,6 +133,7 @@ int dispatch(int argc, char** argv) {
   r->add_flag("--video", run.video, "Write video.mp4 (H.264, 30 fps)");
   r->add_flag("--frames", run.frames, "Write frames/NNNNN.png (30 fps)");
   r->add_option("--duration", run.duration, "Override the simulated duration (s)");
+  r->add_option("--student", run.student, kStudentHelp);
   r->add_option("--scenario", run.scenario, "Run under one rubric scenario (heavy_load, noisy_sensor, ...) exactly as the "
                                           "grader does: its patch and the noise seed the gains file is graded with "
                                           "(default out: out/LAB/scenarios/NAME)");
@@ -146,6 +152,7 @@ int dispatch(int argc, char** argv) {
                                      "overlaid on every plot and named in the legend by its file, e.g. damper vs spring)")
       ->allow_extra_args(false);
   f->add_option("--duration", fig.duration, "Override the simulated duration (s)");
+  f->add_option("--student", fig.student, kStudentHelp);
   f->add_option("--engine", fig.engine, "Which engine(s) to run: hand solid, Bullet dashed (plots) or as a ghost (stills)")
       ->check(CLI::IsMember({"hand", "bullet", "both"}));
   f->add_option("--out", fig.out, "Output directory (default: out/LAB/figures)");
@@ -178,6 +185,11 @@ int dispatch(int argc, char** argv) {
   g->add_option("--lab", grade.lab, "The assignment's lab: a submission naming another lab scores 0");
   g->add_option("--config", grade.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
   g->add_option("--time-budget", grade.time_budget, "Wall-time budget per submission (s)")->check(timeBudget());
+  g->add_option("--student", grade.student, kStudentHelp);
+  g->add_option("--student-from", grade.student_from, "Gradescope's submission_metadata.json: grade on its submitter's "
+                                                      "plant (their Student ID, else e-mail), when the --lab has variants");
+  g->add_option("--roster", grade.roster, "--batch: a CSV whose rows are FILE_OR_FOLDER,STUDENT_ID (default: each "
+                                          "folder's or file's own name is the student's ID when the lab has variants)");
   g->add_flag("!--no-plots", grade.plots, "Skip the response plots (faster)");
   g->add_flag("--inline-plots", grade.inline_plots, "Put each test's plot in results.json as an inline PNG (Gradescope shows "
                                                     "it to the student; 30-100 KB a plot, at most 600 KB in all)");
@@ -215,6 +227,7 @@ int dispatch(int argc, char** argv) {
   u->add_option("--config", ui.config, "Lab config JSON (default: labs/LAB/LAB.json)");
   u->add_option("--gains", ui.gains, "Start from these gains: a submission or gains JSON");
   u->add_option("--scenario", ui.scenario, "Tune under one rubric scenario (its patch and the grader's noise seed)");
+  u->add_option("--student", ui.student, kStudentHelp);
   u->allow_extras();
 
   CompareArgs cmp;

@@ -116,8 +116,11 @@ GradeOutcome gradeSubmission(const json& sub, const std::string& file, const Gra
     }
     const std::string config_file = opt.config_file.empty() ? defaultConfigPath(lab_name) : opt.config_file;
     staff_file = config_file;
-    const json base = loadJsonFile(config_file);
-    const auto base_lab = buildLab(*entry, base, config_file);  // the lab config itself must be valid
+    const json written = loadJsonFile(config_file);
+    buildLab(*entry, written, config_file);  // the lab config itself must be valid
+    // The student's plant (labs/variants.h): the config graded from here on.
+    const json base = plantConfig(written, opt.plant, lab_name, config_file);
+    const auto base_lab = buildLab(*entry, base, config_file);
     const Rubric rubric = parseRubric(JsonView(base, config_file));
     checkColumns(rubric, base_lab->columns(), config_file);
     const json applied = applySubmission(base, view, lab_name, true);
@@ -128,6 +131,8 @@ GradeOutcome gradeSubmission(const json& sub, const std::string& file, const Gra
     rep.lab = lab_name;
     rep.submission = utf8Quotable(file);  // a file name is not always UTF-8; results.json must be
     rep.answers = submissionAnswers(view);
+    rep.student = opt.plant.student;
+    if (!opt.plant.nominal()) rep.plant = drawPlant(JsonView(written, config_file), opt.plant, lab_name);
     rep.fingerprint = {{"dynlab_version", DYNLAB_VERSION},
                        {"lab_config_hash", hashHex(dumpJson(base))},
                        {"submission_hash", submissionHash(sub)}};
@@ -240,6 +245,7 @@ std::string replayCommand(const std::string& program, const std::string& results
   std::string cmd = program + " grade --replay " + path(results_file) + " " + path(submission);
   if (!o.expected_lab.empty()) cmd += " --lab " + shellWord(o.expected_lab);
   if (!o.config_file.empty()) cmd += " --config " + path(o.config_file);
+  if (!o.plant.student.empty()) cmd += " --student " + shellWord(o.plant.student);
   return cmd;
 }
 

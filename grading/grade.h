@@ -19,6 +19,7 @@
 
 #include "grading/report.h"
 #include "labs/config.h"
+#include "labs/variants.h"
 
 namespace dyn {
 
@@ -26,6 +27,7 @@ struct GradeOptions {
   std::string expected_lab;  // the assignment's lab (empty: whatever the submission names)
   std::string config_file;   // lab config (empty: the lab's default JSON)
   std::string out_dir;       // plots go to out_dir/plots/ (empty: no plots)
+  PlantChoice plant;         // whose plant (labs/variants.h; default: the nominal one)
   double time_budget = 300;  // s of wall time for the whole submission
   int plot_width = 640, plot_height = 360;  // px: small enough to inline, large enough to read
   bool inline_plots = false;  // each test's plot inline in results.json (for Gradescope to show)

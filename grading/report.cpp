@@ -113,6 +113,13 @@ double GradeReport::maxScore() const {
   return s;
 }
 
+namespace {
+// The student's plant in words; a lab without variants has one plant for every student.
+std::string plantShown(const GradeReport& r) {
+  return r.plant.empty() ? "the same for every student (the lab declares no variants)" : plantText(r.plant);
+}
+}  // namespace
+
 json resultsJson(const GradeReport& r) {
   json tests = json::array();
   std::size_t budget = kMaxInlinePlotBytes;
@@ -145,6 +152,7 @@ json resultsJson(const GradeReport& r) {
   }
   // The top of the page (Markdown): the score, and what the screening says about the gains.
   std::string output = "**dynlab " + mdText(r.lab) + ": " + points(r.score()) + " / " + points(r.maxScore()) + " points.**\n\n";
+  if (!r.student.empty()) output += "Graded on the plant of student " + mdText(r.student) + ": " + mdText(plantShown(r)) + ".\n\n";
   for (const auto& s : r.scenarios) {
     if (s.scenario.name != "nominal") continue;
     for (const auto& n : s.screen_notes)
@@ -162,6 +170,12 @@ json resultsJson(const GradeReport& r) {
                   {"tests", tests},
                   {"extra_data", {{"lab", r.lab}, {"fingerprint", r.fingerprint}, {"scenarios", scenarios}}}};
   if (!r.answers.empty()) results["extra_data"]["answers"] = r.answers;
+  if (!r.student.empty()) {
+    results["extra_data"]["student"] = r.student;
+    json plant = json::object();
+    for (const PlantValue& v : r.plant) plant[v.parameter.path] = v.value;
+    results["extra_data"]["plant"] = plant;
+  }
   if (!r.plots_note.empty()) results["extra_data"]["plots_note"] = r.plots_note;
   if (!r.leaderboard.empty()) results["leaderboard"] = r.leaderboard;
   return jsonSanitized(results);  // names, notes and keys as valid UTF-8: dump() cannot throw
@@ -169,6 +183,7 @@ json resultsJson(const GradeReport& r) {
 
 std::string terminalReport(const GradeReport& r) {
   std::string s = "Grading " + termText(r.submission) + " (" + termText(r.lab) + ")\n";
+  if (!r.student.empty()) s += "  plant of student " + termText(r.student) + ": " + termText(plantShown(r)) + "\n";
   for (const auto& g : r.tests) {
     s += "  " + points(g.score) + "/" + points(g.test.points) + "  " + termText(g.test.name) + " [" + termText(g.test.scenario) + "]: ";
     s += std::isfinite(g.value) ? termText(g.test.metric) + " = " + termUnit(g.value, g.unit) + " (full " +
@@ -192,6 +207,7 @@ std::string markdownReport(const GradeReport& r) {
   const std::string file = std::filesystem::path(r.submission).filename().string();
   std::string md = "# dynlab grade: " + mdText(r.lab) + "\n\n";
   md += "Submission " + mdText(file) + ": **" + points(r.score()) + " / " + points(r.maxScore()) + " points**.\n\n";
+  if (!r.student.empty()) md += "Graded on the plant of student " + mdText(r.student) + ": " + mdText(plantShown(r)) + ".\n\n";
   md += "| # | test | scenario | metric | value | full credit | zero credit | score |\n";
   md += "|---|---|---|---|---|---|---|---|\n";
   for (std::size_t i = 0; i < r.tests.size(); ++i) {

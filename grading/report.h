@@ -13,6 +13,7 @@
 
 #include "grading/rubric.h"
 #include "grading/scenario.h"
+#include "labs/variants.h"
 
 namespace dyn {
 
@@ -54,6 +55,8 @@ struct GradeReport {
   json leaderboard = json::array();
   json fingerprint;
   json answers = json::object();  // the submission's free-text "answers" (labs/submission.h), for the TA
+  std::string student;        // whose plant was graded ("": the nominal plant)
+  std::vector<PlantValue> plant;  // that plant's varied parameters (labs/variants.h; empty: none)
   std::string replay;         // the command that re-checks this grade (empty: a generic one)
   bool inline_plots = false;  // results.json carries each test's plot (Gradescope shows it)
   std::string plots_note;     // why there are no plots, when drawing them failed (shown to the reader)

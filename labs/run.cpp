@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "labs/submission.h"
+#include "labs/variants.h"
 
 namespace dyn {
 
@@ -13,6 +14,9 @@ std::unique_ptr<Lab> buildLab(const LabEntry& entry, const json& config, const s
   auto lab = entry.create(view);
   // Every lab has the shared simulation block (labs/settings.h); its own parse refused what it cannot honour.
   parseSimulation(view["simulation"], IndependentForm::Yes);
+  // A plant per student (variants.h): its ranges checked with the lab (a scenario may move a varied
+  // value outside them: the config as written is held to them where it is loaded).
+  parseVariants(view, false);
   // The run's trace too (a row of the lab's columns per step): the bound every path shares (settings.h).
   if (const std::string problem = runBoundProblem(lab->dt(), lab->duration(), lab->columns().size()); !problem.empty())
     view["simulation"].fail(problem);
@@ -20,7 +24,7 @@ std::unique_ptr<Lab> buildLab(const LabEntry& entry, const json& config, const s
 }
 
 LoadedLab loadLab(const std::string& name, const std::string& config_file, const std::string& gains_file,
-                  std::optional<double> duration) {
+                  std::optional<double> duration, const PlantChoice& plant) {
   LoadedLab out;
   out.entry = findLab(name);
   if (!out.entry) {
@@ -32,6 +36,8 @@ LoadedLab loadLab(const std::string& name, const std::string& config_file, const
   out.config = loadJsonFile(out.config_file);
   // Validate the config itself first, so its errors name the config file.
   buildLab(*out.entry, out.config, out.config_file);
+  parseVariants(JsonView(out.config, out.config_file));
+  out.config = plantConfig(out.config, plant, name, out.config_file);
   std::string source = out.config_file;
   if (!gains_file.empty()) {
     const json gains = loadJsonFile(gains_file, 1u << 20);

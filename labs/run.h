@@ -5,6 +5,7 @@
 #include <optional>
 
 #include "labs/lab.h"
+#include "labs/variants.h"
 
 namespace dyn {
 
@@ -15,10 +16,11 @@ struct LoadedLab {
   std::unique_ptr<Lab> lab;
 };
 
-// Loads LAB's config (default path unless config_file is given), applies a gains file and a
-// duration override, and builds the lab. Throws InputError on any bad input.
-LoadedLab loadLab(const std::string& name, const std::string& config_file = "",
-                  const std::string& gains_file = "", std::optional<double> duration = std::nullopt);
+// Loads LAB's config (default path unless config_file is given), puts it on `plant` (a student's:
+// labs/variants.h), applies a gains file and a duration override, and builds the lab. Throws
+// InputError on any bad input.
+LoadedLab loadLab(const std::string& name, const std::string& config_file = "", const std::string& gains_file = "",
+                  std::optional<double> duration = std::nullopt, const PlantChoice& plant = {});
 // Builds a lab from a config already in memory (file names the source for error messages).
 std::unique_ptr<Lab> buildLab(const LabEntry& entry, const json& config, const std::string& file);
 

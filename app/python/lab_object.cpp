@@ -7,15 +7,17 @@
 #include "grading/grade.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
+#include "grading/student.h"
 #include "labs/numbers.h"
 #include "labs/submission.h"
 
 namespace dyn::python {
 
-LabObject::LabObject(const std::string& name, const std::string& config_file) {
+LabObject::LabObject(const std::string& name, const std::string& config_file, const std::string& student) {
   // open() would stop at a NUL and read another file.
   if (config_file.find('\0') != std::string::npos) throw InputError(config_file, "", "expected a path without a NUL byte");
-  loaded_ = loadLab(name, config_file);
+  plant_ = studentPlant(student, "student", kArgument);
+  loaded_ = loadLab(name, config_file, "", std::nullopt, plant_);
 }
 
 py::dict LabObject::gains() const {

@@ -19,7 +19,9 @@ namespace dyn::python {
 
 class LabObject {
  public:
-  LabObject(const std::string& name, const std::string& config_file);
+  // On student's plant (labs/variants.h; "" the nominal one).
+  LabObject(const std::string& name, const std::string& config_file, const std::string& student = "");
+  const std::string& student() const { return plant_.student; }
 
   std::string name() const { return loaded_.entry->name; }
   const std::string& configFile() const { return loaded_.config_file; }
@@ -57,6 +59,7 @@ class LabObject {
   // The trace of `run` shown for `engine` ("hand" or "bullet") and the other engine's as its ghost (or null).
   static std::pair<const Trace*, const Trace*> shown(const LastRun& run, const std::string& engine);
 
+  PlantChoice plant_;
   LoadedLab loaded_;
   mutable std::shared_ptr<const LastRun> last_;  // replaced (with the GIL held) by each run()
 };

@@ -13,6 +13,7 @@
 #include "app/python/convert.h"
 #include "app/python/lab_object.h"
 #include "grading/grade.h"
+#include "grading/student.h"
 
 namespace py = pybind11;
 using namespace dyn;
@@ -22,13 +23,15 @@ namespace {
 
 // dynlab.grade: a submission dict or file → results.json as a dict, as `dynlab grade` writes it
 // (no plots). A submission the grader refuses raises InputError with `dynlab grade`'s message.
-py::dict grade(py::handle submission, const std::string& lab, const std::string& config, double time_budget) {
+py::dict grade(py::handle submission, const std::string& lab, const std::string& config, double time_budget,
+               const std::string& student) {
   // `dynlab grade --time-budget`'s check and message (NaN, inf, 0, -1, 1e300 are refused, not graded as out of time).
   if (const std::string problem = timeBudgetProblem(time_budget); !problem.empty())
     throw InputError(kArgument, "time_budget", problem);
   GradeOptions o;
   o.expected_lab = lab;
   o.config_file = config;
+  o.plant = studentPlant(student, "student", kArgument);
   o.time_budget = time_budget;
   std::string file;
   const bool is_file = asPath(submission, file);
@@ -77,8 +80,11 @@ void dyn::python::defineModule(py::module_& m) {
   }, "Every lab: name → one-line summary (dynlab list).");
 
   py::class_<LabObject>(m, "Lab", "One lab: its config, the gains set so far, runs and screening.")
-      .def(py::init<const std::string&, const std::string&>(), py::arg("name"), py::arg("config") = "",
-           "Loads lab NAME with its default config, or the config file given (dynlab run LAB --config F).")
+      .def(py::init<const std::string&, const std::string&, const std::string&>(), py::arg("name"), py::arg("config") = "",
+           py::arg("student") = "",
+           "Loads lab NAME with its default config, or the config file given (dynlab run LAB --config F); on STUDENT's "
+           "plant when given (the lab's variants; DYNLAB_STUDENT_KEY or DYNLAB_COURSE_SECRET must be set).")
+      .def_property_readonly("student", &LabObject::student, "Whose plant ('' the nominal one).")
       .def_property_readonly("name", &LabObject::name)
       .def_property_readonly("config", &LabObject::configFile, "The config file the lab was loaded from.")
       .def_property_readonly("gains", &LabObject::gains, "Current gains: name → value.")
@@ -123,12 +129,14 @@ void dyn::python::defineModule(py::module_& m) {
       }, py::arg("path"), py::arg("engine") = "hand", py::arg("width") = 640, py::arg("height") = 480,
            "Writes the last run as an MP4 (H.264, 30 fps) at path, whole or not at all; returns its absolute path.")
       .def("grade", [](const LabObject& lab, double time_budget) {
-        return grade(toPython(lab.submission()), lab.name(), lab.configFile(), time_budget);
+        return grade(toPython(lab.submission()), lab.name(), lab.configFile(), time_budget, lab.student());
       }, py::arg("time_budget") = 300.0, "Grades the current gains (dynlab.grade of submission()).")
       .def("__repr__", [](const LabObject& lab) { return "<dynlab.Lab " + lab.name() + ">"; });
 
   m.def("grade", &grade, py::arg("submission"), py::arg("lab") = "", py::arg("config") = "", py::arg("time_budget") = 300.0,
-        "Grades a submission (dict or file) as `dynlab grade` does; returns results.json as a dict.");
+        py::arg("student") = "",
+        "Grades a submission (dict or file) as `dynlab grade` does (on STUDENT's plant when given); returns results.json "
+        "as a dict.");
 }
 
 PYBIND11_MODULE(dynlab, m) { defineModule(m); }

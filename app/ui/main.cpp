@@ -14,6 +14,7 @@
 
 #include "app/model_lab.h"
 #include "app/ui/panel.h"
+#include "grading/student.h"
 #include "labs/utf8.h"
 #include "render/fonts.h"
 #include "render/renderer.h"
@@ -25,7 +26,7 @@ using namespace dyn;
 using namespace dyn::ui;
 
 struct Args {
-  std::string lab, config, gains, scenario, engine = "both", size = "1320x720", save, screenshot, state;
+  std::string lab, config, gains, scenario, student, engine = "both", size = "1320x720", save, screenshot, state;
   std::vector<std::string> set;
   double speed = 1.0;
   bool paused = false;
@@ -121,9 +122,9 @@ int run(const Args& a) {
   // A model file where a lab goes: its passive motion (app/model_lab.h), nothing to tune but the engines.
   const bool model = app::isModelFile(a.lab);
   if (model)
-    for (const auto& [given, option] : {std::pair{!a.config.empty(), "--config"}, {!a.gains.empty(), "--gains"}, {!a.scenario.empty(), "--scenario"}})
+    for (const auto& [given, option] : {std::pair{!a.config.empty(), "--config"}, {!a.gains.empty(), "--gains"}, {!a.scenario.empty(), "--scenario"}, {!a.student.empty(), "--student"}})
       if (given) throw InputError("<command line>", option, "a model file runs passive, without a lab's config, gains or scenario");
-  TuningSession session = model ? TuningSession(app::loadModelLab(a.lab, std::nullopt)) : TuningSession(a.lab, a.config, a.gains, a.scenario);
+  TuningSession session = model ? TuningSession(app::loadModelLab(a.lab, std::nullopt)) : TuningSession(a.lab, a.config, a.gains, a.scenario, studentPlant(a.student));
   for (const auto& s : a.set) session.set(s);
   session.setEngine(parseEngineChoice(a.engine));
   session.restart();
@@ -240,6 +241,8 @@ int main(int argc, char** argv) {
   cli.add_option("--config", a.config, "Lab config JSON (default: labs/LAB/LAB.json)");
   cli.add_option("--gains", a.gains, "Start from these gains: a submission or gains JSON");
   cli.add_option("--scenario", a.scenario, "Tune under one rubric scenario (heavy_load, noisy_sensor, ...) exactly as the grader runs it");
+  cli.add_option("--student", a.student, "Tune on this student's plant (the lab's variants; DYNLAB_STUDENT_KEY, the key on "
+                                          "their handout, or DYNLAB_COURSE_SECRET)");
   cli.add_option("--set", a.set, "NAME=VALUE: set a gain or an option (e.g. kp=500, law=integral: names the lab's JSON declares); repeatable");
   cli.add_option("--engine", a.engine, "hand, bullet, or both (Bullet drawn as a ghost)")->check(CLI::IsMember({"hand", "bullet", "both"}));
   cli.add_option("--speed", a.speed, "Simulated seconds per wall second")->check(CLI::Range(0.02, 20.0));

@@ -33,8 +33,8 @@ EngineChoice parseEngineChoice(const std::string& s) {
 }
 
 TuningSession::TuningSession(const std::string& lab, const std::string& config_file, const std::string& gains_file,
-                             const std::string& scenario) {
-  LoadedLab loaded = loadLab(lab, config_file, gains_file);
+                             const std::string& scenario, const PlantChoice& plant) {
+  LoadedLab loaded = loadLab(lab, config_file, gains_file, std::nullopt, plant);
   const std::string config_path = loaded.config_file;
   // The lab's own defaults (before any gains file), for "Lab defaults".
   const json plain = loadJsonFile(config_path);

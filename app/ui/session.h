@@ -37,9 +37,10 @@ class TuningSession {
   // Loads LAB's config (default path unless config_file), applies an optional gains file, builds
   // the lab and starts a run. Throws InputError on bad input (nothing is opened). With a scenario,
   // every run is under that rubric scenario exactly as the grader runs it (grading/scenario.h
-  // scenarioConfig), its noise seeded as grading submission() would seed it.
+  // scenarioConfig), its noise seeded as grading submission() would seed it; with a plant, on that
+  // student's plant (labs/variants.h).
   TuningSession(const std::string& lab, const std::string& config_file = "", const std::string& gains_file = "",
-                const std::string& scenario = "");
+                const std::string& scenario = "", const PlantChoice& plant = {});
   // A lab already built in memory, its config its own defaults (a model file: app/model_lab.h).
   explicit TuningSession(LoadedLab loaded);
 

@@ -71,7 +71,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
                                const model_file::LoadOptions& options) {
   DataSettings s;
   s.name = name, s.folder = folder;
-  c.onlyKeys({"lab", "title", "description", "model_file", "actuated", "torque_limit", "tool", "initial", "trajectory",
+  c.onlyKeys({"lab", "title", "description", "variants", "model_file", "actuated", "torque_limit", "tool", "initial", "trajectory",
               "plant", "controller", "gains", "metrics", "passive_tolerance", "simulation", "rubric", "metric_docs",
               "figures", "submission_options", "map", "drawing", "environment", "target"});
   s.title = c["title"].string();

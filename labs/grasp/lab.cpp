@@ -121,7 +121,7 @@ class Hooks final : public StepHooks {
 
 Settings parseSettings(const JsonView& c) {
   Settings s;
-  c.onlyKeys({"lab", "title", "description", "mechanism", "model", "initial", "simulation", "controller", "gains", "reference",
+  c.onlyKeys({"lab", "title", "description", "variants", "mechanism", "model", "initial", "simulation", "controller", "gains", "reference",
               "disturbance", "metrics", "metric_docs", "rubric", "drawing", "submission_options", "map"});
   const JsonView m = c["mechanism"];
   m.onlyKeys({"fingers", "object", "joint_friction", "mu", "gravity"});

@@ -210,7 +210,7 @@ bool inverseKinematics(const Params& p, const Eigen::Vector3d& x, const Eigen::V
 
 Settings parseSettings(const JsonView& c) {
   Settings s;
-  c.onlyKeys({"lab", "title", "description", "mechanism", "model", "pose_deg", "environment", "simulation", "controller",
+  c.onlyKeys({"lab", "title", "description", "variants", "mechanism", "model", "pose_deg", "environment", "simulation", "controller",
               "target", "gains", "metrics", "rubric", "drawing", "submission_options", "metric_docs", "map", "figures"});
   const JsonView m = c["mechanism"];
   m.onlyKeys({"links", "payload", "gravity", "torque_limit"});

@@ -130,7 +130,7 @@ double fastestMode(const Params& p, const Eigen::VectorXd& theta) {
 
 Settings parseSettings(const JsonView& c) {
   Settings s;
-  c.onlyKeys({"lab", "title", "description", "mechanism", "model", "trajectory", "simulation", "controller", "gains",
+  c.onlyKeys({"lab", "title", "description", "variants", "mechanism", "model", "trajectory", "simulation", "controller", "gains",
               "metrics", "rubric", "drawing", "submission_options", "metric_docs", "map", "figures"});
   const JsonView m = c["mechanism"];
   m.onlyKeys({"links", "friction", "coulomb_width", "payload", "gravity", "torque_limit", "flexible"});

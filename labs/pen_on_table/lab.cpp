@@ -113,7 +113,7 @@ std::string outOfReach(const Params& p, const Eigen::Vector3d& tip) {
 
 Settings parseSettings(const JsonView& c) {
   Settings s;
-  c.onlyKeys({"lab", "title", "description", "mechanism", "table", "initial", "simulation", "controller", "gains", "reference",
+  c.onlyKeys({"lab", "title", "description", "variants", "mechanism", "table", "initial", "simulation", "controller", "gains", "reference",
               "metrics", "metric_docs", "rubric", "drawing", "submission_options", "map", "figures"});
   // The arm.
   const JsonView m = c["mechanism"];

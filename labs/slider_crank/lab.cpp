@@ -74,7 +74,7 @@ Params controllerModel(const Params& plant) {
 
 Settings parseSettings(const JsonView& c) {
   Settings s;
-  c.onlyKeys({"lab", "title", "description", "mechanism", "initial", "simulation", "controller", "gains",
+  c.onlyKeys({"lab", "title", "description", "variants", "mechanism", "initial", "simulation", "controller", "gains",
               "reference", "metrics", "rubric", "scenarios", "drawing", "submission_options",
               "metric_docs", "map"});
   const JsonView m = c["mechanism"];

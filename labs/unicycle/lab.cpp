@@ -111,7 +111,7 @@ std::vector<Eigen::Vector2d> parsePoints(const JsonView& j) {
 
 Settings parseSettings(const JsonView& c) {
   Settings s;
-  c.onlyKeys({"lab", "title", "description", "mechanism", "initial", "simulation", "controller", "gains", "reference",
+  c.onlyKeys({"lab", "title", "description", "variants", "mechanism", "initial", "simulation", "controller", "gains", "reference",
               "metrics", "metric_docs", "rubric", "drawing", "submission_options", "map", "figures"});
   const JsonView m = c["mechanism"];
   m.onlyKeys({"radius", "mass", "axle_inertia", "steer_inertia", "mu", "gravity"});

@@ -264,6 +264,45 @@ def python(code):
                           timeout=900)
 
 
+class Students(unittest.TestCase):
+    """A plant per student: Lab(student=) and grade(student=) are the CLI's --student."""
+
+    SUB = {"lab": "fivebar", "kind": "task_inverse_dynamics", "gains": {"kp": 2000, "kd": 40, "omega_n": 30, "zeta": 0.7}}
+
+    def setUp(self):
+        os.environ["DYNLAB_COURSE_SECRET"] = "python-test-secret"
+
+    def tearDown(self):
+        os.environ.pop("DYNLAB_COURSE_SECRET", None)
+
+    def test_grade_on_a_students_plant_is_the_clis(self):
+        path = write("student_sub.json", self.SUB)
+        out = os.path.join(TMP, "student_grade")
+        env = dict(os.environ)
+        r = subprocess.run([CLI, "grade", path, "--student", "alice", "--no-plots", "--out", out], capture_output=True,
+                           encoding="utf-8", errors="replace", cwd=TMP, env=env)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        with open(os.path.join(out, "results.json"), encoding="utf-8") as f:
+            cli_results = json.load(f)
+        mine = dynlab.grade(self.SUB, student="alice")
+        self.assertEqual(mine["score"], cli_results["score"])
+        self.assertEqual(mine["extra_data"]["plant"], cli_results["extra_data"]["plant"])
+        lab = dynlab.Lab("fivebar", student="alice")
+        self.assertEqual(lab.student, "alice")
+        lab.apply(self.SUB)
+        self.assertEqual(lab.grade()["score"], cli_results["score"])
+
+    def test_no_key_or_a_bad_id_raises(self):
+        os.environ.pop("DYNLAB_COURSE_SECRET", None)
+        with self.assertRaises(dynlab.InputError) as e:
+            dynlab.Lab("fivebar", student="alice")
+        self.assertIn("<python>: student: expected DYNLAB_STUDENT_KEY", str(e.exception))
+        os.environ["DYNLAB_COURSE_SECRET"] = "x"
+        with self.assertRaises(dynlab.InputError) as e:
+            dynlab.grade(self.SUB, student="a b")
+        self.assertIn("student: expected a student ID", str(e.exception))
+
+
 class Hostile(unittest.TestCase):
     """Python input as hostile as a file: never a crash, always the CLI's checks as ValueError or TypeError."""
 
