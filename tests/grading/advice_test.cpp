@@ -8,6 +8,8 @@
 
 #include <cctype>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <set>
 #include <string>
 #include <vector>
@@ -173,4 +175,32 @@ TEST_CASE("every other lab with laws: graded with law A, the advice fits law A")
   for (const char* f : {"examples/mediocre.json", "examples/proportional.json", "examples/unstable_integral.json"}) CHECK(checkFits(load("slider_crank", f)) > 0);
   for (const char* f : {"examples/computed_torque.json", "examples/pd_gravity.json", "examples/pid.json"}) CHECK(checkFits(load("motion_control", f)) > 0);
   for (const char* f : {"examples/joint_space_pid.json", "examples/joint_space_soft.json", "examples/task_space.json"}) CHECK(checkFits(load("impedance", f)) > 0);
+}
+
+// Issue 41, item 9 in the report: the pen's lost-contact test names the cause the run shows.
+TEST_CASE("pen_on_table: the report's verdict on lost contact is the bounce on touchdown or the pressed loop, as the run shows") {
+  const std::string dir = std::string(DYNLAB_TEST_TMP) + "/advice_pen";
+  std::filesystem::create_directories(dir);
+  const auto advice = [&](double D_z, double noise) {
+    json config = dyn::loadJsonFile(dyn::defaultConfigPath("pen_on_table"));
+    config["controller"]["delay"] = 0.03;
+    config["controller"]["noise"] = noise;
+    config["metrics"]["max_liftoffs"] = 1000;  // every lift-off counted, none stops the run
+    const std::string file = dir + "/config.json";
+    std::ofstream(file) << config.dump(1);
+    dyn::GradeOptions o;
+    o.config_file = file;
+    o.keep_runs = true;
+    const json sub = {{"lab", "pen_on_table"}, {"force_law", "damper"}, {"gains", {{"kp", 5000}, {"kv", 110}, {"D_z", D_z}, {"K_z", 2000}}}};
+    const dyn::GradeOutcome g = dyn::gradeSubmission(sub, "submission.json", o);
+    REQUIRE_MESSAGE(g.error.empty(), g.error);
+    for (const auto& t : g.graded.tests)
+      if (t.test.scenario == "nominal" && t.test.metric == "contact_lost_time") return t.advice;
+    return std::string("(no such test)");
+  };
+  const std::string bounce = advice(100, 0.0), pressed = advice(110, 6.0);
+  INFO("bounced and settled: " << bounce << "\npressed: " << pressed);
+  CHECK(bounce.rfind("the pen bounced on touchdown", 0) == 0);
+  CHECK(pressed.rfind("the pressed loop oscillates", 0) == 0);
+  std::filesystem::remove_all(dir);
 }
