@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <set>
 
@@ -195,18 +196,27 @@ std::string chooseAdvice(const std::vector<AdviceEntry>& entries, const AdviceCo
 std::string adviceSummary(const std::vector<AdviceEntry>& entries) {
   std::string out;
   for (const auto& e : entries) {
-    std::string when;
+    // The law first, then the scenario, then what the gains or the run must show.
+    std::string law, rest;
     for (const auto& [key, want] : e.when.items()) {
       std::string part;
-      if (key == "gains_at" || key == "gains_off" || key == "above" || key == "below") {
+      const bool measured = key == "gains_at" || key == "gains_off" || key == "above" || key == "below";
+      if (measured) {
         const std::string op = key == "gains_at" ? " = " : key == "gains_off" ? " ≠ " : key == "above" ? " > " : " < ";
-        for (const auto& [n, v] : want.items()) part += (part.empty() ? "" : key == "gains_off" ? " or " : " and ") + n + op + fmtConfigNumber(v.get<double>());
+        char number[32];
+        for (const auto& [n, v] : want.items()) {
+          std::snprintf(number, sizeof number, "%.4g", v.get<double>());
+          part += (part.empty() ? "" : key == "gains_off" ? " or " : " and ") + n + op + number;
+        }
       } else {
         for (const auto& w : want) part += (part.empty() ? "" : " or ") + w.get<std::string>();
         part = (key == "scenario" ? "in " : key + " ") + part;
       }
-      when += (when.empty() ? "" : ", ") + part;
+      std::string& to = measured || key == "scenario" ? rest : law;
+      if (key == "scenario") rest = part + (rest.empty() ? "" : ", " + rest);
+      else to += (to.empty() ? "" : ", ") + part;
     }
+    const std::string when = law + (law.empty() || rest.empty() ? "" : ", ") + rest;
     out += (out.empty() ? "" : "; ") + (when.empty() ? (entries.size() > 1 ? "otherwise: " : "") : when + ": ") + e.text;
   }
   return out;
