@@ -20,6 +20,7 @@ constexpr double kSameValue = 0.01;  // relative: a gain within 1 % of a value i
 struct Expression {
   const std::string& s;
   std::size_t i = 0;
+  int depth = 0;  // nested parentheses and signs: a hostile "((((…" is refused, not a stack overflow
   void space() {
     while (i < s.size() && s[i] == ' ') ++i;
   }
@@ -30,6 +31,12 @@ struct Expression {
   }
   double primary() {
     space();
+    if (++depth > 64) return NAN;
+    const double v = term();
+    --depth;
+    return v;
+  }
+  double term() {
     if (s.compare(i, 4, "sqrt") == 0) {
       i += 4;
       if (!eat('(')) return NAN;
@@ -68,7 +75,7 @@ struct Expression {
 
 double valueOf(const JsonView& v, const JsonView& config) {
   if (v.raw().is_number()) return v.number();
-  const std::string expected = "a number, or an expression of numbers and \"{/json/pointer}\"s such as \"2*{/target/zeta}\"";
+  const std::string expected = "expected a number, or an expression of numbers and \"{/json/pointer}\"s such as \"2*{/target/zeta}\"";
   if (!v.raw().is_string()) v.fail(expected);
   const std::string text = fillFromConfig(v.string(), config, v.path());
   Expression e{text};
@@ -83,7 +90,7 @@ json namedValues(const JsonView& v, const JsonView& config, bool gains) {
   v.requireObject();
   json out = json::object();
   for (const auto& [name, _] : v.raw().items()) {
-    if (gains && !config["gains"].raw().contains(name)) v[name].fail("a gain of the lab's \"gains\", got \"" + name + "\"");
+    if (gains && !config["gains"].raw().contains(name)) v[name].fail("expected a gain of the lab's \"gains\", got \"" + name + "\"");
     out[name] = valueOf(v[name], config);
   }
   return out;
@@ -97,7 +104,7 @@ json choicesOf(const JsonView& v, const json& allowed, const std::string& what) 
     const std::string name = c.string();
     bool ok = false;
     for (const auto& a : allowed) ok = ok || a == name;
-    if (!ok) c.fail(what + " (" + allowed.dump() + "), got \"" + name + "\"");
+    if (!ok) c.fail("expected " + what + " (" + allowed.dump() + "), got \"" + name + "\"");
   }
   return list;
 }
@@ -126,7 +133,7 @@ AdviceEntry parseEntry(const JsonView& e, const JsonView& config) {
     else {
       std::string list;
       for (const auto& [o, __] : options.items()) list += o + ", ";
-      w[key].fail("a condition: " + list + "scenario, gains_at, gains_off, above or below; got \"" + key + "\"");
+      w[key].fail("expected a condition: " + list + "scenario, gains_at, gains_off, above or below; got \"" + key + "\"");
     }
   }
   return out;
@@ -154,7 +161,7 @@ std::vector<std::string> words(const std::string& text) {
 
 std::vector<AdviceEntry> parseAdvice(const JsonView& v, const JsonView& config) {
   if (v.raw().is_string()) return {parseEntry(v, config)};
-  if (!v.raw().is_array()) v.fail("a text, or a list of {\"when\": {...}, \"text\": \"...\"}");
+  if (!v.raw().is_array()) v.fail("expected a text, or a list of {\"when\": {...}, \"text\": \"...\"}");
   std::vector<AdviceEntry> out;
   for (std::size_t i = 0, n = v.size(1, 64); i < n; ++i) out.push_back(parseEntry(v.at(i), config));
   return out;

@@ -101,10 +101,10 @@ void checkSubmissionOptions(const JsonView& config) {
       for (const auto& [choice, gains] : reads.raw().items()) {
         bool known = false;
         for (const auto& c : o["choices"].raw()) known = known || c == choice;
-        if (!known) reads[choice].fail("a choice of this option (" + o["choices"].raw().dump() + "), got \"" + choice + "\"");
+        if (!known) reads[choice].fail("expected a choice of this option (" + o["choices"].raw().dump() + "), got \"" + choice + "\"");
         for (std::size_t i = 0, n = reads[choice].size(0, 64); i < n; ++i) {
           const std::string g = reads[choice].at(i).string();
-          if (!config.has("gains") || !config["gains"].raw().contains(g)) reads[choice].at(i).fail("a gain of the lab's \"gains\", got \"" + g + "\"");
+          if (!config.has("gains") || !config["gains"].raw().contains(g)) reads[choice].at(i).fail("expected a gain of the lab's \"gains\", got \"" + g + "\"");
         }
       }
     }

@@ -175,6 +175,27 @@ TEST_CASE("every other lab with laws: graded with law A, the advice fits law A")
   for (const char* f : {"examples/mediocre.json", "examples/proportional.json", "examples/unstable_integral.json"}) CHECK(checkFits(load("slider_crank", f)) > 0);
   for (const char* f : {"examples/computed_torque.json", "examples/pd_gravity.json", "examples/pid.json"}) CHECK(checkFits(load("motion_control", f)) > 0);
   for (const char* f : {"examples/joint_space_pid.json", "examples/joint_space_soft.json", "examples/task_space.json"}) CHECK(checkFits(load("impedance", f)) > 0);
+  // The labs without a choice of law: every gain is read, the advice still names only the lab's.
+  for (const char* f : {"examples/mediocre.json", "examples/slipping.json"}) CHECK(checkFits(load("grasp", f)) > 0);
+  for (const char* f : {"examples/mediocre.json", "examples/skidding.json"}) CHECK(checkFits(load("unicycle", f)) > 0);
+}
+
+TEST_CASE("a malformed advice entry is one line naming the lab file and its JSON path") {
+  json config = dyn::loadJsonFile(dyn::defaultConfigPath("puma_impedance"));
+  const auto first = [&](const json& advice) {
+    config["metric_docs"]["deflection_error"]["advice"] = advice;
+    const auto p = dyn::adviceProblems(config, "puma_impedance.json");
+    return p.empty() ? std::string("(none)") : p.front();
+  };
+  CHECK(first(json::array({{{"when", {{"gains_off", {{"k_imp", std::string(200, '(') + "1"}}}}}, {"text", "x"}}})).rfind("/metric_docs/deflection_error/advice/0/when/gains_off/k_imp: expected a number, or an expression", 0) == 0);
+  CHECK(first(json::array({{{"when", {{"gains_off", {{"no_gain", 1}}}}}, {"text", "x"}}})).find("a gain of the lab's \"gains\", got \"no_gain\"") != std::string::npos);
+  CHECK(first(json::array({{{"when", {{"scenario", "nowhere"}}}, {"text", "x"}}})).find("a scenario of the rubric") != std::string::npos);
+  CHECK(first(json::array({{{"when", {{"colour", "red"}}}, {"text", "x"}}})).find("a condition: kind, scenario, gains_at") != std::string::npos);
+  CHECK(first(json::array({{{"when", {{"kind", "impedance_joint"}}}, {"text", "raise omega_n"}}})).find("no entry for kind impedance_task") != std::string::npos);
+  // The expression of the target's damping evaluates as the handout's D_des.
+  config["metric_docs"]["deflection_error"]["advice"] = json::array({{{"when", {{"gains_at", {{"d_imp", "2*{/target/zeta}*sqrt({/target/k}*{/target/m})"}}}}}, {"text", "x"}}, {{"text", "y"}}});
+  const auto entries = dyn::parseAdvice(dyn::JsonView(config, "c.json")["metric_docs"]["deflection_error"]["advice"], dyn::JsonView(config, "c.json"));
+  CHECK(entries.at(0).when["gains_at"]["d_imp"].get<double>() == doctest::Approx(2 * 0.7 * std::sqrt(2000.0)));
 }
 
 // Issue 41, item 9 in the report: the pen's lost-contact test names the cause the run shows.
