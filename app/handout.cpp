@@ -189,7 +189,7 @@ struct Handout {
     for (const auto& m : used) {
       const MetricDoc d = doc(m, nominal);
       md += "| " + code(m) + " | " + cell(d.what) + " | " + cell(d.unit == "1" ? "1 (dimensionless)" : d.unit) + " | " +
-            cell(d.window) + " | " + cell(d.advice) + " |\n";
+            cell(d.window) + " | " + cell(adviceSummary(d.advice)) + " |\n";
     }
     return md + "\n";
   }

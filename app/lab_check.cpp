@@ -8,15 +8,18 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <set>
 #include <sstream>
 
 #include "app/process.h"
 #include "grading/grade.h"
+#include "grading/advice.h"
 #include "grading/lessons.h"
 #include "grading/metric_doc.h"
 #include "grading/rubric.h"
 #include "grading/scenario.h"
 #include "labs/config.h"
+#include "labs/controllers/controller.h"
 #include "labs/run.h"
 #include "labs/settings.h"
 #include "labs/submission.h"
@@ -270,6 +273,34 @@ LabCheckReport checkLab(const LabEntry& entry, const json& config, const LabChec
                                  fmt(energy.front()) + ", relative " + fmt(worst / scale) + ", tolerance " + fmt(stated.tolerance) + ")";
     s.expect(worst <= stated.tolerance * scale, measured + ": beyond the tolerance");
     s.detail = measured;
+  });
+
+  // Every advice entry names options, choices, scenarios and gains that exist; none tells a law to use
+  // itself or names a gain it does not read (grading/advice.h).
+  run(report, "advice", [&](Step& s) {
+    const std::vector<std::string> problems = adviceProblems(config, shown);
+    for (const auto& p : problems) s.fail(p);
+    // A data lab's kinds read what the controller library says they read: "reads" must agree.
+    const json options = config.value("submission_options", json::object());
+    if (options.contains("kind") && options["kind"].value("target", "") == "/controller/kind")
+      for (const auto& c : options["kind"].at("choices")) {
+        const std::string kind = c.get<std::string>();
+        const auto& names = controllers::kindNames();
+        if (std::find(names.begin(), names.end(), kind) == names.end()) continue;
+        json law = config;
+        law["controller"]["kind"] = kind;
+        const std::set<std::string> read = gainsRead(law);
+        std::set<std::string> library;
+        for (const auto& g : controllers::gainsOf(controllers::kindFromName(kind)))
+          if (config["gains"].contains(g)) library.insert(g);
+        for (const auto& [g, _] : config["gains"].items())
+          if (read.count(g) != library.count(g))
+            s.fail("/submission_options/kind/reads: kind " + kind + (library.count(g) ? " reads " : " does not read ") + g +
+                   " (the controller library's), the lab says otherwise");
+      }
+    std::size_t entries = 0;
+    for (const auto& [_, d] : parseMetricDocs(JsonView(config, shown))) entries += d.advice.size();
+    s.detail = std::to_string(entries) + " advice entries: each names a law that exists and gains that law reads";
   });
 
   // Every metric the rubric's tests and leaderboard read exists for every option choice: the lab's

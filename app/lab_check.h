@@ -7,6 +7,8 @@
 //   passive energy  with passivePatch() (τ = 0) the energy stays within the lab's stated tolerance
 //   metrics         the rubric's plot and watchdog columns exist; every rubric and leaderboard metric
 //                   exists, finite, for every submission option choice (metrics + screening)
+//   advice          every advice entry names a law that exists and gains that law reads; none
+//                   tells a law to use itself (grading/advice.h)
 //   grading         every example and every option choice grades to a valid results.json
 //   defaults        the default gains score within the band (20–50 %: a weak, stable start)
 //   plots           every simulated test of the defaults' grade has its plot on disk

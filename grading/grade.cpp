@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <map>
 
+#include "grading/advice.h"
 #include "grading/escape.h"
 #include "grading/metric_doc.h"
 #include "grading/report.h"
@@ -167,7 +168,8 @@ GradeOutcome gradeSubmission(const json& sub, const std::string& file, const Gra
       const RubricTest& t = rubric.tests[i];
       const ScenarioRun& run = runs.at(t.scenario);
       const MetricDoc doc = docOf(t.metric);
-      GradedTest g{t, 0.0, NAN, "", "", doc.unit, std::nullopt, "", doc.advice};
+      // What to change: chosen by the law the submission uses and by what its run measured.
+      GradedTest g{t, 0.0, NAN, "", "", doc.unit, std::nullopt, "", chooseAdvice(doc.advice, {applied, t.scenario, run.metrics})};
       // A test of a simulated metric (not the screening's) gets a plot.
       if (!run.screen.metrics.contains(t.metric)) g.plan = planTestPlot(rubric, i, docs, *base_lab);
       if (run.metrics.contains(t.metric)) {

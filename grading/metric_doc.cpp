@@ -85,7 +85,7 @@ std::map<std::string, MetricDoc> parseMetricDocs(const JsonView& config) {
     MetricDoc& doc = docs[name];
     doc = {fillFromConfig(d["what"].string(), config, d["what"].path()), d["unit"].string(),
            fillFromConfig(d["window"].string(), config, d["window"].path())};
-    if (d.has("advice")) doc.advice = fillFromConfig(d["advice"].string(), config, d["advice"].path());
+    if (d.has("advice")) doc.advice = parseAdvice(d["advice"], config);
     // The window in numbers: "from"/"to" when given, else what its words say ("from t = {/..} s on").
     doc.from = d.has("from") ? windowBound(d["from"], config) : boundIn(doc.window, {"from t = "}, -INFINITY);
     doc.to = d.has("to") ? windowBound(d["to"], config) : boundIn(doc.window, {"until t = ", " to t = "}, INFINITY);
@@ -98,7 +98,10 @@ std::map<std::string, MetricDoc> parseMetricDocs(const JsonView& config) {
 
 std::optional<MetricDoc> screeningMetricDoc(const std::string& metric, const std::vector<LinearLoop>& loops) {
   // Each kind the screening reports, defined as grading/scenario.h computes it.
-  static const std::vector<std::pair<std::string, MetricDoc>> kinds = {
+  struct Kind {
+    std::string what, unit, window, advice;
+  };
+  static const std::vector<std::pair<std::string, Kind>> kinds = {
       {"_delay_margin",
        {"the total measurement delay the loop tolerates before it goes unstable (phase margin / crossover "
         "frequency; reported as 1000 s when |L| < 1 at every frequency, 0 when the loop is not stable even "
@@ -121,7 +124,7 @@ std::optional<MetricDoc> screeningMetricDoc(const std::string& metric, const std
   for (const auto& loop : loops)
     for (const auto& [suffix, doc] : kinds)
       if (metric == loop.name + suffix) {
-        MetricDoc d = doc;
+        MetricDoc d{doc.what, doc.unit, doc.window, {AdviceEntry{json::object(), doc.advice, ""}}};
         d.what = "screening of the " + loop.what + ": " + d.what;
         d.window = "no simulation: the loop linearised at the start (L(s) with its delay of " +
                    fmtConfigNumber(loop.delay * 1e3) + " ms)";

@@ -8,8 +8,9 @@
 // "from t = ", "until t = " or " to t = " — or "from"/"to" when given (seconds, or "{/pointer}"
 // naming a number); the screening
 // metrics (<loop>_delay_margin, <loop>_damping, ... from grading/scenario.h) are documented here,
-// once for every lab, from the loops the lab reports. "advice" (optional) is one line for a student
-// whose test on the metric is not at full marks: what usually causes it and which gain moves it.
+// once for every lab, from the loops the lab reports. "advice" (optional) is what a student whose
+// test on the metric is not at full marks should change: one text, or entries chosen by the law in
+// use and why the test lost points (grading/advice.h).
 #pragma once
 #include <cmath>
 #include <map>
@@ -17,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "grading/advice.h"
 #include "labs/config.h"
 #include "physics/linear.h"
 
@@ -24,7 +26,7 @@ namespace dyn {
 
 struct MetricDoc {
   std::string what, unit, window;  // unit "1": dimensionless
-  std::string advice;              // what to change when the test falls short (may be empty)
+  std::vector<AdviceEntry> advice;  // what to change when the test falls short (may be none)
   double from = -INFINITY, to = INFINITY;  // the time window the metric reads (s)
 };
 

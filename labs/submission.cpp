@@ -1,6 +1,7 @@
 // Applying a submission's gains and options to a lab config; see submission.h.
 #include "labs/submission.h"
 
+#include <algorithm>
 #include <cctype>
 #include <sstream>
 
@@ -82,7 +83,7 @@ void checkSubmissionOptions(const JsonView& config) {
   for (const auto& [key, _] : options.raw().items()) {
     const JsonView o = options[key];
     if (key == "lab" || key == "gains") o.fail("expected an option name other than \"lab\" and \"gains\"");
-    o.onlyKeys({"target", "choices", "doc"});
+    o.onlyKeys({"target", "choices", "doc", "reads"});
     const std::string target = o["target"].string();
     bool found = false;
     try {
@@ -93,7 +94,38 @@ void checkSubmissionOptions(const JsonView& config) {
     if (!found) o["target"].fail("expected a JSON pointer to a string in the config, such as \"/controller/force_law\", got \"" + target + "\"");
     for (std::size_t i = 0, n = o["choices"].size(1, 64); i < n; ++i) o["choices"].at(i).string();
     if (o.has("doc")) o["doc"].string();
+    if (o.has("reads")) {
+      // {"choice": ["gain", ...]}: the gains that depend on this option, those each choice reads.
+      const JsonView reads = o["reads"];
+      reads.requireObject();
+      for (const auto& [choice, gains] : reads.raw().items()) {
+        bool known = false;
+        for (const auto& c : o["choices"].raw()) known = known || c == choice;
+        if (!known) reads[choice].fail("expected a choice of this option (" + o["choices"].raw().dump() + "), got \"" + choice + "\"");
+        for (std::size_t i = 0, n = reads[choice].size(0, 64); i < n; ++i) {
+          const std::string g = reads[choice].at(i).string();
+          if (!config.has("gains") || !config["gains"].raw().contains(g)) reads[choice].at(i).fail("expected a gain of the lab's \"gains\", got \"" + g + "\"");
+        }
+      }
+    }
   }
+}
+
+std::set<std::string> gainsRead(const json& config) {
+  std::set<std::string> read;
+  const json gains = config.value("gains", json::object()), options = config.value("submission_options", json::object());
+  for (const auto& [g, _] : gains.items()) read.insert(g);
+  for (const auto& [key, o] : options.items()) {
+    if (!o.contains("reads")) continue;
+    const json chosen = config.at(json::json_pointer(o.at("target").get<std::string>()));
+    const json none = json::array();
+    const json& mine = chosen.is_string() && o["reads"].contains(chosen.get<std::string>()) ? o["reads"][chosen.get<std::string>()] : none;
+    // A gain some choice lists is read only when the chosen one lists it too.
+    for (const auto& [choice, gains] : o["reads"].items())
+      for (const auto& g : gains)
+        if (std::find(mine.begin(), mine.end(), g) == mine.end()) read.erase(g.get<std::string>());
+  }
+  return read;
 }
 
 json submissionSchema(const json& config, const std::string& lab) {

@@ -4,6 +4,8 @@
 // "/controller/force_law", "choices": [...]}}); this file applies a submission onto a config,
 // validating every value, and derives the submission's JSON Schema from the same declarations.
 #pragma once
+#include <set>
+
 #include "labs/config.h"
 
 namespace dyn {
@@ -21,8 +23,13 @@ constexpr std::size_t kMaxAnswers = 20, kMaxAnswerBytes = 4000;
 json submissionAnswers(const JsonView& submission);
 
 // Validates a config's "submission_options" (an object of {"target": JSON pointer to a string
-// value of the config, "choices": [strings], "doc": string}); buildLab calls it for every lab.
+// value of the config, "choices": [strings], "doc": string, "reads": {choice: [gains]}}); buildLab
+// calls it for every lab. "reads" names the gains that depend on the option: a gain listed under
+// some choice is read only under the choices that list it; a gain listed nowhere, under every one.
 void checkSubmissionOptions(const JsonView& config);
+
+// The gains the law a config selects reads (its options' "reads"; every gain when none says).
+std::set<std::string> gainsRead(const json& config);
 
 // JSON Schema (draft 2020-12) of a submission for this lab.
 json submissionSchema(const json& config, const std::string& lab);

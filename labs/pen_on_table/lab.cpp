@@ -35,6 +35,28 @@ Params believed(const Params& p, const ControllerConfig& c) {
   return b;
 }
 
+// Lift-offs after the first touchdown (the table stops pushing: contact 1 → 0), told apart by when
+// they come: before the pen first stayed on the table for `settle` s (it bounced on touchdown: the
+// impact's impulse reaches the force sensor and the force law moves z_des by it), or after (the
+// pressed loop lost the table). The watchdog and the metrics count them alike, row by row.
+struct Liftoffs {
+  double settle;
+  bool touched = false, in_contact = false, settled = false;
+  double since = 0;  // when the current contact began
+  int on_touchdown = 0, pressed = 0;
+  // One row; true on a lift-off.
+  bool step(double t, bool contact) {
+    const bool lift = touched && in_contact && !contact;
+    if (lift) ++(settled ? pressed : on_touchdown);
+    if (contact && !in_contact) since = t;
+    if (contact && t - since >= settle - 1e-9) settled = true;
+    touched = touched || contact;
+    in_contact = contact;
+    return lift;
+  }
+  int total() const { return on_touchdown + pressed; }
+};
+
 // The lab's part of a run on either engine (labs/mechanism_simulation.h).
 // hand: the hand engine's mechanism (its impact impulses), null for Bullet.
 class Hooks final : public StepHooks {
@@ -70,15 +92,17 @@ class Hooks final : public StepHooks {
   void observe(const StepRecord& r) override { ctrl_.measure(-push(r)); }
   // The lab's watchdog: an unstable force loop on a unilateral contact does not blow up, it hammers the
   // table (a bounded limit cycle of lift-offs); the run stops at max_liftoffs (4) of them after the first
-  // touchdown: a stable loop lifts off at most once (a touchdown's impact may reopen the row for a step).
+  // touchdown. Its verdict names what the trace shows: lift-offs before the pen ever settled (pressed
+  // for the overshoot window) are a bounce on touchdown, any after it the pressed loop oscillating.
   std::string stop(const StepRecord& r) override {
-    const bool contact = push(r) > 0;
-    if (touched_ && in_contact_ && !contact && ++liftoffs_ >= s_.max_liftoffs)
-      return "stopped: the pen bounced, lifting off the table " + std::to_string(liftoffs_) + " times after touching down, at t = " +
-             fmt("%.4g", r.t) + " s (the force loop oscillates)";
-    touched_ = touched_ || contact;
-    in_contact_ = contact;
-    return {};
+    if (!lifts_.step(r.t, push(r) > 0) || lifts_.total() < s_.max_liftoffs) return {};
+    const std::string at = " at t = " + fmt("%.4g", r.t) + " s";
+    if (lifts_.pressed > 0)
+      return "stopped: the pressed loop oscillates (the pen lost the table " + std::to_string(lifts_.pressed) + " of " +
+             std::to_string(lifts_.total()) + " times after it had settled)" + at;
+    const std::string kick = s_.controller.law == ForceLaw::Damper ? "the damper moves z_des by P/D_z" : "the spring kicks z_des by its reading over K_z";
+    return "stopped: the pen bounced on touchdown (" + std::to_string(lifts_.total()) + " lift-offs before it settled)" + at +
+           " (the impact's impulse P reaches the force sensor and " + kick + "; near its delay margin the force loop keeps it bouncing)";
   }
 
  private:
@@ -89,8 +113,7 @@ class Hooks final : public StepHooks {
   std::vector<double> window_;  // the last 5 ms of f_z (a ring)
   std::size_t next_ = 0;
   double sum_ = 0;
-  bool touched_ = false, in_contact_ = false;
-  int liftoffs_ = 0;
+  Liftoffs lifts_{s_.overshoot_window};
 };
 
 Link parseLink(const JsonView& j) {
@@ -262,6 +285,7 @@ json PenOnTableLab::metrics(const Trace& tr) const {
   double overshoot = 0, lost = 0, pull = -INFINITY, tau = 0, drift = 0, residual = 0, radius = 0, gap_min = INFINITY, ss = 0;
   std::size_t drawn = 0, ss_rows = 0;
   int liftoffs = 0;
+  Liftoffs lifts{s_.overshoot_window};
   const double e0 = n ? tr.at(0, "energy") : 0.0;
   for (std::size_t r = 0; r < n; ++r) {
     const double t = tr.at(r, "t"), e = tr.at(r, "f_z_5ms") - f_zd;
@@ -270,6 +294,7 @@ json PenOnTableLab::metrics(const Trace& tr) const {
     if (r >= first && t <= touchdown + s_.overshoot_window) overshoot = std::max(overshoot, -e);
     if (r >= first && !contact) lost += dt;
     if (r > first && r < n && !contact && tr.at(r - 1, "contact") > 0.5) ++liftoffs;
+    lifts.step(t, contact);
     if (contact) pull = std::max(pull, tr.at(r, "f_z"));
     if (t >= t_end - 1.0) ss += e, ++ss_rows;
     if (t >= t_draw) {
@@ -291,6 +316,8 @@ json PenOnTableLab::metrics(const Trace& tr) const {
           {"f_ss_error", ss_rows ? ss / double(ss_rows) : 0.0},
           {"contact_lost_time", lost},
           {"liftoffs", liftoffs},
+          {"liftoffs_touchdown", lifts.on_touchdown},
+          {"liftoffs_pressed", lifts.pressed},
           {"f_pull_max", std::isfinite(pull) ? pull : 0.0},
           {"radius", radius},
           {"radius_error", drawn ? std::abs(radius - s_.circle.radius) : s_.circle.radius},

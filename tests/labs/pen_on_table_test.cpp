@@ -296,7 +296,7 @@ TEST_CASE("pen_on_table: the contact never pulls, and lifts off when the force l
     const auto lab = fixture.makeLab(patch);
     // The lab's watchdog stops the limit cycle at 4 lift-offs: the trace up to there is kept.
     const RunResult res = runEngine(*lab, e);
-    CHECK(res.failure.rfind("stopped: the pen bounced, lifting off the table 4 times", 0) == 0);
+    CHECK(res.failure.rfind("stopped: the pen bounced on touchdown (4 lift-offs before it settled) at t = ", 0) == 0);
     const Trace& tr = res.trace;
     double pull = -INFINITY, free_force = 0;
     for (std::size_t r = 0; r < tr.rows(); ++r) {
@@ -405,7 +405,7 @@ TEST_CASE("pen_on_table: a bouncing pen is stopped by the watchdog, a tuned one 
   bounce["controller"]["delay"] = 0.045;
   const RunResult b = runEngine(*fixture.makeLab(bounce), Engine::Hand);
   MESSAGE("k_p 5000, D_z 30, delay 45 ms: ", b.failure);
-  CHECK(b.failure.rfind("stopped: the pen bounced, lifting off the table 4 times", 0) == 0);
+  CHECK(b.failure.rfind("stopped: the pen bounced on touchdown (4 lift-offs before it settled) at t = ", 0) == 0);
   // Inside the margin (D_z 150: 94 ms against a 45 ms delay) the same arm presses without bouncing.
   json calm = gains(5000, 110, 150, 2000);
   calm["controller"]["delay"] = 0.045;
@@ -415,6 +415,47 @@ TEST_CASE("pen_on_table: a bouncing pen is stopped by the watchdog, a tuned one 
   const json m = lab->metrics(c.trace);
   MESSAGE("D_z 150: ", m["liftoffs"].get<int>(), " lift-offs, ", m["contact_lost_time"].get<double>(), " s off the table");
   CHECK(m["liftoffs"].get<int>() <= 1);
+}
+
+// Issue 41, item 9: the verdict names what the trace shows. Lift-offs before the pen first stayed on the
+// table for /metrics/overshoot_window (0.5 s) are a bounce on touchdown, lift-offs after it the pressed
+// loop losing the table; the metrics count both, the watchdog's message says which stopped the run.
+TEST_CASE("pen_on_table: bounced on touchdown and settled, or the pressed loop oscillating: the verdict follows the trace") {
+  // k_p 5000, D_z 100 against a 30 ms delay: margin π D_z/(2 k_p) = 31.4 ms, barely inside. The pen bounces
+  // three times on touchdown, then stays down for the rest of the run: the run completes.
+  json settles = gains(5000, 110, 100, 2000);
+  settles["controller"]["delay"] = 0.03;
+  const auto a = fixture.makeLab(settles);
+  const RunResult ra = runEngine(*a, Engine::Hand);
+  CHECK(ra.failure.empty());
+  const json ma = a->metrics(ra.trace);
+  MESSAGE("bounce and settle: ", ma["liftoffs_touchdown"].get<int>(), " lift-offs on touchdown, ", ma["liftoffs_pressed"].get<int>(), " pressed");
+  CHECK(ma["liftoffs_touchdown"].get<int>() == 3);
+  CHECK(ma["liftoffs_pressed"].get<int>() == 0);
+  CHECK(ma["liftoffs"].get<int>() == 3);
+  // A loop past its margin (D_z 60: 18.8 ms against 20 ms) bounces from the touchdown on and never
+  // settles: stopped, and the verdict is the bounce on touchdown, not a loop that had settled.
+  json hammers = gains(5000, 110, 60, 2000);
+  hammers["controller"]["delay"] = 0.02;
+  const RunResult rb = runEngine(*fixture.makeLab(hammers), Engine::Hand);
+  MESSAGE(rb.failure);
+  CHECK(rb.failure.rfind("stopped: the pen bounced on touchdown (4 lift-offs before it settled) at t = ", 0) == 0);
+  CHECK(rb.failure.find("the damper moves z_des by P/D_z") != std::string::npos);
+  // Settled, then the pressed loop loses the table: D_z 110 (margin 34.6 ms against 30 ms) lands without a
+  // bounce and presses for 0.6 s, then a 6 N noisy sensor drives the lightly damped loop off the table.
+  json pressed = gains(5000, 110, 110, 2000);
+  pressed["controller"]["delay"] = 0.03;
+  pressed["controller"]["noise"] = 6.0;
+  const auto c = fixture.makeLab(pressed);
+  const RunResult rc = runEngine(*c, Engine::Hand);
+  MESSAGE(rc.failure);
+  CHECK(rc.failure.rfind("stopped: the pressed loop oscillates (the pen lost the table 4 of 4 times after it had settled) at t = ", 0) == 0);
+  // With room for every lift-off the metrics say the same: none on touchdown, all while pressing.
+  pressed["metrics"] = {{"overshoot_window", 0.5}, {"max_liftoffs", 1000}};
+  const auto d = fixture.makeLab(pressed);
+  const json md = d->metrics(runEngine(*d, Engine::Hand).trace);
+  CHECK(md["liftoffs_touchdown"].get<int>() == 0);
+  CHECK(md["liftoffs_pressed"].get<int>() >= 4);
 }
 
 TEST_CASE("pen_on_table: a touchdown at 0.25 m/s reads the impact impulse, as Bullet does, over 5 ms") {
