@@ -72,6 +72,30 @@ double boundIn(const std::string& window, std::initializer_list<const char*> lea
   return none;
 }
 
+// A data-defined metric's window ("metrics": {NAME: {"of", "stat", "from", "to"}}, labs/generic/
+// metric_spec.h) in words and numbers, written from the spec so the handout never disagrees with the
+// grader. False when NAME is not such a metric (a C++ lab documents its own).
+bool specWindow(const JsonView& config, const std::string& name, MetricDoc& doc) {
+  if (!config.has("metrics") || !config["metrics"].raw().is_object() || !config["metrics"].has(name)) return false;
+  const json& m = config["metrics"][name].raw();
+  if (!m.is_object() || !m.contains("of") || !m.contains("stat")) return false;
+  const bool final_value = m["stat"] == "final";
+  const auto bound = [&](const char* key) -> std::optional<double> {
+    if (m.contains(key) && m[key].is_number()) return m[key].get<double>();
+    return std::nullopt;
+  };
+  const auto from = bound("from"), to = bound("to");
+  const auto s = [](double x) { return fmtConfigNumber(x); };
+  if (final_value) doc.window = to ? "at " + s(*to) + " s" : "the last step";
+  else if (from && to) doc.window = s(*from) + "–" + s(*to) + " s";
+  else if (to) doc.window = "0–" + s(*to) + " s";
+  else if (from) doc.window = "from " + s(*from) + " s to the end";
+  else doc.window = "the whole run";
+  doc.from = from.value_or(-INFINITY);
+  doc.to = to.value_or(INFINITY);
+  return true;
+}
+
 }  // namespace
 
 std::map<std::string, MetricDoc> parseMetricDocs(const JsonView& config) {
@@ -83,9 +107,18 @@ std::map<std::string, MetricDoc> parseMetricDocs(const JsonView& config) {
     const JsonView d = all[name];
     d.onlyKeys({"what", "unit", "window", "from", "to", "advice"});
     MetricDoc& doc = docs[name];
-    doc = {fillFromConfig(d["what"].string(), config, d["what"].path()), d["unit"].string(),
-           fillFromConfig(d["window"].string(), config, d["window"].path())};
+    doc.what = fillFromConfig(d["what"].string(), config, d["what"].path());
+    doc.unit = d["unit"].string();
     if (d.has("advice")) doc.advice = parseAdvice(d["advice"], config);
+    // A data-defined metric's window is written from its spec: one typed beside it could disagree.
+    if (specWindow(config, name, doc)) {
+      for (const char* key : {"window", "from", "to"})
+        if (d.has(key))
+          d[key].fail("expected no \"" + std::string(key) + "\": dynlab writes the window of /metrics/" + name +
+                      " from its spec (" + doc.window + ")");
+      continue;
+    }
+    doc.window = fillFromConfig(d["window"].string(), config, d["window"].path());
     // The window in numbers: "from"/"to" when given, else what its words say ("from t = {/..} s on").
     doc.from = d.has("from") ? windowBound(d["from"], config) : boundIn(doc.window, {"from t = "}, -INFINITY);
     doc.to = d.has("to") ? windowBound(d["to"], config) : boundIn(doc.window, {"until t = ", " to t = "}, INFINITY);
