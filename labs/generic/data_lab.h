@@ -4,7 +4,7 @@
 // (simulation, gains, rubric, metric_docs, figures, submission_options):
 //   "model_file": "fivebar.xml"          MJCF or URDF beside the JSON (physics/model_file)
 //   "actuated": ["left_crank", ...]      the joints the controller drives; the others are passive
-//   "torque_limit": [..]                 N·m per actuated joint
+//   "torque_limit": [..]                 N·m per actuated joint (N on a slide: its actuator pushes)
 //   "tool": {"closure": "pin_C"} | {"body": "left_link", "at": [x, y, z]}   the task point (world
 //                                        coordinates at the file's pose), "axes": ["x", "z"]; none: no
 //                                        task and no trajectory (a passive model: `dynlab figure FILE`)
@@ -55,6 +55,7 @@ struct DataSettings {
   std::vector<int> actuated;
   std::vector<std::string> actuated_names, axis_names;
   controllers::TaskPoint tool;
+  bool tool_on_body = false;  // the tool given as {"body", "at"} (drawn as a stick), not a closure's point
   VecN q0;  // assembled start
   std::shared_ptr<const TaskPath> path;
   std::optional<PushForce<Spatial>> push;  // the environment's push on the tool (the plant has it too)
@@ -99,6 +100,8 @@ class DataLab final : public Lab {
   mutable const double* bounds_of_ = nullptr;  // the trace whose run bounds are cached
   mutable std::size_t bounds_rows_ = 0;
   mutable Eigen::AlignedBox3d bounds_;
+  mutable double arrow_ = 0;  // m: the push's arrow at the push's full value (0: none drawn)
+  mutable double tool_ball_ = 0;  // m: the radius of the tool's ball (a tool on a body)
 };
 
 // True if labs/<name>/ is a data lab folder: <name>.json there, and no .cpp or .h.

@@ -134,6 +134,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
       s.tool.link = cl.link1, s.tool.point = cl.point1;
     } else {
       std::tie(s.tool.link, s.tool.point) = bodyPoint(tool["body"], tool["at"], file, probe);
+      s.tool_on_body = true;
     }
     const JsonView axes = tool["axes"];
     for (std::size_t i = 0, n = axes.size(1, 3); i < n; ++i) {
@@ -163,16 +164,32 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     file.mechanism.forces.push_back(std::make_shared<PushForce<Spatial>>(*s.push));
   }
 
-  // The start: the actuators placed, the loop assembled from the file's pose.
+  // The start: the actuators placed, the loop assembled from the file's pose. "actuated_deg" gives hinges
+  // in degrees (a slide has no degrees: refused, naming it); "actuated" every coordinate in its own unit
+  // (rad for a hinge, m for a slide).
   s.q0 = file.q0;
+  const auto slide = [&](int j) { return file.joints[std::size_t(s.actuated[std::size_t(j)])].type == "slide"; };
+  std::string start_key = "actuated_deg";
   if (m > 0 || c.has("initial")) {
     const JsonView init = c["initial"];
-    init.onlyKeys({"actuated_deg"});
-    init["actuated_deg"].size(std::size_t(m), std::size_t(m));
-    for (int j = 0; j < m; ++j) s.q0[s.actuated[std::size_t(j)]] = init["actuated_deg"].at(std::size_t(j)).inRange(-720, 720) * M_PI / 180.0;
+    init.onlyKeys({"actuated_deg", "actuated"});
+    if (init.has("actuated")) start_key = "actuated";
+    if (init.has("actuated") && init.has("actuated_deg")) init["actuated"].fail("either \"actuated\" (rad, m) or \"actuated_deg\", not both");
+    const JsonView start = init[start_key];
+    start.size(std::size_t(m), std::size_t(m));
+    for (int j = 0; j < m; ++j) {
+      const JsonView u = start.at(std::size_t(j));
+      if (start_key == "actuated") {
+        s.q0[s.actuated[std::size_t(j)]] = u.inRange(slide(j) ? -kMaxCoordinate : -4 * M_PI, slide(j) ? kMaxCoordinate : 4 * M_PI);
+      } else {
+        if (slide(j))
+          u.fail("an angle, but " + s.actuated_names[std::size_t(j)] + " is a slide (m): give the start as /initial/actuated, each joint in its own unit (rad, m)");
+        s.q0[s.actuated[std::size_t(j)]] = u.inRange(-720, 720) * M_PI / 180.0;
+      }
+    }
   }
   // (The probe has the file's geometry; the payloads changed only inertias.)
-  if (!assemble(probe, s.q0, s.actuated)) c["initial"]["actuated_deg"].fail("actuator angles at which the loop closes");
+  if (!assemble(probe, s.q0, s.actuated)) c["initial"][start_key].fail("actuator positions at which the loop closes");
 
   // The path, from where the tool starts (a joint path: from where the actuators start).
   if (c.has("trajectory") && TaskPath::isJointSpace(c["trajectory"])) {
@@ -180,6 +197,13 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     VecN u0(m);
     for (int j = 0; j < m; ++j) u0[j] = s.q0[s.actuated[std::size_t(j)]];
     s.path = std::make_shared<TaskPath>(c["trajectory"], u0, 4 * M_PI);
+    // Degrees move hinges only: a slide's target is metres ("move", the coordinates' own units).
+    const JsonView segs = c["trajectory"]["segments"];
+    for (std::size_t i = 0, n = segs.size(0, 64); i < n; ++i)
+      for (int j = 0; j < m && segs.at(i).has("move_deg"); ++j)
+        if (slide(j))
+          segs.at(i)["move_deg"].fail("a hinge path, but " + s.actuated_names[std::size_t(j)] +
+                                      " is a slide (m): give this segment as \"move\", each joint in its own unit (rad, m)");
   } else if (!s.tool.axes.empty()) {
     const Eigen::Vector3d p0 = probe.pointPosition(s.tool.link, s.tool.point, s.q0);
     VecN x0(Eigen::Index(s.tool.axes.size()));
