@@ -101,6 +101,12 @@ struct Reference {
   VecN force = VecN();  // the environment's force on the tool in the task axes (N), what a sensor reads (empty: 0)
 };
 
+// Newton on (φ(θ), x(θ) − x_d) = 0 over every tree coordinate, minimum-norm steps, from q (the last
+// solution): true when every residual is below 1e-12 within 30 steps; q is left at the last iterate
+// (the nearest the tool gets, for a point out of reach). The controller's inverse kinematics, and the
+// data labs' reach check of a task path (labs/generic/reach.h).
+bool inverseKinematics(ConstrainedMechanism<Spatial>& mech, const TaskPoint& task, const VecN& x_d, VecN& q);
+
 class Controller {
  public:
   using Mech = ConstrainedMechanism<Spatial>;

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "labs/generic/data_lab.h"
+#include "labs/generic/reach.h"
 #include "labs/settings.h"
 #include "physics/closed_chain.h"
 
@@ -209,6 +210,8 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     VecN x0(Eigen::Index(s.tool.axes.size()));
     for (std::size_t i = 0; i < s.tool.axes.size(); ++i) x0[Eigen::Index(i)] = p0[s.tool.axes[i] - 3];
     s.path = std::make_shared<TaskPath>(c["trajectory"], x0, kMaxCoordinate);
+    // Every point of it within reach, away from singular poses (labs/generic/reach.h).
+    if (c.has("trajectory")) checkReach(c["trajectory"], *s.path, s.model, s.actuated, s.tool, s.axis_names, s.q0);
   }
 
   const SimulationSettings sim = parseSimulation(c["simulation"]);
