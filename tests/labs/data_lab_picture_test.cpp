@@ -91,7 +91,8 @@ TEST_CASE("each data lab's mechanism fills at least 75 % of the free part of its
       x0 = std::min(x0, ink.x), y0 = std::min(y0, ink.y), x1 = std::max(x1, ink.right()), y1 = std::max(y1, ink.bottom());
     }
     const double wide = (x1 - x0) / free.w, tall = (y1 - y0) / free.h;
-    MESSAGE(std::string(name) + ": the mechanism spans " << 100 * wide << " % of the free width, " << 100 * tall << " % of its height");
+    const std::string lab = name;
+    MESSAGE(lab << ": the mechanism spans " << 100 * wide << " % of the free width, " << 100 * tall << " % of its height");
     CHECK(std::max(wide, tall) >= 0.75);
   }
 }
