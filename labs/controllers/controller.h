@@ -71,7 +71,7 @@ struct Spec {
   Kind kind = Kind::None;
   double period = 1e-3;        // s, a whole number of steps
   long delay_steps = 0;        // encoders read this many steps late
-  double noise_angle = 0, noise_rate = 0;  // rad, rad/s (standard deviations)
+  double noise_angle = 0, noise_rate = 0;  // rad, rad/s (m, m/s on a slide): standard deviations
   double noise_force = 0;                  // N: the force sensor's (impedance laws)
   std::uint64_t seed = 1;
   VecN constant;               // per actuated joint

@@ -5,19 +5,27 @@
 //   "model_file": "fivebar.xml"          MJCF or URDF beside the JSON (physics/model_file)
 //   "actuated": ["left_crank", ...]      the joints the controller drives; the others are passive
 //   "torque_limit": [..]                 N·m per actuated joint (N on a slide: its actuator pushes)
-//   "tool": {"closure": "pin_C"} | {"body": "left_link", "at": [x, y, z]}   the task point (world
-//                                        coordinates at the file's pose), "axes": ["x", "z"]; none: no
+//   "tool": {"closure": "pin_C"} | {"body": "left_link", "at": [x, y, z]}   the task point, "axes":
+//                                        ["x", "z"]; "at" is in metres, world coordinates at the model
+//                                        file's own pose (its qpos0: every joint at 0 in a URDF), not at
+//                                        "initial"'s pose, and moves with the body from there; none: no
 //                                        task and no trajectory (a passive model: `dynlab figure FILE`)
-//   "initial": {"actuated_deg": [..]}    the actuators' start; the passive joints are assembled
-//   "trajectory": {"segments": [...]}    the task path from the tool's start (labs/generic/task_path.h);
+//   "initial": {"actuated_deg": [..]} | {"actuated": [..]}   the actuators' start, in degrees (hinges
+//                                        only: a slide's is refused) or in each joint's own unit (rad,
+//                                        m); the passive joints are assembled
+//   "trajectory": {"segments": [...]}    the task path from the tool's start (labs/generic/task_path.h),
+//                                        refused when read if a point is out of reach or singular (reach.h);
 //                                        with "space": "joint" a joint path of the actuated joints, fed
 //                                        to the joint laws without inverse kinematics (tool optional)
-//   "plant": {"payloads": [{"body", "at", "mass"}]}   point masses the plant carries and the
-//                                        controller's model does not (scenarios change them)
+//   "plant": {"payloads": [{"body", "at", "mass"}]}   point masses (kg) the plant carries and the
+//                                        controller's model does not (scenarios change them); "at" as
+//                                        the tool's: world metres at the file's pose, fixed to the body
 //   "environment": {"force": {"value": [Fx, Fy, Fz], "start", "rise", "hold"}}   a push on the tool
 //                                        (N, world axes; physics/forces.h's profile), on the plant only:
 //                                        both engines apply J_toolᵀ F inside each step; trace push_x/y/z
 //   "controller": {"kind", "control_period", "delay_steps", "noise": {"angle", "rate", "force", "seed"},
+//                  (the encoders' σ per joint in its own unit: "angle" rad on a hinge, m on a slide;
+//                  "rate" rad/s or m/s)
 //                  "constant", "joint_scale", "posture_omega"}   a law of labs/controllers, gains from
 //                                        "gains"; the impedance laws' force sensor reads the push on the
 //                                        tool (in the task axes) as late as the encoders, noise "force" N
