@@ -66,6 +66,27 @@ std::string checkedModelPath(const JsonView& j, const std::string& folder) {
   j.fail("expected a model file in the lab's folder (" + folder + ") or the dynlab tree (" + tree.string() + "), not found there");
 }
 
+// A metric of actuator efforts alone (tau_<joint> columns, a statistic in their unit) is documented in
+// their unit: N·m for hinges, N for slides (the handout prints metric_docs' unit beside its thresholds).
+template <class Slide>
+void checkEffortUnits(const JsonView& c, const DataSettings& s, const Slide& slide) {
+  if (!c.has("metric_docs")) return;
+  for (const auto& [name, spec] : s.metrics) {
+    if (spec.stat == MetricSpec::Stat::Settling || !c["metric_docs"].has(name) || !c["metric_docs"][name].has("unit")) continue;
+    std::string unit;
+    for (const auto& col : spec.of) {
+      std::string u;
+      for (std::size_t j = 0; j < s.actuated.size(); ++j)
+        if (col == "tau_" + columnName(s.actuated_names[j])) u = slide(int(j)) ? "N" : "N·m";
+      if (u.empty() || (!unit.empty() && u != unit)) unit = "-";  // not an effort, or hinges and slides mixed
+      if (unit.empty()) unit = u;
+    }
+    const JsonView given = c["metric_docs"][name]["unit"];
+    if (unit != "-" && !unit.empty() && given.string() != unit)
+      given.fail("\"" + unit + "\": " + name + " is a statistic of " + (unit == "N" ? "slide actuators' forces (N)" : "hinge actuators' torques (N·m)"));
+  }
+}
+
 }  // namespace
 
 DataSettings parseDataSettings(const JsonView& c, const std::string& name, const std::string& folder,
@@ -317,6 +338,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   for (const int j : s.passive)
     for (const char* a : {"x", "y", "z"}) s.columns.push_back("load_" + columnName(file.joints[std::size_t(j)].name) + "_" + a);
   if (c.has("metrics")) s.metrics = parseMetrics(c["metrics"], s.columns, sim.exercise_duration, s.step.dt);
+  checkEffortUnits(c, s, slide);
   s.plant = std::make_shared<const model_file::LoadedModel>(std::move(file));
   return s;
 }

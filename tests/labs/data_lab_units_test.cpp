@@ -1,7 +1,8 @@
 // Units and frames of a data lab (labs/generic), on a scratch cart-pole written in the test (a slide
 // "cart" along x carrying a hinge "pole" about y):
 //  * a slide actuator's force is in N and a hinge's torque in N·m, in the trace's units and the overlay;
-//    a slide's start or joint path in degrees is refused (one line naming it), in metres accepted;
+//    a slide's start or joint path in degrees is refused (one line naming it), in metres accepted; a
+//    metric of a slide's force documented in N·m is refused at its metric_docs unit;
 //  * tool.at and payloads.at are world coordinates at the model file's pose, carried with their body
 //    (not the lab's start pose): the tool's first trace row is where the body took that point, and a
 //    payload written beside the horizontal pole hangs under the hinge once the pole starts hanging;
@@ -135,6 +136,18 @@ TEST_CASE("a slide's start and joint path are refused in degrees, taken in metre
   CHECK(why.find("cart is a slide") != std::string::npos);
   CHECK(why.find("/initial/actuated") != std::string::npos);
   CHECK(why.find('\n') == std::string::npos);
+  // A metric of the cart's force documented in N·m (as a lab copied from a hinged one would say) is
+  // refused at its unit; in N it is taken.
+  c = cartPole();
+  c["metrics"] = {{"cart_peak", {{"of", "tau_cart"}, {"stat", "max_abs"}}}, {"pole_peak", {{"of", "tau_pole"}, {"stat", "max_abs"}}}};
+  c["metric_docs"] = {{"cart_peak", {{"unit", "N·m"}}}, {"pole_peak", {{"unit", "N·m"}}}};
+  why = refusal(c, f, &path);
+  CHECK(path == "/metric_docs/cart_peak/unit");
+  CHECK(why.find("slide actuators' forces (N)") != std::string::npos);
+  c["metric_docs"]["cart_peak"]["unit"] = "N";
+  CHECK(refusal(c, f) == "");
+  c = cartPole();
+  c["initial"] = {{"actuated_deg", {0.0, 90.0}}};
   // Both spellings at once: which one is meant is unclear.
   c["initial"] = {{"actuated_deg", {0.0, 90.0}}, {"actuated", {0.0, 1.0}}};
   CHECK(refusal(c, f, &path).find("not both") != std::string::npos);
