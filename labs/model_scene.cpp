@@ -226,11 +226,11 @@ void ModelPicture::stage(Scene& s) const {
     const Vec3 d = R.transpose() * (box.corner(Box3::CornerType(k)) - centre);
     half = half.cwiseMax(d.head<2>().cwiseAbs());
   }
-  // Wider than the box, running out of the picture (clipped at the panel): the framed box is the arm's
-  // and the pedestal's, so the floor's near corner does not shrink the arm.
-  half = (1.6 * half).cwiseMax(Eigen::Vector2d::Constant(0.8 * half.maxCoeff()));
-  s.planes.push_back({centre, R, half, kFloor, 0.02 * size, niceStep(0.15 * half.maxCoeff())});
-  s.framing.clip = true;
+  // The box's footprint, framed with it (as the pen lab's floor).
+  s.planes.push_back({centre, R, half, kFloor, 0.02 * size, niceStep(0.25 * half.maxCoeff())});
+  for (const double sx : {-1.0, 1.0})
+    for (const double sy : {-1.0, 1.0})
+      for (const double dz : {0.0, -0.02 * size}) box.extend(centre + R * Vec3(sx * half.x(), sy * half.y(), dz));
   // A pedestal (a column) from the floor up to each joint on the world.
   for (std::size_t i = 0; i < bodies.size(); ++i) {
     if (bodies[i].parent >= 0) continue;
