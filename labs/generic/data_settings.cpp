@@ -73,17 +73,19 @@ void checkEffortUnits(const JsonView& c, const DataSettings& s, const Slide& sli
   if (!c.has("metric_docs")) return;
   for (const auto& [name, spec] : s.metrics) {
     if (spec.stat == MetricSpec::Stat::Settling || !c["metric_docs"].has(name) || !c["metric_docs"][name].has("unit")) continue;
-    std::string unit;
+    // The efforts' common unit (none: a column that is not an effort, or hinges and slides mixed).
+    const char* unit = nullptr;
+    bool efforts = !spec.of.empty();
     for (const auto& col : spec.of) {
-      std::string u;
+      const char* u = nullptr;
       for (std::size_t j = 0; j < s.actuated.size(); ++j)
         if (col == "tau_" + columnName(s.actuated_names[j])) u = slide(int(j)) ? "N" : "N·m";
-      if (u.empty() || (!unit.empty() && u != unit)) unit = "-";  // not an effort, or hinges and slides mixed
-      if (unit.empty()) unit = u;
+      efforts = efforts && u && (!unit || std::string(u) == unit);
+      unit = u;
     }
     const JsonView given = c["metric_docs"][name]["unit"];
-    if (unit != "-" && !unit.empty() && given.string() != unit)
-      given.fail("\"" + unit + "\": " + name + " is a statistic of " + (unit == "N" ? "slide actuators' forces (N)" : "hinge actuators' torques (N·m)"));
+    if (efforts && given.string() != unit)
+      given.fail("\"" + std::string(unit) + "\": " + name + " is a statistic of " + (std::string(unit) == "N" ? "slide actuators' forces (N)" : "hinge actuators' torques (N·m)"));
   }
 }
 
