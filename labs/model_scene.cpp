@@ -16,7 +16,7 @@ using Shape = model_file::Geom::Shape;
 // Bodies whose file keeps MuJoCo's default grey get the labs' link colours, neighbours told apart.
 const Color kPalette[4] = {{0.23f, 0.42f, 0.68f, 1.0f}, {0.20f, 0.58f, 0.55f, 1.0f}, {0.52f, 0.42f, 0.72f, 1.0f}, {0.80f, 0.52f, 0.25f, 1.0f}};
 const Color kWorld{0.60f, 0.60f, 0.60f, 1.0f}, kJoint{0.15f, 0.15f, 0.18f, 1.0f}, kClosure{0.90f, 0.45f, 0.10f, 1.0f};
-const Color kGhost{0.55f, 0.35f, 0.75f, 0.35f}, kFloor{0.86f, 0.86f, 0.84f, 1.0f};
+const Color kGhost{0.55f, 0.35f, 0.75f, 0.35f}, kFloor{0.86f, 0.86f, 0.84f, 1.0f}, kPedestal{0.40f, 0.42f, 0.47f, 1.0f};
 
 Color colorOf(const model_file::Geom& g) {
   if (g.file_color) return {g.rgba[0], g.rgba[1], g.rgba[2], g.rgba[3]};
@@ -176,11 +176,17 @@ void ModelPicture::scene(const VecN& q, const VecN* ghost, const Box3& frame, Sc
     Vec3 h = Vec3::UnitX() - up_.x() * up_;
     if (h.norm() < 0.1) h = Vec3::UnitY() - up_.y() * up_;
     h.normalize();
+    const Vec3 side = up_.cross(h);
     s.camera.ortho = false;
     s.camera.fov_y_deg = 35;
     s.camera.up = up_;
     s.camera.target = box.isEmpty() ? Vec3(Vec3::Zero()) : Vec3(box.center());
-    s.camera.eye = s.camera.target + 0.9 * h - 1.1 * up_.cross(h) + 0.6 * up_;
+    // From the front and a little above, the box's longer level side across the picture (an arm
+    // reaching along x is seen from −y, one reaching along y from +x), so the arm, not the box's
+    // depth, fills the width.
+    const Vec3 d = box.isEmpty() ? Vec3(Vec3::Zero()) : Vec3(box.diagonal());
+    const bool along_h = std::abs(d.dot(h)) >= std::abs(d.dot(side));
+    s.camera.eye = s.camera.target + (along_h ? Vec3(0.5 * h - 1.2 * side) : Vec3(1.2 * h - 0.5 * side)) + 0.55 * up_;
   }
   s.framing.fit = true;
   s.framing.bounds = box;
@@ -200,6 +206,41 @@ void ModelPicture::scene(const VecN& q, const VecN* ghost, const Box3& frame, Sc
   }
   place(q);
   drawBodies(false, s);
+}
+
+void ModelPicture::stage(Scene& s) const {
+  Box3& box = s.framing.bounds;
+  if (planar_ || box.isEmpty()) return;
+  for (const auto& g : model_.drawing.geoms)
+    if (g.shape == Shape::Plane) return;
+  const auto& bodies = model_.mechanism.tree.bodies;
+  // The floor: level (normal up), a tenth of the box's size below its lowest corner, as wide as its footprint.
+  const double size = box.diagonal().norm();
+  double low = 1e300;
+  for (int k = 0; k < 8; ++k) low = std::min(low, up_.dot(box.corner(Box3::CornerType(k))));
+  const double floor = low - 0.05 * size;
+  const Mat3 R = axisSpin(up_, 0);
+  const Vec3 centre = box.center() + (floor - up_.dot(box.center())) * up_;
+  Eigen::Vector2d half = Eigen::Vector2d::Zero();
+  for (int k = 0; k < 8; ++k) {
+    const Vec3 d = R.transpose() * (box.corner(Box3::CornerType(k)) - centre);
+    half = half.cwiseMax(d.head<2>().cwiseAbs());
+  }
+  // The box's footprint, framed with it (as the pen lab's floor).
+  s.planes.push_back({centre, R, half, kFloor, 0.02 * size, niceStep(0.25 * half.maxCoeff())});
+  for (const double sx : {-1.0, 1.0})
+    for (const double sy : {-1.0, 1.0})
+      for (const double dz : {0.0, -0.02 * size}) box.extend(centre + R * Vec3(sx * half.x(), sy * half.y(), dz));
+  // A pedestal (a column) from the floor up to each joint on the world.
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    if (bodies[i].parent >= 0) continue;
+    const Vec3 top = data_.X_world[i].r;
+    const double height = up_.dot(top) - floor, radius = 2.5 * joint_radius_;
+    if (height <= 0) continue;
+    s.cylinders.push_back({top - 0.5 * height * up_, R, radius, 0.5 * height, kPedestal});
+    box.extend(top - height * up_ - Vec3::Constant(radius));
+    box.extend(top + Vec3::Constant(radius));
+  }
 }
 
 VecN traceQ(const Trace& trace, std::size_t row, int n) {

@@ -26,6 +26,12 @@ class ModelPicture {
   // The scene at q; ghost, when given, drawn translucent behind it; framed around `frame` (empty:
   // bounds(q)), so a run framed around the space it moves through holds its camera still.
   void scene(const VecN& q, const VecN* ghost, const Eigen::AlignedBox3d& frame, Scene& out) const;
+  // A stage under a spatial model that stands on the world and draws no floor of its own: a floor slab
+  // with a grid, the framed box's footprint a twentieth of its size below it, and a pedestal from it up
+  // to each joint on the world, so the base does not float; the framed box grows to hold them. Call
+  // after scene(). Nothing for a planar model (its ground mounts show where it is fixed) or one with a
+  // floor of its own.
+  void stage(Scene& out) const;
   // True when every hinge turns about one axis and every slide moves across it: drawn side-on.
   bool planar() const { return planar_; }
 

@@ -90,7 +90,7 @@ void dyn::python::defineModule(py::module_& m) {
       .def_property_readonly("gains", &LabObject::gains, "Current gains: name → value.")
       .def_property_readonly("gain_info", &LabObject::gainInfo, "Each gain's value, min, max, unit and doc.")
       .def_property_readonly("columns", &LabObject::columns, "The trace's columns, in order.")
-      .def_property_readonly("units", &LabObject::units, "Each trace column's SI unit ('' if none).")
+      .def_property_readonly("units", &LabObject::units, "Each trace column's SI unit ('' if none); an actuated joint's by its kind: tau_ in N·m on a hinge, N on a slide.")
       .def_property_readonly("dt", &LabObject::dt)
       .def_property_readonly("duration", &LabObject::duration)
       .def("set_gains", [](LabObject& lab, py::object gains, py::kwargs more) {

@@ -76,27 +76,29 @@ void Controller::taskPosition(const VecN& q, VecN& x) {
   for (std::size_t i = 0; i < task_.axes.size(); ++i) x[Eigen::Index(i)] = p[task_.axes[i] - 3];
 }
 
-// Newton on (φ(θ), x(θ) − x_d) = 0 over every coordinate, minimum-norm steps, from the last solution.
-bool Controller::inverseKinematics(const VecN& x_d, VecN& q) {
-  const int n = mech_->n(), d = int(task_.axes.size());
+bool inverseKinematics(ConstrainedMechanism<Spatial>& mech, const TaskPoint& task, const VecN& x_d, VecN& q) {
+  const int n = mech.n(), d = int(task.axes.size());
   for (int it = 0; it < 30; ++it) {
-    VecN phi, x, jd;
+    VecN phi, x(d), jd;
     MatN G, Jp;
-    mech_->constraint(q, phi, G);
-    taskPosition(q, x);
-    mech_->pointJacobian(task_.link, task_.point, q, VecN::Zero(n), Jp, jd);
+    mech.constraint(q, phi, G);
+    const Eigen::Vector3d p = mech.pointPosition(task.link, task.point, q);
+    for (int i = 0; i < d; ++i) x[i] = p[task.axes[std::size_t(i)] - 3];
+    mech.pointJacobian(task.link, task.point, q, VecN::Zero(n), Jp, jd);
     const int r = int(phi.size());
     VecN f(r + d);
     MatN A(r + d, n);
     f.head(r) = phi, A.topRows(r) = G.leftCols(n);
     f.tail(d) = x - x_d;
-    for (int i = 0; i < d; ++i) A.row(r + i) = Jp.row(task_.axes[std::size_t(i)]);
+    for (int i = 0; i < d; ++i) A.row(r + i) = Jp.row(task.axes[std::size_t(i)]);
     if (f.cwiseAbs().maxCoeff() < 1e-12) return true;
     q.head(n) -= Eigen::CompleteOrthogonalDecomposition<MatN>(A).solve(f);
     if (!q.allFinite()) return false;
   }
   return false;
 }
+
+bool Controller::inverseKinematics(const VecN& x_d, VecN& q) { return controllers::inverseKinematics(*mech_, task_, x_d, q); }
 
 // The joint motion that makes the task point move as (x, x', x''): inverse kinematics on the
 // controller's model, then u_d' = J_x⁻¹ x', u_d'' = J_x⁻¹ (x'' − J_x' u_d') (minimum-norm solutions when

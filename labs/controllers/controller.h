@@ -71,7 +71,7 @@ struct Spec {
   Kind kind = Kind::None;
   double period = 1e-3;        // s, a whole number of steps
   long delay_steps = 0;        // encoders read this many steps late
-  double noise_angle = 0, noise_rate = 0;  // rad, rad/s (standard deviations)
+  double noise_angle = 0, noise_rate = 0;  // rad, rad/s (m, m/s on a slide): standard deviations
   double noise_force = 0;                  // N: the force sensor's (impedance laws)
   std::uint64_t seed = 1;
   VecN constant;               // per actuated joint
@@ -100,6 +100,12 @@ struct Reference {
   bool joint = false;
   VecN force = VecN();  // the environment's force on the tool in the task axes (N), what a sensor reads (empty: 0)
 };
+
+// Newton on (φ(θ), x(θ) − x_d) = 0 over every tree coordinate, minimum-norm steps, from q (the last
+// solution): true when every residual is below 1e-12 within 30 steps; q is left at the last iterate
+// (the nearest the tool gets, for a point out of reach). The controller's inverse kinematics, and the
+// data labs' reach check of a task path (labs/generic/reach.h).
+bool inverseKinematics(ConstrainedMechanism<Spatial>& mech, const TaskPoint& task, const VecN& x_d, VecN& q);
 
 class Controller {
  public:

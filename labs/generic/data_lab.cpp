@@ -117,6 +117,13 @@ class Hooks final : public StepHooks {
   double t_target_ = 0;
 };
 
+// Actuated joint j's effort unit: a slide's actuator pushes (N), a hinge's turns (N·m).
+const char* effortUnit(const DataSettings& s, std::size_t j) {
+  return s.plant->joints[std::size_t(s.actuated[j])].type == "slide" ? "N" : "N·m";
+}
+
+const Color kForce{0.85f, 0.15f, 0.10f, 1.0f}, kTool{0.95f, 0.75f, 0.15f, 1.0f};  // as the pen lab's arrow and pen
+
 std::string fmt(const char* f, double x) {
   char b[48];
   std::snprintf(b, sizeof b, f, x);
@@ -137,7 +144,8 @@ std::string DataLab::unit(const std::string& c) const {
   // A joint path's reference and error columns carry their joint's unit (below).
   const bool joint_path = s_.path && s_.path->joint();
   if (starts("tool_") || (!joint_path && (starts("ref_") || starts("e_")))) return "m";
-  if (starts("tau_") && c != "tau_sat") return "N·m";
+  for (std::size_t j = 0; j < s_.actuated.size(); ++j)
+    if (c == "tau_" + columnName(s_.actuated_names[j])) return effortUnit(s_, j);
   if (starts("load_")) return "N";
   if (starts("f_")) {
     const std::string row = c.substr(c.rfind('_') + 1);
@@ -206,7 +214,10 @@ json DataLab::agreement(const Trace& a, const Trace& b) const {
 }
 
 std::string DataLab::agreementUnit(const std::string& key) const {
-  static const std::map<std::string, std::string> units = {{"max_dq", "rad"}, {"max_dx", "m"}, {"max_df", "N, N·m"}};
+  // max_dq spans every coordinate: rad on hinges, m on slides.
+  bool hinge = false, slide = false;
+  for (const auto& j : s_.plant->joints) (j.type == "slide" ? slide : hinge) = true;
+  const std::map<std::string, std::string> units = {{"max_dq", hinge && slide ? "rad, m" : slide ? "m" : "rad"}, {"max_dx", "m"}, {"max_df", "N, N·m"}};
   return unitIn(units, key);
 }
 
@@ -219,12 +230,40 @@ void DataLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene&
   // The run's bounds frame every picture of it (cached: a video asks for every row).
   if (bounds_of_ != tr.data.data() || bounds_rows_ != tr.rows()) {
     bounds_ = runBounds(picture_, n, tr, ghost);
+    // The push's arrow: 18 % of the run's size at the push's full value; the camera holds it where
+    // the tool starts.
+    arrow_ = bounds_.isEmpty() ? 0.0 : 0.18 * bounds_.diagonal().norm();
+    tool_ball_ = 0.01 * std::max(bounds_.isEmpty() ? 0.0 : bounds_.diagonal().norm(), 0.05);
+    if (s_.push && arrow_ > 0 && tr.rows() > 0 && s_.push->value().tail<3>().norm() > 0) {
+      const Eigen::Vector3d dir = s_.push->value().tail<3>().normalized();
+      const Eigen::Vector3d tail = kinematics_->pointPosition(s_.tool.link, s_.tool.point, traceQ(tr, 0, n)) - 1.08 * arrow_ * dir;
+      bounds_.extend(tail - Eigen::Vector3d::Constant(0.04 * arrow_));
+      bounds_.extend(tail + Eigen::Vector3d::Constant(0.04 * arrow_));
+    }
     bounds_of_ = tr.data.data(), bounds_rows_ = tr.rows();
   }
   const VecN q = traceQ(tr, row, n);
   VecN gq;
   if (ghost && row < ghost->rows()) gq = traceQ(*ghost, row, n);
   picture_.scene(q, gq.size() ? &gq : nullptr, bounds_, out);
+  picture_.stage(out);  // a spatial arm stands on a floor, on a pedestal
+  // A tool given as a body's point: a stick from the body's joint to it, as a pen is drawn.
+  if (s_.tool_on_body) {
+    const Eigen::Vector3d from = kinematics_->pointPosition(s_.tool.link, Eigen::Vector3d::Zero(), q);
+    const Eigen::Vector3d tip = kinematics_->pointPosition(s_.tool.link, s_.tool.point, q);
+    out.capsules.push_back({from, tip, tool_ball_ / 1.6, kTool});
+    out.spheres.push_back({tip, tool_ball_, kTool});
+  }
+  // The push on the tool while it acts (the plant's, this row): an arrow ending just short of the tool.
+  if (s_.push && arrow_ > 0) {
+    const Eigen::Vector3d F(tr.at(row, "push_x"), tr.at(row, "push_y"), tr.at(row, "push_z"));
+    const double full = s_.push->value().tail<3>().norm();
+    if (F.norm() > 1e-9 && full > 0) {
+      const Eigen::Vector3d tool = kinematics_->pointPosition(s_.tool.link, s_.tool.point, q);
+      const Eigen::Vector3d v = F * (arrow_ / full), gap = F.normalized() * tool_ball_;
+      out.arrows.push_back({tool - gap - v, v, 0.04 * arrow_, kForce});
+    }
+  }
   // The path: the reference so far as a thin line, the tool's target as a small ball; a joint path's
   // is where the tool would be at the reference angles.
   if (s_.path && s_.path->joint() && !s_.tool.axes.empty()) {
@@ -267,28 +306,34 @@ void DataLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
   std::vector<std::string> errors;
   const bool joint_path = s_.path && s_.path->joint();
   for (const auto& a : joint_path ? s_.actuated_names : s_.axis_names) errors.push_back("e_" + (joint_path ? columnName(a) : a));
-  const char* unit = joint_path ? "mrad" : "mm";
+  // (A joint path's error is in each joint's unit: mrad on hinges, mm on slides.)
+  std::size_t slides = 0;
+  for (std::size_t j = 0; j < s_.actuated.size(); ++j) slides += std::string(effortUnit(s_, j)) == "N" ? 1 : 0;
+  const std::string unit = !joint_path ? "mm" : slides == 0 ? "mrad" : slides == s_.actuated.size() ? "mm" : "mrad, mm";
   auto norm = [&](std::size_t r) {
     double e = 0;
     for (const auto& c : errors) e += std::pow(tr.at(r, c), 2);
     return 1e3 * std::sqrt(e);
   };
   o.lines = {{"t", fmt("%.3f s", tr.at(row, "t"))}, {"tracking |e|", fmt("%.2f ", norm(row)) + unit}};
+  // What is graded: the tool's distance from the target's response (an impedance exercise), else |e|.
+  auto off = [&](std::size_t r) {
+    double d = 0;
+    for (const auto& a : s_.axis_names) d += std::pow(tr.at(r, "dev_" + a), 2);
+    return 1e3 * std::sqrt(d);
+  };
   // An impedance exercise: the push and the tool's distance from the target's response.
   if (s_.push) {
     const double F = std::sqrt(std::pow(tr.at(row, "push_x"), 2) + std::pow(tr.at(row, "push_y"), 2) + std::pow(tr.at(row, "push_z"), 2));
     o.lines.push_back({"push |F|", fmt("%.1f N", F)});
   }
-  if (s_.target.k > 0) {
-    double d = 0;
-    for (const auto& a : s_.axis_names) d += std::pow(tr.at(row, "dev_" + a), 2);
-    o.lines.push_back({"off target", fmt("%.2f mm", 1e3 * std::sqrt(d))});
-  }
-  for (const auto& a : s_.actuated_names)
-    o.lines.push_back({"τ " + a, fmt("%.2f N·m", tr.at(row, "tau_" + columnName(a)))});
+  if (s_.target.k > 0) o.lines.push_back({"off target", fmt("%.2f mm", off(row))});
+  for (std::size_t j = 0; j < s_.actuated.size(); ++j)
+    o.lines.push_back({"τ " + s_.actuated_names[j], fmt("%.2f ", tr.at(row, "tau_" + columnName(s_.actuated_names[j]))) + effortUnit(s_, j)});
   if (!s_.plant->closures.empty()) o.lines.push_back({"closure |φ|", fmt("%.1e m", tr.at(row, "constraint_residual"))});
-  Series err{std::string("|e| (") + unit + ")", {}, {0.85f, 0.2f, 0.2f, 1.0f}};
-  for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) err.values.push_back(float(norm(r)));
+  const bool target = s_.target.k > 0;
+  Series err{target ? "|x − x_target| (mm)" : "|e| (" + unit + ")", {}, {0.85f, 0.2f, 0.2f, 1.0f}};
+  for (std::size_t r = liveWindowStart(row, 2.0, s_.step.dt); r <= row; ++r) err.values.push_back(float(target ? off(r) : norm(r)));
   o.plots = {err};
 }
 

@@ -4,20 +4,28 @@
 // (simulation, gains, rubric, metric_docs, figures, submission_options):
 //   "model_file": "fivebar.xml"          MJCF or URDF beside the JSON (physics/model_file)
 //   "actuated": ["left_crank", ...]      the joints the controller drives; the others are passive
-//   "torque_limit": [..]                 N·m per actuated joint
-//   "tool": {"closure": "pin_C"} | {"body": "left_link", "at": [x, y, z]}   the task point (world
-//                                        coordinates at the file's pose), "axes": ["x", "z"]; none: no
+//   "torque_limit": [..]                 N·m per actuated joint (N on a slide: its actuator pushes)
+//   "tool": {"closure": "pin_C"} | {"body": "left_link", "at": [x, y, z]}   the task point, "axes":
+//                                        ["x", "z"]; "at" is in metres, world coordinates at the model
+//                                        file's own pose (its qpos0: every joint at 0 in a URDF), not at
+//                                        "initial"'s pose, and moves with the body from there; none: no
 //                                        task and no trajectory (a passive model: `dynlab figure FILE`)
-//   "initial": {"actuated_deg": [..]}    the actuators' start; the passive joints are assembled
-//   "trajectory": {"segments": [...]}    the task path from the tool's start (labs/generic/task_path.h);
+//   "initial": {"actuated_deg": [..]} | {"actuated": [..]}   the actuators' start, in degrees (hinges
+//                                        only: a slide's is refused) or in each joint's own unit (rad,
+//                                        m); the passive joints are assembled
+//   "trajectory": {"segments": [...]}    the task path from the tool's start (labs/generic/task_path.h),
+//                                        refused when read if a point is out of reach or singular (reach.h);
 //                                        with "space": "joint" a joint path of the actuated joints, fed
 //                                        to the joint laws without inverse kinematics (tool optional)
-//   "plant": {"payloads": [{"body", "at", "mass"}]}   point masses the plant carries and the
-//                                        controller's model does not (scenarios change them)
+//   "plant": {"payloads": [{"body", "at", "mass"}]}   point masses (kg) the plant carries and the
+//                                        controller's model does not (scenarios change them); "at" as
+//                                        the tool's: world metres at the file's pose, fixed to the body
 //   "environment": {"force": {"value": [Fx, Fy, Fz], "start", "rise", "hold"}}   a push on the tool
 //                                        (N, world axes; physics/forces.h's profile), on the plant only:
 //                                        both engines apply J_toolᵀ F inside each step; trace push_x/y/z
 //   "controller": {"kind", "control_period", "delay_steps", "noise": {"angle", "rate", "force", "seed"},
+//                  (the encoders' σ per joint in its own unit: "angle" rad on a hinge, m on a slide;
+//                  "rate" rad/s or m/s)
 //                  "constant", "joint_scale", "posture_omega"}   a law of labs/controllers, gains from
 //                                        "gains"; the impedance laws' force sensor reads the push on the
 //                                        tool (in the task axes) as late as the encoders, noise "force" N
@@ -55,6 +63,7 @@ struct DataSettings {
   std::vector<int> actuated;
   std::vector<std::string> actuated_names, axis_names;
   controllers::TaskPoint tool;
+  bool tool_on_body = false;  // the tool given as {"body", "at"} (drawn as a stick), not a closure's point
   VecN q0;  // assembled start
   std::shared_ptr<const TaskPath> path;
   std::optional<PushForce<Spatial>> push;  // the environment's push on the tool (the plant has it too)
@@ -99,6 +108,8 @@ class DataLab final : public Lab {
   mutable const double* bounds_of_ = nullptr;  // the trace whose run bounds are cached
   mutable std::size_t bounds_rows_ = 0;
   mutable Eigen::AlignedBox3d bounds_;
+  mutable double arrow_ = 0;  // m: the push's arrow at the push's full value (0: none drawn)
+  mutable double tool_ball_ = 0;  // m: the radius of the tool's ball (a tool on a body)
 };
 
 // True if labs/<name>/ is a data lab folder: <name>.json there, and no .cpp or .h.

@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "labs/generic/data_lab.h"
+#include "labs/generic/reach.h"
 #include "labs/settings.h"
 #include "physics/closed_chain.h"
 
@@ -63,6 +64,29 @@ std::string checkedModelPath(const JsonView& j, const std::string& folder) {
   const auto tree = std::filesystem::path(labsRoot()).parent_path();
   if (std::filesystem::exists(tree / rel, ec)) return (tree / rel).string();
   j.fail("expected a model file in the lab's folder (" + folder + ") or the dynlab tree (" + tree.string() + "), not found there");
+}
+
+// A metric of actuator efforts alone (tau_<joint> columns, a statistic in their unit) is documented in
+// their unit: N·m for hinges, N for slides (the handout prints metric_docs' unit beside its thresholds).
+template <class Slide>
+void checkEffortUnits(const JsonView& c, const DataSettings& s, const Slide& slide) {
+  if (!c.has("metric_docs")) return;
+  for (const auto& [name, spec] : s.metrics) {
+    if (spec.stat == MetricSpec::Stat::Settling || !c["metric_docs"].has(name) || !c["metric_docs"][name].has("unit")) continue;
+    // The efforts' common unit (none: a column that is not an effort, or hinges and slides mixed).
+    const char* unit = nullptr;
+    bool efforts = !spec.of.empty();
+    for (const auto& col : spec.of) {
+      const char* u = nullptr;
+      for (std::size_t j = 0; j < s.actuated.size(); ++j)
+        if (col == "tau_" + columnName(s.actuated_names[j])) u = slide(int(j)) ? "N" : "N·m";
+      efforts = efforts && u && (!unit || std::string(u) == unit);
+      unit = u;
+    }
+    const JsonView given = c["metric_docs"][name]["unit"];
+    if (efforts && given.string() != unit)
+      given.fail("\"" + std::string(unit) + "\": " + name + " is a statistic of " + (std::string(unit) == "N" ? "slide actuators' forces (N)" : "hinge actuators' torques (N·m)"));
+  }
 }
 
 }  // namespace
@@ -134,6 +158,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
       s.tool.link = cl.link1, s.tool.point = cl.point1;
     } else {
       std::tie(s.tool.link, s.tool.point) = bodyPoint(tool["body"], tool["at"], file, probe);
+      s.tool_on_body = true;
     }
     const JsonView axes = tool["axes"];
     for (std::size_t i = 0, n = axes.size(1, 3); i < n; ++i) {
@@ -163,16 +188,32 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     file.mechanism.forces.push_back(std::make_shared<PushForce<Spatial>>(*s.push));
   }
 
-  // The start: the actuators placed, the loop assembled from the file's pose.
+  // The start: the actuators placed, the loop assembled from the file's pose. "actuated_deg" gives hinges
+  // in degrees (a slide has no degrees: refused, naming it); "actuated" every coordinate in its own unit
+  // (rad for a hinge, m for a slide).
   s.q0 = file.q0;
+  const auto slide = [&](int j) { return file.joints[std::size_t(s.actuated[std::size_t(j)])].type == "slide"; };
+  std::string start_key = "actuated_deg";
   if (m > 0 || c.has("initial")) {
     const JsonView init = c["initial"];
-    init.onlyKeys({"actuated_deg"});
-    init["actuated_deg"].size(std::size_t(m), std::size_t(m));
-    for (int j = 0; j < m; ++j) s.q0[s.actuated[std::size_t(j)]] = init["actuated_deg"].at(std::size_t(j)).inRange(-720, 720) * M_PI / 180.0;
+    init.onlyKeys({"actuated_deg", "actuated"});
+    if (init.has("actuated")) start_key = "actuated";
+    if (init.has("actuated") && init.has("actuated_deg")) init["actuated"].fail("either \"actuated\" (rad, m) or \"actuated_deg\", not both");
+    const JsonView start = init[start_key];
+    start.size(std::size_t(m), std::size_t(m));
+    for (int j = 0; j < m; ++j) {
+      const JsonView u = start.at(std::size_t(j));
+      if (start_key == "actuated") {
+        s.q0[s.actuated[std::size_t(j)]] = u.inRange(slide(j) ? -kMaxCoordinate : -4 * M_PI, slide(j) ? kMaxCoordinate : 4 * M_PI);
+      } else {
+        if (slide(j))
+          u.fail("an angle, but " + s.actuated_names[std::size_t(j)] + " is a slide (m): give the start as /initial/actuated, each joint in its own unit (rad, m)");
+        s.q0[s.actuated[std::size_t(j)]] = u.inRange(-720, 720) * M_PI / 180.0;
+      }
+    }
   }
   // (The probe has the file's geometry; the payloads changed only inertias.)
-  if (!assemble(probe, s.q0, s.actuated)) c["initial"]["actuated_deg"].fail("actuator angles at which the loop closes");
+  if (!assemble(probe, s.q0, s.actuated)) c["initial"][start_key].fail("actuator positions at which the loop closes");
 
   // The path, from where the tool starts (a joint path: from where the actuators start).
   if (c.has("trajectory") && TaskPath::isJointSpace(c["trajectory"])) {
@@ -180,11 +221,20 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     VecN u0(m);
     for (int j = 0; j < m; ++j) u0[j] = s.q0[s.actuated[std::size_t(j)]];
     s.path = std::make_shared<TaskPath>(c["trajectory"], u0, 4 * M_PI);
+    // Degrees move hinges only: a slide's target is metres ("move", the coordinates' own units).
+    const JsonView segs = c["trajectory"]["segments"];
+    for (std::size_t i = 0, n = segs.size(0, 64); i < n; ++i)
+      for (int j = 0; j < m && segs.at(i).has("move_deg"); ++j)
+        if (slide(j))
+          segs.at(i)["move_deg"].fail("a hinge path, but " + s.actuated_names[std::size_t(j)] +
+                                      " is a slide (m): give this segment as \"move\", each joint in its own unit (rad, m)");
   } else if (!s.tool.axes.empty()) {
     const Eigen::Vector3d p0 = probe.pointPosition(s.tool.link, s.tool.point, s.q0);
     VecN x0(Eigen::Index(s.tool.axes.size()));
     for (std::size_t i = 0; i < s.tool.axes.size(); ++i) x0[Eigen::Index(i)] = p0[s.tool.axes[i] - 3];
     s.path = std::make_shared<TaskPath>(c["trajectory"], x0, kMaxCoordinate);
+    // Every point of it within reach, away from singular poses (labs/generic/reach.h).
+    if (c.has("trajectory")) checkReach(c["trajectory"], *s.path, s.model, s.actuated, s.tool, s.axis_names, s.q0);
   }
 
   const SimulationSettings sim = parseSimulation(c["simulation"]);
@@ -290,6 +340,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   for (const int j : s.passive)
     for (const char* a : {"x", "y", "z"}) s.columns.push_back("load_" + columnName(file.joints[std::size_t(j)].name) + "_" + a);
   if (c.has("metrics")) s.metrics = parseMetrics(c["metrics"], s.columns, sim.exercise_duration, s.step.dt);
+  checkEffortUnits(c, s, slide);
   s.plant = std::make_shared<const model_file::LoadedModel>(std::move(file));
   return s;
 }

@@ -29,6 +29,11 @@ class TaskPath {
   // The path at t: position, velocity and acceleration.
   void at(double t, VecN& x, VecN& xd, VecN& xdd) const;
   double duration() const { return end_; }
+  // Segment i (in the JSON's order) runs over [segmentStart(i), segmentStart(i) + segmentTime(i)]; a hold stays put.
+  std::size_t segments() const { return segments_.size(); }
+  double segmentStart(std::size_t i) const { return segments_[i].t0; }
+  double segmentTime(std::size_t i) const { return segments_[i].T; }
+  bool segmentHolds(std::size_t i) const { return segments_[i].kind == Segment::Kind::Hold; }
   bool joint() const { return joint_; }
 
  private:
