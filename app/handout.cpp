@@ -308,6 +308,13 @@ std::string html(const std::string& markdown, const std::string& title) {
 
 }  // namespace
 
+HandoutText handoutText(const HandoutArgs& a) {
+  LoadedLab loaded = loadLab(a.lab, a.config);
+  Handout h{a.lab, loaded.config_file, loaded.config, loaded.entry, parseRubric(JsonView(loaded.config, loaded.config_file))};
+  const Prose prose = readProse(fs::path(labFolder(a.lab)) / "handout.md", JsonView(loaded.config, loaded.config_file));
+  return {h.markdown(prose), loaded.config.value("title", a.lab)};
+}
+
 int handout(const HandoutArgs& a) {
   std::string md, page;
   std::vector<std::string> formats;
@@ -322,12 +329,9 @@ int handout(const HandoutArgs& a) {
       formats.push_back(f);
     }
     if (formats.empty()) throw InputError("<command line>", "--format", "expected at least one of md, html");
-    LoadedLab loaded = loadLab(a.lab, a.config);
-    Handout h{a.lab, loaded.config_file, loaded.config, loaded.entry, parseRubric(JsonView(loaded.config, loaded.config_file))};
-    const Prose prose = readProse(fs::path(defaultConfigPath(a.lab)).parent_path() / "handout.md",
-                                  JsonView(loaded.config, loaded.config_file));
-    md = h.markdown(prose);
-    page = html(md, loaded.config.value("title", a.lab) + " — handout");
+    const HandoutText text = handoutText(a);
+    md = text.markdown;
+    page = html(md, text.title + " — handout");
   } catch (const InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

@@ -43,7 +43,12 @@ std::string labsRoot() {
   return std::string(home && *home ? home : DYNLAB_SOURCE_DIR) + "/labs";
 }
 
-std::string defaultConfigPath(const std::string& name) { return labsRoot() + "/" + name + "/" + name + ".json"; }
+std::string labFolder(const std::string& name) {
+  const LabEntry* e = findLab(name);
+  return e && !e->folder.empty() ? e->folder : labsRoot() + "/" + name;
+}
+
+std::string defaultConfigPath(const std::string& name) { return labFolder(name) + "/" + name + ".json"; }
 
 std::string stoppedSentence(const std::string& failure, double t) {
   if (failure.rfind("stopped: ", 0) == 0) return failure;
