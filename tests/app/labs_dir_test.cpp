@@ -217,11 +217,13 @@ TEST_CASE("a relative model path resolves in the lab's folder first, then the tr
   for (const std::string& s : {config.string(), std::string("/model_file"), lab.string(), std::string(DYNLAB_SOURCE_DIR)})
     CHECK_MESSAGE(r.err.find(s) != std::string::npos, "missing: " << s << " in " << r.err);
 
-  // A file that links out of both folders, and a path climbing out: refused at /model_file.
-  fs::create_directories(dir / "elsewhere");
-  fs::copy_file(fs::path(DYNLAB_SOURCE_DIR) / "labs/fivebar/fivebar.xml", dir / "elsewhere/fivebar.xml");
-  fs::create_symlink(dir / "elsewhere/fivebar.xml", lab / "linked.xml");
-  for (const char* path : {"linked.xml", "../../elsewhere/fivebar.xml"}) {
+  // A file that links out of both folders (the scratch folder is inside the build tree: this one is
+  // not), and a path climbing out: refused at /model_file.
+  const fs::path elsewhere = fs::temp_directory_path() / ("dynlab_labs_dir_" + std::to_string(::getpid()));
+  fs::create_directories(elsewhere);
+  fs::copy_file(fs::path(DYNLAB_SOURCE_DIR) / "labs/fivebar/fivebar.xml", elsewhere / "fivebar.xml", fs::copy_options::overwrite_existing);
+  fs::create_symlink(elsewhere / "fivebar.xml", lab / "linked.xml");
+  for (const std::string path : {"linked.xml", "../../elsewhere/fivebar.xml"}) {
     d["model_file"] = path;
     writeFile(config, d.dump(1));
     r = runIt();
@@ -232,20 +234,19 @@ TEST_CASE("a relative model path resolves in the lab's folder first, then the tr
     CHECK(r.err.find("/model_file") != std::string::npos);
     CHECK(r.err.find("expected a model file") != std::string::npos);
   }
+  fs::remove_all(elsewhere);
 }
 
 TEST_CASE("check-lab builds the handout and checks the README: either broken fails it, naming what") {
   const TempDir dir("labs_dir_prose");
-  const fs::path lab = newLab(dir, "prose", dir / "labs");
-  const std::vector<std::string> check = {"check-lab", "prose", "--skip-cli", "--labs", (dir / "labs").string()};
+  const fs::path lab = newLab(dir, "zither", dir / "labs");
+  const std::vector<std::string> check = {"check-lab", "zither", "--skip-cli", "--labs", (dir / "labs").string()};
   // A placeholder naming nothing in the JSON (what a JSON edit leaves behind), and a README that is not UTF-8.
-  writeFile(lab / "handout.md", readFile(lab / "handout.md") + "\nThe second crank is {/actuated/1}.\n");
-  writeFile(lab / "README.md", "# Lab: prose \xE9t\xE9\n");
-  Result r = dynlab(dir, check, [] {
-    ProcessOptions o;
-    o.timeout_s = 900;
-    return o;
-  }());
+  writeFile(lab / "handout.md", readFile(lab / "handout.md") + "\nThe third crank is {/actuated/2}.\n");
+  writeFile(lab / "README.md", "# Lab: zither \xE9t\xE9\n");
+  ProcessOptions slow;
+  slow.timeout_s = 900;
+  Result r = dynlab(dir, check, slow);
   INFO(r.out, r.err);
   CHECK(r.code == 1);
   std::string handout, readme;
@@ -254,8 +255,8 @@ TEST_CASE("check-lab builds the handout and checks the README: either broken fai
     if (line.rfind("  FAIL  handout", 0) == 0) handout = line;
     if (line.rfind("  FAIL  readme", 0) == 0) readme = line;
   }
-  CHECK(handout.find("dynlab handout prose") != std::string::npos);
-  CHECK(handout.find("{/actuated/1}") != std::string::npos);
+  CHECK(handout.find("dynlab handout zither") != std::string::npos);
+  CHECK(handout.find("{/actuated/2}") != std::string::npos);
   CHECK(handout.find((lab / "handout.md").string()) != std::string::npos);
   CHECK(readme.find((lab / "README.md").string()) != std::string::npos);
   CHECK(readme.find("UTF-8") != std::string::npos);
@@ -264,13 +265,15 @@ TEST_CASE("check-lab builds the handout and checks the README: either broken fai
   // The README copied from another lab, and one that is missing; `dynlab handout` agrees with check-lab.
   writeFile(lab / "handout.md", "## Mechanism\n\nA {/model_file}.\n\n## Exercise\n\nTrack it.\n");
   fs::copy_file(fs::path(DYNLAB_SOURCE_DIR) / "labs/fivebar/README.md", lab / "README.md", fs::copy_options::overwrite_existing);
-  r = dynlab(dir, cat(check, {}), [] {
-    ProcessOptions o;
-    o.timeout_s = 900;
-    return o;
-  }());
+  r = dynlab(dir, check, slow);
   CHECK(r.out.find("  ok    handout ") != std::string::npos);
   CHECK(r.out.find("  FAIL  readme") != std::string::npos);
-  CHECK(r.out.find("expected the lab's name prose") != std::string::npos);
-  CHECK(dynlab(dir, {"handout", "prose", "--labs", (dir / "labs").string(), "--out", "h"}).code == 0);
+  CHECK(r.out.find("expected the lab's name zither") != std::string::npos);
+  CHECK(r.code == 1);
+  CHECK(dynlab(dir, {"handout", "zither", "--labs", (dir / "labs").string(), "--out", "h"}).code == 0);
+  fs::remove(lab / "README.md");
+  r = dynlab(dir, check, slow);
+  CHECK(r.code == 1);
+  CHECK(r.out.find("  FAIL  readme") != std::string::npos);
+  CHECK(r.out.find((lab / "README.md").string()) != std::string::npos);
 }
