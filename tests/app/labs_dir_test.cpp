@@ -277,3 +277,48 @@ TEST_CASE("check-lab builds the handout and checks the README: either broken fai
   CHECK(r.out.find("  FAIL  readme") != std::string::npos);
   CHECK(r.out.find((lab / "README.md").string()) != std::string::npos);
 }
+
+TEST_CASE("a lab outside the tree grades with a replay line that runs as printed, in a batch, and packs into the autograder") {
+  const TempDir dir("labs_dir_grade");
+  const fs::path lab = newLab(dir, "outside", dir / "labs");
+  const std::vector<std::string> labs = {"--labs", (dir / "labs").string()};
+  Result r = dynlab(dir, cat({"grade", (lab / "examples/joint_pd.json").string(), "--out", "g", "--no-plots"}, labs));
+  INFO(r.out, r.err);
+  REQUIRE(r.code == 0);
+  const std::string replay = commandLine(r.out.substr(r.out.find("replay:") + 7), "--replay");
+  REQUIRE(!replay.empty());
+  r = run(dir, shellWords(replay));
+  INFO(replay, "\n", r.out, r.err);
+  CHECK(r.code == 0);
+  CHECK(r.out.find("replay: match") != std::string::npos);
+
+  // A batch grades each submission in a process of its own: each finds the lab too.
+  fs::create_directories(dir / "subs");
+  for (const char* f : {"joint_pd.json", "task_pd.json"}) fs::copy_file(lab / "examples" / f, dir / "subs" / f);
+  r = dynlab(dir, cat({"grade", "--batch", "subs", "--out", "batch", "--no-plots"}, labs));
+  INFO(r.out, r.err);
+  CHECK(r.code == 0);
+  for (const char* f : {"joint_pd", "task_pd"}) {
+    const json results = json::parse(readFile(dir / "batch" / f / "results.json"));
+    CHECK(results["score"].get<double>() > 0);
+  }
+
+  // The autograder bundle carries the lab's folder in its tree (names are stored plainly in a zip),
+  // without its instructor answers.
+  r = dynlab(dir, cat({"autograder", "outside", "--out", "outside.zip"}, labs));
+  INFO(r.err);
+  REQUIRE(r.code == 0);
+  const std::string zip = readFile(dir / "outside.zip");
+  CHECK(zip.find("source/labs/outside/outside.json") != std::string::npos);
+  CHECK(zip.find("source/labs/outside/examples/joint_pd.json") != std::string::npos);
+  CHECK(zip.find("source/labs/outside/instructor/") == std::string::npos);
+  CHECK(zip.find("source/labs/fivebar/fivebar.json") != std::string::npos);
+
+  // The window is another program (dynlab-ui, exec'd by dynlab ui): it is told the folders too.
+  if (haveXvfb()) {
+    r = run(dir, inXvfb({DYNLAB_BIN, "ui", "outside", "--labs", (dir / "labs").string(), "--frames", "2"}));
+    INFO(r.out, r.err);
+    CHECK(r.code == 0);
+    CHECK(r.out.find("dynlab-ui: 2 frames") != std::string::npos);
+  }
+}
