@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <map>
 #include <sstream>
@@ -43,11 +42,10 @@ struct Prose {
 };
 
 Prose readProse(const fs::path& file, const JsonView& config) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string(), "/", "expected the lab's handout prose (## Mechanism, ## Exercise, ## Hints)");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
+  std::error_code ec;
+  if (!fs::exists(file, ec)) throw InputError(file.string(), "/", "expected the lab's handout prose (## Mechanism, ## Exercise, ## Hints)");
+  // A lab folder is input too: a regular file of valid UTF-8 (a FIFO there is refused, never waited on).
+  std::string text = readTextFile(file.string(), 1u << 20);
   // Comments are notes to the author, not to the student.
   for (std::size_t a; (a = text.find("<!--")) != std::string::npos;) {
     const std::size_t b = text.find("-->", a);

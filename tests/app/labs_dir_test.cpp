@@ -7,6 +7,8 @@
 #include <doctest/doctest.h>
 
 #include <nlohmann/json.hpp>
+#include <sys/stat.h>
+
 #include <sstream>
 
 #include "tests/app/cli_run.h"
@@ -276,6 +278,21 @@ TEST_CASE("check-lab builds the handout and checks the README: either broken fai
   CHECK(r.code == 1);
   CHECK(r.out.find("  FAIL  readme") != std::string::npos);
   CHECK(r.out.find((lab / "README.md").string()) != std::string::npos);
+  // A lab folder is input: a FIFO as its prose is refused at once (never waited on), naming the file.
+  fs::remove(lab / "handout.md");
+  REQUIRE(::mkfifo((lab / "handout.md").c_str(), 0644) == 0);
+  REQUIRE(::mkfifo((lab / "README.md").c_str(), 0644) == 0);
+  slow.timeout_s = 120;
+  r = dynlab(dir, check, slow);
+  CHECK_FALSE(r.timed_out);
+  CHECK(r.code == 1);
+  for (const char* file : {"handout.md", "README.md"}) {
+    INFO(file, "\n", r.out);
+    CHECK(r.out.find((lab / file).string() + ": /: expected a regular file") != std::string::npos);
+  }
+  r = dynlab(dir, cat({"handout", "zither", "--out", "h2"}, {"--labs", (dir / "labs").string()}), slow);
+  CHECK(r.code == 2);
+  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
 }
 
 TEST_CASE("a lab outside the tree grades with a replay line that runs as printed, in a batch, and packs into the autograder") {
