@@ -12,6 +12,7 @@
 //     not close is reported with no feedback), so every rubric metric exists for every option.
 #pragma once
 #include <functional>
+#include <list>
 #include <map>
 #include <memory>
 #include <string>
@@ -123,7 +124,9 @@ struct LabEntry {
                             // DYNLAB_LABS; labs/generic/lab_folders.h); empty: the dynlab tree
 };
 
-std::vector<LabEntry>& labRegistry();  // sorted by name
+// Sorted by name. A list: an entry stays where it is while labs are added (a folder of labs given to
+// Python's dynlab.Lab(..., labs=) after another Lab holds its entry).
+std::list<LabEntry>& labRegistry();
 const LabEntry* findLab(const std::string& name);
 // Adds a lab (at static initialisation, or at run time from a test); false, and nothing added, if
 // the name is taken.

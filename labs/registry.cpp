@@ -11,16 +11,16 @@
 
 namespace dyn {
 
-std::vector<LabEntry>& labRegistry() {
-  static std::vector<LabEntry> entries;
+std::list<LabEntry>& labRegistry() {
+  static std::list<LabEntry> entries;
   return entries;
 }
 
 bool registerLab(LabEntry entry) {
   if (findLab(entry.name)) return false;
   auto& r = labRegistry();
-  r.push_back(std::move(entry));
-  std::sort(r.begin(), r.end(), [](const LabEntry& a, const LabEntry& b) { return a.name < b.name; });
+  const auto at = std::find_if(r.begin(), r.end(), [&](const LabEntry& e) { return entry.name < e.name; });
+  r.insert(at, std::move(entry));
   return true;
 }
 

@@ -380,8 +380,11 @@ try:
     print("found without labs=")
 except dynlab.InputError as e:
     print("unknown" if "unknown lab" in str(e) else str(e))
+held = [dynlab.Lab(name) for name in dynlab.labs()]  # each holds its lab's registry entry while labs are added
 lab = dynlab.Lab("pylab", labs={self.folder!r})
 print(lab.name, os.path.dirname(lab.config) == os.path.join({self.folder!r}, "pylab"))
+for other in held:
+    assert other.run(engine="hand", duration=0.01)["status"] == "ok", other.name
 names = dynlab.labs()
 print("pylab" in names, "fivebar" in names, "slider_crank" in names)
 print(lab.run(engine="hand", duration=0.05)["status"])
