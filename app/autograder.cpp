@@ -81,6 +81,18 @@ void addSourceTree(const fs::path& src, const std::string& zip_path, std::vector
   }
 }
 
+// A lab folder outside the tree, under source/labs/<lab>/ (what addSourceTree leaves out, left out).
+void addLabFolder(const fs::path& folder, const std::string& lab, const std::string& zip_path, std::vector<Entry>& out) {
+  for (auto it = fs::recursive_directory_iterator(folder); it != fs::recursive_directory_iterator(); ++it) {
+    if (skipped(*it)) {
+      if (it->is_directory()) it.disable_recursion_pending();
+      continue;
+    }
+    if (it->is_regular_file() && !it->is_symlink())
+      out.push_back({"source/labs/" + lab + "/" + fs::relative(it->path(), folder).generic_string(), readFile(it->path(), zip_path), 0644u});
+  }
+}
+
 // setup.sh: once, as root, when Gradescope builds the image (Ubuntu 22.04).
 std::string setupScript() {
   return replaceAll(R"SH(#!/usr/bin/env bash
@@ -339,13 +351,13 @@ void writeZip(std::vector<Entry> entries, const std::string& zip_path) {
 
 }  // namespace
 
-void writeAutograder(const std::string& lab, const std::string& source_dir, const std::string& zip_path) {
+void writeAutograder(const std::string& lab, const std::string& source_dir, const std::string& zip_path, const std::string& lab_folder) {
   // The lab: a plain name with its default config in the tree (the scripts quote it as is).
   const bool plain = !lab.empty() && std::all_of(lab.begin(), lab.end(), [](unsigned char c) {
     return std::isalnum(c) || c == '_' || c == '-';
   });
   if (!plain) fail(zip_path, "\"" + lab + "\" is not a lab name");
-  const fs::path config_file = fs::path(source_dir) / "labs" / lab / (lab + ".json");
+  const fs::path config_file = (lab_folder.empty() ? fs::path(source_dir) / "labs" / lab : fs::path(lab_folder)) / (lab + ".json");
   if (!fs::is_regular_file(config_file)) fail(zip_path, "no lab config " + config_file.string());
   nlohmann::json config;
   try {
@@ -367,6 +379,11 @@ void writeAutograder(const std::string& lab, const std::string& source_dir, cons
     entries.push_back({"course_secret", secret, 0600u});
   }
   addSourceTree(source_dir, zip_path, entries);
+  if (!lab_folder.empty()) {
+    if (std::any_of(entries.begin(), entries.end(), [&](const Entry& e) { return e.name.rfind("source/labs/" + lab + "/", 0) == 0; }))
+      fail(zip_path, "the dynlab tree has a folder labs/" + lab + " already");
+    addLabFolder(lab_folder, lab, zip_path, entries);
+  }
   // The zip being written may sit inside the tree: never pack it (or its temp file) into itself.
   const fs::path out = fs::weakly_canonical(zip_path);
   std::erase_if(entries, [&](const Entry& e) {

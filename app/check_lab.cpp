@@ -1,5 +1,8 @@
 // dynlab check-lab LAB: the every-lab contract (app/lab_check.h) on one lab, for whoever writes a
 // lab: each check with ok/FAIL and one line, then the shares the grade gives and the passive drift.
+// Two checks of the lab's prose follow the contract's: the handout builds as `dynlab handout` builds
+// it, and the lab's README.md is there, valid UTF-8, titled, names the lab and links only to files
+// that exist.
 #include <unistd.h>
 
 #include <algorithm>
@@ -8,7 +11,10 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <sstream>
+
 #include "app/commands.h"
+#include "app/course.h"
 #include "app/lab_check.h"
 #include "grading/escape.h"
 #include "labs/config.h"
@@ -44,6 +50,64 @@ struct ScratchDir {
   }
 };
 
+// The handout, built in memory as `dynlab handout LAB` builds it.
+LabCheck handoutCheck(const std::string& lab) {
+  try {
+    HandoutArgs args;
+    args.lab = lab;
+    const std::string md = handoutText(args).markdown;
+    return {"handout", true, "builds as `dynlab handout " + lab + "` writes it (" +
+                                 std::to_string(std::count(md.begin(), md.end(), '\n')) + " lines of Markdown)"};
+  } catch (const std::exception& e) {
+    return {"handout", false, std::string("`dynlab handout ") + lab + "` fails: " + e.what()};
+  }
+}
+
+// What is wrong with the lab's README.md, or "" (detail then says what holds).
+std::string readmeProblem(const std::string& lab, std::string& detail) {
+  const fs::path file = fs::path(labFolder(lab)) / "README.md";
+  std::string text;
+  try {
+    text = readTextFile(file.string(), 1u << 20);  // a regular file, valid UTF-8, no NUL, at most 1 MB
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  std::string bare = text;  // without HTML comments (notes to the author)
+  for (std::size_t a; (a = bare.find("<!--")) != std::string::npos;) {
+    const std::size_t b = bare.find("-->", a);
+    bare.erase(a, b == std::string::npos ? std::string::npos : b + 3 - a);
+  }
+  std::istringstream lines(bare);
+  std::string first;
+  while (std::getline(lines, first) && first.find_first_not_of(" \t\r") == std::string::npos) {
+  }
+  if (first.rfind("# ", 0) != 0) return file.string() + ": expected a title line \"# ...\" first";
+  // Plain scans, no std::regex: libstdc++'s recurses per character and a README may be 1 MB. The name
+  // anywhere (in a path too: motion_control's README names it in motion_control_test.cpp).
+  const bool named = bare.find(lab) != std::string::npos;
+  if (!named) return file.string() + ": expected the lab's name " + lab + " in it (is it another lab's README?)";
+  // Relative links ("[text](path)", "![pic](path)") name files that exist, from the README's folder.
+  int links = 0;
+  for (std::size_t at = bare.find("]("); at != std::string::npos; at = bare.find("](", at + 2)) {
+    const std::size_t end = bare.find_first_of(") \t\r\n", at + 2);
+    if (end == std::string::npos || bare[end] != ')' || end == at + 2) continue;
+    std::string target = bare.substr(at + 2, end - at - 2);
+    if (target.find("://") != std::string::npos || target.rfind("mailto:", 0) == 0 || target[0] == '#') continue;
+    target = target.substr(0, target.find('#'));
+    std::error_code ec;
+    if (!fs::exists(file.parent_path() / target, ec)) return file.string() + ": the link " + target + " names no file";
+    ++links;
+  }
+  detail = "README.md: valid UTF-8, titled, names " + lab + ", " + std::to_string(links) + " relative link(s) resolve";
+  return "";
+}
+
+LabCheck readmeCheck(const std::string& lab) {
+  std::string detail;
+  const std::string problem = readmeProblem(lab, detail);
+  return {"readme", problem.empty(), problem.empty() ? detail : problem};
+}
+
 }  // namespace
 
 int checkLab(const CheckLabArgs& args) {
@@ -51,7 +115,8 @@ int checkLab(const CheckLabArgs& args) {
   if (!entry) {
     std::string list;
     for (const auto& e : labRegistry()) list += (list.empty() ? "" : ", ") + e.name;
-    std::fprintf(stderr, "error: <command line>: LAB: unknown lab \"%s\" (known labs: %s)\n", termText(args.lab).c_str(), list.c_str());
+    std::fprintf(stderr, "error: <command line>: LAB: unknown lab \"%s\" (known labs: %s; a lab outside the dynlab tree: --labs DIR)\n",
+                 termText(args.lab).c_str(), list.c_str());
     return 2;
   }
   json config;
@@ -70,10 +135,11 @@ int checkLab(const CheckLabArgs& args) {
     std::error_code ec;
     options.dynlab_binary = fs::read_symlink("/proc/self/exe", ec).string();
   }
-  std::printf("dynlab check-lab %s: the lab contract (%s)\n", entry->name.c_str(),
-              fs::path(defaultConfigPath(entry->name)).parent_path().c_str());
+  std::printf("dynlab check-lab %s: the lab contract (%s)\n", entry->name.c_str(), termText(labFolder(entry->name)).c_str());
   std::fflush(stdout);
-  const LabCheckReport report = dyn::checkLab(*entry, config, options);
+  LabCheckReport report = dyn::checkLab(*entry, config, options);
+  report.checks.push_back(handoutCheck(entry->name));
+  report.checks.push_back(readmeCheck(entry->name));
   int failed = 0;
   std::size_t width = 0;
   for (const LabCheck& c : report.checks) width = std::max(width, c.check.size());

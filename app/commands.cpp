@@ -33,7 +33,11 @@ namespace dyn::app {
 
 int listLabs() {
   // A data-defined lab's summary is its JSON's title: escaped and clipped like every name from a file.
-  for (const auto& e : labRegistry()) std::printf("%-16s %s\n", e.name.c_str(), termName(e.summary).c_str());
+  // A lab outside the tree (--labs, DYNLAB_LABS) says where it is.
+  for (const auto& e : labRegistry()) {
+    const std::string where = e.labs_folder.empty() ? "" : "  [" + termText(e.folder) + "]";
+    std::printf("%-16s %s%s\n", e.name.c_str(), termName(e.summary).c_str(), where.c_str());
+  }
   return 0;
 }
 
@@ -221,9 +225,7 @@ static void injectFault(const std::string& submission) {
   if (s.find("throw:" + stem) != std::string::npos) throw std::logic_error("injected fault for " + stem);
 }
 
-// The word that runs this dynlab in a shell: "dynlab" when that is what PATH finds, else its
-// absolute path (a build tree's binary), so a printed command runs as printed.
-static std::string dynlabProgram() {
+std::string dynlabProgram() {
   std::error_code ec;
   const fs::path self = fs::read_symlink("/proc/self/exe", ec);
   if (ec) return "dynlab";
@@ -292,7 +294,8 @@ int gradeOne(const GradeArgs& a) {
               termText((fs::path(a.out) / "report.html").string()).c_str());
   if (!g.input_error && !g.internal_error)
     std::printf("replay:  %s\n", termText(replayCommand(dynlabProgram(), (fs::path(a.out) / "results.json").string(),
-                                                         a.submission, gradeOptions(args, ""))).c_str());
+                                                         a.submission, gradeOptions(args, ""),
+                                                         g.results["extra_data"].value("lab", std::string()))).c_str());
   // A grade the time budget cut short is written (score 0 for what it stopped) but is not a grade.
   if (g.out_of_time) std::fprintf(stderr, "error: %s: the grading time budget of %g s ran out; the grade is incomplete\n",
                                   utf8Quotable(a.submission).c_str(), a.time_budget);
@@ -361,7 +364,8 @@ int writeAutograderZip(const std::string& lab, const std::string& out) {
     return 2;
   }
   try {
-    writeAutograder(lab, DYNLAB_SOURCE_DIR, out);
+    const LabEntry* entry = findLab(lab);
+    writeAutograder(lab, DYNLAB_SOURCE_DIR, out, entry->labs_folder.empty() ? "" : entry->folder);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 1;

@@ -74,7 +74,9 @@ struct CheckLabArgs {
 // dynlab new-lab NAME --from LAB: a data-defined lab copied from another (app/new_lab.cpp).
 struct NewLabArgs {
   std::string name, from;
-  std::string labs;  // the folder of lab folders (default: the dynlab tree's labs/)
+  // --labs: the first is the folder of lab folders written into (default: the first DYNLAB_LABS
+  // folder, else the dynlab tree's labs/); all are searched for --from (app/lab_options.h)
+  std::vector<std::string> labs;
 };
 
 struct BenchArgs {
@@ -96,6 +98,10 @@ json defaultsSubmission(const json& config, const std::string& lab);
 std::string labDisplayName(const json& config, const std::string& lab);
 // Where a command writes by default: out/LAB/SUB, or out/LAB/scenarios/NAME/SUB under a scenario.
 std::filesystem::path defaultOut(const std::string& lab, const std::string& scenario, const std::string& sub = "");
+
+// The word that runs this dynlab in a shell: "dynlab" when that is what PATH finds, else its
+// absolute path (a build tree's binary) as a shell word, so a printed command runs as printed.
+std::string dynlabProgram();
 
 // "key = value unit, ..." of every top-level number of a lab's agreement (run, bench).
 std::string describeAgreement(const Lab& lab, const json& agreement);

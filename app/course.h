@@ -19,6 +19,13 @@ struct MapArgs {
   int jobs = 0;  // threads for --sim (0: every core)
 };
 
+// The handout as `dynlab handout` writes it (its Markdown, and the lab's title), nothing written;
+// throws InputError on bad input (check-lab builds it this way).
+struct HandoutText {
+  std::string markdown, title;
+};
+HandoutText handoutText(const HandoutArgs& args);
+
 // Each returns the exit code: 0 written, 1 a write failed, 2 bad input (one line, nothing written).
 int handout(const HandoutArgs& args);
 int map(const MapArgs& args);

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iterator>
 #include <map>
 #include <sstream>
@@ -44,11 +43,10 @@ struct Prose {
 };
 
 Prose readProse(const fs::path& file, const JsonView& config) {
-  std::ifstream in(file);
-  if (!in) throw InputError(file.string(), "/", "expected the lab's handout prose (## Mechanism, ## Exercise, ## Hints)");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  std::string text = ss.str();
+  std::error_code ec;
+  if (!fs::exists(file, ec)) throw InputError(file.string(), "/", "expected the lab's handout prose (## Mechanism, ## Exercise, ## Hints)");
+  // A lab folder is input too: a regular file of valid UTF-8 (a FIFO there is refused, never waited on).
+  std::string text = readTextFile(file.string(), 1u << 20);
   // Comments are notes to the author, not to the student.
   for (std::size_t a; (a = text.find("<!--")) != std::string::npos;) {
     const std::size_t b = text.find("-->", a);
@@ -337,6 +335,16 @@ std::string html(const std::string& markdown, const std::string& title) {
 
 }  // namespace
 
+HandoutText handoutText(const HandoutArgs& a) {
+  const PlantChoice student = studentPlant(a.student);
+  LoadedLab loaded = loadLab(a.lab, a.config, "", std::nullopt, student);
+  const json written = loadJsonFile(loaded.config_file);
+  Handout h{a.lab, loaded.config_file, loaded.config, loaded.entry, parseRubric(JsonView(loaded.config, loaded.config_file)),
+            student, drawPlant(JsonView(written, loaded.config_file), PlantChoice{}, a.lab)};
+  const Prose prose = readProse(fs::path(labFolder(a.lab)) / "handout.md", JsonView(loaded.config, loaded.config_file));
+  return {h.markdown(prose), loaded.config.value("title", a.lab)};
+}
+
 int handout(const HandoutArgs& a) {
   std::string md, page;
   std::vector<std::string> formats;
@@ -351,15 +359,9 @@ int handout(const HandoutArgs& a) {
       formats.push_back(f);
     }
     if (formats.empty()) throw InputError("<command line>", "--format", "expected at least one of md, html");
-    const PlantChoice student = studentPlant(a.student);
-    LoadedLab loaded = loadLab(a.lab, a.config, "", std::nullopt, student);
-    const json written = loadJsonFile(loaded.config_file);
-    Handout h{a.lab, loaded.config_file, loaded.config, loaded.entry, parseRubric(JsonView(loaded.config, loaded.config_file)),
-              student, drawPlant(JsonView(written, loaded.config_file), PlantChoice{}, a.lab)};
-    const Prose prose = readProse(fs::path(defaultConfigPath(a.lab)).parent_path() / "handout.md",
-                                  JsonView(loaded.config, loaded.config_file));
-    md = h.markdown(prose);
-    page = html(md, loaded.config.value("title", a.lab) + " — handout");
+    const HandoutText text = handoutText(a);
+    md = text.markdown;
+    page = html(md, text.title + " — handout");
   } catch (const InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return 2;

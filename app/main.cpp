@@ -15,6 +15,7 @@
 #include "app/commands.h"
 #include "app/course.h"
 #include "app/isolated_draw.h"
+#include "app/lab_options.h"
 #include "app/model.h"
 #include "app/submission_file.h"
 #include "grading/grade.h"
@@ -261,7 +262,6 @@ int dispatch(int argc, char** argv) {
                                            "examples) under a new name, to edit its JSON; then `dynlab check-lab NAME`");
   nl->add_option("NAME", new_lab.name, "The new lab's name (lowercase letters, digits, _)")->required();
   nl->add_option("--from", new_lab.from, "The data-defined lab to copy, e.g. fivebar")->required();
-  nl->add_option("--labs", new_lab.labs, "The folder of lab folders to write into (default: the dynlab tree's labs/)");
 
   BenchArgs bench_args;
   auto* b = cli.add_subcommand("bench", "Benchmark: hand-written vs Bullet step time, render/PNG/video frame rates");
@@ -277,6 +277,8 @@ int dispatch(int argc, char** argv) {
 
   CourseCommands course(cli);  // dynlab handout, dynlab map (app/course.h)
   ModelCommand model_file(cli);  // dynlab model FILE (app/model.h)
+  LabOptions lab_options;        // --labs DIR on every command that names a lab (app/lab_options.h)
+  addLabOptions(cli, lab_options);
 
   requireFinite(cli);
   try {
@@ -285,6 +287,8 @@ int dispatch(int argc, char** argv) {
     const int code = cli.exit(e);
     return code == 0 ? 0 : 2;
   }
+  if (const int code = useLabOptions(lab_options)) return code;
+  new_lab.labs = lab_options.labs;
   if (*list) return listLabs();
   if (*r) {
     if (isModelFile(run.lab)) return runModelFile(run);

@@ -193,7 +193,7 @@ GradeOutcome gradeSubmission(const json& sub, const std::string& file, const Gra
     // Plots of each test's response against its reference and tolerance band.
     if (!opt.out_dir.empty()) writeTestPlots(rep, runs, opt.out_dir, opt.plot_width, opt.plot_height);
     rep.inline_plots = opt.inline_plots;
-    if (!opt.results_file.empty()) rep.replay = replayCommand(opt.replay_program, opt.results_file, file, opt);
+    if (!opt.results_file.empty()) rep.replay = replayCommand(opt.replay_program, opt.results_file, file, opt, lab_name);
 
     GradeOutcome out;
     for (const auto& s : rep.scenarios) out.out_of_time = out.out_of_time || s.out_of_time;
@@ -242,12 +242,14 @@ std::vector<std::string> compareResults(const json& expected, const json& actual
 }
 
 std::string replayCommand(const std::string& program, const std::string& results_file, const std::string& submission,
-                          const GradeOptions& o) {
+                          const GradeOptions& o, const std::string& lab) {
   const auto path = [](const std::string& p) { return shellWord(std::filesystem::absolute(p).lexically_normal().string()); };
   std::string cmd = program + " grade --replay " + path(results_file) + " " + path(submission);
   if (!o.expected_lab.empty()) cmd += " --lab " + shellWord(o.expected_lab);
   if (!o.config_file.empty()) cmd += " --config " + path(o.config_file);
   if (!o.plant.student.empty()) cmd += " --student " + shellWord(o.plant.student);
+  const LabEntry* entry = findLab(lab.empty() ? o.expected_lab : lab);
+  if (entry && !entry->labs_folder.empty()) cmd += " --labs " + path(entry->labs_folder);
   return cmd;
 }
 

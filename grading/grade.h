@@ -74,9 +74,10 @@ GradeOutcome gradeSubmission(const json& submission, const std::string& file, co
 std::vector<std::string> compareResults(const json& expected, const json& actual);
 
 // The command that re-grades `submission` and checks it against results_file: absolute,
-// shell-quoted paths, with the --lab and --config the grade used.
+// shell-quoted paths, with the --lab and --config the grade used, and --labs DIR when the graded
+// lab (`lab`, when known) is outside the dynlab tree.
 std::string replayCommand(const std::string& program, const std::string& results_file, const std::string& submission,
-                          const GradeOptions& options);
+                          const GradeOptions& options, const std::string& lab = "");
 
 // FNV-1a 64 of a string, as 16 hex digits (fingerprints and seeds).
 std::string hashHex(const std::string& bytes);

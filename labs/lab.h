@@ -12,6 +12,7 @@
 //     not close is reported with no feedback), so every rubric metric exists for every option.
 #pragma once
 #include <functional>
+#include <list>
 #include <map>
 #include <memory>
 #include <string>
@@ -118,18 +119,28 @@ struct LabEntry {
   std::string name;
   std::string summary;
   LabFactory create;
+  std::string folder;       // the lab's folder (empty: labsRoot()/name, a C++ lab's)
+  std::string labs_folder;  // the folder of lab folders outside the tree it came from (--labs DIR,
+                            // DYNLAB_LABS; labs/generic/lab_folders.h); empty: the dynlab tree
 };
 
-std::vector<LabEntry>& labRegistry();  // sorted by name
+// Sorted by name. A list: an entry stays where it is while labs are added (a folder of labs given to
+// Python's dynlab.Lab(..., labs=) after another Lab holds its entry).
+std::list<LabEntry>& labRegistry();
 const LabEntry* findLab(const std::string& name);
 // Adds a lab (at static initialisation, or at run time from a test); false, and nothing added, if
 // the name is taken.
 bool registerLab(LabEntry entry);
 // Removes a lab registered at run time (a test's scratch lab); false if there is none of that name.
 bool unregisterLab(const std::string& name);
-// The lab's default config: labs/<name>/<name>.json in the source tree, or $DYNLAB_HOME/labs/...
+// The lab's folder: where it was registered from (a data lab, in the tree or outside it), else
+// labsRoot()/<name>.
+std::string labFolder(const std::string& name);
+// The lab's default config: <labFolder(name)>/<name>.json.
 std::string defaultConfigPath(const std::string& name);
-// The folder of lab folders: $DYNLAB_HOME/labs, else the source tree's labs/.
+// The dynlab tree's folder of lab folders: the source tree's labs/. DYNLAB_HOME=DIR replaces the tree
+// with DIR (DIR/labs, and DIR for model files a lab names from the tree): a hook for tests that need
+// a tree lab changed. Labs outside the tree are added beside it, not instead (lab_folders.h).
 std::string labsRoot();
 
 #define DYNLAB_REGISTER_LAB(id, summary, factory) \

@@ -11,16 +11,16 @@
 
 namespace dyn {
 
-std::vector<LabEntry>& labRegistry() {
-  static std::vector<LabEntry> entries;
+std::list<LabEntry>& labRegistry() {
+  static std::list<LabEntry> entries;
   return entries;
 }
 
 bool registerLab(LabEntry entry) {
   if (findLab(entry.name)) return false;
   auto& r = labRegistry();
-  r.push_back(std::move(entry));
-  std::sort(r.begin(), r.end(), [](const LabEntry& a, const LabEntry& b) { return a.name < b.name; });
+  const auto at = std::find_if(r.begin(), r.end(), [&](const LabEntry& e) { return entry.name < e.name; });
+  r.insert(at, std::move(entry));
   return true;
 }
 
@@ -43,7 +43,12 @@ std::string labsRoot() {
   return std::string(home && *home ? home : DYNLAB_SOURCE_DIR) + "/labs";
 }
 
-std::string defaultConfigPath(const std::string& name) { return labsRoot() + "/" + name + "/" + name + ".json"; }
+std::string labFolder(const std::string& name) {
+  const LabEntry* e = findLab(name);
+  return e && !e->folder.empty() ? e->folder : labsRoot() + "/" + name;
+}
+
+std::string defaultConfigPath(const std::string& name) { return labFolder(name) + "/" + name + ".json"; }
 
 std::string stoppedSentence(const std::string& failure, double t) {
   if (failure.rfind("stopped: ", 0) == 0) return failure;

@@ -30,7 +30,7 @@ LoadedLab loadLab(const std::string& name, const std::string& config_file, const
   if (!out.entry) {
     std::string list;
     for (const auto& e : labRegistry()) list += (list.empty() ? "" : ", ") + e.name;
-    throw InputError("<command line>", "LAB", "unknown lab \"" + name + "\" (available: " + list + ")");
+    throw InputError("<command line>", "LAB", "unknown lab \"" + name + "\" (available: " + list + "; a lab outside the dynlab tree: --labs DIR)");
   }
   out.config_file = config_file.empty() ? defaultConfigPath(name) : config_file;
   out.config = loadJsonFile(out.config_file);

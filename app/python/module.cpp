@@ -5,6 +5,7 @@
 //   r = lab.run(engine="both", duration=2)   # r["traces"]["hand"]["x"], r["engines"], r["agreement"]
 //   img = lab.frame(1.0)                    # (480, 640, 3) uint8, the last run at t = 1 s
 //   dynlab.grade(lab.submission())["score"]
+//   dynlab.Lab("trammel", labs="~/course/labs")   # a lab outside the tree (the CLI's --labs DIR)
 // Bad input raises dynlab.InputError (a ValueError) with the CLI's one-line message
 // "<file>: <JSON path>: <what was expected>" and its parts as .file, .path, .expected.
 #include <pybind11/pybind11.h>
@@ -14,12 +15,34 @@
 #include "app/python/lab_object.h"
 #include "grading/grade.h"
 #include "grading/student.h"
+#include "labs/generic/lab_folders.h"
 
 namespace py = pybind11;
 using namespace dyn;
 using namespace dyn::python;
 
 namespace {
+
+// labs=: a folder of lab folders outside the tree, or a list of them (the CLI's --labs DIR), then
+// DYNLAB_LABS's, registered after the tree's labs for the rest of the process (labs/generic/lab_folders.h).
+void useLabs(py::handle labs) {
+  std::vector<generic::LabsFolder> folders;
+  std::string path;
+  if (!labs.is_none()) {
+    if (asPath(labs, path)) {
+      folders.push_back({path, "labs", kArgument});
+    } else {
+      if (!py::isinstance<py::sequence>(labs) || py::isinstance<py::str>(labs))
+        throw py::type_error("labs: a folder (str or os.PathLike) or a list of them");
+      for (py::handle item : labs) {
+        if (!asPath(item, path)) throw py::type_error("labs: a folder (str or os.PathLike) or a list of them");
+        folders.push_back({path, "labs", kArgument});
+      }
+    }
+  }
+  for (const auto& f : generic::labsFoldersFromEnvironment()) folders.push_back(f);
+  generic::useLabsFolders(folders);
+}
 
 // dynlab.grade: a submission dict or file → results.json as a dict, as `dynlab grade` writes it
 // (no plots). A submission the grader refuses raises InputError with `dynlab grade`'s message.
@@ -28,6 +51,7 @@ py::dict grade(py::handle submission, const std::string& lab, const std::string&
   // `dynlab grade --time-budget`'s check and message (NaN, inf, 0, -1, 1e300 are refused, not graded as out of time).
   if (const std::string problem = timeBudgetProblem(time_budget); !problem.empty())
     throw InputError(kArgument, "time_budget", problem);
+  useLabs(py::none());  // DYNLAB_LABS's labs, as every command reads them
   GradeOptions o;
   o.expected_lab = lab;
   o.config_file = config;
@@ -73,17 +97,24 @@ void dyn::python::defineModule(py::module_& m) {
     }
   });
 
-  m.def("labs", [] {
+  m.def("labs", [](py::handle labs) {
+    useLabs(labs);
     py::dict out;
     for (const auto& e : labRegistry()) out[py::str(e.name)] = e.summary;
     return out;
-  }, "Every lab: name → one-line summary (dynlab list).");
+  }, py::arg("labs") = py::none(),
+     "Every lab: name → one-line summary (dynlab list); labs=DIR (or a list) adds the labs of a folder outside the "
+     "dynlab tree, as --labs DIR does (DYNLAB_LABS is read too).");
 
   py::class_<LabObject>(m, "Lab", "One lab: its config, the gains set so far, runs and screening.")
-      .def(py::init<const std::string&, const std::string&, const std::string&>(), py::arg("name"), py::arg("config") = "",
-           py::arg("student") = "",
-           "Loads lab NAME with its default config, or the config file given (dynlab run LAB --config F); on STUDENT's "
-           "plant when given (the lab's variants; DYNLAB_STUDENT_KEY or DYNLAB_COURSE_SECRET must be set).")
+      .def(py::init([](const std::string& name, const std::string& config, py::handle labs, const std::string& student) {
+             useLabs(labs);
+             return LabObject(name, config, student);
+           }),
+           py::arg("name"), py::arg("config") = "", py::arg("labs") = py::none(), py::arg("student") = "",
+           "Loads lab NAME with its default config, or the config file given (dynlab run LAB --config F); labs=DIR "
+           "(or a list) finds NAME in a folder of lab folders outside the dynlab tree too (dynlab run LAB --labs DIR); "
+           "on STUDENT's plant when given (the lab's variants; DYNLAB_STUDENT_KEY or DYNLAB_COURSE_SECRET must be set).")
       .def_property_readonly("student", &LabObject::student, "Whose plant ('' the nominal one).")
       .def_property_readonly("name", &LabObject::name)
       .def_property_readonly("config", &LabObject::configFile, "The config file the lab was loaded from.")

@@ -15,6 +15,7 @@
 #include "app/model_lab.h"
 #include "app/ui/panel.h"
 #include "grading/student.h"
+#include "labs/generic/lab_folders.h"
 #include "labs/utf8.h"
 #include "render/fonts.h"
 #include "render/renderer.h"
@@ -27,7 +28,7 @@ using namespace dyn::ui;
 
 struct Args {
   std::string lab, config, gains, scenario, student, engine = "both", size = "1320x720", save, screenshot, state;
-  std::vector<std::string> set;
+  std::vector<std::string> set, labs;
   double speed = 1.0;
   bool paused = false;
   long frames = -1;  // scripted: this many frames, then exit
@@ -239,6 +240,8 @@ int main(int argc, char** argv) {
   cli.set_version_flag("--version", std::string(DYNLAB_VERSION));
   cli.add_option("LAB", a.lab, "Lab name (see `dynlab list`), or a model file (.xml, .urdf) to watch move passive")->required();
   cli.add_option("--config", a.config, "Lab config JSON (default: labs/LAB/LAB.json)");
+  cli.add_option("--labs", a.labs, "A folder of lab folders outside the dynlab tree (repeatable; DYNLAB_LABS=DIR:DIR does the same)")
+      ->type_name("DIR")->allow_extra_args(false);
   cli.add_option("--gains", a.gains, "Start from these gains: a submission or gains JSON");
   cli.add_option("--scenario", a.scenario, "Tune under one rubric scenario (heavy_load, noisy_sensor, ...) exactly as the grader runs it");
   cli.add_option("--student", a.student, "Tune on this student's plant (the lab's variants; DYNLAB_STUDENT_KEY, the key on "
@@ -260,6 +263,11 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   try {
+    // Labs outside the tree, as dynlab's (app/lab_options.h): --labs, then DYNLAB_LABS, after the tree's.
+    std::vector<generic::LabsFolder> folders;
+    for (const auto& dir : a.labs) folders.push_back({dir, "--labs"});
+    for (const auto& f : generic::labsFoldersFromEnvironment()) folders.push_back(f);
+    generic::useLabsFolders(folders);
     return run(a);
   } catch (const InputError& e) {
     std::cerr << "error: " << e.what() << "\n";

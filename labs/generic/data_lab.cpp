@@ -347,7 +347,7 @@ bool isDataLabFolder(const std::string& folder, const std::string& name) {
   return !ec;
 }
 
-bool registerDataLab(const std::string& folder, std::string* why) {
+bool registerDataLab(const std::string& folder, std::string* why, const std::string& labs_folder) {
   const std::string name = fs::path(folder).filename().string();
   // A lab's name goes into paths, reports and results.json: the same rule as dynlab new-lab's.
   if (!std::regex_match(name, std::regex("[a-z][a-z0-9_]{0,39}"))) {
@@ -365,9 +365,11 @@ bool registerDataLab(const std::string& folder, std::string* why) {
     if (j.contains("title") && j["title"].is_string()) summary = j["title"].get<std::string>();
   } catch (const std::exception&) {
   }
-  const bool ok = registerLab({name, summary, [name, folder](const JsonView& config) -> std::unique_ptr<Lab> {
+  const bool ok = registerLab({name, summary,
+                               [name, folder](const JsonView& config) -> std::unique_ptr<Lab> {
                                  return std::make_unique<DataLab>(parseDataSettings(config, name, folder));
-                               }});
+                               },
+                               folder, labs_folder});
   if (!ok && why) *why = "a lab named " + name + " is registered already";
   return ok;
 }

@@ -115,7 +115,8 @@ class DataLab final : public Lab {
 // True if labs/<name>/ is a data lab folder: <name>.json there, and no .cpp or .h.
 bool isDataLabFolder(const std::string& folder, const std::string& name);
 // Registers the data lab in `folder` (named by the folder); false with a sentence in *why if it cannot.
-bool registerDataLab(const std::string& folder, std::string* why = nullptr);
+// labs_folder: the folder of lab folders outside the tree it is in (LabEntry::labs_folder; empty: the tree).
+bool registerDataLab(const std::string& folder, std::string* why = nullptr, const std::string& labs_folder = "");
 // Registers every data lab folder under `labs_root`; returns how many.
 int registerDataLabs(const std::string& labs_root);
 

@@ -50,8 +50,18 @@ std::pair<int, Eigen::Vector3d> bodyPoint(const JsonView& body, const JsonView& 
   return {link, vec3(at) - anchor};
 }
 
-// A model file beside the JSON, or else in the dynlab tree (e.g. "assets/models/fourbar.xml", so a new
-// exercise may name one of the shipped models without copying it).
+// True when `file` (which exists) lies inside `base` once links are followed.
+bool inside(const std::filesystem::path& file, const std::filesystem::path& base) {
+  std::error_code ec;
+  const auto f = std::filesystem::canonical(file, ec), b = std::filesystem::canonical(base, ec);
+  if (ec) return false;
+  const auto rel = f.lexically_relative(b);
+  return !rel.empty() && *rel.begin() != "..";
+}
+
+// A model file in the lab's own folder, or else in the dynlab tree (e.g. "assets/models/fourbar.xml",
+// so a new exercise, in the tree or outside it, may name one of the shipped models without copying
+// it): a relative path without "..", whose file (links followed) lies in the lab's folder or the tree.
 std::string checkedModelPath(const JsonView& j, const std::string& folder) {
   const std::string rel = j.string();
   const std::filesystem::path p(rel);
@@ -59,10 +69,15 @@ std::string checkedModelPath(const JsonView& j, const std::string& folder) {
   for (const auto& part : p) up = up || part == "..";
   if (rel.empty() || p.is_absolute() || up)
     j.fail("expected a model file in the lab's folder or the dynlab tree (a relative path without \"..\")");
-  std::error_code ec;
-  if (std::filesystem::exists(folder + "/" + rel, ec)) return folder + "/" + rel;
   const auto tree = std::filesystem::path(labsRoot()).parent_path();
-  if (std::filesystem::exists(tree / rel, ec)) return (tree / rel).string();
+  std::error_code ec;
+  for (const std::filesystem::path& base : {std::filesystem::path(folder), tree}) {
+    if (!std::filesystem::exists(base / rel, ec)) continue;
+    if (!inside(base / rel, folder) && !inside(base / rel, tree))
+      j.fail("expected a model file inside the lab's folder (" + folder + ") or the dynlab tree (" + tree.string() + "); " +
+             (base / rel).string() + " links out of both");
+    return (base / rel).string();
+  }
   j.fail("expected a model file in the lab's folder (" + folder + ") or the dynlab tree (" + tree.string() + "), not found there");
 }
 

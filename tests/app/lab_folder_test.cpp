@@ -1,5 +1,5 @@
 // A lab folder is input too: course staff run check-lab on labs they download. A lab made with
-// new-lab in a scratch tree (DYNLAB_HOME) is given a hostile example file name and broken metric
+// new-lab in a folder outside the tree (--labs) is given a hostile example file name and broken metric
 // windows; check-lab and run must treat the name as data (no shell runs it) and refuse the windows at
 // their JSON path, naming the lab's own file.
 #include <doctest/doctest.h>
@@ -14,12 +14,11 @@ using namespace dyn::test::cli;
 
 namespace {
 
-// dynlab args in dir (no shell), with DYNLAB_HOME = home (empty: the tree's labs).
+// dynlab args in dir (no shell), with the labs of home/labs beside the tree's (--labs; empty: the tree's only).
 Result dynlabIn(const TempDir& dir, const fs::path& home, const std::vector<std::string>& args) {
   dyn::ProcessOptions o;
-  if (!home.empty()) o.set_env = {{"DYNLAB_HOME", home.string()}};
   o.timeout_s = 600;
-  return dynlab(dir, args, o);
+  return dynlab(dir, home.empty() ? args : cat(args, {"--labs", (home / "labs").string()}), o);
 }
 
 // A copy of the five-bar lab as `name` in home/labs (new-lab), its JSON path returned.

@@ -1,9 +1,10 @@
-// A lab without C++, as the README's lecturer walk-through makes one: `dynlab new-lab fourbar_lab --from
-// fivebar` into a scratch lab tree (DYNLAB_HOME), the copy's JSON edited into a four-bar exercise (the
-// shipped assets/models/fourbar.xml, one actuated crank, the pin's x on a path), and nothing else. The
-// folder registers itself (dynlab list), runs on both engines with the loop closed to rounding level,
-// and grades; the check-lab contract's mechanical checks pass on it. Bad uses of new-lab get one line
-// and exit 2, and write nothing.
+// A lab without C++, as the lecturer's walk-through in docs/teaching.md makes one: `dynlab new-lab
+// fourbar_lab --from fivebar --labs DIR` into a folder outside the tree, the copy's JSON edited into a
+// four-bar exercise (the tree's assets/models/fourbar.xml, found from outside it; one actuated crank, the
+// pin's x on a path), and nothing else. The folder's lab is found with --labs (dynlab list), runs on
+// both engines with the loop closed to rounding level, grades, and its handout (the prose new-lab
+// wrote) builds; the check-lab contract's mechanical checks pass on it. Bad uses of new-lab get one
+// line and exit 2, and write nothing.
 #include <doctest/doctest.h>
 
 #include <nlohmann/json.hpp>
@@ -51,16 +52,14 @@ void makeFourBar(json& d) {
 
 TEST_CASE("new-lab: a four-bar exercise from the five-bar by editing JSON only") {
   const TempDir dir("new_lab");
-  const fs::path home = dir / "home";
-  fs::create_directories(home / "labs");
-  fs::create_directories(home / "assets/models");
-  fs::copy_file(fs::path(DYNLAB_SOURCE_DIR) / "assets/models/fourbar.xml", home / "assets/models/fourbar.xml");
-  const ProcessOptions env = withEnv({{"DYNLAB_HOME", home.string()}});
+  const fs::path labs = dir / "course";
+  fs::create_directories(labs);
+  const std::vector<std::string> in = {"--labs", labs.string()};
 
-  Result r = dynlab(dir, {"new-lab", "fourbar_lab", "--from", "fivebar", "--labs", (home / "labs").string()});
+  Result r = dynlab(dir, cat({"new-lab", "fourbar_lab", "--from", "fivebar"}, in));
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
-  const fs::path lab = home / "labs/fourbar_lab";
+  const fs::path lab = labs / "fourbar_lab";
   CHECK(fs::exists(lab / "fourbar_lab.json"));
   CHECK_FALSE(fs::exists(lab / "fivebar.json"));
   CHECK(fs::exists(lab / "handout.md"));
@@ -77,11 +76,11 @@ TEST_CASE("new-lab: a four-bar exercise from the five-bar by editing JSON only")
   writeFile(lab / "fourbar_lab.json", d.dump(1));
   fs::remove(lab / "fivebar.xml");
 
-  r = dynlab(dir, {"list"}, env);
+  r = dynlab(dir, cat({"list"}, in));
   CHECK(r.out.find("fourbar_lab      Four-bar: move the rocker's pin with the crank") != std::string::npos);
 
   // Both engines, the whole run; the hand engine keeps the loop closed to rounding level.
-  r = dynlab(dir, {"run", "fourbar_lab", "--out", "run"}, env);
+  r = dynlab(dir, cat({"run", "fourbar_lab", "--out", "run"}, in));
   INFO(r.out, r.err);
   REQUIRE(r.code == 0);
   const json summary = json::parse(readFile(dir / "run/summary.json"));
@@ -93,7 +92,7 @@ TEST_CASE("new-lab: a four-bar exercise from the five-bar by editing JSON only")
   CHECK(std::find(trace.header.begin(), trace.header.end(), "f_pin_C_x") != trace.header.end());
 
   // The instructor's answer (task-space inverse dynamics) grades, and tracks the pin's path.
-  r = dynlab(dir, {"grade", (lab / "instructor/good.json").string(), "--out", "grade", "--no-plots"}, env);
+  r = dynlab(dir, cat({"grade", (lab / "instructor/good.json").string(), "--out", "grade", "--no-plots"}, in));
   REQUIRE(r.code == 0);
   const json results = json::parse(readFile(dir / "grade/results.json"));
   double max = 0;
@@ -101,9 +100,17 @@ TEST_CASE("new-lab: a four-bar exercise from the five-bar by editing JSON only")
   CHECK(max == 10.0);
   CHECK(results.at("score").get<double>() > 0.9 * max);
 
-  // The contract's mechanical checks hold on it (the rubric's tuning checks are the lecturer's next step).
-  r = dynlab(dir, {"check-lab", "fourbar_lab", "--skip-cli"}, env);
-  for (const char* check : {"config ", "examples ", "engines ", "passive energy ", "metrics ", "grading ", "render "}) {
+  // The handout builds from the prose new-lab wrote (the five-bar's names its second crank and its
+  // circle segment, which the edit removed), and names the lab.
+  r = dynlab(dir, cat({"handout", "fourbar_lab", "--out", "handout"}, in));
+  INFO(r.err);
+  CHECK(r.code == 0);
+  CHECK(readFile(dir / "handout/handout.md").find("assets/models/fourbar.xml") != std::string::npos);
+
+  // The contract's mechanical checks hold on it (the rubric's tuning checks are the lecturer's next step),
+  // and the handout and README checks.
+  r = dynlab(dir, cat({"check-lab", "fourbar_lab", "--skip-cli"}, in));
+  for (const char* check : {"config ", "examples ", "engines ", "passive energy ", "metrics ", "grading ", "render ", "handout ", "readme "}) {
     INFO("check ", check, "\n", r.out);
     CHECK(r.out.find("  ok    " + std::string(check)) != std::string::npos);
   }

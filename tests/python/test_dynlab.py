@@ -400,5 +400,64 @@ print("failed:", failed)
         self.assertIn("expected a path without a NUL byte", str(e.exception))
 
 
+class LabsOutsideTheTree(unittest.TestCase):
+    """labs= (the CLI's --labs DIR) and DYNLAB_LABS: a lab in a folder outside the tree, found after the tree's.
+    Each case runs in a fresh interpreter: a folder once used stays registered in the process."""
+
+    def setUp(self):
+        self.folder = os.path.join(TMP, "course_labs")
+        if not os.path.isdir(os.path.join(self.folder, "pylab")):
+            os.makedirs(self.folder, exist_ok=True)
+            r = cli("new-lab", "pylab", "--from", "fivebar", "--labs", self.folder)
+            self.assertEqual(r.returncode, 0, r.stderr)
+
+    def test_labs_argument(self):
+        r = python(f"""
+import os, dynlab
+try:
+    dynlab.Lab("pylab")
+    print("found without labs=")
+except dynlab.InputError as e:
+    print("unknown" if "unknown lab" in str(e) else str(e))
+held = [dynlab.Lab(name) for name in dynlab.labs()]  # each holds its lab's registry entry while labs are added
+lab = dynlab.Lab("pylab", labs={self.folder!r})
+print(lab.name, os.path.dirname(lab.config) == os.path.join({self.folder!r}, "pylab"))
+for other in held:
+    assert other.run(engine="hand", duration=0.01)["status"] == "ok", other.name
+names = dynlab.labs()
+print("pylab" in names, "fivebar" in names, "slider_crank" in names)
+print(lab.run(engine="hand", duration=0.05)["status"])
+""")
+        self.assertEqual(r.returncode, 0, r.stderr[-2000:])
+        self.assertEqual(r.stdout.splitlines(), ["unknown", "pylab True", "True True True", "ok"])
+
+    def test_environment_and_list_and_refusals(self):
+        env = dict(os.environ, DYNLAB_LABS=self.folder)
+        r = subprocess.run([sys.executable, "-c", "import dynlab; print(dynlab.Lab('pylab').name)"], capture_output=True,
+                           encoding="utf-8", errors="replace", cwd=TMP, env=env, timeout=900)
+        self.assertEqual(r.returncode, 0, r.stderr[-2000:])
+        self.assertEqual(r.stdout.strip(), "pylab")
+        clash = os.path.join(TMP, "clash_labs")
+        if not os.path.isdir(clash):
+            import shutil
+            shutil.copytree(os.path.join(SOURCE, "labs", "fivebar"), os.path.join(clash, "fivebar"))
+        r = python(f"""
+import dynlab
+print("pylab" in dynlab.labs(labs=[{self.folder!r}]))
+for labs in ({clash!r}, {os.path.join(TMP, "no_such_folder")!r}):
+    try:
+        dynlab.Lab("fivebar", labs=labs)
+        print("no error")
+    except dynlab.InputError as e:
+        print(e.file, e.path, "fivebar" in e.expected or "existing folder" in e.expected)
+try:
+    dynlab.labs(labs=5)
+except TypeError as e:
+    print("TypeError")
+""")
+        self.assertEqual(r.returncode, 0, r.stderr[-2000:])
+        self.assertEqual(r.stdout.splitlines(), ["True", "<python> labs True", "<python> labs True", "TypeError"])
+
+
 if __name__ == "__main__":
     unittest.main(verbosity=2)
