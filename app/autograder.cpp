@@ -260,8 +260,8 @@ This zip is a Gradescope autograder for the dynlab lab `@LAB@`. It holds:
 ## Setting it up on Gradescope
 
 1. Create a **Programming Assignment** (any name; total points as in the lab's rubric).
-2. Under **Configure Autograder**, choose **Zip file upload**, base image **Ubuntu 22.04** (@IMAGE_NOTE@),
-   upload this zip and press **Update Autograder**. The image build installs packages and compiles
+2. Under **Configure Autograder**, choose **Zip file upload**, base image **Ubuntu 22.04**, upload
+   this zip and press **Update Autograder** (@IMAGE_NOTE@). The image build installs packages and compiles
    dynlab: allow 10–20 minutes, and read the build log if it fails: a package the image lacks is
    named in one line starting `autograder-packages:` or `setup.sh:` (docs/teaching.md, "Which
    base image", says what is known about each).
@@ -306,8 +306,8 @@ path/to/dynlab check-results res/results.json   # the check run_autograder makes
   const bool model_files = config.contains("model_file");
   md = replaceAll(md, "@NO_MUJOCO@", model_files ? "" : " (and without MuJoCo: this lab reads no model file)");
   md = replaceAll(md, "@IMAGE_NOTE@",
-                  model_files ? "this lab reads a model file, so the image must offer `libmujoco-dev`; if setup.sh stops "
-                                "with \"this image has no libmujoco-dev\", this lab cannot be graded on that image"
+                  model_files ? "this lab reads a model file, so the image must offer\n   `libmujoco-dev`; if setup.sh stops "
+                                "with \"this image has no libmujoco-dev\", this lab\n   cannot be graded on that image"
                               : "this lab reads no model file: it needs no MuJoCo");
   md = replaceAll(md, "@TITLE@", title);
   md = replaceAll(md, "@LAB@", lab);
