@@ -93,18 +93,29 @@ void addLabFolder(const fs::path& folder, const std::string& lab, const std::str
   }
 }
 
-// setup.sh: once, as root, when Gradescope builds the image (Ubuntu 22.04).
-std::string setupScript() {
-  return replaceAll(R"SH(#!/usr/bin/env bash
-# Gradescope runs this once, as root, when it builds the autograder image (Ubuntu 22.04):
-# the packages dynlab needs (the one list is source/scripts/setup), then dynlab itself (Release).
+// setup.sh: once, as root, when Gradescope builds the image (Ubuntu 22.04): only what grading the lab
+// needs, chosen from what the image's apt offers (scripts/autograder-packages), and a dynlab built
+// without the rest. model_files: the lab reads an MJCF/URDF file (MuJoCo's parser is required).
+std::string setupScript(bool model_files) {
+  return replaceAll(replaceAll(R"SH(#!/usr/bin/env bash
+# Gradescope runs this once, as root, when it builds the autograder image (Ubuntu 22.04; see
+# README.md): the packages grading needs, chosen by source/scripts/autograder-packages from what
+# this image offers, then dynlab itself (Release), without what grading does not use.
 set -euo pipefail
 src=@ROOT@
 export DEBIAN_FRONTEND=noninteractive
 
-# Packages: the same list the developers and CI install.
+# Packages: a package the image lacks is named in one line, and the build stops there.
 apt-get update -qq
-bash "$src/scripts/setup"
+choice="$(bash "$src/scripts/autograder-packages" @MODEL_FILES@)" || exit 1
+read -ra packages <<<"$(printf '%s\n' "$choice" | sed -n 's/^packages: //p')"
+read -ra options <<<"$(printf '%s\n' "$choice" | sed -n 's/^cmake: //p')"
+echo "setup.sh: installing ${packages[*]}"
+apt-get install -y -qq --no-install-recommends "${packages[@]}"
+pkg-config --exists bullet-float64 || {
+  echo "setup.sh: this image's libbullet-dev has no double-precision build (pkg-config bullet-float64), which dynlab needs: see docs/teaching.md, \"Which base image\"" >&2
+  exit 1
+}
 
 # dynlab needs CMake >= 3.25; Ubuntu 22.04 ships 3.22, so take a newer one from PyPI when needed.
 have="$(cmake --version 2>/dev/null | head -n1 | awk '{print $3}')"
@@ -114,11 +125,14 @@ if ! printf '3.25\n%s\n' "$have" | sort -V -C; then
   hash -r
 fi
 
-# Build only the dynlab binary (tests and tools are not needed to grade).
-cmake -S "$src" -B "$src/build" -DCMAKE_BUILD_TYPE=Release
+# Build only the dynlab binary, with the options chosen above (tests, video and, for a lab without a
+# model file, MuJoCo left out).
+echo "setup.sh: cmake options ${options[*]}"
+cmake -S "$src" -B "$src/build" -DCMAKE_BUILD_TYPE=Release "${options[@]}"
 cmake --build "$src/build" --target dynlab -j2
 "$src/build/app/dynlab" list
 )SH",
+                               "@MODEL_FILES@", model_files ? "--model-files" : ""),
                     "@ROOT@", kRoot);
 }
 
@@ -242,8 +256,9 @@ std::string readme(const std::string& lab, const nlohmann::json& config) {
 
 This zip is a Gradescope autograder for the dynlab lab `@LAB@`. It holds:
 
-* `setup.sh`: run once when Gradescope builds the image: installs the packages (the list in
-  `source/scripts/setup`) and compiles dynlab (Release) into `source/build/`.
+* `setup.sh`: run once when Gradescope builds the image: installs only the packages grading needs
+  (chosen by `source/scripts/autograder-packages` from what the image offers) and compiles dynlab
+  (Release) into `source/build/`, without the window, video, Python and the tests@NO_MUJOCO@.
 * `run_autograder`: run for every submission: finds the student's JSON (a symbolic link out of the
   submission, a FIFO or a device is refused unread), runs
   `dynlab grade FILE --time-budget B --lab @LAB@ --inline-plots --out /autograder/results` (B: 3/4
@@ -258,8 +273,10 @@ This zip is a Gradescope autograder for the dynlab lab `@LAB@`. It holds:
 
 1. Create a **Programming Assignment** (any name; total points as in the lab's rubric).
 2. Under **Configure Autograder**, choose **Zip file upload**, base image **Ubuntu 22.04**, upload
-   this zip and press **Update Autograder**. The image build installs packages and compiles
-   dynlab: allow 10–20 minutes, and read the build log if it fails.
+   this zip and press **Update Autograder** (@IMAGE_NOTE@). The image build installs packages and compiles
+   dynlab: allow 10–20 minutes, and read the build log if it fails: a package the image lacks is
+   named in one line starting `autograder-packages:` or `setup.sh:` (docs/teaching.md, "Which
+   base image", says what is known about each).
 3. Keep the autograder timeout at 10 minutes or more: `run_autograder` stops dynlab after 540 s
    so that it can still explain a timeout to the student.
 4. Press **Test Autograder** and upload the example below as `submission.json`.
@@ -297,6 +314,13 @@ DYNLAB_BIN=path/to/dynlab DYNLAB_SUBMISSION_DIR=sub DYNLAB_RESULTS_DIR=res bash 
 path/to/dynlab check-results res/results.json   # the check run_autograder makes
 ```
 )MD";
+  // Which image works: a lab without a model file needs no MuJoCo; one with a model file does.
+  const bool model_files = config.contains("model_file");
+  md = replaceAll(md, "@NO_MUJOCO@", model_files ? "" : " (and without MuJoCo: this lab reads no model file)");
+  md = replaceAll(md, "@IMAGE_NOTE@",
+                  model_files ? "this lab reads a model file, so the image must offer\n   `libmujoco-dev`; if setup.sh stops "
+                                "with \"this image has no libmujoco-dev\", this lab\n   cannot be graded on that image"
+                              : "this lab reads no model file: it needs no MuJoCo");
   md = replaceAll(md, "@TITLE@", title);
   md = replaceAll(md, "@LAB@", lab);
   md = replaceAll(md, "@EXAMPLE@", example.dump(2));
@@ -366,7 +390,8 @@ void writeAutograder(const std::string& lab, const std::string& source_dir, cons
     fail(zip_path, config_file.string() + ": " + e.what());
   }
 
-  std::vector<Entry> entries = {{"setup.sh", setupScript(), 0755u},
+  const bool model_files = config.contains("model_file");
+  std::vector<Entry> entries = {{"setup.sh", setupScript(model_files), 0755u},
                                 {"run_autograder", runScript(lab), 0755u},
                                 {"README.md", readme(lab, config), 0644u}};
   // A lab with a plant per student (labs/variants.h): the course secret rides in the staff-only zip,

@@ -141,12 +141,12 @@ TEST_CASE("the bundle for slider_crank: scripts, README and the source tree") {
     CHECK(name.find(".tmp") == std::string::npos);
   }
 
-  // The scripts name the lab, the one package list and the one target.
+  // The scripts name the lab, the package choice for the image and the one target.
   const std::string run = entries.at("run_autograder").data, setup = entries.at("setup.sh").data;
   CHECK(run.rfind("#!/usr/bin/env bash", 0) == 0);
   CHECK(run.find("lab=\"slider_crank\"") != std::string::npos);
   CHECK(run.find("--lab \"$lab\"") != std::string::npos);
-  CHECK(setup.find("scripts/setup") != std::string::npos);
+  CHECK(setup.find("scripts/autograder-packages") != std::string::npos);
   CHECK(setup.find("--target dynlab") != std::string::npos);
   CHECK(entries.at("README.md").data.find("\"lab\": \"slider_crank\"") != std::string::npos);
   CHECK(entries.at("README.md").data.find("kp_x") != std::string::npos);
