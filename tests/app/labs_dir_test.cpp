@@ -309,10 +309,13 @@ TEST_CASE("a lab outside the tree grades with a replay line that runs as printed
   CHECK(r.code == 0);
   CHECK(r.out.find("replay: match") != std::string::npos);
 
-  // A batch grades each submission in a process of its own: each finds the lab too.
+  // A batch grades each submission in a process of its own: each finds the lab too. The copy keeps
+  // the five-bar's plant per student, so the batch grades each file's student (its name) with the
+  // course secret.
+  const ProcessOptions staff = withEnv({{"DYNLAB_COURSE_SECRET", "labs-dir-test"}});
   fs::create_directories(dir / "subs");
   for (const char* f : {"joint_pd.json", "task_pd.json"}) fs::copy_file(lab / "examples" / f, dir / "subs" / f);
-  r = dynlab(dir, cat({"grade", "--batch", "subs", "--out", "batch", "--no-plots"}, labs));
+  r = dynlab(dir, cat({"grade", "--batch", "subs", "--out", "batch", "--no-plots"}, labs), staff);
   INFO(r.out, r.err);
   CHECK(r.code == 0);
   for (const char* f : {"joint_pd", "task_pd"}) {
@@ -322,7 +325,7 @@ TEST_CASE("a lab outside the tree grades with a replay line that runs as printed
 
   // The autograder bundle carries the lab's folder in its tree (names are stored plainly in a zip),
   // without its instructor answers.
-  r = dynlab(dir, cat({"autograder", "outside", "--out", "outside.zip"}, labs));
+  r = dynlab(dir, cat({"autograder", "outside", "--out", "outside.zip"}, labs), staff);
   INFO(r.err);
   REQUIRE(r.code == 0);
   const std::string zip = readFile(dir / "outside.zip");
