@@ -12,6 +12,7 @@
 #include <sstream>
 
 #include "app/process.h"
+#include "app/readme_numbers.h"
 #include "grading/grade.h"
 #include "grading/advice.h"
 #include "grading/lessons.h"
@@ -497,6 +498,20 @@ LabCheckReport checkLab(const LabEntry& entry, const json& config, const LabChec
       s.expect(code == 0, "dynlab grade exit " + std::to_string(code) + ": " + err);
       s.expect(fs::exists(dir / "grade" / "results.json"), "dynlab grade wrote no results.json");
       s.detail = "dynlab figure, run (both engines, whole run) and grade exit 0";
+    });
+  // The README's measured numbers (app/readme_numbers.h) against that run's summary.json.
+  if (!options.dynlab_binary.empty())
+    run(report, "readme numbers", [&](Step& s) {
+      const fs::path readme = fs::path(lab_dir) / "README.md", summary = dir / "run" / "summary.json";
+      if (!fs::is_regular_file(readme)) {
+        s.detail = "no README.md";
+        return;
+      }
+      if (!s.expect(fs::is_regular_file(summary), "dynlab run wrote no summary.json")) return;
+      const std::string text = readTextFile(readme.string(), 1u << 20);
+      for (const std::string& problem : readmeNumberProblems(text, loadJsonFile(summary.string()), readme.string()))
+        s.fail(problem);
+      s.detail = std::to_string(readmeNumbers(text).size()) + " measured number(s) marked in README.md agree with dynlab run";
     });
   return report;
 }

@@ -17,6 +17,7 @@
 //   instructor ...  each instructor answer scores ≥ 90 %
 //   render          a frame of the scene renders non-blank, with and without the panel (OSMesa)
 //   cli             `dynlab figure`, `dynlab run` (both engines, whole run), `dynlab grade`: exit 0
+//   readme numbers  each number the README marks as measured agrees with that run (app/readme_numbers.h)
 #pragma once
 #include <cmath>
 #include <string>
