@@ -84,6 +84,14 @@ std::string starterReadme(const std::string& name, const std::string& from, cons
          "tree): every check of the lab contract, the handout and this README.\n";
 }
 
+// instructor/README.md: the staff's page of the new lab (the source lab's answer is not this one's).
+std::string starterInstructorNotes(const std::string& name, const std::string& from) {
+  return "# Lab " + name + ": instructor files (course staff only)\n\n"
+         "Left out of the student copy. `good.json` here began as a copy of " + from + "'s answer with its `\"lab\"`\n"
+         "renamed: replace it with this exercise's full-credit answer (check-lab requires it to score at least 90 %),\n"
+         "keep `lessons/` to the pairs this rubric states, and write the answer's gains and grade here.\n";
+}
+
 }  // namespace
 
 int newLab(const NewLabArgs& args) {
@@ -136,6 +144,8 @@ int newLab(const NewLabArgs& args) {
     } catch (const std::exception&) {
     }
     writeText(stage / "handout.md", starterHandout(args.name, args.from));
+    // The source lab's staff notes name its answer's gains and grade: not this lab's.
+    if (fs::is_directory(stage / "instructor")) writeText(stage / "instructor" / "README.md", starterInstructorNotes(args.name, args.from));
     writeText(stage / "README.md", starterReadme(args.name, args.from, title.substr(0, title.find(": "))));
     fs::rename(stage, dest);
   } catch (const std::exception& e) {

@@ -29,6 +29,18 @@ void readWindow(const JsonView& m, double duration, double dt, MetricSpec& s) {
 
 }  // namespace
 
+namespace {
+
+// The trace's columns for a message: the first 40, then how many more (the header of trace_hand.csv has them all).
+std::string columnList(const std::vector<std::string>& columns) {
+  std::string s;
+  for (std::size_t i = 0; i < columns.size() && i < 40; ++i) s += (i ? ", " : "") + columns[i];
+  if (columns.size() > 40) s += ", … " + std::to_string(columns.size() - 40) + " more: the header of `dynlab run`'s trace_hand.csv";
+  return s;
+}
+
+}  // namespace
+
 std::map<std::string, MetricSpec> parseMetrics(const JsonView& j, const std::vector<std::string>& columns, double duration,
                                                double dt) {
   j.requireObject();
@@ -43,7 +55,7 @@ std::map<std::string, MetricSpec> parseMetrics(const JsonView& j, const std::vec
     else
       for (std::size_t i = 0, n = of.size(1, 16); i < n; ++i) s.of.push_back(of.at(i).string());
     for (const auto& c : s.of)
-      if (std::find(columns.begin(), columns.end(), c) == columns.end()) of.fail("expected trace columns of this lab (`dynlab run` lists them), not \"" + c + "\"");
+      if (std::find(columns.begin(), columns.end(), c) == columns.end()) of.fail("expected one of this lab's trace columns (" + columnList(columns) + "), not \"" + c + "\"");
     const std::string stat = m["stat"].oneOf({"rms", "mean", "max", "min", "max_abs", "final", "settling", "variation"});
     using St = MetricSpec::Stat;
     s.stat = stat == "rms" ? St::Rms : stat == "mean" ? St::Mean : stat == "max" ? St::Max : stat == "min" ? St::Min

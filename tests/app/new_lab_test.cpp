@@ -63,6 +63,10 @@ TEST_CASE("new-lab: a four-bar exercise from the five-bar by editing JSON only")
   CHECK(fs::exists(lab / "fourbar_lab.json"));
   CHECK_FALSE(fs::exists(lab / "fivebar.json"));
   CHECK(fs::exists(lab / "handout.md"));
+  // The staff page is the new lab's stub, not the five-bar's notes on its answer's gains and grade.
+  const std::string notes = readFile(lab / "instructor/README.md");
+  CHECK(notes.find("# Lab fourbar_lab: instructor files") == 0);
+  CHECK(notes.find(readFile(fs::path(DYNLAB_SOURCE_DIR) / "labs/fivebar/instructor/README.md").substr(0, 60)) == std::string::npos);
   // The copy is a lab of its own name, its examples and answers too.
   CHECK(json::parse(readFile(lab / "fourbar_lab.json"))["lab"] == "fourbar_lab");
   CHECK(json::parse(readFile(lab / "examples/task_pd.json"))["lab"] == "fourbar_lab");

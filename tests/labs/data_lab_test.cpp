@@ -137,6 +137,12 @@ TEST_CASE("metrics as data: each statistic on a trace with known values") {
   // A column the trace lacks, and a band where none belongs.
   const json bad = json::parse(R"({"e": {"of": ["a", "zz"], "stat": "rms"}})");
   CHECK_THROWS_WITH_AS(generic::parseMetrics(JsonView(bad, "lab.json", "/metrics"), tr.columns, 0.5, 0.1), doctest::Contains("/metrics/e/of"), InputError);
+  // ... naming the columns it has, so the lecturer need not look them up.
+  std::string has;
+  for (const auto& c : tr.columns) has += (has.empty() ? "" : ", ") + c;
+  const std::string says = "expected one of this lab's trace columns (" + has + "), not \"zz\"";
+  CHECK_THROWS_WITH_AS(generic::parseMetrics(JsonView(bad, "lab.json", "/metrics"), tr.columns, 0.5, 0.1),
+                       doctest::Contains(says.c_str()), InputError);
   const json band = json::parse(R"({"e": {"of": "a", "stat": "rms", "band": 1}})");
   CHECK_THROWS_WITH_AS(generic::parseMetrics(JsonView(band, "lab.json", "/metrics"), tr.columns, 0.5, 0.1), doctest::Contains("/metrics/e/band"), InputError);
   // A window must hold a sample of the run: a start past its last row, an end past its end, an empty one.
