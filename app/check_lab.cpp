@@ -138,7 +138,8 @@ int checkLab(const CheckLabArgs& args) {
   std::printf("dynlab check-lab %s: the lab contract (%s)\n", entry->name.c_str(), termText(labFolder(entry->name)).c_str());
   std::fflush(stdout);
   LabCheckReport report = dyn::checkLab(*entry, config, options);
-  report.checks.push_back(handoutCheck(entry->name));
+  // The handout is built from the config too: only once it builds (else the same error, again).
+  if (report.checks.front().ok) report.checks.push_back(handoutCheck(entry->name));
   report.checks.push_back(readmeCheck(entry->name));
   int failed = 0;
   std::size_t width = 0;

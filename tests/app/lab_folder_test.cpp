@@ -94,4 +94,9 @@ TEST_CASE("a data lab's metric window must lie inside its run: refused at the JS
   CHECK(config_line.find(config.string()) != std::string::npos);
   CHECK(config_line.find("/metrics/e_circle_rms/from") != std::string::npos);
   CHECK(check.out.find("config.json") == std::string::npos);
+  // One bad config is one FAIL line and a line saying the rest did not run, not a FAIL from every check.
+  std::size_t fails = 0;
+  for (std::size_t at = check.out.find("  FAIL  "); at != std::string::npos; at = check.out.find("  FAIL  ", at + 1)) ++fails;
+  CHECK(fails == 2);
+  CHECK(check.out.find("FAIL  other checks") != std::string::npos);
 }
