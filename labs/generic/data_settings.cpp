@@ -248,6 +248,12 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     VecN x0(Eigen::Index(s.tool.axes.size()));
     for (std::size_t i = 0; i < s.tool.axes.size(); ++i) x0[Eigen::Index(i)] = p0[s.tool.axes[i] - 3];
     s.path = std::make_shared<TaskPath>(c["trajectory"], x0, kMaxCoordinate);
+    // A task path is followed by the actuators alone: a degree of freedom none drives would be free,
+    // and the path's first point "singular" for it. Said as what it is, before the reach check.
+    if (c.has("trajectory") && m > 0 && file.dof != m)
+      c["actuated"].fail("expected one actuated joint per degree of freedom for a task path: the model file's mechanism has " +
+                         std::to_string(file.dof) + " after its loops close, " + std::to_string(m) +
+                         " actuated (`dynlab model FILE` shows its joints and loops)");
     // Every point of it within reach, away from singular poses (labs/generic/reach.h).
     if (c.has("trajectory")) checkReach(c["trajectory"], *s.path, s.model, s.actuated, s.tool, s.axis_names, s.q0);
   }
