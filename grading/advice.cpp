@@ -146,17 +146,6 @@ double gainOf(const json& config, const std::string& g) {
   return v.is_object() ? v.at("value").get<double>() : v.get<double>();
 }
 
-// The text's identifier-like words (letters, digits and '_').
-std::vector<std::string> words(const std::string& text) {
-  std::vector<std::string> out;
-  std::string w;
-  for (char c : text + " ") {
-    if (std::isalnum(static_cast<unsigned char>(c)) || c == '_') w += c;
-    else if (!w.empty()) out.push_back(w), w.clear();
-  }
-  return out;
-}
-
 }  // namespace
 
 std::vector<AdviceEntry> parseAdvice(const JsonView& v, const JsonView& config) {
@@ -277,7 +266,7 @@ std::vector<std::string> adviceProblems(const json& config, const std::string& f
         std::string which;
         for (const auto& [key, _] : options.items()) which += (which.empty() ? "" : ", ") + key + " " + chosen(law, key);
         // The laws the text names: a choice with '_' in it, or any choice right after its option's name.
-        const std::vector<std::string> ws = words(e.text);
+        const std::vector<std::string> ws = identifierWords(e.text);
         std::vector<json> named;
         for (std::size_t i = 0; i < ws.size(); ++i)
           for (const auto& [key, o] : options.items())
@@ -314,6 +303,16 @@ std::vector<std::string> adviceProblems(const json& config, const std::string& f
   for (const auto& p : problems)
     if (std::find(unique.begin(), unique.end(), p) == unique.end()) unique.push_back(p);
   return unique;
+}
+
+std::vector<std::string> identifierWords(const std::string& text) {
+  std::vector<std::string> out;
+  std::string w;
+  for (char c : text + " ") {
+    if (std::isalnum(static_cast<unsigned char>(c)) || c == '_') w += c;
+    else if (!w.empty()) out.push_back(w), w.clear();
+  }
+  return out;
 }
 
 }  // namespace dyn

@@ -55,4 +55,8 @@ std::string adviceSummary(const std::vector<AdviceEntry>& entries);
 // line per problem ("/metric_docs/e_rms/advice/0: …").
 std::vector<std::string> adviceProblems(const json& config, const std::string& file);
 
+// A text's identifier-like words (runs of letters, digits and '_'): how an advice text is read for
+// the gains and laws it names.
+std::vector<std::string> identifierWords(const std::string& text);
+
 }  // namespace dyn

@@ -23,16 +23,6 @@ namespace {
 
 using json = nlohmann::json;
 
-std::vector<std::string> wordsOf(const std::string& text) {
-  std::vector<std::string> out;
-  std::string w;
-  for (char c : text + " ") {
-    if (std::isalnum(static_cast<unsigned char>(c)) || c == '_') w += c;
-    else if (!w.empty()) out.push_back(w), w.clear();
-  }
-  return out;
-}
-
 struct Graded {
   json config;                                            // the lab's config with the submission applied
   std::vector<std::pair<dyn::GradedTest, std::string>> short_tests;  // below full marks, with their advice
@@ -66,7 +56,7 @@ int checkFits(const json& sub) {
   for (const auto& [t, advice] : g.short_tests) {
     INFO(sub.dump() << ": " << t.test.name << " [" << t.test.scenario << "]: " << advice);
     advised += !advice.empty();
-    const std::vector<std::string> ws = wordsOf(advice);
+    const std::vector<std::string> ws = dyn::identifierWords(advice);
     std::vector<json> named;  // the laws the advice names (to switch to)
     for (std::size_t i = 0; i < ws.size(); ++i)
       for (const auto& [key, o] : options.items())
