@@ -19,6 +19,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "grading/student.h"
+
 namespace dyn::app {
 namespace {
 
@@ -397,8 +399,8 @@ void writeAutograder(const std::string& lab, const std::string& source_dir, cons
   // A lab with a plant per student (labs/variants.h): the course secret rides in the staff-only zip,
   // and run_autograder grades each submission on its submitter's plant.
   if (config.contains("variants")) {
-    const char* secret = std::getenv("DYNLAB_COURSE_SECRET");
-    if (!secret || !*secret)
+    const std::string secret = courseSecret();
+    if (secret.empty())
       fail(zip_path, lab + " gives each student their own plant: set DYNLAB_COURSE_SECRET (the secret the students' keys "
                            "were made with) when writing its autograder");
     entries.push_back({"course_secret", secret, 0600u});

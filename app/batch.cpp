@@ -27,6 +27,7 @@
 #include "grading/escape.h"
 #include "grading/plot.h"
 #include "labs/utf8.h"
+#include "grading/student.h"
 #include "labs/variants.h"
 
 namespace fs = std::filesystem;
@@ -211,8 +212,7 @@ int gradeBatch(const GradeArgs& a) {
   // A lab with variants grades each submission on its student's plant: the IDs come first.
   try {
     if (!args.lab.empty() && declaresVariants(args.config.empty() ? defaultConfigPath(args.lab) : args.config)) {
-      const char* secret = std::getenv("DYNLAB_COURSE_SECRET");
-      if (!secret || !*secret)
+      if (courseSecret().empty())
         throw InputError("<command line>", "--batch", "expected DYNLAB_COURSE_SECRET to be set: " + args.lab +
                                                       " gives each student their own plant, drawn from the course secret");
       batch::assignStudents(found.submissions, a.roster);

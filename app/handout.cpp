@@ -95,8 +95,8 @@ struct Handout {
   json config;  // on the student's plant
   const LabEntry* entry;
   Rubric rubric;
-  PlantChoice student;             // whose handout (nominal: everyone's)
-  std::vector<PlantValue> nominal;  // the varied parameters at the nominal plant's values
+  PlantChoice student;              // whose handout (nominal: everyone's)
+  std::vector<PlantValue> varied;  // the varied parameters (labs/variants.h) at this handout's plant's values
 
   // The lab built with a scenario's patch: its loops name the screening metrics.
   std::vector<LinearLoop> loops(const Scenario& s) const {
@@ -123,23 +123,19 @@ struct Handout {
 
   // The plant per student (labs/variants.h): the ranges, and on a student's handout their values and key.
   std::string plant() const {
-    if (nominal.empty()) return {};
+    if (varied.empty()) return {};
     std::string md = "## Your plant\n\n";
-    if (student.nominal()) {
-      md += "Each student's plant differs in the parameters below, drawn from these ranges by the student's key; you are "
-            "graded on yours. Your own handout, which the course staff make for you with your student ID, shows your "
-            "values and your key.\n\n| parameter | nominal | range | unit | what it is |\n|---|---|---|---|---|\n";
-      for (const PlantValue& v : nominal)
-        md += "| " + cell(v.parameter.name) + " | " + num(v.value) + " | " + num(v.parameter.min) + " … " +
-              num(v.parameter.max) + " | " + cell(v.parameter.unit) + " | " + cell(v.parameter.doc) + " |\n";
-      return md + "\n";
-    }
-    const std::vector<PlantValue> mine = drawPlant(JsonView(config, config_file), PlantChoice{}, lab);
-    md += "This is the handout of student " + code(student.student) + ": every number in it is of your plant, and you are "
-          "graded on it. Your plant's varied parameters:\n\n| parameter | yours | range | unit | what it is |\n|---|---|---|---|---|\n";
-    for (const PlantValue& v : mine)
+    md += student.nominal()
+              ? "Each student's plant differs in the parameters below, drawn from these ranges by the student's key; you are "
+                "graded on yours. Your own handout, which the course staff make for you with your student ID, shows your "
+                "values and your key.\n\n| parameter | nominal | range | unit | what it is |\n|---|---|---|---|---|\n"
+              : "This is the handout of student " + code(student.student) + ": every number in it is of your plant, and you "
+                "are graded on it. Your plant's varied parameters:\n\n| parameter | yours | range | unit | what it is |\n"
+                "|---|---|---|---|---|\n";
+    for (const PlantValue& v : varied)
       md += "| " + cell(v.parameter.name) + " | " + num(v.value) + " | " + num(v.parameter.min) + " … " +
             num(v.parameter.max) + " | " + cell(v.parameter.unit) + " | " + cell(v.parameter.doc) + " |\n";
+    if (student.nominal()) return md + "\n";
     md += "\nYour key is " + code(student.key) + ". To run, tune and grade on your plant, set `DYNLAB_STUDENT_KEY=" +
           student.key + "` and add `--student " + student.student + "` to `dynlab run`, `ui`, `figure` and `grade` "
           "(Python: `dynlab.Lab(\"" + lab + "\", student=\"" + student.student + "\")`). Gains tuned on another "
@@ -338,9 +334,9 @@ std::string html(const std::string& markdown, const std::string& title) {
 HandoutText handoutText(const HandoutArgs& a) {
   const PlantChoice student = studentPlant(a.student);
   LoadedLab loaded = loadLab(a.lab, a.config, "", std::nullopt, student);
-  const json written = loadJsonFile(loaded.config_file);
+  // The config's own values of the varied parameters: the nominal ones, or this student's.
   Handout h{a.lab, loaded.config_file, loaded.config, loaded.entry, parseRubric(JsonView(loaded.config, loaded.config_file)),
-            student, drawPlant(JsonView(written, loaded.config_file), PlantChoice{}, a.lab)};
+            student, drawPlant(JsonView(loaded.config, loaded.config_file), PlantChoice{}, a.lab)};
   const Prose prose = readProse(fs::path(labFolder(a.lab)) / "handout.md", JsonView(loaded.config, loaded.config_file));
   return {h.markdown(prose), loaded.config.value("title", a.lab)};
 }

@@ -118,10 +118,9 @@ GradeOutcome gradeSubmission(const json& sub, const std::string& file, const Gra
     const std::string config_file = opt.config_file.empty() ? defaultConfigPath(lab_name) : opt.config_file;
     staff_file = config_file;
     const json written = loadJsonFile(config_file);
-    buildLab(*entry, written, config_file);  // the lab config itself must be valid
-    // The student's plant (labs/variants.h): the config graded from here on.
+    // The student's plant (labs/variants.h): the config graded from here on; it must build as it is.
     const json base = plantConfig(written, opt.plant, lab_name, config_file);
-    const auto base_lab = buildLab(*entry, base, config_file);
+    const auto base_lab = buildLab(*entry, base, config_file);  // the lab config itself must be valid
     const Rubric rubric = parseRubric(JsonView(base, config_file));
     checkColumns(rubric, base_lab->columns(), config_file);
     const json applied = applySubmission(base, view, lab_name, true);

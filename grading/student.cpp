@@ -11,6 +11,11 @@
 
 namespace dyn {
 
+std::string courseSecret() {
+  const char* secret = std::getenv("DYNLAB_COURSE_SECRET");
+  return secret ? secret : "";
+}
+
 std::string studentKey(const std::string& secret, const std::string& id) {
   unsigned char mac[EVP_MAX_MD_SIZE];
   unsigned int n = 0;
@@ -39,9 +44,9 @@ PlantChoice studentPlant(const std::string& id, const std::string& option, const
   if (id.empty()) return c;
   if (const std::string problem = studentIdProblem(id); !problem.empty()) throw InputError(who, option, problem);
   c.student = id;
-  const char* secret = std::getenv("DYNLAB_COURSE_SECRET");
+  const std::string secret = courseSecret();
   const char* key = std::getenv("DYNLAB_STUDENT_KEY");
-  if (secret && *secret) {
+  if (!secret.empty()) {
     c.key = studentKey(secret, id);
   } else if (key && *key) {
     c.key = key;

@@ -10,6 +10,9 @@
 
 namespace dyn {
 
+// DYNLAB_COURSE_SECRET ("" when unset): the staff's secret every student's key is made with.
+std::string courseSecret();
+
 // The first 16 hex digits of HMAC-SHA256(secret, id).
 std::string studentKey(const std::string& secret, const std::string& id);
 

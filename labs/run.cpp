@@ -36,7 +36,6 @@ LoadedLab loadLab(const std::string& name, const std::string& config_file, const
   out.config = loadJsonFile(out.config_file);
   // Validate the config itself first, so its errors name the config file.
   buildLab(*out.entry, out.config, out.config_file);
-  parseVariants(JsonView(out.config, out.config_file));
   out.config = plantConfig(out.config, plant, name, out.config_file);
   std::string source = out.config_file;
   if (!gains_file.empty()) {
