@@ -459,6 +459,18 @@ LabCheckReport checkLab(const LabEntry& entry, const json& config, const LabChec
         s.expect(scoreShare(g) >= 0.9, "scores " + percent(scoreShare(g)) + ", below 90 %");
         s.detail = "scores " + percent(scoreShare(g));
       });
+    // The designs a student writes from the handout alone, textbook gains not yet tuned, stay below 90 %:
+    // full marks are earned by tuning, not by reading (issue 41).
+    const std::string untuned_dir = instructor_dir + "/untuned";
+    const std::vector<std::string> untuned = jsonFiles(untuned_dir);
+    if (untuned.empty()) run(report, "untuned", [&](Step& s) { s.fail("no untuned design in " + untuned_dir); });
+    for (const std::string& file : untuned)
+      run(report, "untuned " + fileName(file), [&](Step& s) {
+        const GradeOutcome g = graded(s, file, o);
+        if (!s.problem.empty()) return;
+        s.expect(scoreShare(g) < 0.9, "scores " + percent(scoreShare(g)) + " untuned: full marks without tuning");
+        s.detail = "scores " + percent(scoreShare(g));
+      });
   }
 
   run(report, "render", [&](Step& s) {

@@ -15,6 +15,7 @@
 //   lesson ...      each rubric lesson holds (grading/lessons.h); the rubric states at least one
 //   doing nothing   every gain at its minimum scores below the defaults
 //   instructor ...  each instructor answer scores ≥ 90 %
+//   untuned ...     each instructor/untuned/*.json (the handout's round textbook gains) scores < 90 %
 //   render          a frame of the scene renders non-blank, with and without the panel (OSMesa)
 //   cli             `dynlab figure`, `dynlab run` (both engines, whole run), `dynlab grade`: exit 0
 //   readme numbers  each number the README marks as measured agrees with that run (app/readme_numbers.h)
