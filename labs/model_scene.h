@@ -49,7 +49,7 @@ class ModelPicture {
   double joint_radius_ = 0.01, rod_radius_ = 0.005;
 };
 
-// The coordinates q (or rates v) of a model run's trace row: columns 1..n (n..2n), as app/model.cpp writes them.
+// The coordinates q (or rates v) of a model run's trace row: columns 1..n (n..2n), as app/cli/model/model.cpp writes them.
 VecN traceQ(const Trace& trace, std::size_t row, int n);
 
 // The space a run moves through: the box of what is drawn over its rows (and the ghost's), so the

@@ -20,7 +20,7 @@ inline constexpr double kMaxGain = 1e9;                  // |min|, |max| of a de
 // The one bound on a run's work, however the run is asked for (a lab's JSON, a model file's
 // <option timestep>, --duration or --dt on any command, Python's arguments): its steps (duration / dt),
 // its trace's memory (a row of doubles per step) and the frames drawn of it. Commands check it before
-// they simulate; buildLab, runEngine and the frame writer (app/movie.h) hold it again.
+// they simulate; buildLab, runEngine and the frame writer (app/shared/movie.h) hold it again.
 inline constexpr double kMaxSteps = 2e6;         // steps of one run
 inline constexpr double kMaxTraceBytes = 512e6;  // one run's trace: (steps + 1) rows × columns × 8 bytes
 inline constexpr double kMaxFrames = 36000;      // frames drawn of one run: 20 minutes at 30 a second

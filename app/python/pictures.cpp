@@ -5,7 +5,7 @@
 #include <mutex>
 #include <system_error>
 
-#include "app/movie.h"
+#include "app/shared/movie.h"
 #include "app/python/lab_object.h"
 #include "grading/scenario.h"
 #include "labs/numbers.h"

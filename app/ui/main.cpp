@@ -12,7 +12,7 @@
 #include <fstream>
 #include <iostream>
 
-#include "app/model_lab.h"
+#include "labs/generic/model_lab.h"
 #include "app/ui/panel.h"
 #include "grading/student.h"
 #include "labs/generic/lab_folders.h"
@@ -120,7 +120,7 @@ bool writeText(const std::string& path, const std::string& text) {
 
 int run(const Args& a) {
   // Everything that can be wrong with the input is checked before a window opens.
-  // A model file where a lab goes: its passive motion (app/model_lab.h), nothing to tune but the engines.
+  // A model file where a lab goes: its passive motion (labs/generic/model_lab.h), nothing to tune but the engines.
   const bool model = app::isModelFile(a.lab);
   if (model)
     for (const auto& [given, option] : {std::pair{!a.config.empty(), "--config"}, {!a.gains.empty(), "--gains"}, {!a.scenario.empty(), "--scenario"}, {!a.student.empty(), "--student"}})
@@ -263,7 +263,7 @@ int main(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   try {
-    // Labs outside the tree, as dynlab's (app/lab_options.h): --labs, then DYNLAB_LABS, after the tree's.
+    // Labs outside the tree, as dynlab's (app/cli/lab_options.h): --labs, then DYNLAB_LABS, after the tree's.
     std::vector<generic::LabsFolder> folders;
     for (const auto& dir : a.labs) folders.push_back({dir, "--labs"});
     for (const auto& f : generic::labsFoldersFromEnvironment()) folders.push_back(f);

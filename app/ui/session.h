@@ -41,7 +41,7 @@ class TuningSession {
   // student's plant (labs/variants.h).
   TuningSession(const std::string& lab, const std::string& config_file = "", const std::string& gains_file = "",
                 const std::string& scenario = "", const PlantChoice& plant = {});
-  // A lab already built in memory, its config its own defaults (a model file: app/model_lab.h).
+  // A lab already built in memory, its config its own defaults (a model file: labs/generic/model_lab.h).
   explicit TuningSession(LoadedLab loaded);
 
   // ---- what can be tuned --------------------------------------------------------------------

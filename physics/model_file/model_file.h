@@ -149,7 +149,7 @@ struct LoadedModel {
                                    // unilateral, not counted)
 };
 
-// A loop closure given beside the file (plain data; app/model_loops.h reads it from the lab JSON beside
+// A loop closure given beside the file (plain data; labs/generic/model_loops.h reads it from the lab JSON beside
 // a URDF, which cannot express loops): held exactly as an MJCF <equality> connect or weld is.
 struct GivenClosure {
   std::string where;              // where it was given, for errors: "FILE.loops.json: loops[0]"

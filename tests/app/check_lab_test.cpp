@@ -1,4 +1,4 @@
-// dynlab check-lab LAB: the lab contract (app/lab_check.h) on one lab, from the command line: every
+// dynlab check-lab LAB: the lab contract (app/cli/authoring/lab_check.h) on one lab, from the command line: every
 // check printed with ok/FAIL and a reason, the shares and the passive drift; exit 0 when all pass,
 // 1 when one fails (a lab whose default gains are the instructor's), 2 on bad input.
 #include <doctest/doctest.h>

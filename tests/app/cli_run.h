@@ -1,5 +1,5 @@
 // Running the real dynlab binary (DYNLAB_BIN) from a test, and any other program, always as an
-// argument vector (app/process.h: no shell, so no command line is ever built): a scratch directory
+// argument vector (app/shared/process.h: no shell, so no command line is ever built): a scratch directory
 // per test case, the exit code and captured stdout/stderr, snapshots of what a command wrote, the
 // trace CSVs, and the bad-input contract (exit 2, one line naming what was given, nothing written).
 #pragma once
@@ -16,7 +16,7 @@
 #include <utility>
 #include <vector>
 
-#include "app/process.h"
+#include "app/shared/process.h"
 
 namespace dyn::test::cli {
 

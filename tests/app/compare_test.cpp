@@ -1,7 +1,7 @@
 // dynlab compare A B: both graded by the same rubric as `dynlab grade` grades them; a line per test
 // on the terminal (scores and metric with unit, A → B), OUT/comparison.md, one plot per simulated
 // test with both responses; a hostile file name stays text everywhere; bad input exits 2 writing
-// nothing; the exit codes are app/commands.h's.
+// nothing; the exit codes are app/cli/commands.h's.
 #include <doctest/doctest.h>
 
 #include <cstring>

@@ -6,7 +6,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/process.h"
+#include "app/shared/process.h"
 #include "tests/app/cli_run.h"
 
 using json = nlohmann::json;

@@ -1,4 +1,4 @@
-// Labs outside the dynlab tree (labs/generic/lab_folders.h, app/lab_options.h), as a lecturer keeps
+// Labs outside the dynlab tree (labs/generic/lab_folders.h, app/cli/lab_options.h), as a lecturer keeps
 // them: `dynlab new-lab x --from fivebar --labs DIR` prints the command to run next, which runs as
 // printed (parsed as a shell would, run as an argument vector); `dynlab list --labs DIR` shows the
 // tree's labs and x; DYNLAB_LABS names several folders; a name clash is one line and exit 2; a model

@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "app/process.h"
+#include "app/shared/process.h"
 
 namespace dyn::test::limited {
 
@@ -29,7 +29,7 @@ inline std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-// Runs DYNLAB_BIN with args in dir (app/process.h: no shell); address_space_bytes > 0 limits the
+// Runs DYNLAB_BIN with args in dir (app/shared/process.h: no shell); address_space_bytes > 0 limits the
 // child's address space. A child still running after timeout_s is killed (SIGKILL: reported as that signal).
 inline Ended runDynlab(const fs::path& dir, const std::vector<std::string>& args, double address_space_bytes = 0,
                        double timeout_s = 120) {

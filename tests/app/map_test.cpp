@@ -8,7 +8,7 @@
 
 #include <cmath>
 
-#include "app/map_plot.h"
+#include "app/cli/figures/map_plot.h"
 #include "tests/app/cli_run.h"
 #include "tests/app/png_ink.h"
 

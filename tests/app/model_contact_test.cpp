@@ -14,7 +14,7 @@
 #include <cmath>
 #include <nlohmann/json.hpp>
 
-#include "app/model_lab.h"
+#include "labs/generic/model_lab.h"
 #include "tests/app/cli_run.h"
 
 using namespace dyn::test::cli;

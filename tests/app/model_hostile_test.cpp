@@ -3,7 +3,7 @@
 // model reached through a link in another folder, its <include> beside the link's target, is read
 // once from the checked files by the load, the M/h cross-check and bench's MuJoCo engine alike (no
 // "Include error", no hang on a FIFO beside the link). The files are made here, at run time. The
-// binary runs from an argument vector (app/process.h, no shell) with a deadline: a hang fails the
+// binary runs from an argument vector (app/shared/process.h, no shell) with a deadline: a hang fails the
 // test instead of stalling it.
 #include <doctest/doctest.h>
 #include <fcntl.h>
@@ -21,7 +21,7 @@
 #include <thread>
 #include <vector>
 
-#include "app/process.h"
+#include "app/shared/process.h"
 
 namespace {
 
@@ -40,7 +40,7 @@ std::string slurp(const fs::path& p) {
   return s.str();
 }
 
-// dynlab with these arguments in folder dir, killed after `limit` seconds (app/process.h: no shell).
+// dynlab with these arguments in folder dir, killed after `limit` seconds (app/shared/process.h: no shell).
 Run dynlab(const fs::path& dir, const std::vector<std::string>& args, double limit) {
   const fs::path out = dir / ".stdout", err = dir / ".stderr";
   std::vector<std::string> argv{DYNLAB_BIN};

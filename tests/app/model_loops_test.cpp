@@ -1,4 +1,4 @@
-// Loop closures beside a URDF (app/model_loops.h): fourbar.urdf + fourbar.loops.json is fourbar.xml
+// Loop closures beside a URDF (labs/generic/model_loops.h): fourbar.urdf + fourbar.loops.json is fourbar.xml
 // (M, h, φ, the constraint rows, the solve and a 1 s passive run, to 1e-12), a weld keeps the planar
 // rows, and hostile loops files get one line naming the JSON file, the JSON path and what was expected.
 #include <doctest/doctest.h>
@@ -9,7 +9,7 @@
 #include <random>
 #include <unistd.h>
 
-#include "app/model_loops.h"
+#include "labs/generic/model_loops.h"
 #include "physics/constrained_mechanism.h"
 #include "physics/model_file/model_file.h"
 

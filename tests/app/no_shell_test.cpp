@@ -3,7 +3,7 @@
 // command line to a shell — std::system / system(...), popen, "/bin/sh", an exec or argument
 // vector of `sh -c`, `sh -c` on a build or script line, Python's os.system, subprocess with
 // shell=True or a command given as one string — and each hit is named as file:line. A program is
-// run with an argument vector instead (app/process.h; tests/app/cli_run.h in the tests). The one
+// run with an argument vector instead (app/shared/process.h; tests/app/cli_run.h in the tests). The one
 // line allowed carries kException: a test that runs the command line dynlab prints for a user to
 // paste into a shell, which is the point of that test. The build trees and .git are not scanned.
 #include <doctest/doctest.h>

@@ -1,9 +1,9 @@
-// app/process.h: a program run from an argument vector, never a shell. An argument holding $(...),
+// app/shared/process.h: a program run from an argument vector, never a shell. An argument holding $(...),
 // spaces or quotes arrives as it is; the child's folder, stdin/stdout files and environment are as
 // asked; a deadline kills it; a missing program is an error, not a crash. startProgram/waitProgram:
 // two programs at once (a reader and a writer of one FIFO, which neither finishes alone) and a
 // signal sent to a started one.
-#include "app/process.h"
+#include "app/shared/process.h"
 
 #include <doctest/doctest.h>
 #include <signal.h>

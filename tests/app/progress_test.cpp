@@ -1,4 +1,4 @@
-// Progress bars (app/progress.h): the line's format, and the real dynlab's `run --frames` and
+// Progress bars (app/shared/progress.h): the line's format, and the real dynlab's `run --frames` and
 // `figure` drawing one on a terminal (a pseudo-terminal here) and writing nothing of it anywhere
 // else (tests, logs and pipes stay clean). Where no pseudo-terminal can be opened (a chroot without
 // /dev/pts) the terminal half prints DYNLAB_TEST_SKIPPED, which ctest reports as skipped.
@@ -13,7 +13,7 @@
 #include <iostream>
 #include <optional>
 
-#include "app/progress.h"
+#include "app/shared/progress.h"
 #include "tests/app/cli_run.h"
 
 using namespace dyn::app;

@@ -1,10 +1,10 @@
-// A README's measured numbers (app/readme_numbers.h): each marked number is found on its line with its
+// A README's measured numbers (app/cli/authoring/readme_numbers.h): each marked number is found on its line with its
 // pointer, agrees when the run's value rounds to it at the digits written (and only then), and one
 // that disagrees or points at nothing is named with its line, what is written and what the run
 // measures. The five-bar's README once said 3.5e-4 rad where the run measured 1.94e-3.
 #include <doctest/doctest.h>
 
-#include "app/readme_numbers.h"
+#include "app/cli/authoring/readme_numbers.h"
 
 using namespace dyn;
 

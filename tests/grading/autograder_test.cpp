@@ -2,11 +2,11 @@
 // without build output), byte-identical rewrites, errors naming the path, and run_autograder's
 // promise of a valid results.json, run for real against fake dynlab binaries (whose check-results
 // is the real one); and `dynlab check-results` itself, through the real binary (DYNLAB_BIN).
-#include "app/autograder.h"
+#include "app/cli/course/autograder.h"
 
 #include <doctest/doctest.h>
 
-#include "app/process.h"
+#include "app/shared/process.h"
 #include "tests/test_files.h"
 #include <sys/stat.h>
 #include <zip.h>
@@ -181,7 +181,7 @@ TEST_CASE("build output, VCS data and temp files stay out of the bundle") {
   writeText(src / "labs/build/junk.o", "x");
   writeText(src / "labs/build-debug/junk.o", "x");
   writeText(src / "app/out/trace.csv", "x");
-  writeText(src / "app/main.cpp", "int main() {}\n");
+  writeText(src / "app/cli/main.cpp", "int main() {}\n");
   writeText(src / "grading/half.json.tmp", "x");
   writeText(src / "grading/.staging/results.json", "x");
   writeText(src / "physics/.git/HEAD", "x");
@@ -198,13 +198,13 @@ TEST_CASE("build output, VCS data and temp files stay out of the bundle") {
                                              "setup.sh",
                                              "source/CMakeLists.txt",
                                              "source/README.md",
-                                             "source/app/main.cpp",
+                                             "source/app/cli/main.cpp",
                                              "source/labs/demo/demo.json",
                                              "source/scripts/build"};
   CHECK(names == expected);
   const auto entries = asMap(readZip(zip));
   CHECK(entries.at("source/scripts/build").mode == 0755);
-  CHECK(entries.at("source/app/main.cpp").mode == 0644);
+  CHECK(entries.at("source/app/cli/main.cpp").mode == 0644);
   CHECK(entries.at("README.md").data.find("Demo") != std::string::npos);
 
   // A zip written inside a packed folder does not pack itself.

@@ -15,7 +15,7 @@
 #include <string>
 #include <vector>
 
-#include "app/process.h"
+#include "app/shared/process.h"
 #include "tests/test_files.h"
 
 namespace fs = std::filesystem;

@@ -3,7 +3,7 @@
 // exactly as alone, whatever --jobs is.
 #include <doctest/doctest.h>
 
-#include "app/process.h"
+#include "app/shared/process.h"
 #include "tests/test_files.h"
 
 #include <cstdio>

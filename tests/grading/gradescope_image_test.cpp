@@ -16,8 +16,8 @@
 #include <utility>
 #include <vector>
 
-#include "app/autograder.h"
-#include "app/process.h"
+#include "app/cli/course/autograder.h"
+#include "app/shared/process.h"
 #include "tests/test_files.h"
 
 namespace fs = std::filesystem;

@@ -1,6 +1,6 @@
 // The lab contract (labs/lab.h), checked on one lab: every_lab_test runs it on each registered lab,
 // and a test may register a scratch lab (registerLab / unregisterLab) and run it on that too. The
-// checks themselves are app/lab_check.h (the same ones `dynlab check-lab LAB` prints): config,
+// checks themselves are app/cli/authoring/lab_check.h (the same ones `dynlab check-lab LAB` prints): config,
 // examples, engines, drift independent, passive energy, metrics, grading, defaults (20–50 %), plots,
 // lessons (each holds), doing nothing (below the defaults), instructor answers (≥ 90 %), render, and
 // cli (`dynlab figure`, `dynlab run`, `dynlab grade`: exit 0). Here each must be ok; a failure
@@ -12,7 +12,7 @@
 #include <string>
 #include <utility>
 
-#include "app/lab_check.h"
+#include "app/cli/authoring/lab_check.h"
 #include "labs/run.h"
 #include "tests/app/cli_run.h"
 

@@ -17,7 +17,7 @@
 #include <regex>
 #include <sstream>
 
-#include "app/process.h"
+#include "app/shared/process.h"
 #include "labs/numbers.h"
 
 namespace {

@@ -31,7 +31,7 @@ TEST_CASE("every lab's frames: the mechanism large in the frame and clear of the
     for (auto [w, h] : {std::pair{640, 480}, std::pair{1280, 720}, std::pair{1920, 1080}}) {
       auto context = makeOffscreenContext(w, h);
       for (const char* panel : {"", "short", kLongTitle}) {
-        // The frame as `dynlab run`/`figure` draw it (app/movie.cpp renderRow).
+        // The frame as `dynlab run`/`figure` draw it (app/shared/movie.cpp renderRow).
         Scene scene;
         Overlay overlay;
         lab.scene(trace, row, nullptr, scene);

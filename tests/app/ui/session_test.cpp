@@ -10,7 +10,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "app/model_lab.h"
+#include "labs/generic/model_lab.h"
 #include "app/ui/session.h"
 #include "grading/grade.h"
 #include "labs/run.h"

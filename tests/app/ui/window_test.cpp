@@ -12,7 +12,7 @@
 #include <iostream>
 #include <nlohmann/json.hpp>
 
-#include "app/model_lab.h"
+#include "labs/generic/model_lab.h"
 #include "labs/run.h"
 #include "render/renderer.h"
 #include "tests/app/cli_run.h"

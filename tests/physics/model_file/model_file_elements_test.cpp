@@ -1,5 +1,5 @@
 // dynlab's own elements beside a model file (physics/model_file: GivenRolling, GivenContact; the JSON
-// read by app/model_loops.cpp) against the labs' C++ descriptions of the same mechanisms:
+// read by labs/generic/model_loops.cpp) against the labs' C++ descriptions of the same mechanisms:
 //  * unicycle.xml + unicycle.loops.json and the unicycle lab's describe() (labs/unicycle), and
 //  * pen.xml + pen.loops.json and the pen-on-table lab's describe() (labs/pen_on_table),
 // each with its plant read from the lab's JSON, give the same M(q), h(q, v) = C v + G, constraint rows
@@ -13,7 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <random>
 
-#include "app/model_loops.h"
+#include "labs/generic/model_loops.h"
 #include "labs/pen_on_table/mechanism.h"
 #include "labs/unicycle/mechanism.h"
 #include "physics/constrained_mechanism.h"

@@ -452,7 +452,7 @@ TEST_CASE("the sized hand engine (hand_engine.h) steps as the dynamically sized 
 }
 
 TEST_CASE("closures given as plain data beside a URDF are held as MJCF equalities are") {
-  // The four-bar's URDF tree with its pin given in C++ (app/model_loops.h reads the same from JSON).
+  // The four-bar's URDF tree with its pin given in C++ (labs/generic/model_loops.h reads the same from JSON).
   model_file::LoadOptions options;
   model_file::GivenClosure pin;
   pin.where = "test: loops[0]";

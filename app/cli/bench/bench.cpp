@@ -1,0 +1,286 @@
+// dynlab bench: speed is measured here, never asserted in tests.
+//   hand vs Bullet: median µs per step of each engine on the lab's default config, and the ratio,
+//     for the engine alone (advance the state one dt with the control held: the headline) and for
+//     the full simulation step (+ controller and trace row: energy, residual, constraint force);
+//   and speed with accuracy: the hand engine also with Bullet's order of method (labs/settings.h
+//     firstOrderPatch: one dynamics evaluation per step, as Bullet's own step), each run's error
+//     against the reference (the lab's configured hand run) in the lab's measures of agreement;
+//     the reference engine described by the lab (Lab::referenceEngine);
+//   render, render+PNG, render+video: frames per second at 640×480 (MSAA 4, overlay on);
+//   grading: CPU seconds of a full rubric grade of the lab's instructor/good.json.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <string>
+
+#include "app/cli/bench/bench.h"
+#include "app/cli/commands.h"
+#include "app/cli/model/model.h"
+#include "app/shared/movie.h"
+#include "labs/run.h"
+#include "render/video.h"
+
+namespace fs = std::filesystem;
+using Clock = std::chrono::steady_clock;
+
+namespace dyn::app {
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+Ratio ratio(const std::vector<double>& slow, const std::vector<double>& fast) {
+  std::vector<double> r;
+  for (std::size_t k = 0; k < slow.size() && k < fast.size(); ++k)
+    if (fast[k] > 0) r.push_back(slow[k] / fast[k]);
+  if (r.empty()) return {};
+  std::sort(r.begin(), r.end());
+  return {r[r.size() / 2], r[r.size() / 4], r[(3 * r.size()) / 4]};
+}
+
+double clockOverhead() {
+  using Micros = std::chrono::duration<double, std::micro>;
+  std::vector<double> pairs(2001);
+  for (double& p : pairs) {
+    const auto t0 = Clock::now();
+    p = Micros(Clock::now() - t0).count();
+  }
+  return median(pairs);
+}
+
+namespace {
+
+// Wall times per step, µs, less the clock reads' own cost (clockOverhead), on every engine alike.
+struct StepTimes {
+  double full = 0;    // median Simulation::step: controller, trace row, engine
+  double engine = 0;  // median Simulation::advanceEngine after each (untimed) step: the engine alone
+  bool has_engine = false;
+  std::vector<double> full_blocks, engine_blocks;  // the same medians, block by block
+};
+
+// The runs compared, timed in turn in short blocks (hand, Bullet, hand, ... 50 steps each): this
+// machine's clock speed wanders by half within milliseconds (a fixed chain of multiply-adds takes 0.83
+// to 1.26 µs from one 2 ms block to the next), so engines timed one after the other would each catch
+// their own phase and their ratio would move by ±10 % from run to run. Blocks keep each engine's data
+// in cache (one step each in turn would time the hand step after Bullet's had evicted it).
+struct TimedRun {
+  const Lab* lab;
+  Engine engine;
+};
+constexpr int kBlock = 50;
+
+std::vector<StepTimes> stepMicros(const std::vector<TimedRun>& runs, int steps) {
+  using Micros = std::chrono::duration<double, std::micro>;
+  const std::size_t count = runs.size();
+  std::vector<double> row;
+  std::vector<StepTimes> out(count);
+  std::vector<std::vector<double>> full(count), alone(count);
+  const double clock = clockOverhead();
+  std::vector<std::unique_ptr<Simulation>> sims;
+  auto restart = [&](std::size_t i) { sims[i] = runs[i].lab->simulate(runs[i].engine); };
+  for (const TimedRun& r : runs) sims.push_back(r.lab->simulate(r.engine));
+  // One block of run i: the full step, or the engine alone every other step with the torque of the
+  // step before held (500 Hz control). Short runs wrap around.
+  auto block = [&](std::size_t i, bool engine_alone, std::vector<double>& all) {
+    std::vector<double> times;
+    for (int k = 0; k < kBlock; ++k) {
+      if (engine_alone) {
+        if (!sims[i]->step(row)) {
+          restart(i);
+          continue;
+        }
+        const auto t0 = Clock::now();
+        const bool advanced = sims[i]->advanceEngine();
+        const double t = Micros(Clock::now() - t0).count() - clock;
+        if (advanced) times.push_back(t);
+      } else {
+        const auto t0 = Clock::now();
+        const bool stepped = sims[i]->step(row);
+        const double t = Micros(Clock::now() - t0).count() - clock;
+        if (stepped) times.push_back(t);
+        else restart(i);
+      }
+    }
+    all.insert(all.end(), times.begin(), times.end());
+    return median(times);
+  };
+  const int rounds = std::max(1, steps / kBlock);
+  for (int r = 0; r < rounds; ++r)
+    for (std::size_t i = 0; i < count; ++i) out[i].full_blocks.push_back(block(i, false, full[i]));
+  for (std::size_t i = 0; i < count; ++i) restart(i);
+  for (int r = 0; r < rounds; ++r)
+    for (std::size_t i = 0; i < count; ++i) out[i].engine_blocks.push_back(block(i, true, alone[i]));
+  for (std::size_t i = 0; i < count; ++i) {
+    out[i].full = median(full[i]);
+    out[i].engine = median(alone[i]);
+    out[i].has_engine = !alone[i].empty();
+  }
+  return out;
+}
+
+// Frames per second of draw+read (+ PNG, + video) over `frames` frames of the hand run.
+struct Fps {
+  double render = 0, png = 0, video = 0;
+};
+
+Fps frameRates(const Lab& lab, const Trace& trace, int frames) {
+  auto context = makeOffscreenContext(640, 480);
+  Renderer renderer(*context);
+  const auto rows = frameRows(trace, lab.dt(), 30);
+  const fs::path dir = fs::temp_directory_path() / "dynlab-bench";
+  fs::create_directories(dir);
+  auto run = [&](int mode) {
+    std::unique_ptr<VideoWriter> video;
+    if (mode == 2) video = std::make_unique<VideoWriter>((dir / "bench.mp4").string(), 640, 480, 30);
+    const auto t0 = Clock::now();
+    for (int k = 0; k < frames; ++k) {
+      Scene scene;
+      Overlay overlay;
+      const std::size_t row = rows[std::size_t(k) % rows.size()];
+      lab.scene(trace, row, nullptr, scene);
+      lab.overlay(trace, row, overlay);
+      const Image image = renderer.render(scene, &overlay);
+      if (mode == 1) writePng((dir / "bench.png").string(), image, nullptr, PngEncoding::Fast);  // as run --frames writes them
+      if (video) video->addFrame(image);
+    }
+    if (video) video->close();
+    return frames / std::chrono::duration<double>(Clock::now() - t0).count();
+  };
+  run(0);  // warm up (shader compilation, first ImGui frame)
+  Fps f{run(0), run(1), run(2)};
+  fs::remove_all(dir);
+  return f;
+}
+
+// "integrator + drift" of a config's simulation block, as labs/ parses it for every lab.
+std::string schemeOf(const json& config, const std::string& file) {
+  return schemeName(parseSimulation(JsonView(config, file)["simulation"], IndependentForm::Yes).step);
+}
+
+// The hand engine with a reference engine's order of method (labs/settings.h firstOrderPatch),
+// unless the lab is configured that way already (lab null).
+struct Variant {
+  std::unique_ptr<Lab> lab;
+  std::string scheme;
+};
+Variant firstOrderVariant(const LoadedLab& loaded) {
+  const json config = mergePatch(loaded.config, firstOrderPatch());
+  const std::string scheme = schemeOf(config, loaded.config_file);
+  if (scheme == schemeOf(loaded.config, loaded.config_file)) return {nullptr, scheme};
+  return {buildLab(*loaded.entry, config, loaded.config_file + " (bench: " + scheme + ")"), scheme};
+}
+
+// The lab's own measures of disagreement (numbers at the top level of Lab::agreement; counts left out).
+json errorAgainst(const Lab& lab, const Trace& run, const Trace& reference) {
+  const json agreement = lab.agreement(run, reference);
+  json out = json::object();
+  for (const auto& [k, v] : agreement.items())
+    if (v.is_number_float()) out[k] = v;
+  return out;
+}
+
+}  // namespace
+
+int bench(const BenchArgs& a) {
+  if (isModelFile(a.lab)) return benchModel(a);  // a model file where a lab goes (app/cli/bench/bench_model.cpp)
+  bool found = a.lab.empty();
+  for (const auto& entry : labRegistry()) found = found || entry.name == a.lab;
+  if (!found) {
+    std::fprintf(stderr, "error: <command line>: LAB: unknown lab \"%s\" (see dynlab list)\n", a.lab.c_str());
+    return 2;
+  }
+  for (const auto& entry : labRegistry()) {
+    if (!a.lab.empty() && entry.name != a.lab) continue;
+    LoadedLab loaded;
+    try {
+      loaded = loadLab(entry.name);
+    } catch (const InputError& e) {
+      std::fprintf(stderr, "error: %s\n", e.what());
+      return 2;
+    }
+    const Lab& lab = *loaded.lab;
+    const Variant variant = firstOrderVariant(loaded);
+    const std::unique_ptr<Lab>& first_order = variant.lab;
+    const std::string& first_scheme = variant.scheme;
+    const std::string scheme = schemeOf(loaded.config, loaded.config_file);
+    // Every engine timed in the same stretch of time, in turn (stepMicros).
+    std::vector<TimedRun> runs{{&lab, Engine::Hand}, {&lab, Engine::Bullet}};
+    if (first_order) runs.push_back({first_order.get(), Engine::Hand});
+    const std::vector<StepTimes> times = stepMicros(runs, a.steps);
+    const StepTimes hand_t = times[0], bullet_t = times[1];
+    const StepTimes first_t = first_order ? times[2] : StepTimes{};
+    // The headline compares the engines alone, when the lab offers it.
+    const bool alone = hand_t.has_engine && bullet_t.has_engine;
+    const double hand = alone ? hand_t.engine : hand_t.full, bullet = alone ? bullet_t.engine : bullet_t.full;
+    // Speed with accuracy: errors of whole runs against the configured hand run.
+    const RunResult reference = runEngine(lab, Engine::Hand);
+    const json bullet_error = errorAgainst(lab, runEngine(lab, Engine::Bullet).trace, reference.trace);
+    json first_error;
+    if (first_order) first_error = errorAgainst(lab, runEngine(*first_order, Engine::Hand).trace, reference.trace);
+    const double first_us = first_t.has_engine ? first_t.engine : first_t.full;
+    // Ratios from the blocks timed side by side (stepMicros), not from the overall medians.
+    auto blocks = [&](const StepTimes& t) -> const std::vector<double>& { return alone ? t.engine_blocks : t.full_blocks; };
+    const Ratio speedup = ratio(blocks(bullet_t), blocks(hand_t));
+    const Ratio speedup_full = ratio(bullet_t.full_blocks, hand_t.full_blocks);
+    const Ratio speedup_first = first_order ? ratio(blocks(bullet_t), blocks(first_t)) : Ratio{};
+    const Fps fps = frameRates(lab, reference.trace, a.frames);
+    const json grading = gradeThroughput(entry.name, 5);
+    if (a.json) {
+      json out = {{"lab", entry.name},
+                  {"step_timed", alone ? "engine" : "full"},
+                  {"hand_us_per_step", hand},
+                  {"bullet_us_per_step", bullet},
+                  {"bullet_over_hand", speedup.median},
+                  {"bullet_over_hand_quartiles", {speedup.low, speedup.high}},
+                  {"hand_full_us_per_step", hand_t.full},
+                  {"bullet_full_us_per_step", bullet_t.full},
+                  {"bullet_over_hand_full", speedup_full.median},
+                  {"hand_scheme", scheme},
+                  {"bullet_error", bullet_error},
+                  {"render_fps", fps.render},
+                  {"render_png_fps", fps.png},
+                  {"render_video_fps", fps.video},
+                  {"resolution", "640x480"}};
+      if (first_order) {
+        out["hand_first_order_scheme"] = first_scheme;
+        out["hand_first_order_us_per_step"] = first_us;
+        out["bullet_over_hand_first_order"] = speedup_first.median;
+        out["bullet_over_hand_first_order_quartiles"] = {speedup_first.low, speedup_first.high};
+        out["hand_first_order_error"] = first_error;
+      }
+      for (const auto& [k, v] : grading.items()) out[k] = v;
+      std::cout << out.dump() << "\n";
+    } else {
+      std::printf("%s\n", entry.name.c_str());
+      if (alone)
+        std::printf("  engine step     hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median; advance one dt, control held)\n",
+                    hand, bullet, speedup.median);
+      std::printf("  full step       hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median; + controller, trace row)\n",
+                  hand_t.full, bullet_t.full, speedup_full.median);
+      std::printf("  speed and error of whole runs against the reference (hand, %s, dt %g s):\n", scheme.c_str(), lab.dt());
+      std::printf("    hand   %-34s %6.2f µs   reference\n", scheme.c_str(), hand);
+      // The first-order ratio with the middle half of its blocks; the Bullet line's errors aligned under it.
+      char ratio_text[96] = "";
+      if (first_order) {
+        std::snprintf(ratio_text, sizeof ratio_text, "Bullet/hand %.1fx (blocks %.1f–%.1f)", speedup_first.median, speedup_first.low,
+                      speedup_first.high);
+        std::printf("    hand   %-34s %6.2f µs   %s   %s\n", first_scheme.c_str(), first_us, ratio_text,
+                    describeAgreement(lab, first_error).c_str());
+      }
+      const int pad = int(std::string(ratio_text).size()) - 2;  // "–" is 3 bytes, 1 column
+      std::printf("    %-41s %6.2f µs   %*s   %s\n", lab.referenceEngine().c_str(), bullet, std::max(pad, 0), "",
+                  describeAgreement(lab, bullet_error).c_str());
+      std::printf("  640x480 fps     render %.0f   +PNG %.0f   +video %.0f\n", fps.render, fps.png, fps.video);
+      if (!grading.empty())
+        std::printf("  grading         %.3f s CPU per full rubric (%.3f s with plots): %.0f per s per core, 1000 with plots on 2 cores in %.0f s\n",
+                    grading["grade_cpu_s"].get<double>(), grading["grade_cpu_s_with_plots"].get<double>(),
+                    grading["grade_per_s_per_core"].get<double>(), grading["class_of_1000_on_2_cores_s"].get<double>());
+    }
+  }
+  return 0;
+}
+
+}  // namespace dyn::app

@@ -1,0 +1,29 @@
+// A model file (MJCF or URDF, with what stands beside it: STEM.loops.json) where a lab name goes, for
+// the commands that work on a lab's run: `dynlab figure FILE` and the tuning window `dynlab ui FILE`.
+// The file is read once into a lab of its own (no actuated joint, no task): its passive motion from
+// its pose at rest, at the file's step, both engines, run as `dynlab model` runs it (labs/generic/model_run.h:
+// with wheels or contacts, stepped as the labs step, the touchdowns' losses in the books), its trace
+// `dynlab model`'s columns and each joint's bearing load (load_JOINT_x|y|z). Shared by dynlab and
+// dynlab-ui (part of dynlab_labs, beside the data lab it resembles).
+#pragma once
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "labs/run.h"
+
+namespace dyn::app {
+
+// True when LAB names a model file (ends in .xml or .urdf, any case): no lab's name does.
+bool isModelFile(const std::string& name);
+
+// The model file as a lab, passive, for `duration` s (default 2 s), with the closures, wheels and
+// contacts beside it; its figures are the coordinates, the energy books (with the touchdowns' losses),
+// each closure's force and each wheel's or contact's.
+// Throws InputError (one line, naming the file) on bad input.
+LoadedLab loadModelLab(const std::string& file, std::optional<double> duration);
+
+// Names joined by sep ("q_crank, q_rocker"; "x z"): a model's columns and rows in figures and summaries.
+std::string join(const std::vector<std::string>& v, const char* sep = " ");
+
+}  // namespace dyn::app

@@ -1,0 +1,218 @@
+// One engine's run of a loaded model: see model_run.h (moved from app/cli/model/model.cpp, unchanged).
+#include "labs/generic/model_run.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <memory>
+
+#include "physics/bullet/bullet_mechanism.h"
+#include "physics/constraints/plane_contact.h"
+#include "physics/constraints/rolling.h"
+#include "physics/model_file/hand_engine.h"
+
+namespace dyn::app {
+namespace {
+
+// The row at t: state, energy, the work so far (torques, friction, impacts), |φ|∞ (the description's,
+// at this state) and each closure's force on its kept rows, then the elements' columns; the run's
+// extremes follow.
+void record(ModelRun& run, ConstrainedMechanism<Spatial>& mech, double t, const VecN& q, const VecN& v, double work,
+            const std::vector<double>& forces, double phi) {
+  const double e = mech.energy(q, v);
+  if (run.trace.rows() == 0) run.e0 = e;
+  std::vector<double> row{t};
+  row.insert(row.end(), q.data(), q.data() + q.size());
+  row.insert(row.end(), v.data(), v.data() + v.size());
+  row.insert(row.end(), {e, work, phi});
+  row.insert(row.end(), forces.begin(), forces.end());
+  run.trace.append(row);
+  run.residual = std::max(run.residual, phi);
+  run.balance = std::max(run.balance, std::abs(e - run.e0 - work));
+  run.kinetic = std::max(run.kinetic, mech.kineticEnergy(q, v));
+}
+
+}  // namespace
+
+// |φ|∞ of a model with dynlab's elements at a state: the closures' and wheels' rows, position and
+// velocity forms (a wheel's x, y rows have only the latter: its slip), and each contact's depth past
+// its plane (the description's mechanism, whose contacts stay open: their gaps are read, not held).
+double elementResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, const VecN& q, const VecN& v) {
+  double phi = desc.residual(q, v);
+  desc.stage(q);
+  for (std::size_t i = 0; i < m.contacts.size(); ++i)
+    if (const auto* pc = dynamic_cast<const PlaneContact<Spatial>*>(m.mechanism.constraints[m.closures.size() + i].get()))
+      if (!pc->compliant()) phi = std::max(phi, -pc->gap(desc.kinematics()));
+  return phi;
+}
+
+// The power the joints' damping and friction take out of the mechanism (≥ 0), by the description's
+// law (JointProperties::friction), for Bullet's books; the hand engine integrates its own (Books).
+double frictionPower(const MechanismModel<Spatial>& d, const VecN& v) {
+  double p = 0;
+  for (std::size_t i = 0; i < d.joints.size(); ++i) {
+    const JointProperties& j = d.joints[i];
+    const double w = v[Eigen::Index(i)];
+    p += j.friction(w) * w;
+  }
+  return p;
+}
+
+
+// A rigid plane contact among the model's elements: its touchdowns are plastic impacts.
+bool anyImpacts(const model_file::LoadedModel& m) {
+  for (std::size_t i = 0; i < m.contacts.size(); ++i)
+    if (m.contacts[i].kind == "plane_contact" && !m.mechanism.constraints[m.closures.size() + i]->compliant()) return true;
+  return false;
+}
+
+Trace modelColumns(const model_file::LoadedModel& m) {
+  Trace t;
+  t.columns.push_back("t");
+  for (const auto& j : m.joints) t.columns.push_back("q_" + columnName(j.name));
+  for (const auto& j : m.joints) t.columns.push_back("v_" + columnName(j.name));
+  t.columns.insert(t.columns.end(), {"energy", "work", "constraint_residual"});
+  for (const auto& c : m.closures)
+    for (const auto& r : c.kept) t.columns.push_back("f_" + columnName(c.name) + "_" + r);
+  // dynlab's own elements: a wheel's ground force in wheel axes (heading, axle, up), its skid margin
+  // and slip speed; a contact's normal and tangential force and its gap; the touchdowns' energy.
+  if (anyImpacts(m)) t.columns.push_back("impacts");
+  for (const auto& c : m.contacts) {
+    const std::string n = columnName(c.name);
+    if (c.kind == "rolling")
+      t.columns.insert(t.columns.end(), {"f_" + n + "_long", "f_" + n + "_lat", "f_" + n + "_normal", "skid_margin_" + n, "slip_" + n});
+    else
+      t.columns.insert(t.columns.end(), {"f_" + n + "_normal", "f_" + n + "_tangent", "gap_" + n});
+  }
+  return t;
+}
+
+// The hand engine from the file's pose at rest: RK4, positions and velocities projected each step,
+// stepped by the sized engine the bench times (hand_engine.h); the rows' energy, residual and forces
+// (the solve's η at the row's state) from the description's mechanism.
+ModelRun runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, double dt, double duration, const VecN& tau) {
+  ModelRun run;
+  run.trace = modelColumns(m);
+  StepOptions o;
+  o.dt = dt;
+  const int steps = int(std::lround(duration / dt)), n = mech.n();
+  VecN q = m.q0, v = VecN::Zero(n);
+  const std::unique_ptr<ConstrainedSystem> engine = model_file::handEngine(m.mechanism, &run.summary);
+  // The books (friction's work) integrated with the motion, at RK4's order (integrate.h).
+  engine->setTime(0);
+  engine->books() = Books{};
+  for (int k = 0; k <= steps; ++k) {
+    const auto s = mech.solve(q, v, tau);
+    const Books b = engine->books();
+    record(run, mech, k * dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()), mech.residual(q));
+    if (k == steps) break;
+    if (!(run.ok = step(*engine, o, tau, q, v) && q.allFinite() && v.allFinite())) break;
+  }
+  return run;
+}
+
+// The hand engine with dynlab's elements, stepped as the labs step (labs/mechanism_simulation.h): at
+// each step's start the contacts close (a plastic impact on v) or open, and a touchdown inside the step
+// is located and closed there. A row's forces are the solve's at its state, plus a touchdown's impulse
+// over the step / dt (the step's mean, as impulse engines report it); its work includes the touchdowns'
+// −ΔT (the column impacts alone), so E − E0 − W stays RK4's error.
+ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, double dt, double duration, const VecN& tau) {
+  ModelRun run;
+  run.trace = modelColumns(m);
+  run.summary = "dynamic sizes; contacts closed and opened between steps, touchdowns located";
+  StepOptions o;
+  o.dt = dt;
+  const int steps = int(std::lround(duration / dt)), n = desc.n();
+  const std::size_t closures = m.closures.size();
+  int closure_rows = 0;
+  for (const auto& c : m.closures) closure_rows += int(c.kept.size());
+  const bool impacts = anyImpacts(m);
+  ConstrainedMechanism<Spatial> engine(m.mechanism);
+  engine.setTime(0);
+  engine.books() = Books{};
+  VecN q = m.q0, v = VecN::Zero(n);
+  for (int k = 0; k <= steps; ++k) {
+    engine.updateContacts(q, v, tau);
+    const auto s = engine.solve(q, v, tau);
+    std::vector<double> row(s.eta.data(), s.eta.data() + closure_rows);
+    const double loss = engine.impactLoss();
+    if (impacts) row.push_back(loss);
+    std::vector<std::array<double, 5>> report(m.contacts.size());
+    for (std::size_t i = 0; i < m.contacts.size(); ++i) engine.constraintReport(int(closures + i), s, report[i].data());
+    const Books b = engine.books();
+    const VecN q_row = q, v_row = v;
+    bool stepped = false;
+    if (k < steps) {
+      stepped = engine.stepLocatingContacts(o, tau, q, v) && q.allFinite() && v.allFinite();
+      run.ok = stepped;
+    }
+    for (std::size_t i = 0; i < m.contacts.size(); ++i) {
+      const auto& r = report[i];
+      if (m.contacts[i].kind == "rolling") {
+        row.insert(row.end(), r.begin(), r.end());
+        continue;
+      }
+      // gap, f_n; a touchdown in the step adds its impulse's normal share / dt.
+      const auto* pc = static_cast<const PlaneContact<Spatial>*>(m.mechanism.constraints[closures + i].get());
+      const double P = stepped ? pc->normal().dot(Spatial::linear(engine.impactImpulse(int(closures + i)))) : 0.0;
+      row.insert(row.end(), {r[1] + P / dt, 0.0, r[0]});
+    }
+    record(run, desc, k * dt, q_row, v_row, b.work + b.friction - loss, row, elementResidual(m, desc, q_row, v_row));
+    if (k == steps || !run.ok) break;
+  }
+  return run;
+}
+
+// Bullet from the same state; forces: each closure's over the step that starts at the row (the last
+// row repeats the last step's).
+ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, double dt, double duration, const VecN& tau) {
+  ModelRun run;
+  run.trace = modelColumns(m);
+  const int steps = int(std::lround(duration / dt)), n = mech.n();
+  VecN q = m.q0, v = VecN::Zero(n);
+  bullet::BulletMechanism<Spatial> bt(m.mechanism, dt, q, v);
+  run.summary = bt.describe();
+  const bool impacts = anyImpacts(m);
+  // The power flowing in: the torques' τ·v less what damping and friction take.
+  auto inflow = [&](const VecN& w) { return tau.dot(w) - frictionPower(m.mechanism, w); };
+  double work = 0, power = inflow(v);
+  std::vector<double> forces;
+  for (int k = 0; k <= steps; ++k) {
+    VecN qn = q, vn = v;
+    if (k < steps) {
+      bt.step(tau);
+      bt.state(qn, vn);
+      forces.clear();
+      for (std::size_t c = 0; c < m.closures.size(); ++c)
+        for (const auto& r : m.closures[c].kept) forces.push_back(bt.constraintForce(int(c))[model_file::rowIndex(r)]);
+      // Bullet's impacts are inside its contact impulses: its books hold no separate share.
+      if (impacts) forces.push_back(0.0);
+      mech.stage(q, &v);
+      for (std::size_t i = 0; i < m.contacts.size(); ++i) {
+        const int c = int(m.closures.size() + i);
+        const Spatial::Vec f = bt.constraintForce(c);
+        const Spatial::Pos f_lin = Spatial::linear(f);
+        const Constraint<Spatial>& k_c = *m.mechanism.constraints[std::size_t(c)];
+        if (m.contacts[i].kind == "rolling") {
+          double r[5];
+          k_c.report(mech.kinematics(), f_lin.data(), r);  // the rolling rows' η are the force's world components
+          forces.insert(forces.end(), r, r + 5);
+        } else {
+          const auto& pc = static_cast<const PlaneContact<Spatial>&>(k_c);
+          const double fn = pc.normal().dot(f_lin);
+          forces.insert(forces.end(), {fn, (f_lin - fn * pc.normal()).norm(), pc.gap(mech.kinematics())});
+        }
+      }
+    }
+    record(run, mech, k * dt, q, v, work, forces, m.contacts.empty() ? mech.residual(q) : elementResidual(m, mech, q, v));
+    if (k == steps) break;
+    if (!(run.ok = qn.allFinite() && vn.allFinite())) break;
+    const double p = inflow(vn);
+    work += 0.5 * (power + p) * dt;
+    power = p;
+    q = qn, v = vn;
+  }
+  return run;
+}
+
+}  // namespace dyn::app
