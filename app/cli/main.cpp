@@ -115,169 +115,231 @@ void requireFinite(CLI::App& app) {
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) requireFinite(*sub);
 }
 
-int dispatch(int argc, char** argv) {
-  using namespace dyn::app;
-  CLI::App cli{"dynlab — a teaching lab for the dynamics of constrained mechanisms"};
-  cli.require_subcommand(1);
-  cli.set_version_flag("--version", std::string(DYNLAB_VERSION));
+// Every command's arguments and its subcommand (null until added); the adders below fill it, in the
+// order `dynlab --help` lists them, and runChosen runs the one the command line chose.
+struct Commands {
+  CLI::App *list = nullptr, *r = nullptr, *f = nullptr, *g = nullptr, *z = nullptr, *c = nullptr, *s = nullptr,
+           *sf = nullptr, *u = nullptr, *k = nullptr, *l = nullptr, *cl = nullptr, *nl = nullptr, *b = nullptr;
+  dyn::app::RunArgs run;
+  dyn::app::FigureArgs fig;
+  dyn::app::GradeArgs grade;
+  std::string zip_lab, zip_out = "autograder.zip";
+  std::string results_file, schema_lab, upload_dir;
+  dyn::app::UiArgs ui;
+  dyn::app::CompareArgs cmp;
+  dyn::app::LessonsArgs les;
+  dyn::app::CheckLabArgs check_lab;
+  dyn::app::NewLabArgs new_lab;
+  dyn::app::BenchArgs bench_args;
+};
 
-  auto* list = cli.add_subcommand("list", "List the labs, one line each");
+// list and run: a lab (or a model file) run with both engines.
+void addRun(CLI::App& cli, Commands& x) {
+  x.list = cli.add_subcommand("list", "List the labs, one line each");
 
-  RunArgs run;
-  auto* r = cli.add_subcommand("run", "Run a lab with the hand-written dynamics and/or Bullet; write traces, summary, video");
-  r->add_option("LAB", run.lab, "Lab name (see `dynlab list`), or an MJCF (.xml) / URDF (.urdf) model file: run as "
+  x.r = cli.add_subcommand("run", "Run a lab with the hand-written dynamics and/or Bullet; write traces, summary, video");
+  x.r->add_option("LAB", x.run.lab, "Lab name (see `dynlab list`), or an MJCF (.xml) / URDF (.urdf) model file: run as "
                                 "`dynlab model FILE` does")->required();
-  r->add_option("--config", run.config, "Lab config JSON (default: labs/LAB/LAB.json)");
-  r->add_option("--gains", run.gains, "Gains JSON: {\"gains\": {...}} as in a submission");
-  r->add_option("--out", run.out, "Output directory (default: out/LAB)");
-  r->add_option("--engine", run.engine, "Which engine(s) to run")->check(CLI::IsMember({"hand", "bullet", "both"}));
-  r->add_flag("--video", run.video, "Write video.mp4 (H.264, 30 fps)");
-  r->add_flag("--frames", run.frames, "Write frames/NNNNN.png (30 fps)");
-  r->add_option("--duration", run.duration, "Override the simulated duration (s)");
-  r->add_option("--student", run.student, kStudentHelp);
-  r->add_option("--scenario", run.scenario, "Run under one rubric scenario (heavy_load, noisy_sensor, ...) exactly as the "
+  x.r->add_option("--config", x.run.config, "Lab config JSON (default: labs/LAB/LAB.json)");
+  x.r->add_option("--gains", x.run.gains, "Gains JSON: {\"gains\": {...}} as in a submission");
+  x.r->add_option("--out", x.run.out, "Output directory (default: out/LAB)");
+  x.r->add_option("--engine", x.run.engine, "Which engine(s) to run")->check(CLI::IsMember({"hand", "bullet", "both"}));
+  x.r->add_flag("--video", x.run.video, "Write video.mp4 (H.264, 30 fps)");
+  x.r->add_flag("--frames", x.run.frames, "Write frames/NNNNN.png (30 fps)");
+  x.r->add_option("--duration", x.run.duration, "Override the simulated duration (s)");
+  x.r->add_option("--student", x.run.student, kStudentHelp);
+  x.r->add_option("--scenario", x.run.scenario, "Run under one rubric scenario (heavy_load, noisy_sensor, ...) exactly as the "
                                           "grader does: its patch and the noise seed the gains file is graded with "
                                           "(default out: out/LAB/scenarios/NAME)");
-  r->add_option("--torque", run.torques, "A model file only: a constant joint torque JOINT=VALUE (N·m; N on a slide), "
+  x.r->add_option("--torque", x.run.torques, "A model file only: a constant joint torque JOINT=VALUE (N·m; N on a slide), "
                                          "repeatable (default: passive)")->allow_extra_args(false);
-  r->add_option("--loops", run.loops, "A model file only: loop closures beside it (JSON; default: STEM.loops.json beside a .urdf)");
+  x.r->add_option("--loops", x.run.loops, "A model file only: loop closures beside it (JSON; default: STEM.loops.json beside a .urdf)");
+}
 
-  FigureArgs fig;
-  auto* f = cli.add_subcommand("figure", "Lecture figures from a lab's run: plots of trace columns (PDF/SVG/PNG) and "
+// figure: lecture plots and stills from a run.
+void addFigure(CLI::App& cli, Commands& x) {
+  x.f = cli.add_subcommand("figure", "Lecture figures from a lab's run: plots of trace columns (PDF/SVG/PNG) and "
                                          "rendered stills (PNG); without --plot/--still, the lab's own plots (its "
                                          "rubric's and its JSON's \"figures\") and stills at the start, middle "
                                          "and end");
-  f->add_option("LAB", fig.lab, "Lab name (see `dynlab list`)")->required();
-  f->add_option("--config", fig.config, "Lab config JSON (default: labs/LAB/LAB.json)");
-  f->add_option("--gains", fig.gains, "Gains JSON: {\"gains\": {...}} as in a submission (repeatable: each file a run, "
+  x.f->add_option("LAB", x.fig.lab, "Lab name (see `dynlab list`)")->required();
+  x.f->add_option("--config", x.fig.config, "Lab config JSON (default: labs/LAB/LAB.json)");
+  x.f->add_option("--gains", x.fig.gains, "Gains JSON: {\"gains\": {...}} as in a submission (repeatable: each file a run, "
                                      "overlaid on every plot and named in the legend by its file, e.g. damper vs spring)")
       ->allow_extra_args(false);
-  f->add_option("--duration", fig.duration, "Override the simulated duration (s)");
-  f->add_option("--student", fig.student, kStudentHelp);
-  f->add_option("--engine", fig.engine, "Which engine(s) to run: hand solid, Bullet dashed (plots) or as a ghost (stills)")
+  x.f->add_option("--duration", x.fig.duration, "Override the simulated duration (s)");
+  x.f->add_option("--student", x.fig.student, kStudentHelp);
+  x.f->add_option("--engine", x.fig.engine, "Which engine(s) to run: hand solid, Bullet dashed (plots) or as a ghost (stills)")
       ->check(CLI::IsMember({"hand", "bullet", "both"}));
-  f->add_option("--out", fig.out, "Output directory (default: out/LAB/figures)");
-  f->add_option("--plot", fig.plots, "Trace columns to plot against t, e.g. theta,theta_d, or Y:X for column Y "
+  x.f->add_option("--out", x.fig.out, "Output directory (default: out/LAB/figures)");
+  x.f->add_option("--plot", x.fig.plots, "Trace columns to plot against t, e.g. theta,theta_d, or Y:X for column Y "
                                      "against column X, e.g. \"y:x, y_d:x_d\" (the path in the plane; equal scales "
                                      "when both axes have one unit); a curve followed by @M is drawn only where "
                                      "column M is nonzero, e.g. \"y_p:x_p@contact\" (repeatable: one plot each); "
                                      "written as plot_<cols joined by +>.<format> (Y:X as Y-vs-X, @M as -where-M)")
       ->allow_extra_args(false);
-  f->add_option("--still", fig.stills, "Render the scene at this time (s), nearest trace row (repeatable); "
+  x.f->add_option("--still", x.fig.stills, "Render the scene at this time (s), nearest trace row (repeatable); "
                                        "written as still_<t>.png")
       ->allow_extra_args(false);
-  f->add_option("--format", fig.format, "Plot format: pdf, svg or png (default: pdf)");
-  f->add_option("--size", fig.size, "Size WIDTHxHEIGHT in pixels of the stills and the plots (a PDF or SVG page in "
+  x.f->add_option("--format", x.fig.format, "Plot format: pdf, svg or png (default: pdf)");
+  x.f->add_option("--size", x.fig.size, "Size WIDTHxHEIGHT in pixels of the stills and the plots (a PDF or SVG page in "
                                     "points; default: stills 1920x1080, plots 800x450)");
-  f->add_option("--font-scale", fig.font_scale, "Plot text size relative to the default for the plot's size (default: 1)")
+  x.f->add_option("--font-scale", x.fig.font_scale, "Plot text size relative to the default for the plot's size (default: 1)")
       ->check(CLI::Range(0.25, 8.0));
-  f->add_option("--y-scale", fig.y_scale, "Plot y axis: auto (log when the data are positive and span over 3 decades, "
+  x.f->add_option("--y-scale", x.fig.y_scale, "Plot y axis: auto (log when the data are positive and span over 3 decades, "
                                           "e.g. a constraint residual), linear or log (default: auto)")
       ->check(CLI::IsMember({"auto", "linear", "log"}));
-  f->add_flag("!--no-overlay", fig.overlay, "Stills without the overlay panel");
-  f->add_option("--title", fig.title, "Title of every plot and of the stills' panel (default: the lab and columns)");
-  f->add_option("--scenario", fig.scenario, "Run under one rubric scenario exactly as the grader does "
+  x.f->add_flag("!--no-overlay", x.fig.overlay, "Stills without the overlay panel");
+  x.f->add_option("--title", x.fig.title, "Title of every plot and of the stills' panel (default: the lab and columns)");
+  x.f->add_option("--scenario", x.fig.scenario, "Run under one rubric scenario exactly as the grader does "
                                           "(default out: out/LAB/scenarios/NAME/figures)");
+}
 
-  GradeArgs grade;
-  auto* g = cli.add_subcommand("grade", "Grade a submission (gains JSON) against its lab's rubric, or a whole directory");
-  g->add_option("SUBMISSION", grade.submission, "Submission JSON: {\"lab\": ..., \"gains\": {...}}");
-  g->add_option("--out", grade.out, "Output directory: results.json, report.md/html, plots/ (default: out/grade)");
-  g->add_option("--lab", grade.lab, "The assignment's lab: a submission naming another lab scores 0");
-  g->add_option("--config", grade.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
-  g->add_option("--time-budget", grade.time_budget, "Wall-time budget per submission (s)")->check(timeBudget());
-  g->add_option("--student", grade.student, kStudentHelp);
-  g->add_option("--student-from", grade.student_from, "Gradescope's submission_metadata.json: grade on its submitter's "
+// grade: one submission, a replay, or a whole folder.
+void addGrade(CLI::App& cli, Commands& x) {
+  x.g = cli.add_subcommand("grade", "Grade a submission (gains JSON) against its lab's rubric, or a whole directory");
+  x.g->add_option("SUBMISSION", x.grade.submission, "Submission JSON: {\"lab\": ..., \"gains\": {...}}");
+  x.g->add_option("--out", x.grade.out, "Output directory: results.json, report.md/html, plots/ (default: out/grade)");
+  x.g->add_option("--lab", x.grade.lab, "The assignment's lab: a submission naming another lab scores 0");
+  x.g->add_option("--config", x.grade.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
+  x.g->add_option("--time-budget", x.grade.time_budget, "Wall-time budget per submission (s)")->check(timeBudget());
+  x.g->add_option("--student", x.grade.student, kStudentHelp);
+  x.g->add_option("--student-from", x.grade.student_from, "Gradescope's submission_metadata.json: grade on its submitter's "
                                                       "plant (their Student ID, else e-mail), when the --lab has variants");
-  g->add_option("--roster", grade.roster, "--batch: a CSV whose rows are FILE_OR_FOLDER,STUDENT_ID (default: each "
+  x.g->add_option("--roster", x.grade.roster, "--batch: a CSV whose rows are FILE_OR_FOLDER,STUDENT_ID (default: each "
                                           "folder's or file's own name is the student's ID when the lab has variants)");
-  g->add_flag("!--no-plots", grade.plots, "Skip the response plots (faster)");
-  g->add_flag("--inline-plots", grade.inline_plots, "Put each test's plot in results.json as an inline PNG (Gradescope shows "
+  x.g->add_flag("!--no-plots", x.grade.plots, "Skip the response plots (faster)");
+  x.g->add_flag("--inline-plots", x.grade.inline_plots, "Put each test's plot in results.json as an inline PNG (Gradescope shows "
                                                     "it to the student; 30-100 KB a plot, at most 600 KB in all)");
-  g->add_option("--replay", grade.replay, "Re-grade SUBMISSION and check it matches this results.json");
-  g->add_option("--batch", grade.batch, "Grade every *.json in this directory, and each folder below it as one student (a Gradescope export); one process each");
-  g->add_option("--jobs", grade.jobs, "Submissions graded in parallel with --batch")->check(CLI::Range(1, 256));
-  g->callback([&] {
-    if (grade.batch.empty() && grade.submission.empty())
+  x.g->add_option("--replay", x.grade.replay, "Re-grade SUBMISSION and check it matches this results.json");
+  x.g->add_option("--batch", x.grade.batch, "Grade every *.json in this directory, and each folder below it as one student (a Gradescope export); one process each");
+  x.g->add_option("--jobs", x.grade.jobs, "Submissions graded in parallel with --batch")->check(CLI::Range(1, 256));
+  x.g->callback([&] {
+    if (x.grade.batch.empty() && x.grade.submission.empty())
       throw CLI::ValidationError("SUBMISSION", "give a submission file, or --batch DIR");
   });
+}
 
-  std::string zip_lab, zip_out = "autograder.zip";
-  auto* z = cli.add_subcommand("autograder", "Write a Gradescope autograder zip for a lab");
-  z->add_option("LAB", zip_lab, "Lab name")->required();
-  z->add_option("--out", zip_out, "Zip file to write (default: autograder.zip)");
+// autograder, check-results, schema, submission-file: the files a course hands around.
+void addCourseFiles(CLI::App& cli, Commands& x) {
+  x.z = cli.add_subcommand("autograder", "Write a Gradescope autograder zip for a lab");
+  x.z->add_option("LAB", x.zip_lab, "Lab name")->required();
+  x.z->add_option("--out", x.zip_out, "Zip file to write (default: autograder.zip)");
 
-  std::string results_file;
-  auto* c = cli.add_subcommand("check-results", "Check that a results.json has the shape Gradescope accepts "
+  x.c = cli.add_subcommand("check-results", "Check that a results.json has the shape Gradescope accepts "
                                                 "(exit 0 valid, 2 invalid with the JSON path)");
-  c->add_option("FILE", results_file, "The results.json to check")->required();
+  x.c->add_option("FILE", x.results_file, "The results.json to check")->required();
 
-  std::string schema_lab;
-  auto* s = cli.add_subcommand("schema", "Print the JSON Schema of a lab's submission");
-  s->add_option("LAB", schema_lab, "Lab name")->required();
+  x.s = cli.add_subcommand("schema", "Print the JSON Schema of a lab's submission");
+  x.s->add_option("LAB", x.schema_lab, "Lab name")->required();
 
-  std::string upload_dir;
-  auto* sf = cli.add_subcommand("submission-file", "Print which file of an upload folder is graded (the rule the batch and "
+  x.sf = cli.add_subcommand("submission-file", "Print which file of an upload folder is graded (the rule the batch and "
                                                    "run_autograder share), or why none is (exit 2)");
-  sf->add_option("DIR", upload_dir, "The student's upload folder")->required();
+  x.sf->add_option("DIR", x.upload_dir, "The student's upload folder")->required();
+}
 
-  UiArgs ui;
-  auto* u = cli.add_subcommand("ui", "Tune a lab's gains in a window and watch it move (runs dynlab-ui; options after LAB "
+// ui: the tuning window (dynlab-ui).
+void addUi(CLI::App& cli, Commands& x) {
+  x.u = cli.add_subcommand("ui", "Tune a lab's gains in a window and watch it move (runs dynlab-ui; options after LAB "
                                      "go to it, see `dynlab-ui --help`)");
-  u->add_option("LAB", ui.lab, "Lab name (see `dynlab list`)")->required();
-  u->add_option("--config", ui.config, "Lab config JSON (default: labs/LAB/LAB.json)");
-  u->add_option("--gains", ui.gains, "Start from these gains: a submission or gains JSON");
-  u->add_option("--scenario", ui.scenario, "Tune under one rubric scenario (its patch and the grader's noise seed)");
-  u->add_option("--student", ui.student, kStudentHelp);
-  u->allow_extras();
+  x.u->add_option("LAB", x.ui.lab, "Lab name (see `dynlab list`)")->required();
+  x.u->add_option("--config", x.ui.config, "Lab config JSON (default: labs/LAB/LAB.json)");
+  x.u->add_option("--gains", x.ui.gains, "Start from these gains: a submission or gains JSON");
+  x.u->add_option("--scenario", x.ui.scenario, "Tune under one rubric scenario (its patch and the grader's noise seed)");
+  x.u->add_option("--student", x.ui.student, kStudentHelp);
+  x.u->allow_extras();
+}
 
-  CompareArgs cmp;
-  auto* k = cli.add_subcommand("compare", "Grade two submissions (gain sets) of one lab with the same rubric, side by side: "
+// compare and lessons: submissions graded side by side, and the rubric's lesson pairs.
+void addCompareLessons(CLI::App& cli, Commands& x) {
+  x.k = cli.add_subcommand("compare", "Grade two submissions (gain sets) of one lab with the same rubric, side by side: "
                                           "a table per test, OUT/comparison.md and one plot per simulated test with both responses");
-  k->add_option("A", cmp.a, "First submission JSON")->required();
-  k->add_option("B", cmp.b, "Second submission JSON")->required();
-  k->add_option("--out", cmp.out, "Output directory: comparison.md, plots/ (default: out/compare)");
-  k->add_option("--lab", cmp.lab, "The lab both must name (default: the lab A names)");
-  k->add_option("--config", cmp.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
-  k->add_option("--time-budget", cmp.time_budget, "Wall-time budget per submission (s)")->check(timeBudget());
-  k->add_flag("!--no-plots", cmp.plots, "Skip the plots (faster)");
+  x.k->add_option("A", x.cmp.a, "First submission JSON")->required();
+  x.k->add_option("B", x.cmp.b, "Second submission JSON")->required();
+  x.k->add_option("--out", x.cmp.out, "Output directory: comparison.md, plots/ (default: out/compare)");
+  x.k->add_option("--lab", x.cmp.lab, "The lab both must name (default: the lab A names)");
+  x.k->add_option("--config", x.cmp.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json)");
+  x.k->add_option("--time-budget", x.cmp.time_budget, "Wall-time budget per submission (s)")->check(timeBudget());
+  x.k->add_flag("!--no-plots", x.cmp.plots, "Skip the plots (faster)");
 
-  LessonsArgs les;
-  auto* l = cli.add_subcommand("lessons", "Grade the rubric's lesson pairs (the lecture's preferred design against its "
+  x.l = cli.add_subcommand("lessons", "Grade the rubric's lesson pairs (the lecture's preferred design against its "
                                           "foil) and check each ranks as the lecture says (exit 1 if one does not)");
-  l->add_option("LAB", les.lab, "Lab name (see `dynlab list`)")->required();
-  l->add_option("--config", les.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json); the pairs' paths are "
+  x.l->add_option("LAB", x.les.lab, "Lab name (see `dynlab list`)")->required();
+  x.l->add_option("--config", x.les.config, "Lab config JSON with the rubric (default: labs/LAB/LAB.json); the pairs' paths are "
                                         "relative to its folder");
-  l->add_option("--time-budget", les.time_budget, "Wall-time budget per submission (s)")->check(timeBudget());
+  x.l->add_option("--time-budget", x.les.time_budget, "Wall-time budget per submission (s)")->check(timeBudget());
+}
 
-  CheckLabArgs check_lab;
-  auto* cl = cli.add_subcommand("check-lab", "Check one lab against the lab contract the every-lab test holds every lab to: "
+// check-lab and new-lab: a lecturer's tools.
+void addAuthoring(CLI::App& cli, Commands& x) {
+  x.cl = cli.add_subcommand("check-lab", "Check one lab against the lab contract the every-lab test holds every lab to: "
                                              "each check with ok/FAIL and a reason, the default gains', examples' and instructor "
                                              "answers' shares, the passive energy drift (exit 1 if a check fails)");
-  cl->add_option("LAB", check_lab.lab, "Lab name (see `dynlab list`)")->required();
-  cl->add_flag("--skip-cli", check_lab.skip_cli, "Skip running dynlab figure/run/grade on the lab as subprocesses (faster)");
+  x.cl->add_option("LAB", x.check_lab.lab, "Lab name (see `dynlab list`)")->required();
+  x.cl->add_flag("--skip-cli", x.check_lab.skip_cli, "Skip running dynlab figure/run/grade on the lab as subprocesses (faster)");
 
-  NewLabArgs new_lab;
-  auto* nl = cli.add_subcommand("new-lab", "Start a lab without C++: copy a data-defined lab's folder (JSON, model file, handout, "
+  x.nl = cli.add_subcommand("new-lab", "Start a lab without C++: copy a data-defined lab's folder (JSON, model file, handout, "
                                            "examples) under a new name, to edit its JSON; then `dynlab check-lab NAME`");
-  nl->add_option("NAME", new_lab.name, "The new lab's name (lowercase letters, digits, _)")->required();
-  nl->add_option("--from", new_lab.from, "The data-defined lab to copy, e.g. fivebar")->required();
+  x.nl->add_option("NAME", x.new_lab.name, "The new lab's name (lowercase letters, digits, _)")->required();
+  x.nl->add_option("--from", x.new_lab.from, "The data-defined lab to copy, e.g. fivebar")->required();
+}
 
-  BenchArgs bench_args;
-  auto* b = cli.add_subcommand("bench", "Benchmark: hand-written vs Bullet step time, render/PNG/video frame rates");
-  b->add_flag("--json", bench_args.json, "One JSON object per lab");
-  b->add_option("--steps", bench_args.steps, "Steps timed per engine")->check(CLI::Range(100, 1000000));
-  b->add_option("--frames", bench_args.frames, "Frames timed per output kind")->check(CLI::Range(5, 10000));
-  b->add_option("LAB", bench_args.lab, "Only this lab (default: every lab), or an MJCF/URDF model file: its hand step against "
+// bench: the step, the frame rates, the scaling.
+void addBench(CLI::App& cli, Commands& x) {
+  x.b = cli.add_subcommand("bench", "Benchmark: hand-written vs Bullet step time, render/PNG/video frame rates");
+  x.b->add_flag("--json", x.bench_args.json, "One JSON object per lab");
+  x.b->add_option("--steps", x.bench_args.steps, "Steps timed per engine")->check(CLI::Range(100, 1000000));
+  x.b->add_option("--frames", x.bench_args.frames, "Frames timed per output kind")->check(CLI::Range(5, 10000));
+  x.b->add_option("LAB", x.bench_args.lab, "Only this lab (default: every lab), or an MJCF/URDF model file: its hand step against "
                                       "Bullet's and MuJoCo's at equal order");
-  b->add_flag("--scaling", bench_args.scaling,
+  x.b->add_flag("--scaling", x.bench_args.scaling,
               "Step cost against chain length (3 to 1,000 links): hand ABA, hand CRBA + Cholesky, Bullet; "
               "a table, OUT/scaling.csv and OUT/scaling.png");
-  b->add_option("--out", bench_args.out, "--scaling: output directory (default: out/bench)");
+  x.b->add_option("--out", x.bench_args.out, "--scaling: output directory (default: out/bench)");
+}
 
-  CourseCommands course(cli);  // dynlab handout, dynlab map (app/cli/course/course.h)
-  ModelCommand model_file(cli);  // dynlab model FILE (app/cli/model/model.h)
-  LabOptions lab_options;        // --labs DIR on every command that names a lab (app/cli/lab_options.h)
+// The chosen command, run: its exit code (2 when none was chosen, which CLI11 already refuses).
+int runChosen(Commands& x, const dyn::app::LabOptions& lab_options) {
+  using namespace dyn::app;
+  x.new_lab.labs = lab_options.labs;
+  if (*x.list) return listLabs();
+  if (*x.r) {
+    if (isModelFile(x.run.lab)) return runModelFile(x.run);
+    if (!x.run.torques.empty() || !x.run.loops.empty()) {
+      std::fprintf(stderr, "error: <command line>: %s: a lab's torques come from its controller; --torque and --loops are for a model file\n",
+                   x.run.torques.empty() ? "--loops" : "--torque");
+      return 2;
+    }
+    return runLab(x.run);
+  }
+  if (*x.f) return figure(x.fig);
+  if (*x.g) return !x.grade.batch.empty() ? gradeBatch(x.grade) : !x.grade.replay.empty() ? gradeReplay(x.grade) : gradeOne(x.grade);
+  if (*x.z) return writeAutograderZip(x.zip_lab, x.zip_out);
+  if (*x.c) return checkResults(x.results_file);
+  if (*x.s) return printSchema(x.schema_lab);
+  if (*x.sf) return printSubmissionFile(x.upload_dir);
+  if (*x.k) return compare(x.cmp);
+  if (*x.l) return lessons(x.les);
+  if (*x.cl) return checkLab(x.check_lab);
+  if (*x.nl) return newLab(x.new_lab);
+  if (*x.b) return x.bench_args.scaling ? benchScaling(x.bench_args) : bench(x.bench_args);
+  if (*x.u) {
+    x.ui.extra = x.u->remaining();
+    return openUi(x.ui);
+  }
+  return 2;
+}
+
+int dispatch(int argc, char** argv) {
+  using namespace dyn::app;
+  CLI::App cli{"dynlab — a teaching lab for the dynamics of constrained mechanisms"};
+  cli.require_subcommand(1);
+  cli.set_version_flag("--version", std::string(DYNLAB_VERSION));
+  Commands x;
+  for (auto add : {addRun, addFigure, addGrade, addCourseFiles, addUi, addCompareLessons, addAuthoring, addBench}) add(cli, x);
+  CourseCommands course(cli);      // dynlab handout, dynlab map (app/cli/course/course.h)
+  ModelCommand model_file(cli);    // dynlab model FILE (app/cli/model/model.h)
+  LabOptions lab_options;          // --labs DIR on every command that names a lab (app/cli/lab_options.h)
   addLabOptions(cli, lab_options);
 
   requireFinite(cli);
@@ -288,34 +350,8 @@ int dispatch(int argc, char** argv) {
     return code == 0 ? 0 : 2;
   }
   if (const int code = useLabOptions(lab_options)) return code;
-  new_lab.labs = lab_options.labs;
-  if (*list) return listLabs();
-  if (*r) {
-    if (isModelFile(run.lab)) return runModelFile(run);
-    if (!run.torques.empty() || !run.loops.empty()) {
-      std::fprintf(stderr, "error: <command line>: %s: a lab's torques come from its controller; --torque and --loops are for a model file\n",
-                   run.torques.empty() ? "--loops" : "--torque");
-      return 2;
-    }
-    return runLab(run);
-  }
-  if (*f) return figure(fig);
-  if (*g) return !grade.batch.empty() ? gradeBatch(grade) : !grade.replay.empty() ? gradeReplay(grade) : gradeOne(grade);
-  if (*z) return writeAutograderZip(zip_lab, zip_out);
-  if (*c) return checkResults(results_file);
-  if (*s) return printSchema(schema_lab);
-  if (*sf) return printSubmissionFile(upload_dir);
-  if (*k) return compare(cmp);
-  if (*l) return lessons(les);
-  if (*cl) return checkLab(check_lab);
-  if (*nl) return newLab(new_lab);
-  if (*b) return bench_args.scaling ? benchScaling(bench_args) : bench(bench_args);
   if (course.chosen()) return course.run();
   if (model_file.chosen()) return model_file.run();
-  if (*u) {
-    ui.extra = u->remaining();
-    return openUi(ui);
-  }
-  return 2;
+  return runChosen(x, lab_options);
 }
 }  // namespace

@@ -73,7 +73,6 @@ struct TimedRun {
 constexpr int kBlock = 50;
 
 std::vector<StepTimes> stepMicros(const std::vector<TimedRun>& runs, int steps) {
-  using Micros = std::chrono::duration<double, std::micro>;
   const std::size_t count = runs.size();
   std::vector<double> row;
   std::vector<StepTimes> out(count);
@@ -85,27 +84,10 @@ std::vector<StepTimes> stepMicros(const std::vector<TimedRun>& runs, int steps) 
   // One block of run i: the full step, or the engine alone every other step with the torque of the
   // step before held (500 Hz control). Short runs wrap around.
   auto block = [&](std::size_t i, bool engine_alone, std::vector<double>& all) {
-    std::vector<double> times;
-    for (int k = 0; k < kBlock; ++k) {
-      if (engine_alone) {
-        if (!sims[i]->step(row)) {
-          restart(i);
-          continue;
-        }
-        const auto t0 = Clock::now();
-        const bool advanced = sims[i]->advanceEngine();
-        const double t = Micros(Clock::now() - t0).count() - clock;
-        if (advanced) times.push_back(t);
-      } else {
-        const auto t0 = Clock::now();
-        const bool stepped = sims[i]->step(row);
-        const double t = Micros(Clock::now() - t0).count() - clock;
-        if (stepped) times.push_back(t);
-        else restart(i);
-      }
-    }
-    all.insert(all.end(), times.begin(), times.end());
-    return median(times);
+    if (engine_alone)  // the step untimed (a failed one restarts the run), then the engine alone timed
+      return timedBlock(kBlock, clock, all, [&] { return sims[i]->step(row) || (restart(i), false); },
+                        [&] { return sims[i]->advanceEngine(); });
+    return timedBlock(kBlock, clock, all, [] { return true; }, [&] { return sims[i]->step(row) || (restart(i), false); });
   };
   const int rounds = std::max(1, steps / kBlock);
   for (int r = 0; r < rounds; ++r)

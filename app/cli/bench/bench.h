@@ -1,5 +1,6 @@
 // Timing helpers shared by the bench commands (app/cli/bench/bench.cpp, app/cli/bench/bench_scaling.cpp, app/cli/bench/bench_model.cpp).
 #pragma once
+#include <chrono>
 #include <vector>
 
 namespace dyn::app {
@@ -15,6 +16,25 @@ struct Ratio {
   double median = 0, low = 0, high = 0;  // median, 25th and 75th percentiles
 };
 Ratio ratio(const std::vector<double>& slow, const std::vector<double>& fast);
+
+// The one timing loop of every bench: `calls` calls of timed() (true when it counted), each between two
+// clock reads less their cost `clock`; before() runs untimed first and skips the call when false. The
+// median µs of the counted calls; each also appended to all.
+template <class Before, class Timed>
+double timedBlock(int calls, double clock, std::vector<double>& all, Before&& before, Timed&& timed) {
+  using Clock = std::chrono::steady_clock;
+  using Micros = std::chrono::duration<double, std::micro>;
+  std::vector<double> times;
+  for (int k = 0; k < calls; ++k) {
+    if (!before()) continue;
+    const auto t0 = Clock::now();
+    const bool counted = timed();
+    const double t = Micros(Clock::now() - t0).count() - clock;
+    if (counted) times.push_back(t);
+  }
+  all.insert(all.end(), times.begin(), times.end());
+  return median(times);
+}
 
 struct BenchArgs;
 // dynlab bench FILE.xml|FILE.urdf: the hand step against Bullet's and MuJoCo's for a model file (app/cli/bench/bench_model.cpp).

@@ -132,22 +132,11 @@ void build(const model_file::LoadedModel& m, double dt, bool beside, Engines& e)
 // Every engine's steps timed in blocks, in turn; a run that fails (or leaves the finite numbers)
 // starts again from the file's pose.
 void timeBlocks(std::vector<Engine>& engines, int steps) {
-  using Micros = std::chrono::duration<double, std::micro>;
   const double clock = clockOverhead();
   const int rounds = std::max(1, steps / kBlock);
   for (int r = 0; r < rounds; ++r)
-    for (Engine& e : engines) {
-      std::vector<double> times;
-      for (int k = 0; k < kBlock; ++k) {
-        const auto t0 = Clock::now();
-        const bool ok = e.step();
-        const double t = Micros(Clock::now() - t0).count() - clock;
-        if (ok) times.push_back(t);
-        else e.restart();
-      }
-      e.all.insert(e.all.end(), times.begin(), times.end());
-      e.blocks.push_back(median(times));
-    }
+    for (Engine& e : engines)
+      e.blocks.push_back(timedBlock(kBlock, clock, e.all, [] { return true; }, [&] { return e.step() || (e.restart(), false); }));
 }
 
 // Accuracy over `steps` steps from the file's pose: the largest |φ|∞ (the description's, at each

@@ -161,80 +161,48 @@ std::string withLab(std::string md, const std::string& lab_line) {
   return at == std::string::npos ? md + "\n" + line : md.insert(at + 2, line);
 }
 
-}  // namespace
-
-int gradeBatch(const GradeArgs& a) {
-  const fs::path out = a.out;
-  std::error_code ec;
-  // OUT must not be DIR itself: its result folders would be taken for students on the next run.
-  if (fs::equivalent(a.batch, out, ec)) {
-    std::fprintf(stderr, "error: %s: --out must not be the submissions folder itself; give a folder beside or inside it\n",
-                 out.c_str());
-    return 2;
-  }
-  // Read-only first: a DIR with nothing to grade is an error that writes nothing.
-  batch::Found found = batch::findSubmissions(a.batch, out);
-  if (!found.error.empty()) {
-    std::fprintf(stderr, "error: %s: %s\n", a.batch.c_str(), found.error.c_str());
-    return 2;
-  }
-  fs::create_directories(out, ec);
-  if (ec) {
-    std::fprintf(stderr, "error: %s: cannot create the output folder (%s)\n", out.c_str(), ec.message().c_str());
-    return 1;
-  }
-  // One batch per OUT at a time: a second one refuses before touching anything in it.
-  std::string why;
-  const int lock_fd = lockOut(out, why);
-  if (lock_fd < 0) {
-    std::fprintf(stderr, "error: %s: %s\n", out.c_str(), why.c_str());
-    return 2;
-  }
-  batch::assignFolders(found.submissions, out);
-  // The batch's lab is known before the first grade: --lab, else the lab the first submission (in
-  // name order) that names a known lab names. Every grader gets it, so a submission for another lab
-  // is an invalid row naming both labs, never graded against its own rubric.
-  GradeArgs args = a;
-  std::string lab_source = "--lab";
+// The batch's lab, known before the first grade: --lab, else the lab the first submission (in name
+// order) that names a known lab names. Every grader gets it, so a submission for another lab is an
+// invalid row naming both labs, never graded against its own rubric. source: where it came from.
+std::string batchLab(const GradeArgs& a, const batch::Found& found, std::string& source) {
+  source = "--lab";
+  if (!a.lab.empty()) return a.lab;
   for (const auto& s : found.submissions) {
-    if (!args.lab.empty()) break;
     if (!s.problem.empty()) continue;
     try {
       const json j = loadJsonFile(s.file.string(), 1u << 20);
       if (j.is_object() && j.contains("lab") && j["lab"].is_string() && findLab(j["lab"].get<std::string>())) {
-        args.lab = j["lab"].get<std::string>();
-        lab_source = "the first submission naming a lab, " + s.folder;
+        source = "the first submission naming a lab, " + s.folder;
+        return j["lab"].get<std::string>();
       }
     } catch (const std::exception&) {
       // Not valid: the next one decides.
     }
   }
-  // A lab with variants grades each submission on its student's plant: the IDs come first.
-  try {
-    if (!args.lab.empty() && declaresVariants(args.config.empty() ? defaultConfigPath(args.lab) : args.config)) {
-      if (courseSecret().empty())
-        throw InputError("<command line>", "--batch", "expected DYNLAB_COURSE_SECRET to be set: " + args.lab +
-                                                      " gives each student their own plant, drawn from the course secret");
-      batch::assignStudents(found.submissions, a.roster);
-    } else if (!a.roster.empty()) {
-      throw InputError("<command line>", "--roster", "expected a lab with variants (a plant per student); " + args.lab + " has none");
-    }
-  } catch (const InputError& e) {
-    ::close(lock_fd);
-    std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
-    return 2;
+  return "";
+}
+
+// A lab with variants grades each submission on its student's plant: the IDs come first. Throws InputError.
+void assignPlants(const GradeArgs& args, const std::string& roster, batch::Found& found) {
+  if (!args.lab.empty() && declaresVariants(args.config.empty() ? defaultConfigPath(args.lab) : args.config)) {
+    if (courseSecret().empty())
+      throw InputError("<command line>", "--batch", "expected DYNLAB_COURSE_SECRET to be set: " + args.lab +
+                                                    " gives each student their own plant, drawn from the course secret");
+    batch::assignStudents(found.submissions, roster);
+  } else if (!roster.empty()) {
+    throw InputError("<command line>", "--roster", "expected a lab with variants (a plant per student); " + args.lab + " has none");
   }
-  const std::string lab_line = args.lab.empty() ? "lab: none (no submission names a known lab)"
-                                                 : "lab: " + args.lab + " (from " + lab_source + ")";
-  if (a.plots) warmUpPlotting();  // fonts loaded once here, not in every grader
+}
+
+// Every submission graded, N graders at a time, each in its own process under its budget (killed past
+// it); one row each, in the order they finish, with a bar (a terminal) or a line each (a log).
+std::vector<Row> runGraders(const GradeArgs& args, const batch::Found& found, const fs::path& out, std::size_t& problems) {
   const std::size_t total = found.submissions.size();
   const bool tty = isatty(STDERR_FILENO);
   // A grader process gets its own budget plus a margin to write its results, then it is killed.
-  const double kill_s = a.time_budget + std::clamp(a.time_budget, 2.0, 30.0);
+  const double kill_s = args.time_budget + std::clamp(args.time_budget, 2.0, 30.0);
   const auto kill_after = std::chrono::milliseconds(long(kill_s * 1e3));
-
   std::vector<Row> rows;
-  std::size_t problems = 0;
   auto progress = [&](Row r) {
     if (r.status != "graded") ++problems;
     if (tty) {
@@ -247,13 +215,12 @@ int gradeBatch(const GradeArgs& a) {
     }
     rows.push_back(std::move(r));
   };
-
   std::vector<Job> pending, running;
   for (auto it = found.submissions.rbegin(); it != found.submissions.rend(); ++it)
     pending.push_back({*it, out / it->folder, -1, {}, false});
   while (!pending.empty() || !running.empty()) {
     // Keep N graders busy; a submission with nothing to grade gets its row (and results.json) at once.
-    while (!pending.empty() && int(running.size()) < std::max(1, a.jobs)) {
+    while (!pending.empty() && int(running.size()) < std::max(1, args.jobs)) {
       Job j = std::move(pending.back());
       pending.pop_back();
       std::string problem;
@@ -296,6 +263,54 @@ int gradeBatch(const GradeArgs& a) {
     if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(5));
   }
   if (tty) std::fprintf(stderr, "\n");
+  return rows;
+}
+
+}  // namespace
+
+int gradeBatch(const GradeArgs& a) {
+  const fs::path out = a.out;
+  std::error_code ec;
+  // OUT must not be DIR itself: its result folders would be taken for students on the next run.
+  if (fs::equivalent(a.batch, out, ec)) {
+    std::fprintf(stderr, "error: %s: --out must not be the submissions folder itself; give a folder beside or inside it\n",
+                 out.c_str());
+    return 2;
+  }
+  // Read-only first: a DIR with nothing to grade is an error that writes nothing.
+  batch::Found found = batch::findSubmissions(a.batch, out);
+  if (!found.error.empty()) {
+    std::fprintf(stderr, "error: %s: %s\n", a.batch.c_str(), found.error.c_str());
+    return 2;
+  }
+  fs::create_directories(out, ec);
+  if (ec) {
+    std::fprintf(stderr, "error: %s: cannot create the output folder (%s)\n", out.c_str(), ec.message().c_str());
+    return 1;
+  }
+  // One batch per OUT at a time: a second one refuses before touching anything in it.
+  std::string why;
+  const int lock_fd = lockOut(out, why);
+  if (lock_fd < 0) {
+    std::fprintf(stderr, "error: %s: %s\n", out.c_str(), why.c_str());
+    return 2;
+  }
+  batch::assignFolders(found.submissions, out);
+  GradeArgs args = a;
+  std::string lab_source;
+  args.lab = batchLab(a, found, lab_source);
+  try {
+    assignPlants(args, a.roster, found);
+  } catch (const InputError& e) {
+    ::close(lock_fd);
+    std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
+    return 2;
+  }
+  const std::string lab_line = args.lab.empty() ? "lab: none (no submission names a known lab)"
+                                                 : "lab: " + args.lab + " (from " + lab_source + ")";
+  if (a.plots) warmUpPlotting();  // fonts loaded once here, not in every grader
+  std::size_t problems = 0;
+  const std::vector<Row> rows = runGraders(args, found, out, problems);
 
   // The gradebook, and its summary beside it (score statistics, histogram, common failure reasons).
   const fs::path book = out / "gradebook.csv", summary = out / "gradebook.md";
@@ -308,8 +323,8 @@ int gradeBatch(const GradeArgs& a) {
       return 1;
     }
   }
-  std::printf("graded %zu submission(s) into %s; gradebook: %s (summary: %s)\n%s\n", total, out.c_str(), book.c_str(),
-              summary.c_str(), termText(lab_line).c_str());
+  std::printf("graded %zu submission(s) into %s; gradebook: %s (summary: %s)\n%s\n", found.submissions.size(), out.c_str(),
+              book.c_str(), summary.c_str(), termText(lab_line).c_str());
   if (problems) std::printf("%zu submission(s) need a look (see the status and reason columns)\n", problems);
   ::close(lock_fd);
   return 0;

@@ -194,180 +194,228 @@ std::vector<std::string> ownedFigures(const fs::path& dir) {
   return names;
 }
 
+// What the command line asks for, checked before anything is simulated or written.
+struct FigureRequest {
+  std::vector<LoadedLab> loads;  // one per gains file (none given: the lab's own gains)
+  std::pair<int, int> size{1920, 1080}, plot_size{800, 450};
+  std::vector<double> stills;
+  std::vector<FigurePlot> declared, plots;
+  bool own_set = false;  // neither --plot nor --still: the lab's plots and stills
+};
+
+// The options each checked (--format, --size, each --gains file once, one run for stills).
+void checkOptions(const FigureArgs& a, FigureRequest& q) {
+  if (a.format != "pdf" && a.format != "svg" && a.format != "png") badOption("--format", a.format, "expected pdf, svg or png");
+  // One --size for stills and plots (a plot needs at least 100x100 for its labels).
+  if (!a.size.empty()) {
+    q.size = q.plot_size = parseSize(a.size);
+    const bool draws_plots = !a.plots.empty() || a.stills.empty();  // the lab's own set has plots
+    if (draws_plots && (q.size.first < 100 || q.size.second < 100)) badOption("--size", a.size, "expected at least 100x100 for a plot");
+  }
+  // Each gains file once (the same file twice, however spelled, is a mistake); several: no stills.
+  std::set<fs::path> seen;
+  for (const auto& g : a.gains) {
+    std::error_code ec;
+    const fs::path key = fs::weakly_canonical(fs::path(g), ec);
+    if (!seen.insert(ec ? fs::path(g) : key).second) badOption("--gains", g, "expected each gains file once (it is given twice)");
+  }
+  if (a.gains.size() > 1 && !a.stills.empty())
+    badOption("--still", fmt("%g", a.stills.front()), "expected one --gains file with --still (a still shows one run)");
+}
+
+// The lab (or model file) loaded once per gains file, under the scenario.
+void loadRuns(const FigureArgs& a, FigureRequest& q) {
+  if (isModelFile(a.lab)) {
+    // A model file where a lab goes: its passive run (app/cli/model/model.h loadModelLab); no gains, scenario or config.
+    const std::string gains = a.gains.empty() ? "" : a.gains.front();
+    for (const auto& [option, value] : {std::pair{"--gains", gains}, {"--scenario", a.scenario}, {"--config", a.config}})
+      if (!value.empty()) badOption(option, value, "a model file runs passive: it has no gains, scenarios or lab config");
+    q.loads.push_back(loadModelLab(a.lab, a.duration));
+    return;
+  }
+  const std::vector<std::string> gains_files = a.gains.empty() ? std::vector<std::string>{""} : a.gains;
+  for (const auto& g : gains_files) {
+    q.loads.push_back(loadLab(a.lab, a.config, g, a.duration, studentPlant(a.student)));
+    applyScenario(q.loads.back(), a.scenario, a.duration);
+  }
+}
+
+// The request checked: options, the runs loaded, the plots and stills within the run. Throws InputError.
+FigureRequest checkRequest(const FigureArgs& a) {
+  FigureRequest q;
+  q.stills = a.stills;
+  checkOptions(a, q);
+  loadRuns(a, q);
+  const LoadedLab& loaded = q.loads.front();
+  std::vector<std::vector<PlotCurve>> requested;
+  for (const auto& spec : a.plots) requested.push_back(parsePlotCurves(spec, loaded.lab->columns(), "<command line>", "--plot " + spec));
+  const double duration = loaded.lab->duration();
+  if (duration < loaded.lab->dt())  // a figure of a run needs at least one step of it
+    badOption("--duration", exactNumber(duration), "expected at least one step (dt = " + fmt("%g", loaded.lab->dt()) + " s)");
+  if (double(q.stills.size()) > kMaxFrames)  // the frames a run may draw (labs/settings.h)
+    badOption("--still", fmt("%g", q.stills.back()), std::to_string(q.stills.size()) + " stills are more than the " +
+                                                         fmt("%g", kMaxFrames) + " frames a run may draw");
+  for (double t : q.stills)
+    if (!(t >= 0 && t <= duration))
+      badOption("--still", exactNumber(t), "expected a time in [0, " + fmt("%g", duration) + "] s (the run's duration)");
+  const std::vector<FigurePlot> rubric_plots = rubricPlots(loaded);
+  q.declared = declaredPlots(loaded);
+  std::vector<FigurePlot> known = q.declared;  // a declared figure's labels first: they are for figures
+  known.insert(known.end(), rubric_plots.begin(), rubric_plots.end());
+  for (const auto& curves : requested) q.plots.push_back(labelled(curves, known));
+  q.own_set = a.plots.empty() && q.stills.empty();
+  if (q.own_set) {
+    if (q.loads.size() == 1) q.stills = {0.0, 0.5 * duration, duration};
+    q.plots = rubric_plots;
+  }
+  return q;
+}
+
+// Each gains file's runs (in the order given), with a bar on a terminal; the first one's are the stills'.
+struct FigureRuns {
+  std::vector<std::optional<RunResult>> hands, bullets;
+  std::vector<PlotRun> runs;
+  const RunResult& shown() const { return hands.front() ? *hands.front() : *bullets.front(); }
+  // "ok", or the last run that failed and why.
+  std::string status() const {
+    std::string status = "ok";
+    for (std::size_t i = 0; i < hands.size(); ++i)
+      for (const auto* r : {&hands[i], &bullets[i]})
+        if (*r && !(*r)->failure.empty())
+          status = (runs[i].name.empty() ? "" : runs[i].name + ", ") + (r == &hands[i] ? "hand" : "bullet") + ": " + (*r)->failure;
+    return status;
+  }
+};
+
+void simulate(const FigureArgs& a, const std::vector<LoadedLab>& loads, FigureRuns& f) {
+  auto run = [&](const Lab& l, Engine engine) {
+    Progress bar(std::string("simulating ") + (engine == Engine::Hand ? "hand" : "Bullet"),
+                 std::size_t(std::max(1L, std::lround(l.duration() / l.dt()))));
+    return runEngine(l, engine, -1, [&](long steps) { bar.set(std::size_t(steps)); });
+  };
+  f.hands.resize(loads.size());
+  f.bullets.resize(loads.size());
+  for (std::size_t i = 0; i < loads.size(); ++i) {
+    if (a.engine != "bullet") f.hands[i] = run(*loads[i].lab, Engine::Hand);
+    if (a.engine != "hand") f.bullets[i] = run(*loads[i].lab, Engine::Bullet);
+  }
+  for (std::size_t i = 0; i < loads.size(); ++i)
+    f.runs.push_back({loads.size() > 1 ? runName(a.gains, i) : "", f.hands[i] ? &f.hands[i]->trace : nullptr,
+                      f.bullets[i] ? &f.bullets[i]->trace : nullptr});
+}
+
+// What a figure run wrote, and what it did not and why.
+struct Written {
+  std::vector<std::string> files, skipped;
+  std::set<std::string> names;  // each file's name once
+};
+
+// The plots, each drawn in a child (PLplot's cairo driver ends the process when memory runs out).
+void writePlots(const FigureArgs& a, const Lab& lab, const FigureRequest& q, const FigureRuns& f, const std::string& lab_title,
+                Staging& staging, Progress& bar, Written& w) {
+  std::size_t made = 0;
+  for (const FigurePlot& p : q.plots) {
+    const std::string name = fileStem(p.curves) + "." + a.format;
+    bar.set(made++);
+    if (!w.names.insert(name).second) continue;
+    const std::string title = !a.title.empty() ? a.title : lab_title + ": " + (p.title.empty() ? curvesText(p.curves) : p.title);
+    const PlotSpec spec = plotSpec(lab, p, title, f.runs, a);
+    // Masks that are 0 all run long leave nothing to draw: said, never an empty picture.
+    const auto drawn = [](const PlotSeries& ser) {
+      for (std::size_t i = 0; i < ser.x.size(); ++i)
+        if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i])) return true;
+      return false;
+    };
+    const bool masked = std::any_of(p.curves.begin(), p.curves.end(), [](const PlotCurve& c) { return !c.mask.empty(); });
+    if (masked && std::none_of(spec.series.begin(), spec.series.end(), drawn)) {
+      w.skipped.push_back(name + " (" + curvesText(p.curves) + ": nothing to draw, its masks are 0 throughout)");
+      continue;
+    }
+    drawIsolated(name, [&] { writePlot(staging.path(name).string(), spec, q.plot_size.first, q.plot_size.second); });
+    w.files.push_back(name);
+  }
+}
+
+// The stills of the first run, each name once, drawn in a child (OSMesa's llvmpipe aborts when memory runs out).
+void writeStills(const FigureArgs& a, const Lab& lab, const FigureRequest& q, const FigureRuns& f, Staging& staging,
+                 Progress& bar, Written& w) {
+  std::vector<std::pair<double, std::string>> todo;
+  for (double t : q.stills)
+    if (const std::string name = "still_" + fmt("%.3f", t + 0.0) + ".png"; w.names.insert(name).second)  // + 0.0: no "-0.000"
+      todo.push_back({t, name});
+  const std::optional<RunResult>& hand = f.hands.front();
+  const std::optional<RunResult>& bullet = f.bullets.front();
+  const RunResult& shown = f.shown();
+  drawIsolated(todo.size() == 1 ? todo.front().second : "the stills", [&] {
+    auto context = makeOffscreenContext(q.size.first, q.size.second);
+    RenderOptions options;
+    options.show_overlay = a.overlay;
+    Renderer renderer(*context, options);
+    const Trace* ghost = hand && bullet ? &bullet->trace : nullptr;
+    for (std::size_t i = 0; i < todo.size(); ++i) {
+      bar.set(q.plots.size() + i);
+      const std::size_t row = rowAt(shown.trace, lab.dt(), todo[i].first);
+      const Image image = renderRow(renderer, lab, shown.trace, row, ghost, a.overlay, a.title);
+      if (std::string why; !writePng(staging.path(todo[i].second).string(), image, &why)) throw std::runtime_error(why);
+    }
+  });
+  for (const auto& still : todo) w.files.push_back(still.second);
+}
+
+// The report: the run, each file written, what was not and why, and an earlier run's figures now gone.
+void printWritten(const FigureArgs& a, const Lab& lab, const std::string& status, const fs::path& out, const Written& w,
+            const std::vector<std::string>& earlier) {
+  std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n",
+              termText(a.scenario.empty() ? a.lab : a.lab + " (" + a.scenario + ")").c_str(), lab.duration(), lab.dt(),
+              a.engine.c_str(), status.c_str());
+  for (const auto& name : w.files) std::printf("  %s\n", (out / name).c_str());
+  for (const auto& why : w.skipped) std::printf("  not written: %s\n", termText(why).c_str());
+  // An earlier figure run's figures this one did not remake are gone: said, never silent.
+  std::string removed;
+  for (const auto& name : earlier)
+    if (std::find(w.files.begin(), w.files.end(), name) == w.files.end()) removed += (removed.empty() ? "" : ", ") + name;
+  if (!removed.empty())
+    std::printf("  removed the earlier figure run's %s (use another --out to keep figures side by side)\n", termText(removed).c_str());
+}
+
 }  // namespace
 
 int figure(const FigureArgs& a) {
-  // Check every input before simulating or writing anything.
-  std::vector<LoadedLab> loads;  // one per gains file (none: the lab's own gains)
-  std::pair<int, int> size{1920, 1080}, plot_size{800, 450};
-  std::vector<std::vector<PlotCurve>> requested;
-  std::vector<double> stills = a.stills;
-  std::vector<FigurePlot> rubric_plots, declared, plots;
-  bool own_set = false;  // neither --plot nor --still: the lab's plots and stills
+  FigureRequest q;
   try {
-    if (a.format != "pdf" && a.format != "svg" && a.format != "png")
-      badOption("--format", a.format, "expected pdf, svg or png");
-    // One --size for stills and plots (a plot needs at least 100x100 for its labels).
-    if (!a.size.empty()) {
-      size = plot_size = parseSize(a.size);
-      const bool draws_plots = !a.plots.empty() || a.stills.empty();  // the lab's own set has plots
-      if (draws_plots && (size.first < 100 || size.second < 100))
-        badOption("--size", a.size, "expected at least 100x100 for a plot");
-    }
-    // Each gains file once (the same file twice, however spelled, is a mistake); several: no stills.
-    std::set<fs::path> seen;
-    for (const auto& g : a.gains) {
-      std::error_code ec;
-      const fs::path key = fs::weakly_canonical(fs::path(g), ec);
-      if (!seen.insert(ec ? fs::path(g) : key).second)
-        badOption("--gains", g, "expected each gains file once (it is given twice)");
-    }
-    if (a.gains.size() > 1 && !a.stills.empty())
-      badOption("--still", fmt("%g", a.stills.front()), "expected one --gains file with --still (a still shows one run)");
-    const std::vector<std::string> gains_files = a.gains.empty() ? std::vector<std::string>{""} : a.gains;
-    if (isModelFile(a.lab)) {
-      // A model file where a lab goes: its passive run (app/cli/model/model.h loadModelLab); no gains, scenario or config.
-      const std::string gains = a.gains.empty() ? "" : a.gains.front();
-      for (const auto& [option, value] : {std::pair{"--gains", gains}, {"--scenario", a.scenario}, {"--config", a.config}})
-        if (!value.empty()) badOption(option, value, "a model file runs passive: it has no gains, scenarios or lab config");
-      loads.push_back(loadModelLab(a.lab, a.duration));
-    } else {
-      for (const auto& g : gains_files) {
-        loads.push_back(loadLab(a.lab, a.config, g, a.duration, studentPlant(a.student)));
-        applyScenario(loads.back(), a.scenario, a.duration);
-      }
-    }
-    const LoadedLab& loaded = loads.front();
-    const std::vector<std::string> columns = loaded.lab->columns();
-    for (const auto& spec : a.plots) requested.push_back(parsePlotCurves(spec, columns, "<command line>", "--plot " + spec));
-    const double duration = loaded.lab->duration();
-    if (duration < loaded.lab->dt())  // a figure of a run needs at least one step of it
-      badOption("--duration", exactNumber(duration), "expected at least one step (dt = " + fmt("%g", loaded.lab->dt()) + " s)");
-    if (double(stills.size()) > kMaxFrames)  // the frames a run may draw (labs/settings.h)
-      badOption("--still", fmt("%g", stills.back()), std::to_string(stills.size()) + " stills are more than the " +
-                                                         fmt("%g", kMaxFrames) + " frames a run may draw");
-    for (double t : stills)
-      if (!(t >= 0 && t <= duration))
-        badOption("--still", exactNumber(t), "expected a time in [0, " + fmt("%g", duration) + "] s (the run's duration)");
-    rubric_plots = rubricPlots(loaded);
-    declared = declaredPlots(loaded);
-    std::vector<FigurePlot> known = declared;  // a declared figure's labels first: they are for figures
-    known.insert(known.end(), rubric_plots.begin(), rubric_plots.end());
-    for (const auto& curves : requested) plots.push_back(labelled(curves, known));
-    own_set = a.plots.empty() && stills.empty();
-    if (own_set) {
-      if (loads.size() == 1) stills = {0.0, 0.5 * duration, duration};
-      plots = rubric_plots;
-    }
+    q = checkRequest(a);  // every input checked before simulating or writing anything
   } catch (const InputError& e) {
     std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
     return 2;
   }
-  const Lab& lab = *loads.front().lab;
+  const Lab& lab = *q.loads.front().lab;
   const fs::path out = a.out.empty() ? defaultOut(a.lab, a.scenario, "figures") : fs::path(a.out);
   // Titles name the lab as its handout does ("Impedance control"), not by its id.
-  const std::string shown = labDisplayName(loads.front().config, a.lab);
+  const std::string shown = labDisplayName(q.loads.front().config, a.lab);
   const std::string lab_title = a.scenario.empty() ? shown : shown + " (" + a.scenario + ")";
   try {
-    // A bar on a terminal for each stage (nothing otherwise): the runs, then the figures.
-    auto run = [&](const Lab& l, Engine engine) {
-      Progress bar(std::string("simulating ") + (engine == Engine::Hand ? "hand" : "Bullet"),
-                   std::size_t(std::max(1L, std::lround(l.duration() / l.dt()))));
-      return runEngine(l, engine, -1, [&](long steps) { bar.set(std::size_t(steps)); });
-    };
-    // Each gains file's runs (in the order given); the first one's are the stills'.
-    std::vector<std::optional<RunResult>> hands(loads.size()), bullets(loads.size());
-    std::vector<PlotRun> runs;
-    for (std::size_t i = 0; i < loads.size(); ++i) {
-      if (a.engine != "bullet") hands[i] = run(*loads[i].lab, Engine::Hand);
-      if (a.engine != "hand") bullets[i] = run(*loads[i].lab, Engine::Bullet);
-    }
-    for (std::size_t i = 0; i < loads.size(); ++i)
-      runs.push_back({loads.size() > 1 ? runName(a.gains, i) : "", hands[i] ? &hands[i]->trace : nullptr,
-                      bullets[i] ? &bullets[i]->trace : nullptr});
-    const std::optional<RunResult>& hand = hands.front();
-    const std::optional<RunResult>& bullet = bullets.front();
-    const RunResult& shown = hand ? *hand : *bullet;
-
+    FigureRuns f;
+    simulate(a, q.loads, f);
     // The lab's own set: its rubric's plots (else its overlay's), then the figures it declares
     // (one of the same curves as a rubric plot takes its place, with its title and labels).
-    if (own_set) {
-      if (plots.empty()) plots = overlayPlots(lab, shown.trace);
-      for (const auto& p : declared) addPlot(plots, p, true);
+    if (q.own_set) {
+      if (q.plots.empty()) q.plots = overlayPlots(lab, f.shown().trace);
+      for (const auto& p : q.declared) addPlot(q.plots, p, true);
     }
-    for (auto& p : plots) fillLabels(lab, p);
+    for (auto& p : q.plots) fillLabels(lab, p);
 
     Staging staging(out);
     const std::vector<std::string> earlier = ownedFigures(out);
     staging.owns(earlier);
-    std::vector<std::string> written, skipped;
-    std::set<std::string> names;
-    Progress bar("figures", plots.size() + stills.size());
-    std::size_t made = 0;
-    for (const FigurePlot& p : plots) {
-      const std::string name = fileStem(p.curves) + "." + a.format;
-      bar.set(made++);
-      if (!names.insert(name).second) continue;
-      const std::string title =
-          !a.title.empty() ? a.title : lab_title + ": " + (p.title.empty() ? curvesText(p.curves) : p.title);
-      const PlotSpec spec = plotSpec(lab, p, title, runs, a);
-      // Masks that are 0 all run long leave nothing to draw: said below, never an empty picture.
-      const auto drawn = [](const PlotSeries& ser) {
-        for (std::size_t i = 0; i < ser.x.size(); ++i)
-          if (std::isfinite(ser.x[i]) && std::isfinite(ser.y[i])) return true;
-        return false;
-      };
-      const bool masked = std::any_of(p.curves.begin(), p.curves.end(), [](const PlotCurve& c) { return !c.mask.empty(); });
-      if (masked && std::none_of(spec.series.begin(), spec.series.end(), drawn)) {
-        skipped.push_back(name + " (" + curvesText(p.curves) + ": nothing to draw, its masks are 0 throughout)");
-        continue;
-      }
-      // PLplot's cairo driver (GLib, pango) ends the process when memory runs out: drawn in a child.
-      drawIsolated(name, [&] { writePlot(staging.path(name).string(), spec, plot_size.first, plot_size.second); });
-      written.push_back(name);
-    }
-    if (!stills.empty()) {
-      // Each still's name once; drawn in a child (OSMesa's llvmpipe aborts when memory runs out).
-      std::vector<std::pair<double, std::string>> todo;
-      for (double t : stills)
-        if (const std::string name = "still_" + fmt("%.3f", t + 0.0) + ".png"; names.insert(name).second)  // + 0.0: no "-0.000"
-          todo.push_back({t, name});
-      drawIsolated(todo.size() == 1 ? todo.front().second : "the stills", [&] {
-        auto context = makeOffscreenContext(size.first, size.second);
-        RenderOptions options;
-        options.show_overlay = a.overlay;
-        Renderer renderer(*context, options);
-        const Trace* ghost = hand && bullet ? &bullet->trace : nullptr;
-        for (std::size_t i = 0; i < todo.size(); ++i) {
-          bar.set(made + i);
-          const std::size_t row = rowAt(shown.trace, lab.dt(), todo[i].first);
-          const Image image = renderRow(renderer, lab, shown.trace, row, ghost, a.overlay, a.title);
-          if (std::string why; !writePng(staging.path(todo[i].second).string(), image, &why)) throw std::runtime_error(why);
-        }
-      });
-      made += stills.size();
-      for (const auto& still : todo) written.push_back(still.second);
-    }
-    bar.set(made);
+    Written w;
+    Progress bar("figures", q.plots.size() + q.stills.size());
+    writePlots(a, lab, q, f, lab_title, staging, bar, w);
+    if (!q.stills.empty()) writeStills(a, lab, q, f, staging, bar, w);
+    bar.set(q.plots.size() + q.stills.size());
     bar.done();
     staging.commit();
-
-    std::string status = "ok";
-    for (std::size_t i = 0; i < loads.size(); ++i)
-      for (const auto* r : {&hands[i], &bullets[i]})
-        if (*r && !(*r)->failure.empty())
-          status = (runs[i].name.empty() ? "" : runs[i].name + ", ") + (r == &hands[i] ? "hand" : "bullet") + ": " + (*r)->failure;
-    std::printf("dynlab figure %s: %.2f s at dt = %g s, engine %s (%s)\n",
-                termText(a.scenario.empty() ? a.lab : a.lab + " (" + a.scenario + ")").c_str(), lab.duration(),
-                lab.dt(), a.engine.c_str(), status.c_str());
-    for (const auto& name : written) std::printf("  %s\n", (out / name).c_str());
-    for (const auto& why : skipped) std::printf("  not written: %s\n", termText(why).c_str());
-    // An earlier figure run's figures this one did not remake are gone: said, never silent.
-    std::string removed;
-    for (const auto& name : earlier)
-      if (std::find(written.begin(), written.end(), name) == written.end()) removed += (removed.empty() ? "" : ", ") + name;
-    if (!removed.empty())
-      std::printf("  removed the earlier figure run's %s (use another --out to keep figures side by side)\n", termText(removed).c_str());
+    const std::string status = f.status();
+    printWritten(a, lab, status, out, w, earlier);
     return status == "ok" ? 0 : 1;
   } catch (const std::bad_alloc&) {
     throw;  // main's one line for it (app/cli/main.cpp)

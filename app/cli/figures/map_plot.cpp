@@ -186,8 +186,70 @@ Ticks ticksFor(double lo, double hi) {
 // The character scale at which `text` (width w at scale s) fits in `room`: s, or smaller.
 double fitScale(double s, double w, double room) { return w <= room ? s : s * room / w; }
 
-void draw(const MapPicture& m, int width_px, int height_px) {
+// The cells: a value's colour (values), else stable or not.
+void drawCells(const MapPicture& m, const std::vector<double>& ex, const std::vector<double>& ey, double vmin, double vmax) {
   const std::size_t nx = m.xs.size(), ny = m.ys.size();
+  const bool values = !m.value.empty();
+  for (std::size_t j = 0; j < ny; ++j)
+    for (std::size_t i = 0; i < nx; ++i) {
+      const std::size_t k = j * nx + i;
+      if (values && m.stable[k] && std::isfinite(m.value[k])) plcol1((m.value[k] - vmin) / (vmax - vmin));
+      else plcol0(values ? kNoValue : m.stable[k] ? kStable : kUnstable);
+      fillCell(ex[i], ex[i + 1], ey[j], ey[j + 1]);
+    }
+
+}
+
+// The boundary: the field's zero level, interpolated between grid points (white under ink).
+void drawBoundary(const MapPicture& m, double scale) {
+  const std::size_t nx = m.xs.size(), ny = m.ys.size();
+  if (!m.boundary.empty() && nx > 1 && ny > 1) {
+    std::vector<std::vector<PLFLT>> f(nx, std::vector<PLFLT>(ny));
+    std::vector<const PLFLT*> rows(nx);
+    for (std::size_t i = 0; i < nx; ++i) {
+      for (std::size_t j = 0; j < ny; ++j) f[i][j] = m.boundary[j * nx + i];
+      rows[i] = f[i].data();
+    }
+    std::vector<PLFLT> xg(m.xs.begin(), m.xs.end()), yg(m.ys.begin(), m.ys.end());
+    PLcGrid grid{xg.data(), yg.data(), nullptr, PLINT(nx), PLINT(ny), 0};
+    const PLFLT level[] = {0.0};
+    for (auto [colour, width] : {std::pair{kWhiteLine, 5.5}, std::pair{kInk, 2.5}}) {
+      plcol0(colour);
+      plwidth(width * scale);
+      plcont(rows.data(), PLINT(nx), PLINT(ny), 1, PLINT(nx), 1, PLINT(ny), level, 1, pltr1, &grid);
+    }
+  }
+}
+
+// Where the frame sits on the page (fractions of it) and the margin no ink enters.
+struct FrameBox {
+  double mx, my, fl, fr, fb, ft;
+};
+
+// Each axis label centred on its side of the frame, moved (and if need be shrunk) to stay on the
+// page; the title across the whole page (it may be wider than the frame).
+void drawAxisLabels(const MapPicture& m, TextMeter& meter, double text, double title_scale, const FrameBox& b) {
+  const auto [mx, my, fl, fr, fb, ft] = b;
+  {
+    const double room = 1 - 2 * mx, s = fitScale(text, meter.width(m.xlabel, text), room);
+    const double w = meter.width(m.xlabel, s), centre = std::clamp((fl + fr) / 2, mx + w / 2, 1 - mx - w / 2);
+    plschr(0, s);
+    plmtex("b", 3.3 * text / s, (centre - fl) / (fr - fl), 0.5, m.xlabel.c_str());
+  }
+  {
+    const double room = 1 - 2 * my, s = fitScale(text, meter.widthToHeight(meter.width(m.ylabel, text)), room);
+    const double h = meter.widthToHeight(meter.width(m.ylabel, s));
+    const double centre = std::clamp((fb + ft) / 2, my + h / 2, 1 - my - h / 2);
+    plschr(0, s);
+    plmtex("l", (fl - mx) / meter.charHeightX(s) - 1.0, (centre - fb) / (ft - fb), 0.5, m.ylabel.c_str());
+  }
+  // The title across the whole page (it may be wider than the frame).
+  plvpor(0.0, 1.0, 0.0, 1 - my);
+  plschr(0, title_scale);
+  plmtex("t", -1.3, 0.5, 0.5, m.title.c_str());
+}
+
+void draw(const MapPicture& m, int width_px, int height_px) {
   const auto ex = edges(m.xs), ey = edges(m.ys);
   const bool values = !m.value.empty();
   double vmin = INFINITY, vmax = -INFINITY;
@@ -253,56 +315,15 @@ void draw(const MapPicture& m, int width_px, int height_px) {
   plsyax(8, 0);
   plschr(0, text);
 
-  // The cells.
-  for (std::size_t j = 0; j < ny; ++j)
-    for (std::size_t i = 0; i < nx; ++i) {
-      const std::size_t k = j * nx + i;
-      if (values && m.stable[k] && std::isfinite(m.value[k])) plcol1((m.value[k] - vmin) / (vmax - vmin));
-      else plcol0(values ? kNoValue : m.stable[k] ? kStable : kUnstable);
-      fillCell(ex[i], ex[i + 1], ey[j], ey[j + 1]);
-    }
-
-  // The boundary: the field's zero level, interpolated between grid points.
-  if (!m.boundary.empty() && nx > 1 && ny > 1) {
-    std::vector<std::vector<PLFLT>> f(nx, std::vector<PLFLT>(ny));
-    std::vector<const PLFLT*> rows(nx);
-    for (std::size_t i = 0; i < nx; ++i) {
-      for (std::size_t j = 0; j < ny; ++j) f[i][j] = m.boundary[j * nx + i];
-      rows[i] = f[i].data();
-    }
-    std::vector<PLFLT> xg(m.xs.begin(), m.xs.end()), yg(m.ys.begin(), m.ys.end());
-    PLcGrid grid{xg.data(), yg.data(), nullptr, PLINT(nx), PLINT(ny), 0};
-    const PLFLT level[] = {0.0};
-    for (auto [colour, width] : {std::pair{kWhiteLine, 5.5}, std::pair{kInk, 2.5}}) {
-      plcol0(colour);
-      plwidth(width * scale);
-      plcont(rows.data(), PLINT(nx), PLINT(ny), 1, PLINT(nx), 1, PLINT(ny), level, 1, pltr1, &grid);
-    }
-  }
+  drawCells(m, ex, ey, vmin, vmax);
+  drawBoundary(m, scale);
 
   // Frame, ticks at the measured steps, labels.
   plwidth(1.0 * scale);
   plcol0(kFrame);
   plbox("bcnts", xt.step, 0, "bcntsv", yt.step, 0);
   plcol0(kInk);
-  // Each axis label centred on its side of the frame, moved (and if need be shrunk) to stay on the page.
-  {
-    const double room = 1 - 2 * mx, s = fitScale(text, meter.width(m.xlabel, text), room);
-    const double w = meter.width(m.xlabel, s), centre = std::clamp((fl + fr) / 2, mx + w / 2, 1 - mx - w / 2);
-    plschr(0, s);
-    plmtex("b", 3.3 * text / s, (centre - fl) / (fr - fl), 0.5, m.xlabel.c_str());
-  }
-  {
-    const double room = 1 - 2 * my, s = fitScale(text, meter.widthToHeight(meter.width(m.ylabel, text)), room);
-    const double h = meter.widthToHeight(meter.width(m.ylabel, s));
-    const double centre = std::clamp((fb + ft) / 2, my + h / 2, 1 - my - h / 2);
-    plschr(0, s);
-    plmtex("l", (fl - mx) / meter.charHeightX(s) - 1.0, (centre - fb) / (ft - fb), 0.5, m.ylabel.c_str());
-  }
-  // The title across the whole page (it may be wider than the frame).
-  plvpor(0.0, 1.0, 0.0, 1 - my);
-  plschr(0, title_scale);
-  plmtex("t", -1.3, 0.5, 0.5, m.title.c_str());
+  drawAxisLabels(m, meter, text, title_scale, {mx, my, fl, fr, fb, ft});
 
   // The legend at the top of the right-hand column.
   std::vector<const char*> ctexts;
