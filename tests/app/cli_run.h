@@ -160,17 +160,35 @@ inline Csv readCsv(const fs::path& p) {
   return csv;
 }
 
-// Bad input: exit code 2, one line on stderr naming what is given, nothing written at all.
-inline void checkBadInput(const TempDir& dir, const std::vector<std::string>& args, const std::vector<std::string>& names,
-                          const fs::path& out) {
-  const Result r = dynlab(dir, args);
-  INFO("dynlab ", shown(args), "\nstderr: ", r.err);
+// The bad-input contract of a finished run r (a Result, or any type with code, out and err): exit code
+// 2, nothing on stdout, one line on stderr that starts "error: " and names each of names.
+template <class R>
+void checkRefused(const R& r, const std::vector<std::string>& names) {
+  INFO("stdout: ", r.out, "\nstderr: ", r.err);
   CHECK(r.code == 2);
   CHECK(r.out.empty());
   CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
   CHECK(r.err.rfind("error: ", 0) == 0);
   for (const auto& n : names) CHECK_MESSAGE(r.err.find(n) != std::string::npos, "missing: " << n);
+}
+
+// Bad input: refused (checkRefused), and nothing written at all.
+inline void checkBadInput(const TempDir& dir, const std::vector<std::string>& args, const std::vector<std::string>& names,
+                          const fs::path& out) {
+  INFO("dynlab ", shown(args));
+  checkRefused(dynlab(dir, args), names);
   CHECK_FALSE(fs::exists(out));
+}
+
+// ffprobe's decode of a video (every frame is read, not just the header's count): the stream's
+// entries (e.g. "codec_name,pix_fmt,nb_read_frames") as one CSV line, its line break trimmed.
+inline std::string probeVideo(const TempDir& dir, const std::string& video, const std::string& entries) {
+  const Result probe = run(dir, {"ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
+                                 "stream=" + entries, "-of", "csv=p=0", video});
+  REQUIRE_MESSAGE(probe.code == 0, probe.err);
+  std::string line = probe.out;
+  line.erase(line.find_last_not_of(" \r\n") + 1);
+  return line;
 }
 
 inline std::string defaultConfigText() { return readFile(fs::path(DYNLAB_SOURCE_DIR) / "labs/slider_crank/slider_crank.json"); }

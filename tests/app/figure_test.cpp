@@ -10,6 +10,7 @@
 #include "labs/run.h"
 #include "render/renderer.h"
 #include "tests/app/cli_run.h"
+#include "tests/render/test_scene.h"
 #include "tests/test_files.h"
 
 namespace fs = std::filesystem;
@@ -58,12 +59,7 @@ Png loadPng(const fs::path& p) {
 }
 
 // Within a few levels of a scene colour (lighting shades the faces a little).
-bool near(const std::uint8_t* p, const Color& c, int tol = 40) {
-  const float want[3] = {c.r, c.g, c.b};
-  for (int i = 0; i < 3; ++i)
-    if (std::abs(int(p[i]) - int(want[i] * 255.0f + 0.5f)) > tol) return false;
-  return true;
-}
+bool near(const std::uint8_t* p, const Color& c) { return test::nearColor(p, c, 40); }
 
 }  // namespace
 

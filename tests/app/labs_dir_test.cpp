@@ -72,15 +72,6 @@ std::map<std::string, std::string> listed(const std::string& out) {
   return labs;
 }
 
-void checkOneLineRefusal(const Result& r, const std::vector<std::string>& names) {
-  INFO(r.out, r.err);
-  CHECK(r.code == 2);
-  CHECK(r.out.empty());
-  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
-  CHECK(r.err.rfind("error: ", 0) == 0);
-  for (const auto& n : names) CHECK_MESSAGE(r.err.find(n) != std::string::npos, "missing: " << n);
-}
-
 }  // namespace
 
 TEST_CASE("new-lab --labs DIR: the next step printed runs as printed; list shows the tree's labs and the new one") {
@@ -168,19 +159,19 @@ TEST_CASE("a lab outside the tree may not take a name another lab has: one line,
   fs::copy(fs::path(DYNLAB_SOURCE_DIR) / "labs/fivebar", dir / "mine/fivebar", fs::copy_options::recursive);
   for (const auto& cmd : std::vector<std::vector<std::string>>{{"list"}, {"run", "fivebar", "--duration", "0.01"}, {"check-lab", "fivebar"}}) {
     INFO(shown(cmd));
-    checkOneLineRefusal(dynlab(dir, cat(cmd, {"--labs", "mine"})),
+    checkRefused(dynlab(dir, cat(cmd, {"--labs", "mine"})),
                         {"--labs", (dir / "mine/fivebar").string(), "the dynlab tree's lab fivebar", std::string(DYNLAB_SOURCE_DIR) + "/labs/fivebar"});
   }
   // Two outside folders with the same name in them: both named.
   newLab(dir, "twin", dir / "one");
   newLab(dir, "twin", dir / "two");
-  checkOneLineRefusal(dynlab(dir, {"list"}, withEnv({{"DYNLAB_LABS", (dir / "one").string() + ":" + (dir / "two").string()}})),
+  checkRefused(dynlab(dir, {"list"}, withEnv({{"DYNLAB_LABS", (dir / "one").string() + ":" + (dir / "two").string()}})),
                       {"<environment>", "DYNLAB_LABS", (dir / "two/twin").string(), (dir / "one").string()});
   // A folder that is not there, and a lab folder named unlike a lab.
-  checkOneLineRefusal(dynlab(dir, {"list", "--labs", "missing"}), {"--labs", "expected an existing folder", "missing"});
+  checkRefused(dynlab(dir, {"list", "--labs", "missing"}), {"--labs", "expected an existing folder", "missing"});
   fs::create_directories(dir / "odd/Odd");
   writeFile(dir / "odd/Odd/Odd.json", "{}");
-  checkOneLineRefusal(dynlab(dir, {"list", "--labs", "odd"}), {"--labs", "Odd", "lowercase"});
+  checkRefused(dynlab(dir, {"list", "--labs", "odd"}), {"--labs", "Odd", "lowercase"});
 }
 
 TEST_CASE("a relative model path resolves in the lab's folder first, then the tree; one linking out of both is refused") {

@@ -12,15 +12,15 @@
 #include "labs/generic/model_loops.h"
 #include "physics/constrained_mechanism.h"
 #include "physics/model_file/model_file.h"
+#include "tests/physics/model_file/fixtures.h"
 
 using namespace dyn;
 namespace fs = std::filesystem;
 
 namespace {
 
-std::string model(const char* name) { return std::string(DYNLAB_SOURCE_DIR) + "/assets/models/" + name; }
-
-double maxAbs(const MatN& a) { return a.size() ? a.cwiseAbs().maxCoeff() : 0.0; }
+using test_model_file::maxAbs;
+using test_model_file::model;
 
 fs::path scratch() {
   const fs::path dir = fs::path(DYNLAB_TEST_TMP) / ("model_loops_" + std::to_string(::getpid()));
@@ -79,13 +79,7 @@ TEST_CASE("fourbar.urdf with fourbar.loops.json beside it equals fourbar.xml (M,
     for (int i = 0; i < 3; ++i) q[i] = 2.0 * u(rng), v[i] = 3.0 * u(rng), tau[i] = u(rng);
     CHECK(maxAbs(a.massMatrix(q) - b.massMatrix(q)) < 1e-12);
     CHECK(maxAbs(a.inverseDynamics(q, v, VecN::Zero(3)) - b.inverseDynamics(q, v, VecN::Zero(3))) < 1e-12);
-    VecN phi_a, phi_b;
-    MatN G_a, G_b;
-    a.constraint(q, phi_a, G_a);
-    b.constraint(q, phi_b, G_b);
-    REQUIRE(G_b.rows() == 2);
-    CHECK(maxAbs(phi_a - phi_b) < 1e-12);
-    CHECK(maxAbs(G_a - G_b) < 1e-12);
+    test_model_file::checkSameConstraints(a, q, b, q, 2);
     const auto sa = a.solve(q, v, tau), sb = b.solve(q, v, tau);
     CHECK(maxAbs(sa.qdd - sb.qdd) < 1e-12 * std::max(1.0, maxAbs(sa.qdd)));
     CHECK(maxAbs(sa.eta - sb.eta) < 1e-12 * std::max(1.0, maxAbs(sa.eta)));

@@ -120,12 +120,8 @@ TEST_CASE("dynlab run FILE.xml --engine both --video --frames: the model command
   std::size_t pngs = 0;
   for (const auto& e : fs::directory_iterator(dir / "out/frames")) pngs += e.path().extension() == ".png";
   CHECK(pngs == std::size_t(expected));
-  const Result probe = run(dir, {"ffprobe", "-v", "error", "-count_frames", "-select_streams", "v:0", "-show_entries",
-                                 "stream=nb_read_frames,pix_fmt,codec_name,width,height", "-of", "csv=p=0", "out/video.mp4"});
-  REQUIRE_MESSAGE(probe.code == 0, probe.err);
-  std::string line = probe.out;
-  line.erase(line.find_last_not_of(" \r\n") + 1);
-  CHECK(line == "h264,640,480,yuv420p," + std::to_string(expected));
+  CHECK(probeVideo(dir, "out/video.mp4", "nb_read_frames,pix_fmt,codec_name,width,height") ==
+        "h264,640,480,yuv420p," + std::to_string(expected));
   // The last frame: the mechanism drawn right of the panel (the panel fills the top-left), in colour.
   char name[32];
   std::snprintf(name, sizeof name, "%05d.png", expected - 1);

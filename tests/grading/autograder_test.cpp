@@ -11,6 +11,8 @@
 #include <sys/stat.h>
 #include <zip.h>
 
+#include "tests/app/cli_run.h"
+
 #include <algorithm>
 #include <regex>
 #include <sstream>
@@ -394,14 +396,7 @@ const BadCase kBadCases[] = {
 };
 
 // The bad-input contract: exit 2, nothing on stdout, one line "error: FILE: ..." holding each part.
-void checkRejected(const Ran& r, const std::vector<std::string>& parts) {
-  INFO("stderr: " << r.err);
-  CHECK(r.code == 2);
-  CHECK(r.out.empty());
-  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
-  CHECK(r.err.rfind("error: ", 0) == 0);
-  for (const auto& p : parts) CHECK_MESSAGE(r.err.find(p) != std::string::npos, "missing: " << p);
-}
+void checkRejected(const Ran& r, const std::vector<std::string>& parts) { dyn::test::cli::checkRefused(r, parts); }
 
 }  // namespace
 

@@ -18,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "tests/app/cli_run.h"
+#include "tests/grading/csv_rows.h"
 
 namespace fs = std::filesystem;
 using nlohmann::json;
@@ -27,35 +28,7 @@ namespace {
 
 const fs::path kExamples = fs::path(DYNLAB_SOURCE_DIR) / "labs/slider_crank/examples";
 
-// A gradebook parsed as RFC 4180: quoted fields may hold commas, quotes ("") and line breaks.
-std::vector<std::vector<std::string>> parseCsv(const std::string& text) {
-  std::vector<std::vector<std::string>> rows(1);
-  std::string cell;
-  bool quoted = false, was_quoted = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') cell += '"', ++i;
-      else if (c == '"') quoted = false;
-      else cell += c;
-    } else if (c == '"') {
-      REQUIRE_MESSAGE(cell.empty(), "a quote inside an unquoted field");
-      quoted = was_quoted = true;
-    } else if (c == ',' || c == '\n') {
-      rows.back().push_back(cell);
-      cell.clear();
-      was_quoted = false;
-      if (c == '\n') rows.emplace_back();
-    } else {
-      REQUIRE_MESSAGE(!was_quoted, "text after a closing quote");
-      cell += c;
-    }
-  }
-  REQUIRE_MESSAGE(!quoted, "an unterminated quoted field");
-  REQUIRE_MESSAGE(rows.back().empty(), "the last line has no line break");
-  rows.pop_back();
-  return rows;
-}
+using dyn::test::parseCsv;  // tests/grading/csv_rows.h
 
 // The gradebook as maps (column → cell), keyed by the submission column; checks its shape.
 std::map<std::string, std::map<std::string, std::string>> readBook(const fs::path& file) {

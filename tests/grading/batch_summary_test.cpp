@@ -17,6 +17,7 @@
 
 #include "app/shared/process.h"
 #include "tests/test_files.h"
+#include "tests/grading/csv_rows.h"
 
 namespace fs = std::filesystem;
 using dyn::test::readBytes;
@@ -27,31 +28,7 @@ const fs::path kLab = fs::path(DYNLAB_SOURCE_DIR) / "labs/slider_crank";
 
 void put(const fs::path& p, const std::string& text) { std::ofstream(p, std::ios::binary) << text; }
 
-// RFC 4180 rows (quoted fields may hold commas, quotes and line breaks).
-std::vector<std::vector<std::string>> parseCsv(const std::string& text) {
-  std::vector<std::vector<std::string>> rows(1);
-  std::string field;
-  bool quoted = false;
-  for (std::size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (quoted) {
-      if (c == '"' && i + 1 < text.size() && text[i + 1] == '"') field += '"', ++i;
-      else if (c == '"') quoted = false;
-      else field += c;
-    } else if (c == '"') {
-      quoted = true;
-    } else if (c == ',') {
-      rows.back().push_back(field), field.clear();
-    } else if (c == '\n') {
-      rows.back().push_back(field), field.clear();
-      rows.emplace_back();
-    } else {
-      field += c;
-    }
-  }
-  if (rows.back().empty()) rows.pop_back();
-  return rows;
-}
+using dyn::test::parseCsv;  // tests/grading/csv_rows.h
 
 std::string fmt(double x) {
   char b[32];

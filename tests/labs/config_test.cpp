@@ -19,6 +19,14 @@ namespace {
 
 json defaultConfig() { return loadJsonFile(defaultConfigPath("slider_crank")); }
 
+// The default config's text with "load_mass": 0.5 written as "load_mass": VALUE (what JSON cannot say).
+std::string configTextWithLoadMass(const std::string& value) {
+  std::string text = defaultConfig().dump(2);
+  const std::string key = "\"load_mass\": 0.5";
+  REQUIRE(text.find(key) != std::string::npos);
+  return text.replace(text.find(key), key.size(), "\"load_mass\": " + value);
+}
+
 // A scratch directory unique to this process, removed at the end.
 struct TempDir {
   fs::path path = fs::temp_directory_path() / ("dynlab_labs_config_test_" + std::to_string(::getpid()));
@@ -172,21 +180,11 @@ TEST_CASE("bad files: malformed, empty, missing, a number that overflows, NaN in
     checkNames(loadError(f), f, "", "expected a readable file");
   }
   SUBCASE("NaN written in the file is not JSON") {
-    json c = defaultConfig();
-    std::string text = c.dump(2);
-    const std::string key = "\"load_mass\": 0.5";
-    REQUIRE(text.find(key) != std::string::npos);
-    text.replace(text.find(key), key.size(), "\"load_mass\": NaN");
-    const std::string f = tmp.write("nan.json", text);
+    const std::string f = tmp.write("nan.json", configTextWithLoadMass("NaN"));
     checkNames(loadError(f), f, "", "expected valid JSON");
   }
   SUBCASE("1e999 overflows a double: an input error, not some other exception") {
-    json c = defaultConfig();
-    std::string text = c.dump(2);
-    const std::string key = "\"load_mass\": 0.5";
-    REQUIRE(text.find(key) != std::string::npos);
-    text.replace(text.find(key), key.size(), "\"load_mass\": 1e999");
-    const std::string f = tmp.write("overflow.json", text);
+    const std::string f = tmp.write("overflow.json", configTextWithLoadMass("1e999"));
     const InputError e = loadError(f);
     checkNames(e, f, "", "1e999");
   }

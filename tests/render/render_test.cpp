@@ -12,12 +12,8 @@ namespace {
 
 bool reddish(const std::uint8_t* p) { return p[0] > 150 && p[1] < 90 && p[2] < 90; }
 
-bool nearColor(const std::uint8_t* p, const Color& c, int tolerance = 2) {
-  const float want[3] = {c.r, c.g, c.b};
-  for (int i = 0; i < 3; ++i)
-    if (std::abs(int(p[i]) - int(want[i] * 255.0f + 0.5f)) > tolerance) return false;
-  return true;
-}
+// The background exactly (2 levels: rounding).
+bool isBackground(const std::uint8_t* p, const Color& bg) { return test::nearColor(p, bg, 2); }
 
 }  // namespace
 
@@ -49,12 +45,12 @@ TEST_CASE("a red capsule is drawn where project() says, and nowhere else") {
   for (const Eigen::Vector3d& w :
        {Eigen::Vector3d(-0.8, -0.8, 0), Eigen::Vector3d(0.8, -0.5, 0), Eigen::Vector3d(-0.5, 0.7, 0)}) {
     const Eigen::Vector2d px = Renderer::project(scene.camera, 320, 240, w);
-    CHECK(nearColor(image.pixel(int(px.x()), int(px.y())), scene.background));
+    CHECK(isBackground(image.pixel(int(px.x()), int(px.y())), scene.background));
   }
   // Just beyond the radius (perpendicular to the axis) is background too.
   const Eigen::Vector3d mid(0.25, 0.15, 0), normal = Eigen::Vector3d(-0.3, 0.5, 0).normalized();
   const Eigen::Vector2d off = Renderer::project(scene.camera, 320, 240, mid + 0.08 * normal);
-  CHECK(nearColor(image.pixel(int(off.x()), int(off.y())), scene.background));
+  CHECK(isBackground(image.pixel(int(off.x()), int(off.y())), scene.background));
 }
 
 TEST_CASE("the same scene renders to identical bytes") {

@@ -14,6 +14,14 @@
 
 namespace dyn::test {
 
+// Whether an RGB pixel is within tolerance levels (0–255, per channel) of a scene colour.
+inline bool nearColor(const std::uint8_t* p, const Color& c, int tolerance) {
+  const float want[3] = {c.r, c.g, c.b};
+  for (int i = 0; i < 3; ++i)
+    if (std::abs(int(p[i]) - int(want[i] * 255.0f + 0.5f)) > tolerance) return false;
+  return true;
+}
+
 // The pixel box of every pixel that is not the background colour (rows and columns inclusive).
 inline PixelRect inkBox(const Image& image, const Color& bg) {
   int x0 = image.width, y0 = image.height, x1 = -1, y1 = -1;

@@ -1,13 +1,17 @@
 // What the model-file tests share: the example files' paths, a scratch folder to write model files
-// into, seeded random states, a matrix's size.
+// into, seeded random states, a matrix's size, the one-line error a refused file gets, and two
+// mechanisms' constraint rows compared.
 #pragma once
+#include <doctest/doctest.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
 
+#include "physics/model_file/model_file.h"
 #include "physics/types.h"
 
 namespace dyn::test_model_file {
@@ -43,5 +47,35 @@ struct Random {
 };
 
 inline double maxAbs(const MatN& a) { return a.size() ? a.cwiseAbs().maxCoeff() : 0.0; }
+
+// The error model_file::load refuses file with ("" when it loads), checked to be one line that starts
+// with the file's path; seconds (when asked): how long the loader took.
+inline std::string errorOf(const std::filesystem::path& file, double* seconds = nullptr) {
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string what;
+  try {
+    model_file::load(file.string());
+  } catch (const model_file::ModelFileError& e) {
+    what = e.what();
+  }
+  if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  CHECK(what.find('\n') == std::string::npos);
+  CHECK(what.rfind(file.string() + ": ", 0) == 0);
+  return what;
+}
+
+// φ and the constraint rows G of two mechanisms, each at its own coordinates, agree to tol; both have
+// `rows` rows.
+template <class A, class B>
+void checkSameConstraints(A& a, const VecN& qa, B& b, const VecN& qb, long rows, double tol = 1e-12) {
+  VecN phi_a, phi_b;
+  MatN G_a, G_b;
+  a.constraint(qa, phi_a, G_a);
+  b.constraint(qb, phi_b, G_b);
+  REQUIRE(G_a.rows() == rows);
+  REQUIRE(G_b.rows() == rows);
+  CHECK(maxAbs(phi_a - phi_b) < tol);
+  CHECK(maxAbs(G_a - G_b) < tol);
+}
 
 }  // namespace dyn::test_model_file

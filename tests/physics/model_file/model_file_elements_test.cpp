@@ -95,12 +95,18 @@ Worst compare(const MechanismModel<Spatial>& file, const MechanismModel<Spatial>
   return w;
 }
 
+// Every quantity compare() measures agrees to rounding (1e-12).
+void checkEqual(const Worst& w) {
+  CHECK(w.M < 1e-12);
+  CHECK(w.h < 1e-12);
+  CHECK(w.rows < 1e-12);
+  CHECK(w.bias < 1e-12);
+  CHECK(w.solve < 1e-12);
+}
+
 std::string writeJson(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / "dynlab_model_file_elements_test";
-  fs::create_directories(dir);
-  const std::string path = (dir / name).string();
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
+  static const fs::path dir = scratchFolder("model_file_elements_test");
+  return writeFile(dir, name, text).string();
 }
 
 // The loader's one line for a model with the given JSON beside it ("" if it loads).
@@ -128,12 +134,7 @@ TEST_CASE("unicycle.xml + its rolling element equals the unicycle lab's C++ desc
   VecN q0(5), v0(5);
   unicycle::Mechanism(p).state(0, 0, 0, 0, 0, 0, q0, v0);
   CHECK(maxAbs(file.q0 - q0) < 1e-15);  // the wheel written on the ground at the lab's start
-  const Worst w = compare(file.mechanism, unicycle::describe(p), q0, 2.0, 40);
-  CHECK(w.M < 1e-12);
-  CHECK(w.h < 1e-12);
-  CHECK(w.rows < 1e-12);
-  CHECK(w.bias < 1e-12);
-  CHECK(w.solve < 1e-12);
+  checkEqual(compare(file.mechanism, unicycle::describe(p), q0, 2.0, 40));
 }
 
 TEST_CASE("pen.xml + its contact element equals the pen-on-table lab's C++ description (M, h, rows, bias, solve; 1e-12)") {
@@ -142,12 +143,7 @@ TEST_CASE("pen.xml + its contact element equals the pen-on-table lab's C++ descr
   CHECK(file.contacts[0].kind == "plane_contact");
   CHECK(file.dof == 3);  // the contact is one-sided: not counted
   const pen_on_table::Params p = penParams();
-  const Worst w = compare(file.mechanism, pen_on_table::describe(p), VecN::Zero(3), 2.0, 40);
-  CHECK(w.M < 1e-12);
-  CHECK(w.h < 1e-12);
-  CHECK(w.rows < 1e-12);
-  CHECK(w.bias < 1e-12);
-  CHECK(w.solve < 1e-12);
+  checkEqual(compare(file.mechanism, pen_on_table::describe(p), VecN::Zero(3), 2.0, 40));
 }
 
 TEST_CASE("the comparison can fail: a wheel 1 mm larger or a tip 1 mm off is seen") {

@@ -68,27 +68,9 @@ std::pair<double, double> passiveRun(ConstrainedMechanism<Spatial>& mech, VecN q
   return {de, phi};
 }
 
-// The error a file gets: one line naming the file, and the time the loader took.
-std::string errorOf(const std::string& path, double* seconds = nullptr) {
-  const auto t0 = std::chrono::steady_clock::now();
-  std::string what;
-  try {
-    model_file::load(path);
-  } catch (const model_file::ModelFileError& e) {
-    what = e.what();
-  }
-  if (seconds) *seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  CHECK(what.find('\n') == std::string::npos);
-  CHECK(what.rfind(path + ": ", 0) == 0);
-  return what;
-}
-
 std::string writeFile(const std::string& name, const std::string& text) {
-  const fs::path dir = fs::temp_directory_path() / "dynlab_model_file_test";
-  fs::create_directories(dir);
-  const std::string path = (dir / name).string();
-  std::ofstream(path, std::ios::binary) << text;
-  return path;
+  static const fs::path dir = scratchFolder("model_file_test");
+  return test_model_file::writeFile(dir, name, text).string();
 }
 
 // A one-body MJCF around a body's inside and an extra top-level section.
@@ -126,13 +108,7 @@ TEST_CASE("the slider crank as MJCF equals the lab's C++ description (M, h, φ, 
     CHECK(maxAbs(hf.head(3) - hl) < 1e-12);
     CHECK(std::abs(hf[3]) < 1e-12);
     // φ and G = [J, −A] row by row (the lab's payload column is −A; the file's slider is a tree joint).
-    VecN phif, phil;
-    MatN Gf, Gl;
-    f.constraint(q, phif, Gf);
-    lab.constraint(ql, phil, Gl);
-    REQUIRE(Gf.rows() == 3);
-    CHECK(maxAbs(phif - phil) < 1e-12);
-    CHECK(maxAbs(Gf - Gl) < 1e-12);
+    checkSameConstraints(f, q, lab, ql, 3);
     // The whole solve: accelerations and the constraint force (η), so also J'θ' − A'v_c.
     VecN tau_f = VecN::Zero(4);  // the file's slider is a tree joint: no force on it
     tau_f.head(3) = tau;
