@@ -80,11 +80,22 @@ TEST_CASE("students' examples score well below full marks; the instructor's scor
   CHECK(labs >= 1);
 }
 
-TEST_CASE("the slider crank's instructor/good.json scores full marks" * doctest::skip(!dyn::test::instructorFilesPresent())) {
+// The rubric trades one gain against another (issue 41): no design earns every point, and the tuned
+// answer finishes clearly ahead of each design written from the handout alone (instructor/untuned/).
+TEST_CASE("the slider crank's instructor/good.json scores ahead of every untuned design" *
+          doctest::skip(!dyn::test::instructorFilesPresent())) {
   const TempDir dir("instructor_full");
   const auto [score, max] = grade(dir, kLabs / "slider_crank/instructor/good.json");
   CHECK(max > 0);
-  CHECK(score == doctest::Approx(max));
+  CHECK(score >= 0.9 * max);
+  const std::vector<fs::path> untuned = jsonFiles(kLabs / "slider_crank/instructor/untuned");
+  CHECK(untuned.size() >= 2);
+  for (const fs::path& file : untuned) {
+    const auto [u, m] = grade(dir, file);
+    // Tuning buys points: the answer at least 2 % of them ahead (before issue 41's calibration the
+    // handout's round gains came within 0.2 % of full marks).
+    CHECK_MESSAGE(u < score - 0.02 * max, file.string() << " scores " << u << " of " << m << ", the answer " << score);
+  }
 }
 
 TEST_CASE("the Gradescope bundle has the students' examples and no instructor folder") {

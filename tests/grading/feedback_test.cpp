@@ -171,7 +171,7 @@ TEST_CASE("what a test without a plot of its own plots, derived in order") {
   p = plan(config, 0);
   CHECK(p.request.columns == std::vector<std::string>{"x_c"});
   CHECK(p.request.reference == "x_d");
-  CHECK(p.request.band == doctest::Approx(0.003));
+  CHECK(p.request.band == doctest::Approx(config["rubric"]["tests"][0]["full"].get<double>()));
   CHECK(p.request.ylabel == "x_c, x_d (m)");
   CHECK(std::isinf(p.from));
   p = plan(config, 1);  // f_rms: f_Ty against f_des, counted from settle_time on
@@ -287,7 +287,7 @@ TEST_CASE("replay differences say what each value was and is now") {
   REQUIRE(diff.size() == 3);
   const std::string all = diff[0] + "\n" + diff[1] + "\n" + diff[2];
   CHECK(all.find("/extra_data/scenarios/nominal/metrics/x_rms: was 0.02 → now 0.0116") != std::string::npos);
-  CHECK(all.find("/tests/0/score: was 2.5 → now 2.03") != std::string::npos);
+  CHECK(all.find("/tests/0/score: was 2.5 → now 0") != std::string::npos);  // x_rms 0.0116 m: past the zero threshold
   CHECK(all.find("/tests/1/tags: added, now [\"nominal\"]") != std::string::npos);
 }
 
@@ -333,7 +333,7 @@ TEST_CASE("dynlab grade: the replay hints run as printed, from any folder, and r
       run(dir, {"sh", "-c", terminal_hint}, from_root);  // a user's shell: the test checks the command line printed for pasting
   CHECK(changed.code == 1);
   CHECK(changed.out.find("metric x_rms of test 1 (Slider tracks x_d(t)): was 0.02 → now 0.0116") != std::string::npos);
-  CHECK(changed.out.find("score was 2.5 → now 2.03") != std::string::npos);
+  CHECK(changed.out.find("score was 2.5 → now 0") != std::string::npos);
 }
 
 TEST_CASE("inline plots stop at their budget: later ones are named as left out, and replay strips both") {
