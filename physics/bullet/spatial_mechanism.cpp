@@ -69,6 +69,7 @@
 #include <stdexcept>
 
 #include "physics/bullet/bullet_mechanism.h"
+#include "physics/bullet/bullet_mechanism_members.h"
 #include "physics/bullet/bullet_world.h"
 #include "physics/bullet/contact_balls.h"
 #include "physics/bullet/rolling_constraint.h"
@@ -179,6 +180,7 @@ struct BulletMechanism<Spatial>::Impl {
   std::vector<Spatial::Vec> force;  // per description constraint, over the last step
   std::vector<int> rotor_joint;     // per rotor link (Bullet link n + k): the joint it is geared to
   std::string summary;
+  const std::string& describe() const { return summary; }
   std::unique_ptr<TreeData<Spatial>> kinematics;  // the external forces' points (none: no forces)
 
   BulletWorld world;  // before what it holds: destroyed after it
@@ -205,15 +207,7 @@ struct BulletMechanism<Spatial>::Impl {
     summarise();
   }
 
-  ~Impl() {
-    for (auto& c : closures) world->removeMultiBodyConstraint(c.get());
-    balls.clear(world);
-    for (auto& c : colliders) world->removeCollisionObject(c.get());
-    if (body) world->removeMultiBody(body.get());
-    closures.clear();
-    colliders.clear();
-    body.reset();
-  }
+  ~Impl() { removeModel(world, body, colliders, closures, balls); }
 
   // What this model cannot build, said before anything is built.
   void check(const VecN& q0, const VecN& v0) const {
@@ -542,25 +536,6 @@ struct BulletMechanism<Spatial>::Impl {
   }
 };
 
-template <>
-BulletMechanism<Spatial>::BulletMechanism(const MechanismModel<Spatial>& model, double dt, const VecN& q0, const VecN& v0)
-    : impl_(std::make_unique<Impl>(model, dt, q0, v0)) {}
-template <>
-BulletMechanism<Spatial>::~BulletMechanism() {}
-template <>
-void BulletMechanism<Spatial>::step(const VecN& tau, double t) {
-  impl_->step(tau, t);
-}
-template <>
-Books BulletMechanism<Spatial>::books() const { return impl_->books; }
-template <>
-void BulletMechanism<Spatial>::state(VecN& q, VecN& v) const { impl_->state(q, v); }
-template <>
-Spatial::Vec BulletMechanism<Spatial>::constraintForce(int i) const {
-  if (i < 0 || i >= int(impl_->force.size())) throw std::out_of_range("BulletMechanism::constraintForce: no such constraint");
-  return impl_->force[std::size_t(i)];
-}
-template <>
-std::string BulletMechanism<Spatial>::describe() const { return impl_->summary; }
+template class BulletMechanism<Spatial>;
 
 }  // namespace dyn::bullet
