@@ -142,17 +142,7 @@ struct BulletMechanism<Planar>::Impl {
 
     // Pitfall 1: every link needs a collider for the constraints to act; mask 0 = no contacts.
     shape = std::make_unique<btSphereShape>(0.01);
-    for (int i = -1; i < n; ++i) {
-      auto c = std::make_unique<btMultiBodyLinkCollider>(body.get(), i);
-      c->setCollisionShape(shape.get());
-      c->setActivationState(DISABLE_DEACTIVATION);
-      world->addCollisionObject(c.get(), btBroadphaseProxy::DefaultFilter, 0);
-      if (i < 0)
-        body->setBaseCollider(c.get());
-      else
-        body->getLink(i).m_collider = c.get();
-      colliders.push_back(std::move(c));
-    }
+    addLinkColliders(world, *body, n, shape.get(), colliders);
 
     // Cut joints and point attachments: point-to-point (to the world: pivot_b in world coordinates).
     for (const PlanConstraint& pc : plan.constraints) {
@@ -342,12 +332,7 @@ struct BulletMechanism<Planar>::Impl {
       applied.emplace_back(l, r_local, F, p, m.phi);
     }
     for (int i = 0; i < n; ++i) {
-      double tau = tau_in[i];
-      if (!model.joints.empty()) {  // spring, viscous and Coulomb friction from the step's start
-        const JointProperties& jp = model.joints[std::size_t(i)];
-        friction[i] = jp.friction(v[i]);
-        tau -= jp.stiffness * (q[i] - jp.rest) + friction[i];
-      }
+      const double tau = heldTorque(model.joints, i, tau_in[i], q[i], v[i], friction[i]);
       // Pitfall 3: applied torques are cleared after each step; apply them every step.
       const int k = joint_link[std::size_t(i)];
       if (k >= 0) {

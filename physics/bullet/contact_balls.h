@@ -85,6 +85,12 @@ class ContactBalls {
   std::vector<std::unique_ptr<btRigidBody>> planes_;
 };
 
+// Pitfall 1: the base and each of `links` links of body get a collider on `shape` (constraints act only
+// between links with one), with mask 0: no contacts (build() above gives a ball's link its group);
+// added to the world and to colliders, the base's first.
+void addLinkColliders(BulletWorld& world, btMultiBody& body, int links, btCollisionShape* shape,
+                      std::vector<std::unique_ptr<btMultiBodyLinkCollider>>& colliders);
+
 // A builder's teardown, before its world goes: its constraints, the balls' planes, its link colliders
 // and its multibody taken out of the world, then freed.
 void removeModel(BulletWorld& world, std::unique_ptr<btMultiBody>& body, std::vector<std::unique_ptr<btMultiBodyLinkCollider>>& colliders,

@@ -295,17 +295,7 @@ struct BulletMechanism<Spatial>::Impl {
   // Pitfall 1: every link gets a collider, with mask 0 (no contacts) unless a friction wheel's.
   void buildColliders() {
     shapes.push_back(std::make_unique<btSphereShape>(0.01));
-    for (int i = -1; i < body->getNumLinks(); ++i) {
-      auto c = std::make_unique<btMultiBodyLinkCollider>(body.get(), i);
-      c->setCollisionShape(shapes.front().get());
-      c->setActivationState(DISABLE_DEACTIVATION);
-      world->addCollisionObject(c.get(), btBroadphaseProxy::DefaultFilter, 0);
-      if (i < 0)
-        body->setBaseCollider(c.get());
-      else
-        body->getLink(i).m_collider = c.get();
-      colliders.push_back(std::move(c));
-    }
+    addLinkColliders(world, *body, body->getNumLinks(), shapes.front().get(), colliders);
   }
 
   // Rolling wheels (a NoSlip constraint or a Friction ball) and plane contacts (a ball), in description order.
@@ -491,12 +481,7 @@ struct BulletMechanism<Spatial>::Impl {
     const VecN pushed = applyForces(t, q, v);  // pitfall 3: cleared after every step, like the torques
     VecN friction = VecN::Zero(n);
     for (int i = 0; i < n; ++i) {
-      double tau = tau_in[i];
-      if (!model.joints.empty()) {  // spring, viscous and Coulomb friction from the step's start
-        const JointProperties& jp = model.joints[std::size_t(i)];
-        friction[i] = jp.friction(v[i]);
-        tau -= jp.stiffness * (q[i] - jp.rest) + friction[i];
-      }
+      const double tau = heldTorque(model.joints, i, tau_in[i], q[i], v[i], friction[i]);
       body->addJointTorque(i, tau);  // pitfall 3: cleared after every step
     }
     for (Wheel& w : wheels)
