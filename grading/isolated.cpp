@@ -10,7 +10,7 @@
 #include <exception>
 #include <new>
 
-#include "util/pipe.h"
+#include "physics/util/pipe.h"
 
 namespace dyn {
 namespace {

@@ -16,7 +16,7 @@
 #include <new>
 
 #include "physics/model_file/model_file.h"
-#include "util/pipe.h"
+#include "physics/util/pipe.h"
 
 namespace dyn::model_file::detail {
 namespace {

@@ -19,7 +19,7 @@
 #include <set>
 
 #include "physics/model_file/mujoco_call.h"
-#include "util/utf8.h"
+#include "physics/util/utf8.h"
 
 namespace dyn::model_file::detail {
 namespace {

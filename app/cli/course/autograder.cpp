@@ -30,7 +30,7 @@ namespace fs = std::filesystem;
 constexpr const char* kRoot = "/autograder/source/source";
 // What of the dynlab tree goes into the bundle (tests/ too: the top CMakeLists adds it; docs/: the README links the notes).
 constexpr const char* kTopFiles[] = {"CMakeLists.txt", "README.md"};
-constexpr const char* kTopDirs[] = {"app", "assets", "docs", "grading", "labs", "physics", "render", "scripts", "tests", "util"};
+constexpr const char* kTopDirs[] = {"app", "assets", "docs", "grading", "labs", "physics", "render", "scripts", "tests"};
 
 struct Entry {
   std::string name;  // path inside the zip, '/'-separated

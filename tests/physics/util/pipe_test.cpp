@@ -1,6 +1,6 @@
 // util/pipe.h: what readPipe keeps and says when the writer closes, writes too much (stopping or
 // draining) or stays silent past the deadline.
-#include "util/pipe.h"
+#include "physics/util/pipe.h"
 
 #include <doctest/doctest.h>
 #include <unistd.h>

@@ -1,5 +1,5 @@
 // UTF-8 well-formedness; see util/utf8.h.
-#include "util/utf8.h"
+#include "physics/util/utf8.h"
 
 #include <cstdio>
 #include <string>

@@ -1,6 +1,6 @@
 // util/utf8.h: the one UTF-8 checker (model files and JSON alike) finds the first byte of every kind of
 // ill-formed sequence, and quotes it.
-#include "util/utf8.h"
+#include "physics/util/utf8.h"
 
 #include <doctest/doctest.h>
 

@@ -1,5 +1,5 @@
 // A child's pipe: every byte written, and read back until closed, late or too large; see pipe.h.
-#include "util/pipe.h"
+#include "physics/util/pipe.h"
 
 #include <poll.h>
 #include <unistd.h>
