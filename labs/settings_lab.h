@@ -5,8 +5,9 @@
 //   units_            column → SI unit ("rad", "N·m"; absent: none or dimensionless)
 //   agreement_units_  key of agreement() → unit
 //   passive_          the passive energy check (Lab::PassiveEnergy: tolerance, window, conservative patch)
-// agreement() is shared too: the rows compared and each engine's health around the lab's differences().
-// The lab's own class then holds only its own parts: the run (simulate, referenceEngine), the grade
+// agreement() is shared too: the rows compared and each engine's health around the lab's differences();
+// and referenceEngine(): what the Bullet run of simulate() says it built.
+// The lab's own class then holds only its own parts: the run (simulate), the grade
 // (metrics, differences, linearise), the picture (scene, overlay), and unit() where a rule says more
 // than a table (a column per finger or joint).
 #pragma once
@@ -38,6 +39,11 @@ class SettingsLab : public Lab {
   }
   std::string agreementUnit(const std::string& key) const override { return unitIn(agreement_units_, key); }
   PassiveEnergy passiveEnergy() const override { return passive_; }
+  // The Bullet run's own description: the same mechanism, from the same start, as simulate() builds it.
+  std::string referenceEngine() const override {
+    const std::string built = simulate(Engine::Bullet)->describeEngine();
+    return built.empty() ? Lab::referenceEngine() : built;
+  }
   const S& settings() const { return s_; }
 
  protected:

@@ -219,10 +219,6 @@ json DataLab::differences(const Trace& a, const Trace& b, std::size_t n) const {
   return {{"max_dq", dq}, {"max_dx", dx}, {"max_df", df}};
 }
 
-std::string DataLab::referenceEngine() const {
-  return bullet::BulletMechanism<Spatial>(s_.plant->mechanism, s_.step.dt, s_.q0, VecN::Zero(s_.q0.size())).describe();
-}
-
 void DataLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene& out) const {
   const int n = int(s_.plant->joints.size());
   // The run's bounds frame every picture of it (cached: a video asks for every row).

@@ -309,13 +309,6 @@ json GraspLab::differences(const Trace& a, const Trace& b, std::size_t n) const 
           {"max_df_int", dint}};
 }
 
-std::string GraspLab::referenceEngine() const {
-  Mechanism mech(s_.params);
-  VecN q, v;
-  mech.assemble(s_.pose0, Eigen::Vector3d::Zero(), q, v);
-  return bullet::BulletMechanism<Planar>(mech.model(), s_.step.dt, q, v).describe();
-}
-
 DYNLAB_REGISTER_LAB(grasp, "Multi-finger grasp: carry an object held by two fingers, squeezing just enough to stay inside every friction cone",
                     [](const JsonView& config) -> std::unique_ptr<Lab> {
                       return std::make_unique<GraspLab>(parseSettings(config));

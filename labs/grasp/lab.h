@@ -39,7 +39,6 @@ class GraspLab final : public SettingsLab<Settings> {
   std::string unit(const std::string& column) const override;
   // The run: fingers and object assembled at pose0, the object-level controller, the push (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
-  std::string referenceEngine() const override;
   int fingers() const { return int(s_.params.fingers.size()); }
   // The grade: the object's tracking, the internal force, the friction cones' margin (lab.cpp);
   // the loops screened (linearise.cpp).

@@ -295,12 +295,6 @@ json MotionControlLab::differences(const Trace& a, const Trace& b, std::size_t r
   return {{"max_dq", dq}, {"max_dtau", dtau}};
 }
 
-std::string MotionControlLab::referenceEngine() const {
-  VecN q, v;
-  treeState(s_.plant, s_.trajectory.outstretched, staticDeflection(s_.plant, s_.trajectory.outstretched), q, v);
-  return bullet::BulletMechanism<Planar>(describe(s_.plant), s_.step.dt, q, v).describe();
-}
-
 DYNLAB_REGISTER_LAB(motion_control, "Motion control: PID, computed torque and PD + gravity on an arm, rigid or with flexible joints",
                     [](const JsonView& config) -> std::unique_ptr<Lab> {
                       return std::make_unique<MotionControlLab>(parseSettings(config));

@@ -364,13 +364,6 @@ json PenOnTableLab::differences(const Trace& a, const Trace& b, std::size_t n) c
           {"contact_mismatch_time", mismatch}};
 }
 
-std::string PenOnTableLab::referenceEngine() const {
-  Mechanism mech(s_.params);
-  VecN q, v;
-  initialState(q, v);
-  return bullet::BulletMechanism<Spatial>(mech.model(), s_.step.dt, q, v).describe();
-}
-
 DYNLAB_REGISTER_LAB(pen_on_table, "Pen on table: draw a circle while pressing with a set force (position accommodation, a unilateral contact)",
                     [](const JsonView& config) -> std::unique_ptr<Lab> {
                       return std::make_unique<PenOnTableLab>(parseSettings(config));

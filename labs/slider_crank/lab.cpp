@@ -197,14 +197,6 @@ json SliderCrankLab::differences(const Trace& a, const Trace& b, std::size_t n) 
           {"max_dtau_T", dtau_T}};
 }
 
-std::string SliderCrankLab::referenceEngine() const {
-  // How the builder models this description (the tree it grew, where it cut, the solver's effort).
-  Mechanism mech(s_.params);
-  VecN q, v;
-  mech.initialState(s_.theta1, s_.theta1_rate, s_.branch, q, v);
-  return bullet::BulletMechanism<Planar>(mech.model(), s_.step.dt, q, v).describe();
-}
-
 DYNLAB_REGISTER_LAB(slider_crank, "Slider crank: move the slider along x_d(t) while regulating its rail force (direct force control on a closed chain)",
                     [](const JsonView& config) -> std::unique_ptr<Lab> {
                       return std::make_unique<SliderCrankLab>(parseSettings(config));

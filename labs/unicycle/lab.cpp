@@ -234,13 +234,6 @@ json UnicycleLab::differences(const Trace& a, const Trace& b, std::size_t n) con
           {"friction_max_slip", slip_fric}, {"friction_max_dpos", dpos_fric}};
 }
 
-std::string UnicycleLab::referenceEngine() const {
-  Mechanism mech(s_.params);
-  VecN q, v;
-  mech.state(s_.x0, s_.y0, s_.phi0, 0.0, s_.phi_rate0, s_.theta_rate0, q, v);
-  return bullet::BulletMechanism<Spatial>(mech.model(), s_.step.dt, q, v).describe();
-}
-
 DYNLAB_REGISTER_LAB(unicycle, "Rolling unicycle: drive a wheel along a path without skidding (a nonholonomic constraint)",
                     [](const JsonView& config) -> std::unique_ptr<Lab> {
                       return std::make_unique<UnicycleLab>(parseSettings(config));
