@@ -13,6 +13,7 @@
 #pragma once
 #include <algorithm>
 #include <map>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -57,5 +58,12 @@ class SettingsLab : public Lab {
   std::map<std::string, std::string> units_, agreement_units_;
   PassiveEnergy passive_;
 };
+
+// The factory DYNLAB_REGISTER_LAB takes, for a lab class L built from what `parse` reads from the config:
+//   DYNLAB_REGISTER_LAB(grasp, "...", labFactory<GraspLab>(parseSettings));
+template <class L, class Parse>
+LabFactory labFactory(Parse parse) {
+  return [parse](const JsonView& config) -> std::unique_ptr<Lab> { return std::make_unique<L>(parse(config)); };
+}
 
 }  // namespace dyn

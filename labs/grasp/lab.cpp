@@ -5,7 +5,6 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <cstdio>
-#include <map>
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
@@ -310,8 +309,6 @@ json GraspLab::differences(const Trace& a, const Trace& b, std::size_t n) const 
 }
 
 DYNLAB_REGISTER_LAB(grasp, "Multi-finger grasp: carry an object held by two fingers, squeezing just enough to stay inside every friction cone",
-                    [](const JsonView& config) -> std::unique_ptr<Lab> {
-                      return std::make_unique<GraspLab>(parseSettings(config));
-                    });
+                    labFactory<GraspLab>(parseSettings));
 
 }  // namespace dyn::grasp

@@ -7,7 +7,6 @@
 
 #include <cmath>
 #include <functional>
-#include <map>
 #include <random>
 
 #include "labs/controllers/laws.h"
@@ -341,8 +340,6 @@ std::unique_ptr<Simulation> ImpedanceLab::simulate(Engine engine) const {
 }
 
 DYNLAB_REGISTER_LAB(impedance, "Impedance control: make the hand feel like a given mass-spring-damper, three ways",
-                    [](const JsonView& config) -> std::unique_ptr<Lab> {
-                      return std::make_unique<ImpedanceLab>(parseSettings(config));
-                    });
+                    labFactory<ImpedanceLab>(parseSettings));
 
 }  // namespace dyn::impedance

@@ -5,7 +5,6 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
@@ -296,8 +295,6 @@ json MotionControlLab::differences(const Trace& a, const Trace& b, std::size_t r
 }
 
 DYNLAB_REGISTER_LAB(motion_control, "Motion control: PID, computed torque and PD + gravity on an arm, rigid or with flexible joints",
-                    [](const JsonView& config) -> std::unique_ptr<Lab> {
-                      return std::make_unique<MotionControlLab>(parseSettings(config));
-                    });
+                    labFactory<MotionControlLab>(parseSettings));
 
 }  // namespace dyn::motion_control

@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
@@ -365,8 +364,6 @@ json PenOnTableLab::differences(const Trace& a, const Trace& b, std::size_t n) c
 }
 
 DYNLAB_REGISTER_LAB(pen_on_table, "Pen on table: draw a circle while pressing with a set force (position accommodation, a unilateral contact)",
-                    [](const JsonView& config) -> std::unique_ptr<Lab> {
-                      return std::make_unique<PenOnTableLab>(parseSettings(config));
-                    });
+                    labFactory<PenOnTableLab>(parseSettings));
 
 }  // namespace dyn::pen_on_table

@@ -3,7 +3,6 @@
 #include "labs/slider_crank/lab.h"
 
 #include <cmath>
-#include <map>
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
@@ -198,8 +197,6 @@ json SliderCrankLab::differences(const Trace& a, const Trace& b, std::size_t n) 
 }
 
 DYNLAB_REGISTER_LAB(slider_crank, "Slider crank: move the slider along x_d(t) while regulating its rail force (direct force control on a closed chain)",
-                    [](const JsonView& config) -> std::unique_ptr<Lab> {
-                      return std::make_unique<SliderCrankLab>(parseSettings(config));
-                    });
+                    labFactory<SliderCrankLab>(parseSettings));
 
 }  // namespace dyn::slider_crank

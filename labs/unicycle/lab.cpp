@@ -4,7 +4,6 @@
 #include "labs/unicycle/lab.h"
 
 #include <cmath>
-#include <map>
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
@@ -235,8 +234,6 @@ json UnicycleLab::differences(const Trace& a, const Trace& b, std::size_t n) con
 }
 
 DYNLAB_REGISTER_LAB(unicycle, "Rolling unicycle: drive a wheel along a path without skidding (a nonholonomic constraint)",
-                    [](const JsonView& config) -> std::unique_ptr<Lab> {
-                      return std::make_unique<UnicycleLab>(parseSettings(config));
-                    });
+                    labFactory<UnicycleLab>(parseSettings));
 
 }  // namespace dyn::unicycle
