@@ -301,11 +301,7 @@ json GraspLab::differences(const Trace& a, const Trace& b, std::size_t n) const 
     dnet = std::max(dnet, net.norm());
     dint = std::max(dint, std::abs(a.at(r, "f_int") - b.at(r, "f_int")));
   }
-  return {{"max_dq", dq},
-          {"max_dpos", dpos},
-          {"max_dpsi", dpsi},
-          {"max_dnet_force", dnet},
-          {"max_df_int", dint}};
+  return {{"max_dq", dq}, {"max_dpos", dpos}, {"max_dpsi", dpsi}, {"max_dnet_force", dnet}, {"max_df_int", dint}};
 }
 
 DYNLAB_REGISTER_LAB(grasp, "Multi-finger grasp: carry an object held by two fingers, squeezing just enough to stay inside every friction cone",

@@ -190,10 +190,7 @@ json SliderCrankLab::differences(const Trace& a, const Trace& b, std::size_t n) 
     for (const char* c : {"f_Tx", "f_Ty"}) df = std::max(df, std::abs(a.at(r, c) - b.at(r, c)));
     dtau_T = std::max(dtau_T, std::abs(a.at(r, "tau_T") - b.at(r, "tau_T")));
   }
-  return {{"max_dq", dq},
-          {"max_dx_c", dx},
-          {"max_df", df},
-          {"max_dtau_T", dtau_T}};
+  return {{"max_dq", dq}, {"max_dx_c", dx}, {"max_df", df}, {"max_dtau_T", dtau_T}};
 }
 
 DYNLAB_REGISTER_LAB(slider_crank, "Slider crank: move the slider along x_d(t) while regulating its rail force (direct force control on a closed chain)",
