@@ -44,6 +44,9 @@ class Simulation {
   // last step() held (no controller, no trace row; it uses up one step of the run). False once the
   // run is over, or if the lab does not offer it.
   virtual bool advanceEngine() { return false; }
+  // The engine in one line, when it can say more than its name (Bullet: the multibody it built from the
+  // description, where it cut the loops, the solver's effort); empty otherwise.
+  virtual std::string describeEngine() const { return {}; }
 };
 
 class Lab {

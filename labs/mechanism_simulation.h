@@ -37,6 +37,8 @@ class MechanismEngine {
   virtual void setTime(double t) = 0;
   // The work done on the mechanism since the start (integrate.h Books): of τ and the external forces, of friction.
   virtual Books books() const = 0;
+  // What the engine built, in one line (Simulation::describeEngine); empty for the hand engine.
+  virtual std::string describe() const { return {}; }
 };
 
 // The hand-written engine: eq. (2)/(3) through the generic mechanism M, integrated by physics/integrate.
@@ -87,7 +89,7 @@ class BulletEngine final : public MechanismEngine {
   const std::vector<VecN>& forces() const override { return forces_; }
   void setTime(double t) override { t_ = t; }
   Books books() const override { return world_.books(); }
-  std::string describe() const { return world_.describe(); }
+  std::string describe() const override { return world_.describe(); }
 
  private:
   bullet::BulletMechanism<S> world_;
@@ -174,6 +176,7 @@ class MechanismSimulation final : public Simulation {
   }
 
   std::string failure() const override { return failure_; }
+  std::string describeEngine() const override { return stepper_->describe(); }
   M& model() { return *model_; }
 
  private:

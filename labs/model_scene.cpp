@@ -5,6 +5,8 @@
 #include <cmath>
 #include <cstdio>
 
+#include "labs/run_bounds.h"
+
 namespace dyn {
 namespace {
 
@@ -251,12 +253,7 @@ VecN traceQ(const Trace& trace, std::size_t row, int n) {
 
 Box3 runBounds(const ModelPicture& picture, int n, const Trace& trace, const Trace* ghost) {
   Box3 box;
-  for (const Trace* t : {&trace, ghost}) {
-    if (!t || t->rows() == 0) continue;
-    const std::size_t stride = std::max<std::size_t>(1, t->rows() / 400);
-    for (std::size_t r = 0; r < t->rows(); r += stride) box.extend(picture.bounds(traceQ(*t, r, n)));
-    box.extend(picture.bounds(traceQ(*t, t->rows() - 1, n)));
-  }
+  forBoundsRows(trace, ghost, [&](const Trace& run, std::size_t r) { box.extend(picture.bounds(traceQ(run, r, n))); });
   return box;
 }
 

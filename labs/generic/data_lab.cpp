@@ -132,7 +132,16 @@ std::string fmt(const char* f, double x) {
 
 }  // namespace
 
-DataLab::DataLab(DataSettings s) : s_(std::move(s)), picture_(*s_.plant), kinematics_(std::make_unique<Mech>(s_.plant->mechanism)) {}
+DataLab::DataLab(DataSettings s)
+    : SettingsLab(std::move(s)), picture_(*s_.plant), kinematics_(std::make_unique<Mech>(s_.plant->mechanism)) {
+  columns_ = s_.columns;
+  // max_dq spans every coordinate: rad on hinges, m on slides.
+  bool hinge = false, slide = false;
+  for (const auto& j : s_.plant->joints) (j.type == "slide" ? slide : hinge) = true;
+  agreement_units_ = {{"max_dq", hinge && slide ? "rad, m" : slide ? "m" : "rad"}, {"max_dx", "m"}, {"max_df", "N, N·m"}};
+  // The push does work by design: the passive check runs without it (E itself must then stay put).
+  passive_ = {s_.passive_tolerance, 0, s_.push ? json{{"environment", nullptr}} : json::object()};
+}
 
 std::string DataLab::unit(const std::string& c) const {
   auto starts = [&](const char* p) { return c.rfind(p, 0) == 0; };
@@ -198,8 +207,7 @@ json DataLab::metrics(const Trace& tr) const {
   return out;
 }
 
-json DataLab::agreement(const Trace& a, const Trace& b) const {
-  const std::size_t n = std::min(a.rows(), b.rows());
+json DataLab::differences(const Trace& a, const Trace& b, std::size_t n) const {
   const std::size_t joints = s_.plant->joints.size();
   double dq = 0, dx = 0, df = 0;
   for (std::size_t r = 0; r < n; ++r) {
@@ -208,21 +216,7 @@ json DataLab::agreement(const Trace& a, const Trace& b) const {
     for (std::size_t c = 0; c < s_.columns.size(); ++c)
       if (s_.columns[c].rfind("f_", 0) == 0) df = std::max(df, std::abs(a.at(r, int(c)) - b.at(r, int(c))));
   }
-  json out = {{"rows_compared", n}, {"max_dq", dq}, {"max_dx", dx}, {"max_df", df}};
-  out.update(engineHealth(metrics(a), metrics(b)));
-  return out;
-}
-
-std::string DataLab::agreementUnit(const std::string& key) const {
-  // max_dq spans every coordinate: rad on hinges, m on slides.
-  bool hinge = false, slide = false;
-  for (const auto& j : s_.plant->joints) (j.type == "slide" ? slide : hinge) = true;
-  const std::map<std::string, std::string> units = {{"max_dq", hinge && slide ? "rad, m" : slide ? "m" : "rad"}, {"max_dx", "m"}, {"max_df", "N, N·m"}};
-  return unitIn(units, key);
-}
-
-std::string DataLab::referenceEngine() const {
-  return bullet::BulletMechanism<Spatial>(s_.plant->mechanism, s_.step.dt, s_.q0, VecN::Zero(s_.q0.size())).describe();
+  return {{"max_dq", dq}, {"max_dx", dx}, {"max_df", df}};
 }
 
 void DataLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene& out) const {

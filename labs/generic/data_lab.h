@@ -49,8 +49,8 @@
 #include "labs/controllers/controller.h"
 #include "labs/generic/metric_spec.h"
 #include "labs/generic/task_path.h"
-#include "labs/lab.h"
 #include "labs/model_scene.h"
+#include "labs/settings_lab.h"
 #include "physics/forces.h"
 #include "physics/model_file/model_file.h"
 
@@ -82,27 +82,23 @@ struct DataSettings {
 DataSettings parseDataSettings(const JsonView& config, const std::string& name, const std::string& folder,
                                const model_file::LoadOptions& options = {});
 
-class DataLab final : public Lab {
+class DataLab final : public SettingsLab<DataSettings> {
  public:
+  // Its tables (settings_lab.h): the columns parsed, the agreement's units (max_dq in the joints' own),
+  // the passive check (without the push, which does work by design: E itself must then stay put).
   explicit DataLab(DataSettings s);
-  std::vector<std::string> columns() const override { return s_.columns; }
+  // Each column's unit from its joint's kind (rad or m, N·m or N) and the blocks the JSON declares.
   std::string unit(const std::string& column) const override;
-  double dt() const override { return s_.step.dt; }
-  double duration() const override { return s_.duration; }
+  // The run: the model file's mechanism assembled, a law of labs/controllers, the push (data_lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  // The grade: the JSON's metrics (metric_spec.h), the engines' agreement.
   json metrics(const Trace& trace) const override;
-  json agreement(const Trace& hand, const Trace& bullet) const override;
-  std::string agreementUnit(const std::string& key) const override;
-  std::string referenceEngine() const override;
-  // The push does work by design: the passive check runs without it (E itself must then stay put).
-  PassiveEnergy passiveEnergy() const override {
-    return {s_.passive_tolerance, 0, s_.push ? json{{"environment", nullptr}} : json::object()};
-  }
+  json differences(const Trace& hand, const Trace& bullet, std::size_t rows) const override;
+  // The picture: the model file's bodies, the tool, its path and the push (model_scene.h).
   void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
   void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
 
  private:
-  DataSettings s_;
   ModelPicture picture_;
   std::unique_ptr<ConstrainedMechanism<Spatial>> kinematics_;  // the plant's, for the tool's place in a picture
   mutable const double* bounds_of_ = nullptr;  // the trace whose run bounds are cached

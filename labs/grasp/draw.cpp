@@ -7,6 +7,7 @@
 
 #include "labs/grasp/lab.h"
 #include "labs/numbers.h"
+#include "labs/run_bounds.h"
 
 namespace dyn::grasp {
 namespace {
@@ -47,26 +48,20 @@ Eigen::AlignedBox3d runBounds(const Mechanism& mech, const Trace& tr, const Trac
   const Eigen::Vector3d pad(0.009, 0.009, 0.0);
   for (const Finger& f : p.fingers) box.extend(at(f.base) - Eigen::Vector3d(0.014, 0.022, 0)), box.extend(at(f.base) + Eigen::Vector3d(0.014, 0, 0));
   const Eigen::Vector2d h = 0.5 * p.object.size;
-  for (const Trace* t : {&tr, ghost}) {
-    if (!t || t->rows() == 0) continue;
-    const std::size_t stride = std::max<std::size_t>(1, t->rows() / 400);
-    auto add = [&](std::size_t r) {
-      const VecN q = stateAt(*t, r, mech.fingers());
-      const Eigen::Vector3d pose = q.tail(3);
-      const Eigen::Matrix2d R = rotZ(pose[0]).topLeftCorner<2, 2>();
-      for (int i = 0; i < mech.fingers(); ++i) {
-        for (const auto& pt : mech.fingerPoints(i, q)) box.extend(at(pt) - pad), box.extend(at(pt) + pad);
-        // The cone's far rim: L (n ± μ t) from the contact.
-        const Eigen::Vector2d c = mech.contactPoint(i, pose), n = mech.contactNormal(i, pose[0]);
-        const Eigen::Vector2d t(-n.y(), n.x());
-        for (const double sgn : {-1.0, 1.0}) box.extend(at(c + kConeLength * (n + sgn * p.mu * t)));
-      }
-      for (const double sx : {-1.0, 1.0})
-        for (const double sy : {-1.0, 1.0}) box.extend(at(pose.tail<2>() + R * Eigen::Vector2d(sx * h.x(), sy * h.y())));
-    };
-    for (std::size_t r = 0; r < t->rows(); r += stride) add(r);
-    add(t->rows() - 1);
-  }
+  forBoundsRows(tr, ghost, [&](const Trace& run, std::size_t r) {
+    const VecN q = stateAt(run, r, mech.fingers());
+    const Eigen::Vector3d pose = q.tail(3);
+    const Eigen::Matrix2d R = rotZ(pose[0]).topLeftCorner<2, 2>();
+    for (int i = 0; i < mech.fingers(); ++i) {
+      for (const auto& pt : mech.fingerPoints(i, q)) box.extend(at(pt) - pad), box.extend(at(pt) + pad);
+      // The cone's far rim: L (n ± μ t) from the contact.
+      const Eigen::Vector2d c = mech.contactPoint(i, pose), n = mech.contactNormal(i, pose[0]);
+      const Eigen::Vector2d t(-n.y(), n.x());
+      for (const double sgn : {-1.0, 1.0}) box.extend(at(c + kConeLength * (n + sgn * p.mu * t)));
+    }
+    for (const double sx : {-1.0, 1.0})
+      for (const double sy : {-1.0, 1.0}) box.extend(at(pose.tail<2>() + R * Eigen::Vector2d(sx * h.x(), sy * h.y())));
+  });
   return box;
 }
 

@@ -5,7 +5,6 @@
 #include <Eigen/Cholesky>
 #include <cmath>
 #include <cstdio>
-#include <map>
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
@@ -222,15 +221,25 @@ Settings parseSettings(const JsonView& c) {
   return s;
 }
 
-GraspLab::GraspLab(Settings s) : s_(std::move(s)), columns_(makeColumns(int(s_.params.fingers.size()))) {}
-
-std::string GraspLab::unit(const std::string& c) const {
-  static const std::map<std::string, std::string> units = {
+GraspLab::GraspLab(Settings s) : SettingsLab(std::move(s)) {
+  columns_ = makeColumns(fingers());
+  // The units of the object's and the whole grasp's columns; unit() adds the fingers' (q*, tau*, f*).
+  units_ = {
       {"t", "s"},      {"x_o", "m"},       {"y_o", "m"},         {"psi_o", "rad"},   {"vx_o", "m/s"},  {"vy_o", "m/s"},
       {"w_o", "rad/s"}, {"x_d", "m"},      {"y_d", "m"},         {"psi_d", "rad"},   {"cone_margin", "N"},
       {"f_int", "N"},  {"f_int_d", "N"}, {"f_int_meas", "N"}, {"squeeze", "N"},    {"energy", "J"},    {"work", "J"},
       {"constraint_residual", "m"}};
-  if (std::string u = unitIn(units, c); !u.empty()) return u;
+  agreement_units_ = {
+      {"max_dq", "rad"}, {"max_dpos", "m"}, {"max_dpsi", "rad"}, {"max_dnet_force", "N"}, {"max_df_int", "N"}};
+  // Passive (τ = 0, no joint friction) the fingers and the object fall together for 2 s, through the
+  // configuration where both fingers hang straight (t ≈ 0.35, 0.93, 1.62 s: the accelerations peak there).
+  // RK4 + projection at dt 1 ms keeps E within 2.5e-6·|E0| (1.9e-6 measured); at 0.5 ms within 1e-6, 16× less
+  // (fourth order; tests/labs/grasp_test.cpp).
+  passive_ = {2.5e-6, 2.0, {{"mechanism", {{"joint_friction", nullptr}}}}};
+}
+
+std::string GraspLab::unit(const std::string& c) const {
+  if (std::string u = SettingsLab::unit(c); !u.empty()) return u;
   if (c.size() > 1 && c[0] == 'q' && std::isdigit(static_cast<unsigned char>(c[1]))) return "rad";
   if (c.rfind("tau", 0) == 0) return "N·m";
   if (c.size() > 2 && c[0] == 'f' && std::isdigit(static_cast<unsigned char>(c[1]))) return "N";
@@ -276,8 +285,7 @@ json GraspLab::metrics(const Trace& tr) const {
           {"steps", tr.rows()},          {"settle_time", s_.settle_time}};
 }
 
-json GraspLab::agreement(const Trace& a, const Trace& b) const {
-  const std::size_t n = std::min(a.rows(), b.rows());
+json GraspLab::differences(const Trace& a, const Trace& b, std::size_t n) const {
   double dq = 0, dpos = 0, dpsi = 0, dnet = 0, dint = 0;
   const int m = fingers();
   for (std::size_t r = 0; r < n; ++r) {
@@ -293,38 +301,10 @@ json GraspLab::agreement(const Trace& a, const Trace& b) const {
     dnet = std::max(dnet, net.norm());
     dint = std::max(dint, std::abs(a.at(r, "f_int") - b.at(r, "f_int")));
   }
-  json out = {{"rows_compared", n},
-          {"max_dq", dq},
-          {"max_dpos", dpos},
-          {"max_dpsi", dpsi},
-          {"max_dnet_force", dnet},
-          {"max_df_int", dint}};
-  out.update(engineHealth(metrics(a), metrics(b)));
-  return out;
+  return {{"max_dq", dq}, {"max_dpos", dpos}, {"max_dpsi", dpsi}, {"max_dnet_force", dnet}, {"max_df_int", dint}};
 }
-
-std::string GraspLab::agreementUnit(const std::string& key) const {
-  static const std::map<std::string, std::string> units = {
-      {"max_dq", "rad"}, {"max_dpos", "m"}, {"max_dpsi", "rad"}, {"max_dnet_force", "N"}, {"max_df_int", "N"}};
-  return unitIn(units, key);
-}
-
-std::string GraspLab::referenceEngine() const {
-  Mechanism mech(s_.params);
-  VecN q, v;
-  mech.assemble(s_.pose0, Eigen::Vector3d::Zero(), q, v);
-  return bullet::BulletMechanism<Planar>(mech.model(), s_.step.dt, q, v).describe();
-}
-
-// Passive (τ = 0, no joint friction) the fingers and the object fall together for 2 s, through the
-// configuration where both fingers hang straight (t ≈ 0.35, 0.93, 1.62 s: the accelerations peak there).
-// RK4 + projection at dt 1 ms keeps E within 2.5e-6·|E0| (1.9e-6 measured); at 0.5 ms within 1e-6, 16× less
-// (fourth order; tests/labs/grasp_test.cpp).
-Lab::PassiveEnergy GraspLab::passiveEnergy() const { return {2.5e-6, 2.0, {{"mechanism", {{"joint_friction", nullptr}}}}}; }
 
 DYNLAB_REGISTER_LAB(grasp, "Multi-finger grasp: carry an object held by two fingers, squeezing just enough to stay inside every friction cone",
-                    [](const JsonView& config) -> std::unique_ptr<Lab> {
-                      return std::make_unique<GraspLab>(parseSettings(config));
-                    });
+                    labFactory<GraspLab>(parseSettings));
 
 }  // namespace dyn::grasp

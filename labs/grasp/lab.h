@@ -1,7 +1,10 @@
-// The multi-finger grasp lab: mechanism + controller + scenario from grasp.json.
+// The multi-finger grasp lab (lecture §3 "Multi-finger grasp"): two-link fingers hold an object through
+// point contacts with friction (mechanism.h), M_c α_c + G_c = Σ_i A_iᵀ f_i, each f_i inside its cone;
+// the object-level controller (controller.h) asks a wrench W of the contacts, F = G⁺ W + s d, squeezing
+// along the internal forces N(Aᵀ) just enough; the scenario from grasp.json.
 #pragma once
 #include "labs/grasp/controller.h"
-#include "labs/lab.h"
+#include "labs/settings_lab.h"
 
 namespace dyn::grasp {
 
@@ -28,28 +31,23 @@ struct Settings {
 // Reads and validates the lab JSON; throws InputError naming file and path.
 Settings parseSettings(const JsonView& config);
 
-class GraspLab final : public Lab {
+class GraspLab final : public SettingsLab<Settings> {
  public:
+  // Its tables (settings_lab.h): the trace columns and their units, the agreement's units, the passive check.
   explicit GraspLab(Settings s);
-  std::vector<std::string> columns() const override { return columns_; }
+  // The fingers' columns (q*, tau*, f*) by rule, the others from the table.
   std::string unit(const std::string& column) const override;
-  double dt() const override { return s_.step.dt; }
-  double duration() const override { return s_.duration; }
+  // The run: fingers and object assembled at pose0, the object-level controller, the push (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  int fingers() const { return int(s_.params.fingers.size()); }
+  // The grade: the object's tracking, the internal force, the friction cones' margin (lab.cpp);
+  // the loops screened (linearise.cpp).
   json metrics(const Trace& trace) const override;
-  json agreement(const Trace& hand, const Trace& bullet) const override;
-  std::string agreementUnit(const std::string& key) const override;
-  std::string referenceEngine() const override;
-  PassiveEnergy passiveEnergy() const override;
+  json differences(const Trace& hand, const Trace& bullet, std::size_t rows) const override;
+  std::vector<LinearLoop> linearise() const override;
+  // The picture: fingers, object, friction cones and contact forces (draw.cpp).
   void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
   void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
-  std::vector<LinearLoop> linearise() const override;
-  const Settings& settings() const { return s_; }
-  int fingers() const { return int(s_.params.fingers.size()); }
-
- private:
-  Settings s_;
-  std::vector<std::string> columns_;
 };
 
 }  // namespace dyn::grasp

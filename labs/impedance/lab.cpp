@@ -7,7 +7,6 @@
 
 #include <cmath>
 #include <functional>
-#include <map>
 #include <random>
 
 #include "labs/controllers/laws.h"
@@ -306,19 +305,17 @@ Settings parseSettings(const JsonView& c) {
   return s;
 }
 
-ImpedanceLab::ImpedanceLab(Settings s) : s_(std::move(s)) {}
-
-std::vector<std::string> ImpedanceLab::columns() const {
-  return {"t", "q1", "q2", "q3", "tau1", "tau2", "tau3", "x", "y", "phi", "x_ref", "y_ref", "phi_ref",
-          "x_des", "y_des", "F_ext_x", "F_ext_y", "energy", "work", "x_target", "y_target", "F_spring_x"};
-}
-
-std::string ImpedanceLab::unit(const std::string& c) const {
-  static const std::map<std::string, std::string> u = {
+ImpedanceLab::ImpedanceLab(Settings s) : SettingsLab(std::move(s)) {
+  columns_ = {"t", "q1", "q2", "q3", "tau1", "tau2", "tau3", "x", "y", "phi", "x_ref", "y_ref", "phi_ref",
+              "x_des", "y_des", "F_ext_x", "F_ext_y", "energy", "work", "x_target", "y_target", "F_spring_x"};
+  units_ = {
       {"t", "s"}, {"q1", "rad"}, {"q2", "rad"}, {"q3", "rad"}, {"tau1", "N·m"}, {"tau2", "N·m"}, {"tau3", "N·m"},
       {"x", "m"}, {"y", "m"}, {"phi", "rad"}, {"x_ref", "m"}, {"y_ref", "m"}, {"phi_ref", "rad"}, {"x_des", "m"},
       {"y_des", "m"}, {"x_target", "m"}, {"y_target", "m"}, {"F_ext_x", "N"}, {"F_ext_y", "N"}, {"F_spring_x", "N"}, {"energy", "J"}, {"work", "J"}};
-  return unitIn(u, c);
+  agreement_units_ = {{"max_dx", "m"}, {"max_dtau", "N·m"}};
+  // Passive with no push and no wall the arm falls from the reference pose and whips through fast
+  // swings (E0 ≈ 16 J): RK4 at 1 ms keeps E within 1e-5·|E0| over 1 s (measured 3e-6).
+  passive_ = {1e-5, 1.0, {{"environment", {{"force", {{"value", {0.0, 0.0}}}}, {"wall", {{"enabled", false}}}}}}};
 }
 
 namespace {
@@ -338,19 +335,11 @@ std::unique_ptr<Simulation> run(const Settings& s, Engine engine, const std::vec
 
 // The arm alone: 3 joints, no rows; with the wall: 3 joints, its one contact row (mechanism.cpp).
 std::unique_ptr<Simulation> ImpedanceLab::simulate(Engine engine) const {
-  if (s_.wall.enabled) return run<WallArm>(s_, engine, columns());
-  return run<motion_control::FixedArm<3>>(s_, engine, columns());
-}
-
-// Passive with no push and no wall the arm falls from the reference pose and whips through fast
-// swings (E0 ≈ 16 J): RK4 at 1 ms keeps E within 1e-5·|E0| over 1 s (measured 3e-6).
-Lab::PassiveEnergy ImpedanceLab::passiveEnergy() const {
-  return {1e-5, 1.0, {{"environment", {{"force", {{"value", {0.0, 0.0}}}}, {"wall", {{"enabled", false}}}}}}};
+  if (s_.wall.enabled) return run<WallArm>(s_, engine, columns_);
+  return run<motion_control::FixedArm<3>>(s_, engine, columns_);
 }
 
 DYNLAB_REGISTER_LAB(impedance, "Impedance control: make the hand feel like a given mass-spring-damper, three ways",
-                    [](const JsonView& config) -> std::unique_ptr<Lab> {
-                      return std::make_unique<ImpedanceLab>(parseSettings(config));
-                    });
+                    labFactory<ImpedanceLab>(parseSettings));
 
 }  // namespace dyn::impedance

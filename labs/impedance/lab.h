@@ -7,9 +7,9 @@
 #pragma once
 #include <Eigen/Core>
 
-#include "labs/lab.h"
 #include "labs/motion_control/controller.h"
 #include "labs/motion_control/mechanism.h"
+#include "labs/settings_lab.h"
 #include "physics/forces.h"
 
 namespace dyn::impedance {
@@ -68,28 +68,23 @@ Eigen::Vector3d tipPose(const motion_control::Params& p, const Eigen::Vector3d& 
 bool inverseKinematics(const motion_control::Params& p, const Eigen::Vector3d& x, const Eigen::Vector3d& like,
                        Eigen::Vector3d& theta);
 
-class ImpedanceLab final : public Lab {
+class ImpedanceLab final : public SettingsLab<Settings> {
  public:
+  // Its tables (settings_lab.h): the trace columns and their units, the agreement's units, the passive check.
   explicit ImpedanceLab(Settings s);
-  std::vector<std::string> columns() const override;
-  std::string unit(const std::string& column) const override;
-  double dt() const override { return s_.step.dt; }
-  double duration() const override { return s_.duration; }
+  // The run: the arm at its pose, the impedance law of the kind chosen, the push and the wall (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  // The grade: the hand against the target's response, the wall's force (metrics.cpp); the loops
+  // screened (linearise.cpp).
   json metrics(const Trace& trace) const override;
-  json agreement(const Trace& hand, const Trace& bullet) const override;
-  std::string agreementUnit(const std::string& key) const override;
-  PassiveEnergy passiveEnergy() const override;
+  json differences(const Trace& hand, const Trace& bullet, std::size_t rows) const override;
   std::vector<LinearLoop> linearise() const override;
+  // The picture: the arm, the wall, the spring glyph (draw.cpp): along the push (x̂ without one), its
+  // stretch magnified g times.
   void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
   void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
-  const Settings& settings() const { return s_; }
-  // The drawing's spring glyph: along the push (x̂ without one), its stretch magnified g times.
   Eigen::Vector2d pushDirection() const;
   double springMagnification(const Trace& tr) const;
-
- private:
-  Settings s_;
 };
 
 }  // namespace dyn::impedance

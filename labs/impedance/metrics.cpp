@@ -155,21 +155,13 @@ json ImpedanceLab::metrics(const Trace& tr) const {
   return m;
 }
 
-json ImpedanceLab::agreement(const Trace& a, const Trace& b) const {
-  const std::size_t rows = std::min(a.rows(), b.rows());
+json ImpedanceLab::differences(const Trace& a, const Trace& b, std::size_t rows) const {
   double dx = 0, dtau = 0;
   for (std::size_t r = 0; r < rows; ++r) {
     dx = std::max({dx, std::abs(a.at(r, "x") - b.at(r, "x")), std::abs(a.at(r, "y") - b.at(r, "y"))});
     for (const char* c : {"tau1", "tau2", "tau3"}) dtau = std::max(dtau, std::abs(a.at(r, c) - b.at(r, c)));
   }
-  json out = {{"rows_compared", rows}, {"max_dx", dx}, {"max_dtau", dtau}};
-  out.update(engineHealth(metrics(a), metrics(b)));
-  return out;
-}
-
-std::string ImpedanceLab::agreementUnit(const std::string& key) const {
-  static const std::map<std::string, std::string> units = {{"max_dx", "m"}, {"max_dtau", "N·m"}};
-  return unitIn(units, key);
+  return {{"max_dx", dx}, {"max_dtau", dtau}};
 }
 
 }  // namespace dyn::impedance

@@ -5,7 +5,6 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
@@ -215,22 +214,25 @@ Settings parseSettings(const JsonView& c) {
   return s;
 }
 
-MotionControlLab::MotionControlLab(Settings s) : s_(std::move(s)) {}
-
-std::vector<std::string> MotionControlLab::columns() const {
+MotionControlLab::MotionControlLab(Settings s) : SettingsLab(std::move(s)) {
   const int n = s_.plant.n();
-  std::vector<std::string> c{"t"};
+  columns_ = {"t"};
   for (const char* base : {"q", "qd", "e", "tau"})
-    for (int i = 0; i < n; ++i) c.push_back(col(base, i));
-  for (const char* x : {"tau_sat", "energy", "work", "V"}) c.push_back(x);
+    for (int i = 0; i < n; ++i) columns_.push_back(col(base, i));
+  for (const char* x : {"tau_sat", "energy", "work", "V"}) columns_.push_back(x);
   for (const char* base : {"defl", "u_i"})
-    for (int i = 0; i < n; ++i) c.push_back(col(base, i));
-  return c;
+    for (int i = 0; i < n; ++i) columns_.push_back(col(base, i));
+  // The units of the arm's own columns; unit() adds the joints' (q*, qd*, e*, defl*, tau*, u_i*).
+  units_ = {{"t", "s"}, {"energy", "J"}, {"work", "J"}, {"V", "J"}};
+  agreement_units_ = {{"max_dq", "rad"}, {"max_dtau", "N·m"}};
+  // Passive without friction (the conservative patch) the arm swings freely: RK4 keeps E within 1e-6·|E0|.
+  json zero = json::array();
+  for (int i = 0; i < n; ++i) zero.push_back({{"viscous", 0.0}, {"coulomb", 0.0}});
+  passive_ = {1e-6, 1.0, {{"mechanism", {{"friction", zero}}}}};
 }
 
 std::string MotionControlLab::unit(const std::string& c) const {
-  static const std::map<std::string, std::string> fixed = {{"t", "s"}, {"energy", "J"}, {"work", "J"}, {"V", "J"}};
-  if (const auto u = unitIn(fixed, c); !u.empty()) return u;
+  if (const auto u = SettingsLab::unit(c); !u.empty()) return u;
   for (const char* base : {"q", "qd", "e", "defl"})
     if (c.rfind(base, 0) == 0 && c.size() > std::string(base).size() && std::isdigit(c[std::string(base).size()])) return "rad";
   if (c.rfind("tau", 0) == 0 && c != "tau_sat") return "N·m";
@@ -282,40 +284,17 @@ json MotionControlLab::metrics(const Trace& tr) const {
           {"max_constraint_residual", 0.0}, {"steps", tr.rows()}};
 }
 
-json MotionControlLab::agreement(const Trace& a, const Trace& b) const {
-  const std::size_t rows = std::min(a.rows(), b.rows());
+json MotionControlLab::differences(const Trace& a, const Trace& b, std::size_t rows) const {
   double dq = 0, dtau = 0;
   for (std::size_t r = 0; r < rows; ++r)
     for (int i = 0; i < s_.plant.n(); ++i) {
       dq = std::max(dq, std::abs(a.at(r, col("q", i)) - b.at(r, col("q", i))));
       dtau = std::max(dtau, std::abs(a.at(r, col("tau", i)) - b.at(r, col("tau", i))));
     }
-  json out = {{"rows_compared", rows}, {"max_dq", dq}, {"max_dtau", dtau}};
-  out.update(engineHealth(metrics(a), metrics(b)));
-  return out;
-}
-
-std::string MotionControlLab::agreementUnit(const std::string& key) const {
-  static const std::map<std::string, std::string> units = {{"max_dq", "rad"}, {"max_dtau", "N·m"}};
-  return unitIn(units, key);
-}
-
-std::string MotionControlLab::referenceEngine() const {
-  VecN q, v;
-  treeState(s_.plant, s_.trajectory.outstretched, staticDeflection(s_.plant, s_.trajectory.outstretched), q, v);
-  return bullet::BulletMechanism<Planar>(describe(s_.plant), s_.step.dt, q, v).describe();
-}
-
-// Passive without friction (the conservative patch) the arm swings freely: RK4 keeps E within 1e-6·|E0|.
-Lab::PassiveEnergy MotionControlLab::passiveEnergy() const {
-  json zero = json::array();
-  for (int i = 0; i < s_.plant.n(); ++i) zero.push_back({{"viscous", 0.0}, {"coulomb", 0.0}});
-  return {1e-6, 1.0, {{"mechanism", {{"friction", zero}}}}};
+  return {{"max_dq", dq}, {"max_dtau", dtau}};
 }
 
 DYNLAB_REGISTER_LAB(motion_control, "Motion control: PID, computed torque and PD + gravity on an arm, rigid or with flexible joints",
-                    [](const JsonView& config) -> std::unique_ptr<Lab> {
-                      return std::make_unique<MotionControlLab>(parseSettings(config));
-                    });
+                    labFactory<MotionControlLab>(parseSettings));
 
 }  // namespace dyn::motion_control

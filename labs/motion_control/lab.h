@@ -1,9 +1,11 @@
-// The motion-control lab: the arm (mechanism.h), its controller (controller.h) and the scenario from
-// motion_control.json. Angle conventions: trace columns q*, qd*, e* are link-side relative joint
+// The motion-control lab (lecture §1, §4): an n-link planar arm, rigid or with flexible joints
+// (mechanism.h), M(θ)θ'' + C(θ, θ')θ' + G(θ) + friction = τ, moved from pose to pose by PID, computed
+// torque or PD + gravity (controller.h), e.g. τ = M̂(θ)(θ_d'' − K_p e − K_d e') + Ĉθ' + Ĝ; the scenario
+// from motion_control.json. Angle conventions: trace columns q*, qd*, e* are link-side relative joint
 // angles (flexible: θ = θm + δ; the controller itself sees the motor side θm), defl* the deflections δ.
 #pragma once
-#include "labs/lab.h"
 #include "labs/motion_control/controller.h"
+#include "labs/settings_lab.h"
 
 namespace dyn::motion_control {
 
@@ -25,26 +27,22 @@ double fastestMode(const Params& plant, const Eigen::VectorXd& theta);
 // ω dt of the fastest mode that the hand engine's sub-steps keep (RK4's phase error per step ~ (ω dt)⁴/120).
 inline constexpr double kResolvedOmegaDt = 0.05;
 
-class MotionControlLab final : public Lab {
+class MotionControlLab final : public SettingsLab<Settings> {
  public:
+  // Its tables (settings_lab.h): the trace columns and their units, the agreement's units, the passive check.
   explicit MotionControlLab(Settings s);
-  std::vector<std::string> columns() const override;
+  // The joints' columns (q*, qd*, e*, defl*, tau*, u_i*) by rule, the others from the table.
   std::string unit(const std::string& column) const override;
-  double dt() const override { return s_.step.dt; }
-  double duration() const override { return s_.duration; }
+  // The run: the arm (rigid or flexible) from the trajectory's start, its joint controller (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  // The grade: the joint errors over the move and the hold, torques, energy (lab.cpp); each joint's
+  // loop at both poses, screened (linearise.cpp).
   json metrics(const Trace& trace) const override;
-  json agreement(const Trace& hand, const Trace& bullet) const override;
-  std::string agreementUnit(const std::string& key) const override;
-  std::string referenceEngine() const override;
-  PassiveEnergy passiveEnergy() const override;
+  json differences(const Trace& hand, const Trace& bullet, std::size_t rows) const override;
+  std::vector<LinearLoop> linearise() const override;
+  // The picture: the arm and its target pose (draw.cpp).
   void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
   void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
-  std::vector<LinearLoop> linearise() const override;
-  const Settings& settings() const { return s_; }
-
- private:
-  Settings s_;
 };
 
 }  // namespace dyn::motion_control

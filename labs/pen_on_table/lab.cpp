@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <map>
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
@@ -238,7 +237,21 @@ Settings parseSettings(const JsonView& c) {
   return s;
 }
 
-PenOnTableLab::PenOnTableLab(Settings s) : s_(std::move(s)) {}
+PenOnTableLab::PenOnTableLab(Settings s) : SettingsLab(std::move(s)) {
+  columns_ = kColumns;
+  units_ = {
+      {"t", "s"},      {"q1", "rad"},   {"q2", "rad"},   {"q3", "rad"},     {"tau1", "N·m"},  {"tau2", "N·m"},
+      {"tau3", "N·m"}, {"x_p", "m"},    {"y_p", "m"},    {"z_p", "m"},      {"x_d", "m"},     {"y_d", "m"},
+      {"z_des", "m"},  {"f_z", "N"},    {"f_zd", "N"},   {"f_meas", "N"},   {"contact", "1"}, {"gap", "m"},
+      {"energy", "J"}, {"work", "J"},   {"constraint_residual", "m"}, {"f_z_5ms", "N"}};
+  agreement_units_ = {
+      {"max_dq", "rad"},          {"max_dp", "m"},           {"touchdown_hand", "s"}, {"touchdown_bullet", "s"}, {"d_touchdown", "s"},
+      {"max_df_settled", "N"},    {"mean_df_settled", "N"},  {"contact_mismatch_time", "s"}};
+  // Passive (τ = 0) under gravity the arm falls onto the table, and the plastic touchdown takes energy by
+  // design; the check's patch takes gravity out and sets the arm turning about the column instead: a free
+  // spatial arm, off the table, whose energy RK4 + projection keeps (tests/labs/pen_on_table_test.cpp).
+  passive_ = {1e-9, 0.0, {{"mechanism", {{"gravity", 0.0}}}, {"initial", {{"rates", {0.6, -0.2, 0.1}}}}}};
+}
 
 void PenOnTableLab::initialState(VecN& q, VecN& v) const {
   const Eigen::Vector3d start(s_.circle.centre.x() + s_.circle.radius, s_.circle.centre.y(), s_.params.table_height + s_.start_height);
@@ -246,17 +259,6 @@ void PenOnTableLab::initialState(VecN& q, VecN& v) const {
   inverseKinematics(s_.params, start, th);  // parseSettings checked the start is reachable
   q = th;
   v = s_.rates0;
-}
-
-std::vector<std::string> PenOnTableLab::columns() const { return kColumns; }
-
-std::string PenOnTableLab::unit(const std::string& c) const {
-  static const std::map<std::string, std::string> units = {
-      {"t", "s"},      {"q1", "rad"},   {"q2", "rad"},   {"q3", "rad"},     {"tau1", "N·m"},  {"tau2", "N·m"},
-      {"tau3", "N·m"}, {"x_p", "m"},    {"y_p", "m"},    {"z_p", "m"},      {"x_d", "m"},     {"y_d", "m"},
-      {"z_des", "m"},  {"f_z", "N"},    {"f_zd", "N"},   {"f_meas", "N"},   {"contact", "1"}, {"gap", "m"},
-      {"energy", "J"}, {"work", "J"},   {"constraint_residual", "m"}, {"f_z_5ms", "N"}};
-  return unitIn(units, c);
 }
 
 std::unique_ptr<Simulation> PenOnTableLab::simulate(Engine engine) const {
@@ -330,8 +332,7 @@ json PenOnTableLab::metrics(const Trace& tr) const {
           {"steps", n}};
 }
 
-json PenOnTableLab::agreement(const Trace& a, const Trace& b) const {
-  const std::size_t n = std::min(a.rows(), b.rows());
+json PenOnTableLab::differences(const Trace& a, const Trace& b, std::size_t n) const {
   const auto touchdown = [](const Trace& tr, std::size_t rows) {
     for (std::size_t r = 0; r < rows; ++r)
       if (tr.at(r, "contact") > 0.5) return tr.at(r, "t");
@@ -352,43 +353,17 @@ json PenOnTableLab::agreement(const Trace& a, const Trace& b) const {
       df = std::max(df, d), df_sum += d, ++compared;
     }
   }
-  json out = {{"rows_compared", n},
-              {"max_dq", dq},
-              {"max_dp", dp},
-              {"touchdown_hand", ta},
-              {"touchdown_bullet", tb},
-              {"d_touchdown", std::abs(ta - tb)},
-              {"max_df_settled", df},
-              {"mean_df_settled", compared ? df_sum / double(compared) : 0.0},
-              {"contact_mismatch_time", mismatch}};
-  out.update(engineHealth(metrics(a), metrics(b)));
-  return out;
-}
-
-std::string PenOnTableLab::agreementUnit(const std::string& key) const {
-  static const std::map<std::string, std::string> units = {
-      {"max_dq", "rad"},          {"max_dp", "m"},           {"touchdown_hand", "s"}, {"touchdown_bullet", "s"}, {"d_touchdown", "s"},
-      {"max_df_settled", "N"},    {"mean_df_settled", "N"},  {"contact_mismatch_time", "s"}};
-  return unitIn(units, key);
-}
-
-std::string PenOnTableLab::referenceEngine() const {
-  Mechanism mech(s_.params);
-  VecN q, v;
-  initialState(q, v);
-  return bullet::BulletMechanism<Spatial>(mech.model(), s_.step.dt, q, v).describe();
-}
-
-// Passive (τ = 0) under gravity the arm falls onto the table, and the plastic touchdown takes energy by
-// design; the check's patch takes gravity out and sets the arm turning about the column instead: a free
-// spatial arm, off the table, whose energy RK4 + projection keeps (tests/labs/pen_on_table_test.cpp).
-Lab::PassiveEnergy PenOnTableLab::passiveEnergy() const {
-  return {1e-9, 0.0, {{"mechanism", {{"gravity", 0.0}}}, {"initial", {{"rates", {0.6, -0.2, 0.1}}}}}};
+  return {{"max_dq", dq},
+          {"max_dp", dp},
+          {"touchdown_hand", ta},
+          {"touchdown_bullet", tb},
+          {"d_touchdown", std::abs(ta - tb)},
+          {"max_df_settled", df},
+          {"mean_df_settled", compared ? df_sum / double(compared) : 0.0},
+          {"contact_mismatch_time", mismatch}};
 }
 
 DYNLAB_REGISTER_LAB(pen_on_table, "Pen on table: draw a circle while pressing with a set force (position accommodation, a unilateral contact)",
-                    [](const JsonView& config) -> std::unique_ptr<Lab> {
-                      return std::make_unique<PenOnTableLab>(parseSettings(config));
-                    });
+                    labFactory<PenOnTableLab>(parseSettings));
 
 }  // namespace dyn::pen_on_table

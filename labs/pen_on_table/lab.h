@@ -1,7 +1,11 @@
-// The pen-on-table lab: the arm, the table and the accommodation controller from pen_on_table.json.
+// The pen-on-table lab (lecture §3 "Pen on table"): a spatial 3-DOF arm whose pen tip touches a table
+// under a unilateral contact, gap ≥ 0 and η ≥ 0 (mechanism.h), drawing a circle while pressing f_zd
+// by position accommodation (controller.h): an inner task-space position loop, an outer force law on z_des
+//   damper  ż_des = −(f_meas − f_zd) / D_z,   spring  z_des = z_ref − (f_meas − f_zd) / K_z
+// with the scenario from pen_on_table.json.
 #pragma once
-#include "labs/lab.h"
 #include "labs/pen_on_table/controller.h"
+#include "labs/settings_lab.h"
 
 namespace dyn::pen_on_table {
 
@@ -21,30 +25,24 @@ struct Settings {
 // Reads and validates the lab JSON; throws InputError naming file and path.
 Settings parseSettings(const JsonView& config);
 
-class PenOnTableLab final : public Lab {
+class PenOnTableLab final : public SettingsLab<Settings> {
  public:
+  // Its tables (settings_lab.h): the trace columns and their units, the agreement's units, the passive check.
   explicit PenOnTableLab(Settings s);
-  std::vector<std::string> columns() const override;
-  std::string unit(const std::string& column) const override;
-  double dt() const override { return s_.step.dt; }
-  double duration() const override { return s_.duration; }
+  // The run: the tip start_height above the circle's first point, the accommodation controller (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
-  json metrics(const Trace& trace) const override;
-  json agreement(const Trace& hand, const Trace& bullet) const override;
-  std::string agreementUnit(const std::string& key) const override;
-  std::string referenceEngine() const override;
-  PassiveEnergy passiveEnergy() const override;
-  void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
-  void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
-  std::vector<LinearLoop> linearise() const override;
-  const Settings& settings() const { return s_; }
   // The initial state: at rest (or at rates0), the tip start_height above the circle's first point.
   void initialState(VecN& q, VecN& v) const;
+  // The grade: the force's overshoot and RMS from touchdown, the circle's error, lift-offs (lab.cpp);
+  // the loops screened (linearise.cpp).
+  json metrics(const Trace& trace) const override;
+  json differences(const Trace& hand, const Trace& bullet, std::size_t rows) const override;
+  std::vector<LinearLoop> linearise() const override;
   // When the circle runs at full speed (t_s + T_r).
   double drawingStart() const { return s_.circle.start + std::max(s_.circle.ramp, 0.0); }
-
- private:
-  Settings s_;
+  // The picture: the arm, the table, the pen's force (draw.cpp).
+  void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
+  void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
 };
 
 }  // namespace dyn::pen_on_table

@@ -7,6 +7,7 @@
 
 #include "labs/slider_crank/lab.h"
 #include "labs/numbers.h"
+#include "labs/run_bounds.h"
 
 namespace dyn::slider_crank {
 namespace {
@@ -31,20 +32,13 @@ Eigen::Vector3d thetaAt(const Trace& tr, std::size_t r) { return {tr.at(r, "q1")
 Eigen::AlignedBox3d runBounds(const Mechanism& mech, const Trace& tr, const Trace* ghost, double arrow_scale) {
   Eigen::AlignedBox3d box;
   const Eigen::Vector3d pad(0.03, 0.03, 0.03);
-  for (const Trace* t : {&tr, ghost}) {
-    if (!t || t->rows() == 0) continue;
-    const std::size_t stride = std::max<std::size_t>(1, t->rows() / 400);
-    const int fx = t->column("f_Tx"), fy = t->column("f_Ty"), xc = t->column("x_c");
-    auto add = [&](std::size_t r) {
-      for (const auto& p : mech.jointPoints(thetaAt(*t, r))) box.extend(at(p) - pad), box.extend(at(p) + pad);
-      Eigen::Vector3d f(t->at(r, fx), t->at(r, fy), 0);
-      f *= arrow_scale;
-      if (f.norm() > 0.25) f *= 0.25 / f.norm();
-      box.extend(Eigen::Vector3d(t->at(r, xc), 0, 0) + f);
-    };
-    for (std::size_t r = 0; r < t->rows(); r += stride) add(r);
-    add(t->rows() - 1);
-  }
+  forBoundsRows(tr, ghost, [&](const Trace& run, std::size_t r) {
+    for (const auto& p : mech.jointPoints(thetaAt(run, r))) box.extend(at(p) - pad), box.extend(at(p) + pad);
+    Eigen::Vector3d f(run.at(r, "f_Tx"), run.at(r, "f_Ty"), 0);
+    f *= arrow_scale;
+    if (f.norm() > 0.25) f *= 0.25 / f.norm();
+    box.extend(Eigen::Vector3d(run.at(r, "x_c"), 0, 0) + f);
+  });
   return box;
 }
 

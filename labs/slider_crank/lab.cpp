@@ -3,7 +3,6 @@
 #include "labs/slider_crank/lab.h"
 
 #include <cmath>
-#include <map>
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
@@ -138,18 +137,17 @@ Settings parseSettings(const JsonView& c) {
   return s;
 }
 
-SliderCrankLab::SliderCrankLab(Settings s) : s_(std::move(s)) {}
-
-std::vector<std::string> SliderCrankLab::columns() const { return kColumns; }
-
-std::string SliderCrankLab::unit(const std::string& c) const {
-  static const std::map<std::string, std::string> units = {
+SliderCrankLab::SliderCrankLab(Settings s) : SettingsLab(std::move(s)) {
+  columns_ = kColumns;
+  units_ = {
       {"t", "s"},       {"q1", "rad"},   {"q2", "rad"},   {"q3", "rad"},    {"x_c", "m"},
       {"v_c", "m/s"},   {"f_Tx", "N"},   {"f_Ty", "N"},   {"tau_T", "N·m"}, {"tau1", "N·m"},
       {"tau2", "N·m"},  {"tau3", "N·m"}, {"energy", "J"}, {"x_d", "m"},     {"f_des", "N"},
       {"f_meas", "N"},  {"work", "J"},
       {"constraint_residual", "m, rad"}};  // |φ|∞ over (θ1+θ2+θ3, x_T − x_c, y_T)
-  return unitIn(units, c);
+  agreement_units_ = {{"max_dq", "rad"}, {"max_dx_c", "m"}, {"max_df", "N"}, {"max_dtau_T", "N·m"}};
+  // Passive (τ = 0) the arm falls through its whole range; RK4 + projection keeps E within 1e-6·|E0|.
+  passive_ = {1e-6, 0};
 }
 
 std::unique_ptr<Simulation> SliderCrankLab::simulate(Engine engine) const {
@@ -184,8 +182,7 @@ json SliderCrankLab::metrics(const Trace& tr) const {
           {"steps", tr.rows()},        {"settle_time", s_.settle_time}};
 }
 
-json SliderCrankLab::agreement(const Trace& a, const Trace& b) const {
-  const std::size_t n = std::min(a.rows(), b.rows());
+json SliderCrankLab::differences(const Trace& a, const Trace& b, std::size_t n) const {
   double dq = 0, dx = 0, df = 0, dtau_T = 0;
   for (std::size_t r = 0; r < n; ++r) {
     for (const char* c : {"q1", "q2", "q3"}) dq = std::max(dq, std::abs(a.at(r, c) - b.at(r, c)));
@@ -193,35 +190,10 @@ json SliderCrankLab::agreement(const Trace& a, const Trace& b) const {
     for (const char* c : {"f_Tx", "f_Ty"}) df = std::max(df, std::abs(a.at(r, c) - b.at(r, c)));
     dtau_T = std::max(dtau_T, std::abs(a.at(r, "tau_T") - b.at(r, "tau_T")));
   }
-  json out = {{"rows_compared", n},
-          {"max_dq", dq},
-          {"max_dx_c", dx},
-          {"max_df", df},
-          {"max_dtau_T", dtau_T}};
-  out.update(engineHealth(metrics(a), metrics(b)));
-  return out;
+  return {{"max_dq", dq}, {"max_dx_c", dx}, {"max_df", df}, {"max_dtau_T", dtau_T}};
 }
-
-std::string SliderCrankLab::agreementUnit(const std::string& key) const {
-  static const std::map<std::string, std::string> units = {
-      {"max_dq", "rad"}, {"max_dx_c", "m"}, {"max_df", "N"}, {"max_dtau_T", "N·m"}};
-  return unitIn(units, key);
-}
-
-std::string SliderCrankLab::referenceEngine() const {
-  // How the builder models this description (the tree it grew, where it cut, the solver's effort).
-  Mechanism mech(s_.params);
-  VecN q, v;
-  mech.initialState(s_.theta1, s_.theta1_rate, s_.branch, q, v);
-  return bullet::BulletMechanism<Planar>(mech.model(), s_.step.dt, q, v).describe();
-}
-
-// Passive (τ = 0) the arm falls through its whole range; RK4 + projection keeps E within 1e-6·|E0|.
-Lab::PassiveEnergy SliderCrankLab::passiveEnergy() const { return {1e-6, 0}; }
 
 DYNLAB_REGISTER_LAB(slider_crank, "Slider crank: move the slider along x_d(t) while regulating its rail force (direct force control on a closed chain)",
-                    [](const JsonView& config) -> std::unique_ptr<Lab> {
-                      return std::make_unique<SliderCrankLab>(parseSettings(config));
-                    });
+                    labFactory<SliderCrankLab>(parseSettings));
 
 }  // namespace dyn::slider_crank

@@ -1,6 +1,9 @@
-// The slider-crank lab: mechanism + controller + scenario from slider_crank.json.
+// The slider-crank lab (lecture §3, closed-chain force control): the arm's tip welded to a slider on a
+// rail (mechanism.h), φ(q) = (θ1+θ2+θ3, x_T − x_c, y_T) = 0, driven by direct force control
+//   τ = G(θ) + Jᵀ A u + Jᵀ (0, 0, ξ),   u on x_c − x_d,   ξ on the measured rail force f_Ty (controller.h)
+// with the scenario from slider_crank.json.
 #pragma once
-#include "labs/lab.h"
+#include "labs/settings_lab.h"
 #include "labs/slider_crank/controller.h"
 
 namespace dyn::slider_crank {
@@ -23,26 +26,19 @@ Params controllerModel(const Params& plant);
 // Reads and validates the lab JSON; throws InputError naming file and path.
 Settings parseSettings(const JsonView& config);
 
-class SliderCrankLab final : public Lab {
+class SliderCrankLab final : public SettingsLab<Settings> {
  public:
+  // Its tables (settings_lab.h): the trace columns and their units, the agreement's units, the passive check.
   explicit SliderCrankLab(Settings s);
-  std::vector<std::string> columns() const override;
-  std::string unit(const std::string& column) const override;
-  double dt() const override { return s_.step.dt; }
-  double duration() const override { return s_.duration; }
+  // The run: the arm and slider assembled at θ1 on their branch, the force controller (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  // The grade: x and f_Ty tracking, energy and residual (lab.cpp); the loops screened (linearise.cpp).
   json metrics(const Trace& trace) const override;
-  json agreement(const Trace& hand, const Trace& bullet) const override;
-  std::string agreementUnit(const std::string& key) const override;
-  std::string referenceEngine() const override;
-  PassiveEnergy passiveEnergy() const override;
+  json differences(const Trace& hand, const Trace& bullet, std::size_t rows) const override;
+  std::vector<LinearLoop> linearise() const override;
+  // The picture: the arm, the rail, the rail force's arrow (draw.cpp).
   void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
   void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
-  std::vector<LinearLoop> linearise() const override;
-  const Settings& settings() const { return s_; }
-
- private:
-  Settings s_;
 };
 
 }  // namespace dyn::slider_crank

@@ -4,7 +4,6 @@
 #include "labs/unicycle/lab.h"
 
 #include <cmath>
-#include <map>
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
@@ -168,19 +167,22 @@ Settings parseSettings(const JsonView& c) {
   return s;
 }
 
-UnicycleLab::UnicycleLab(Settings s) : s_(std::move(s)), path_(s_.reference.points) {}
-
-std::vector<std::string> UnicycleLab::columns() const { return kColumns; }
-
-std::string UnicycleLab::unit(const std::string& c) const {
-  static const std::map<std::string, std::string> units = {
+UnicycleLab::UnicycleLab(Settings s) : SettingsLab(std::move(s)), path_(s_.reference.points) {
+  columns_ = kColumns;
+  units_ = {
       {"t", "s"},          {"x", "m"},           {"y", "m"},           {"phi", "rad"},         {"theta", "rad"},
       {"phi_rate", "rad/s"}, {"theta_rate", "rad/s"}, {"tau_drive", "N·m"}, {"tau_steer", "N·m"}, {"f_long", "N"},
       {"f_lat", "N"},      {"f_normal", "N"},    {"skid_margin", "N"}, {"slip", "m/s"},        {"x_d", "m"},
       {"y_d", "m"},        {"phi_d", "rad"},     {"v_d", "m/s"},       {"speed", "m/s"},       {"speed_meas", "m/s"},
       {"cross_track", "m"}, {"s_d", "m"},        {"energy", "J"},      {"work", "J"},          {"constraint_residual", "m/s"},
       {"x_fric", "m"},     {"y_fric", "m"},      {"phi_fric", "rad"},  {"slip_fric", "m/s"},   {"f_lat_fric", "N"}};
-  return unitIn(units, c);
+  agreement_units_ = {
+      {"max_dpos", "m"},       {"max_dphi", "rad"},         {"max_dtheta_rate", "rad/s"}, {"max_df_lat", "N"},
+      {"max_df_normal", "N"},  {"bullet_max_slip", "m/s"}, {"friction_max_slip", "m/s"}, {"friction_max_dpos", "m"}};
+  // Passive (τ = 0) the wheel rolls on at its initial rates; with none it stands still, so the check's
+  // patch gives it some: a circle of radius r θ'/φ'. The rolling rows do no work: E stays put to RK4's
+  // accuracy (tests/labs/unicycle_test.cpp measures it).
+  passive_ = {1e-9, 0.0, {{"initial", {{"theta_rate", 20.0}, {"phi_rate", 1.5}}}}};
 }
 
 std::unique_ptr<Simulation> UnicycleLab::simulate(Engine engine) const {
@@ -214,8 +216,7 @@ json UnicycleLab::metrics(const Trace& tr) const {
           {"max_constraint_residual", residual}, {"steps", tr.rows()}};
 }
 
-json UnicycleLab::agreement(const Trace& a, const Trace& b) const {
-  const std::size_t n = std::min(a.rows(), b.rows());
+json UnicycleLab::differences(const Trace& a, const Trace& b, std::size_t n) const {
   double dpos = 0, dphi = 0, drate = 0, dlat = 0, dnormal = 0, slip = 0, slip_fric = 0, dpos_fric = 0;
   for (std::size_t r = 0; r < n; ++r) {
     dpos = std::max(dpos, std::hypot(a.at(r, "x") - b.at(r, "x"), a.at(r, "y") - b.at(r, "y")));
@@ -227,37 +228,12 @@ json UnicycleLab::agreement(const Trace& a, const Trace& b) const {
     slip_fric = std::max(slip_fric, b.at(r, "slip_fric"));
     dpos_fric = std::max(dpos_fric, std::hypot(a.at(r, "x") - b.at(r, "x_fric"), a.at(r, "y") - b.at(r, "y_fric")));
   }
-  json out = {{"rows_compared", n},     {"max_dpos", dpos},           {"max_dphi", dphi},
-              {"max_dtheta_rate", drate}, {"max_df_lat", dlat},        {"max_df_normal", dnormal},
-              {"bullet_max_slip", slip}, {"friction_max_slip", slip_fric}, {"friction_max_dpos", dpos_fric}};
-  out.update(engineHealth(metrics(a), metrics(b)));
-  return out;
-}
-
-std::string UnicycleLab::agreementUnit(const std::string& key) const {
-  static const std::map<std::string, std::string> units = {
-      {"max_dpos", "m"},       {"max_dphi", "rad"},         {"max_dtheta_rate", "rad/s"}, {"max_df_lat", "N"},
-      {"max_df_normal", "N"},  {"bullet_max_slip", "m/s"}, {"friction_max_slip", "m/s"}, {"friction_max_dpos", "m"}};
-  return unitIn(units, key);
-}
-
-std::string UnicycleLab::referenceEngine() const {
-  Mechanism mech(s_.params);
-  VecN q, v;
-  mech.state(s_.x0, s_.y0, s_.phi0, 0.0, s_.phi_rate0, s_.theta_rate0, q, v);
-  return bullet::BulletMechanism<Spatial>(mech.model(), s_.step.dt, q, v).describe();
-}
-
-// Passive (τ = 0) the wheel rolls on at its initial rates; with none it stands still, so the check's
-// patch gives it some: a circle of radius r θ'/φ'. The rolling rows do no work: E stays put to RK4's
-// accuracy (tests/labs/unicycle_test.cpp measures it).
-Lab::PassiveEnergy UnicycleLab::passiveEnergy() const {
-  return {1e-9, 0.0, {{"initial", {{"theta_rate", 20.0}, {"phi_rate", 1.5}}}}};
+  return {{"max_dpos", dpos},        {"max_dphi", dphi},              {"max_dtheta_rate", drate},
+          {"max_df_lat", dlat},      {"max_df_normal", dnormal},      {"bullet_max_slip", slip},
+          {"friction_max_slip", slip_fric}, {"friction_max_dpos", dpos_fric}};
 }
 
 DYNLAB_REGISTER_LAB(unicycle, "Rolling unicycle: drive a wheel along a path without skidding (a nonholonomic constraint)",
-                    [](const JsonView& config) -> std::unique_ptr<Lab> {
-                      return std::make_unique<UnicycleLab>(parseSettings(config));
-                    });
+                    labFactory<UnicycleLab>(parseSettings));
 
 }  // namespace dyn::unicycle

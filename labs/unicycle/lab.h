@@ -1,6 +1,9 @@
-// The rolling-unicycle lab: mechanism + controller + path from unicycle.json.
+// The rolling-unicycle lab (lecture §3 "Unicycle"): a disk wheel under the rolling constraint (no slip,
+// no tilt: mechanism.h), whose reduced dynamics decouple into one loop per torque
+//   (I_a + m r²) θ'' = τ_y,   I_z φ'' = τ_z      (controller.h: PI on the spin rate, PD on the heading)
+// following the path from unicycle.json.
 #pragma once
-#include "labs/lab.h"
+#include "labs/settings_lab.h"
 #include "labs/unicycle/controller.h"
 
 namespace dyn::unicycle {
@@ -18,27 +21,23 @@ struct Settings {
 // Reads and validates the lab JSON; throws InputError naming file and path.
 Settings parseSettings(const JsonView& config);
 
-class UnicycleLab final : public Lab {
+class UnicycleLab final : public SettingsLab<Settings> {
  public:
+  // Its tables (settings_lab.h): the trace columns and their units, the agreement's units, the passive check.
   explicit UnicycleLab(Settings s);
-  std::vector<std::string> columns() const override;
-  std::string unit(const std::string& column) const override;
-  double dt() const override { return s_.step.dt; }
-  double duration() const override { return s_.duration; }
+  // The run: the wheel rolling from its start pose, the path follower; Bullet also drives its
+  // friction-contact wheel, which can skid (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  const Path& path() const { return path_; }
+  // The grade: cross-track, speed, skid margin, energy and residual (lab.cpp); the loops screened (linearise.cpp).
   json metrics(const Trace& trace) const override;
-  json agreement(const Trace& hand, const Trace& bullet) const override;
-  std::string agreementUnit(const std::string& key) const override;
-  std::string referenceEngine() const override;
-  PassiveEnergy passiveEnergy() const override;
+  json differences(const Trace& hand, const Trace& bullet, std::size_t rows) const override;
+  std::vector<LinearLoop> linearise() const override;
+  // The picture: the wheel, its path, the contact force (draw.cpp).
   void scene(const Trace& trace, std::size_t row, const Trace* ghost, Scene& out) const override;
   void overlay(const Trace& trace, std::size_t row, Overlay& out) const override;
-  std::vector<LinearLoop> linearise() const override;
-  const Settings& settings() const { return s_; }
-  const Path& path() const { return path_; }
 
  private:
-  Settings s_;
   Path path_;
 };
 
