@@ -111,6 +111,14 @@ std::string RowWatch::budget(long steps) const {
   return "stopped: the run exceeded its step budget of " + std::to_string(max_steps_) + " steps";
 }
 
+json engineSummary(const Lab& lab, const WatchedRun& run) {
+  const bool complete = run.failure.empty();
+  json e = {{"status", complete ? "ok" : run.failure}, {"complete", complete}, {"trace_hash", run.trace.hash()}};
+  if (complete) e["metrics"] = lab.metrics(run.trace);
+  else e["stopped_at"] = run.failure_time;
+  return e;
+}
+
 WatchedRun runWatched(const Lab& lab, Engine engine, const Watchdog& wd, Deadline deadline,
                       const std::string& config_file, const StopRequest& stop_request) {
   WatchedRun out;

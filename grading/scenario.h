@@ -67,6 +67,11 @@ struct WatchedRun {
 WatchedRun runWatched(const Lab& lab, Engine engine, const Watchdog& watchdog, Deadline deadline,
                       const std::string& config_file, const StopRequest& stop = {});
 
+// One engine's entry of a run's summary (`dynlab run`, Python's Lab.run): its status, whether it ran
+// to its end, its trace's hash, and the lab's metrics only when it did (numbers over part of a run
+// read as if they described all of it); a stopped run says when it stopped.
+json engineSummary(const Lab& lab, const WatchedRun& run);
+
 // Runs the lab's hand-written engine under the watchdog; throws InputError (naming config_file)
 // if a watchdog limit names a column the lab does not have.
 ScenarioRun runScenario(const Lab& lab, const Watchdog& watchdog, Deadline deadline,

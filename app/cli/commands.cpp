@@ -158,17 +158,10 @@ int runLab(const RunArgs& a) {
     for (auto* r : {&hand, &bullet}) {
       if (!*r) continue;
       const char* engine = r == &hand ? "hand" : "bullet";
-      const bool complete = (*r)->failure.empty();
       staging.write(std::string("trace_") + engine + ".csv", (*r)->trace.csv());
-      // A stopped run's trace is kept (it shows the blow-up) but its metrics are omitted: numbers
-      // over part of a run read as if they described all of it.
-      json& e = summary["engines"][engine];
-      e = {{"status", complete ? "ok" : (*r)->failure}, {"complete", complete}, {"trace_hash", (*r)->trace.hash()}};
-      if (complete) e["metrics"] = lab.metrics((*r)->trace);
-      else {
-        e["stopped_at"] = (*r)->failure_time;
-        status += (status.empty() ? "" : "; ") + std::string(engine) + ": " + (*r)->failure;
-      }
+      // A stopped run's trace is kept (it shows the blow-up) but its metrics are omitted (engineSummary).
+      summary["engines"][engine] = engineSummary(lab, **r);
+      if (!(*r)->failure.empty()) status += (status.empty() ? "" : "; ") + std::string(engine) + ": " + (*r)->failure;
     }
     if (status.empty()) status = "ok";
     if (hand && bullet && hand->failure.empty() && bullet->failure.empty())

@@ -142,14 +142,8 @@ py::dict LabObject::run(const std::string& engine, std::optional<double> duratio
   for (auto* r : {&hand, &bullet}) {
     if (!*r) continue;
     const char* e = r == &hand ? "hand" : "bullet";
-    const bool complete = (*r)->failure.empty();
-    json& s = summary["engines"][e];
-    s = {{"status", complete ? "ok" : (*r)->failure}, {"complete", complete}, {"trace_hash", (*r)->trace.hash()}};
-    if (complete) s["metrics"] = lab.metrics((*r)->trace);
-    else {
-      s["stopped_at"] = (*r)->failure_time;
-      status += (status.empty() ? "" : "; ") + std::string(e) + ": " + (*r)->failure;
-    }
+    summary["engines"][e] = engineSummary(lab, **r);
+    if (!(*r)->failure.empty()) status += (status.empty() ? "" : "; ") + std::string(e) + ": " + (*r)->failure;
     traces[e] = traceArrays((*r)->trace);
   }
   if (hand && bullet && hand->failure.empty() && bullet->failure.empty()) summary["agreement"] = lab.agreement(hand->trace, bullet->trace);

@@ -145,30 +145,24 @@ GradeOutcome graded(Step& s, const std::string& file, const GradeOptions& o) {
 }
 
 // The default config builds and its simulation block parses.
-void checkConfig(const Checked& c, LabCheckReport& report) {
-  const LabEntry& entry = c.entry;
-  const json& config = c.config;
-  const std::string& shown = c.shown;
+void checkConfig(const Checked& chk, LabCheckReport& report) {
   run(report, "config", [&](Step& s) {
-    buildLab(entry, config, shown);
-    parseSimulation(JsonView(config, shown)["simulation"]);
+    buildLab(chk.entry, chk.config, chk.shown);
+    parseSimulation(JsonView(chk.config, chk.shown)["simulation"]);
     s.detail = "builds; the simulation block parses";
   });
 }
 
 // The examples (and the instructor's answers) apply strictly and match the submission schema.
-void checkExamples(const Checked& c, LabCheckReport& report) {
-  const json& config = c.config;
-  const std::vector<std::string>& examples = c.examples;
-  const std::string& name = c.entry.name;
+void checkExamples(const Checked& chk, LabCheckReport& report) {
   run(report, "examples", [&](Step& s) {
-    s.expect(!examples.empty(), "no example submission (labs/" + name + "/examples/*.json)");
-    const json schema = submissionSchema(config, name);
+    s.expect(!chk.examples.empty(), "no example submission (labs/" + chk.entry.name + "/chk.examples/*.json)");
+    const json schema = submissionSchema(chk.config, chk.entry.name);
     const json& props = schema.at("properties");
-    for (const std::string& file : examples) {
+    for (const std::string& file : chk.examples) {
       const json sub = loadJsonFile(file);
       try {
-        applySubmission(config, JsonView(sub, file), name, true);
+        applySubmission(chk.config, JsonView(sub, file), chk.entry.name, true);
       } catch (const std::exception& e) {
         s.fail(e.what());
       }
@@ -184,18 +178,15 @@ void checkExamples(const Checked& c, LabCheckReport& report) {
       for (const auto& required : schema.at("required"))
         s.expect(sub.contains(required.get<std::string>()), fileName(file) + ": lacks \"" + required.get<std::string>() + "\"");
     }
-    s.detail = std::to_string(examples.size()) + " files apply strictly and match the submission schema";
+    s.detail = std::to_string(chk.examples.size()) + " files apply strictly and match the submission schema";
   });
 }
 
 // Both engines run; drift "independent" runs or is refused where it is read; the passive energy holds.
-void checkPhysics(const Checked& c, LabCheckReport& report) {
-  const LabEntry& entry = c.entry;
-  const json& config = c.config;
-  const std::string& shown = c.shown;
-  const std::string passive_name = c.shown + " (passive: τ = 0)";
+void checkPhysics(const Checked& chk, LabCheckReport& report) {
+  const std::string passive_name = chk.shown + " (passive: τ = 0)";
   run(report, "engines", [&](Step& s) {
-    const auto lab = buildLab(entry, config, shown);
+    const auto lab = buildLab(chk.entry, chk.config, chk.shown);
     const long expected = std::min(200L, std::lround(lab->duration() / lab->dt()));
     for (const Engine e : {Engine::Hand, Engine::Bullet}) {
       const RunResult r = runEngine(*lab, e, 200);
@@ -208,19 +199,19 @@ void checkPhysics(const Checked& c, LabCheckReport& report) {
     s.detail = "hand and Bullet: " + std::to_string(expected) + " steps, finite";
   });
 
-  // The shared options a lab cannot honour are refused when its config is read, naming the option,
+  // The shared options a lab cannot honour are refused when its chk.config is read, naming the option,
   // not at t = 0: drift "independent" either runs on φ = 0 or is an InputError at /simulation/drift.
   run(report, "drift independent", [&](Step& s) {
-    json c = config;
+    json c = chk.config;
     c["simulation"]["drift"] = "independent";
     std::unique_ptr<Lab> lab;
     try {
-      lab = buildLab(entry, c, shown);
+      lab = buildLab(chk.entry, c, chk.shown);
     } catch (const InputError& e) {
       s.expect(e.path() == "/simulation/drift", "refused at " + e.path() + ", not at /simulation/drift");
       s.expect(e.expected().find("independent-coordinate form") != std::string::npos,
                "the refusal does not say \"independent-coordinate form\": " + e.expected());
-      s.detail = "refused when the config is read, at /simulation/drift";
+      s.detail = "refused when the chk.config is read, at /simulation/drift";
       return;
     }
     const RunResult r = runEngine(*lab, Engine::Hand, 50);
@@ -230,11 +221,11 @@ void checkPhysics(const Checked& c, LabCheckReport& report) {
   });
 
   run(report, "passive energy", [&](Step& s) {
-    json passive = mergePatch(config, passivePatch());
-    const Lab::PassiveEnergy stated = buildLab(entry, passive, passive_name)->passiveEnergy();
+    json passive = mergePatch(chk.config, passivePatch());
+    const Lab::PassiveEnergy stated = buildLab(chk.entry, passive, passive_name)->passiveEnergy();
     passive = mergePatch(passive, stated.conservative);
     if (stated.duration > 0) setRunDuration(passive, stated.duration);
-    const auto lab = buildLab(entry, passive, passive_name);
+    const auto lab = buildLab(chk.entry, passive, passive_name);
     const RunResult r = runEngine(*lab, Engine::Hand);
     s.expect(r.failure.empty(), r.failure);
     if (!s.expect(r.trace.rows() > 1, "the passive run has fewer than 2 rows")) return;
@@ -253,17 +244,9 @@ void checkPhysics(const Checked& c, LabCheckReport& report) {
 }
 
 // A frame renders; the command line runs the lab; the README's measured numbers agree with that run.
-void checkOutputs(const Checked& c, LabCheckReport& report) {
-  const LabEntry& entry = c.entry;
-  const json& config = c.config;
-  const LabCheckOptions& options = c.options;
-  const fs::path& dir = c.dir;
-  const std::string& shown = c.shown;
-  const std::string& lab_dir = c.lab_dir;
-  const std::vector<std::string>& examples = c.examples;
-  const std::string& name = c.entry.name;
+void checkOutputs(const Checked& chk, LabCheckReport& report) {
   run(report, "render", [&](Step& s) {
-      const auto lab = buildLab(entry, config, shown);
+      const auto lab = buildLab(chk.entry, chk.config, chk.shown);
       const RunResult r = runEngine(*lab, Engine::Hand, 50);
       if (!s.expect(r.trace.rows() > 0, "no trace row to draw")) return;
       Scene scene;
@@ -286,30 +269,30 @@ void checkOutputs(const Checked& c, LabCheckReport& report) {
       s.detail = "320x240 frames, pixels unlike the background: " + counts;
     });
 
-  if (!options.dynlab_binary.empty())
+  if (!chk.options.dynlab_binary.empty())
     run(report, "cli", [&](Step& s) {
-      const auto lab = buildLab(entry, config, shown);
+      const auto lab = buildLab(chk.entry, chk.config, chk.shown);
       const std::vector<std::string> columns = lab->columns();
       if (!s.expect(columns.size() >= 3, "fewer than 3 trace columns")) return;
-      const std::string& bin = options.dynlab_binary;
+      const std::string& bin = chk.options.dynlab_binary;
       const std::string plot = columns[1] + "," + columns[2];
-      auto [code, err] = runDynlab(dir, bin, {"figure", name, "--plot", plot, "--duration", "0.2", "--format", "png", "--out", "figures"});
+      auto [code, err] = runDynlab(chk.dir, bin, {"figure", chk.entry.name, "--plot", plot, "--duration", "0.2", "--format", "png", "--out", "figures"});
       s.expect(code == 0, "dynlab figure exit " + std::to_string(code) + ": " + err);
-      s.expect(fs::exists(dir / "figures" / ("plot_" + columns[1] + "+" + columns[2] + ".png")), "dynlab figure wrote no plot");
-      // What scripts/demo runs: the default config, both engines, its whole duration, under the
+      s.expect(fs::exists(chk.dir / "figures" / ("plot_" + columns[1] + "+" + columns[2] + ".png")), "dynlab figure wrote no plot");
+      // What scripts/demo runs: the default chk.config, both engines, its whole duration, under the
       // rubric's watchdog (which both engines must pass with the shipped gains).
-      std::tie(code, err) = runDynlab(dir, bin, {"run", name, "--out", "run"});
+      std::tie(code, err) = runDynlab(chk.dir, bin, {"run", chk.entry.name, "--out", "run"});
       s.expect(code == 0, "dynlab run exit " + std::to_string(code) + ": " + err);
-      if (!s.expect(!examples.empty(), "no example to grade")) return;
-      std::tie(code, err) = runDynlab(dir, bin, {"grade", examples.front(), "--out", "grade"});
+      if (!s.expect(!chk.examples.empty(), "no example to grade")) return;
+      std::tie(code, err) = runDynlab(chk.dir, bin, {"grade", chk.examples.front(), "--out", "grade"});
       s.expect(code == 0, "dynlab grade exit " + std::to_string(code) + ": " + err);
-      s.expect(fs::exists(dir / "grade" / "results.json"), "dynlab grade wrote no results.json");
+      s.expect(fs::exists(chk.dir / "grade" / "results.json"), "dynlab grade wrote no results.json");
       s.detail = "dynlab figure, run (both engines, whole run) and grade exit 0";
     });
   // The README's measured numbers (app/cli/authoring/readme_numbers.h) against that run's summary.json.
-  if (!options.dynlab_binary.empty())
+  if (!chk.options.dynlab_binary.empty())
     run(report, "readme numbers", [&](Step& s) {
-      const fs::path readme = fs::path(lab_dir) / "README.md", summary = dir / "run" / "summary.json";
+      const fs::path readme = fs::path(chk.lab_dir) / "README.md", summary = chk.dir / "run" / "summary.json";
       if (!fs::is_regular_file(readme)) {
         s.detail = "no README.md";
         return;
