@@ -117,7 +117,7 @@ TEST_CASE("what a model file names: hostile files get one line naming the file, 
   CHECK(errorOf(write("model/twins.xml", mjcf("<mesh name=\"m1\" file=\"a/tet.stl\"/><mesh name=\"m2\" file=\"b/tet.stl\"/>", "m1")))
             .find("another file named 'tet.stl'") != std::string::npos);
   // Named but missing: MuJoCo's own error, with the name it did not find (never the disk's elsewhere).
-  CHECK(errorOf(write("model/missing.xml", "<mujoco><include file=\"nothere.xml\"/></mujoco>")).find("not found in the model's folder: 'nothere.xml'") !=
+  CHECK(errorOf(write("model/missing.xml", "<mujoco><include file=\"nothere.xml\"/></mujoco>")).find("file 'nothere.xml' not found (looked in ") !=
         std::string::npos);
   // A file naming more files than allowed.
   std::string many;
