@@ -1,0 +1,144 @@
+// Model files as users have them, through the real binary on every command that takes one (model, run,
+// figure, bench; issue 40): a URDF in robot/urdf/ whose meshes are package://robot/meshes/… loads; a
+// package found only through --package-path is a one-line refusal naming where dynlab looked until
+// the option names it; --ignore-contacts, which the contact refusal advises, is taken by each command
+// (and refused in one line for a lab); a file's <option timestep> is the step the run takes, `run
+// --dt` another, checked. Never exit 3. The files are written here, at run time.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tests/app/cli_run.h"
+
+using namespace dyn::test::cli;
+
+namespace {
+
+// A binary STL of the tetrahedron (0, s e_x, s e_y, s e_z).
+std::string tetrahedron(float s) {
+  const float O[3] = {0, 0, 0}, X[3] = {s, 0, 0}, Y[3] = {0, s, 0}, Z[3] = {0, 0, s};
+  const float* faces[4][3] = {{O, Y, X}, {O, X, Z}, {O, Z, Y}, {X, Y, Z}};
+  std::string b(80, ' ');
+  const std::uint32_t count = 4;
+  b.append(reinterpret_cast<const char*>(&count), 4);
+  for (const auto& f : faces) {
+    const float normal[3] = {0, 0, 0};
+    b.append(reinterpret_cast<const char*>(normal), 12);
+    for (const float* v : f) b.append(reinterpret_cast<const char*>(v), 12);
+    b.append(2, '\0');
+  }
+  return b;
+}
+
+// A one-link URDF arm whose collision shape is the mesh `filename`, as ROS exports write it.
+std::string urdf(const std::string& filename) {
+  return "<robot name=\"arm\"><link name=\"base\"/><link name=\"l1\"><inertial><origin xyz=\"0 0 -0.2\"/><mass value=\"1\"/>"
+         "<inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>"
+         "<collision><geometry><mesh filename=\"" + filename + "\"/></geometry></collision></link>"
+         "<joint name=\"j1\" type=\"revolute\"><parent link=\"base\"/><child link=\"l1\"/><origin rpy=\"0.3 0 0\"/><axis xyz=\"0 1 0\"/>"
+         "<limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint></robot>";
+}
+
+// A pendulum: `option` inside <option …/>, and `extra` in the world body.
+std::string pendulum(const std::string& option, const std::string& extra = "") {
+  return "<mujoco><option " + option + "/><worldbody>" + extra +
+         "<body name=\"bob\" pos=\"0 0 1\"><joint name=\"swing\" type=\"hinge\" axis=\"0 1 0\"/>"
+         "<geom type=\"capsule\" fromto=\"0 0 0 0.3 0 -0.3\" size=\"0.02\" mass=\"1\" contype=\"1\" conaffinity=\"1\"/></body></worldbody></mujoco>";
+}
+
+// Each command on FILE with extra arguments: short runs, a scratch output each.
+std::vector<std::vector<std::string>> commands(const TempDir& dir, const std::string& file, const std::vector<std::string>& extra) {
+  return {cat({"model", file, "--duration", "0.05", "--out", (dir / "o_model").string()}, extra),
+          cat({"run", file, "--duration", "0.05", "--out", (dir / "o_run").string()}, extra),
+          cat({"figure", file, "--duration", "0.05", "--plot", "q_j1", "--still", "0", "--format", "png", "--out", (dir / "o_fig").string()}, extra),
+          cat({"bench", file, "--steps", "100"}, extra)};
+}
+
+// The step of a trace: the time between its first two rows.
+double stepOf(const fs::path& trace) {
+  const Csv c = readCsv(trace);
+  REQUIRE(c.rows.size() > 2);
+  return c.rows[1][0] - c.rows[0][0];
+}
+
+}  // namespace
+
+TEST_CASE("a URDF whose meshes are package://robot/meshes/…, beside its urdf/ folder, runs on model, run, figure and bench") {
+  TempDir dir("model_files_layout");
+  fs::create_directories(dir / "robot/meshes");
+  fs::create_directories(dir / "robot/urdf");
+  writeFile(dir / "robot/meshes/body.stl", tetrahedron(0.1f));
+  writeFile(dir / "robot/urdf/arm.urdf", urdf("package://robot/meshes/body.stl"));
+  for (const auto& args : commands(dir, "robot/urdf/arm.urdf", {})) {
+    const Result r = dynlab(dir, args);
+    INFO(shown(args), "\n", r.err);
+    CHECK(r.code == 0);
+  }
+}
+
+TEST_CASE("a package found only through --package-path: one line naming where dynlab looked, then it loads on every command") {
+  TempDir dir("model_files_package_path");
+  fs::create_directories(dir / "vendor/parts/meshes");
+  fs::create_directories(dir / "ws");
+  writeFile(dir / "vendor/parts/meshes/body.stl", tetrahedron(0.1f));
+  writeFile(dir / "ws/arm.urdf", urdf("package://parts/meshes/body.stl"));
+  for (const auto& args : commands(dir, "ws/arm.urdf", {})) {
+    const Result r = dynlab(dir, args);
+    INFO(shown(args), "\n", r.err);
+    CHECK(r.code == 2);
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    CHECK(r.err.find("ws/arm.urdf: file 'package://parts/meshes/body.stl' not found (no package folder 'parts' in the folders above ") !=
+          std::string::npos);
+    CHECK(r.err.find("pass --package-path DIR") != std::string::npos);
+  }
+  for (const auto& args : commands(dir, "ws/arm.urdf", {"--package-path", (dir / "vendor").string()})) {
+    const Result r = dynlab(dir, args);
+    INFO(shown(args), "\n", r.err);
+    CHECK(r.code == 0);
+  }
+  // ROS_PACKAGE_PATH, as ROS users set it.
+  const Result ros = dynlab(dir, commands(dir, "ws/arm.urdf", {})[0], withEnv({{"ROS_PACKAGE_PATH", (dir / "vendor").string()}}));
+  CHECK(ros.code == 0);
+}
+
+TEST_CASE("--ignore-contacts, which the contact refusal advises, is taken by model, run, figure and bench; a lab refuses it in one line") {
+  TempDir dir("model_files_contacts");
+  writeFile(dir / "floor.xml", pendulum("timestep=\"0.001\"", "<geom name=\"floor\" type=\"plane\" size=\"1 1 0.1\" pos=\"0 0 0.5\"/>"));
+  const Result refused = dynlab(dir, {"model", "floor.xml", "--out", (dir / "o").string()});
+  CHECK(refused.code == 2);
+  CHECK(refused.err.find("or pass --ignore-contacts") != std::string::npos);
+  std::vector<std::vector<std::string>> all = commands(dir, "floor.xml", {"--ignore-contacts"});
+  all[2][5] = "q_swing";  // figure's --plot
+  for (const auto& args : all) {
+    const Result r = dynlab(dir, args);
+    INFO(shown(args), "\n", r.err);
+    CHECK(r.code == 0);
+  }
+  for (const std::string command : {"run", "figure", "bench"}) {
+    const Result r = dynlab(dir, {command, "slider_crank", "--ignore-contacts", "--out", (dir / "lab").string()});
+    INFO(command, "\n", r.err);
+    checkRefused(r, {"--ignore-contacts", "slider_crank"});
+  }
+}
+
+TEST_CASE("a model file runs at its own <option timestep>; run --dt sets another, checked") {
+  TempDir dir("model_files_timestep");
+  writeFile(dir / "fine.xml", pendulum("timestep=\"0.0005\" gravity=\"0 0 -3\""));
+  REQUIRE(dynlab(dir, {"model", "fine.xml", "--duration", "0.01", "--engine", "hand", "--out", (dir / "m").string()}).code == 0);
+  CHECK(stepOf(dir / "m/trace.csv") == doctest::Approx(0.0005).epsilon(1e-9));
+  CHECK(readFile(dir / "m/summary.txt").find("gravity (0, 0, -3)") != std::string::npos);
+  REQUIRE(dynlab(dir, {"run", "fine.xml", "--duration", "0.01", "--engine", "hand", "--out", (dir / "r").string()}).code == 0);
+  CHECK(stepOf(dir / "r/trace.csv") == doctest::Approx(0.0005).epsilon(1e-9));
+  REQUIRE(dynlab(dir, {"run", "fine.xml", "--duration", "0.01", "--dt", "0.002", "--engine", "hand", "--out", (dir / "d").string()}).code == 0);
+  CHECK(stepOf(dir / "d/trace.csv") == doctest::Approx(0.002).epsilon(1e-9));
+  // A bad --dt, a --dt for a lab, a file step outside the bounds: one line each, exit 2.
+  checkBadInput(dir, {"run", "fine.xml", "--dt", "1", "--out", (dir / "bad").string()}, {"--dt", "1"}, dir / "bad");
+  checkBadInput(dir, {"run", "fine.xml", "--dt", "0", "--out", (dir / "bad").string()}, {"--dt", "0"}, dir / "bad");
+  checkBadInput(dir, {"run", "slider_crank", "--dt", "0.001", "--out", (dir / "bad").string()}, {"--dt"}, dir / "bad");
+  writeFile(dir / "coarse.xml", pendulum("timestep=\"0.05\""));
+  checkBadInput(dir, {"model", "coarse.xml", "--out", (dir / "bad").string()}, {"coarse.xml", "<option timestep>", "--dt"}, dir / "bad");
+  CHECK(dynlab(dir, {"model", "coarse.xml", "--dt", "0.001", "--duration", "0.01", "--out", (dir / "ok").string()}).code == 0);
+}
