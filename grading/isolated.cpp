@@ -1,30 +1,23 @@
 // A forked child for work that may die; see isolated.h.
 #include "grading/isolated.h"
 
-#include <poll.h>
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <cerrno>
-#include <chrono>
 #include <cstring>
 #include <exception>
 #include <new>
+
+#include "physics/util/pipe.h"
 
 namespace dyn {
 namespace {
 
 constexpr char kThrew = '\x1f';  // precedes an exception's message on the pipe
 constexpr int kThrewStatus = 2, kOutOfMemoryStatus = 3;
-
-void writeAll(int fd, const std::string& s) {
-  for (std::size_t done = 0; done < s.size();) {
-    const ssize_t n = ::write(fd, s.data() + done, s.size() - done);
-    if (n <= 0 && errno != EINTR) return;
-    if (n > 0) done += std::size_t(n);
-  }
-}
+constexpr std::size_t kMaxMessage = 65536;  // bytes of the child's message kept
 
 // The signal's name, the same in every locale (glibc's abbreviation: "TRAP", "ABRT").
 std::string abbrev(int sig) {
@@ -61,25 +54,9 @@ IsolatedOutcome runIsolated(const std::function<void()>& work, double timeout_s)
 
   // The parent: read until the child closes the pipe (it exits) or the time is up.
   ::close(fds[1]);
-  std::string text;
-  bool timed_out = false;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
-  for (;;) {
-    const double left = std::chrono::duration<double>(until - std::chrono::steady_clock::now()).count();
-    if (left <= 0) {
-      timed_out = true;
-      break;
-    }
-    pollfd p{fds[0], POLLIN, 0};
-    const int ready = ::poll(&p, 1, int(left * 1000) + 1);
-    if (ready < 0 && errno == EINTR) continue;
-    if (ready <= 0) continue;  // time is checked above
-    char buf[4096];
-    const ssize_t n = ::read(fds[0], buf, sizeof buf);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    if (text.size() < 65536) text.append(buf, std::size_t(n));
-  }
+  const PipeRead read = readPipe(fds[0], timeout_s, kMaxMessage, Overflow::Keep);
+  const std::string& text = read.bytes;
+  const bool timed_out = read.late;
   ::close(fds[0]);
   if (timed_out) ::kill(pid, SIGKILL);
   int status = 0;

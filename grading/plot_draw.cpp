@@ -421,79 +421,80 @@ void setColours() {
   }
 }
 
-PlotLayout draw(const Prepared& p, int width_px, int height_px) {
-  const PlotSpec& spec = p.spec;
-  Range xr = p.xr, yr = p.yr;  // equal_aspect widens one of them to the frame's shape
-  // Lines scale with the picture; text also with the spec's font scale.
-  const double scale = std::clamp(std::min(width_px / 800.0, height_px / 450.0), 0.8, 4.0);
-  const double text_scale = scale * std::clamp(spec.font_scale, 0.25, 8.0);
-  pladv(0);
-  const double ch = kCharHeightPx * kMmPerPx * text_scale;
-  plschr(ch, 1.0);
-  PLFLT page_x0, page_x1, page_y0, page_y1;
-  plgspa(&page_x0, &page_x1, &page_y0, &page_y1);
-  const double page_w = page_x1 - page_x0, page_h = page_y1 - page_y0;
+namespace {
 
+// Where the frame sits on the page (margins in mm) and the data ranges it shows (equal aspect widens
+// one of them to the frame's shape); the legend's place and shape.
+struct Placement {
+  Range xr, yr;
+  double left = 0, right = 0, top = 0, bottom = 0;
+  double axis_below = 0;  // the tick labels and x label below the frame
+  size_t ytick_w = 1;     // the widest y tick label, in glyphs
+  bool legend_right = false;
+  int columns = 1, rows = 0;
+};
+
+// Ticks and margins: tick and axis labels left and below, the title on top, the legend right of the
+// frame (narrow) or below the x label (wide, in as many columns as fit); then equal aspect.
+Placement place(const Prepared& p, const Legend& legend, double ch, double page_w, double page_h) {
+  const PlotSpec& spec = p.spec;
+  Placement f;
+  f.xr = p.xr, f.yr = p.yr;
+  Range &xr = f.xr, &yr = f.yr;
   // Ticks at nice steps (whole decades on a log axis; one step on both axes of an equal-aspect
   // plot, so the grid is square), labelled by our own formatter so their widths are known.
-  size_t ytick_w = 1, xtick_w = 1;
+  size_t xtick_w = 1;
   const auto setTicks = [&] {
     tick_x = {niceStep(xr.hi - xr.lo, kXTicks), std::max(std::abs(xr.lo), std::abs(xr.hi)), false};
     tick_y = {niceStep(yr.hi - yr.lo, kYTicks), std::max(std::abs(yr.lo), std::abs(yr.hi)), p.log_y};
     if (p.log_y) tick_y.step = std::max(1.0, std::round(tick_y.step));
     if (spec.equal_aspect) tick_x.step = tick_y.step = std::max(tick_x.step, tick_y.step);
-    ytick_w = widestTick(tick_y, yr.lo, yr.hi), xtick_w = widestTick(tick_x, xr.lo, xr.hi);
+    f.ytick_w = widestTick(tick_y, yr.lo, yr.hi), xtick_w = widestTick(tick_x, xr.lo, xr.hi);
   };
   setTicks();
-  plslabelfunc(tickLabel, nullptr);
-
-  // Margins in mm: tick and axis labels left and below, the title on top, the legend right of
-  // the frame (narrow) or below the x label (wide, in as many columns as fit).
-  const Legend legend(p, text_scale, ch, page_w);
   const double cw = kGlyphWidth * ch, gap = 0.8 * ch;
-  const bool legend_right = !legend.empty() && legend.entryMm() <= kMaxRightLegend * page_w;
-  const auto leftMargin = [&] { return 0.6 * ch + (spec.ylabel.empty() ? 0.0 : 2.5 * ch) + ytick_w * cw + 0.8 * ch; };
+  f.legend_right = !legend.empty() && legend.entryMm() <= kMaxRightLegend * page_w;
+  const auto leftMargin = [&] { return 0.6 * ch + (spec.ylabel.empty() ? 0.0 : 2.5 * ch) + f.ytick_w * cw + 0.8 * ch; };
   const auto rightMargin = [&] {
-    return legend_right ? legend.entryMm() + 1.2 * ch : std::max(1.8 * ch, 0.5 * xtick_w * cw + 0.5 * ch);
+    return f.legend_right ? legend.entryMm() + 1.2 * ch : std::max(1.8 * ch, 0.5 * xtick_w * cw + 0.5 * ch);
   };
-  double left = leftMargin(), right = rightMargin();
-  const double axis_below = (spec.xlabel.empty() ? 0.0 : 1.8 * ch) + 1.8 * ch;  // tick labels and x label
-  int columns = 1, rows = static_cast<int>(legend.texts.size());
-  if (!legend.empty() && !legend_right) {
-    columns = std::clamp(static_cast<int>((page_w - 2 * gap) / legend.entryMm()), 1, rows);
-    rows = (rows + columns - 1) / columns;
+  f.left = leftMargin(), f.right = rightMargin();
+  f.axis_below = (spec.xlabel.empty() ? 0.0 : 1.8 * ch) + 1.8 * ch;
+  f.rows = static_cast<int>(legend.texts.size());
+  if (!legend.empty() && !f.legend_right) {
+    f.columns = std::clamp(static_cast<int>((page_w - 2 * gap) / legend.entryMm()), 1, f.rows);
+    f.rows = (f.rows + f.columns - 1) / f.columns;
   }
-  const double legend_below = legend.empty() || legend_right ? 0.0 : gap + legend.heightMm(rows);
-  double bottom = 1.0 * ch + axis_below + legend_below;  // the x label's descenders clear the page's edge
-  double top = spec.title.empty() ? 1.2 * ch : 3.0 * ch;
+  const double legend_below = legend.empty() || f.legend_right ? 0.0 : gap + legend.heightMm(f.rows);
+  f.bottom = 1.0 * ch + f.axis_below + legend_below;  // the x label's descenders clear the page's edge
+  f.top = spec.title.empty() ? 1.2 * ch : 3.0 * ch;
   // Equal aspect: widen the data to the frame's shape, re-tick (labels may change width), then
   // trim the frame about its middle so a unit is exactly as long along x as along y.
-  if (spec.equal_aspect && page_w - right - left > 0 && page_h - top - bottom > 0) {
-    const PlotWindow w = equalAspect({xr.lo, xr.hi, yr.lo, yr.hi}, page_w - right - left, page_h - top - bottom);
+  if (spec.equal_aspect && page_w - f.right - f.left > 0 && page_h - f.top - f.bottom > 0) {
+    const PlotWindow w = equalAspect({xr.lo, xr.hi, yr.lo, yr.hi}, page_w - f.right - f.left, page_h - f.top - f.bottom);
     xr = {w.x0, w.x1}, yr = {w.y0, w.y1};
     setTicks();
-    left = leftMargin(), right = rightMargin();
-    const double fw = page_w - right - left, fh = page_h - top - bottom;
+    f.left = leftMargin(), f.right = rightMargin();
+    const double fw = page_w - f.right - f.left, fh = page_h - f.top - f.bottom;
     const double per_x = (xr.hi - xr.lo) / fw, per_y = (yr.hi - yr.lo) / fh;  // data per mm
     if (per_x < per_y) {
       const double cut = 0.5 * (fw - (xr.hi - xr.lo) / per_y);
-      left += cut, right += cut;
+      f.left += cut, f.right += cut;
     } else {
       const double cut = 0.5 * (fh - (yr.hi - yr.lo) / per_x);
-      bottom += cut, top += cut;
+      f.bottom += cut, f.top += cut;
     }
   }
-  const double frame_w = page_w - right - left, frame_h = page_h - top - bottom;
-  plsvpa(left, page_w - right, bottom, page_h - top);
-  plwind(xr.lo, xr.hi, yr.lo, yr.hi);
+  return f;
+}
 
-  // Grid underneath everything.
+// The grid underneath, then the layers: spans, faint series, bands, solid series, dashed ones (a
+// reference stays visible over a response that tracks it), then the markers on top.
+void drawData(const Prepared& p, const Range& xr, const Range& yr, double frame_w, double scale) {
+  const PlotSpec& spec = p.spec;
   plcol0(kGrid);
   plwidth(scale);
   plbox("g", tick_x.step, 0, "g", tick_y.step, 0);
-
-  // Layers: spans, faint series, bands, solid series, dashed ones (a reference stays visible over
-  // a response that tracks it), then the markers on top.
   if (!spec.parametric)
     for (const auto& s : spec.spans) drawSpan(s, xr, yr, scale);
   const size_t budget = std::max<size_t>(400, static_cast<size_t>(2 * frame_w / kMmPerPx));
@@ -512,48 +513,76 @@ PlotLayout draw(const Prepared& p, int width_px, int height_px) {
     plline(2, mx, my);
   }
   pllsty(1);
+}
 
-  // Frame, ticks and labels (y tick labels upright).
+// The title, centred on the page (it may be wider than the frame), shrunk to fit it down to the tick
+// labels' size, and beyond that cut at the end with "…": never cut by the page's edge.
+void drawTitle(const std::string& text, double ch, double page_w, double left, double frame_w) {
+  const double room = page_w - 1.2 * ch, per_char = kTitleGlyphWidth * ch;
+  std::string title = text;
+  std::size_t chars = utf8Chars(title);
+  const double s = std::clamp(room / (per_char * double(chars)), 1.0, 1.25);
+  if (per_char * s * double(chars) > room) {
+    const std::size_t keep = static_cast<std::size_t>(std::max(1.0, room / (per_char * s) - 1));
+    title = utf8Prefix(title, keep);
+    while (!title.empty() && (title.back() == ' ' || title.back() == ',')) title.pop_back();
+    title += "…";
+  }
+  plschr(ch, s);
+  plmtex("t", 1.2 * 1.25 / s, (0.5 * page_w - left) / frame_w, 0.5, ("#<bold/>" + plText(title)).c_str());
+  plschr(ch, 1.0);
+}
+
+}  // namespace
+
+PlotLayout draw(const Prepared& p, int width_px, int height_px) {
+  const PlotSpec& spec = p.spec;
+  // Lines scale with the picture; text also with the spec's font scale.
+  const double scale = std::clamp(std::min(width_px / 800.0, height_px / 450.0), 0.8, 4.0);
+  const double text_scale = scale * std::clamp(spec.font_scale, 0.25, 8.0);
+  pladv(0);
+  const double ch = kCharHeightPx * kMmPerPx * text_scale;
+  plschr(ch, 1.0);
+  PLFLT page_x0, page_x1, page_y0, page_y1;
+  plgspa(&page_x0, &page_x1, &page_y0, &page_y1);
+  const double page_w = page_x1 - page_x0, page_h = page_y1 - page_y0;
+
+  // The frame placed, then the data in it.
+  const Legend legend(p, text_scale, ch, page_w);
+  const Placement f = place(p, legend, ch, page_w, page_h);
+  const Range &xr = f.xr, &yr = f.yr;
+  plslabelfunc(tickLabel, nullptr);
+  const double frame_w = page_w - f.right - f.left, frame_h = page_h - f.top - f.bottom;
+  plsvpa(f.left, page_w - f.right, f.bottom, page_h - f.top);
+  plwind(xr.lo, xr.hi, yr.lo, yr.hi);
+  drawData(p, xr, yr, frame_w, scale);
+
+  // Frame, ticks and labels (y tick labels upright), and the title.
   plcol0(kAxis);
   plwidth(scale);
   plbox("bcnto", tick_x.step, 0, "bcntvo", tick_y.step, 0);
   plcol0(kInk);
   if (!spec.xlabel.empty()) plmtex("b", 3.3, 0.5, 0.5, plText(spec.xlabel).c_str());
-  if (!spec.ylabel.empty()) plmtex("l", ytick_w * kGlyphWidth + 2.2, 0.5, 0.5, plText(spec.ylabel).c_str());
-  if (!spec.title.empty()) {
-    // Centred on the page (it may be wider than the frame), shrunk to fit it down to the tick
-    // labels' size, and beyond that cut at the end with "…": never cut by the page's edge.
-    const double room = page_w - 1.2 * ch, per_char = kTitleGlyphWidth * ch;
-    std::string title = spec.title;
-    std::size_t chars = utf8Chars(title);
-    const double s = std::clamp(room / (per_char * double(chars)), 1.0, 1.25);
-    if (per_char * s * double(chars) > room) {
-      const std::size_t keep = static_cast<std::size_t>(std::max(1.0, room / (per_char * s) - 1));
-      title = utf8Prefix(title, keep);
-      while (!title.empty() && (title.back() == ' ' || title.back() == ',')) title.pop_back();
-      title += "…";
-    }
-    plschr(ch, s);
-    plmtex("t", 1.2 * 1.25 / s, (0.5 * page_w - left) / frame_w, 0.5, ("#<bold/>" + plText(title)).c_str());
-    plschr(ch, 1.0);
-  }
+  if (!spec.ylabel.empty()) plmtex("l", f.ytick_w * kGlyphWidth + 2.2, 0.5, 0.5, plText(spec.ylabel).c_str());
+  if (!spec.title.empty()) drawTitle(spec.title, ch, page_w, f.left, frame_w);
 
   // Where things are, in pixels from the top-left corner.
   PlotLayout layout;
   layout.log_y = p.log_y;
   layout.x_lo = xr.lo, layout.x_hi = xr.hi, layout.y_lo = yr.lo, layout.y_hi = yr.hi;
-  layout.frame = {left / kMmPerPx, top / kMmPerPx, (page_w - right) / kMmPerPx, (page_h - bottom) / kMmPerPx};
+  layout.frame = {f.left / kMmPerPx, f.top / kMmPerPx, (page_w - f.right) / kMmPerPx, (page_h - f.bottom) / kMmPerPx};
   if (legend.empty()) return layout;
   // Legend: right of the frame, top-aligned; or below the x label, centred on the page.
+  const double gap = 0.8 * ch;
   double lx = 1.0 + gap / frame_w, ly = 0.0;
-  if (!legend_right) {
-    lx = (0.5 * (page_w - columns * legend.entryMm()) - left) / frame_w;
-    ly = 1.0 + (axis_below + gap) / frame_h;
+  if (!f.legend_right) {
+    lx = (0.5 * (page_w - f.columns * legend.entryMm()) - f.left) / frame_w;
+    ly = 1.0 + (f.axis_below + gap) / frame_h;
   }
-  const auto [w, h] = legend.draw(lx, ly, rows, columns, frame_w);
-  const PlotBox& f = layout.frame;
-  const double fw = f.x1 - f.x0, fh = f.y1 - f.y0;
-  layout.legend = {f.x0 + lx * fw, f.y0 + ly * fh, f.x0 + (lx + w) * fw, f.y0 + (ly + h) * fh};
+  const auto [w, h] = legend.draw(lx, ly, f.rows, f.columns, frame_w);
+  const PlotBox& fr = layout.frame;
+  const double fw = fr.x1 - fr.x0, fh = fr.y1 - fr.y0;
+  layout.legend = {fr.x0 + lx * fw, fr.y0 + ly * fh, fr.x0 + (lx + w) * fw, fr.y0 + (ly + h) * fh};
   return layout;
 }
 

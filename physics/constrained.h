@@ -57,6 +57,16 @@ struct ConstrainedSolutionT {
   bool ok = true;       // false when the block matrix is singular (reported, never thrown)
 };
 
+// A problem or a solution at other sizes (fixed as bounded, or back), field by field.
+template <int ToNj, int ToNr, int ToNl, int Nj, int Nr, int Nl>
+ConstrainedProblemT<ToNj, ToNr, ToNl> withSizes(const ConstrainedProblemT<Nj, Nr, Nl>& p) {
+  return {p.M, p.h, p.tau, p.J, p.Jdot_qd, p.A, p.Adot_vc, p.Mc, p.bc_Gc, p.Ht, p.Hdot_w, p.stab, p.compliance};
+}
+template <int ToNj, int ToNr, int ToNl, int Nj, int Nr, int Nl>
+ConstrainedSolutionT<ToNj, ToNr, ToNl> withSizes(const ConstrainedSolutionT<Nj, Nr, Nl>& s) {
+  return {s.alpha_c, s.eta, s.f, s.qdd, s.ok};
+}
+
 using ConstrainedProblem = ConstrainedProblemT<Eigen::Dynamic, Eigen::Dynamic, Eigen::Dynamic>;
 using ConstrainedSolution = ConstrainedSolutionT<Eigen::Dynamic, Eigen::Dynamic, Eigen::Dynamic>;
 

@@ -162,6 +162,16 @@ class ConstrainedMechanism : public ConstrainedSystem {
     return false;
   }
   bool stepToTouchdowns(const StepOptions& options, const VecN& tau, VecN& q, VecN& v);
+  // The velocity change dx = (dθ, dx_c) an impulse makes at the staged configuration (factored):
+  // eq. (2) for impulses with J dθ − A dx_c = e; its impulses in s. False if dx is not finite.
+  bool impulseResponse(const VecN& e, Solution& s, VecN& dx);
+  // M_ii += a_i: the rotors' reflected inertia (armature) on the diagonal of a tree mass matrix.
+  template <class Mat>
+  void addArmature(Mat& M) const {
+    if (!has_armature_) return;
+    const int nn = n();
+    for (int i = 0; i < nn; ++i) M(i, i) += model_.joints[std::size_t(i)].armature;
+  }
   // Forget every cached stage (the released rows changed).
   void invalidate() { have_position_ = have_velocity_ = have_last_ = false; }
 

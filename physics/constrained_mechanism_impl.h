@@ -1,7 +1,9 @@
 // The generic constrained mechanism's implementation (constrained_mechanism.h). Include this (not only
 // the header) to instantiate it at a lab's fixed sizes, e.g.
 //   template class dyn::ConstrainedMechanism<dyn::Planar, 3, 3, 1>;
-// physics/constrained_mechanism.cpp instantiates the bounded (Dynamic) sizes for both algebras.
+// physics/constrained_mechanism.cpp instantiates the bounded (Dynamic) sizes for both algebras. Here:
+// construction, the two stages, the solve, the integrator's interface, energy and the controllers'
+// queries; the rigid contacts' touchdowns, impacts and lift-offs are in constrained_mechanism_contacts.h.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -9,6 +11,7 @@
 
 #include "physics/chain_world.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/constrained_mechanism_contacts.h"
 
 namespace dyn {
 
@@ -105,8 +108,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   // M from world composite inertias; the world inertias stay for the velocity stage.
   problem_.M.resize(nn, nn);
   crbaWorld(model_.tree, data_, problem_.M);
-  if (has_armature_)  // rotor inertias: M_ii += a_i
-    for (int i = 0; i < nn; ++i) problem_.M(i, i) += model_.joints[std::size_t(i)].armature;
+  addArmature(problem_.M);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
   if constexpr (S::kDim == 3)
     for (int i = 0; i < nn; ++i) {
@@ -271,152 +273,6 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
 }
 
 template <class S, int Nj, int Nr, int Nl>
-void ConstrainedMechanism<S, Nj, Nr, Nl>::setClosed(int i, bool closed) {
-  const auto& c = *model_.constraints[std::size_t(i)];
-  if (!c.unilateral() || c.compliant())
-    throw std::invalid_argument("ConstrainedMechanism::setClosed: constraint " + std::to_string(i) + " is not a rigid unilateral contact");
-  released_[std::size_t(i)] = char(!closed);
-  invalidate();
-}
-
-// A contact at or past its plane closes unless it separates faster than this (m/s): rounding-size
-// rates (±1e-17 after an impact that reopened) must not leave a penetrating contact open a step.
-constexpr double kSeparating = 1e-9;
-
-template <class S, int Nj, int Nr, int Nl>
-int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, const VecN& tau) {
-  if (!any_released_kind_) return 0;
-  const std::size_t count = model_.constraints.size();
-  auto rigid = [&](std::size_t i) { return rigid_contact_[i] != 0; };
-  // Touchdown: an open contact at or past its plane (φ = −gap ≥ 0) not moving away (−gap' ≥ 0).
-  positionStage(q);
-  int changes = 0;
-  for (std::size_t i = 0; i < count; ++i) {
-    if (!rigid(i) || !released_[i]) continue;
-    const int r = offsets_[i];
-    const double approach = J_full_.row(r).dot(v.head(n())) - (k() ? A_full_.row(r).dot(v.tail(k())) : 0.0);
-    if (phi_full_[r] >= 0.0 && approach >= -kSeparating) {
-      released_[i] = 0;
-      ++changes;
-    }
-  }
-  // The plastic impact: the least-kinetic-energy velocity that satisfies every closed row, eq. (2) for
-  // impulses (as correction(): M dθ = −Jᵀ p, J dθ − A dx_c = e = J θ' − A v_c, θ' ← θ' − dθ): the
-  // table's impulse on the closed rows is P = −p.
-  if (any_impact_) {
-    for (Vec& p : impact_) p.setZero();
-    any_impact_ = false;
-  }
-  if (changes) {
-    invalidate();
-    positionStage(q);
-    if (!factored_) {
-      projectVelocities(*this, q, v);  // the block LU's correction: no impulse recorded
-    } else {
-      VecN phi, dx;
-      MatN G;
-      constraint(q, phi, G);
-      Problem impulse;
-      impulse.tau.setZero(n());
-      impulse.h.setZero(n());
-      impulse.Jdot_qd = -(G * v);
-      Solution s;
-      factor_.solve(impulse, s);
-      dx.resize(n() + k());
-      dx.head(n()) = s.qdd;
-      dx.tail(k()) = s.alpha_c;
-      if (dx.allFinite()) {
-        v -= dx;
-        const VecN dv = dx.head(n()), dvc = dx.tail(k());
-        impact_loss_ += 0.5 * (dv.dot(problem_.M * dv) + (k() ? dvc.dot(problem_.Mc * dvc) : 0.0));
-        const VecN P = -s.eta;
-        for (std::size_t i = 0; i < count; ++i)
-          if (rigid(i) && !released_[i]) impact_[i] = model_.constraints[i]->force(kin_, P.data() + offsets_[i]);
-        any_impact_ = true;
-      }
-    }
-  }
-  // Lift-off: while a closed contact's η would pull, open the one pulling most and solve again.
-  bool any_closed = false;
-  for (std::size_t i = 0; i < count; ++i) any_closed = any_closed || (rigid(i) && !released_[i]);
-  for (std::size_t pass = 0; any_closed && pass < count; ++pass) {
-    const Solution s = evaluate(q, v, tau, nullptr, false);  // η alone
-    std::size_t worst = count;
-    double most = 0.0;
-    for (std::size_t i = 0; i < count; ++i)
-      if (rigid(i) && !released_[i] && s.eta[offsets_[i]] < most) most = s.eta[offsets_[i]], worst = i;
-    if (worst == count) break;
-    released_[worst] = 1;
-    invalidate();
-    ++changes;
-  }
-  return changes;
-}
-
-// m: how far past its plane a located touchdown may land (the root-finder's tolerance on φ).
-constexpr double kTouchdownDepth = 1e-13;
-
-template <class S, int Nj, int Nr, int Nl>
-double ConstrainedMechanism<S, Nj, Nr, Nl>::openDepth(const VecN& q) {
-  positionStage(q);
-  double depth = -INFINITY;
-  for (std::size_t i = 0; i < released_.size(); ++i)
-    if (rigid_contact_[i] && released_[i]) depth = std::max(depth, phi_full_[offsets_[i]]);
-  return depth;
-}
-
-template <class S, int Nj, int Nr, int Nl>
-bool ConstrainedMechanism<S, Nj, Nr, Nl>::stepToTouchdowns(const StepOptions& o, const VecN& tau, VecN& q, VecN& v) {
-  auto anyOpen = [&] { return anyOpenContact(); };
-  StepOptions sub = o;  // the part of the step still to take
-  // At most a few touchdowns per step (a contact the impact reopens may come back at once): past
-  // them the step ends as it lands, and the next step's updateContacts closes what it finds.
-  for (int event = 0;; ++event) {
-    if (!anyOpen()) return dyn::step(*this, sub, tau, q, v);
-    const VecN q0 = q, v0 = v;
-    // The clock and the books advance with every step taken: a trial restarts them from here.
-    const double t0 = time();
-    const Books b0 = books();
-    if (!dyn::step(*this, sub, tau, q, v)) return false;
-    if (event == 3 || !(openDepth(q) > 0.0)) return true;
-    // A crossing inside the step: bracket it from the start (φ < 0 there, else nothing to locate).
-    double lo = 0.0, f_lo = openDepth(q0), hi = sub.dt, f_hi = openDepth(q), depth = f_hi;
-    if (!(f_lo < 0.0)) return true;
-    VecN q_hi = q, v_hi = v;
-    double t_hi = time();
-    Books b_hi = books();
-    int side = 0;  // Illinois: the end kept twice in a row has its value halved (depth: its true φ)
-    for (int it = 0; it < 100 && depth > kTouchdownDepth && hi - lo > 1e-15 * o.dt; ++it) {
-      double h = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
-      if (!(h > lo && h < hi)) h = 0.5 * (lo + hi);
-      StepOptions trial = o;
-      trial.dt = h;
-      VecN qt = q0, vt = v0;
-      setTime(t0);
-      books() = b0;
-      if (!dyn::step(*this, trial, tau, qt, vt)) return false;
-      const double f = openDepth(qt);
-      if (f > 0.0) {
-        hi = h, f_hi = depth = f, q_hi = qt, v_hi = vt, t_hi = time(), b_hi = books();
-        if (side == 1) f_lo *= 0.5;
-        side = 1;
-      } else {
-        lo = h, f_lo = f;
-        if (side == -1) f_hi *= 0.5;
-        side = -1;
-      }
-    }
-    // At the touchdown (at most kTouchdownDepth past the plane): close it, then the rest of the step.
-    q = q_hi, v = v_hi;
-    setTime(t_hi);
-    books() = b_hi;
-    updateContacts(q, v, tau);
-    sub.dt -= hi;
-    if (!(sub.dt > 1e-15 * o.dt)) return true;
-  }
-}
-
-template <class S, int Nj, int Nr, int Nl>
 typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, Nj, Nr, Nl>::solve(
     const VecN& q, const VecN& v, const VecN& tau, const VecN* stab) {
   Solution s = evaluate(q, v, tau, stab);
@@ -507,12 +363,17 @@ template <class S, int Nj, int Nr, int Nl>
 bool ConstrainedMechanism<S, Nj, Nr, Nl>::correction(const VecN& q, const VecN& e, VecN& dx) {
   positionStage(q);
   if (!factored_) return ConstrainedSystem::correction(q, e, dx);
+  Solution s;
+  return impulseResponse(e, s, dx);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+bool ConstrainedMechanism<S, Nj, Nr, Nl>::impulseResponse(const VecN& e, Solution& s, VecN& dx) {
   // Eq. (2) for impulses: M dθ = −Jᵀ f, M_c dx_c = Aᵀ f, J dθ − A dx_c = e (τ − h = 0, J'θ' = −e).
   Problem impulse;
   impulse.tau.setZero(n());
   impulse.h.setZero(n());
   impulse.Jdot_qd = -e;
-  Solution s;
   factor_.solve(impulse, s);
   dx.resize(n() + k());
   dx.head(n()) = s.qdd;
@@ -634,8 +495,7 @@ template <class S, int Nj, int Nr, int Nl>
 MatN ConstrainedMechanism<S, Nj, Nr, Nl>::massMatrix(const VecN& q) {
   treeStage(q);
   MatN M = crba(model_.tree, data_);
-  if (has_armature_)
-    for (int i = 0; i < n(); ++i) M(i, i) += model_.joints[std::size_t(i)].armature;
+  addArmature(M);
   return M;
 }
 

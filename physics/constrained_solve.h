@@ -124,15 +124,8 @@ ConstrainedSolutionT<Nj, Nr, Nl> solveConstrainedBlockLU(const ConstrainedProble
   if constexpr (Nj == Eigen::Dynamic && Nr == Eigen::Dynamic && Nl == Eigen::Dynamic) {
     return solveConstrainedBlockLU(p);
   } else {
-    const ConstrainedProblem d{p.M, p.h, p.tau, p.J, p.Jdot_qd, p.A, p.Adot_vc, p.Mc, p.bc_Gc, p.Ht, p.Hdot_w, p.stab, p.compliance};
-    const ConstrainedSolution x = solveConstrainedBlockLU(d);
-    ConstrainedSolutionT<Nj, Nr, Nl> s;
-    s.alpha_c = x.alpha_c;
-    s.eta = x.eta;
-    s.f = x.f;
-    s.qdd = x.qdd;
-    s.ok = x.ok;
-    return s;
+    constexpr int D = Eigen::Dynamic;
+    return withSizes<Nj, Nr, Nl>(solveConstrainedBlockLU(withSizes<D, D, D>(p)));
   }
 }
 

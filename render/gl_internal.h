@@ -9,6 +9,7 @@
 #include <GL/glext.h>
 
 #include <Eigen/Core>
+#include <cstddef>
 #include <memory>
 #include <vector>
 
@@ -44,6 +45,10 @@ struct Vertex {
   float normal[3];
   float end;
 };
+
+// Enables vertex attribute `index` of the bound VAO: `size` floats at `offset` bytes into each
+// `stride`-byte vertex of the bound array buffer.
+void floatAttribute(GLuint index, GLint size, GLsizei stride, std::size_t offset);
 
 // An indexed triangle mesh in a VAO.
 struct Mesh {

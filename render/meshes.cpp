@@ -24,15 +24,9 @@ Mesh upload(const std::vector<Vertex>& vertices, const std::vector<GLuint>& indi
   glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(GLuint)),
                indices.data(), GL_STATIC_DRAW);
   // Attributes: 0 position, 1 normal, 2 end flag.
-  glEnableVertexAttribArray(0);
-  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex),
-                        reinterpret_cast<void*>(offsetof(Vertex, position)));
-  glEnableVertexAttribArray(1);
-  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(Vertex),
-                        reinterpret_cast<void*>(offsetof(Vertex, normal)));
-  glEnableVertexAttribArray(2);
-  glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, sizeof(Vertex),
-                        reinterpret_cast<void*>(offsetof(Vertex, end)));
+  floatAttribute(0, 3, sizeof(Vertex), offsetof(Vertex, position));
+  floatAttribute(1, 3, sizeof(Vertex), offsetof(Vertex, normal));
+  floatAttribute(2, 1, sizeof(Vertex), offsetof(Vertex, end));
   glBindVertexArray(0);
   mesh.index_count = GLsizei(indices.size());
   return mesh;
@@ -48,6 +42,11 @@ void stitchRings(std::vector<GLuint>& indices, GLuint first, GLuint n) {
 }
 
 }  // namespace
+
+void floatAttribute(GLuint index, GLint size, GLsizei stride, std::size_t offset) {
+  glEnableVertexAttribArray(index);
+  glVertexAttribPointer(index, size, GL_FLOAT, GL_FALSE, stride, reinterpret_cast<void*>(offset));
+}
 
 void Mesh::draw() const {
   glBindVertexArray(vao);

@@ -59,15 +59,9 @@ struct Renderer::Impl {
     glGenBuffers(1, &line_vbo);
     glBindVertexArray(line_vao);
     glBindBuffer(GL_ARRAY_BUFFER, line_vbo);
-    glEnableVertexAttribArray(0);
-    glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, sizeof(LineVertex),
-                          reinterpret_cast<void*>(offsetof(LineVertex, position)));
-    glEnableVertexAttribArray(1);
-    glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, sizeof(LineVertex),
-                          reinterpret_cast<void*>(offsetof(LineVertex, other)));
-    glEnableVertexAttribArray(2);
-    glVertexAttribPointer(2, 1, GL_FLOAT, GL_FALSE, sizeof(LineVertex),
-                          reinterpret_cast<void*>(offsetof(LineVertex, side)));
+    gl::floatAttribute(0, 3, sizeof(LineVertex), offsetof(LineVertex, position));
+    gl::floatAttribute(1, 3, sizeof(LineVertex), offsetof(LineVertex, other));
+    gl::floatAttribute(2, 1, sizeof(LineVertex), offsetof(LineVertex, side));
     glBindVertexArray(0);
   }
 

@@ -77,19 +77,26 @@ out vec4 frag_color;
 void main() { frag_color = u_color; }
 )";
 
+// Unless the object's status (compile or link) is set: deletes the object and throws `what` and its
+// info log.
+template <class GetStatus, class GetLog, class Delete>
+void requireStatus(GLuint id, GLenum status, GetStatus get_status, GetLog get_log, Delete remove, const std::string& what) {
+  GLint ok = 0;
+  get_status(id, status, &ok);
+  if (ok) return;
+  char log[2048] = {};
+  get_log(id, sizeof log, nullptr, log);
+  remove(id);
+  throw std::runtime_error(what + log);
+}
+
 // Compiles one stage; throws with the info log on failure.
 GLuint compileStage(GLenum type, const char* source, const char* name) {
   GLuint shader = glCreateShader(type);
   glShaderSource(shader, 1, &source, nullptr);
   glCompileShader(shader);
-  GLint ok = 0;
-  glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-    glDeleteShader(shader);
-    throw std::runtime_error(std::string("render: shader '") + name + "' failed: " + log);
-  }
+  requireStatus(shader, GL_COMPILE_STATUS, glGetShaderiv, glGetShaderInfoLog, glDeleteShader,
+                std::string("render: shader '") + name + "' failed: ");
   return shader;
 }
 
@@ -103,14 +110,8 @@ GLuint linkProgram(const char* vertex, const char* fragment, const char* name) {
   glLinkProgram(program);
   glDeleteShader(vs);
   glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(program, GL_LINK_STATUS, &ok);
-  if (!ok) {
-    char log[2048] = {};
-    glGetProgramInfoLog(program, sizeof log, nullptr, log);
-    glDeleteProgram(program);
-    throw std::runtime_error(std::string("render: program '") + name + "' failed to link: " + log);
-  }
+  requireStatus(program, GL_LINK_STATUS, glGetProgramiv, glGetProgramInfoLog, glDeleteProgram,
+                std::string("render: program '") + name + "' failed to link: ");
   return program;
 }
 

@@ -104,18 +104,9 @@ void checkEffortUnits(const JsonView& c, const DataSettings& s, const Slide& sli
   }
 }
 
-}  // namespace
-
-DataSettings parseDataSettings(const JsonView& c, const std::string& name, const std::string& folder,
-                               const model_file::LoadOptions& options) {
-  DataSettings s;
-  s.name = name, s.folder = folder;
-  c.onlyKeys({"lab", "title", "description", "variants", "model_file", "actuated", "torque_limit", "tool", "initial", "trajectory",
-              "plant", "controller", "gains", "metrics", "passive_tolerance", "simulation", "rubric", "metric_docs",
-              "figures", "submission_options", "map", "drawing", "environment", "target"});
-  s.title = c["title"].string();
-  // The model, and the plant: the model with the payloads the controller does not know.
-  const JsonView mf = c["model_file"];
+// The model file, loaded from the lab's folder (or the tree) with the given options; one without free
+// payload bodies.
+model_file::LoadedModel loadModel(const JsonView& mf, const std::string& folder, const model_file::LoadOptions& options) {
   model_file::LoadedModel file;
   try {
     file = model_file::load(checkedModelPath(mf, folder), options);
@@ -123,24 +114,29 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     mf.fail(std::string("a model file dynlab reads (") + e.what() + ")");
   }
   if (!file.mechanism.payloads.empty()) mf.fail("a model without free payload bodies");
-  s.model = file.mechanism;
-  ConstrainedMechanism<Spatial> probe(file.mechanism);
-  if (c.has("plant")) {
-    const JsonView p = c["plant"];
-    p.onlyKeys({"payloads"});
-    const JsonView loads = p["payloads"];
-    for (std::size_t i = 0, n = loads.size(0, 16); i < n; ++i) {
-      const JsonView l = loads.at(i);
-      l.onlyKeys({"body", "at", "mass"});
-      const auto [link, point] = bodyPoint(l["body"], l["at"], file, probe);
-      const double mass = l["mass"].inRange(0, kMaxMass);
-      auto& b = file.mechanism.tree.bodies[std::size_t(link)];
-      b.inertia += Spatial::inertia(mass, point, Eigen::Matrix3d::Zero());
-      b.central = Spatial::central(b.inertia);
-      b.massless = Spatial::massless(b.inertia);
-    }
+  return file;
+}
+
+// The plant: point masses the controller does not know, added to the bodies they sit on.
+void addPayloads(const JsonView& c, model_file::LoadedModel& file, ConstrainedMechanism<Spatial>& probe) {
+  if (!c.has("plant")) return;
+  const JsonView p = c["plant"];
+  p.onlyKeys({"payloads"});
+  const JsonView loads = p["payloads"];
+  for (std::size_t i = 0, n = loads.size(0, 16); i < n; ++i) {
+    const JsonView l = loads.at(i);
+    l.onlyKeys({"body", "at", "mass"});
+    const auto [link, point] = bodyPoint(l["body"], l["at"], file, probe);
+    const double mass = l["mass"].inRange(0, kMaxMass);
+    auto& b = file.mechanism.tree.bodies[std::size_t(link)];
+    b.inertia += Spatial::inertia(mass, point, Eigen::Matrix3d::Zero());
+    b.central = Spatial::central(b.inertia);
+    b.massless = Spatial::massless(b.inertia);
   }
-  // Actuated joints, by name.
+}
+
+// Actuated joints, by name, and their torque limits.
+void parseActuated(const JsonView& c, const model_file::LoadedModel& file, DataSettings& s) {
   const JsonView act = c["actuated"];
   std::vector<std::string> joint_names;
   for (const auto& j : file.joints) joint_names.push_back(j.name);
@@ -157,57 +153,68 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   lim.size(std::size_t(m), std::size_t(m));
   s.controller.torque_limit.resize(m);
   for (int j = 0; j < m; ++j) s.controller.torque_limit[j] = lim.at(std::size_t(j)).positive(kMaxTorque);
+}
 
-  // The tool: a closure's point or a body's (none: a passive or open-loop lab without a task).
-  if (c.has("tool")) {
-    const JsonView tool = c["tool"];
-    tool.onlyKeys({"closure", "body", "at", "axes"});
-    if (tool.has("closure")) {
-      const std::string cn = tool["closure"].string();
-      std::vector<std::string> names;
-      for (const auto& cl : file.closures) names.push_back(cl.name);
-      const auto it = std::find(names.begin(), names.end(), cn);
-      if (it == names.end()) tool["closure"].fail("expected a closure of the model file (" + list(names) + ")");
-      const auto& cl = file.closures[std::size_t(it - names.begin())];
-      if (cl.link1 < 0) tool["closure"].fail("expected a closure whose first body moves");
-      s.tool.link = cl.link1, s.tool.point = cl.point1;
-    } else {
-      std::tie(s.tool.link, s.tool.point) = bodyPoint(tool["body"], tool["at"], file, probe);
-      s.tool_on_body = true;
-    }
-    const JsonView axes = tool["axes"];
-    for (std::size_t i = 0, n = axes.size(1, 3); i < n; ++i) {
-      const std::string a = axes.at(i).oneOf({"x", "y", "z"});
-      if (std::find(s.axis_names.begin(), s.axis_names.end(), a) != s.axis_names.end()) axes.at(i).fail("each axis once");
-      s.tool.axes.push_back(3 + (a[0] - 'x'));
-      s.axis_names.push_back(a);
-    }
-  } else if (c.has("trajectory") && !TaskPath::isJointSpace(c["trajectory"])) {
-    c["trajectory"].fail("no task trajectory without a \"tool\" to follow it (or \"space\": \"joint\")");
+// The tool: a closure's point or a body's (none: a passive or open-loop lab without a task).
+void parseTool(const JsonView& c, const model_file::LoadedModel& file, ConstrainedMechanism<Spatial>& probe, DataSettings& s) {
+  if (!c.has("tool")) {
+    if (c.has("trajectory") && !TaskPath::isJointSpace(c["trajectory"]))
+      c["trajectory"].fail("no task trajectory without a \"tool\" to follow it (or \"space\": \"joint\")");
+    return;
   }
-
-  // The environment: a push on the tool, the plant's only (the controller's model was copied above).
-  if (c.has("environment")) {
-    const JsonView env = c["environment"];
-    env.onlyKeys({"force"});
-    const JsonView f = env["force"];
-    f.onlyKeys({"value", "start", "rise", "hold"});
-    if (s.tool.link < 0) f.fail("a \"tool\" to push on (/tool)");
-    const JsonView v = f["value"];
-    v.size(3, 3);
-    Spatial::Vec w = Spatial::Vec::Zero();
-    for (int i = 0; i < 3; ++i) w[3 + i] = v.at(std::size_t(i)).inRange(-kMaxForce, kMaxForce);
-    const ForceProfile profile{f["start"].inRange(0, 1e4), f.has("rise") ? f["rise"].inRange(0, 1e4) : 0.0,
-                               f.has("hold") ? f["hold"].inRange(0, 1e4) : 0.0};
-    s.push.emplace(BodyRef::link(s.tool.link), s.tool.point, w, profile);
-    file.mechanism.forces.push_back(std::make_shared<PushForce<Spatial>>(*s.push));
+  const JsonView tool = c["tool"];
+  tool.onlyKeys({"closure", "body", "at", "axes"});
+  if (tool.has("closure")) {
+    const std::string cn = tool["closure"].string();
+    std::vector<std::string> names;
+    for (const auto& cl : file.closures) names.push_back(cl.name);
+    const auto it = std::find(names.begin(), names.end(), cn);
+    if (it == names.end()) tool["closure"].fail("expected a closure of the model file (" + list(names) + ")");
+    const auto& cl = file.closures[std::size_t(it - names.begin())];
+    if (cl.link1 < 0) tool["closure"].fail("expected a closure whose first body moves");
+    s.tool.link = cl.link1, s.tool.point = cl.point1;
+  } else {
+    std::tie(s.tool.link, s.tool.point) = bodyPoint(tool["body"], tool["at"], file, probe);
+    s.tool_on_body = true;
   }
+  const JsonView axes = tool["axes"];
+  for (std::size_t i = 0, n = axes.size(1, 3); i < n; ++i) {
+    const std::string a = axes.at(i).oneOf({"x", "y", "z"});
+    if (std::find(s.axis_names.begin(), s.axis_names.end(), a) != s.axis_names.end()) axes.at(i).fail("each axis once");
+    s.tool.axes.push_back(3 + (a[0] - 'x'));
+    s.axis_names.push_back(a);
+  }
+}
 
-  // The start: the actuators placed, the loop assembled from the file's pose. "actuated_deg" gives hinges
-  // in degrees (a slide has no degrees: refused, naming it); "actuated" every coordinate in its own unit
-  // (rad for a hinge, m for a slide).
+// The environment: a push on the tool, the plant's only (the controller's model is copied before).
+void parseEnvironment(const JsonView& c, model_file::LoadedModel& file, DataSettings& s) {
+  if (!c.has("environment")) return;
+  const JsonView env = c["environment"];
+  env.onlyKeys({"force"});
+  const JsonView f = env["force"];
+  f.onlyKeys({"value", "start", "rise", "hold"});
+  if (s.tool.link < 0) f.fail("a \"tool\" to push on (/tool)");
+  const JsonView v = f["value"];
+  v.size(3, 3);
+  Spatial::Vec w = Spatial::Vec::Zero();
+  for (int i = 0; i < 3; ++i) w[3 + i] = v.at(std::size_t(i)).inRange(-kMaxForce, kMaxForce);
+  const ForceProfile profile{f["start"].inRange(0, 1e4), f.has("rise") ? f["rise"].inRange(0, 1e4) : 0.0,
+                             f.has("hold") ? f["hold"].inRange(0, 1e4) : 0.0};
+  s.push.emplace(BodyRef::link(s.tool.link), s.tool.point, w, profile);
+  file.mechanism.forces.push_back(std::make_shared<PushForce<Spatial>>(*s.push));
+}
+
+// True when actuated joint j (in s.actuated's order) is a slide (metres, not radians).
+bool isSlide(const model_file::LoadedModel& file, const DataSettings& s, int j) {
+  return file.joints[std::size_t(s.actuated[std::size_t(j)])].type == "slide";
+}
+
+// The start: the actuators placed, the loop assembled from the file's pose. "actuated_deg" gives hinges
+// in degrees (a slide has no degrees: refused, naming it); "actuated" every coordinate in its own unit
+// (rad for a hinge, m for a slide).
+void parseStart(const JsonView& c, const model_file::LoadedModel& file, ConstrainedMechanism<Spatial>& probe, DataSettings& s) {
   s.q0 = file.q0;
-  const auto slide = [&](int j) { return file.joints[std::size_t(s.actuated[std::size_t(j)])].type == "slide"; };
+  const int m = int(s.actuated.size());
   std::string start_key = "actuated_deg";
   if (m > 0 || c.has("initial")) {
     const JsonView init = c["initial"];
@@ -218,10 +225,11 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     start.size(std::size_t(m), std::size_t(m));
     for (int j = 0; j < m; ++j) {
       const JsonView u = start.at(std::size_t(j));
+      const bool slide = isSlide(file, s, j);
       if (start_key == "actuated") {
-        s.q0[s.actuated[std::size_t(j)]] = u.inRange(slide(j) ? -kMaxCoordinate : -4 * M_PI, slide(j) ? kMaxCoordinate : 4 * M_PI);
+        s.q0[s.actuated[std::size_t(j)]] = u.inRange(slide ? -kMaxCoordinate : -4 * M_PI, slide ? kMaxCoordinate : 4 * M_PI);
       } else {
-        if (slide(j))
+        if (slide)
           u.fail("an angle, but " + s.actuated_names[std::size_t(j)] + " is a slide (m): give the start as /initial/actuated, each joint in its own unit (rad, m)");
         s.q0[s.actuated[std::size_t(j)]] = u.inRange(-720, 720) * M_PI / 180.0;
       }
@@ -229,8 +237,11 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   }
   // (The probe has the file's geometry; the payloads changed only inertias.)
   if (!assemble(probe, s.q0, s.actuated)) c["initial"][start_key].fail("actuator positions at which the loop closes");
+}
 
-  // The path, from where the tool starts (a joint path: from where the actuators start).
+// The path, from where the tool starts (a joint path: from where the actuators start).
+void parsePath(const JsonView& c, const model_file::LoadedModel& file, ConstrainedMechanism<Spatial>& probe, DataSettings& s) {
+  const int m = int(s.actuated.size());
   if (c.has("trajectory") && TaskPath::isJointSpace(c["trajectory"])) {
     if (m == 0) c["trajectory"]["space"].fail("a task path: a joint path needs actuated joints (/actuated)");
     VecN u0(m);
@@ -240,7 +251,7 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     const JsonView segs = c["trajectory"]["segments"];
     for (std::size_t i = 0, n = segs.size(0, 64); i < n; ++i)
       for (int j = 0; j < m && segs.at(i).has("move_deg"); ++j)
-        if (slide(j))
+        if (isSlide(file, s, j))
           segs.at(i)["move_deg"].fail("a hinge path, but " + s.actuated_names[std::size_t(j)] +
                                       " is a slide (m): give this segment as \"move\", each joint in its own unit (rad, m)");
   } else if (!s.tool.axes.empty()) {
@@ -257,15 +268,14 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     // Every point of it within reach, away from singular poses (labs/generic/reach.h).
     if (c.has("trajectory")) checkReach(c["trajectory"], *s.path, s.model, s.actuated, s.tool, s.axis_names, s.q0);
   }
+}
 
-  const SimulationSettings sim = parseSimulation(c["simulation"]);
-  s.step = sim.step, s.duration = sim.duration;
-  s.passive_tolerance = c.has("passive_tolerance") ? c["passive_tolerance"].inRange(1e-14, 1.0) : 1e-6;
-
-  // The controller: a kind of the library, the gains it reads declared in "gains".
-  const JsonView ctl = c["controller"];
+// The controller: a kind of the library, its period, delay, noise, constant torques and the joint laws'
+// options (labs/controllers/laws.h: per-joint gain scale, pid's anti-windup, Coulomb compensation).
+void parseController(const JsonView& ctl, DataSettings& s) {
   ctl.onlyKeys({"kind", "control_period", "delay_steps", "noise", "constant", "joint_scale", "anti_windup", "tracking_time",
                "coulomb_compensation", "compensation_width", "posture_omega"});
+  const int m = int(s.actuated.size());
   const std::string kind = ctl["kind"].string();
   if (std::find(controllers::kindNames().begin(), controllers::kindNames().end(), kind) == controllers::kindNames().end())
     ctl["kind"].fail("one of " + list(controllers::kindNames()));
@@ -287,8 +297,6 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     ctl["constant"].size(std::size_t(m), std::size_t(m));
     for (int j = 0; j < m; ++j) cs.constant[j] = ctl["constant"].at(std::size_t(j)).inRange(-kMaxTorque, kMaxTorque);
   }
-  // The joint laws' options (labs/controllers/laws.h): per-joint gain scale, pid's anti-windup and
-  // Coulomb compensation.
   cs.joint_scale = VecN::Ones(m);
   if (ctl.has("joint_scale")) {
     ctl["joint_scale"].size(std::size_t(m), std::size_t(m));
@@ -304,11 +312,15 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
   if (ctl.has("coulomb_compensation")) cs.coulomb_compensation = ctl["coulomb_compensation"].boolean();
   if (ctl.has("compensation_width")) cs.compensation_width = ctl["compensation_width"].inRange(1e-6, 100);
   if (ctl.has("posture_omega")) cs.posture_omega = ctl["posture_omega"].inRange(0, 1e4);
+}
+
+// The gains declared in "gains": every kind a submission may pick finds its own (a joint path feeds
+// the joint laws only: the task laws need a task path).
+void parseControllerGains(const JsonView& c, DataSettings& s) {
   std::vector<std::string> declared;
   for (const auto& [g, _] : c["gains"].raw().items()) declared.push_back(g);
   const auto gains = parseGains(c["gains"], declared);
-  // Every kind a submission may pick must find its gains.
-  std::vector<std::string> possible{kind};
+  std::vector<std::string> possible{c["controller"]["kind"].string()};
   if (c.has("submission_options") && c["submission_options"].has("kind"))
     for (const auto& k : c["submission_options"]["kind"]["choices"].raw()) possible.push_back(k.get<std::string>());
   for (const auto& k : possible) {
@@ -316,7 +328,6 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
       c["submission_options"]["kind"].fail("controller kinds of the library (" + list(controllers::kindNames()) + ")");
     for (const auto& g : controllers::gainsOf(controllers::kindFromName(k)))
       if (!gains.count(g)) c["gains"].fail("a gain \"" + g + "\" (the controller kind " + k + " reads it)");
-    // A joint path feeds the joint laws only: the task laws need a task path.
     const auto kk = controllers::kindFromName(k);
     using K = controllers::Kind;
     const bool task = kk == K::TaskPdGravity || kk == K::TaskInverseDynamics || kk == K::ImpedanceTask || kk == K::ImpedanceInverseDynamics ||
@@ -324,26 +335,31 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     if (s.path && s.path->joint() && task)
       c["trajectory"]["space"].fail("\"task\" for the controller kind " + k + " (a joint path feeds joint_pd_gravity, pid and computed_torque)");
   }
+  auto& cs = s.controller;
   auto gain = [&](const char* g) { return gains.count(g) ? gains.at(g) : 0.0; };
   cs.kp = gain("kp"), cs.kd = gain("kd"), cs.ki = gain("ki"), cs.omega_n = gain("omega_n"), cs.zeta = gain("zeta");
   cs.k_imp = gain("k_imp"), cs.d_imp = gain("d_imp"), cs.m_imp = gains.count("m_imp") ? gains.at("m_imp") : 1.0;
   if (!(cs.m_imp > 0)) c["gains"]["m_imp"].fail("a mass above 0 (kg): the impedance law divides by it");
+}
 
-  // The exercise's target impedance M ξ'' + D ξ' + K ξ = F (ξ = x − x_d per task axis; D = 2ζ√(KM)).
-  if (c.has("target")) {
-    const JsonView t = c["target"];
-    t.onlyKeys({"k", "m", "zeta"});
-    if (s.tool.axes.empty() || (s.path && s.path->joint())) t.fail("a task: the target is the tool's (/tool and a task trajectory)");
-    s.target.k = t["k"].positive(1e7), s.target.m = t["m"].positive(1e5), s.target.zeta = t["zeta"].inRange(0, 100);
-  }
+// The exercise's target impedance M ξ'' + D ξ' + K ξ = F (ξ = x − x_d per task axis; D = 2ζ√(KM)).
+void parseTarget(const JsonView& c, DataSettings& s) {
+  if (!c.has("target")) return;
+  const JsonView t = c["target"];
+  t.onlyKeys({"k", "m", "zeta"});
+  if (s.tool.axes.empty() || (s.path && s.path->joint())) t.fail("a task: the target is the tool's (/tool and a task trajectory)");
+  s.target.k = t["k"].positive(1e7), s.target.m = t["m"].positive(1e5), s.target.zeta = t["zeta"].inRange(0, 100);
+}
 
-  // The trace's columns, then the metrics that read them.
+// The trace's columns: time, coordinates, rates, efforts, the task's (x, its reference, the error) or a
+// joint path's (u_d and e_u per actuated joint), the push, the target, the books, the closure forces and
+// the passive joints' loads.
+void traceColumns(const model_file::LoadedModel& file, DataSettings& s) {
   s.columns = {"t"};
   for (const auto& j : file.joints) s.columns.push_back("q_" + columnName(j.name));
   for (const auto& j : file.joints) s.columns.push_back("v_" + columnName(j.name));
   for (const auto& a : s.actuated_names) s.columns.push_back("tau_" + columnName(a));
   s.columns.push_back("tau_sat");
-  // The task's columns (x, its reference, the error), or a joint path's (u_d and e_u per actuated joint).
   const bool joint_path = s.path && s.path->joint();
   for (const auto& a : s.axis_names) s.columns.push_back("tool_" + a);
   for (const char* p : {"ref_", "e_"})
@@ -360,8 +376,40 @@ DataSettings parseDataSettings(const JsonView& c, const std::string& name, const
     if (std::find(s.actuated.begin(), s.actuated.end(), j) == s.actuated.end()) s.passive.push_back(j);
   for (const int j : s.passive)
     for (const char* a : {"x", "y", "z"}) s.columns.push_back("load_" + columnName(file.joints[std::size_t(j)].name) + "_" + a);
+}
+
+}  // namespace
+
+// Parsed in the order the checks depend on: the model and plant, the actuators, the tool and its push,
+// the start and the path, the simulation, the controller and its gains, the target, the trace's
+// columns and the metrics that read them.
+DataSettings parseDataSettings(const JsonView& c, const std::string& name, const std::string& folder,
+                               const model_file::LoadOptions& options) {
+  DataSettings s;
+  s.name = name, s.folder = folder;
+  c.onlyKeys({"lab", "title", "description", "variants", "model_file", "actuated", "torque_limit", "tool", "initial", "trajectory",
+              "plant", "controller", "gains", "metrics", "passive_tolerance", "simulation", "rubric", "metric_docs",
+              "figures", "submission_options", "map", "drawing", "environment", "target"});
+  s.title = c["title"].string();
+  // The model (the controller's), and the plant: the model with the payloads the controller does not know.
+  model_file::LoadedModel file = loadModel(c["model_file"], folder, options);
+  s.model = file.mechanism;
+  ConstrainedMechanism<Spatial> probe(file.mechanism);
+  addPayloads(c, file, probe);
+  parseActuated(c, file, s);
+  parseTool(c, file, probe, s);
+  parseEnvironment(c, file, s);
+  parseStart(c, file, probe, s);
+  parsePath(c, file, probe, s);
+  const SimulationSettings sim = parseSimulation(c["simulation"]);
+  s.step = sim.step, s.duration = sim.duration;
+  s.passive_tolerance = c.has("passive_tolerance") ? c["passive_tolerance"].inRange(1e-14, 1.0) : 1e-6;
+  parseController(c["controller"], s);
+  parseControllerGains(c, s);
+  parseTarget(c, s);
+  traceColumns(file, s);
   if (c.has("metrics")) s.metrics = parseMetrics(c["metrics"], s.columns, sim.exercise_duration, s.step.dt);
-  checkEffortUnits(c, s, slide);
+  checkEffortUnits(c, s, [&](int j) { return isSlide(file, s, j); });
   s.plant = std::make_shared<const model_file::LoadedModel>(std::move(file));
   return s;
 }

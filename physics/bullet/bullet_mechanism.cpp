@@ -52,6 +52,7 @@
 #include <stdexcept>
 #include <tuple>
 
+#include "physics/bullet/bullet_mechanism_members.h"
 #include "physics/bullet/bullet_world.h"
 #include "physics/bullet/contact_balls.h"
 #include "physics/bullet/planar_multibody.h"
@@ -97,6 +98,7 @@ struct BulletMechanism<Planar>::Impl {
   std::vector<Vec2> link_force;                   // link forces (at the centre of mass) over the last step
   std::vector<Planar::Vec> force;                 // per description constraint, last step
   Books books;                                    // work of the held forces along each step's displacement
+  const std::string& describe() const { return plan.summary; }
 
   BulletWorld world;  // before what it holds: destroyed after it
   std::unique_ptr<btMultiBody> body;
@@ -132,15 +134,7 @@ struct BulletMechanism<Planar>::Impl {
     setState(q0, v0);
   }
 
-  ~Impl() {
-    for (auto& c : closures) world->removeMultiBodyConstraint(c.get());
-    balls.clear(world);
-    for (auto& c : colliders) world->removeCollisionObject(c.get());
-    if (body) world->removeMultiBody(body.get());
-    closures.clear();
-    colliders.clear();
-    body.reset();
-  }
+  ~Impl() { removeModel(world, body, colliders, closures, balls); }
 
   void build() {
     const int n = int(plan.links.size());
@@ -148,17 +142,7 @@ struct BulletMechanism<Planar>::Impl {
 
     // Pitfall 1: every link needs a collider for the constraints to act; mask 0 = no contacts.
     shape = std::make_unique<btSphereShape>(0.01);
-    for (int i = -1; i < n; ++i) {
-      auto c = std::make_unique<btMultiBodyLinkCollider>(body.get(), i);
-      c->setCollisionShape(shape.get());
-      c->setActivationState(DISABLE_DEACTIVATION);
-      world->addCollisionObject(c.get(), btBroadphaseProxy::DefaultFilter, 0);
-      if (i < 0)
-        body->setBaseCollider(c.get());
-      else
-        body->getLink(i).m_collider = c.get();
-      colliders.push_back(std::move(c));
-    }
+    addLinkColliders(world, *body, n, shape.get(), colliders);
 
     // Cut joints and point attachments: point-to-point (to the world: pivot_b in world coordinates).
     for (const PlanConstraint& pc : plan.constraints) {
@@ -348,12 +332,7 @@ struct BulletMechanism<Planar>::Impl {
       applied.emplace_back(l, r_local, F, p, m.phi);
     }
     for (int i = 0; i < n; ++i) {
-      double tau = tau_in[i];
-      if (!model.joints.empty()) {  // spring, viscous and Coulomb friction from the step's start
-        const JointProperties& jp = model.joints[std::size_t(i)];
-        friction[i] = jp.friction(v[i]);
-        tau -= jp.stiffness * (q[i] - jp.rest) + friction[i];
-      }
+      const double tau = heldTorque(model.joints, i, tau_in[i], q[i], v[i], friction[i]);
       // Pitfall 3: applied torques are cleared after each step; apply them every step.
       const int k = joint_link[std::size_t(i)];
       if (k >= 0) {
@@ -469,27 +448,6 @@ struct BulletMechanism<Planar>::Impl {
     return sign * Planar::Vec(M, F.x(), F.y());
   }
 };
-
-template <>
-BulletMechanism<Planar>::BulletMechanism(const MechanismModel<Planar>& model, double dt, const VecN& q0, const VecN& v0)
-    : impl_(std::make_unique<Impl>(model, dt, q0, v0)) {}
-
-template <class S>
-BulletMechanism<S>::~BulletMechanism() = default;
-
-template <>
-void BulletMechanism<Planar>::step(const VecN& tau, double t) { impl_->step(tau, t); }
-template <>
-Books BulletMechanism<Planar>::books() const { return impl_->books; }
-template <>
-void BulletMechanism<Planar>::state(VecN& q, VecN& v) const { impl_->state(q, v); }
-template <>
-Planar::Vec BulletMechanism<Planar>::constraintForce(int i) const {
-  if (i < 0 || i >= int(impl_->force.size())) throw std::out_of_range("BulletMechanism::constraintForce: no such constraint");
-  return impl_->force[std::size_t(i)];
-}
-template <>
-std::string BulletMechanism<Planar>::describe() const { return impl_->plan.summary; }
 
 // Spatial mechanisms: spatial_mechanism.cpp.
 template class BulletMechanism<Planar>;

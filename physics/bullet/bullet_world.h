@@ -10,8 +10,21 @@
 #include <BulletDynamics/Featherstone/btMultiBodyDynamicsWorld.h>
 
 #include <memory>
+#include <vector>
+
+#include "physics/mechanism.h"
 
 namespace dyn::bullet {
+
+// The torque both builders hold on tree joint i over a step: τ_i less the description's spring,
+// viscous and Coulomb friction from the step's start, τ − k (θ − θ_rest) − F(θ'); F(θ') into friction
+// (for the books). Without joint properties, τ_i.
+inline double heldTorque(const std::vector<JointProperties>& joints, int i, double tau, double q, double v, double& friction) {
+  if (joints.empty()) return tau;
+  const JointProperties& jp = joints[std::size_t(i)];
+  friction = jp.friction(v);
+  return tau - (jp.stiffness * (q - jp.rest) + friction);
+}
 
 struct BulletWorld {
   std::unique_ptr<btDefaultCollisionConfiguration> config = std::make_unique<btDefaultCollisionConfiguration>();

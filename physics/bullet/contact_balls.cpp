@@ -1,6 +1,8 @@
 // Balls on Bullet links against static planes (contact_balls.h): colliders, planes, groups, forces.
 #include "physics/bullet/contact_balls.h"
 
+#include <BulletDynamics/Featherstone/btMultiBody.h>
+
 #include <algorithm>
 #include <stdexcept>
 
@@ -136,6 +138,32 @@ void ContactBalls::force(const BulletWorld& world, int i, double dt, const btVec
       m += (x - P).cross(fj);
     }
   }
+}
+
+void addLinkColliders(BulletWorld& world, btMultiBody& body, int links, btCollisionShape* shape,
+                      std::vector<std::unique_ptr<btMultiBodyLinkCollider>>& colliders) {
+  for (int i = -1; i < links; ++i) {
+    auto c = std::make_unique<btMultiBodyLinkCollider>(&body, i);
+    c->setCollisionShape(shape);
+    c->setActivationState(DISABLE_DEACTIVATION);
+    world->addCollisionObject(c.get(), btBroadphaseProxy::DefaultFilter, 0);
+    if (i < 0)
+      body.setBaseCollider(c.get());
+    else
+      body.getLink(i).m_collider = c.get();
+    colliders.push_back(std::move(c));
+  }
+}
+
+void removeModel(BulletWorld& world, std::unique_ptr<btMultiBody>& body, std::vector<std::unique_ptr<btMultiBodyLinkCollider>>& colliders,
+                 std::vector<std::unique_ptr<btMultiBodyConstraint>>& closures, ContactBalls& balls) {
+  for (auto& c : closures) world->removeMultiBodyConstraint(c.get());
+  balls.clear(world);
+  for (auto& c : colliders) world->removeCollisionObject(c.get());
+  if (body) world->removeMultiBody(body.get());
+  closures.clear();
+  colliders.clear();
+  body.reset();
 }
 
 }  // namespace dyn::bullet

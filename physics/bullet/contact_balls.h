@@ -36,6 +36,7 @@
 // One link carries balls against one plane with one μ, stiffness, damping and radius (a collider has one
 // of each); more is refused (std::invalid_argument, "not yet").
 #pragma once
+#include <BulletDynamics/Featherstone/btMultiBodyConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBodyLinkCollider.h>
 
 #include <memory>
@@ -83,5 +84,16 @@ class ContactBalls {
   std::vector<std::unique_ptr<btCollisionShape>> shapes_;
   std::vector<std::unique_ptr<btRigidBody>> planes_;
 };
+
+// Pitfall 1: the base and each of `links` links of body get a collider on `shape` (constraints act only
+// between links with one), with mask 0: no contacts (build() above gives a ball's link its group);
+// added to the world and to colliders, the base's first.
+void addLinkColliders(BulletWorld& world, btMultiBody& body, int links, btCollisionShape* shape,
+                      std::vector<std::unique_ptr<btMultiBodyLinkCollider>>& colliders);
+
+// A builder's teardown, before its world goes: its constraints, the balls' planes, its link colliders
+// and its multibody taken out of the world, then freed.
+void removeModel(BulletWorld& world, std::unique_ptr<btMultiBody>& body, std::vector<std::unique_ptr<btMultiBodyLinkCollider>>& colliders,
+                 std::vector<std::unique_ptr<btMultiBodyConstraint>>& closures, ContactBalls& balls);
 
 }  // namespace dyn::bullet

@@ -67,8 +67,10 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <typeinfo>
 
 #include "physics/bullet/bullet_mechanism.h"
+#include "physics/bullet/bullet_mechanism_members.h"
 #include "physics/bullet/bullet_world.h"
 #include "physics/bullet/contact_balls.h"
 #include "physics/bullet/rolling_constraint.h"
@@ -82,6 +84,9 @@
 
 namespace dyn::bullet {
 namespace {
+
+// A point closure itself: its subclass the point contact (point_contact.h) is not modelled here yet.
+bool isPointClosure(const Constraint<Spatial>* k) { return k && typeid(*k) == typeid(PointClosure<Spatial>); }
 
 using Pos = Spatial::Pos;
 using Mat3 = Eigen::Matrix3d;
@@ -179,6 +184,7 @@ struct BulletMechanism<Spatial>::Impl {
   std::vector<Spatial::Vec> force;  // per description constraint, over the last step
   std::vector<int> rotor_joint;     // per rotor link (Bullet link n + k): the joint it is geared to
   std::string summary;
+  const std::string& describe() const { return summary; }
   std::unique_ptr<TreeData<Spatial>> kinematics;  // the external forces' points (none: no forces)
 
   BulletWorld world;  // before what it holds: destroyed after it
@@ -205,15 +211,7 @@ struct BulletMechanism<Spatial>::Impl {
     summarise();
   }
 
-  ~Impl() {
-    for (auto& c : closures) world->removeMultiBodyConstraint(c.get());
-    balls.clear(world);
-    for (auto& c : colliders) world->removeCollisionObject(c.get());
-    if (body) world->removeMultiBody(body.get());
-    closures.clear();
-    colliders.clear();
-    body.reset();
-  }
+  ~Impl() { removeModel(world, body, colliders, closures, balls); }
 
   // What this model cannot build, said before anything is built.
   void check(const VecN& q0, const VecN& v0) const {
@@ -235,8 +233,7 @@ struct BulletMechanism<Spatial>::Impl {
     }
     for (std::size_t c = 0; c < model.constraints.size(); ++c) {
       const Constraint<Spatial>* k = model.constraints[c].get();
-      if (!dynamic_cast<const Rolling*>(k) && !dynamic_cast<const PlaneContact<Spatial>*>(k) &&
-          !dynamic_cast<const PointClosure<Spatial>*>(k))
+      if (!dynamic_cast<const Rolling*>(k) && !dynamic_cast<const PlaneContact<Spatial>*>(k) && !isPointClosure(k))
         throw std::invalid_argument(who + "constraint " + std::to_string(c) + " (" + k->kind() +
                                     "): not yet (only rolling, plane_contact and point_closure)");
     }
@@ -301,17 +298,7 @@ struct BulletMechanism<Spatial>::Impl {
   // Pitfall 1: every link gets a collider, with mask 0 (no contacts) unless a friction wheel's.
   void buildColliders() {
     shapes.push_back(std::make_unique<btSphereShape>(0.01));
-    for (int i = -1; i < body->getNumLinks(); ++i) {
-      auto c = std::make_unique<btMultiBodyLinkCollider>(body.get(), i);
-      c->setCollisionShape(shapes.front().get());
-      c->setActivationState(DISABLE_DEACTIVATION);
-      world->addCollisionObject(c.get(), btBroadphaseProxy::DefaultFilter, 0);
-      if (i < 0)
-        body->setBaseCollider(c.get());
-      else
-        body->getLink(i).m_collider = c.get();
-      colliders.push_back(std::move(c));
-    }
+    addLinkColliders(world, *body, body->getNumLinks(), shapes.front().get(), colliders);
   }
 
   // Rolling wheels (a NoSlip constraint or a Friction ball) and plane contacts (a ball), in description order.
@@ -319,7 +306,7 @@ struct BulletMechanism<Spatial>::Impl {
     const bool friction = model.bullet.rolling == RollingModel::Friction;
     std::vector<ContactBall> list;
     for (std::size_t c = 0; c < model.constraints.size(); ++c) {
-      if (dynamic_cast<const PointClosure<Spatial>*>(model.constraints[c].get())) {
+      if (isPointClosure(model.constraints[c].get())) {
         buildLoop(int(c));
         continue;
       }
@@ -497,12 +484,7 @@ struct BulletMechanism<Spatial>::Impl {
     const VecN pushed = applyForces(t, q, v);  // pitfall 3: cleared after every step, like the torques
     VecN friction = VecN::Zero(n);
     for (int i = 0; i < n; ++i) {
-      double tau = tau_in[i];
-      if (!model.joints.empty()) {  // spring, viscous and Coulomb friction from the step's start
-        const JointProperties& jp = model.joints[std::size_t(i)];
-        friction[i] = jp.friction(v[i]);
-        tau -= jp.stiffness * (q[i] - jp.rest) + friction[i];
-      }
+      const double tau = heldTorque(model.joints, i, tau_in[i], q[i], v[i], friction[i]);
       body->addJointTorque(i, tau);  // pitfall 3: cleared after every step
     }
     for (Wheel& w : wheels)
@@ -542,25 +524,6 @@ struct BulletMechanism<Spatial>::Impl {
   }
 };
 
-template <>
-BulletMechanism<Spatial>::BulletMechanism(const MechanismModel<Spatial>& model, double dt, const VecN& q0, const VecN& v0)
-    : impl_(std::make_unique<Impl>(model, dt, q0, v0)) {}
-template <>
-BulletMechanism<Spatial>::~BulletMechanism() {}
-template <>
-void BulletMechanism<Spatial>::step(const VecN& tau, double t) {
-  impl_->step(tau, t);
-}
-template <>
-Books BulletMechanism<Spatial>::books() const { return impl_->books; }
-template <>
-void BulletMechanism<Spatial>::state(VecN& q, VecN& v) const { impl_->state(q, v); }
-template <>
-Spatial::Vec BulletMechanism<Spatial>::constraintForce(int i) const {
-  if (i < 0 || i >= int(impl_->force.size())) throw std::out_of_range("BulletMechanism::constraintForce: no such constraint");
-  return impl_->force[std::size_t(i)];
-}
-template <>
-std::string BulletMechanism<Spatial>::describe() const { return impl_->summary; }
+template class BulletMechanism<Spatial>;
 
 }  // namespace dyn::bullet

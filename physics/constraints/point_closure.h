@@ -14,7 +14,7 @@
 namespace dyn {
 
 template <class S>
-class PointClosure final : public Constraint<S> {
+class PointClosure : public Constraint<S> {  // a point contact (point_contact.h) is one
  public:
   using Vec = typename S::Vec;
   using Pos = typename S::Pos;

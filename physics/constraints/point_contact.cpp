@@ -7,11 +7,11 @@ namespace dyn {
 
 template <class S>
 PointContact<S>::PointContact(BodyRef a, const Pos& point_a, BodyRef b, const Pos& point_b, const Pos& normal_b, double mu)
-    : rows_(a, point_a, b, point_b, PointClosure<S>::translations()), normal_b_(normal_b.normalized()), mu_(mu) {}
+    : PointClosure<S>(a, point_a, b, point_b, PointClosure<S>::translations()), normal_b_(normal_b.normalized()), mu_(mu) {}
 
 template <class S>
 typename S::Pos PointContact<S>::normal(const MechanismKinematics<S>& k) const {
-  return k.direction(attachment().b, normal_b_);
+  return k.direction(this->attachment().b, normal_b_);
 }
 
 template <class S>
@@ -30,7 +30,7 @@ void PointContact<S>::contactAxes(const Pos& f, const Pos& n, double mu, double*
 
 template <class S>
 void PointContact<S>::report(const MechanismKinematics<S>& k, const double* eta, double* out) const {
-  contactAxes(S::linear(force(k, eta)), normal(k), mu_, out);
+  contactAxes(S::linear(this->force(k, eta)), normal(k), mu_, out);
 }
 
 template class PointContact<Planar>;

@@ -14,24 +14,17 @@
 
 namespace dyn {
 
+// The rows, their force and point are the point closure's (translations only); a contact adds its kind,
+// its axes and its report.
 template <class S>
-class PointContact final : public Constraint<S> {
+class PointContact final : public PointClosure<S> {
  public:
-  using Vec = typename S::Vec;
   using Pos = typename S::Pos;
 
   // normal_b: b's outward surface normal at point_b, in b's frame; mu ≥ 0.
   PointContact(BodyRef a, const Pos& point_a, BodyRef b, const Pos& point_b, const Pos& normal_b, double mu);
 
   const char* kind() const override { return "point_contact"; }
-  int rows() const override { return rows_.rows(); }
-  void position(const MechanismKinematics<S>& k, int row, VecN& phi, MatN& J, MatN& A) const override {
-    rows_.position(k, row, phi, J, A);
-  }
-  void bias(const MechanismKinematics<S>& k, int row, VecN& b) const override { rows_.bias(k, row, b); }
-  Vec force(const MechanismKinematics<S>& k, const double* eta) const override { return rows_.force(k, eta); }
-  Pos point(const MechanismKinematics<S>& k) const override { return rows_.point(k); }
-  Attachment<S> attachment() const override { return rows_.attachment(); }
   // f_n, f_t, cone margin.
   std::vector<std::string> reportNames() const override { return {"f_n", "f_t", "cone_margin"}; }
   void report(const MechanismKinematics<S>& k, const double* eta, double* out) const override;
@@ -44,7 +37,6 @@ class PointContact final : public Constraint<S> {
   Pos normal(const MechanismKinematics<S>& k) const;
 
  private:
-  PointClosure<S> rows_;
   Pos normal_b_;
   double mu_;
 };

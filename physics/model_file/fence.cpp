@@ -3,7 +3,6 @@
 
 #include <fcntl.h>
 #include <malloc.h>
-#include <poll.h>
 #include <signal.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -11,13 +10,13 @@
 
 #include <algorithm>
 #include <cerrno>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <new>
 
 #include "physics/model_file/model_file.h"
+#include "physics/util/pipe.h"
 
 namespace dyn::model_file::detail {
 namespace {
@@ -25,15 +24,6 @@ namespace {
 // How the child ends: its reply follows a tag byte on the pipe.
 constexpr char kReply = 'R', kRefused = 'E';
 constexpr int kOutOfMemory = 97;
-
-void writeAll(int fd, const char* data, std::size_t size) {
-  for (std::size_t done = 0; done < size;) {
-    const ssize_t n = ::write(fd, data + done, size - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) return;
-    done += std::size_t(n);
-  }
-}
 
 [[noreturn]] void outOfMemory() { ::_exit(kOutOfMemory); }
 
@@ -81,8 +71,8 @@ std::size_t addressSpace() {
     tag = kRefused;
     reply = "unexpected error";
   }
-  writeAll(fd, &tag, 1);
-  writeAll(fd, reply.data(), reply.size());
+  writeAll(fd, std::string_view(&tag, 1));
+  writeAll(fd, reply);
   ::_exit(0);
 }
 
@@ -118,29 +108,10 @@ std::string fenced(const std::string& file, const std::string& who, const FenceL
     child(fds[1], limits, work);
   }
   ::close(fds[1]);
-  // Read until the child closes the pipe, the reply passes its bound or the time is up.
-  std::string bytes;
-  bool late = false, large = false;
-  const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(limits.seconds);
-  for (;;) {
-    const double left = std::chrono::duration<double>(until - std::chrono::steady_clock::now()).count();
-    if (left <= 0) {
-      late = true;
-      break;
-    }
-    pollfd p{fds[0], POLLIN, 0};
-    const int ready = ::poll(&p, 1, int(std::min(left, 3600.0) * 1000) + 1);
-    if (ready <= 0) continue;  // EINTR or time: the clock above decides
-    char buf[65536];
-    const ssize_t n = ::read(fds[0], buf, sizeof buf);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) break;
-    if (bytes.size() + std::size_t(n) > limits.max_reply + 1) {
-      large = true;
-      break;
-    }
-    bytes.append(buf, std::size_t(n));
-  }
+  // Read until the child closes the pipe, the reply (after its tag byte) passes its bound or the time is up.
+  const PipeRead read = readPipe(fds[0], limits.seconds, limits.max_reply + 1, Overflow::Stop);
+  const std::string& bytes = read.bytes;
+  const bool late = read.late, large = read.large;
   ::close(fds[0]);
   if (late || large) ::kill(pid, SIGKILL);
   int status = 0;

@@ -5,7 +5,8 @@
 // one line (a ModelFileError naming the file), never a signal or a hang. The child only
 // works, writes and _exit()s: no atexit handler, no flushed stdio buffer, nothing else of the
 // caller's (safe to fork from a threaded process such as the Python module or the window).
-// (grading/isolated.h does the same for work that may abort while drawing; physics may not use it.)
+// (grading/isolated.h does the same for work that may abort while drawing; physics may not use it. Both
+// read the child's pipe with physics/util/pipe.h.)
 #pragma once
 #include <cstddef>
 #include <functional>

@@ -3,7 +3,8 @@
 // a file up there by its name alone (no folder, any case) and reads the disk only when it is missing:
 // every name the text gives a file (an attribute file, filename or file*, as <include>, <mesh>,
 // <hfield>, <texture>, <skin> and URDF's <mesh filename> write them) is put there, either as the
-// checked bytes of a regular file inside the model's folder or, when no such file exists, as a
+// checked bytes of a regular file inside the folders packages.cpp allows (the model's, its ROS package,
+// the packages it names) or, when no such file exists, as a
 // one-byte stand-in that MuJoCo then reports as unreadable: MuJoCo never opens a FIFO, a device, a
 // link out of the folder or a file past the limits. The names are found by scanning the text for
 // attribute values (a lexical scan, not a parse: a name in a comment is checked too, harmlessly).
@@ -19,32 +20,12 @@
 #include <set>
 
 #include "physics/model_file/mujoco_call.h"
+#include "physics/util/utf8.h"
 
 namespace dyn::model_file::detail {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Offset of the first byte that is not well-formed UTF-8 (no overlongs, surrogates or cut-off
-// sequences), or npos.
-std::size_t utf8ErrorAt(const std::string& s) {
-  const auto* p = reinterpret_cast<const unsigned char*>(s.data());
-  const std::size_t n = s.size();
-  for (std::size_t i = 0; i < n;) {
-    const unsigned c = p[i];
-    int len = c < 0x80 ? 1 : (c >> 5) == 0x6 ? 2 : (c >> 4) == 0xE ? 3 : (c >> 3) == 0x1E ? 4 : 0;
-    if (len == 0 || i + std::size_t(len) > n) return i;
-    unsigned cp = len == 1 ? c : len == 2 ? (c & 0x1F) : len == 3 ? (c & 0x0F) : (c & 0x07);
-    for (int k = 1; k < len; ++k) {
-      if ((p[i + std::size_t(k)] & 0xC0) != 0x80) return i;
-      cp = (cp << 6) | (p[i + std::size_t(k)] & 0x3F);
-    }
-    const unsigned least[5] = {0, 0, 0x80, 0x800, 0x10000};
-    if (cp < least[len] || cp > 0x10FFFF || (cp >= 0xD800 && cp <= 0xDFFF)) return i;
-    i += std::size_t(len);
-  }
-  return std::string::npos;
-}
 
 // A regular file's bytes, at most `limit`: opened without blocking (a FIFO swapped in after the check
 // opens and is refused), its type and size taken from the open file. `who` starts each error.

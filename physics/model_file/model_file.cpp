@@ -134,31 +134,16 @@ struct Frame {
 
 BodyRef ref(int link) { return link < 0 ? BodyRef::world() : BodyRef::link(link); }
 
-}  // namespace
+// The frames' links and origins, per MuJoCo body, as drawing.cpp and elements.cpp take them.
+void splitFrames(const std::vector<Frame>& frame, std::vector<int>& link, std::vector<Vec3>& origin) {
+  for (const Frame& f : frame) link.push_back(f.link), origin.push_back(f.origin);
+}
 
-LoadedModel load(const std::string& path, const LoadOptions& options) {
-  LoadedModel out;
-  out.file = path;
-  std::string warnings;
-  out.compiled = detail::compile(path, &warnings, options.package_paths);
-  const mjModel* m = out.compiled->m;
-  if (!warnings.empty() && warnings != " ") out.notes.push_back("MuJoCo: " + warnings);
-  checkSupported(path, m, options, out.notes);
-  // The reference pose: MuJoCo's kinematics at qpos0 (anchors, axes, centres of mass, principal axes).
-  detail::MujocoGuard guard;
-  DataPtr data;
-  MUJOCO_CALL(path, data.reset(mj_makeData(m)));
-  if (!data) throw ModelFileError(path + ": MuJoCo could not make its data");
-  mjData* d = data.get();
-  MUJOCO_CALL(path, mj_kinematics(m, d));
-  checkNumbers(path, m, d);
-  const int flags = m->opt.disableflags;
-  out.timestep = m->opt.timestep;
-  out.q0 = VecN::Zero(m->nq);
-  for (int i = 0; i < m->nq; ++i) out.q0[i] = m->qpos0[i];
-
-  // The trees: one body per joint, in MuJoCo's order (parents first), frames on the anchors.
+// The trees: one body per joint, in MuJoCo's order (parents first), frames on the anchors; each body's
+// inertia, gravity and what to draw. Returns each MuJoCo body's frame.
+std::vector<Frame> readTree(const std::string& path, const mjModel* m, const mjData* d, LoadedModel& out) {
   MechanismModel<Spatial>& mech = out.mechanism;
+  const int flags = m->opt.disableflags;
   std::vector<Frame> frame(std::size_t(m->nbody));
   std::vector<Spatial::Mat> inertia;
   for (int b = 1; b < m->nbody; ++b) {
@@ -204,15 +189,18 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   }
   if (!(flags & mjDSBL_GRAVITY)) mech.tree.gravity.tail<3>() = Vec3(m->opt.gravity);
   // What to draw: the geoms, each on the tree body its MuJoCo body moves with.
-  {
-    std::vector<int> link;
-    std::vector<Vec3> origin;
-    for (const Frame& f : frame) link.push_back(f.link), origin.push_back(f.origin);
-    detail::readDrawing(m, d, link, origin, out.drawing);
-  }
+  std::vector<int> link;
+  std::vector<Vec3> origin;
+  splitFrames(frame, link, origin);
+  detail::readDrawing(m, d, link, origin, out.drawing);
+  return frame;
+}
 
-  // Joint springs, damping and friction (MuJoCo's passive forces and frictionloss), and armature
-  // (MuJoCo adds it to M's diagonal whatever the flags).
+// Joint springs, damping and friction (MuJoCo's passive forces and frictionloss), and armature
+// (MuJoCo adds it to M's diagonal whatever the flags); none when every joint is plain.
+void readJointProperties(const mjModel* m, LoadedModel& out) {
+  MechanismModel<Spatial>& mech = out.mechanism;
+  const int flags = m->opt.disableflags;
   bool any = false;
   mech.joints.resize(std::size_t(m->nv));
   for (int j = 0; j < m->nv; ++j) {
@@ -230,24 +218,31 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     any = any || p.stiffness != 0 || p.viscous != 0 || p.coulomb != 0 || p.armature != 0;
   }
   if (!any) mech.joints.clear();
+}
 
-  // Loop closures: connect and weld, points and rows at qpos0: the file's equalities, then the
-  // closures given beside it. `where` starts each error about one ("FILE: equality 'pin_C'").
-  struct Tie {
-    BodyRef a, b;
-    Vec3 pa, pb;
-    bool weld;
-    std::string where;
-  };
-  std::vector<Tie> ties;
+// A loop closure as read: body a's point tied to body b's, in their frames (world-aligned at qpos0).
+// `where` starts each error about it ("FILE: equality 'pin_C'").
+struct Tie {
+  BodyRef a, b;
+  Vec3 pa, pb;
+  bool weld;
+  std::string where;
+};
+
+// The ties read so far, each also a Closure for the report (out.closures, in the same order).
+struct Ties {
+  const mjModel* m;
+  const std::vector<Frame>& frame;
+  LoadedModel& out;
+  std::vector<Tie> list;
   // Body b1's point p1 tied to body b2's p2 (world, at qpos0).
-  auto tie = [&](const std::string& where, const std::string& name, bool weld, bool rotation, int b1, int b2, const Vec3& p1, const Vec3& p2) {
+  void add(const std::string& where, const std::string& name, bool weld, bool rotation, int b1, int b2, const Vec3& p1, const Vec3& p2) {
     const Frame& f1 = frame[std::size_t(b1)];
     const Frame& f2 = frame[std::size_t(b2)];
     if (f1.link == f2.link)
       throw ModelFileError(where + " ties body '" + nameOf(m, mjOBJ_BODY, b1, "body") + "' to '" + nameOf(m, mjOBJ_BODY, b2, "body") +
                            "', which no joint separates (they move as one body)");
-    ties.push_back({ref(f1.link), ref(f2.link), p1 - f1.origin, p2 - f2.origin, rotation, where});
+    list.push_back({ref(f1.link), ref(f2.link), p1 - f1.origin, p2 - f2.origin, rotation, where});
     Closure c;
     c.name = name;
     c.kind = weld ? "weld" : "connect";
@@ -255,9 +250,15 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     c.body2 = nameOf(m, mjOBJ_BODY, b2, "body");
     c.link1 = f1.link, c.link2 = f2.link, c.point1 = p1 - f1.origin, c.point2 = p2 - f2.origin;
     out.closures.push_back(c);
-  };
-  auto rotationOf = [&](int b) { return Mat3(Eigen::Map<const RowMat3>(d->xmat + 9 * b)); };
-  const bool equalities = !(flags & (mjDSBL_EQUALITY | mjDSBL_CONSTRAINT));
+  }
+};
+
+Mat3 rotationOf(const mjData* d, int b) { return Mat3(Eigen::Map<const RowMat3>(d->xmat + 9 * b)); }
+
+// The file's equalities, connect and weld, as ties (points and rows at qpos0).
+void readEqualities(const std::string& path, const mjModel* m, const mjData* d, Ties& ties) {
+  LoadedModel& out = ties.out;
+  const bool equalities = !(m->opt.disableflags & (mjDSBL_EQUALITY | mjDSBL_CONSTRAINT));
   if (!equalities && m->neq > 0) out.notes.push_back(std::to_string(m->neq) + " equalities off (<option><flag equality=\"disable\"/>)");
   for (int e = 0; equalities && e < m->neq; ++e) {
     const std::string name = nameOf(m, mjOBJ_EQUALITY, e, m->eq_type[e] == mjEQ_WELD ? "weld" : "connect");
@@ -269,7 +270,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     }
     const int b1 = m->eq_obj1id[e], b2 = m->eq_obj2id[e];
     const mjtNum* data_e = m->eq_data + mjNEQDATA * e;
-    const Mat3 R1 = rotationOf(b1), R2 = rotationOf(b2);
+    const Mat3 R1 = rotationOf(d, b1), R2 = rotationOf(d, b2);
     const bool weld = m->eq_type[e] == mjEQ_WELD;
     // connect: data = (anchor in body1, anchor in body2); weld: (anchor in body2, relpose in body1: point, quaternion, torquescale).
     const Vec3 p1 = Vec3(d->xpos + 3 * b1) + R1 * Vec3(data_e + (weld ? 3 : 0));
@@ -285,10 +286,13 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
         out.notes.push_back("weld '" + name + "' has torquescale 0: held as a connect (no rotation rows)");
       }
     }
-    tie(path + ": equality '" + name + "'", name, weld, rotation, b1, b2, p1, p2);
+    ties.add(path + ": equality '" + name + "'", name, weld, rotation, b1, b2, p1, p2);
   }
-  // Closures given beside the file: links by name, points in their frames (a weld holds the relative
-  // orientation at qpos0, as an MJCF weld without relpose does).
+}
+
+// Closures given beside the file, as ties: links by name, points in their frames (a weld holds the
+// relative orientation at qpos0, as an MJCF weld without relpose does).
+void readGivenClosures(const std::string& path, const mjModel* m, const mjData* d, const LoadOptions& options, Ties& ties) {
   for (const GivenClosure& g : options.closures) {
     auto body = [&](const std::string& field, const std::string& name) {
       const int b = name == "world" ? 0 : mj_name2id(m, mjOBJ_BODY, name.c_str());
@@ -299,53 +303,35 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     };
     if (g.kind != "connect" && g.kind != "weld") throw ModelFileError(g.where + ".kind: expected \"connect\" or \"weld\", got '" + g.kind + "'");
     // Names head the trace's force columns: one per closure.
-    for (const Closure& c : out.closures)
+    for (const Closure& c : ties.out.closures)
       if (c.name == g.name) throw ModelFileError(g.where + ".name: '" + g.name + "' names a closure of " + path + " too (expected a new name)");
     const int b1 = body("body1", g.body1), b2 = body("body2", g.body2);
-    const Vec3 p1 = Vec3(d->xpos + 3 * b1) + rotationOf(b1) * g.point1;
-    const Vec3 p2 = g.has_point2 ? Vec3(Vec3(d->xpos + 3 * b2) + rotationOf(b2) * g.point2) : p1;
-    tie(g.where + " ('" + g.name + "')", g.name, g.kind == "weld", g.kind == "weld", b1, b2, p1, p2);
+    const Vec3 p1 = Vec3(d->xpos + 3 * b1) + rotationOf(d, b1) * g.point1;
+    const Vec3 p2 = g.has_point2 ? Vec3(Vec3(d->xpos + 3 * b2) + rotationOf(d, b2) * g.point2) : p1;
+    ties.add(g.where + " ('" + g.name + "')", g.name, g.kind == "weld", g.kind == "weld", b1, b2, p1, p2);
   }
-  auto rowsOf = [](bool weld) { return weld ? PointClosure<Spatial>::all() : PointClosure<Spatial>::translations(); };
-  for (const Tie& t : ties) mech.constraints.push_back(std::make_shared<PointClosure<Spatial>>(t.a, t.pa, t.b, t.pb, rowsOf(t.weld)));
-  if (const std::string why = mech.validate(); !why.empty()) throw ModelFileError(path + ": " + why);
-  auto rank = [](const Eigen::MatrixXd& A) {
-    if (A.rows() == 0) return 0;
-    Eigen::FullPivLU<Eigen::MatrixXd> lu(A);
-    lu.setThreshold(1e-9);
-    return int(lu.rank());
-  };
-  // Last, dynlab's own elements beside the file (rolling wheels, plane contacts), and the mechanism's
-  // freedom at q0: coordinates minus the rank of the bilateral rows there (a contact's row is one-sided).
-  auto finish = [&]() {
-    {
-      std::vector<int> link;
-      std::vector<Vec3> origin;
-      for (const Frame& f : frame) link.push_back(f.link), origin.push_back(f.origin);
-      detail::addElements(path, m, d, link, origin, options, out);
-    }
-    MechanismModel<Spatial> bilateral = mech;
-    bilateral.constraints.clear();
-    for (const auto& c : mech.constraints)
-      if (!c->unilateral()) bilateral.constraints.push_back(c);
-    ConstrainedMechanism<Spatial> reduced(bilateral);
-    VecN phi;
-    MatN G;
-    reduced.constraint(out.q0, phi, G);
-    out.dof = m->nv - rank(Eigen::MatrixXd(G));
-    return out;
-  };
-  if (ties.empty()) return finish();
+}
 
-  // Each loop closes at qpos0 (MuJoCo places connect's second anchor there; a weld's relpose was checked).
-  const int n = m->nv;
+PointClosure<Spatial>::Rows rowsOf(bool weld) { return weld ? PointClosure<Spatial>::all() : PointClosure<Spatial>::translations(); }
+
+int rank(const Eigen::MatrixXd& A) {
+  if (A.rows() == 0) return 0;
+  Eigen::FullPivLU<Eigen::MatrixXd> lu(A);
+  lu.setThreshold(1e-9);
+  return int(lu.rank());
+}
+
+// Each loop closes at qpos0 (MuJoCo places connect's second anchor there; a weld's relpose was
+// checked); the description keeps each tie's rows that are not identically dependent on the rows
+// before them (a planar loop's out-of-plane rows), a closure left with none noted and dropped.
+void keepIndependentRows(const std::vector<Tie>& ties, int n, LoadedModel& out) {
+  MechanismModel<Spatial>& mech = out.mechanism;
   ConstrainedMechanism<Spatial> full(mech);
   for (std::size_t i = 0; i < ties.size(); ++i)
     if (const double gap = full.residual(int(i), out.q0); !(gap <= 1e-9))
       throw ModelFileError(ties[i].where + " does not hold at the reference pose (gap " + num(gap) +
                            "); write the file in its closed pose");
-  // Rows identically dependent on the rows before them (a planar loop's out-of-plane rows): J at
-  // seeded configurations around q0, side by side; a row is kept when it raises the rank.
+  // J at seeded configurations around q0, side by side; a row is kept when it raises the rank.
   constexpr int kSamples = 4;
   const int rows = full.rows();
   Eigen::MatrixXd stacked(rows, n * kSamples);
@@ -372,7 +358,6 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
       if (independent) kept = with;
     }
   }
-  // The description keeps the independent rows (a closure left with none is noted and dropped).
   mech.constraints.clear();
   std::vector<Closure> closures;
   for (std::size_t i = 0; i < ties.size(); ++i) {
@@ -384,14 +369,76 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     closures.push_back(out.closures[i]);
   }
   out.closures = closures;
-  // A body drawn as rods (no geom) reaches to its loop anchors too, so the drawn loop closes.
+}
+
+// A body drawn as rods (no geom) reaches to its loop anchors too, so the drawn loop closes.
+void reachLoopAnchors(LoadedModel& out) {
   auto reach = [&](int link, const Vec3& point) {
     const auto& bones = out.drawing.bones;
     if (link >= 0 && std::any_of(bones.begin(), bones.end(), [&](const Bone& b) { return b.link == link; }))
       out.drawing.bones.push_back({link, Vec3::Zero(), point});
   };
   for (const Closure& c : out.closures) reach(c.link1, c.point1), reach(c.link2, c.point2);
-  return finish();
+}
+
+// Last, dynlab's own elements beside the file (rolling wheels, plane contacts), and the mechanism's
+// freedom at q0: coordinates minus the rank of the bilateral rows there (a contact's row is one-sided).
+void addElementsAndFreedom(const std::string& path, const mjModel* m, const mjData* d, const std::vector<Frame>& frame,
+                           const LoadOptions& options, LoadedModel& out) {
+  std::vector<int> link;
+  std::vector<Vec3> origin;
+  splitFrames(frame, link, origin);
+  detail::addElements(path, m, d, link, origin, options, out);
+  MechanismModel<Spatial> bilateral = out.mechanism;
+  bilateral.constraints.clear();
+  for (const auto& c : out.mechanism.constraints)
+    if (!c->unilateral()) bilateral.constraints.push_back(c);
+  ConstrainedMechanism<Spatial> reduced(bilateral);
+  VecN phi;
+  MatN G;
+  reduced.constraint(out.q0, phi, G);
+  out.dof = m->nv - rank(Eigen::MatrixXd(G));
+}
+
+}  // namespace
+
+// Compiled and checked, then read at the reference pose: the trees, the joints, the loop closures
+// (their independent rows), dynlab's own elements.
+LoadedModel load(const std::string& path, const LoadOptions& options) {
+  LoadedModel out;
+  out.file = path;
+  std::string warnings;
+  out.compiled = detail::compile(path, &warnings, options.package_paths);
+  const mjModel* m = out.compiled->m;
+  if (!warnings.empty() && warnings != " ") out.notes.push_back("MuJoCo: " + warnings);
+  checkSupported(path, m, options, out.notes);
+  // The reference pose: MuJoCo's kinematics at qpos0 (anchors, axes, centres of mass, principal axes).
+  detail::MujocoGuard guard;
+  DataPtr data;
+  MUJOCO_CALL(path, data.reset(mj_makeData(m)));
+  if (!data) throw ModelFileError(path + ": MuJoCo could not make its data");
+  mjData* d = data.get();
+  MUJOCO_CALL(path, mj_kinematics(m, d));
+  checkNumbers(path, m, d);
+  out.timestep = m->opt.timestep;
+  out.q0 = VecN::Zero(m->nq);
+  for (int i = 0; i < m->nq; ++i) out.q0[i] = m->qpos0[i];
+
+  const std::vector<Frame> frame = readTree(path, m, d, out);
+  readJointProperties(m, out);
+  // Loop closures: the file's equalities, then the closures given beside it, every row at first.
+  Ties ties{m, frame, out, {}};
+  readEqualities(path, m, d, ties);
+  readGivenClosures(path, m, d, options, ties);
+  MechanismModel<Spatial>& mech = out.mechanism;
+  for (const Tie& t : ties.list) mech.constraints.push_back(std::make_shared<PointClosure<Spatial>>(t.a, t.pa, t.b, t.pb, rowsOf(t.weld)));
+  if (const std::string why = mech.validate(); !why.empty()) throw ModelFileError(path + ": " + why);
+  if (!ties.list.empty()) {
+    keepIndependentRows(ties.list, m->nv, out);
+    reachLoopAnchors(out);
+  }
+  addElementsAndFreedom(path, m, d, frame, options, out);
+  return out;
 }
 
 }  // namespace dyn::model_file

@@ -60,20 +60,6 @@ MujocoGuard::~MujocoGuard() {
 std::string MujocoGuard::warnings() const { return oneLine(collected()); }
 }  // namespace detail
 
-struct MujocoReference::Impl {
-  mjModel* m = nullptr;
-  mjData* d = nullptr;
-  std::string file;
-  detail::MujocoGuard guard;
-  void at(const VecN& q, const VecN* v) {
-    std::copy(q.data(), q.data() + m->nq, d->qpos);
-    if (v) std::copy(v->data(), v->data() + m->nv, d->qvel);
-    else std::fill(d->qvel, d->qvel + m->nv, 0.0);
-    MUJOCO_CALL(file, mj_fwdPosition(m, d));
-    if (v) MUJOCO_CALL(file, mj_fwdVelocity(m, d));
-  }
-};
-
 namespace {
 
 // A copy of the model compiled at load (the cross-check and the bench each own one).
@@ -85,26 +71,50 @@ mjModel* copyOf(const LoadedModel& model) {
   return m;
 }
 
+// An owned copy of the model and its data, under MuJoCo's handlers while it lives; `adjust` changes
+// the copy (its options) before the data is made.
+struct OwnedModel {
+  detail::MujocoGuard guard;
+  std::string file;
+  mjModel* m = nullptr;
+  mjData* d = nullptr;
+  template <class Adjust>
+  OwnedModel(const LoadedModel& model, Adjust adjust) : file(model.file) {
+    m = copyOf(model);
+    try {
+      adjust(m);
+      MUJOCO_CALL(model.file, d = mj_makeData(m));
+      if (!d) throw ModelFileError(model.file + ": MuJoCo could not make its data");
+    } catch (...) {
+      mj_deleteModel(m);
+      throw;
+    }
+  }
+  ~OwnedModel() {
+    if (d) mj_deleteData(d);
+    if (m) mj_deleteModel(m);
+  }
+  OwnedModel(const OwnedModel&) = delete;
+  OwnedModel& operator=(const OwnedModel&) = delete;
+};
+
 }  // namespace
 
-MujocoReference::MujocoReference(const LoadedModel& model) : impl_(new Impl) {
-  impl_->file = model.file;
-  try {
-    impl_->m = copyOf(model);
-    MUJOCO_CALL(model.file, impl_->d = mj_makeData(impl_->m));
-    if (!impl_->d) throw ModelFileError(model.file + ": MuJoCo could not make its data");
-  } catch (...) {
-    if (impl_->m) mj_deleteModel(impl_->m);
-    delete impl_;
-    throw;
+// The cross-check: the model as loaded, its state set and MuJoCo's position (and velocity) stages run.
+struct MujocoReference::Impl : OwnedModel {
+  explicit Impl(const LoadedModel& model) : OwnedModel(model, [](mjModel*) {}) {}
+  void at(const VecN& q, const VecN* v) {
+    std::copy(q.data(), q.data() + m->nq, d->qpos);
+    if (v) std::copy(v->data(), v->data() + m->nv, d->qvel);
+    else std::fill(d->qvel, d->qvel + m->nv, 0.0);
+    MUJOCO_CALL(file, mj_fwdPosition(m, d));
+    if (v) MUJOCO_CALL(file, mj_fwdVelocity(m, d));
   }
-}
+};
 
-MujocoReference::~MujocoReference() {
-  if (impl_->d) mj_deleteData(impl_->d);
-  if (impl_->m) mj_deleteModel(impl_->m);
-  delete impl_;
-}
+MujocoReference::MujocoReference(const LoadedModel& model) : impl_(new Impl(model)) {}
+
+MujocoReference::~MujocoReference() { delete impl_; }
 
 int MujocoReference::nv() const { return impl_->m->nv; }
 
@@ -126,33 +136,18 @@ VecN MujocoReference::bias(const VecN& q, const VecN& v) {
   return out;
 }
 
-struct MujocoSimulation::Impl {
-  mjModel* m = nullptr;
-  mjData* d = nullptr;
-  std::string file;
-  detail::MujocoGuard guard;
+// The bench's simulation: the model at the given step with the Euler integrator.
+struct MujocoSimulation::Impl : OwnedModel {
+  Impl(const LoadedModel& model, double dt)
+      : OwnedModel(model, [dt](mjModel* m) {
+          m->opt.timestep = dt;
+          m->opt.integrator = mjINT_EULER;
+        }) {}
 };
 
-MujocoSimulation::MujocoSimulation(const LoadedModel& model, double dt) : impl_(new Impl) {
-  impl_->file = model.file;
-  try {
-    impl_->m = copyOf(model);
-    impl_->m->opt.timestep = dt;
-    impl_->m->opt.integrator = mjINT_EULER;
-    MUJOCO_CALL(model.file, impl_->d = mj_makeData(impl_->m));
-    if (!impl_->d) throw ModelFileError(model.file + ": MuJoCo could not make its data");
-  } catch (...) {
-    if (impl_->m) mj_deleteModel(impl_->m);
-    delete impl_;
-    throw;
-  }
-}
+MujocoSimulation::MujocoSimulation(const LoadedModel& model, double dt) : impl_(new Impl(model, dt)) {}
 
-MujocoSimulation::~MujocoSimulation() {
-  if (impl_->d) mj_deleteData(impl_->d);
-  if (impl_->m) mj_deleteModel(impl_->m);
-  delete impl_;
-}
+MujocoSimulation::~MujocoSimulation() { delete impl_; }
 
 void MujocoSimulation::reset(const VecN& q, const VecN& v) {
   mjData* d = impl_->d;

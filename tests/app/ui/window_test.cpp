@@ -221,7 +221,13 @@ TEST_CASE("gains saved by the window grade exactly like the same gains written b
   CHECK(saved == by_hand);
   std::ofstream(dir / "by_hand.json") << by_hand.dump();
   const json a = grade(dir, "mine.json", "graded_mine"), b = grade(dir, "by_hand.json", "graded_by_hand");
-  CHECK(a["score"].get<double>() > 10.0);  // these gains (about 12/15), not the lab's defaults (5.4/15)
+  // These gains, not the lab's defaults: the defaults (each gain's "value" in the config) grade lower.
+  json defaults = {{"lab", "slider_crank"}, {"gains", json::object()}};
+  const json config = loadJsonFile(std::string(DYNLAB_SOURCE_DIR) + "/labs/slider_crank/slider_crank.json");
+  for (const auto& [name, g] : config["gains"].items()) defaults["gains"][name] = g["value"];
+  std::ofstream(dir / "defaults.json") << defaults.dump();
+  const json d = grade(dir, "defaults.json", "graded_defaults");
+  CHECK(a["score"].get<double>() > d["score"].get<double>() + 0.5);
   CHECK(a["score"] == b["score"]);
   CHECK(a["tests"] == b["tests"]);
   CHECK(a["extra_data"]["fingerprint"]["submission_hash"] == b["extra_data"]["fingerprint"]["submission_hash"]);
