@@ -12,35 +12,14 @@
 #include <vector>
 
 #include "tests/app/cli_run.h"
+#include "tests/physics/model_file/mesh_files.h"
 
 using namespace dyn::test::cli;
 
 namespace {
 
-// A binary STL of the tetrahedron (0, s e_x, s e_y, s e_z).
-std::string tetrahedron(float s) {
-  const float O[3] = {0, 0, 0}, X[3] = {s, 0, 0}, Y[3] = {0, s, 0}, Z[3] = {0, 0, s};
-  const float* faces[4][3] = {{O, Y, X}, {O, X, Z}, {O, Z, Y}, {X, Y, Z}};
-  std::string b(80, ' ');
-  const std::uint32_t count = 4;
-  b.append(reinterpret_cast<const char*>(&count), 4);
-  for (const auto& f : faces) {
-    const float normal[3] = {0, 0, 0};
-    b.append(reinterpret_cast<const char*>(normal), 12);
-    for (const float* v : f) b.append(reinterpret_cast<const char*>(v), 12);
-    b.append(2, '\0');
-  }
-  return b;
-}
-
-// A one-link URDF arm whose collision shape is the mesh `filename`, as ROS exports write it.
-std::string urdf(const std::string& filename) {
-  return "<robot name=\"arm\"><link name=\"base\"/><link name=\"l1\"><inertial><origin xyz=\"0 0 -0.2\"/><mass value=\"1\"/>"
-         "<inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>"
-         "<collision><geometry><mesh filename=\"" + filename + "\"/></geometry></collision></link>"
-         "<joint name=\"j1\" type=\"revolute\"><parent link=\"base\"/><child link=\"l1\"/><origin rpy=\"0.3 0 0\"/><axis xyz=\"0 1 0\"/>"
-         "<limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint></robot>";
-}
+using dyn::test_model_file::meshArmUrdf;
+using dyn::test_model_file::tetrahedronStl;
 
 // A pendulum: `option` inside <option …/>, and `extra` in the world body.
 std::string pendulum(const std::string& option, const std::string& extra = "") {
@@ -70,8 +49,8 @@ TEST_CASE("a URDF whose meshes are package://robot/meshes/…, beside its urdf/ 
   TempDir dir("model_files_layout");
   fs::create_directories(dir / "robot/meshes");
   fs::create_directories(dir / "robot/urdf");
-  writeFile(dir / "robot/meshes/body.stl", tetrahedron(0.1f));
-  writeFile(dir / "robot/urdf/arm.urdf", urdf("package://robot/meshes/body.stl"));
+  writeFile(dir / "robot/meshes/body.stl", tetrahedronStl(0.1f));
+  writeFile(dir / "robot/urdf/arm.urdf", meshArmUrdf("package://robot/meshes/body.stl"));
   for (const auto& args : commands(dir, "robot/urdf/arm.urdf", {})) {
     const Result r = dynlab(dir, args);
     INFO(shown(args), "\n", r.err);
@@ -83,8 +62,8 @@ TEST_CASE("a package found only through --package-path: one line naming where dy
   TempDir dir("model_files_package_path");
   fs::create_directories(dir / "vendor/parts/meshes");
   fs::create_directories(dir / "ws");
-  writeFile(dir / "vendor/parts/meshes/body.stl", tetrahedron(0.1f));
-  writeFile(dir / "ws/arm.urdf", urdf("package://parts/meshes/body.stl"));
+  writeFile(dir / "vendor/parts/meshes/body.stl", tetrahedronStl(0.1f));
+  writeFile(dir / "ws/arm.urdf", meshArmUrdf("package://parts/meshes/body.stl"));
   for (const auto& args : commands(dir, "ws/arm.urdf", {})) {
     const Result r = dynlab(dir, args);
     INFO(shown(args), "\n", r.err);

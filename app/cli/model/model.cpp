@@ -161,6 +161,16 @@ std::string report(const ModelRun& r, const std::string& engine, const model_fil
   return o.str();
 }
 
+// The step the run takes: --dt, else the file's own <option timestep> within --dt's bounds; 0 after
+// one line on stderr.
+double runStep(const ModelArgs& args, const model_file::LoadedModel& m) {
+  if (args.dt > 0) return args.dt;
+  if (m.timestep >= kMinDt && m.timestep <= kMaxDt) return m.timestep;
+  std::fprintf(stderr, "error: %s: <option timestep>: %s s, outside the steps dynlab runs a model file at ([%g, %g] s); pass --dt\n",
+               nameShown(m.file).c_str(), exactNumber(m.timestep).c_str(), kMinDt, kMaxDt);
+  return 0;
+}
+
 }  // namespace
 
 ModelCommand::ModelCommand(CLI::App& cli) {
@@ -253,16 +263,7 @@ int model(const ModelArgs& asked) {
     std::fprintf(stderr, "error: %s\n", shownLine(e.what()).c_str());
     return 2;
   }
-  // The file's own step unless --dt gives one: within --dt's bounds, and the run's.
-  if (args.dt == 0) {
-    if (!(m.timestep >= kMinDt && m.timestep <= kMaxDt)) {
-      std::fprintf(stderr, "error: %s: <option timestep>: %s s, outside the steps dynlab runs a model file at ([%g, %g] s); pass --dt\n",
-                   nameShown(m.file).c_str(), exactNumber(m.timestep).c_str(), kMinDt, kMaxDt);
-      return 2;
-    }
-    args.dt = m.timestep;
-    if (const std::string problem = runBoundProblem(args.dt, args.duration, 0, "timestep"); !problem.empty()) return refuse("--duration", problem);
-  }
+  if ((args.dt = runStep(args, m)) == 0) return 2;
   if (const std::string problem = runBoundProblem(args.dt, args.duration, modelColumns(m).columns.size()); !problem.empty())
     return refuse("--duration", problem);
   // Constant torques by joint name: each "JOINT=VALUE" once, a joint of the file, a finite value.

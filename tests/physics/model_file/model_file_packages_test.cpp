@@ -13,11 +13,15 @@
 
 #include "physics/model_file/model_file.h"
 #include "tests/physics/model_file/fixtures.h"
+#include "tests/physics/model_file/mesh_files.h"
 
 using namespace dyn;
 namespace fs = std::filesystem;
 
 namespace {
+
+using dyn::test_model_file::meshArmUrdf;
+using dyn::test_model_file::tetrahedronStl;
 
 fs::path folder() {
   static const fs::path dir = test_model_file::scratchFolder("model_packages");
@@ -25,31 +29,6 @@ fs::path folder() {
 }
 
 fs::path write(const std::string& name, const std::string& text) { return test_model_file::writeFile(folder(), name, text); }
-
-// A binary STL of the tetrahedron (0, s e_x, s e_y, s e_z).
-std::string tetrahedron(float s) {
-  const float O[3] = {0, 0, 0}, X[3] = {s, 0, 0}, Y[3] = {0, s, 0}, Z[3] = {0, 0, s};
-  const float* faces[4][3] = {{O, Y, X}, {O, X, Z}, {O, Z, Y}, {X, Y, Z}};
-  std::string b(80, ' ');
-  const std::uint32_t count = 4;
-  b.append(reinterpret_cast<const char*>(&count), 4);
-  for (const auto& f : faces) {
-    const float normal[3] = {0, 0, 0};
-    b.append(reinterpret_cast<const char*>(normal), 12);
-    for (const float* v : f) b.append(reinterpret_cast<const char*>(v), 12);
-    b.append(2, '\0');
-  }
-  return b;
-}
-
-// A one-link URDF arm whose collision shape is the mesh `filename` (as ROS exports write it).
-std::string urdf(const std::string& filename) {
-  return "<robot name=\"arm\"><link name=\"base\"/><link name=\"l1\"><inertial><origin xyz=\"0 0 -0.2\"/><mass value=\"1\"/>"
-         "<inertia ixx=\"0.01\" iyy=\"0.01\" izz=\"0.01\" ixy=\"0\" ixz=\"0\" iyz=\"0\"/></inertial>"
-         "<collision><geometry><mesh filename=\"" + filename + "\"/></geometry></collision></link>"
-         "<joint name=\"j1\" type=\"revolute\"><parent link=\"base\"/><child link=\"l1\"/><axis xyz=\"0 1 0\"/>"
-         "<limit lower=\"-3\" upper=\"3\" effort=\"1\" velocity=\"1\"/></joint></robot>";
-}
 
 // The size of the capsule drawn for the model's one mesh: it scales with the mesh MuJoCo read.
 double drawnSize(const fs::path& file, const model_file::LoadOptions& options = {}) {
@@ -66,15 +45,15 @@ bool has(const std::string& s, const std::string& part) { return s.find(part) !=
 
 TEST_CASE("package://NAME/… is found in the folders above the file, beside them, through --package-path and ROS_PACKAGE_PATH") {
   // robot/urdf/arm.urdf naming package://robot/meshes/body.stl: the folder above is the package.
-  write("robot/meshes/body.stl", tetrahedron(0.1f));
-  const double ref = drawnSize(write("robot/urdf/arm.urdf", urdf("package://robot/meshes/body.stl")));
+  write("robot/meshes/body.stl", tetrahedronStl(0.1f));
+  const double ref = drawnSize(write("robot/urdf/arm.urdf", meshArmUrdf("package://robot/meshes/body.stl")));
   CHECK(ref > 0.01);
   // package://assets/body.stl beside the file: assets/ is the package (was "not in the model's folder").
-  write("flat/assets/body.stl", tetrahedron(0.2f));
-  CHECK(drawnSize(write("flat/arm.urdf", urdf("package://assets/body.stl"))) == doctest::Approx(2 * ref).epsilon(0.02));
+  write("flat/assets/body.stl", tetrahedronStl(0.2f));
+  CHECK(drawnSize(write("flat/arm.urdf", meshArmUrdf("package://assets/body.stl"))) == doctest::Approx(2 * ref).epsilon(0.02));
   // A package elsewhere: not found until named by --package-path or ROS_PACKAGE_PATH; each then read.
-  write("elsewhere/parts/meshes/body.stl", tetrahedron(0.3f));
-  const fs::path far = write("ws/far.urdf", urdf("package://parts/meshes/body.stl"));
+  write("elsewhere/parts/meshes/body.stl", tetrahedronStl(0.3f));
+  const fs::path far = write("ws/far.urdf", meshArmUrdf("package://parts/meshes/body.stl"));
   const std::string missing = errorOf(far);
   CHECK(has(missing, "file 'package://parts/meshes/body.stl' not found (no package folder 'parts' in the folders above "));
   CHECK(has(missing, "--package-path DIR"));
@@ -87,21 +66,21 @@ TEST_CASE("package://NAME/… is found in the folders above the file, beside the
   CHECK(drawnSize(far) == doctest::Approx(3 * ref).epsilon(0.02));
   ::unsetenv("ROS_PACKAGE_PATH");
   // The package is found but lacks the file: where dynlab looked.
-  CHECK(has(errorOf(write("robot/urdf/typo.urdf", urdf("package://robot/meshes/bodyy.stl"))),
+  CHECK(has(errorOf(write("robot/urdf/typo.urdf", meshArmUrdf("package://robot/meshes/bodyy.stl"))),
             "file 'package://robot/meshes/bodyy.stl' not found (looked in package 'robot' at "));
 }
 
 TEST_CASE("meshes beside a URDF's folder load inside a ROS package; file:// is a path; outside stays refused") {
-  write("pkg/meshes/body.stl", tetrahedron(0.1f));
-  const fs::path up = write("pkg/urdf/up.urdf", urdf("../meshes/body.stl"));
+  write("pkg/meshes/body.stl", tetrahedronStl(0.1f));
+  const fs::path up = write("pkg/urdf/up.urdf", meshArmUrdf("../meshes/body.stl"));
   CHECK(has(errorOf(up), "outside the model's folder"));  // no package.xml: not a package
   write("pkg/package.xml", "<package><name>pkg</name></package>");
   CHECK(drawnSize(up) > 0.01);
   // file:// with an absolute path inside the package, and a relative one.
-  CHECK(drawnSize(write("pkg/urdf/abs.urdf", urdf("file://" + (folder() / "pkg/meshes/body.stl").string()))) > 0.01);
-  CHECK(drawnSize(write("pkg/urdf/rel.urdf", urdf("file://../meshes/body.stl"))) > 0.01);
+  CHECK(drawnSize(write("pkg/urdf/abs.urdf", meshArmUrdf("file://" + (folder() / "pkg/meshes/body.stl").string()))) > 0.01);
+  CHECK(drawnSize(write("pkg/urdf/rel.urdf", meshArmUrdf("file://../meshes/body.stl"))) > 0.01);
   // A package:// name does not open the rest of the disk: no system folder is a package.
-  CHECK(has(errorOf(write("pkg/urdf/dev.urdf", urdf("package://dev/zero"))), "no package folder 'dev'"));
-  CHECK(has(errorOf(write("pkg/urdf/etc.urdf", urdf("package://etc/passwd"))), "no package folder 'etc'"));
+  CHECK(has(errorOf(write("pkg/urdf/dev.urdf", meshArmUrdf("package://dev/zero"))), "no package folder 'dev'"));
+  CHECK(has(errorOf(write("pkg/urdf/etc.urdf", meshArmUrdf("package://etc/passwd"))), "no package folder 'etc'"));
   fs::remove_all(folder());
 }
