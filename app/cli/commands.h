@@ -9,6 +9,7 @@
 #include <string>
 #include <vector>
 
+#include "labs/generic/model_lab.h"
 #include "labs/lab.h"
 #include "labs/run.h"
 
@@ -22,6 +23,8 @@ struct RunArgs {
   // A model file's run only (dynlab model's options): constant torques JOINT=VALUE, loops beside it.
   std::vector<std::string> torques;
   std::string loops;
+  ModelFileFlags model_files;  // --ignore-contacts, --package-path
+  std::optional<double> dt;    // --dt (s; default: the file's <option timestep>)
 };
 
 struct GradeArgs {
@@ -50,6 +53,7 @@ struct FigureArgs {
   std::vector<double> stills;      // simulated times (s)
   std::optional<double> duration;
   bool overlay = true;
+  ModelFileFlags model_files;  // a model file's --ignore-contacts, --package-path
 };
 
 // dynlab compare A B: two submissions of one lab graded by the same rubric, side by side.
@@ -85,6 +89,7 @@ struct BenchArgs {
   std::string lab;         // empty: every lab
   bool scaling = false;    // the chain-length sweep instead (app/cli/bench/bench_scaling.cpp)
   std::string out;         // --scaling: where scaling.csv and scaling.png go (default out/bench)
+  ModelFileFlags model_files;  // a model file's --ignore-contacts, --package-path
 };
 
 // --scenario NAME (run, figure): rebuilds the loaded lab under the rubric scenario's patch and noise

@@ -154,6 +154,8 @@ void addRun(CLI::App& cli, Commands& x) {
   x.r->add_option("--torque", x.run.torques, "A model file only: a constant joint torque JOINT=VALUE (N·m; N on a slide), "
                                          "repeatable (default: passive)")->allow_extra_args(false);
   x.r->add_option("--loops", x.run.loops, "A model file only: loop closures beside it (JSON; default: STEM.loops.json beside a .urdf)");
+  x.r->add_option("--dt", x.run.dt, "A model file only: the fixed step (s, 1e-5 to 1e-2; default: the file's <option timestep>)");
+  dyn::app::addModelFileOptions(x.r, x.run.model_files);
 }
 
 // figure: lecture plots and stills from a run.
@@ -193,6 +195,7 @@ void addFigure(CLI::App& cli, Commands& x) {
   x.f->add_option("--title", x.fig.title, "Title of every plot and of the stills' panel (default: the lab and columns)");
   x.f->add_option("--scenario", x.fig.scenario, "Run under one rubric scenario exactly as the grader does "
                                           "(default out: out/LAB/scenarios/NAME/figures)");
+  dyn::app::addModelFileOptions(x.f, x.fig.model_files);
 }
 
 // grade: one submission, a replay, or a whole folder.
@@ -296,6 +299,7 @@ void addBench(CLI::App& cli, Commands& x) {
               "Step cost against chain length (3 to 1,000 links): hand ABA, hand CRBA + Cholesky, Bullet; "
               "a table, OUT/scaling.csv and OUT/scaling.png");
   x.b->add_option("--out", x.bench_args.out, "--scaling: output directory (default: out/bench)");
+  dyn::app::addModelFileOptions(x.b, x.bench_args.model_files);
 }
 
 // The chosen command, run: its exit code (2 when none was chosen, which CLI11 already refuses).
@@ -305,14 +309,18 @@ int runChosen(Commands& x, const dyn::app::LabOptions& lab_options) {
   if (*x.list) return listLabs();
   if (*x.r) {
     if (isModelFile(x.run.lab)) return runModelFile(x.run);
-    if (!x.run.torques.empty() || !x.run.loops.empty()) {
-      std::fprintf(stderr, "error: <command line>: %s: a lab's torques come from its controller; --torque and --loops are for a model file\n",
-                   x.run.torques.empty() ? "--loops" : "--torque");
+    if (!x.run.torques.empty() || !x.run.loops.empty() || x.run.dt) {
+      std::fprintf(stderr, "error: <command line>: %s: a lab's torques come from its controller and its step from its config; --torque, "
+                   "--loops and --dt are for a model file\n", x.run.dt ? "--dt" : x.run.torques.empty() ? "--loops" : "--torque");
       return 2;
     }
+    if (const int refused = refuseModelFileFlags(x.run.lab, x.run.model_files)) return refused;
     return runLab(x.run);
   }
-  if (*x.f) return figure(x.fig);
+  if (*x.f) {
+    if (!isModelFile(x.fig.lab) && refuseModelFileFlags(x.fig.lab, x.fig.model_files)) return 2;
+    return figure(x.fig);
+  }
   if (*x.g) return !x.grade.batch.empty() ? gradeBatch(x.grade) : !x.grade.replay.empty() ? gradeReplay(x.grade) : gradeOne(x.grade);
   if (*x.z) return writeAutograderZip(x.zip_lab, x.zip_out);
   if (*x.c) return checkResults(x.results_file);
@@ -322,7 +330,10 @@ int runChosen(Commands& x, const dyn::app::LabOptions& lab_options) {
   if (*x.l) return lessons(x.les);
   if (*x.cl) return checkLab(x.check_lab);
   if (*x.nl) return newLab(x.new_lab);
-  if (*x.b) return x.bench_args.scaling ? benchScaling(x.bench_args) : bench(x.bench_args);
+  if (*x.b) {
+    if (!isModelFile(x.bench_args.lab) && refuseModelFileFlags(x.bench_args.lab, x.bench_args.model_files)) return 2;
+    return x.bench_args.scaling ? benchScaling(x.bench_args) : bench(x.bench_args);
+  }
   if (*x.u) {
     x.ui.extra = x.u->remaining();
     return openUi(x.ui);

@@ -146,8 +146,10 @@ class ModelFileLab final : public Lab {
 
 }  // namespace
 
-LoadedLab loadModelLab(const std::string& file, std::optional<double> duration) {
+LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, const ModelFileFlags& flags) {
   model_file::LoadOptions options;
+  options.ignore_contacts = flags.ignore_contacts;
+  options.package_paths = flags.package_paths;
   auto m = std::make_shared<model_file::LoadedModel>();
   try {
     if (const std::string beside = loopsBeside(file); !beside.empty()) readBeside(beside, options);

@@ -14,6 +14,13 @@
 
 namespace dyn::app {
 
+// What the command line adds to a model file's load (dynlab model, run, figure, bench: --ignore-contacts,
+// --package-path DIR).
+struct ModelFileFlags {
+  bool ignore_contacts = false;            // geoms that may collide: loaded, contacts ignored (noted)
+  std::vector<std::string> package_paths;  // folders holding package://NAME/… packages
+};
+
 // True when LAB names a model file (ends in .xml or .urdf, any case): no lab's name does.
 bool isModelFile(const std::string& name);
 
@@ -21,7 +28,7 @@ bool isModelFile(const std::string& name);
 // contacts beside it; its figures are the coordinates, the energy books (with the touchdowns' losses),
 // each closure's force and each wheel's or contact's.
 // Throws InputError (one line, naming the file) on bad input.
-LoadedLab loadModelLab(const std::string& file, std::optional<double> duration);
+LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, const ModelFileFlags& flags = {});
 
 // Names joined by sep ("q_crank, q_rocker"; "x z"): a model's columns and rows in figures and summaries.
 std::string join(const std::vector<std::string>& v, const char* sep = " ");

@@ -49,13 +49,12 @@ std::string parse(const std::string& path, const std::string& bytes, const mjVFS
   MujocoGuard guard;
   MUJOCO_CALL(path, m = mj_loadXML(path.c_str(), vfs, error, sizeof error));
   if (!m) {
-    std::string why = path + ": MuJoCo's parser: " + oneLine(error[0] ? error : "no model");
-    if (!missing.empty()) {
-      why += " (named but not found in the model's folder:";
-      for (std::size_t i = 0; i < missing.size() && i < 3; ++i) why += " '" + oneLine(missing[i]) + "'";
-      why += missing.size() > 3 ? " ...)" : ")";
-    }
-    throw ModelFileError(why);
+    // A file the model names and dynlab did not find is the likely cause: named first, with where it was looked for.
+    std::string why = path + ": ";
+    for (std::size_t i = 0; i < missing.size() && i < 3; ++i) why += (i ? "; " : "file ") + missing[i];
+    if (missing.size() > 3) why += "; and " + std::to_string(missing.size() - 3) + " more";
+    if (!missing.empty()) why += "; then ";
+    throw ModelFileError(why + "MuJoCo's parser: " + oneLine(error[0] ? error : "no model"));
   }
   mjData* d = nullptr;
   MUJOCO_CALL(path, d = mj_makeData(m));
@@ -83,7 +82,7 @@ Compiled::~Compiled() {
   if (m) mj_deleteModel(m);
 }
 
-std::shared_ptr<const Compiled> compile(const std::string& path, std::string* warnings) {
+std::shared_ptr<const Compiled> compile(const std::string& path, std::string* warnings, const std::vector<std::string>& package_paths) {
   const std::string bytes = readChecked(path);
   const std::string name = std::filesystem::path(path).filename().string();
   if (name.size() >= mjMAXVFSNAME) throw ModelFileError(path + ": file name longer than MuJoCo's " + std::to_string(mjMAXVFSNAME - 1) + " characters");
@@ -91,7 +90,7 @@ std::shared_ptr<const Compiled> compile(const std::string& path, std::string* wa
   // The virtual file keeps the name alone; loading it by its path keeps the file's folder as the
   // model's, where MuJoCo looks for includes and meshes.
   putFile(vfs.get(), path, path, bytes);
-  const std::vector<std::string> missing = addReferencedFiles(path, bytes, vfs.get());
+  const std::vector<std::string> missing = addReferencedFiles(path, bytes, vfs.get(), package_paths);
   FenceLimits limits;
   limits.seconds = kParseSeconds;
   limits.memory_bytes = kParseMemoryBytes;

@@ -3,7 +3,8 @@
 // a file up there by its name alone (no folder, any case) and reads the disk only when it is missing:
 // every name the text gives a file (an attribute file, filename or file*, as <include>, <mesh>,
 // <hfield>, <texture>, <skin> and URDF's <mesh filename> write them) is put there, either as the
-// checked bytes of a regular file inside the model's folder or, when no such file exists, as a
+// checked bytes of a regular file inside the folders packages.cpp allows (the model's, its ROS package,
+// the packages it names) or, when no such file exists, as a
 // one-byte stand-in that MuJoCo then reports as unreadable: MuJoCo never opens a FIFO, a device, a
 // link out of the folder or a file past the limits. The names are found by scanning the text for
 // attribute values (a lexical scan, not a parse: a name in a comment is checked too, harmlessly).
@@ -136,11 +137,6 @@ std::string vfsKey(const std::string& name) {
   return key;
 }
 
-bool inside(const fs::path& folder, const fs::path& p) {
-  const auto [f, q] = std::mismatch(folder.begin(), folder.end(), p.begin(), p.end());
-  return f == folder.end();
-}
-
 }  // namespace
 
 std::string readChecked(const std::string& path) {
@@ -160,11 +156,13 @@ void putFile(mjVFS* vfs, const std::string& path, const std::string& name, const
   std::copy(bytes.begin(), bytes.end(), static_cast<char*>(vfs->filedata[at]));
 }
 
-std::vector<std::string> addReferencedFiles(const std::string& path, const std::string& bytes, mjVFS* vfs) {
+std::vector<std::string> addReferencedFiles(const std::string& path, const std::string& bytes, mjVFS* vfs,
+                                            const std::vector<std::string>& package_paths) {
   std::error_code ec;
   const fs::path main = fs::canonical(path, ec);
   if (ec) throw ModelFileError(path + ": cannot resolve its folder (" + ec.message() + ")");
   const fs::path folder = main.parent_path();
+  FileSearch search(folder, package_paths);
   // The texts to scan (the model, then each include found), every name found, and the folders named.
   std::vector<std::pair<std::string, std::string>> texts{{path, bytes}};  // (who, text)
   std::vector<std::string> dirs{""};
@@ -183,29 +181,28 @@ std::vector<std::string> addReferencedFiles(const std::string& path, const std::
       if (seen.size() > std::size_t(kMaxAssetFiles))
         throw ModelFileError(path + ": names more than " + std::to_string(kMaxAssetFiles) + " files (meshes, textures, includes)");
       const std::string who = path + ": file '" + oneLine(name) + "'";
-      // Where MuJoCo may look: the name as written, or its last part, under the model's folder and
-      // under each folder the file names (meshdir, texturedir, assetdir); the first that exists.
+      // Where it may be (packages.cpp: package://, file://, the name or its last part under the model's
+      // folder and each folder the file names: meshdir, texturedir, assetdir); the first that exists.
       fs::path found;
-      for (const std::string& d : dirs) {
-        const fs::path base = fs::path(d).is_absolute() ? fs::path(d) : folder / d;
-        for (const fs::path& c : {fs::path(name).is_absolute() ? fs::path(name) : base / name, base / fs::path(name).filename()})
-          if (found.empty() && fs::exists(fs::symlink_status(c, ec))) found = c;
-      }
+      std::string looked;
+      for (const fs::path& c : search.candidates(name, dirs, looked))
+        if (found.empty() && fs::exists(fs::symlink_status(c, ec))) found = c;
       const std::string key = vfsKey(name);
       if (found.empty()) {
         // None: a stand-in under its name, so that MuJoCo cannot read it from elsewhere.
         if (!taken.count(key)) {
           putFile(vfs, path, key, "\n");
           taken[key] = fs::path();
-          missing.push_back(name);
+          missing.push_back("'" + oneLine(name) + "' not found (" + looked + ")");
         }
         continue;
       }
       const fs::path real = fs::canonical(found, ec);
       if (ec) throw ModelFileError(who + " is a link that leads nowhere (" + found.string() + ")");
-      if (!inside(folder, real))
-        throw ModelFileError(who + " resolves to " + real.string() + ", outside the model's folder " + folder.string() +
-                             " (dynlab reads the files a model names from its own folder)");
+      if (!search.allowed(real))
+        throw ModelFileError(who + " resolves to " + real.string() + ", outside " + search.roots() +
+                             " (dynlab reads the files a model names from its folder, the ROS package it is in, "
+                             "the packages its package:// names find and --package-path folders)");
       if (const auto it = taken.find(key); it != taken.end()) {
         if (it->second == real) continue;  // the same file, already there
         throw ModelFileError(who + ": another file named '" + key + "' is named too (MuJoCo finds files by name alone: rename one)");

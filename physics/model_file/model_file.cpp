@@ -408,7 +408,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   LoadedModel out;
   out.file = path;
   std::string warnings;
-  out.compiled = detail::compile(path, &warnings);
+  out.compiled = detail::compile(path, &warnings, options.package_paths);
   const mjModel* m = out.compiled->m;
   if (!warnings.empty() && warnings != " ") out.notes.push_back("MuJoCo: " + warnings);
   checkSupported(path, m, options, out.notes);

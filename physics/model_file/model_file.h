@@ -34,7 +34,8 @@ namespace dyn::model_file {
 inline constexpr std::size_t kMaxFileBytes = 4u << 20;
 // What a model file may name (meshes, textures, height fields, includes): each file at most
 // kMaxAssetBytes, at most kMaxAssetFiles names, at most kMaxAssetsBytes in all; only regular files
-// inside the model file's folder (resolved through links). Checked before MuJoCo parses.
+// (resolved through links) inside the model file's folder, the ROS package it sits in, or a package
+// folder a package:// name finds (mujoco_call.h's FileSearch). Checked before MuJoCo parses.
 inline constexpr std::size_t kMaxAssetBytes = 16u << 20;
 inline constexpr std::size_t kMaxAssetsBytes = 64u << 20;
 inline constexpr int kMaxAssetFiles = 256;
@@ -184,6 +185,9 @@ struct GivenContact {
 
 struct LoadOptions {
   bool ignore_contacts = false;  // load a file whose geoms may collide, ignoring contacts (noted)
+  // Folders holding the packages package://NAME/… names (DIR/NAME, or DIR itself named NAME), searched
+  // before the folders above the file and ROS_PACKAGE_PATH's (--package-path)
+  std::vector<std::string> package_paths;
   std::vector<GivenClosure> closures;  // held after the file's own equalities, in this order
   std::vector<GivenRolling> rolling;   // then these, in this order
   std::vector<GivenContact> contacts;  // then these

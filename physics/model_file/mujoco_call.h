@@ -8,6 +8,7 @@
 
 #include <Eigen/Core>
 #include <csetjmp>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -44,7 +45,8 @@ struct Compiled {
 
 // FILE compiled by MuJoCo from the checked files, in the fence (compile.cpp); MuJoCo's warnings into
 // *warnings. Throws ModelFileError.
-std::shared_ptr<const Compiled> compile(const std::string& path, std::string* warnings);
+std::shared_ptr<const Compiled> compile(const std::string& path, std::string* warnings,
+                                        const std::vector<std::string>& package_paths = {});
 
 // The model's text and its includes (in vfs) within kMaxBodies, kMaxJoints, kMaxGeoms and
 // kMaxEqualities, no <composite>, includes nested at most kMaxIncludeDepth (sizes.cpp).
@@ -57,11 +59,33 @@ std::string readChecked(const std::string& path);
 // bytes as the virtual file `name` (MuJoCo keeps its last part); errors name `path`.
 void putFile(mjVFS* vfs, const std::string& path, const std::string& name, const std::string& bytes);
 
+// Where a name the model gives a file is looked for (package://NAME/…, file://…, plain names under the
+// model's folder and its meshdir/texturedir/assetdir) and the folders it may be read from
+// (packages.cpp).
+class FileSearch {
+ public:
+  // folder: the model's folder, canonical; package_paths: --package-path folders (ROS_PACKAGE_PATH is read too).
+  FileSearch(const std::filesystem::path& folder, const std::vector<std::string>& package_paths);
+  // The paths name may be at, in order (none: a package not found); `looked` says where, for errors.
+  std::vector<std::filesystem::path> candidates(const std::string& name, const std::vector<std::string>& dirs, std::string& looked);
+  // real (canonical) lies inside the model's folder, its ROS package, a --package-path folder or a package found.
+  bool allowed(const std::filesystem::path& real) const;
+  std::string roots() const;  // those folders, for errors
+
+ private:
+  std::filesystem::path package(const std::string& name) const;
+  std::filesystem::path folder_;
+  std::vector<std::string> package_paths_, ros_;
+  std::vector<std::filesystem::path> roots_;
+};
+
 // Every file the model's text names (includes, meshes, textures, height fields, skins; URDF's mesh
-// filename), checked (a regular file inside the model's folder, within kMaxAssetBytes, kMaxAssetFiles
-// and kMaxAssetsBytes; an included .xml or .urdf as the model file is, and scanned in turn) and put
-// into vfs under its name; a name with no such file gets a one-byte stand-in. Returns those names.
-std::vector<std::string> addReferencedFiles(const std::string& path, const std::string& bytes, mjVFS* vfs);
+// filename), checked (a regular file inside the folders FileSearch allows, within kMaxAssetBytes,
+// kMaxAssetFiles and kMaxAssetsBytes; an included .xml or .urdf as the model file is, and scanned in
+// turn) and put into vfs under its name; a name with no such file gets a one-byte stand-in. Returns
+// those names, each with where it was looked for ("'NAME' not found (looked in …)").
+std::vector<std::string> addReferencedFiles(const std::string& path, const std::string& bytes, mjVFS* vfs,
+                                            const std::vector<std::string>& package_paths = {});
 
 // The model's geoms at qpos0 (after mj_kinematics) as drawing shapes on the tree bodies: body b moves
 // with tree body link[b] (−1: the world), whose frame origin at qpos0 is origin[b] (drawing.cpp).

@@ -181,7 +181,10 @@ int benchModel(const BenchArgs& a) {
   const std::string beside = loopsBeside(a.lab);
   model_file::LoadedModel m;
   try {
-    m = loadWithLoops(a.lab, "");
+    model_file::LoadOptions options;
+    options.ignore_contacts = a.model_files.ignore_contacts;
+    options.package_paths = a.model_files.package_paths;
+    m = loadWithLoops(a.lab, "", options);
   } catch (const model_file::ModelFileError& e) {
     std::fprintf(stderr, "error: %s\n", termName(e.what(), 1000).c_str());
     return 2;

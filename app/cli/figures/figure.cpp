@@ -230,7 +230,7 @@ void loadRuns(const FigureArgs& a, FigureRequest& q) {
     const std::string gains = a.gains.empty() ? "" : a.gains.front();
     for (const auto& [option, value] : {std::pair{"--gains", gains}, {"--scenario", a.scenario}, {"--config", a.config}})
       if (!value.empty()) badOption(option, value, "a model file runs passive: it has no gains, scenarios or lab config");
-    q.loads.push_back(loadModelLab(a.lab, a.duration));
+    q.loads.push_back(loadModelLab(a.lab, a.duration, a.model_files));
     return;
   }
   const std::vector<std::string> gains_files = a.gains.empty() ? std::vector<std::string>{""} : a.gains;

@@ -161,6 +161,16 @@ std::string report(const ModelRun& r, const std::string& engine, const model_fil
   return o.str();
 }
 
+// The step the run takes: --dt, else the file's own <option timestep> within --dt's bounds; 0 after
+// one line on stderr.
+double runStep(const ModelArgs& args, const model_file::LoadedModel& m) {
+  if (args.dt > 0) return args.dt;
+  if (m.timestep >= kMinDt && m.timestep <= kMaxDt) return m.timestep;
+  std::fprintf(stderr, "error: %s: <option timestep>: %s s, outside the steps dynlab runs a model file at ([%g, %g] s); pass --dt\n",
+               nameShown(m.file).c_str(), exactNumber(m.timestep).c_str(), kMinDt, kMaxDt);
+  return 0;
+}
+
 }  // namespace
 
 ModelCommand::ModelCommand(CLI::App& cli) {
@@ -171,15 +181,30 @@ ModelCommand::ModelCommand(CLI::App& cli) {
                                          "OUT/trace.csv, OUT/trace_bullet.csv");
   command_->add_option("FILE", a.file, "MJCF (.xml) or URDF file (assets/models/ has examples)")->required();
   command_->add_option("--duration", a.duration, "Simulated time (s, default 2)")->check(CLI::Range(0.0, 600.0));
-  command_->add_option("--dt", a.dt, "Fixed step (s, default 0.001; RK4 + projection)")->check(CLI::Range(1e-5, 1e-2));
+  command_->add_option("--dt", a.dt, "Fixed step (s, RK4 + projection; default: the file's <option timestep>)")->check(CLI::Range(kMinDt, kMaxDt));
   command_->add_option("--out", a.out, "Output directory (default: out/model/FILE's stem)");
   command_->add_option("--engine", a.engine, "Which engine(s) to run (default: both)")->check(CLI::IsMember({"hand", "bullet", "both"}));
   command_->add_option("--torque", a.torques, "A constant joint torque JOINT=VALUE (N·m; N on a slide), repeatable (default: passive)")
       ->allow_extra_args(false);
   command_->add_option("--loops", a.loops, "Loop closures beside the file (JSON; default: STEM.loops.json beside FILE when it exists)");
-  command_->add_flag("--ignore-contacts", a.ignore_contacts, "Load a file whose geoms may collide, ignoring contacts (noted)");
+  addModelFileOptions(command_, a.files);
   command_->add_flag("--video", a.video, "Write video.mp4 of the run drawn from the file's geoms (H.264, 30 fps; the Bullet run as a ghost)");
   command_->add_flag("--frames", a.frames, "Write frames/NNNNN.png (30 fps)");
+}
+
+void addModelFileOptions(CLI::App* command, ModelFileFlags& flags) {
+  command->add_flag("--ignore-contacts", flags.ignore_contacts, "A model file: load it though its geoms may collide, ignoring contacts (noted)");
+  command->add_option("--package-path", flags.package_paths, "A model file: a folder holding the packages its package://NAME/… paths name "
+                                                            "(DIR/NAME, or DIR itself), repeatable; searched before the folders above "
+                                                            "the file and ROS_PACKAGE_PATH")
+      ->allow_extra_args(false);
+}
+
+int refuseModelFileFlags(const std::string& lab, const ModelFileFlags& flags) {
+  if (!flags.ignore_contacts && flags.package_paths.empty()) return 0;
+  std::fprintf(stderr, "error: <command line>: %s: for a model file (.xml, .urdf); %s is a lab\n",
+               flags.ignore_contacts ? "--ignore-contacts" : "--package-path", nameShown(lab).c_str());
+  return 2;
 }
 
 int runModelFile(const RunArgs& r) {
@@ -197,6 +222,15 @@ int runModelFile(const RunArgs& r) {
   a.frames = r.frames;
   a.torques = r.torques;
   a.loops = r.loops;
+  a.files = r.model_files;
+  if (r.dt) {
+    if (!(*r.dt >= kMinDt && *r.dt <= kMaxDt)) {
+      std::fprintf(stderr, "error: <command line>: --dt: expected a step in [%g, %g] s for a model file, got %s\n", kMinDt, kMaxDt,
+                   exactNumber(*r.dt).c_str());
+      return 2;
+    }
+    a.dt = *r.dt;
+  }
   if (r.duration) {
     if (!(*r.duration > 0 && *r.duration <= 600)) {
       std::fprintf(stderr, "error: <command line>: --duration: expected a time in (0, 600] s for a model file, got %s\n", exactNumber(*r.duration).c_str());
@@ -207,25 +241,29 @@ int runModelFile(const RunArgs& r) {
   return model(a);
 }
 
-int model(const ModelArgs& args) {
+int model(const ModelArgs& asked) {
   // A trace row per step and the frames drawn: the bound every run has (labs/settings.h), before anything runs.
   const auto refuse = [](const char* option, const std::string& problem) {
     std::fprintf(stderr, "error: <command line>: %s: %s\n", option, problem.c_str());
     return 2;
   };
-  if (const std::string problem = runBoundProblem(args.dt, args.duration); !problem.empty()) return refuse("--duration", problem);
+  ModelArgs args = asked;
+  if (args.dt > 0)
+    if (const std::string problem = runBoundProblem(args.dt, args.duration); !problem.empty()) return refuse("--duration", problem);
   if (args.video || args.frames)
     if (const std::string problem = frameBoundProblem(args.duration, 30); !problem.empty())
       return refuse(args.video ? "--video" : "--frames", problem);
   model_file::LoadedModel m;
   try {
     model_file::LoadOptions options;
-    options.ignore_contacts = args.ignore_contacts;
+    options.ignore_contacts = args.files.ignore_contacts;
+    options.package_paths = args.files.package_paths;
     m = loadWithLoops(args.file, args.loops, options);
   } catch (const model_file::ModelFileError& e) {
     std::fprintf(stderr, "error: %s\n", shownLine(e.what()).c_str());
     return 2;
   }
+  if ((args.dt = runStep(args, m)) == 0) return 2;
   if (const std::string problem = runBoundProblem(args.dt, args.duration, modelColumns(m).columns.size()); !problem.empty())
     return refuse("--duration", problem);
   // Constant torques by joint name: each "JOINT=VALUE" once, a joint of the file, a finite value.

@@ -21,15 +21,26 @@
 
 namespace dyn::app {
 
+// The steps a model file runs at (--dt, or the file's <option timestep>), s.
+inline constexpr double kMinDt = 1e-5, kMaxDt = 1e-2;
+
 struct ModelArgs {
   std::string file, out, engine = "both";
   std::string loops;  // closures beside the file (labs/generic/model_loops.h); "": STEM.loops.json when it exists
   double duration = 2.0;  // s
-  double dt = 1e-3;       // s
-  bool ignore_contacts = false;
+  double dt = 0;          // s; 0: the file's <option timestep>
+  ModelFileFlags files;   // --ignore-contacts, --package-path
   bool video = false, frames = false;  // 30 frames per second of simulated time, 640×480
   std::vector<std::string> torques;    // "JOINT=VALUE": constant torques (N·m; N on a slide); none: passive
 };
+
+// --ignore-contacts and --package-path DIR (repeatable) on a command that reads model files (model, run,
+// figure, bench), into flags.
+void addModelFileOptions(CLI::App* command, ModelFileFlags& flags);
+
+// 0, or 2 after one line on stderr when model-file options (`--ignore-contacts`, `--package-path`) are
+// given for a lab, not a model file.
+int refuseModelFileFlags(const std::string& lab, const ModelFileFlags& flags);
 
 struct RunArgs;
 // `dynlab run FILE`: the run's options onto `dynlab model FILE`'s (lab-only options refused: exit 2).

@@ -14,11 +14,14 @@
 
 #include "physics/model_file/model_file.h"
 #include "tests/physics/model_file/fixtures.h"
+#include "tests/physics/model_file/mesh_files.h"
 
 using namespace dyn;
 namespace fs = std::filesystem;
 
 namespace {
+
+using dyn::test_model_file::tetrahedronStl;
 
 // A fresh folder for this process's files (model files go in its "model" folder).
 fs::path folder() {
@@ -31,22 +34,6 @@ fs::path folder() {
 }
 
 fs::path write(const std::string& name, const std::string& text) { return test_model_file::writeFile(folder(), name, text); }
-
-// A binary STL of the tetrahedron (0, s e_x, s e_y, s e_z), faces outward.
-std::string tetrahedron(float s) {
-  const float O[3] = {0, 0, 0}, X[3] = {s, 0, 0}, Y[3] = {0, s, 0}, Z[3] = {0, 0, s};
-  const float* faces[4][3] = {{O, Y, X}, {O, X, Z}, {O, Z, Y}, {X, Y, Z}};
-  std::string b(80, ' ');
-  const std::uint32_t count = 4;
-  b.append(reinterpret_cast<const char*>(&count), 4);
-  for (const auto& f : faces) {
-    const float normal[3] = {0, 0, 0};
-    b.append(reinterpret_cast<const char*>(normal), 12);
-    for (const float* v : f) b.append(reinterpret_cast<const char*>(v), 12);
-    b.append(2, '\0');
-  }
-  return b;
-}
 
 // A one-joint model naming assets (a mesh geom when mesh is given) and an extra top-level section.
 std::string mjcf(const std::string& assets, const std::string& mesh = "", const std::string& extra = "") {
@@ -74,7 +61,7 @@ TEST_CASE("a mesh in the file's meshdir is read through the checked copy: its ma
   const float sizes[2] = {0.3f, 0.15f};
   for (int k = 0; k < 2; ++k) {
     const std::string stl = "tet" + std::to_string(k) + ".stl";
-    write("model/meshes/" + stl, tetrahedron(sizes[k]));
+    write("model/meshes/" + stl, tetrahedronStl(sizes[k]));
     const fs::path file = write("model/mesh" + std::to_string(k) + ".xml", mjcf("<mesh name=\"tet\" file=\"" + stl + "\"/>", "tet"));
     const model_file::LoadedModel m = model_file::load(file.string());
     Eigen::Vector3d com;
@@ -112,12 +99,12 @@ TEST_CASE("what a model file names: hostile files get one line naming the file, 
   write("model/latin1_part.xml", "<mujoco model=\"caf\xE9\"/>");
   CHECK(errorOf(write("model/latin1_main.xml", "<mujoco><include file=\"latin1_part.xml\"/></mujoco>")).find("not valid UTF-8") != std::string::npos);
   // Two files of one name: MuJoCo would read the first for both.
-  write("model/meshes/a/tet.stl", tetrahedron(0.1f));
-  write("model/meshes/b/tet.stl", tetrahedron(0.2f));
+  write("model/meshes/a/tet.stl", tetrahedronStl(0.1f));
+  write("model/meshes/b/tet.stl", tetrahedronStl(0.2f));
   CHECK(errorOf(write("model/twins.xml", mjcf("<mesh name=\"m1\" file=\"a/tet.stl\"/><mesh name=\"m2\" file=\"b/tet.stl\"/>", "m1")))
             .find("another file named 'tet.stl'") != std::string::npos);
   // Named but missing: MuJoCo's own error, with the name it did not find (never the disk's elsewhere).
-  CHECK(errorOf(write("model/missing.xml", "<mujoco><include file=\"nothere.xml\"/></mujoco>")).find("not found in the model's folder: 'nothere.xml'") !=
+  CHECK(errorOf(write("model/missing.xml", "<mujoco><include file=\"nothere.xml\"/></mujoco>")).find("file 'nothere.xml' not found (looked in ") !=
         std::string::npos);
   // A file naming more files than allowed.
   std::string many;

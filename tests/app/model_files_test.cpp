@@ -1,0 +1,123 @@
+// Model files as users have them, through the real binary on every command that takes one (model, run,
+// figure, bench; issue 40): a URDF in robot/urdf/ whose meshes are package://robot/meshes/… loads; a
+// package found only through --package-path is a one-line refusal naming where dynlab looked until
+// the option names it; --ignore-contacts, which the contact refusal advises, is taken by each command
+// (and refused in one line for a lab); a file's <option timestep> is the step the run takes, `run
+// --dt` another, checked. Never exit 3. The files are written here, at run time.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "tests/app/cli_run.h"
+#include "tests/physics/model_file/mesh_files.h"
+
+using namespace dyn::test::cli;
+
+namespace {
+
+using dyn::test_model_file::meshArmUrdf;
+using dyn::test_model_file::tetrahedronStl;
+
+// A pendulum: `option` inside <option …/>, and `extra` in the world body.
+std::string pendulum(const std::string& option, const std::string& extra = "") {
+  return "<mujoco><option " + option + "/><worldbody>" + extra +
+         "<body name=\"bob\" pos=\"0 0 1\"><joint name=\"swing\" type=\"hinge\" axis=\"0 1 0\"/>"
+         "<geom type=\"capsule\" fromto=\"0 0 0 0.3 0 -0.3\" size=\"0.02\" mass=\"1\" contype=\"1\" conaffinity=\"1\"/></body></worldbody></mujoco>";
+}
+
+// Each command on FILE with extra arguments: short runs, a scratch output each.
+std::vector<std::vector<std::string>> commands(const TempDir& dir, const std::string& file, const std::vector<std::string>& extra) {
+  return {cat({"model", file, "--duration", "0.05", "--out", (dir / "o_model").string()}, extra),
+          cat({"run", file, "--duration", "0.05", "--out", (dir / "o_run").string()}, extra),
+          cat({"figure", file, "--duration", "0.05", "--plot", "q_j1", "--still", "0", "--format", "png", "--out", (dir / "o_fig").string()}, extra),
+          cat({"bench", file, "--steps", "100"}, extra)};
+}
+
+// The step of a trace: the time between its first two rows.
+double stepOf(const fs::path& trace) {
+  const Csv c = readCsv(trace);
+  REQUIRE(c.rows.size() > 2);
+  return c.rows[1][0] - c.rows[0][0];
+}
+
+}  // namespace
+
+TEST_CASE("a URDF whose meshes are package://robot/meshes/…, beside its urdf/ folder, runs on model, run, figure and bench") {
+  TempDir dir("model_files_layout");
+  fs::create_directories(dir / "robot/meshes");
+  fs::create_directories(dir / "robot/urdf");
+  writeFile(dir / "robot/meshes/body.stl", tetrahedronStl(0.1f));
+  writeFile(dir / "robot/urdf/arm.urdf", meshArmUrdf("package://robot/meshes/body.stl"));
+  for (const auto& args : commands(dir, "robot/urdf/arm.urdf", {})) {
+    const Result r = dynlab(dir, args);
+    INFO(shown(args), "\n", r.err);
+    CHECK(r.code == 0);
+  }
+}
+
+TEST_CASE("a package found only through --package-path: one line naming where dynlab looked, then it loads on every command") {
+  TempDir dir("model_files_package_path");
+  fs::create_directories(dir / "vendor/parts/meshes");
+  fs::create_directories(dir / "ws");
+  writeFile(dir / "vendor/parts/meshes/body.stl", tetrahedronStl(0.1f));
+  writeFile(dir / "ws/arm.urdf", meshArmUrdf("package://parts/meshes/body.stl"));
+  for (const auto& args : commands(dir, "ws/arm.urdf", {})) {
+    const Result r = dynlab(dir, args);
+    INFO(shown(args), "\n", r.err);
+    CHECK(r.code == 2);
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    CHECK(r.err.find("ws/arm.urdf: file 'package://parts/meshes/body.stl' not found (no package folder 'parts' in the folders above ") !=
+          std::string::npos);
+    CHECK(r.err.find("pass --package-path DIR") != std::string::npos);
+  }
+  for (const auto& args : commands(dir, "ws/arm.urdf", {"--package-path", (dir / "vendor").string()})) {
+    const Result r = dynlab(dir, args);
+    INFO(shown(args), "\n", r.err);
+    CHECK(r.code == 0);
+  }
+  // ROS_PACKAGE_PATH, as ROS users set it.
+  const Result ros = dynlab(dir, commands(dir, "ws/arm.urdf", {})[0], withEnv({{"ROS_PACKAGE_PATH", (dir / "vendor").string()}}));
+  CHECK(ros.code == 0);
+}
+
+TEST_CASE("--ignore-contacts, which the contact refusal advises, is taken by model, run, figure and bench; a lab refuses it in one line") {
+  TempDir dir("model_files_contacts");
+  writeFile(dir / "floor.xml", pendulum("timestep=\"0.001\"", "<geom name=\"floor\" type=\"plane\" size=\"1 1 0.1\" pos=\"0 0 0.5\"/>"));
+  const Result refused = dynlab(dir, {"model", "floor.xml", "--out", (dir / "o").string()});
+  CHECK(refused.code == 2);
+  CHECK(refused.err.find("or pass --ignore-contacts") != std::string::npos);
+  std::vector<std::vector<std::string>> all = commands(dir, "floor.xml", {"--ignore-contacts"});
+  all[2][5] = "q_swing";  // figure's --plot
+  for (const auto& args : all) {
+    const Result r = dynlab(dir, args);
+    INFO(shown(args), "\n", r.err);
+    CHECK(r.code == 0);
+  }
+  for (const std::string command : {"run", "figure", "bench"}) {
+    const Result r = dynlab(dir, {command, "slider_crank", "--ignore-contacts", "--out", (dir / "lab").string()});
+    INFO(command, "\n", r.err);
+    checkRefused(r, {"--ignore-contacts", "slider_crank"});
+  }
+}
+
+TEST_CASE("a model file runs at its own <option timestep>; run --dt sets another, checked") {
+  TempDir dir("model_files_timestep");
+  writeFile(dir / "fine.xml", pendulum("timestep=\"0.0005\" gravity=\"0 0 -3\""));
+  REQUIRE(dynlab(dir, {"model", "fine.xml", "--duration", "0.01", "--engine", "hand", "--out", (dir / "m").string()}).code == 0);
+  CHECK(stepOf(dir / "m/trace.csv") == doctest::Approx(0.0005).epsilon(1e-9));
+  CHECK(readFile(dir / "m/summary.txt").find("gravity (0, 0, -3)") != std::string::npos);
+  REQUIRE(dynlab(dir, {"run", "fine.xml", "--duration", "0.01", "--engine", "hand", "--out", (dir / "r").string()}).code == 0);
+  CHECK(stepOf(dir / "r/trace.csv") == doctest::Approx(0.0005).epsilon(1e-9));
+  REQUIRE(dynlab(dir, {"run", "fine.xml", "--duration", "0.01", "--dt", "0.002", "--engine", "hand", "--out", (dir / "d").string()}).code == 0);
+  CHECK(stepOf(dir / "d/trace.csv") == doctest::Approx(0.002).epsilon(1e-9));
+  // A bad --dt, a --dt for a lab, a file step outside the bounds: one line each, exit 2.
+  checkBadInput(dir, {"run", "fine.xml", "--dt", "1", "--out", (dir / "bad").string()}, {"--dt", "1"}, dir / "bad");
+  checkBadInput(dir, {"run", "fine.xml", "--dt", "0", "--out", (dir / "bad").string()}, {"--dt", "0"}, dir / "bad");
+  checkBadInput(dir, {"run", "slider_crank", "--dt", "0.001", "--out", (dir / "bad").string()}, {"--dt"}, dir / "bad");
+  writeFile(dir / "coarse.xml", pendulum("timestep=\"0.05\""));
+  checkBadInput(dir, {"model", "coarse.xml", "--out", (dir / "bad").string()}, {"coarse.xml", "<option timestep>", "--dt"}, dir / "bad");
+  CHECK(dynlab(dir, {"model", "coarse.xml", "--dt", "0.001", "--duration", "0.01", "--out", (dir / "ok").string()}).code == 0);
+}

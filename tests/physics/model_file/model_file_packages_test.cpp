@@ -1,0 +1,86 @@
+// Files laid out as users lay robots out (physics/model_file/packages.cpp): a URDF in robot/urdf/
+// whose meshes are package://robot/meshes/…, package://assets/… beside the file, a package found
+// through --package-path (LoadOptions::package_paths) or ROS_PACKAGE_PATH, ../meshes inside a ROS
+// package (package.xml above), file:// paths. Each loads and reads the bytes meant (the drawn
+// capsule's size follows the mesh written); a missing package or file is one line naming the
+// name and where dynlab looked.
+#include <doctest/doctest.h>
+#include <stdlib.h>
+
+#include <cstdint>
+#include <filesystem>
+#include <string>
+
+#include "physics/model_file/model_file.h"
+#include "tests/physics/model_file/fixtures.h"
+#include "tests/physics/model_file/mesh_files.h"
+
+using namespace dyn;
+namespace fs = std::filesystem;
+
+namespace {
+
+using dyn::test_model_file::meshArmUrdf;
+using dyn::test_model_file::tetrahedronStl;
+
+fs::path folder() {
+  static const fs::path dir = test_model_file::scratchFolder("model_packages");
+  return dir;
+}
+
+fs::path write(const std::string& name, const std::string& text) { return test_model_file::writeFile(folder(), name, text); }
+
+// The size of the capsule drawn for the model's one mesh: it scales with the mesh MuJoCo read.
+double drawnSize(const fs::path& file, const model_file::LoadOptions& options = {}) {
+  const model_file::LoadedModel m = model_file::load(file.string(), options);
+  REQUIRE(m.drawing.geoms.size() == 1);
+  return m.drawing.geoms[0].size.norm();
+}
+
+std::string errorOf(const fs::path& file) { return test_model_file::errorOf(file); }
+
+bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+}  // namespace
+
+TEST_CASE("package://NAME/… is found in the folders above the file, beside them, through --package-path and ROS_PACKAGE_PATH") {
+  // robot/urdf/arm.urdf naming package://robot/meshes/body.stl: the folder above is the package.
+  write("robot/meshes/body.stl", tetrahedronStl(0.1f));
+  const double ref = drawnSize(write("robot/urdf/arm.urdf", meshArmUrdf("package://robot/meshes/body.stl")));
+  CHECK(ref > 0.01);
+  // package://assets/body.stl beside the file: assets/ is the package (was "not in the model's folder").
+  write("flat/assets/body.stl", tetrahedronStl(0.2f));
+  CHECK(drawnSize(write("flat/arm.urdf", meshArmUrdf("package://assets/body.stl"))) == doctest::Approx(2 * ref).epsilon(0.02));
+  // A package elsewhere: not found until named by --package-path or ROS_PACKAGE_PATH; each then read.
+  write("elsewhere/parts/meshes/body.stl", tetrahedronStl(0.3f));
+  const fs::path far = write("ws/far.urdf", meshArmUrdf("package://parts/meshes/body.stl"));
+  const std::string missing = errorOf(far);
+  CHECK(has(missing, "file 'package://parts/meshes/body.stl' not found (no package folder 'parts' in the folders above "));
+  CHECK(has(missing, "--package-path DIR"));
+  model_file::LoadOptions options;
+  options.package_paths = {(folder() / "elsewhere").string()};
+  CHECK(drawnSize(far, options) == doctest::Approx(3 * ref).epsilon(0.02));
+  options.package_paths = {(folder() / "elsewhere/parts").string()};  // the package folder itself
+  CHECK(drawnSize(far, options) == doctest::Approx(3 * ref).epsilon(0.02));
+  REQUIRE(::setenv("ROS_PACKAGE_PATH", ("/nonexistent:" + (folder() / "elsewhere").string()).c_str(), 1) == 0);
+  CHECK(drawnSize(far) == doctest::Approx(3 * ref).epsilon(0.02));
+  ::unsetenv("ROS_PACKAGE_PATH");
+  // The package is found but lacks the file: where dynlab looked.
+  CHECK(has(errorOf(write("robot/urdf/typo.urdf", meshArmUrdf("package://robot/meshes/bodyy.stl"))),
+            "file 'package://robot/meshes/bodyy.stl' not found (looked in package 'robot' at "));
+}
+
+TEST_CASE("meshes beside a URDF's folder load inside a ROS package; file:// is a path; outside stays refused") {
+  write("pkg/meshes/body.stl", tetrahedronStl(0.1f));
+  const fs::path up = write("pkg/urdf/up.urdf", meshArmUrdf("../meshes/body.stl"));
+  CHECK(has(errorOf(up), "outside the model's folder"));  // no package.xml: not a package
+  write("pkg/package.xml", "<package><name>pkg</name></package>");
+  CHECK(drawnSize(up) > 0.01);
+  // file:// with an absolute path inside the package, and a relative one.
+  CHECK(drawnSize(write("pkg/urdf/abs.urdf", meshArmUrdf("file://" + (folder() / "pkg/meshes/body.stl").string()))) > 0.01);
+  CHECK(drawnSize(write("pkg/urdf/rel.urdf", meshArmUrdf("file://../meshes/body.stl"))) > 0.01);
+  // A package:// name does not open the rest of the disk: no system folder is a package.
+  CHECK(has(errorOf(write("pkg/urdf/dev.urdf", meshArmUrdf("package://dev/zero"))), "no package folder 'dev'"));
+  CHECK(has(errorOf(write("pkg/urdf/etc.urdf", meshArmUrdf("package://etc/passwd"))), "no package folder 'etc'"));
+  fs::remove_all(folder());
+}
