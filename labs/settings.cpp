@@ -92,6 +92,17 @@ std::map<std::string, double> parseGains(const JsonView& g, const std::vector<st
   return out;
 }
 
+void parseMetricsAndDrawing(const JsonView& config, double& settle_time, double& arrow_scale) {
+  if (config.has("metrics")) {
+    config["metrics"].onlyKeys({"settle_time"});
+    settle_time = config["metrics"]["settle_time"].inRange(0, 1e6);
+  }
+  if (config.has("drawing")) {
+    config["drawing"].onlyKeys({"arrow_scale"});
+    arrow_scale = config["drawing"]["arrow_scale"].positive(1e3);
+  }
+}
+
 std::string schemeName(const StepOptions& step) {
   return std::string(name(step.integrator)) + " + " + name(step.drift.kind);
 }

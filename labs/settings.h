@@ -62,6 +62,11 @@ std::map<std::string, double> parseGains(const JsonView& gains, std::initializer
 // The same for names known only at run time (a data-defined lab's); a key not among them is refused.
 std::map<std::string, double> parseGains(const JsonView& gains, const std::vector<std::string>& names);
 
+// The two optional blocks a C++ lab's config may carry beside its own: "metrics" {settle_time: when
+// the metrics' windows start, s, in [0, 1e6]} and "drawing" {arrow_scale: m per N of a force arrow,
+// positive, ≤ 1e3}. Each value is left as it is when its block is absent.
+void parseMetricsAndDrawing(const JsonView& config, double& settle_time, double& arrow_scale);
+
 // The simulation block's scheme in words, e.g. "rk4 + projection".
 std::string schemeName(const StepOptions& step);
 

@@ -274,14 +274,9 @@ int gradeOne(const GradeArgs& a) {
     staging.write("report.md", g.markdown);
     staging.write("report.html", g.html);
     staging.commit();
-  } catch (const OutputConflict& e) {
-    // OUT is the user's choice, and something of theirs is in the way: nothing was removed.
-    std::fprintf(stderr, "error: results not written: %s\n", termText(e.what()).c_str());
-    return 2;
   } catch (const std::exception& e) {
-    // A disk or folder error: the grader's fault, not the submission's; the old results stay.
-    std::fprintf(stderr, "error: results not written: %s\n", termText(e.what()).c_str());
-    return 3;
+    // A disk or folder error is the grader's fault, not the submission's (3); the old results stay.
+    return notWritten("results", e, 3);
   }
   if (!g.error.empty()) std::fprintf(stderr, "error: %s\n", g.error.c_str());
   std::fputs(g.report.c_str(), stdout);

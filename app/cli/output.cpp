@@ -8,10 +8,12 @@
 
 #include <atomic>
 #include <cerrno>
+#include <cstdio>
 #include <cstdlib>
 #include <system_error>
 
 #include "labs/file_write.h"
+#include "labs/utf8.h"
 
 namespace fs = std::filesystem;
 
@@ -117,6 +119,11 @@ void Staging::commit() {
   fs::remove_all(staging_);
   syncDirectory(out_.string());
   committed_ = true;
+}
+
+int notWritten(const std::string& what, const std::exception& e, int other) {
+  std::fprintf(stderr, "error: %s not written: %s\n", what.c_str(), termText(e.what()).c_str());
+  return dynamic_cast<const OutputConflict*>(&e) ? 2 : other;
 }
 
 }  // namespace dyn::app

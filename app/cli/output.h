@@ -19,6 +19,11 @@ class OutputConflict : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// A staged write that failed, said in one line on stderr ("error: WHAT not written: why"): the exit code
+// is 2 for an OutputConflict (OUT is the user's choice and something of theirs is in the way: nothing
+// was removed), else `other` (a disk or folder error; what was there before stays).
+int notWritten(const std::string& what, const std::exception& e, int other);
+
 class Staging {
  public:
   explicit Staging(const std::filesystem::path& out_dir);

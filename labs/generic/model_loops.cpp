@@ -120,14 +120,21 @@ void readBeside(const std::string& file, model_file::LoadOptions& options) {
       throw ModelFileError(file + ": " + at + ".name: '" + n + "' names an earlier " + it->second + " too (expected a new name: it heads trace columns)");
     return n;
   };
+  // Each element of the array `key` (elements() has checked its keys) into `out`: its where and its
+  // name first (the default PREFIX + index), then read(path, object, element) fills in the rest.
+  auto readEach = [&]<class T>(const std::vector<std::string>& paths, const char* key, const std::string& prefix, const char* what,
+                               std::vector<T>& out, auto&& read) {
+    for (std::size_t i = 0; i < paths.size(); ++i) {
+      T element;
+      element.where = file + ": " + paths[i];
+      element.name = name(j[key][i], paths[i], prefix + std::to_string(i), what);
+      read(paths[i], j[key][i], element);
+      out.push_back(element);
+    }
+  };
   const std::vector<std::string> loops =
       elements(j, "loops", "closures", file, {"name", "kind", "body1", "point1", "body2", "point2", "comment"}, {"kind", "body1", "point1", "body2"}, "");
-  for (std::size_t i = 0; i < loops.size(); ++i) {
-    const std::string& at = loops[i];
-    const json& l = j["loops"][i];
-    model_file::GivenClosure c;
-    c.where = file + ": " + at;
-    c.name = name(l, at, "loop" + std::to_string(i), "closure");
+  readEach(loops, "loops", "loop", "closure", options.closures, [&](const std::string& at, const json& l, model_file::GivenClosure& c) {
     c.kind = text(l["kind"], at + ".kind", file);
     if (c.kind != "connect" && c.kind != "weld")
       throw ModelFileError(file + ": " + at + ".kind: expected \"connect\" (3 translation rows) or \"weld\" (6 rows), got " + shown(l["kind"]));
@@ -135,35 +142,23 @@ void readBeside(const std::string& file, model_file::LoadOptions& options) {
     c.body2 = text(l["body2"], at + ".body2", file);
     c.point1 = point(l["point1"], at + ".point1", file);
     if (l.contains("point2")) c.has_point2 = true, c.point2 = point(l["point2"], at + ".point2", file);
-    options.closures.push_back(c);
-  }
+  });
   // A rolling wheel: the rolling kind rolls without slip on a horizontal ground z = height.
   const std::vector<std::string> wheels = elements(j, "rolling", "wheels", file, {"name", "body", "centre", "axle", "radius", "height", "mu", "comment"},
                                                    {"body", "axle", "radius"}, " (the ground is the plane z = height, the wheel never slips)");
-  for (std::size_t i = 0; i < wheels.size(); ++i) {
-    const std::string& at = wheels[i];
-    const json& w = j["rolling"][i];
-    model_file::GivenRolling r;
-    r.where = file + ": " + at;
-    r.name = name(w, at, "wheel" + std::to_string(i), "wheel");
+  readEach(wheels, "rolling", "wheel", "wheel", options.rolling, [&](const std::string& at, const json& w, model_file::GivenRolling& r) {
     r.body = text(w["body"], at + ".body", file);
     if (w.contains("centre")) r.centre = point(w["centre"], at + ".centre", file);
     r.axle = direction(w["axle"], at + ".axle", file);
     r.radius = number(w["radius"], at + ".radius", file, 1e-6, 1e3, "the wheel's radius in metres, in [1e-6, 1e3]");
     if (w.contains("height")) r.height = number(w["height"], at + ".height", file, -1e6, 1e6, "the ground's height z in metres, within ±1e6");
     if (w.contains("mu")) r.mu = number(w["mu"], at + ".mu", file, 0, 10, "a friction coefficient in [0, 10]");
-    options.rolling.push_back(r);
-  }
+  });
   // A ball against a plane: one unilateral row; the hand engine's rigid contact is plastic and frictionless.
   const std::vector<std::string> contacts = elements(
       j, "contacts", "contacts", file, {"name", "body", "point", "radius", "normal", "height", "mu", "stiffness", "damping", "comment"}, {"body", "point"},
       " (a rigid contact's touchdown is plastic: no restitution; mu is Coulomb friction in Bullet only)");
-  for (std::size_t i = 0; i < contacts.size(); ++i) {
-    const std::string& at = contacts[i];
-    const json& e = j["contacts"][i];
-    model_file::GivenContact c;
-    c.where = file + ": " + at;
-    c.name = name(e, at, "contact" + std::to_string(i), "contact");
+  readEach(contacts, "contacts", "contact", "contact", options.contacts, [&](const std::string& at, const json& e, model_file::GivenContact& c) {
     c.body = text(e["body"], at + ".body", file);
     c.point = point(e["point"], at + ".point", file);
     if (e.contains("radius")) c.radius = number(e["radius"], at + ".radius", file, 0, 1e3, "the ball's radius in metres, in [0, 1e3]");
@@ -175,8 +170,7 @@ void readBeside(const std::string& file, model_file::LoadOptions& options) {
       c.damping = number(e["damping"], at + ".damping", file, 0, 1e9, "a damping in N·s/m in [0, 1e9]");
     if (c.damping > 0 && c.stiffness == 0)
       throw ModelFileError(file + ": " + at + ".damping: expected 0 for a rigid contact (damping acts on a compliant one, stiffness > 0)");
-    options.contacts.push_back(c);
-  }
+  });
 }
 
 std::string loopsBeside(const std::string& model) {

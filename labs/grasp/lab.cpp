@@ -200,14 +200,7 @@ Settings parseSettings(const JsonView& c) {
     s.push.start = d["start"].inRange(0, 1e6);
     s.push.duration = d["duration"].inRange(0, 1e6);
   }
-  if (c.has("metrics")) {
-    c["metrics"].onlyKeys({"settle_time"});
-    s.settle_time = c["metrics"]["settle_time"].inRange(0, 1e6);
-  }
-  if (c.has("drawing")) {
-    c["drawing"].onlyKeys({"arrow_scale"});
-    s.arrow_scale = c["drawing"]["arrow_scale"].positive(1e3);
-  }
+  parseMetricsAndDrawing(c, s.settle_time, s.arrow_scale);
   // The fingers must reach their contact points, and the contacts must hold the object in every direction.
   const Mechanism mech(s.params);
   VecN q, v;

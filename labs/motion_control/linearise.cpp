@@ -21,15 +21,12 @@
 #include <cstdio>
 
 #include "labs/motion_control/lab.h"
+#include "labs/numbers.h"
 
 namespace dyn::motion_control {
 namespace {
 
-std::string fmtNumber(double x) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.3g", x);
-  return buf;
-}
+std::string fmtNumber(double x) { return fmt("%.3g", x); }
 
 // The vibration mode of a flexible loop in one sentence (empty if its poles have no complex pair).
 std::string modeRemark(const LinearLoop& loop) {

@@ -120,14 +120,7 @@ Settings parseSettings(const JsonView& c) {
   s.reference.amplitude = ref["amplitude"].inRange(-2, 2);
   s.reference.period = ref["period"].inRange(1e-3, 1e6);
 
-  if (c.has("metrics")) {
-    c["metrics"].onlyKeys({"settle_time"});
-    s.settle_time = c["metrics"]["settle_time"].inRange(0, 1e6);
-  }
-  if (c.has("drawing")) {
-    c["drawing"].onlyKeys({"arrow_scale"});
-    s.arrow_scale = c["drawing"]["arrow_scale"].positive(1e3);
-  }
+  parseMetricsAndDrawing(c, s.settle_time, s.arrow_scale);
   // The reference starts where the slider starts.
   Mechanism mech(s.params);
   VecN q, v;

@@ -36,6 +36,14 @@ std::vector<std::vector<std::string>> commands(const TempDir& dir, const std::st
           cat({"bench", file, "--steps", "100"}, extra)};
 }
 
+// A mesh arm laid out as users lay it out: its STL at `mesh`, its URDF at `urdf` naming the mesh as `ref`.
+void layOut(const TempDir& dir, const std::string& mesh, const std::string& urdf, const std::string& ref) {
+  fs::create_directories((dir / mesh).parent_path());
+  fs::create_directories((dir / urdf).parent_path());
+  writeFile(dir / mesh, tetrahedronStl(0.1f));
+  writeFile(dir / urdf, meshArmUrdf(ref));
+}
+
 // The step of a trace: the time between its first two rows.
 double stepOf(const fs::path& trace) {
   const Csv c = readCsv(trace);
@@ -47,10 +55,7 @@ double stepOf(const fs::path& trace) {
 
 TEST_CASE("a URDF whose meshes are package://robot/meshes/…, beside its urdf/ folder, runs on model, run, figure and bench") {
   TempDir dir("model_files_layout");
-  fs::create_directories(dir / "robot/meshes");
-  fs::create_directories(dir / "robot/urdf");
-  writeFile(dir / "robot/meshes/body.stl", tetrahedronStl(0.1f));
-  writeFile(dir / "robot/urdf/arm.urdf", meshArmUrdf("package://robot/meshes/body.stl"));
+  layOut(dir, "robot/meshes/body.stl", "robot/urdf/arm.urdf", "package://robot/meshes/body.stl");
   for (const auto& args : commands(dir, "robot/urdf/arm.urdf", {})) {
     const Result r = dynlab(dir, args);
     INFO(shown(args), "\n", r.err);
@@ -60,10 +65,7 @@ TEST_CASE("a URDF whose meshes are package://robot/meshes/…, beside its urdf/ 
 
 TEST_CASE("a package found only through --package-path: one line naming where dynlab looked, then it loads on every command") {
   TempDir dir("model_files_package_path");
-  fs::create_directories(dir / "vendor/parts/meshes");
-  fs::create_directories(dir / "ws");
-  writeFile(dir / "vendor/parts/meshes/body.stl", tetrahedronStl(0.1f));
-  writeFile(dir / "ws/arm.urdf", meshArmUrdf("package://parts/meshes/body.stl"));
+  layOut(dir, "vendor/parts/meshes/body.stl", "ws/arm.urdf", "package://parts/meshes/body.stl");
   for (const auto& args : commands(dir, "ws/arm.urdf", {})) {
     const Result r = dynlab(dir, args);
     INFO(shown(args), "\n", r.err);

@@ -216,12 +216,8 @@ int compare(const CompareArgs& args) {
     }
     staging.write("comparison.md", markdown(a, b, plots));
     staging.commit();
-  } catch (const OutputConflict& e) {
-    std::fprintf(stderr, "error: comparison not written: %s\n", termText(e.what()).c_str());
-    return 2;
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "error: comparison not written: %s\n", termText(e.what()).c_str());
-    return 1;
+    return notWritten("comparison", e, 1);
   }
   std::printf("comparison: %s\n", termText((out / "comparison.md").string()).c_str());
   // A grade the time budget cut short is shown, but it is not a whole grade.

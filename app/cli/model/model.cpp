@@ -34,11 +34,7 @@
 namespace dyn::app {
 namespace {
 
-std::string fmt(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", x);
-  return b;
-}
+std::string fmt(double x) { return dyn::fmt("%.4g", x); }
 
 // A name or path from the file (or the command line) as `dynlab model` prints it: escaped and clipped.
 std::string nameShown(const std::string& s) { return termName(s); }
@@ -214,15 +210,8 @@ int runModelFile(const RunArgs& r) {
                    nameShown(r.lab).c_str());
       return 2;
     }
-  ModelArgs a;
-  a.file = r.lab;
-  a.out = r.out;
-  a.engine = r.engine;
-  a.video = r.video;
-  a.frames = r.frames;
-  a.torques = r.torques;
-  a.loops = r.loops;
-  a.files = r.model_files;
+  ModelArgs a{.file = r.lab, .out = r.out, .engine = r.engine, .loops = r.loops, .files = r.model_files,
+              .video = r.video, .frames = r.frames, .torques = r.torques};
   if (r.dt) {
     if (!(*r.dt >= kMinDt && *r.dt <= kMaxDt)) {
       std::fprintf(stderr, "error: <command line>: --dt: expected a step in [%g, %g] s for a model file, got %s\n", kMinDt, kMaxDt,
