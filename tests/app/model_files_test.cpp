@@ -44,6 +44,15 @@ void layOut(const TempDir& dir, const std::string& mesh, const std::string& urdf
   writeFile(dir / urdf, meshArmUrdf(ref));
 }
 
+// FILE (with extra arguments) loads and runs on every command: exit 0 each.
+void loadsOnEveryCommand(const TempDir& dir, const std::string& file, const std::vector<std::string>& extra) {
+  for (const auto& args : commands(dir, file, extra)) {
+    const Result r = dynlab(dir, args);
+    INFO(shown(args), "\n", r.err);
+    CHECK(r.code == 0);
+  }
+}
+
 // The step of a trace: the time between its first two rows.
 double stepOf(const fs::path& trace) {
   const Csv c = readCsv(trace);
@@ -56,11 +65,7 @@ double stepOf(const fs::path& trace) {
 TEST_CASE("a URDF whose meshes are package://robot/meshes/…, beside its urdf/ folder, runs on model, run, figure and bench") {
   TempDir dir("model_files_layout");
   layOut(dir, "robot/meshes/body.stl", "robot/urdf/arm.urdf", "package://robot/meshes/body.stl");
-  for (const auto& args : commands(dir, "robot/urdf/arm.urdf", {})) {
-    const Result r = dynlab(dir, args);
-    INFO(shown(args), "\n", r.err);
-    CHECK(r.code == 0);
-  }
+  loadsOnEveryCommand(dir, "robot/urdf/arm.urdf", {});
 }
 
 TEST_CASE("a package found only through --package-path: one line naming where dynlab looked, then it loads on every command") {
@@ -75,11 +80,7 @@ TEST_CASE("a package found only through --package-path: one line naming where dy
           std::string::npos);
     CHECK(r.err.find("pass --package-path DIR") != std::string::npos);
   }
-  for (const auto& args : commands(dir, "ws/arm.urdf", {"--package-path", (dir / "vendor").string()})) {
-    const Result r = dynlab(dir, args);
-    INFO(shown(args), "\n", r.err);
-    CHECK(r.code == 0);
-  }
+  loadsOnEveryCommand(dir, "ws/arm.urdf", {"--package-path", (dir / "vendor").string()});
   // ROS_PACKAGE_PATH, as ROS users set it.
   const Result ros = dynlab(dir, commands(dir, "ws/arm.urdf", {})[0], withEnv({{"ROS_PACKAGE_PATH", (dir / "vendor").string()}}));
   CHECK(ros.code == 0);
