@@ -17,6 +17,7 @@
 #include "grading/rubric.h"
 #include "grading/scenario.h"
 #include "labs/config.h"
+#include "labs/numbers.h"
 #include "labs/run.h"
 #include "labs/settings.h"
 #include "labs/submission.h"
@@ -58,11 +59,7 @@ std::pair<int, std::string> runDynlab(const fs::path& dir, const std::string& bi
 
 }  // namespace
 
-std::string fmt(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", x);
-  return b;
-}
+std::string fmt(double x) { return dyn::fmt("%.4g", x); }
 std::string percent(double share) {
   char b[32];
   std::snprintf(b, sizeof b, "%.1f %%", share * 100);
