@@ -72,7 +72,8 @@ std::string parse(const std::string& path, const std::string& bytes, mjVFS* vfs,
     throw ModelFileError(path + ": MuJoCo's data for this model takes " + mib(data) + ", more than " + mib(kMaxDataBytes) +
                          " (<size> nstack, njmax, nconmax: leave them to MuJoCo)");
   const int size = mj_sizeModel(m);
-  const std::string warnings = oneLine(notes + (notes.empty() ? "" : "; ") + std::string(error) + " " + guard.warnings());
+  const std::string said = oneLine(std::string(error) + " " + guard.warnings());
+  const std::string warnings = notes.empty() ? said : said.empty() ? notes : notes + "; " + said;
   const auto n = std::uint32_t(warnings.size());
   std::string reply(reinterpret_cast<const char*>(&n), 4);
   reply += warnings;

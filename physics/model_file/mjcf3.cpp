@@ -223,7 +223,7 @@ void Translation::placeTie(const mjModel* m, const mjData* d, const Tie& t) {
     throw ModelFileError(docs.where(e) + ": " + what + ": the loop is not closed at the reference pose (site2 is " + shortNum(gap) + " m from site1" +
                          (weld ? ", turned " + shortNum(angle) + " rad" : std::string()) +
                          "); Debian's MuJoCo 2.2.2 holds a loop as it is at the reference pose: write the file in its closed pose");
-  if (gap > 0 || angle > 0)
+  if (gap > 1e-12 * std::max(1e-3, double(m->stat.extent)) || angle > 1e-12)
     notes.push_back(what + " apart by " + shortNum(gap) + " m" + (weld ? ", " + shortNum(angle) + " rad" : std::string()) +
                     " at the reference pose (rounded digits): held as they are there");
   const int b1 = m->site_bodyid[s[0]], b2 = m->site_bodyid[s[1]];
@@ -300,7 +300,7 @@ std::string translateMjcf3(const std::string& path, const std::string& text, mjV
     docs.store();
   }
   std::string out = "MuJoCo 3 syntax translated for Debian's MuJoCo 2.2.2";
-  if (!t.ties.empty()) out += ": " + std::to_string(t.ties.size()) + " site-to-site equalities as body1/body2/anchor";
+  if (!t.ties.empty()) out += "; site-to-site equalities as body1/body2/anchor: " + std::to_string(t.ties.size());
   for (const std::string& n : t.notes) out += "; " + n;
   return out;
 }

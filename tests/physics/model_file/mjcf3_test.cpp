@@ -219,3 +219,34 @@ TEST_CASE("a site-to-site loop open at the reference pose and a later MuJoCo's a
   const std::string e2 = errorOf(writeFile(folder(), "later3.xml", later));
   CHECK(e2.find(": line 28: attribute 'actuatorfrcrange' of <joint> is MuJoCo 3.x syntax that Debian's MuJoCo 2.2.2 does not read") != std::string::npos);
 }
+
+TEST_CASE("a weld between sites is 2.2.2's weld between their bodies; one whose frames are turned is refused") {
+  auto weld = [](std::string text, const std::string& quat) {
+    text.replace(text.find("<connect"), std::string("<connect").size(), "<weld");
+    text.replace(text.find("quat=\"0 0 0 1\""), std::string("quat=\"0 0 0 1\"").size(), "quat=\"" + quat + "\"");
+    return text;
+  };
+  const auto c = compiled(writeFile(folder(), "weld3.xml", weld(passive(mujoco3()), "1 0 0 0")));
+  std::string twin = passive(mujoco2(0));
+  twin.replace(twin.find("<connect body1=\"left_link\" body2=\"right_link\" anchor=\"0.2 -0.2 0\"/>"),
+               std::string("<connect body1=\"left_link\" body2=\"right_link\" anchor=\"0.2 -0.2 0\"/>").size(),
+               "<weld body1=\"left_link\" body2=\"right_link\" anchor=\"-0.2 -0.2 0\"/>");
+  const auto r = compiled(writeFile(folder(), "weld2.xml", twin));
+  REQUIRE(c->m->neq == 1);
+  CHECK(c->m->eq_type[0] == mjEQ_WELD);
+  CHECK(c->m->eq_obj1id[0] == r->m->eq_obj1id[0]);
+  CHECK(c->m->eq_obj2id[0] == r->m->eq_obj2id[0]);
+  for (int k = 0; k < mjNEQDATA; ++k) CHECK(std::abs(c->m->eq_data[k] - r->m->eq_data[k]) < 1e-15);
+  // Loaded, the same closure as the twin's (its rows are issue 40 item 1's: a loop in the x-z plane).
+  const model_file::LoadedModel a = model_file::load(writeFile(folder(), "weld3.xml", weld(passive(mujoco3()), "1 0 0 0")).string());
+  const model_file::LoadedModel b = model_file::load(writeFile(folder(), "weld2.xml", twin).string());
+  REQUIRE(a.closures.size() == 1);
+  CHECK(a.closures[0].kind == "weld");
+  CHECK(a.closures[0].kept == b.closures[0].kept);
+  CHECK(a.dof == b.dof);
+  CHECK(ConstrainedMechanism<Spatial>(a.mechanism).residual(a.q0) <= 1e-12);
+  const std::string e = errorOf(writeFile(folder(), "turned3.xml", weld(passive(mujoco3()), "0 0 0 1")));
+  CHECK(e.find("<weld site1='closing_C_1' site2='closing_C_2'>: the loop is not closed at the reference pose (site2 is ") != std::string::npos);
+  CHECK(e.find("m from site1, turned 3.14 rad)") !=
+        std::string::npos);
+}
