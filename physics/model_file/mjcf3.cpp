@@ -11,11 +11,13 @@
 //    servo law: gain kp, bias (0, −kp, −kv); dampratio as MuJoCo 3 computes it at compile time,
 //    kv = dampratio · 2 √(kp · M_jj / gear²) with M_jj the joint's diagonal inertia at qpos0 (armature
 //    included), for an actuator on one hinge or slide joint (other transmissions refused: write kv).
+//  * inheritrange on <position> (or from its class) → ctrlrange: the joint's range scaled about its
+//    middle (a hinge or slide joint with a range; others refused: write ctrlrange).
 //  * MuJoCo 3's autolimits default (true; 2.2.2's is false and refuses a range without `limited`):
 //    <compiler autolimits="true"> when the file says nothing and writes such a range. A file 2.2.2
 //    reads compiles the same either way.
 //  * <size memory> (MuJoCo 3's arena size): left out, 2.2.2 sizes its own.
-// The sites' bodies and frames, and M, come from a first compile of the text with those equalities
+// The sites' bodies and frames, M and the joints' ranges come from a first compile of the text with those equalities
 // left out (MuJoCo resolves the defaults, classes and frames, not dynlab). Everything else 2.2.2's
 // schema lacks is refused by mjcf3_schema.cpp in one line naming the file, line and attribute.
 #include "physics/model_file/mjcf3.h"
@@ -61,8 +63,9 @@ std::vector<double> numbers(const XMLElement* e, const char* attribute) {
 // A position servo's gains as MuJoCo 3 resolves them: the element's own, else its class's, else the
 // classes it inherits from (MuJoCo's defaults: 1 for kp, no damping).
 struct Gains {
-  bool has_kp = false, has_damping = false, ratio = false;
+  bool has_kp = false, has_damping = false, ratio = false, has_inherit = false;
   double kp = 1, damping = 0;  // damping: kv, or the damping ratio when `ratio`
+  double inherit = 0;          // inheritrange: the joint's range scaled about its middle as ctrlrange
   // Fills what is still missing from a <position> or <general> element.
   void from(const XMLElement* e) {
     if (is(e, "position")) {
@@ -70,6 +73,8 @@ struct Gains {
       if (!has_damping && e->Attribute("kv")) has_damping = e->QueryDoubleAttribute("kv", &damping) == tinyxml2::XML_SUCCESS;
       if (!has_damping && e->Attribute("dampratio"))
         has_damping = ratio = e->QueryDoubleAttribute("dampratio", &damping) == tinyxml2::XML_SUCCESS;
+      if (!has_inherit && e->Attribute("inheritrange"))
+        has_inherit = e->QueryDoubleAttribute("inheritrange", &inherit) == tinyxml2::XML_SUCCESS;
     } else if (is(e, "general")) {
       const std::vector<double> gain = numbers(e, "gainprm"), bias = numbers(e, "biasprm");
       if (!has_kp && !gain.empty()) has_kp = true, kp = gain[0];
@@ -85,21 +90,23 @@ struct Tie {
   tinyxml2::XMLComment* mark;
 };
 
-// A position servo with a damping ratio: actuator `index`, written as <general>, kv still to compute.
-struct RatioServo {
+// A position servo whose damping ratio (kv still to compute) or inheritrange (ctrlrange still to set)
+// needs the compiled model: actuator `index`.
+struct Pending {
   std::size_t index;
-  XMLElement* general;
-  double kp, ratio;
+  XMLElement* element;
+  double kp, value;  // value: the damping ratio, or the inheritrange scale
 };
 
 struct Translation {
+  explicit Translation(MjcfDocs& d) : docs(d) {}
   MjcfDocs& docs;
   std::map<std::string, std::pair<XMLElement*, std::string>> classes;  // class → (its <default>, parent class)
   std::vector<XMLElement*> actuators;                                 // in MuJoCo's order
   std::vector<XMLElement*> default_positions, compilers, sizes, sited;
   bool autolimits_said = false, range_without_limited = false;
   std::vector<Tie> ties;
-  std::vector<RatioServo> servos;
+  std::vector<Pending> servos, ranges;
   std::vector<std::string> notes;
 
   void changed(const tinyxml2::XMLNode* e) { docs.docOf(e).changed = true; }
@@ -144,6 +151,13 @@ struct Translation {
       XMLElement* a = actuators[i];
       if (!is(a, "position")) continue;
       const Gains g = resolve(a);
+      if (g.has_inherit && g.inherit > 0) {
+        if (a->Attribute("ctrlrange"))
+          throw ModelFileError(docs.where(a) + ": <position> has both ctrlrange and inheritrange (MuJoCo 3 refuses them together too)");
+        ranges.push_back({i, a, g.kp, g.inherit});
+        changed(a);
+      }
+      a->DeleteAttribute("inheritrange");
       if (!g.has_damping) continue;
       a->SetName("general");
       for (const char* gone : {"kp", "kv", "dampratio"}) a->DeleteAttribute(gone);
@@ -158,7 +172,8 @@ struct Translation {
     }
     if (translated) notes.push_back(std::to_string(translated) + " <position> servos with kv or dampratio as <general>");
     for (XMLElement* d : default_positions)
-      if (d->Attribute("kv") || d->Attribute("dampratio")) d->DeleteAttribute("kv"), d->DeleteAttribute("dampratio"), changed(d);
+      for (const char* gone : {"kv", "dampratio", "inheritrange"})
+        if (d->Attribute(gone)) d->DeleteAttribute(gone), changed(d);
   }
 
   void plainOnes() {
@@ -189,7 +204,8 @@ struct Translation {
 
   void finish(const mjModel* m);
   void placeTie(const mjModel* m, const mjData* d, const Tie& t);
-  void setRatio(const mjModel* m, const mjData* d, const RatioServo& s);
+  void setRatio(const mjModel* m, const mjData* d, const Pending& s);
+  void setRange(const mjModel* m, const Pending& s);
 };
 
 // A body's name for MuJoCo 2.2.2's form of an equality.
@@ -238,19 +254,30 @@ void Translation::placeTie(const mjModel* m, const mjData* d, const Tie& t) {
   t.mark->Parent()->DeleteChild(t.mark);
 }
 
-void Translation::setRatio(const mjModel* m, const mjData* d, const RatioServo& s) {
+void Translation::setRatio(const mjModel* m, const mjData* d, const Pending& s) {
   const int a = int(s.index);
   const int j = m->actuator_trnid[2 * a];
   const double gear = m->actuator_gear[6 * a];
   if (m->actuator_trntype[a] != mjTRN_JOINT || (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE) || gear == 0)
-    throw ModelFileError(docs.where(s.general) + ": dampratio on <position>: dynlab translates it for a servo on one hinge or slide joint "
+    throw ModelFileError(docs.where(s.element) + ": dampratio on <position>: dynlab translates it for a servo on one hinge or slide joint "
                          "(MuJoCo 3 computes kv from the inertia it drives); write kv instead");
   const int dof = m->jnt_dofadr[j];
   const double inertia = d->qM[m->dof_Madr[dof]] / (gear * gear);
-  const double kv = s.ratio * 2 * std::sqrt(s.kp * inertia);
-  s.general->SetAttribute("biasprm", ("0 " + num(-s.kp) + " " + num(-kv)).c_str());
+  const double kv = s.value * 2 * std::sqrt(s.kp * inertia);
+  s.element->SetAttribute("biasprm", ("0 " + num(-s.kp) + " " + num(-kv)).c_str());
   const char* name = mj_id2name(m, mjOBJ_ACTUATOR, a);
-  notes.push_back("dampratio " + shortNum(s.ratio) + " of actuator '" + (name ? name : "#" + std::to_string(a)) + "' read as kv " + shortNum(kv));
+  notes.push_back("dampratio " + shortNum(s.value) + " of actuator '" + (name ? std::string(name) : std::to_string(a).insert(0, 1, '#')) + "' read as kv " + shortNum(kv));
+}
+
+// inheritrange as MuJoCo 3 reads it: ctrlrange the joint's range scaled by X about its middle.
+void Translation::setRange(const mjModel* m, const Pending& s) {
+  const int a = int(s.index), j = m->actuator_trnid[2 * a];
+  if (m->actuator_trntype[a] != mjTRN_JOINT || (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE) || !m->jnt_limited[j])
+    throw ModelFileError(docs.where(s.element) + ": inheritrange on <position>: dynlab translates it for a servo on one hinge or slide joint "
+                         "with a range (MuJoCo 3 takes the range from it); write ctrlrange instead");
+  const double mid = 0.5 * (m->jnt_range[2 * j] + m->jnt_range[2 * j + 1]), half = 0.5 * s.value * (m->jnt_range[2 * j + 1] - m->jnt_range[2 * j]);
+  s.element->SetAttribute("ctrllimited", "true");
+  s.element->SetAttribute("ctrlrange", (num(mid - half) + " " + num(mid + half)).c_str());
 }
 
 // After the first compile: the parked equalities in 2.2.2's form, the damping ratios as kv.
@@ -264,7 +291,8 @@ void Translation::finish(const mjModel* m) {
   try {
     MUJOCO_CALL(docs.path, mj_kinematics(m, d); mj_comPos(m, d); mj_crb(m, d));
     for (const Tie& t : ties) changed(t.mark), placeTie(m, d, t);
-    for (const RatioServo& s : servos) changed(s.general), setRatio(m, d, s);
+    for (const Pending& s : servos) changed(s.element), setRatio(m, d, s);
+    for (const Pending& s : ranges) changed(s.element), setRange(m, s);
   } catch (...) {
     mj_deleteData(d);
     throw;
@@ -279,7 +307,7 @@ std::string translateMjcf3(const std::string& path, const std::string& text, mjV
   *translated = false;
   MjcfDocs docs(path, text, vfs);
   if (!docs.mjcf()) return "";
-  Translation t{docs, {}, {}, {}, {}, {}, {}, false, false, {}, {}, {}};
+  Translation t(docs);
   t.collect(docs.root(), "", false);
   t.servosToGeneral();
   t.plainOnes();
@@ -288,7 +316,7 @@ std::string translateMjcf3(const std::string& path, const std::string& text, mjV
   for (const auto& d : docs.docs) *translated = *translated || d.changed;
   if (!*translated) return "";
   docs.store();
-  if (!t.ties.empty() || !t.servos.empty()) {
+  if (!t.ties.empty() || !t.servos.empty() || !t.ranges.empty()) {
     mjModel* m = compile();
     try {
       t.finish(m);

@@ -67,7 +67,7 @@ const Schema& schema() {
 
 // What dynlab translates from MuJoCo 3, named in the refusal of what it does not.
 constexpr const char* kTranslated =
-    "dynlab translates site1/site2 on <connect> and <weld>, kv and dampratio on <position>, <size memory> and "
+    "dynlab translates site1/site2 on <connect> and <weld>, kv, dampratio and inheritrange on <position>, <size memory> and "
     "MuJoCo 3's autolimits default";
 
 void checkElement(MjcfDocs& docs, XMLElement* e, int node) {

@@ -1,7 +1,7 @@
 // MuJoCo 3 syntax read by Debian's MuJoCo 2.2.2 (physics/model_file/mjcf3.cpp): a planar five-bar
 // written as onshape-to-robot writes one (body frames turned so each hinge is its local z, a default
 // class with frictionloss and armature, sites closing the loop, <connect site1 site2>, position servos
-// with kp and dampratio from the class and kv on one) is the same mechanism as the file written in
+// with kp and dampratio from the class, kv on one, inheritrange on the other) is the same mechanism as the file written in
 // 2.2.2's terms (body1/anchor, <general> servos): the compiled models agree, the loop closes at the
 // reference pose and over a 1 s run to 1e-12, and the motion is the same. An include is translated too;
 // a loop open at the reference pose and an attribute of a later MuJoCo are refused in one line.
@@ -38,7 +38,7 @@ std::string bodies(const std::string& site1, const std::string& site2) {
     <body name="base" childclass="fivebar">
       <inertial pos="0.15 0 0" mass="1" diaginertia="0.01 0.01 0.01"/>
       <body name="left_crank" pos="0 0 0" quat="0.707107 -0.707107 0 0">
-        <joint name="left_motor" type="hinge"/>
+        <joint name="left_motor" type="hinge" limited="true" range="-1 2"/>
         <inertial pos="-0.025 -0.1 0" mass="0.15" fullinertia="0.0005 0.00005 0.0005 0.0001 0 0"/>
         <body name="left_link" pos="-0.05 -0.2 0" quat="1 0 0 0">
           <joint name="left_passive" type="hinge"/>
@@ -59,7 +59,8 @@ std::string bodies(const std::string& site1, const std::string& site2) {
   </worldbody>)";
 }
 
-// MuJoCo 3, as onshape-to-robot writes it: the servos' damping from the class's dampratio (one with kv),
+// MuJoCo 3, as onshape-to-robot writes it: the servos' damping from the class's dampratio (one with kv;
+// the other's ctrlrange from its joint's range by inheritrange),
 // the loop closed by sites (site2 turned, its position from a class of its own).
 std::string mujoco3(const std::string& site2_pos = "-0.2 -0.2 0") {
   return R"(<?xml version="1.0" ?>
@@ -79,7 +80,7 @@ std::string mujoco3(const std::string& site2_pos = "-0.2 -0.2 0") {
          bodies(R"(<site group="3" name="closing_C_1" pos="0.2 -0.2 0" quat="1 0 0 0"/>)",
                 R"(<site class="closing" name="closing_C_2" quat="0 0 0 1"/>)") + R"(
   <actuator>
-    <position class="fivebar" name="left_motor" joint="left_motor" ctrlrange="-3.14 3.14"/>
+    <position class="fivebar" name="left_motor" joint="left_motor" inheritrange="0.5"/>
     <position class="fivebar" name="right_motor" joint="right_motor" kv="2" forcerange="-10 10" ctrlrange="-3.14 3.14"/>
   </actuator>
   <equality>
@@ -107,7 +108,7 @@ std::string mujoco2(double kv_left) {
   </default>)" +
          bodies("", "") + R"(
   <actuator>
-    <general name="left_motor" joint="left_motor" ctrllimited="true" ctrlrange="-3.14 3.14" gaintype="fixed" biastype="affine"
+    <general name="left_motor" joint="left_motor" ctrllimited="true" ctrlrange="-0.25 1.25" gaintype="fixed" biastype="affine"
              gainprm="50" biasprm="0 -50 )" + exact(-kv_left) + R"("/>
     <general name="right_motor" joint="right_motor" ctrllimited="true" ctrlrange="-3.14 3.14" forcelimited="true" forcerange="-10 10"
              gaintype="fixed" biastype="affine" gainprm="50" biasprm="0 -50 -2"/>
@@ -164,6 +165,7 @@ TEST_CASE("an onshape-style MuJoCo 3 five-bar compiles as the same file written 
     for (int k = 0; k < 2; ++k) CHECK(m->actuator_biasprm[mjNBIAS * a + k] == r->actuator_biasprm[mjNBIAS * a + k]);
     CHECK(std::abs(m->actuator_biasprm[mjNBIAS * a + 2] - r->actuator_biasprm[mjNBIAS * a + 2]) < 1e-12);
     CHECK(m->actuator_ctrllimited[a] == 1);
+    for (int k = 0; k < 2; ++k) CHECK(m->actuator_ctrlrange[2 * a + k] == r->actuator_ctrlrange[2 * a + k]);
     CHECK(m->actuator_forcelimited[a] == r->actuator_forcelimited[a]);
     for (int k = 0; k < 2; ++k) CHECK(m->actuator_forcerange[2 * a + k] == r->actuator_forcerange[2 * a + k]);
   }
