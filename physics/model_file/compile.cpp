@@ -47,7 +47,7 @@ std::string parse(const std::string& path, const std::string& bytes, mjVFS* vfs,
   checkSizes(path, bytes, vfs);
   char error[1024] = "";
   MujocoGuard guard;
-  bool translated = false;
+  Mjcf3 translation;
   auto load = [&] {
     mjModel* m = nullptr;
     MUJOCO_CALL(path, m = mj_loadXML(path.c_str(), vfs, error, sizeof error));
@@ -57,11 +57,11 @@ std::string parse(const std::string& path, const std::string& bytes, mjVFS* vfs,
     for (std::size_t i = 0; i < missing.size() && i < 3; ++i) why += (i ? "; " : "file ") + missing[i];
     if (missing.size() > 3) why += "; and " + std::to_string(missing.size() - 3) + " more";
     if (!missing.empty()) why += "; then ";
-    throw ModelFileError(why + "MuJoCo's parser: " + oneLine(error[0] ? error : "no model") +
-                         (translated ? " (lines as in dynlab's translation of the file's MuJoCo 3 syntax)" : ""));
+    throw ModelFileError(why + "MuJoCo's parser: " + translation.ownLines(oneLine(error[0] ? error : "no model")));
   };
   // MuJoCo 3 syntax into 2.2.2's, in the virtual files (mjcf3.cpp), then the model MuJoCo compiles.
-  const std::string notes = translateMjcf3(path, bytes, vfs, load, &translated);
+  translateMjcf3(path, bytes, vfs, load, translation);
+  const std::string& notes = translation.notes;
   mjModel* m = load();
   mjData* d = nullptr;
   MUJOCO_CALL(path, d = mj_makeData(m));

@@ -23,6 +23,7 @@
 #include "physics/model_file/mjcf3.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -302,20 +303,37 @@ void Translation::finish(const mjModel* m) {
 
 }  // namespace
 
-std::string translateMjcf3(const std::string& path, const std::string& text, mjVFS* vfs, const std::function<mjModel*()>& compile,
-                           bool* translated) {
-  *translated = false;
+std::string Mjcf3::ownLines(const std::string& message) const {
+  if (lines.empty()) return message;
+  std::string out;
+  std::size_t from = 0;
+  // "line 9" (a schema error) and "line = 9" (a compiler error).
+  for (std::size_t at = message.find("line"); at != std::string::npos; at = message.find("line", at + 4)) {
+    std::size_t digits = at + 4;
+    while (digits < message.size() && (message[digits] == ' ' || message[digits] == '=')) ++digits;
+    std::size_t end = digits;
+    while (end < message.size() && std::isdigit(static_cast<unsigned char>(message[end]))) ++end;
+    if (end == digits || end - digits > 9) continue;
+    const std::size_t n = std::stoul(message.substr(digits, end - digits));
+    if (n == 0 || n >= lines.size() || lines[n] == 0) continue;
+    out += message.substr(from, digits - from) + std::to_string(lines[n]);
+    from = end;
+  }
+  return out + message.substr(from);
+}
+
+void translateMjcf3(const std::string& path, const std::string& text, mjVFS* vfs, const std::function<mjModel*()>& compile, Mjcf3& out) {
   MjcfDocs docs(path, text, vfs);
-  if (!docs.mjcf()) return "";
+  if (!docs.mjcf()) return;
   Translation t(docs);
   t.collect(docs.root(), "", false);
   t.servosToGeneral();
   t.plainOnes();
   t.parkTies();
   checkSchema(docs);
-  for (const auto& d : docs.docs) *translated = *translated || d.changed;
-  if (!*translated) return "";
+  if (std::none_of(docs.docs.begin(), docs.docs.end(), [](const MjcfDocs::Doc& d) { return d.changed; })) return;
   docs.store();
+  out.lines = docs.lines;
   if (!t.ties.empty() || !t.servos.empty() || !t.ranges.empty()) {
     mjModel* m = compile();
     try {
@@ -326,11 +344,11 @@ std::string translateMjcf3(const std::string& path, const std::string& text, mjV
     }
     mj_deleteModel(m);
     docs.store();
+    out.lines = docs.lines;
   }
-  std::string out = "MuJoCo 3 syntax translated for Debian's MuJoCo 2.2.2";
-  if (!t.ties.empty()) out += "; site-to-site equalities as body1/body2/anchor: " + std::to_string(t.ties.size());
-  for (const std::string& n : t.notes) out += "; " + n;
-  return out;
+  out.notes = "MuJoCo 3 syntax translated for Debian's MuJoCo 2.2.2";
+  if (!t.ties.empty()) out.notes += "; site-to-site equalities as body1/body2/anchor: " + std::to_string(t.ties.size());
+  for (const std::string& n : t.notes) out.notes += "; " + n;
 }
 
 }  // namespace dyn::model_file::detail

@@ -33,6 +33,8 @@ struct MjcfDocs {
   void children(tinyxml2::XMLElement* e, const std::function<void(tinyxml2::XMLElement*)>& f, int depth = 0);
   // The changed documents printed back into the virtual file system in place of the originals.
   void store();
+  // When the model file was printed back: its printed lines' numbers as written ([n]: line n's; 0: none).
+  std::vector<int> lines;
 
   std::string path;
   mjVFS* vfs;
@@ -49,12 +51,21 @@ struct MjcfDocs {
 // the attribute (mjcf3_schema.cpp).
 void checkSchema(MjcfDocs& docs);
 
+// What translateMjcf3 did: notes for the warnings, and the model file's lines when it was rewritten.
+struct Mjcf3 {
+  std::string notes;
+  std::vector<int> lines;  // as MjcfDocs::lines
+  // MuJoCo's message with each "line N" of the rewritten model file given as the file's own line (an
+  // included element's line MuJoCo gives as 0: left so).
+  std::string ownLines(const std::string& message) const;
+};
+
 // In the parser's child, before MuJoCo parses: MuJoCo 3 syntax translated into 2.2.2's (the list is
 // at the top of mjcf3.cpp) and the rest checked against 2.2.2's schema; the translated texts put into
 // vfs in place of the originals. `compile` compiles what vfs holds then (a first pass that site-to-site
-// equalities and dampratio need: the sites' bodies and frames, the inertia at qpos0) and throws
-// MuJoCo's error. Returns notes for the warnings (what was translated) and sets *translated.
-std::string translateMjcf3(const std::string& path, const std::string& text, mjVFS* vfs,
-                           const std::function<mjModel*()>& compile, bool* translated);
+// equalities, dampratio and inheritrange need: the sites' bodies and frames, the inertia and the
+// joints' ranges at qpos0) and throws MuJoCo's error (out.lines is set before it runs).
+void translateMjcf3(const std::string& path, const std::string& text, mjVFS* vfs, const std::function<mjModel*()>& compile,
+                    Mjcf3& out);
 
 }  // namespace dyn::model_file::detail

@@ -144,11 +144,31 @@ void MjcfDocs::children(XMLElement* e, const std::function<void(XMLElement*)>& f
   }
 }
 
+namespace {
+// A printer that notes, for each element, the line it prints it on and the line it was written on.
+class LinePrinter : public tinyxml2::XMLPrinter {
+ public:
+  std::vector<int> lines{0, 0};
+  bool VisitEnter(const XMLElement& e, const tinyxml2::XMLAttribute* a) override {
+    const bool more = XMLPrinter::VisitEnter(e, a);
+    const char* text = CStr();
+    for (; counted_ < std::size_t(CStrSize() > 0 ? CStrSize() - 1 : 0); ++counted_)
+      if (text[counted_] == '\n') lines.push_back(0);
+    if (lines.back() == 0) lines.back() = e.GetLineNum();
+    return more;
+  }
+
+ private:
+  std::size_t counted_ = 0;
+};
+}  // namespace
+
 void MjcfDocs::store() {
   for (Doc& d : docs) {
     if (!d.changed) continue;
-    tinyxml2::XMLPrinter printer;
+    LinePrinter printer;
     d.doc->Print(&printer);
+    if (&d == &docs[0]) lines = printer.lines;
     const std::string text(printer.CStr(), std::size_t(printer.CStrSize() > 0 ? printer.CStrSize() - 1 : 0));
     // In place: 2.2.2's mj_deleteFileVFS can loop forever (fixed in MuJoCo 2.3.2).
     const int at = mj_findFileVFS(vfs, d.vfsname.c_str());

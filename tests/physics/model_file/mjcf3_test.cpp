@@ -7,6 +7,7 @@
 // a loop open at the reference pose and an attribute of a later MuJoCo are refused in one line.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -263,4 +264,17 @@ TEST_CASE("a weld between sites is 2.2.2's weld between their bodies; one whose 
   CHECK(e.find("<weld site1='closing_C_1' site2='closing_C_2'>: the loop is not closed at the reference pose (site2 is ") != std::string::npos);
   CHECK(e.find("m from site1, turned 3.14 rad)") !=
         std::string::npos);
+}
+
+TEST_CASE("MuJoCo's own error in a translated file names the line as the file writes it") {
+  std::string text = passive(mujoco3());
+  // An element over several lines before the error (the translation prints it on one), then a bad keyword.
+  text.replace(text.find("<option noslip_iterations=\"1\"></option>"), std::string("<option noslip_iterations=\"1\"></option>").size(),
+               "<option\n      noslip_iterations=\"1\"\n\n  />");
+  const std::size_t bad = text.find("type=\"hinge\"/>\n          <inertial pos=\"-0.1");
+  REQUIRE(bad != std::string::npos);
+  text.replace(bad, std::string("type=\"hinge\"").size(), "type=\"hing\"");
+  const long line = 1 + std::count(text.begin(), text.begin() + long(bad), '\n');
+  const std::string e = errorOf(writeFile(folder(), "keyword3.xml", text));
+  CHECK(e.find("invalid keyword: 'hing' Element 'joint', line " + std::to_string(line)) != std::string::npos);
 }
