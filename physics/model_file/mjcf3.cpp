@@ -17,6 +17,8 @@
 //    <compiler autolimits="true"> when the file says nothing and writes such a range. A file 2.2.2
 //    reads compiles the same either way.
 //  * <size memory> (MuJoCo 3's arena size): left out, 2.2.2 sizes its own.
+//  * <option integrator="implicitfast"> (MuJoCo 3's implicit integrator without the Coriolis terms'
+//    derivatives) → "implicit": dynlab's engines use their own integrators and its MuJoCo runs Euler.
 // The sites' bodies and frames, M and the joints' ranges come from a first compile of the text with those equalities
 // left out (MuJoCo resolves the defaults, classes and frames, not dynlab). Everything else 2.2.2's
 // schema lacks is refused by mjcf3_schema.cpp in one line naming the file, line and attribute.
@@ -104,7 +106,7 @@ struct Translation {
   MjcfDocs& docs;
   std::map<std::string, std::pair<XMLElement*, std::string>> classes;  // class → (its <default>, parent class)
   std::vector<XMLElement*> actuators;                                 // in MuJoCo's order
-  std::vector<XMLElement*> default_positions, compilers, sizes, sited;
+  std::vector<XMLElement*> default_positions, compilers, sizes, sited, options;
   bool autolimits_said = false, range_without_limited = false;
   std::vector<Tie> ties;
   std::vector<Pending> servos, ranges;
@@ -126,6 +128,7 @@ struct Translation {
       if (is(e, "equality") && (is(c, "connect") || is(c, "weld")) && (c->Attribute("site1") || c->Attribute("site2"))) sited.push_back(c);
       if (is(c, "compiler")) compilers.push_back(c), autolimits_said = autolimits_said || c->Attribute("autolimits");
       if (is(c, "size") && c->Attribute("memory")) sizes.push_back(c);
+      if (is(c, "option") && c->Attribute("integrator", "implicitfast")) options.push_back(c);
       static const char* const kRanges[4][2] = {{"range", "limited"}, {"ctrlrange", "ctrllimited"}, {"forcerange", "forcelimited"}, {"actrange", "actlimited"}};
       for (const auto& r : kRanges)
         if (c->Attribute(r[0]) && !c->Attribute(r[1])) range_without_limited = true;
@@ -186,6 +189,8 @@ struct Translation {
       notes.push_back("autolimits=\"true\" (MuJoCo 3's default)");
     }
     for (XMLElement* s : sizes) s->DeleteAttribute("memory"), changed(s), notes.push_back("<size memory> left out (2.2.2 sizes its own)");
+    for (XMLElement* o : options)
+      o->SetAttribute("integrator", "implicit"), changed(o), notes.push_back("integrator implicitfast read as implicit (MuJoCo's runs here use Euler)");
   }
 
   // Site-to-site equalities parked for the first compile: a comment in their place.

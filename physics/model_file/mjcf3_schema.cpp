@@ -67,8 +67,8 @@ const Schema& schema() {
 
 // What dynlab translates from MuJoCo 3, named in the refusal of what it does not.
 constexpr const char* kTranslated =
-    "dynlab translates site1/site2 on <connect> and <weld>, kv, dampratio and inheritrange on <position>, <size memory> and "
-    "MuJoCo 3's autolimits default";
+    "dynlab translates site1/site2 on <connect> and <weld>, kv, dampratio and inheritrange on <position>, <size memory>, integrator "
+    "implicitfast and MuJoCo 3's autolimits default";
 
 void checkElement(MjcfDocs& docs, XMLElement* e, int node) {
   const Schema& s = schema();

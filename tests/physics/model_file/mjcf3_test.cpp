@@ -68,7 +68,7 @@ std::string mujoco3(const std::string& site2_pos = "-0.2 -0.2 0") {
 <!-- Generated the way onshape-to-robot writes a robot -->
 <mujoco model="fivebar3">
   <compiler angle="radian" autolimits="true"/>
-  <option noslip_iterations="1"></option>
+  <option noslip_iterations="1" integrator="implicitfast"></option>
   <default>
     <default class="fivebar">
       <joint frictionloss="0.1" armature="0.005"/>
@@ -101,7 +101,7 @@ std::string exact(double x) {
 std::string mujoco2(double kv_left) {
   return R"(<mujoco model="fivebar2">
   <compiler angle="radian"/>
-  <option noslip_iterations="1"/>
+  <option noslip_iterations="1" integrator="implicit"/>
   <default>
     <default class="fivebar">
       <joint frictionloss="0.1" armature="0.005"/>
@@ -176,6 +176,7 @@ TEST_CASE("an onshape-style MuJoCo 3 five-bar compiles as the same file written 
   CHECK(m->eq_obj1id[0] == r->eq_obj1id[0]);
   CHECK(m->eq_obj2id[0] == r->eq_obj2id[0]);
   for (int k = 0; k < 6; ++k) CHECK(std::abs(m->eq_data[k] - r->eq_data[k]) < 1e-15);
+  CHECK(m->opt.integrator == mjINT_IMPLICIT);
   const int s2 = mj_name2id(m, mjOBJ_SITE, "closing_C_2");
   for (int k = 0; k < 3; ++k) CHECK(std::abs(m->eq_data[3 + k] - m->site_pos[3 * s2 + k]) < 1e-15);
 }
@@ -269,8 +270,8 @@ TEST_CASE("a weld between sites is 2.2.2's weld between their bodies; one whose 
 TEST_CASE("MuJoCo's own error in a translated file names the line as the file writes it") {
   std::string text = passive(mujoco3());
   // An element over several lines before the error (the translation prints it on one), then a bad keyword.
-  text.replace(text.find("<option noslip_iterations=\"1\"></option>"), std::string("<option noslip_iterations=\"1\"></option>").size(),
-               "<option\n      noslip_iterations=\"1\"\n\n  />");
+  const std::string option = "<option noslip_iterations=\"1\" integrator=\"implicitfast\"></option>";
+  text.replace(text.find(option), option.size(), "<option\n      noslip_iterations=\"1\"\n\n  />");
   const std::size_t bad = text.find("type=\"hinge\"/>\n          <inertial pos=\"-0.1");
   REQUIRE(bad != std::string::npos);
   text.replace(bad, std::string("type=\"hinge\"").size(), "type=\"hing\"");
