@@ -79,10 +79,11 @@ struct Gains {
       if (!has_inherit && e->Attribute("inheritrange"))
         has_inherit = e->QueryDoubleAttribute("inheritrange", &inherit) == tinyxml2::XML_SUCCESS;
     } else if (is(e, "general")) {
-      const std::vector<double> gain = numbers(e, "gainprm"), bias = numbers(e, "biasprm");
+      // A class's actuator default is one for all kinds: a <general> gain is a position servo's kp.
+      // (Its bias is not read: only kv and dampratio written on a <position> are MuJoCo 3 syntax, and
+      // a file without them is left as 2.2.2 reads it.)
+      const std::vector<double> gain = numbers(e, "gainprm");
       if (!has_kp && !gain.empty()) has_kp = true, kp = gain[0];
-      // MuJoCo 3 reads a positive third bias number of a position-like servo as a damping ratio.
-      if (!has_damping && bias.size() >= 3) has_damping = true, ratio = bias[2] > 0, damping = std::abs(bias[2]);
     }
   }
 };
@@ -161,7 +162,7 @@ struct Translation {
         ranges.push_back({i, a, g.kp, g.inherit});
         changed(a);
       }
-      a->DeleteAttribute("inheritrange");
+      if (a->Attribute("inheritrange")) a->DeleteAttribute("inheritrange"), changed(a);
       if (!g.has_damping) continue;
       a->SetName("general");
       for (const char* gone : {"kp", "kv", "dampratio"}) a->DeleteAttribute(gone);
