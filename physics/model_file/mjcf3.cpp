@@ -126,7 +126,10 @@ struct Translation {
       }
       if (in_default && is(c, "position")) default_positions.push_back(c);
       if (is(e, "actuator")) actuators.push_back(c);
-      if (is(e, "equality") && (is(c, "connect") || is(c, "weld")) && (c->Attribute("site1") || c->Attribute("site2"))) sited.push_back(c);
+      // (A file included twice is one document: its equality is parked once.)
+      if (is(e, "equality") && (is(c, "connect") || is(c, "weld")) && (c->Attribute("site1") || c->Attribute("site2")) &&
+          std::find(sited.begin(), sited.end(), c) == sited.end())
+        sited.push_back(c);
       if (is(c, "compiler")) compilers.push_back(c), autolimits_said = autolimits_said || c->Attribute("autolimits");
       if (is(c, "size") && c->Attribute("memory")) sizes.push_back(c);
       if (is(c, "option") && c->Attribute("integrator", "implicitfast")) options.push_back(c);
