@@ -32,12 +32,15 @@ std::vector<Vector3d> placed(const Geom& g) {
   return out;
 }
 
-// True when every point of `want` is one of `got` (to float precision) and both have as many.
+// True when every point of `got` is one of `want` and every point of `want` one of `got` (to float
+// precision; MuJoCo may repeat a vertex for each face it is on).
 bool sameSet(const std::vector<Vector3d>& got, const std::vector<Vector3d>& want) {
-  if (got.size() != want.size()) return false;
-  return std::all_of(want.begin(), want.end(), [&](const Vector3d& w) {
-    return std::any_of(got.begin(), got.end(), [&](const Vector3d& p) { return (p - w).norm() < 1e-6; });
-  });
+  auto within = [](const std::vector<Vector3d>& a, const std::vector<Vector3d>& b) {
+    return std::all_of(a.begin(), a.end(), [&](const Vector3d& p) {
+      return std::any_of(b.begin(), b.end(), [&](const Vector3d& q) { return (p - q).norm() < 1e-6; });
+    });
+  };
+  return !got.empty() && within(got, want) && within(want, got);
 }
 
 }  // namespace
@@ -46,7 +49,7 @@ TEST_CASE("a mesh in a subfolder is drawn as its triangles, where the file puts 
   const model_file::LoadedModel m = model_file::load(meshArm());
   const Geom* block = named(m, "block_visual");
   REQUIRE(block);
-  CHECK(block->shape == Geom::Shape::Mesh);
+  REQUIRE(block->shape == Geom::Shape::Mesh);
   REQUIRE(block->mesh);
   CHECK(block->mesh->triangles.size() == 12);
   CHECK(block->link == 0);
@@ -71,7 +74,7 @@ TEST_CASE("a mesh in a subfolder is drawn as its triangles, where the file puts 
   // The tetrahedron on link2, on its joint's anchor (0.4, 0, 0.5): the file's four vertices.
   const Geom* tip = named(m, "tip_visual");
   REQUIRE(tip);
-  CHECK(tip->shape == Geom::Shape::Mesh);
+  REQUIRE(tip->shape == Geom::Shape::Mesh);
   CHECK(tip->link == 1);
   CHECK(tip->mesh->triangles.size() == 4);
   CHECK(sameSet(placed(*tip), {{-0.05, -0.05, 0.02}, {0.08, -0.05, 0.02}, {-0.05, 0.08, 0.02}, {0, 0, -0.25}}));
