@@ -36,6 +36,8 @@ std::vector<std::uint32_t> weld(const std::vector<Eigen::Vector3f>& v) {
 void meshVertices(const TriangleMesh& mesh, std::vector<Vertex>& out) {
   out.clear();
   const auto& v = mesh.vertices;
+  // (A vertex that is not a number could not be sorted by weld(): such a mesh is not drawn.)
+  if (!std::all_of(v.begin(), v.end(), [](const Eigen::Vector3f& p) { return p.allFinite(); })) return;
   // Each triangle's normal scaled by twice its area, and its direction.
   std::vector<Vector3d> area, unit;
   std::vector<std::size_t> kept;

@@ -321,7 +321,10 @@ struct Renderer::Impl {
       if (inset.scene.framing.fit) {
         const Eigen::AlignedBox3d box =
             inset.scene.framing.bounds.isEmpty() ? sceneBounds(inset.scene) : inset.scene.framing.bounds;
-        view = fitCamera(view, box, iw, ih, {0, 0, double(iw), double(ih)}, inset.scene.framing.margin);
+        const PixelRect all{0, 0, double(iw), double(ih)};
+        const auto& points = inset.scene.framing.points;
+        view = points.empty() ? fitCamera(view, box, iw, ih, all, inset.scene.framing.margin)
+                              : fitCamera(view, points, iw, ih, all, inset.scene.framing.margin);
       }
       drawContent(inset.scene, view, iw, ih);
       glDisable(GL_SCISSOR_TEST);
