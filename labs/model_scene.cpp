@@ -133,11 +133,13 @@ Box3 ModelPicture::bounds(const VecN& q) const {
 }
 
 void ModelPicture::drawBodies(bool ghost, Scene& s) const {
-  // The ghost sits a little behind the mechanism when seen side-on.
-  const Vec3 back = ghost && planar_ ? Vec3(-(s.camera.eye - s.camera.target).normalized() * 3 * joint_radius_) : Vec3::Zero();
+  // The ghost sits a little behind the mechanism when seen side-on, and its meshes always: where the
+  // engines agree, a robot shows its own colours, not the ghost's over them.
+  const Vec3 behind = -(s.camera.eye - s.camera.target).normalized() * 3 * joint_radius_;
+  const Vec3 back = ghost && planar_ ? behind : Vec3::Zero();
   for (const auto& g : model_.drawing.geoms) {
     if (g.shape == Shape::Plane || (ghost && g.link < 0)) continue;
-    const Vec3 c = point(g.link, g.pos) + back;
+    const Vec3 c = point(g.link, g.pos) + (ghost && g.shape == Shape::Mesh ? behind : back);
     const Mat3 R = rotation(g.link) * g.rot;
     const Color color = ghost ? kGhost : colorOf(g);
     switch (g.shape) {

@@ -1,8 +1,8 @@
 // A model file's meshes in its frames (labs/model_scene.h, render/mesh_cache.cpp): tests/models/mesh_arm's
 // box is drawn where its vertices project, in its material's red, its tetrahedron in blue, its floor
 // under it; the frame is fitted to the points the shapes reach (every mesh vertex inside the part of the
-// frame the panel leaves free, and the robot filling it), and a second frame of the same scene is the
-// same pixels.
+// frame the panel leaves free, and the robot filling it), a second frame of the same scene is the same
+// pixels, and the Bullet ghost at the same state leaves the robot's colours as they are.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -99,4 +99,13 @@ TEST_CASE("a model's meshes are drawn in their materials' colours, on its floor,
   // Drawn again (the meshes already uploaded): the same pixels.
   const Image again = renderer.render(scene, &panel);
   CHECK(again.rgba == image.rgba);
+
+  // With the other engine's ghost at the same state: its meshes sit behind the robot's, so the box
+  // keeps its own red (not the ghost's purple over it).
+  Scene with_ghost;
+  picture.scene(m.q0, &m.q0, picture.bounds(m.q0), with_ghost, points);
+  CHECK(with_ghost.meshes.size() == 4);
+  const Image ghosted = renderer.render(with_ghost, &panel);
+  const std::uint8_t* still_red = pixelAt(ghosted, renderer, mean(block));
+  for (int c = 0; c < 3; ++c) CHECK(still_red[c] == red[c]);
 }
