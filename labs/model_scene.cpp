@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 
 #include "labs/run_bounds.h"
 
@@ -44,6 +45,11 @@ void extendShape(Box3& box, const Vec3& c, const Mat3& R, const model_file::Geom
     case Shape::Sphere: half = Vec3::Constant(g.size[0]); break;
     case Shape::Capsule: half = {g.size[0], g.size[0], g.size[1] + g.size[0]}; break;
     case Shape::Cylinder: half = {g.size[0], g.size[0], g.size[1]}; break;
+    case Shape::Mesh:  // its vertices' box, which need not be centred on the geom's origin
+      half = 0.5 * g.mesh->box.sizes();
+      box.extend(c + R * g.mesh->box.center() - R.cwiseAbs() * half);
+      box.extend(c + R * g.mesh->box.center() + R.cwiseAbs() * half);
+      return;
     default: half = g.size; break;
   }
   const Vec3 world = R.cwiseAbs() * half;
@@ -85,6 +91,7 @@ ModelPicture::ModelPicture(const model_file::LoadedModel& model) : model_(model)
   const double rod = radii.empty() ? 0.02 * extent : radii[radii.size() / 2];
   rod_radius_ = std::clamp(rod, 0.004 * extent, 0.03 * extent);
   joint_radius_ = std::max(1.4 * rod_radius_, 0.015 * extent);
+  keepShapePoints();
 }
 
 bool ModelPicture::groundPivot(std::size_t i) const {
@@ -126,17 +133,20 @@ Box3 ModelPicture::bounds(const VecN& q) const {
 }
 
 void ModelPicture::drawBodies(bool ghost, Scene& s) const {
-  // The ghost sits a little behind the mechanism when seen side-on.
-  const Vec3 back = ghost && planar_ ? Vec3(-(s.camera.eye - s.camera.target).normalized() * 3 * joint_radius_) : Vec3::Zero();
+  // The ghost sits a little behind the mechanism when seen side-on, and its meshes always: where the
+  // engines agree, a robot shows its own colours, not the ghost's over them.
+  const Vec3 behind = -(s.camera.eye - s.camera.target).normalized() * 3 * joint_radius_;
+  const Vec3 back = ghost && planar_ ? behind : Vec3::Zero();
   for (const auto& g : model_.drawing.geoms) {
     if (g.shape == Shape::Plane || (ghost && g.link < 0)) continue;
-    const Vec3 c = point(g.link, g.pos) + back;
+    const Vec3 c = point(g.link, g.pos) + (ghost && g.shape == Shape::Mesh ? behind : back);
     const Mat3 R = rotation(g.link) * g.rot;
     const Color color = ghost ? kGhost : colorOf(g);
     switch (g.shape) {
       case Shape::Sphere: s.spheres.push_back({c, g.size[0], color}); break;
       case Shape::Capsule: s.capsules.push_back({c - g.size[1] * R.col(2), c + g.size[1] * R.col(2), g.size[0], color}); break;
       case Shape::Cylinder: s.cylinders.push_back({c, R, g.size[0], g.size[1], color}); break;
+      case Shape::Mesh: s.meshes.push_back({g.mesh, c, R, color}); break;
       default: s.boxes.push_back({c, g.size, R, color}); break;
     }
   }
@@ -158,7 +168,7 @@ void ModelPicture::drawBodies(bool ghost, Scene& s) const {
   for (const auto& c : model_.closures) s.spheres.push_back({point(c.link1, c.point1), 0.85 * joint_radius_, kClosure});
 }
 
-void ModelPicture::scene(const VecN& q, const VecN* ghost, const Box3& frame, Scene& s) const {
+void ModelPicture::scene(const VecN& q, const VecN* ghost, const Box3& frame, Scene& s, const std::vector<Vec3>& points) const {
   const Box3 box = frame.isEmpty() ? bounds(q) : frame;
   // The camera's direction; the renderer fits the box beside the panel (Scene::framing).
   if (planar_) {
@@ -192,6 +202,7 @@ void ModelPicture::scene(const VecN& q, const VecN* ghost, const Box3& frame, Sc
   }
   s.framing.fit = true;
   s.framing.bounds = box;
+  s.framing.points = points;
   // Floors: under the framed box, about as large as it, slabs so a side-on view shows their edge.
   const double reach = box.isEmpty() ? 1.0 : 0.75 * box.diagonal().norm();
   for (const auto& g : model_.drawing.geoms) {
@@ -242,6 +253,12 @@ void ModelPicture::stage(Scene& s) const {
     s.cylinders.push_back({top - 0.5 * height * up_, R, radius, 0.5 * height, kPedestal});
     box.extend(top - height * up_ - Vec3::Constant(radius));
     box.extend(top + Vec3::Constant(radius));
+    if (!s.framing.points.empty())
+      for (const double z : {0.0, -height})
+        for (int k = 0; k < 16; ++k) {  // the column's ends, as rings of 16 round its circle
+          const double a = 2 * std::numbers::pi * k / 16, r = radius / std::cos(std::numbers::pi / 16);
+          s.framing.points.push_back(top + z * up_ + r * (std::cos(a) * R.col(0) + std::sin(a) * R.col(1)));
+        }
   }
 }
 

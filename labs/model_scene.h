@@ -2,7 +2,9 @@
 // q by the description's own kinematics, its joints and loop closures marked, a second state (the
 // Bullet run) as a translucent ghost, framed like every lab (Scene::framing): a planar mechanism
 // side-on and orthographic, looking along its hinges' common axis; a spatial one in perspective; up
-// against gravity. And the overlay panel of a run's trace (time, energy, closure residual).
+// against gravity; a spatial one that draws shapes of its own fitted to those shapes' points, not to
+// their box, so the robot fills the frame. And the overlay panel of a run's trace (time, energy,
+// closure residual).
 #pragma once
 #include <Eigen/Geometry>
 #include <vector>
@@ -24,16 +26,25 @@ class ModelPicture {
   // The box what is drawn at q occupies (floors left out).
   Eigen::AlignedBox3d bounds(const VecN& q) const;
   // The scene at q; ghost, when given, drawn translucent behind it; framed around `frame` (empty:
-  // bounds(q)), so a run framed around the space it moves through holds its camera still.
-  void scene(const VecN& q, const VecN* ghost, const Eigen::AlignedBox3d& frame, Scene& out) const;
+  // bounds(q)), so a run framed around the space it moves through holds its camera still, and, when
+  // `points` are given (runPoints), fitted to their picture (Scene::framing.points).
+  void scene(const VecN& q, const VecN* ghost, const Eigen::AlignedBox3d& frame, Scene& out,
+             const std::vector<Eigen::Vector3d>& points = {}) const;
+  // Points whose picture holds what is drawn at q (model_points.cpp): each mesh's vertices that are
+  // farthest along 98 directions, the corners of a polytope round each ball (capsule ends, joints),
+  // cylinder and bone, a box's corners; floors left out. Appended to out.
+  void shapePoints(const VecN& q, std::vector<Eigen::Vector3d>& out) const;
   // A stage under a spatial model that stands on the world and draws no floor of its own: a floor slab
   // with a grid, the framed box's footprint a twentieth of its size below it, and a pedestal from it up
   // to each joint on the world, so the base does not float; the framed box grows to hold them. Call
   // after scene(). Nothing for a planar model (its ground mounts show where it is fixed) or one with a
-  // floor of its own.
+  // floor of its own. A scene fitted to points gets the pedestal's among them, not the floor's.
   void stage(Scene& out) const;
   // True when every hinge turns about one axis and every slide moves across it: drawn side-on.
   bool planar() const { return planar_; }
+  // True when its frames are fitted to shapePoints: a spatial model drawing geoms of its own (a
+  // planar one is seen side-on, where its box is already its outline; bones alone keep the box).
+  bool fitsPoints() const { return !planar_ && !local_points_.empty(); }
 
  private:
   void place(const VecN& q) const;  // the tree's world frames at q
@@ -41,12 +52,15 @@ class ModelPicture {
   Eigen::Matrix3d rotation(int link) const;
   void drawBodies(bool ghost, Scene& out) const;
   bool groundPivot(std::size_t link) const;  // a hinge on the world: drawn on a mount
+  void keepShapePoints();                     // local_points_, once (model_points.cpp)
 
   const model_file::LoadedModel& model_;
   mutable TreeData<Spatial> data_;
   bool planar_ = false;
   Eigen::Vector3d axis_ = Eigen::Vector3d::UnitY(), up_ = Eigen::Vector3d::UnitZ();
   double joint_radius_ = 0.01, rod_radius_ = 0.005;
+  // Per drawn geom (floors aside) its link and the points shapePoints places, in the link's frame.
+  std::vector<std::pair<int, std::vector<Eigen::Vector3d>>> local_points_;
 };
 
 // The coordinates q (or rates v) of a model run's trace row: columns 1..n (n..2n), as app/cli/model/model.cpp writes them.
@@ -55,6 +69,9 @@ VecN traceQ(const Trace& trace, std::size_t row, int n);
 // The space a run moves through: the box of what is drawn over its rows (and the ghost's), so the
 // camera holds still from frame to frame, as in every lab.
 Eigen::AlignedBox3d runBounds(const ModelPicture& picture, int n, const Trace& trace, const Trace* ghost);
+// The same space as points (shapePoints over the rows runBounds takes, thinned to those farthest along
+// 218 directions), for ModelPicture::scene; none unless the picture fitsPoints().
+std::vector<Eigen::Vector3d> runPoints(const ModelPicture& picture, int n, const Trace& trace, const Trace* ghost);
 
 // The overlay panel at a row: time, energy and its balance, closure residual (and the ghost's), and
 // live plots of the energy balance and the residual over the last two seconds.

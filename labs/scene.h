@@ -5,12 +5,15 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 #include <numbers>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "physics/triangle_mesh.h"
 
 namespace dyn {
 
@@ -106,6 +109,16 @@ struct Spring {
   double lead = 0.1;         // fraction of the length that is straight at each end
 };
 
+// A triangle mesh (a model file's mesh geom) placed in the world: rotation maps the mesh's axes to world
+// axes, position is where its origin goes. Drawn two-sided, lit as smooth surfaces broken at sharp
+// edges; the renderer uploads each mesh once (by the shared pointer) however many frames show it.
+struct MeshShape {
+  std::shared_ptr<const TriangleMesh> mesh;
+  Eigen::Vector3d position = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Color color;
+};
+
 // The camera's orthonormal frame: right, up, and back (from the target towards the eye).
 struct CameraBasis {
   Eigen::Vector3d right, up, back;
@@ -140,11 +153,15 @@ struct Camera {
 // clip: the scene is cut at the edge of the part of the frame it is fitted into, so a camera that
 // follows something across a large floor (Inset below shows the whole of it) never draws under the
 // panel; without it, what lies outside bounds may spill over the rest of the frame.
+// points: when given, what is fitted is these points' picture (the shapes' own extents over the run,
+// a model picture's mesh vertices) rather than the picture of bounds' eight corners, which seen at
+// an angle is larger than what it holds; bounds still places the camera's target and floor.
 struct Framing {
   bool fit = false;
   Eigen::AlignedBox3d bounds;  // default-constructed: empty
   double margin = 1.08;
   bool clip = false;
+  std::vector<Eigen::Vector3d> points;
 };
 
 struct Inset;
@@ -165,6 +182,7 @@ struct Scene {
   std::vector<Spring> springs;
   Framing framing;  // fit: the renderer chooses the camera (see Framing)
   std::vector<Inset> insets;  // second views drawn over a corner of this one (see Inset)
+  std::vector<MeshShape> meshes;  // drawn after the other shapes
 
   // A spatial lab's view: perspective, z up, looking at box from its centre + `from`, and the
   // renderer fitting box in the frame (Framing).

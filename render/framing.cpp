@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <vector>
 
 #include "render/renderer.h"
 
@@ -15,6 +16,7 @@ namespace {
 
 using Eigen::AlignedBox3d;
 using Eigen::Vector3d;
+using Points = std::vector<Vector3d>;
 
 // Adds a ball of radius r around p.
 void addBall(AlignedBox3d& box, const Vector3d& p, double r) {
@@ -29,20 +31,28 @@ void addOriented(AlignedBox3d& box, const Vector3d& centre, const Eigen::Matrix3
   box.extend(centre + reach);
 }
 
-std::array<Vector3d, 8> corners(const AlignedBox3d& box) {
-  std::array<Vector3d, 8> c;
+// The box's eight corners (none for an empty box).
+Points corners(const AlignedBox3d& box) {
+  Points c;
+  if (box.isEmpty()) return c;
   for (int i = 0; i < 8; ++i)
-    c[std::size_t(i)] = {(i & 1 ? box.max() : box.min()).x(), (i & 2 ? box.max() : box.min()).y(),
-                         (i & 4 ? box.max() : box.min()).z()};
+    c.push_back({(i & 1 ? box.max() : box.min()).x(), (i & 2 ? box.max() : box.min()).y(), (i & 4 ? box.max() : box.min()).z()});
   return c;
 }
 
-// Half extents of the box along the camera's right and up axes (how big it is, seen from there).
-Eigen::Vector2d halfExtents(const Camera& camera, const AlignedBox3d& box) {
+AlignedBox3d boxOf(const Points& points) {
+  AlignedBox3d box;
+  for (const Vector3d& p : points) box.extend(p);
+  return box;
+}
+
+// Half extents of the points about their box's centre along the camera's right and up axes (how big
+// they are, seen from there).
+Eigen::Vector2d halfExtents(const Camera& camera, const Points& points) {
   const CameraBasis b = camera.basis();
-  const Vector3d centre = box.center();
+  const Vector3d centre = boxOf(points).center();
   double x = 0, y = 0;
-  for (const Vector3d& c : corners(box)) {
+  for (const Vector3d& c : points) {
     x = std::max(x, std::abs((c - centre).dot(b.right)));
     y = std::max(y, std::abs((c - centre).dot(b.up)));
   }
@@ -80,13 +90,20 @@ AlignedBox3d sceneBounds(const Scene& s) {
     const double r = sp.radius + (sp.wire_radius > 0 ? sp.wire_radius : sp.radius / 8);
     addBall(box, sp.p0, r), addBall(box, sp.p1, r);
   }
+  for (const auto& m : s.meshes)
+    if (m.mesh && !m.mesh->box.isEmpty())
+      addOriented(box, m.position + m.rotation * m.mesh->box.center(), m.rotation, 0.5 * m.mesh->box.sizes());
   return box;
 }
 
 PixelRect projectedBox(const Camera& camera, int width, int height, const AlignedBox3d& box) {
-  if (box.isEmpty()) return {};
+  return projectedPoints(camera, width, height, corners(box));
+}
+
+PixelRect projectedPoints(const Camera& camera, int width, int height, const Points& points) {
+  if (points.empty()) return {};
   double x0 = std::numeric_limits<double>::infinity(), y0 = x0, x1 = -x0, y1 = -x0;
-  for (const Vector3d& c : corners(box)) {
+  for (const Vector3d& c : points) {
     const Eigen::Vector2d p = Renderer::project(camera, width, height, c);
     x0 = std::min(x0, p.x()), x1 = std::max(x1, p.x()), y0 = std::min(y0, p.y()), y1 = std::max(y1, p.y());
   }
@@ -95,12 +112,16 @@ PixelRect projectedBox(const Camera& camera, int width, int height, const Aligne
 
 PixelRect freeRect(int width, int height, const PixelRect& panel, const Camera& camera, const AlignedBox3d& box,
                    double gap) {
+  return freeRect(width, height, panel, camera, corners(box), gap);
+}
+
+PixelRect freeRect(int width, int height, const PixelRect& panel, const Camera& camera, const Points& box, double gap) {
   const PixelRect whole{0, 0, double(width), double(height)};
   if (panel.empty() || !panel.intersects(whole)) return whole;
   // Right of the panel (full height), or below it (full width): the one the box fills the larger.
   const PixelRect right{panel.right() + gap, 0, width - panel.right() - gap, double(height)};
   const PixelRect below{0, panel.bottom() + gap, double(width), height - panel.bottom() - gap};
-  if (box.isEmpty()) return right.empty() ? below : right;
+  if (box.empty()) return right.empty() ? below : right;
   const Eigen::Vector2d half = halfExtents(camera, box);
   const double s_right = right.empty() ? 0 : fillScale(half, right.w, right.h);
   const double s_below = below.empty() ? 0 : fillScale(half, below.w, below.h);
@@ -109,10 +130,15 @@ PixelRect freeRect(int width, int height, const PixelRect& panel, const Camera& 
 }
 
 Camera fitCamera(Camera camera, const AlignedBox3d& box, int width, int height, const PixelRect& free, double margin) {
-  if (box.isEmpty() || free.empty() || width <= 0 || height <= 0) return camera;
+  return fitCamera(camera, corners(box), width, height, free, margin);
+}
+
+Camera fitCamera(Camera camera, const Points& points, int width, int height, const PixelRect& free, double margin) {
+  if (points.empty() || free.empty() || width <= 0 || height <= 0) return camera;
   margin = std::max(margin, 1.0);
   const Vector3d view = camera.eye - camera.target;
   const Vector3d dir = view.norm() > 1e-12 ? view.normalized() : Vector3d::UnitZ();
+  const AlignedBox3d box = boxOf(points);
   const Vector3d centre = box.center();
   const double extent = std::max(box.diagonal().norm(), 1e-6);
   camera.target = centre;
@@ -121,7 +147,7 @@ Camera fitCamera(Camera camera, const AlignedBox3d& box, int width, int height, 
   const double cx = free.x + 0.5 * free.w, cy = free.y + 0.5 * free.h;
   if (camera.ortho) {
     // Pixels per metre: the box's larger side (against the rectangle's) fills it, less the margin.
-    const double s = fillScale(halfExtents(camera, box), free.w / margin, free.h / margin);
+    const double s = fillScale(halfExtents(camera, points), free.w / margin, free.h / margin);
     camera.half_height = 0.5 * height / s;
     camera.half_width = 0;
     // The box's centre at the rectangle's centre: slide the target by the offset, in metres.
@@ -130,11 +156,11 @@ Camera fitCamera(Camera camera, const AlignedBox3d& box, int width, int height, 
     return camera;
   }
   // Perspective: a distance and a sideways slide of the camera (the view direction is kept), found
-  // by a few rounds of "scale by the overflow, slide by the offset", so the corners' pixel box is
+  // by a few rounds of "scale by the overflow, slide by the offset", so the points' pixel box is
   // centred in the rectangle and just fills it.
   const double tan_y = std::tan(camera.fov_y_deg * std::numbers::pi / 360.0);
   const double tan_x = tan_y * width / height;
-  const std::array<Vector3d, 8> cs = corners(box);
+  const Points& cs = points;
   auto nearest = [&](const Vector3d& target) {
     double d = 0;
     for (const Vector3d& c : cs) d = std::max(d, 1.05 * (c - target).dot(b.back) + 0.01 * extent);
@@ -151,7 +177,7 @@ Camera fitCamera(Camera camera, const AlignedBox3d& box, int width, int height, 
   for (int round = 0; round < 40; ++round) {
     camera.target = target;
     camera.eye = target + dir * distance;
-    const PixelRect p = projectedBox(camera, width, height, box);
+    const PixelRect p = projectedPoints(camera, width, height, points);
     const double k = std::max(p.w / (free.w / margin), p.h / (free.h / margin));
     const double du = cx - (p.x + 0.5 * p.w), dv = cy - (p.y + 0.5 * p.h);
     if (std::abs(k - 1) < 1e-6 && std::abs(du) < 1e-3 && std::abs(dv) < 1e-3) break;

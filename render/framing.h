@@ -4,6 +4,7 @@
 // without drawing.
 #pragma once
 #include <Eigen/Geometry>
+#include <vector>
 
 #include "labs/scene.h"
 
@@ -28,6 +29,8 @@ Eigen::AlignedBox3d sceneBounds(const Scene& scene);
 // Where `box` lands on screen under `camera` in a width x height frame: the pixel box of its
 // eight corners (exact for ortho, and for perspective as long as the box is in front of the eye).
 PixelRect projectedBox(const Camera& camera, int width, int height, const Eigen::AlignedBox3d& box);
+// The pixel box of the points (the same for a box's eight corners).
+PixelRect projectedPoints(const Camera& camera, int width, int height, const std::vector<Eigen::Vector3d>& points);
 
 // The free part of a width x height frame with `panel` (a rectangle touching the top-left corner;
 // empty: no panel) in it: the whole frame, or the part right of the panel, or the part below
@@ -35,11 +38,18 @@ PixelRect projectedBox(const Camera& camera, int width, int height, const Eigen:
 // from the panel.
 PixelRect freeRect(int width, int height, const PixelRect& panel, const Camera& camera,
                    const Eigen::AlignedBox3d& box, double gap);
+// The same for what the points show (Framing::points), the box's version being its eight corners'.
+PixelRect freeRect(int width, int height, const PixelRect& panel, const Camera& camera,
+                   const std::vector<Eigen::Vector3d>& points, double gap);
 
 // `camera` moved (target, eye, and the ortho half sizes or the perspective distance) so that `box`
 // fills `free` as far as its aspect allows, centred in it, with `margin` spare (1.08: 4 % on each
 // side); the view direction, up, projection and fov are kept. An empty box leaves it unchanged.
 Camera fitCamera(Camera camera, const Eigen::AlignedBox3d& box, int width, int height, const PixelRect& free,
+                 double margin);
+// The same fit for the points' picture (their box's centre the starting target); fitCamera(box) is
+// this for the box's eight corners.
+Camera fitCamera(Camera camera, const std::vector<Eigen::Vector3d>& points, int width, int height, const PixelRect& free,
                  double margin);
 
 // Where an inset goes (labs/scene.h Inset): its rectangle in `free` (the part of the frame the main

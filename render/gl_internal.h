@@ -10,6 +10,7 @@
 
 #include <Eigen/Core>
 #include <cstddef>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -27,6 +28,7 @@ struct ShadedProgram {
   GLuint id = 0;
   GLint view_proj = -1, model = -1, normal_matrix = -1, stretch = -1, color = -1;
   GLint light_dir = -1, view_dir = -1, eye = -1, ortho = -1;
+  GLint two_sided = -1;  // a back face lit as the front turned over (a file's mesh, drawn without culling)
 };
 // Screen-space-width line program for polylines (quads expanded in the vertex shader).
 struct LineProgram {
@@ -58,6 +60,9 @@ struct Mesh {
   void destroy();
 };
 
+// Uploads vertices and triangle indices into a fresh VAO.
+Mesh uploadMesh(const std::vector<Vertex>& vertices, const std::vector<GLuint>& indices);
+
 // Unit capsule along +z: radius 1, hemispheres at z=0 and z=0+stretch; with stretch 0 a sphere.
 Mesh makeCapsule(int slices, int half_stacks);
 // Unit cone: base radius 1 at z=0 (capped), apex at z=1.
@@ -68,6 +73,32 @@ Mesh makeBox();
 Mesh makeCylinder(int slices);
 // Square [-1,1]^2 at z=0, two-sided (front normal +z, back normal -z).
 Mesh makeQuad();
+
+// ---- mesh_cache.cpp -----------------------------------------------------------------------
+
+// A triangle mesh's vertices for drawing, three per triangle (degenerate ones left out), each corner's
+// normal the area-weighted mean of the normals of the triangles round its point (vertices at the same
+// position are one point) that turn from its own triangle's by at most kCreaseDegrees: curved
+// surfaces shade smooth, edges stay sharp.
+inline constexpr double kCreaseDegrees = 40;
+void meshVertices(const TriangleMesh& mesh, std::vector<Vertex>& out);
+
+// The scene's triangle meshes, each uploaded the first time a frame shows it and kept while anything
+// else holds it: sweep() releases those only the cache still holds (a scene is rebuilt every frame,
+// so a mesh no scene names any more goes at the next frame).
+class MeshCache {
+ public:
+  const Mesh& get(const std::shared_ptr<const TriangleMesh>& mesh);
+  void sweep();
+  void destroy();
+
+ private:
+  struct Entry {
+    std::shared_ptr<const TriangleMesh> data;  // held, so its address names it while cached
+    Mesh gl;
+  };
+  std::map<const TriangleMesh*, Entry> entries_;
+};
 
 // ---- primitives.cpp -----------------------------------------------------------------------
 
@@ -91,17 +122,18 @@ struct DrawItem {
   Color color;
   double depth;               // distance in front of the camera of the item's centre
   bool pushed_back = false;   // planes: drawn behind their exact depth so lines on them show
+  bool two_sided = false;     // a file's mesh: no culling, back faces lit as front ones
 };
 
 // A frame's primitives: mesh draws in scene order (capsules, spheres, boxes, arrows, then planes,
-// cylinders and spokes, cones, springs) and the planes' grid lines.
+// cylinders and spokes, cones, springs, the scene's triangle meshes) and the planes' grid lines.
 struct DrawList {
   std::vector<DrawItem> items;
   std::vector<Polyline> grid_lines;
 };
 // Fills `out` (cleared first) for a frame of width x height seen through `camera`.
-void collectDrawList(const Scene& scene, const Camera& camera, const Meshes& meshes, int width, int height,
-                     DrawList& out);
+void collectDrawList(const Scene& scene, const Camera& camera, const Meshes& meshes, MeshCache& cache, int width,
+                     int height, DrawList& out);
 
 // ---- overlay.cpp --------------------------------------------------------------------------
 

@@ -1,6 +1,6 @@
 // Unit meshes uploaded once: a stretchable capsule (also used for spheres), a capped cone, a
 // flat-shaded box, a capped cylinder and a two-sided square. Model matrices and the capsule
-// stretch place them in the world.
+// stretch place them in the world. (A scene's own triangle meshes: mesh_cache.cpp.)
 #include <cmath>
 #include <numbers>
 #include <vector>
@@ -10,8 +10,19 @@
 namespace dyn::gl {
 namespace {
 
+// Connects ring r to ring r+1 (each `n` vertices, counter-clockwise seen from outside).
+void stitchRings(std::vector<GLuint>& indices, GLuint first, GLuint n) {
+  for (GLuint i = 0; i < n; ++i) {
+    GLuint j = (i + 1) % n;
+    GLuint a = first + i, b = first + j, c = first + n + i, d = first + n + j;
+    indices.insert(indices.end(), {a, b, d, a, d, c});
+  }
+}
+
+}  // namespace
+
 // Uploads vertices and triangle indices into a fresh VAO.
-Mesh upload(const std::vector<Vertex>& vertices, const std::vector<GLuint>& indices) {
+Mesh uploadMesh(const std::vector<Vertex>& vertices, const std::vector<GLuint>& indices) {
   Mesh mesh;
   glGenVertexArrays(1, &mesh.vao);
   glGenBuffers(1, &mesh.vbo);
@@ -31,17 +42,6 @@ Mesh upload(const std::vector<Vertex>& vertices, const std::vector<GLuint>& indi
   mesh.index_count = GLsizei(indices.size());
   return mesh;
 }
-
-// Connects ring r to ring r+1 (each `n` vertices, counter-clockwise seen from outside).
-void stitchRings(std::vector<GLuint>& indices, GLuint first, GLuint n) {
-  for (GLuint i = 0; i < n; ++i) {
-    GLuint j = (i + 1) % n;
-    GLuint a = first + i, b = first + j, c = first + n + i, d = first + n + j;
-    indices.insert(indices.end(), {a, b, d, a, d, c});
-  }
-}
-
-}  // namespace
 
 void floatAttribute(GLuint index, GLint size, GLsizei stride, std::size_t offset) {
   glEnableVertexAttribArray(index);
@@ -79,7 +79,7 @@ Mesh makeCapsule(int slices, int half_stacks) {
     }
   }
   for (int r = 0; r + 1 < rings; ++r) stitchRings(indices, GLuint(r * slices), GLuint(slices));
-  return upload(vertices, indices);
+  return uploadMesh(vertices, indices);
 }
 
 Mesh makeCone(int slices) {
@@ -112,7 +112,7 @@ Mesh makeCone(int slices) {
     GLuint a = centre + 1 + GLuint(s), b = centre + 1 + GLuint((s + 1) % slices);
     indices.insert(indices.end(), {centre, b, a});
   }
-  return upload(vertices, indices);
+  return uploadMesh(vertices, indices);
 }
 
 Mesh makeBox() {
@@ -135,7 +135,7 @@ Mesh makeBox() {
       indices.insert(indices.end(), {first, first + 1, first + 2, first, first + 2, first + 3});
     }
   }
-  return upload(vertices, indices);
+  return uploadMesh(vertices, indices);
 }
 
 Mesh makeCylinder(int slices) {
@@ -164,7 +164,7 @@ Mesh makeCylinder(int slices) {
       else indices.insert(indices.end(), {centre, b, a});
     }
   }
-  return upload(vertices, indices);
+  return uploadMesh(vertices, indices);
 }
 
 Mesh makeQuad() {
@@ -178,7 +178,7 @@ Mesh makeQuad() {
     if (side > 0) indices.insert(indices.end(), {first, first + 1, first + 2, first, first + 2, first + 3});
     else indices.insert(indices.end(), {first, first + 2, first + 1, first, first + 3, first + 2});
   }
-  return upload(vertices, indices);
+  return uploadMesh(vertices, indices);
 }
 
 }  // namespace dyn::gl

@@ -1,6 +1,6 @@
 // The scene's primitives as draws of the unit meshes: capsules, spheres, boxes, arrows (a capsule
 // and a cone), planes (a quad or a slab, plus grid lines), cylinders with their spoke bars, cones
-// and coil springs (a chain of capsules along a helix).
+// and coil springs (a chain of capsules along a helix), and the scene's own triangle meshes.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
@@ -126,6 +126,17 @@ class Collector {
                           Eigen::Vector3f::Zero(), c.color, depthOf(c.apex + 0.6 * c.length * dir)});
   }
 
+  // A scene's triangle mesh (uploaded once, cache), two-sided; its normals turned by the inverse
+  // transpose of the placement.
+  void mesh(const MeshShape& m, MeshCache& cache) {
+    if (!m.mesh || m.mesh->triangles.empty() || m.mesh->box.isEmpty()) return;
+    const Matrix3d normal = std::abs(m.rotation.determinant()) > 1e-12 ? Matrix3d(m.rotation.inverse().transpose()) : m.rotation;
+    DrawItem item{&cache.get(m.mesh), affine(m.rotation, m.position), normal.cast<float>(), Eigen::Vector3f::Zero(),
+                  m.color, depthOf(m.position + m.rotation * m.mesh->box.center())};
+    item.two_sided = true;
+    out_.items.push_back(item);
+  }
+
   // Lead, radial step onto the helix, `turns` turns (16 capsules each), radial step, lead.
   void spring(const Spring& s) {
     const Vector3d d = s.p1 - s.p0;
@@ -189,8 +200,8 @@ void Meshes::destroy() {
   for (Mesh* mesh : {&cone, &box, &cylinder, &quad}) mesh->destroy();
 }
 
-void collectDrawList(const Scene& scene, const Camera& camera, const Meshes& meshes, int width, int height,
-                     DrawList& out) {
+void collectDrawList(const Scene& scene, const Camera& camera, const Meshes& meshes, MeshCache& cache, int width,
+                     int height, DrawList& out) {
   out.items.clear();
   out.grid_lines.clear();
   Collector add(camera, meshes, width, height, out);
@@ -204,6 +215,7 @@ void collectDrawList(const Scene& scene, const Camera& camera, const Meshes& mes
   for (const auto& c : scene.cylinders) add.cylinder(c);
   for (const auto& c : scene.cones) add.cone(c);
   for (const auto& s : scene.springs) add.spring(s);
+  for (const auto& m : scene.meshes) add.mesh(m, cache);
 }
 
 }  // namespace dyn::gl

@@ -38,6 +38,7 @@ struct Renderer::Impl {
   gl::ShadedProgram shaded;
   gl::LineProgram line;
   gl::Meshes meshes;
+  gl::MeshCache mesh_cache;                   // the scenes' triangle meshes, uploaded once each
   GLuint line_vao = 0, line_vbo = 0;
   std::unique_ptr<gl::OverlayPanel> overlay;  // created on first use
   gl::DrawList draw_list;                     // reused between frames
@@ -74,6 +75,7 @@ struct Renderer::Impl {
     }
     overlay.reset();
     meshes.destroy();
+    mesh_cache.destroy();
     glDeleteBuffers(1, &line_vbo);
     glDeleteVertexArrays(1, &line_vao);
     glDeleteProgram(shaded.id);
@@ -117,8 +119,13 @@ struct Renderer::Impl {
     glUniformMatrix3fv(shaded.normal_matrix, 1, GL_FALSE, item.normal.data());
     glUniform3fv(shaded.stretch, 1, item.stretch.data());
     glUniform4f(shaded.color, item.color.r, item.color.g, item.color.b, item.color.a);
-    // A mirroring box rotation flips the winding; keep culling the back faces.
+    // A mirroring box rotation flips the winding; keep culling the back faces (a file's mesh: both
+    // sides drawn, as its winding is the file's).
     glFrontFace(item.model.topLeftCorner<3, 3>().determinant() < 0 ? GL_CW : GL_CCW);
+    if (item.two_sided) {
+      glDisable(GL_CULL_FACE);
+      glUniform1i(shaded.two_sided, 1);
+    }
     // Planes sit a little behind their depth (about 2 pixels of their slope), so lines on them win.
     if (item.pushed_back) {
       glEnable(GL_POLYGON_OFFSET_FILL);
@@ -126,6 +133,10 @@ struct Renderer::Impl {
     }
     item.mesh->draw();
     if (item.pushed_back) glDisable(GL_POLYGON_OFFSET_FILL);
+    if (item.two_sided) {
+      glEnable(GL_CULL_FACE);
+      glUniform1i(shaded.two_sided, 0);
+    }
   }
 
   // Polylines as screen-space quads of width_px, one draw per polyline.
@@ -209,7 +220,7 @@ struct Renderer::Impl {
     glUniform1i(shaded.ortho, camera.ortho ? 1 : 0);
 
     // Opaque meshes in scene order.
-    gl::collectDrawList(scene, camera, meshes, vw, vh, draw_list);
+    gl::collectDrawList(scene, camera, meshes, mesh_cache, vw, vh, draw_list);
     for (const auto& item : draw_list.items)
       if (item.color.a >= 1.0f) drawItem(item);
     // Grid lines on the planes: depth-tested but not written, so paths on a plane cover them.
@@ -246,6 +257,7 @@ struct Renderer::Impl {
   }
 
   void draw(const Scene& scene, const Overlay* panel) {
+    mesh_cache.sweep();  // meshes no scene holds any more
     const GLuint target = samples > 0 ? msaa_fbo : resolve_fbo;
     glBindFramebuffer(GL_FRAMEBUFFER, target);
     glViewport(0, 0, width, height);
@@ -274,9 +286,15 @@ struct Renderer::Impl {
     scene_rect = {0, 0, double(width), double(height)};
     if (scene.framing.fit) {
       const Eigen::AlignedBox3d box = scene.framing.bounds.isEmpty() ? sceneBounds(scene) : scene.framing.bounds;
-      // As far from the panel as the panel is from the frame's edge.
-      scene_rect = freeRect(width, height, panel_rect, camera, box, panel_rect.x);
-      camera = fitCamera(camera, box, width, height, scene_rect, scene.framing.margin);
+      // As far from the panel as the panel is from the frame's edge; the points' picture when given.
+      const auto& points = scene.framing.points;
+      if (points.empty()) {
+        scene_rect = freeRect(width, height, panel_rect, camera, box, panel_rect.x);
+        camera = fitCamera(camera, box, width, height, scene_rect, scene.framing.margin);
+      } else {
+        scene_rect = freeRect(width, height, panel_rect, camera, points, panel_rect.x);
+        camera = fitCamera(camera, points, width, height, scene_rect, scene.framing.margin);
+      }
     }
 
     // The whole scene is cleared to its background; a clipped one is drawn only in its free part.
@@ -303,7 +321,10 @@ struct Renderer::Impl {
       if (inset.scene.framing.fit) {
         const Eigen::AlignedBox3d box =
             inset.scene.framing.bounds.isEmpty() ? sceneBounds(inset.scene) : inset.scene.framing.bounds;
-        view = fitCamera(view, box, iw, ih, {0, 0, double(iw), double(ih)}, inset.scene.framing.margin);
+        const PixelRect all{0, 0, double(iw), double(ih)};
+        const auto& points = inset.scene.framing.points;
+        view = points.empty() ? fitCamera(view, box, iw, ih, all, inset.scene.framing.margin)
+                              : fitCamera(view, points, iw, ih, all, inset.scene.framing.margin);
       }
       drawContent(inset.scene, view, iw, ih);
       glDisable(GL_SCISSOR_TEST);

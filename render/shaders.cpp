@@ -35,9 +35,11 @@ uniform vec3 u_light_dir;  // towards the light, world space, unit
 uniform vec3 u_view_dir;   // towards the viewer (orthographic)
 uniform vec3 u_eye;        // camera position (perspective)
 uniform bool u_ortho;
+uniform bool u_two_sided;  // a back face seen: lit as the front face turned over
 out vec4 frag_color;
 void main() {
   vec3 n = normalize(v_normal);
+  if (u_two_sided && !gl_FrontFacing) n = -n;
   vec3 v = u_ortho ? u_view_dir : normalize(u_eye - v_world);
   // Soft key light plus a sky/ground ambient so shadowed sides keep their colour.
   float diffuse = max(dot(n, u_light_dir), 0.0);
@@ -129,6 +131,7 @@ ShadedProgram makeShadedProgram() {
   p.view_dir = glGetUniformLocation(p.id, "u_view_dir");
   p.eye = glGetUniformLocation(p.id, "u_eye");
   p.ortho = glGetUniformLocation(p.id, "u_ortho");
+  p.two_sided = glGetUniformLocation(p.id, "u_two_sided");
   return p;
 }
 

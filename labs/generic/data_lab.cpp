@@ -227,6 +227,7 @@ void DataLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene&
   // The run's bounds frame every picture of it (cached: a video asks for every row).
   if (bounds_of_ != tr.data.data() || bounds_rows_ != tr.rows()) {
     bounds_ = runBounds(picture_, n, tr, ghost);
+    points_ = runPoints(picture_, n, tr, ghost);
     // The push's arrow: 18 % of the run's size at the push's full value; the camera holds it where
     // the tool starts.
     arrow_ = bounds_.isEmpty() ? 0.0 : 0.18 * bounds_.diagonal().norm();
@@ -236,13 +237,14 @@ void DataLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene&
       const Eigen::Vector3d tail = kinematics_->pointPosition(s_.tool.link, s_.tool.point, traceQ(tr, 0, n)) - 1.08 * arrow_ * dir;
       bounds_.extend(tail - Eigen::Vector3d::Constant(0.04 * arrow_));
       bounds_.extend(tail + Eigen::Vector3d::Constant(0.04 * arrow_));
+      if (!points_.empty()) points_.push_back(tail);
     }
     bounds_of_ = tr.data.data(), bounds_rows_ = tr.rows();
   }
   const VecN q = traceQ(tr, row, n);
   VecN gq;
   if (ghost && row < ghost->rows()) gq = traceQ(*ghost, row, n);
-  picture_.scene(q, gq.size() ? &gq : nullptr, bounds_, out);
+  picture_.scene(q, gq.size() ? &gq : nullptr, bounds_, out, points_);
   picture_.stage(out);  // a spatial arm stands on a floor, on a pedestal
   // A tool given as a body's point: a stick from the body's joint to it, as a pen is drawn.
   if (s_.tool_on_body) {

@@ -104,6 +104,7 @@ class DataLab final : public SettingsLab<DataSettings> {
   mutable const double* bounds_of_ = nullptr;  // the trace whose run bounds are cached
   mutable std::size_t bounds_rows_ = 0;
   mutable Eigen::AlignedBox3d bounds_;
+  mutable std::vector<Eigen::Vector3d> points_;  // the run's shapes' points (runPoints; none for rods or a planar plant)
   mutable double arrow_ = 0;  // m: the push's arrow at the push's full value (0: none drawn)
   mutable double tool_ball_ = 0;  // m: the radius of the tool's ball (a tool on a body)
 };

@@ -123,11 +123,12 @@ class ModelFileLab final : public Lab {
     // The run's bounds frame every picture of it (cached: a video asks for every row).
     if (bounds_of_ != tr.data.data() || bounds_rows_ != tr.rows()) {
       bounds_ = runBounds(picture_, n, tr, ghost);
+      points_ = runPoints(picture_, n, tr, ghost);
       bounds_of_ = tr.data.data(), bounds_rows_ = tr.rows();
     }
     VecN gq;
     if (ghost && row < ghost->rows()) gq = traceQ(*ghost, row, n);
-    picture_.scene(traceQ(tr, row, n), gq.size() ? &gq : nullptr, bounds_, out);
+    picture_.scene(traceQ(tr, row, n), gq.size() ? &gq : nullptr, bounds_, out, points_);
   }
   void overlay(const Trace& tr, std::size_t row, Overlay& o) const override {
     o.title = title_;
@@ -141,6 +142,7 @@ class ModelFileLab final : public Lab {
   std::vector<std::string> columns_;
   ModelPicture picture_;
   mutable Eigen::AlignedBox3d bounds_;
+  mutable std::vector<Eigen::Vector3d> points_;  // the run's shapes' points (runPoints), cached with bounds_
   mutable const double* bounds_of_ = nullptr;
   mutable std::size_t bounds_rows_ = 0;
 };

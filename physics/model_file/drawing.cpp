@@ -1,13 +1,17 @@
 // What a model file draws (model_file.h Drawing): its geoms at qpos0, each on the tree body it moves
-// with. Spheres, capsules, cylinders and boxes as written; an ellipsoid or a mesh as its bounding
-// capsule, a plane as a floor, a height field not at all (each noted). Geoms in MuJoCo's hidden groups
-// (3 and up: by convention the collision shapes behind visual ones) and fully transparent ones are
-// left out, as MuJoCo's own viewer does. A moving body without a geom gets bones, so it is seen.
+// with. Spheres, capsules, cylinders, boxes and meshes (the triangles MuJoCo decoded, each mesh read
+// once and shared by the geoms that draw it) as written; an ellipsoid as its bounding capsule, a plane
+// as a floor, a height field not at all (each noted). Geoms in MuJoCo's hidden groups (3 and up: by
+// convention the collision shapes behind visual ones) and fully transparent ones are left out, as
+// MuJoCo's own viewer does, and so is a colliding geom on a body that draws visual-only geoms
+// (contype = conaffinity = 0) of another group: the file drew the body twice, once to be seen. A
+// moving body without a geom gets bones, so it is seen.
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
+#include <memory>
 
 #include "physics/model_file/mujoco_call.h"
 
@@ -59,6 +63,49 @@ void boundingCapsule(const std::vector<Vec3>& points, bool ellipsoid, Geom& g) {
   g.size = {std::max(radius, 1e-6), ellipsoid ? std::max(half[k] - radius, 0.0) : half[k], 0};
 }
 
+// Mesh `id` as MuJoCo decoded it (vertices in the mesh's frame: MuJoCo 2.2.2 moved them to the mesh's
+// inertial frame and geom_pos/geom_quat with them), or null when it has no triangles, a vertex is not
+// finite or a face names a vertex the mesh does not have.
+std::shared_ptr<const TriangleMesh> meshOf(const mjModel* m, int id) {
+  auto mesh = std::make_shared<TriangleMesh>();
+  const int nv = m->mesh_vertnum[id], nf = m->mesh_facenum[id];
+  const float* v = m->mesh_vert + 3 * m->mesh_vertadr[id];
+  for (int k = 0; k < nv; ++k) {
+    const Eigen::Vector3f p(v[3 * k], v[3 * k + 1], v[3 * k + 2]);
+    if (!p.allFinite()) return nullptr;
+    mesh->vertices.push_back(p);
+    mesh->box.extend(p.cast<double>());
+  }
+  const int* f = m->mesh_face + 3 * m->mesh_faceadr[id];
+  for (int k = 0; k < nf; ++k) {
+    std::array<std::uint32_t, 3> t{};
+    for (int c = 0; c < 3; ++c) {
+      if (f[3 * k + c] < 0 || f[3 * k + c] >= nv) return nullptr;
+      t[std::size_t(c)] = std::uint32_t(f[3 * k + c]);
+    }
+    mesh->triangles.push_back(t);
+  }
+  if (mesh->triangles.empty()) return nullptr;
+  return mesh;
+}
+
+// Geoms that only collide, on bodies that also draw visual-only geoms (contype = conaffinity = 0) of
+// another group (MuJoCo Menagerie: visual in group 2, collision in 3; URDF visuals beside collisions):
+// the same body drawn twice, so the colliding ones are left out. Planes are floors, never duplicates.
+std::vector<bool> duplicates(const mjModel* m) {
+  auto visualOnly = [&](int i) { return m->geom_contype[i] == 0 && m->geom_conaffinity[i] == 0; };
+  std::map<int, std::vector<int>> visual_groups;  // body → groups of its visual-only geoms
+  for (int i = 0; i < m->ngeom; ++i)
+    if (visualOnly(i) && m->geom_group[i] <= 2) visual_groups[m->geom_bodyid[i]].push_back(m->geom_group[i]);
+  std::vector<bool> out(std::size_t(m->ngeom), false);
+  for (int i = 0; i < m->ngeom; ++i) {
+    const auto it = visual_groups.find(m->geom_bodyid[i]);
+    if (visualOnly(i) || m->geom_type[i] == mjGEOM_PLANE || it == visual_groups.end()) continue;
+    out[std::size_t(i)] = std::find(it->second.begin(), it->second.end(), m->geom_group[i]) == it->second.end();
+  }
+  return out;
+}
+
 std::string num(double x) {
   char b[32];
   std::snprintf(b, sizeof b, "%.3g", x);
@@ -69,7 +116,9 @@ std::string num(double x) {
 
 void readDrawing(const mjModel* m, const mjData* d, const std::vector<int>& link, const std::vector<Vec3>& origin, Drawing& out) {
   std::vector<bool> drawn(std::size_t(m->nbody), false);
-  int hidden = 0, clear = 0;
+  const std::vector<bool> duplicate = duplicates(m);
+  std::map<int, std::shared_ptr<const TriangleMesh>> meshes;  // mesh id → its triangles, read once
+  int hidden = 0, clear = 0, doubled = 0;
   for (int i = 0; i < m->ngeom; ++i) {
     const int b = m->geom_bodyid[i];
     Geom g;
@@ -78,6 +127,10 @@ void readDrawing(const mjModel* m, const mjData* d, const std::vector<int>& link
     const std::string what = "geom '" + g.name + "' (body '" + g.body + "')";
     if (m->geom_group[i] > 2) {
       ++hidden;
+      continue;
+    }
+    if (duplicate[std::size_t(i)]) {
+      ++doubled;
       continue;
     }
     g.rgba = colorOf(m, i, g.file_color);
@@ -102,18 +155,26 @@ void readDrawing(const mjModel* m, const mjData* d, const std::vector<int>& link
         break;
       }
       case mjGEOM_MESH: {
-        const int mesh = m->geom_dataid[i];
-        if (mesh < 0 || m->mesh_vertnum[mesh] <= 0) {
+        const int id = m->geom_dataid[i];
+        if (id < 0 || m->mesh_vertnum[id] <= 0) {
           out.notes.push_back(what + ": a mesh without vertices, not drawn");
           continue;
         }
-        // The vertices in the mesh's frame, which MuJoCo places at the geom's pose.
+        if (!meshes.count(id)) meshes[id] = meshOf(m, id);
+        g.mesh = meshes[id];
+        if (g.mesh) {
+          // Its triangles in the geom's frame, which MuJoCo places at the mesh's (geom_xpos, geom_xmat).
+          g.shape = Geom::Shape::Mesh;
+          g.size = 0.5 * g.mesh->box.sizes();
+          break;
+        }
+        // No usable faces: the capsule around the vertices.
         std::vector<Vec3> points;
-        const float* v = m->mesh_vert + 3 * m->mesh_vertadr[mesh];
-        for (int k = 0; k < m->mesh_vertnum[mesh]; ++k) points.emplace_back(v[3 * k], v[3 * k + 1], v[3 * k + 2]);
+        const float* v = m->mesh_vert + 3 * m->mesh_vertadr[id];
+        for (int k = 0; k < m->mesh_vertnum[id]; ++k) points.emplace_back(v[3 * k], v[3 * k + 1], v[3 * k + 2]);
         boundingCapsule(points, false, g);
-        out.notes.push_back(what + ": a mesh, drawn as its bounding capsule (radius " + num(g.size[0]) + " m, length " +
-                            num(2 * (g.size[0] + g.size[1])) + " m)");
+        out.notes.push_back(what + ": a mesh without usable faces, drawn as its bounding capsule (radius " + num(g.size[0]) +
+                            " m, length " + num(2 * (g.size[0] + g.size[1])) + " m)");
         break;
       }
       case mjGEOM_PLANE:
@@ -122,13 +183,14 @@ void readDrawing(const mjModel* m, const mjData* d, const std::vector<int>& link
         break;
       default:
         out.notes.push_back(what + ": a height field, not drawn (dynlab draws spheres, capsules, cylinders, boxes, planes, "
-                                   "and meshes as their bounding capsules)");
+                                   "meshes and planes)");
         continue;
     }
     // Drawing only: a shape beyond what the description reads (±1e9) is left out, not refused.
     constexpr double kLargest = 1e9;
+    const bool far_mesh = g.mesh && (g.mesh->box.min().cwiseAbs().maxCoeff() > kLargest || g.mesh->box.max().cwiseAbs().maxCoeff() > kLargest);
     if (!g.rot.allFinite() || !g.pos.allFinite() || !g.size.allFinite() || g.pos.cwiseAbs().maxCoeff() > kLargest ||
-        g.size.cwiseAbs().maxCoeff() > kLargest) {
+        g.size.cwiseAbs().maxCoeff() > kLargest || far_mesh) {
       out.notes.push_back(what + ": its position or size is not finite or beyond ±1e9 m, not drawn");
       continue;
     }
@@ -136,6 +198,9 @@ void readDrawing(const mjModel* m, const mjData* d, const std::vector<int>& link
     out.geoms.push_back(g);
   }
   if (hidden > 0) out.notes.push_back(std::to_string(hidden) + " geom" + (hidden == 1 ? "" : "s") + " in groups 3 and up not drawn (MuJoCo's viewer hides them)");
+  if (doubled > 0)
+    out.notes.push_back(std::to_string(doubled) + " colliding geom" + (doubled == 1 ? "" : "s") +
+                        " not drawn: " + (doubled == 1 ? "its body draws" : "their bodies draw") + " visual-only geoms (contype = conaffinity = 0) of another group");
   if (clear > 0) out.notes.push_back(std::to_string(clear) + " transparent geom" + (clear == 1 ? "" : "s") + " (alpha 0) not drawn");
 
   // Bones for each tree body that nothing is drawn on: from its anchor to its children's anchors and

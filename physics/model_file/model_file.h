@@ -26,6 +26,7 @@
 #include <vector>
 
 #include "physics/mechanism.h"
+#include "physics/triangle_mesh.h"
 #include "physics/types.h"
 
 namespace dyn::model_file {
@@ -95,15 +96,16 @@ struct Contact {
 // What the file draws (drawing only: the dynamics never reads it). Each shape is fixed to a tree body
 // (link −1: the world), its pose given in that body's frame (on its joint's anchor, world-aligned at q0).
 struct Geom {
-  enum class Shape { Sphere, Capsule, Cylinder, Box, Plane };
+  enum class Shape { Sphere, Capsule, Cylinder, Box, Plane, Mesh };
   Shape shape = Shape::Sphere;
   std::string name, body;
   int link = -1;
   Eigen::Vector3d pos = Eigen::Vector3d::Zero();
   Eigen::Matrix3d rot = Eigen::Matrix3d::Identity();  // the shape's axes (capsule, cylinder: along z)
   // sphere: radius; capsule, cylinder: radius, half length; box: half extents; plane: half sizes x, y
-  // (0: unbounded)
+  // (0: unbounded); mesh: the half extents of its vertices' box
   Eigen::Vector3d size = Eigen::Vector3d::Zero();
+  std::shared_ptr<const TriangleMesh> mesh;  // a mesh's triangles in the shape's frame (shared by the geoms that draw it)
   std::array<float, 4> rgba{0.5f, 0.5f, 0.5f, 1.0f};
   bool file_color = false;  // rgba is the file's (a geom's or its material's), not MuJoCo's default grey
 };
@@ -118,7 +120,7 @@ struct Bone {
 struct Drawing {
   std::vector<Geom> geoms;
   std::vector<Bone> bones;
-  std::vector<std::string> notes;  // what is drawn other than as written (a mesh as its bounding capsule, ...)
+  std::vector<std::string> notes;  // what is drawn other than as written (an ellipsoid as its bounding capsule, ...)
 };
 
 // A joint as the file names it (one per coordinate, in coordinate order).

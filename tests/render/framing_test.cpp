@@ -1,11 +1,13 @@
 // Framing (render/framing.h) and the mini-plots' y scale (render/plot_widget.h): a fitted camera
-// puts the box centred in the free rectangle and fills it (ortho and perspective), the free
+// puts the box centred in the free rectangle and fills it (ortho and perspective), one fitted to
+// points (Scene::framing.points) fills it with what the points outline, not their box, the free
 // rectangle is the side of the panel that shows the box larger, the renderer keeps a fitted scene
 // clear of the panel, and the y scale's labels say how big a ripple is.
 #include <doctest/doctest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "render/framing.h"
 #include "render/plot_widget.h"
@@ -46,6 +48,37 @@ TEST_CASE("fitCamera centres the box in the free rectangle and fills it, ortho a
       CHECK((fitted.eye - fitted.target).normalized().isApprox((cam.eye - cam.target).normalized(), 1e-9));
     }
   }
+}
+
+TEST_CASE("fitCamera on points: a box's corners give the box's camera; a slanted rod fills the frame, its box does not") {
+  const int w = 640, h = 480;
+  const PixelRect free{0, 0, 640, 480};
+  Camera cam;
+  cam.ortho = false;
+  cam.fov_y_deg = 35;
+  cam.up = {0, 0, 1};
+  cam.target = {0, 0, 0};
+  cam.eye = {0.5, -1.2, 0.55};  // the model pictures' view: from the front, a little from above
+  // A box's eight corners as points: the very camera fitCamera(box) places.
+  const Eigen::AlignedBox3d b = box({-0.2, -0.1, 0}, {0.6, 0.3, 0.9});
+  std::vector<Eigen::Vector3d> corners;
+  for (int k = 0; k < 8; ++k) corners.push_back(b.corner(Eigen::AlignedBox3d::CornerType(k)));
+  const Camera by_box = fitCamera(cam, b, w, h, free, 1.08), by_points = fitCamera(cam, corners, w, h, free, 1.08);
+  CHECK(by_box.eye == by_points.eye);
+  CHECK(by_box.target == by_points.target);
+  // A rod across the box's diagonal (a robot reaching out over its base): fitted by its points it
+  // fills the frame; fitted by its box, whose corners stand far out of it seen at an angle, it does not.
+  std::vector<Eigen::Vector3d> rod;
+  for (int k = 0; k <= 10; ++k) rod.push_back(b.min() + 0.1 * k * (b.max() - b.min()));
+  const PixelRect fill = projectedPoints(fitCamera(cam, rod, w, h, free, 1.08), w, h, rod);
+  const PixelRect loose = projectedPoints(fitCamera(cam, b, w, h, free, 1.08), w, h, rod);
+  INFO("points ", fill.w, "x", fill.h, "; box ", loose.w, "x", loose.h);
+  CHECK(fill.x >= -1e-6);
+  CHECK(fill.right() <= w + 1e-6);
+  CHECK(fill.y >= -1e-6);
+  CHECK(fill.bottom() <= h + 1e-6);
+  CHECK(std::max(fill.w / w, fill.h / h) == doctest::Approx(1 / 1.08).epsilon(1e-3));
+  CHECK(std::max(loose.w / w, loose.h / h) < 0.85);
 }
 
 TEST_CASE("freeRect: the whole frame without a panel, else beside or below it, whichever shows the box larger") {

@@ -318,13 +318,14 @@ int model(const ModelArgs& asked) {
       const int n = mech.n();
       const ModelPicture picture(m);
       const Eigen::AlignedBox3d box = runBounds(picture, n, shown, ghost);
+      const std::vector<Eigen::Vector3d> points = runPoints(picture, n, shown, ghost);
       const std::string title = std::filesystem::path(m.file).filename().string();
       const std::string engines = hand ? (ghost ? "hand; Bullet ghost" : "hand") : "Bullet";
       const DrawRow draw = [&](std::size_t row, Scene& scene, Overlay* panel) {
         const VecN q = traceQ(shown, row, n);
         VecN gq;
         if (ghost && row < ghost->rows()) gq = traceQ(*ghost, row, n);
-        picture.scene(q, gq.size() ? &gq : nullptr, box, scene);
+        picture.scene(q, gq.size() ? &gq : nullptr, box, scene, points);
         if (panel) modelOverlay(termName(title), engines, shown, row, args.dt, ghost, *panel);
       };
       // Drawn in a child (app/cli/isolated_draw.h): llvmpipe ends the process when memory runs out.

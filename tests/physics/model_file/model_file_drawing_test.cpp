@@ -1,8 +1,9 @@
 // What a model file draws (model_file.h Drawing), against the file's own numbers: the four-bar's
 // capsules end where its fromto says, on the tree bodies their MuJoCo bodies move with, and its pin
-// is where the connect's anchor is; a mesh is drawn as a capsule that holds every vertex the file
-// lists, an ellipsoid as one that holds its semi-axes; a plane is a floor; hidden and transparent
-// geoms are left out and each substitution is noted; a URDF without geoms is drawn as rods.
+// is where the connect's anchor is; a mesh is drawn as its triangles, its vertices where the file
+// lists them (model_file_mesh_test.cpp: meshes from files); an ellipsoid as a capsule that holds its
+// semi-axes; a plane is a floor; hidden and transparent geoms are left out and each substitution is
+// noted; a URDF without geoms is drawn as rods.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -68,7 +69,7 @@ TEST_CASE("the four-bar's capsules are drawn where its file puts them, on the bo
   CHECK((m.closures[0].point2 - Vector3d(-0.1, 0, 0.3)).norm() < 1e-12);
 }
 
-TEST_CASE("meshes and ellipsoids as bounding capsules, planes as floors, hidden geoms left out, each noted") {
+TEST_CASE("meshes as triangles, ellipsoids as bounding capsules, planes as floors, hidden geoms left out, each noted") {
   const fs::path file = fs::temp_directory_path() / ("dynlab_drawing_" + std::to_string(::getpid()) + ".xml");
   // A wedge mesh (vertices as the file lists them, in its body's frame), off-centre and long along y.
   std::ofstream(file) << R"(<mujoco>
@@ -95,15 +96,19 @@ TEST_CASE("meshes and ellipsoids as bounding capsules, planes as floors, hidden 
   const auto& notes = m.drawing.notes;
   INFO(notes.size());
   CHECK(m.drawing.geoms.size() == 4);  // floor, wedge, egg, painted
-  // The mesh: a capsule (body frame = the hinge's frame: the anchor is the body's origin) holding every vertex.
+  // The mesh: its triangles (MuJoCo's hull of the listed vertices), every vertex the file lists where it
+  // lists it, in the body's frame (= the hinge's frame: the anchor is the body's origin).
   const Geom& wedge = named(m, "wedge");
-  CHECK(wedge.shape == Geom::Shape::Capsule);
+  CHECK(wedge.shape == Geom::Shape::Mesh);
   CHECK(wedge.link == 0);
+  REQUIRE(wedge.mesh);
+  CHECK(wedge.mesh->triangles.size() >= 4);
   const double v[6][3] = {{0, 0, 0}, {0.1, 0, 0}, {0, 0.5, 0}, {0, 0, 0.05}, {0.1, 0.5, 0.05}, {0.02, 0.3, 0.01}};
-  for (const auto& p : v) CHECK(toSegment(wedge, Vector3d(p[0], p[1], p[2])) <= wedge.size[0] + 1e-6);
-  CHECK(std::abs(wedge.rot.col(2).y()) > 0.99);  // along its long side (MuJoCo's mesh frame: its principal axes)
-  CHECK(wedge.size[0] < 0.1);                                       // and not a ball around it
-  CHECK(has(notes, "wedge", "bounding capsule"));
+  for (const auto& p : v)
+    CHECK(std::any_of(wedge.mesh->vertices.begin(), wedge.mesh->vertices.end(), [&](const Eigen::Vector3f& q) {
+      return (wedge.pos + wedge.rot * q.cast<double>() - Vector3d(p[0], p[1], p[2])).norm() < 1e-6;
+    }));
+  CHECK_FALSE(has(notes, "wedge", "bounding capsule"));
   // The ellipsoid: its six semi-axis ends inside, its capsule along its longest (y, turned 30° about z).
   const Geom& egg = named(m, "egg");
   CHECK(egg.shape == Geom::Shape::Capsule);
