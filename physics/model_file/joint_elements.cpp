@@ -13,12 +13,6 @@
 namespace dyn::model_file::detail {
 namespace {
 
-std::string num(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", x);
-  return b;
-}
-
 std::string named(const mjModel* m, int type, int id, const char* what) {
   const char* n = mj_id2name(m, type, id);
   return n && *n ? std::string(n) : std::string(what) + " #" + std::to_string(id);
@@ -29,6 +23,13 @@ Coupling::Form tendonForm(const mjModel* m, int t) {
   Coupling::Form f;
   for (int w = m->tendon_adr[t]; w < m->tendon_adr[t] + m->tendon_num[t]; ++w) f.push_back({m->jnt_dofadr[m->wrap_objid[w]], m->wrap_prm[w]});
   return f;
+}
+
+// A number as the errors show it (6 significant digits).
+std::string num(double x) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.6g", x);
+  return text;
 }
 
 }  // namespace
@@ -76,8 +77,8 @@ void addJointElements(const std::string& path, const mjModel* m, const LoadOptio
     }
   }
   // Joint and tendon equalities (connect and weld are the closures, read before).
-  if (m->opt.disableflags & (mjDSBL_EQUALITY | mjDSBL_CONSTRAINT)) return;
-  for (int e = 0; e < m->neq; ++e) {
+  const bool equalities = !(m->opt.disableflags & (mjDSBL_EQUALITY | mjDSBL_CONSTRAINT));
+  for (int e = 0; equalities && e < m->neq; ++e) {
     const bool joint = m->eq_type[e] == mjEQ_JOINT;
     if ((!joint && m->eq_type[e] != mjEQ_TENDON) || !m->eq_active[e]) continue;
     const std::string name = named(m, mjOBJ_EQUALITY, e, joint ? "joint equality" : "tendon equality");
@@ -92,6 +93,9 @@ void addJointElements(const std::string& path, const mjModel* m, const LoadOptio
     mech.constraints.push_back(std::make_shared<Coupling>(joint ? "joint_coupling" : "tendon_coupling", first, second, poly, out.q0));
     out.contacts.push_back({name, joint ? "joint_coupling" : "tendon_coupling", out.joints[std::size_t(first.front().joint)].body, first.front().joint, 0.0});
   }
+  if (mech.rows() > kMaxDof)
+    throw ModelFileError(path + ": its loops, joint limits (a row per limited side) and couplings make " + std::to_string(mech.rows()) +
+                         " constraint rows, more than dynlab's " + std::to_string(kMaxDof) + "; remove limited=\"true\" from joints that cannot reach their stops");
 }
 
 }  // namespace dyn::model_file::detail
