@@ -122,18 +122,26 @@ TEST_CASE("the slider's stops against MuJoCo's own soft limits and Bullet's limi
   CHECK(std::abs(dq[0]) < 2e-3);
   CHECK(std::abs(dq[1]) < 5e-3);
   // Bullet: btMultiBodyJointLimitConstraint, a row only once at or past the stop, plastic, the overshoot
-  // pushed back by ERP: it passes the stop by about the landing speed × dt (the carriage lands at
-  // √(2 g 0.3) ≈ 2.4 m/s: ≈ 2.4 mm at 1 ms), then returns to it.
+  // pushed back by ERP: a joint passes its stop by at most one step's travel at its landing speed
+  // (the carriage lands at √(2 g 0.3) ≈ 2.4 m/s, the arm at ≈ 7.6 rad/s), then returns to it.
   bullet::BulletMechanism<Spatial> bt(m.mechanism, dt, m.q0, VecN::Zero(2));
   CHECK(bt.describe().find("btMultiBodyJointLimitConstraint") != std::string::npos);
   VecN q, v;
-  double past = 0;
+  double lift_past = 0, swing_past = 0, lift_speed = 0, swing_speed = 0;
   for (int k = 0; k < int(std::lround(duration / dt)); ++k) {
     bt.step(VecN::Zero(2));
     bt.state(q, v);
-    past = std::max({past, -0.3 - q[0], q[1] - 0.8});
+    lift_past = std::max(lift_past, -0.3 - q[0]);
+    swing_past = std::max(swing_past, q[1] - 0.8);
+    lift_speed = std::max(lift_speed, std::abs(v[0]));
+    swing_speed = std::max(swing_speed, std::abs(v[1]));
   }
-  MESSAGE("Bullet: deepest past a stop " << past << "; rest − hand rest " << (q - hand.q.back()).transpose());
-  CHECK(past < 5e-3);
+  MESSAGE("Bullet: deepest past the stops " << lift_past << " m, " << swing_past << " rad (speeds up to " << lift_speed << " m/s, "
+                                            << swing_speed << " rad/s); rest − hand rest " << (q - hand.q.back()).transpose());
+  CHECK(lift_past > 0);  // Bullet's limit lets the joint through for a step: the disagreement measured here
+  CHECK(lift_past <= lift_speed * dt);
+  CHECK(swing_past <= swing_speed * dt);
   CHECK((q - hand.q.back()).cwiseAbs().maxCoeff() < 1e-3);
 }
+
+}  // namespace dyn
