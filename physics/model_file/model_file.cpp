@@ -53,7 +53,8 @@ void checkSupported(const std::string& file, const mjModel* m, const LoadOptions
   for (int j = 0; j < m->njnt; ++j)
     if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE)
       fail("joint '" + nameOf(m, mjOBJ_JOINT, j, "joint") + "' (body '" + nameOf(m, mjOBJ_BODY, m->jnt_bodyid[j], "body") +
-           "') is a " + kJoint[m->jnt_type[j]] + " joint; dynlab reads hinge and slide joints (URDF: revolute, continuous, prismatic, fixed)");
+           "') is a " + kJoint[m->jnt_type[j]] + " joint; dynlab reads hinge and slide joints (URDF: revolute, continuous, prismatic, fixed): " +
+           (m->jnt_type[j] == mjJNT_BALL ? "write it as three hinges about orthogonal axes" : "remove it to fix the body, or give it the hinges and slides it moves by"));
   if (m->nv == 0) fail("no hinge or slide joint: nothing moves (dynlab reads bodies moved by hinge and slide joints)");
   if (m->nv > kMaxDof) fail(std::to_string(m->nv) + " joints, more than dynlab's " + std::to_string(kMaxDof));
   for (int b = 1; b < m->nbody; ++b)

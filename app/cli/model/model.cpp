@@ -87,8 +87,9 @@ std::string describe(const model_file::LoadedModel& m) {
       o << "  limit " << nameShown(c.name) << ": joint stop at " << fmt(jl->bound()) << ", unilateral, rigid (plastic stops, release)\n";
     } else if (const auto* cp = dynamic_cast<const Coupling*>(&k)) {
       const auto& p = cp->poly();
-      o << "  coupling " << nameShown(c.name) << ": " << nameShown(c.kind) << ", 1 row, s1 = " << fmt(p[0]) << " + " << fmt(p[1]) << " s2 + " << fmt(p[2])
-        << " s2^2 + " << fmt(p[3]) << " s2^3 + " << fmt(p[4]) << " s2^4 (s: from the reference pose)\n";
+      o << "  coupling " << nameShown(c.name) << ": " << nameShown(c.kind) << ", 1 row, s1 = " << fmt(p[0]);
+      if (!cp->second().empty()) o << " + " << fmt(p[1]) << " s2 + " << fmt(p[2]) << " s2^2 + " << fmt(p[3]) << " s2^3 + " << fmt(p[4]) << " s2^4";
+      o << " (s: from the reference pose)\n";
     } else {
       const auto& p = static_cast<const PlaneContact<Spatial>&>(k);
       const Eigen::Vector3d nn = p.normal();
