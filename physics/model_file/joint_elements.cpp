@@ -93,6 +93,13 @@ void addJointElements(const std::string& path, const mjModel* m, const LoadOptio
     mech.constraints.push_back(std::make_shared<Coupling>(joint ? "joint_coupling" : "tendon_coupling", first, second, poly, out.q0));
     out.contacts.push_back({name, joint ? "joint_coupling" : "tendon_coupling", out.joints[std::size_t(first.front().joint)].body, first.front().joint, 0.0});
   }
+  // A fixed tendon no equality holds (one an actuator would read): noted, nothing to hold.
+  for (int t = 0; t < m->ntendon; ++t) {
+    bool used = false;
+    for (int e = 0; equalities && e < m->neq; ++e)
+      used = used || (m->eq_type[e] == mjEQ_TENDON && m->eq_active[e] && (m->eq_obj1id[e] == t || m->eq_obj2id[e] == t));
+    if (!used) out.notes.push_back("tendon '" + named(m, mjOBJ_TENDON, t, "tendon") + "': a fixed tendon no equality holds; read, nothing to hold");
+  }
   if (mech.rows() > kMaxDof)
     throw ModelFileError(path + ": its loops, joint limits (a row per limited side) and couplings make " + std::to_string(mech.rows()) +
                          " constraint rows, more than dynlab's " + std::to_string(kMaxDof) + "; remove limited=\"true\" from joints that cannot reach their stops");
