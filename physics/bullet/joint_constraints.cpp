@@ -25,7 +25,7 @@ std::string JointConstraints::refusal(const Constraint<Spatial>& k) {
   const auto* c = dynamic_cast<const Coupling*>(&k);
   if (!c || c->linearPair()) return {};
   return std::string(k.kind()) + ": Bullet holds a linear coupling of two joints only (polycoef \"0 c1 0 0 0\" between <joint> elements); "
-         "run this file with the hand engine alone (--engine hand)";
+         "it runs in the hand engine alone (--engine hand on model, run and figure)";
 }
 
 void JointConstraints::add(btMultiBodyDynamicsWorld& world, btMultiBody& body, const MechanismModel<Spatial>& model, int c, double max_impulse,

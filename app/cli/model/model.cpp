@@ -126,7 +126,7 @@ std::string report(const ModelRun& r, const std::string& engine, const model_fil
   const bool driven = !args.torques.empty();
   o << (driven ? "run with constant torques (" + shownLine(join(args.torques, ", ")) + "), " : std::string("passive run, ")) << engine << ", dt "
     << fmt(args.dt) << " s, " << fmt(args.duration) << " s from q0 at rest\n"
-    << "  " << (m.contacts.empty() ? "closure residual" : "constraint residual (closures, no-slip rows, contact depth)") << " max |φ|∞ "
+    << "  " << (m.contacts.empty() ? "closure residual" : "constraint residual (closures, couplings, no-slip rows, contact and joint-stop depth)") << " max |φ|∞ "
     << fmt(r.residual) << "\n"
     << "  energy E0 " << fmt(r.e0) << " J, max |E − E0 − " << (driven || anyImpacts(m) ? "W" : "W_friction") << "| " << fmt(r.balance)
     << " J (kinetic energy up to " << fmt(r.kinetic) << " J"
