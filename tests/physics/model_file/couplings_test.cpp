@@ -101,6 +101,41 @@ TEST_CASE("a polycoef joint equality holds b − b0 = 0.5 s + 0.3 s² (s = a −
   CHECK(c.gap < 0.02 * c.motion);
 }
 
+TEST_CASE("a coupling's J is φ's gradient and its bias is J'θ' (central differences, a quartic over a tendon of two joints)") {
+  // s₁ = θ₀ − 0.3 θ₂ (a tendon), s₂ = 2 θ₁ + θ₂, P = 0.5 s + 0.3 s² − 0.2 s³ + 0.1 s⁴, about θ_ref.
+  VecN ref(3);
+  ref << 0.1, -0.2, 0.3;
+  const Coupling c("tendon_coupling", {{0, 1.0}, {2, -0.3}}, {{1, 2.0}, {2, 1.0}}, {0, 0.5, 0.3, -0.2, 0.1}, ref);
+  MechanismKinematics<Spatial> k;
+  auto phiAt = [&](const VecN& q) {
+    k.theta = q;
+    VecN phi = VecN::Zero(1);
+    MatN J = MatN::Zero(1, 3), A = MatN::Zero(1, 0);
+    c.position(k, 0, phi, J, A);
+    return std::pair{phi[0], VecN(J.row(0).transpose())};
+  };
+  Random rnd;
+  const double h = 1e-5;
+  for (int s = 0; s < 4; ++s) {
+    const VecN q = ref + rnd.vec(3, 0.8), v = rnd.vec(3, 2.0);
+    const auto [phi, J] = phiAt(q);
+    VecN fd(3);
+    for (int i = 0; i < 3; ++i) {
+      VecN e = VecN::Zero(3);
+      e[i] = h;
+      fd[i] = (phiAt(q + e).first - phiAt(q - e).first) / (2 * h);
+    }
+    CHECK((fd - J).cwiseAbs().maxCoeff() < 1e-8);
+    // J'θ' = d/dt (J θ') along θ' held: (J(q + v h) − J(q − v h)) · v / 2h.
+    const double jdot_v = (phiAt(q + h * v).second - phiAt(q - h * v).second).dot(v) / (2 * h);
+    k.theta = q, k.theta_rate = v;
+    VecN b = VecN::Zero(1);
+    c.bias(k, 0, b);
+    CHECK(std::abs(b[0] - jdot_v) < 1e-6 * (1 + std::abs(jdot_v)));
+  }
+  CHECK(!c.linearPair());
+}
+
 TEST_CASE("a linear joint equality is a Bullet gear: Bullet keeps the coupling") {
   const std::filesystem::path file = writeFile(scratchFolder("couplings_gear"), "mirror.xml", R"(<mujoco><option><flag contact="disable"/></option><worldbody>
     <body name="a" pos="0 0 1"><joint name="a" type="hinge" axis="0 1 0"/><geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02" mass="1"/></body>
