@@ -69,6 +69,8 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
   kin_.payload_rate.assign(model_.payloads.size(), Eigen::Vector3d::Zero());
   kin_.payload_cs.assign(model_.payloads.size(), Eigen::Vector2d(1, 0));
   kin_.link_angle.assign(std::size_t(n()), 0.0);
+  kin_.theta = VecN::Zero(n());
+  kin_.theta_rate = VecN::Zero(n());
   // Planar: the fixed part of each link's angle, its placement's rotation (X_tree.E = rotation(angle)).
   if constexpr (S::kDim == 3)
     for (const auto& b : model_.tree.bodies) tree_angle_.push_back(std::atan2(b.X_tree.E(0, 1), b.X_tree.E(0, 0)));
@@ -109,6 +111,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   problem_.M.resize(nn, nn);
   crbaWorld(model_.tree, data_, problem_.M);
   addArmature(problem_.M);
+  kin_.theta = q.head(nn);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
   if constexpr (S::kDim == 3)
     for (int i = 0; i < nn; ++i) {
@@ -167,6 +170,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   have_last_ = false;  // the last solve was at other rates
   // Link velocities, each link's velocity-product acceleration and h = Cθ' + G, in world coordinates.
   problem_.h.resize(nn);
+  kin_.theta_rate = qd.head(nn);
   biasForcesWorld(model_.tree, data_, qd, problem_.h);
   // Joint springs and friction join h; friction's power for the books.
   friction_power_ = 0.0;

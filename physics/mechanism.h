@@ -212,6 +212,9 @@ struct MechanismKinematics {
   std::vector<Eigen::Vector2d> payload_cs;
   // Planar: each link's absolute angle (the sum of its path's joint angles and fixed placements).
   std::vector<double> link_angle;
+  // The tree's joint coordinates θ (position stage) and rates θ' (velocity stage): what joint-space
+  // kinds (joint_limit.h, coupling.h) read.
+  VecN theta, theta_rate;
 
   // World position of a point given in a body's frame (the world's frame is the world).
   Pos position(const BodyRef& b, const Pos& p) const;

@@ -108,8 +108,10 @@ void checkEffortUnits(const JsonView& c, const DataSettings& s, const Slide& sli
 // payload bodies.
 model_file::LoadedModel loadModel(const JsonView& mf, const std::string& folder, const model_file::LoadOptions& options) {
   model_file::LoadedModel file;
+  model_file::LoadOptions held = options;
+  held.joint_limits = false;  // the controller keeps the arm inside its range: limits noted, not held
   try {
-    file = model_file::load(checkedModelPath(mf, folder), options);
+    file = model_file::load(checkedModelPath(mf, folder), held);
   } catch (const model_file::ModelFileError& e) {
     mf.fail(std::string("a model file dynlab reads (") + e.what() + ")");
   }

@@ -177,7 +177,9 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, 
   for (const auto& k : m->closures)
     for (const auto& r : k.kept) f.push_back("f_" + columnName(k.name) + "_" + r);
   for (const auto& k : m->contacts)
-    for (const char* part : k.kind == "rolling" ? std::vector<const char*>{"_long", "_lat", "_normal"} : std::vector<const char*>{"_normal"})
+    for (const char* part : k.kind == "rolling"                                   ? std::vector<const char*>{"_long", "_lat", "_normal"}
+                            : k.kind == "plane_contact" || k.kind == "joint_limit" ? std::vector<const char*>{"_normal"}
+                                                                                   : std::vector<const char*>{""})  // a coupling: f_NAME
       c.push_back("f_" + columnName(k.name) + part);
   const bool impacts = anyImpacts(*m);
   json figures = json::array(

@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "physics/bullet/bullet_mechanism.h"
+#include "physics/constraints/joint_limit.h"
 #include "physics/constraints/plane_contact.h"
 #include "physics/constraints/rolling.h"
 #include "physics/model_file/closure_rows.h"
@@ -52,8 +53,11 @@ double elementResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Sp
   double phi = desc.residual(q, v);
   desc.stage(q);
   for (std::size_t i = 0; i < m.contacts.size(); ++i)
-    if (const auto* pc = dynamic_cast<const PlaneContact<Spatial>*>(m.mechanism.constraints[m.closures.size() + i].get()))
+    if (const auto* pc = dynamic_cast<const PlaneContact<Spatial>*>(m.mechanism.constraints[m.closures.size() + i].get())) {
       if (!pc->compliant()) phi = std::max(phi, -pc->gap(desc.kinematics()));
+    } else if (const auto* jl = dynamic_cast<const JointLimit*>(m.mechanism.constraints[m.closures.size() + i].get())) {
+      phi = std::max(phi, -jl->gap(desc.kinematics()));
+    }
   return phi;
 }
 
@@ -73,7 +77,8 @@ double frictionPower(const MechanismModel<Spatial>& d, const VecN& v) {
 // A rigid plane contact among the model's elements: its touchdowns are plastic impacts.
 bool anyImpacts(const model_file::LoadedModel& m) {
   for (std::size_t i = 0; i < m.contacts.size(); ++i)
-    if (m.contacts[i].kind == "plane_contact" && !m.mechanism.constraints[m.closures.size() + i]->compliant()) return true;
+    if ((m.contacts[i].kind == "plane_contact" || m.contacts[i].kind == "joint_limit") && !m.mechanism.constraints[m.closures.size() + i]->compliant())
+      return true;
   return false;
 }
 
@@ -92,6 +97,10 @@ Trace modelColumns(const model_file::LoadedModel& m) {
     const std::string n = columnName(c.name);
     if (c.kind == "rolling")
       t.columns.insert(t.columns.end(), {"f_" + n + "_long", "f_" + n + "_lat", "f_" + n + "_normal", "skid_margin_" + n, "slip_" + n});
+    else if (c.kind == "joint_limit")  // the stop's force (N·m or N, ≥ 0) and the joint's distance to it
+      t.columns.insert(t.columns.end(), {"f_" + n + "_normal", "gap_" + n});
+    else if (c.kind != "plane_contact")  // a coupling: η, its generalised force
+      t.columns.push_back("f_" + n);
     else
       t.columns.insert(t.columns.end(), {"f_" + n + "_normal", "f_" + n + "_tangent", "gap_" + n});
   }
@@ -166,6 +175,16 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
         row.insert(row.end(), r.begin(), r.end());
         continue;
       }
+      const Constraint<Spatial>& k_c = *m.mechanism.constraints[closures + i];
+      if (const auto* jl = dynamic_cast<const JointLimit*>(&k_c)) {  // gap, f_n (+ a touchdown's impulse / dt)
+        const double P = stepped ? jl->along(engine.kinematics(), engine.impactImpulse(int(closures + i))) : 0.0;
+        row.insert(row.end(), {r[1] + P / dt, r[0]});
+        continue;
+      }
+      if (m.contacts[i].kind != "plane_contact") {  // a coupling: its η
+        row.push_back(s.eta[engine.rowOffset(int(closures + i))]);
+        continue;
+      }
       // gap, f_n; a touchdown in the step adds its impulse's normal share / dt.
       const auto* pc = static_cast<const PlaneContact<Spatial>*>(m.mechanism.constraints[closures + i].get());
       const double P = stepped ? pc->normal().dot(Spatial::linear(engine.impactImpulse(int(closures + i)))) : 0.0;
@@ -208,7 +227,11 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
         const Spatial::Vec f = bt.constraintForce(c);
         const Spatial::Pos f_lin = Spatial::linear(f);
         const Constraint<Spatial>& k_c = *m.mechanism.constraints[std::size_t(c)];
-        if (m.contacts[i].kind == "rolling") {
+        if (const auto* jl = dynamic_cast<const JointLimit*>(&k_c)) {
+          forces.insert(forces.end(), {jl->along(mech.kinematics(), f), jl->gap(mech.kinematics())});
+        } else if (m.contacts[i].kind != "rolling" && m.contacts[i].kind != "plane_contact") {
+          forces.push_back(f[0]);  // a coupling: Bullet's gear impulse / dt (builder: constraintForce's first entry)
+        } else if (m.contacts[i].kind == "rolling") {
           double r[5];
           k_c.report(mech.kinematics(), f_lin.data(), r);  // the rolling rows' η are the force's world components
           forces.insert(forces.end(), r, r + 5);

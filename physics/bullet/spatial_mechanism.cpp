@@ -9,6 +9,7 @@
 //             μ, restitution 0, rigid or with the contact stiffness and damping (k_e, d_e) of the
 //             description (contact_balls.h: the shared ball-on-plane model, and what Bullet does with
 //             ρ < 1 mm, stiffness and its speculative touchdown).
+//   joint_limit, joint_coupling: joint_constraints.h (btMultiBodyJointLimitConstraint, btMultiBodyGearConstraint);
 //   point_closure (loop closures, e.g. from a model file): a btMultiBodyPoint2Point when it holds
 //             translations only, a btMultiBodyFixedConstraint (the body frames kept aligned) when it
 //             holds a rotation row; Bullet then holds all 3 (or 6) rows, so rows the description
@@ -73,6 +74,7 @@
 #include "physics/bullet/bullet_mechanism_members.h"
 #include "physics/bullet/bullet_world.h"
 #include "physics/bullet/contact_balls.h"
+#include "physics/bullet/joint_constraints.h"
 #include "physics/bullet/rolling_constraint.h"
 #include "physics/constraints/plane_contact.h"
 #include "physics/constraints/point_closure.h"
@@ -193,6 +195,7 @@ struct BulletMechanism<Spatial>::Impl {
   std::vector<std::unique_ptr<btMultiBodyLinkCollider>> colliders;
   std::vector<std::unique_ptr<btMultiBodyConstraint>> closures;
   ContactBalls balls;  // Friction wheels and plane contacts
+  JointConstraints joint_constraints;  // joint limits and couplings
 
   Impl(const MechanismModel<Spatial>& m, double step, const VecN& q0, const VecN& v0) : model(m), dt(step), world(bt(Spatial::linear(m.tree.gravity)), m.bullet.solver_iterations) {
     check(q0, v0);
@@ -233,7 +236,8 @@ struct BulletMechanism<Spatial>::Impl {
     }
     for (std::size_t c = 0; c < model.constraints.size(); ++c) {
       const Constraint<Spatial>* k = model.constraints[c].get();
-      if (!dynamic_cast<const Rolling*>(k) && !dynamic_cast<const PlaneContact<Spatial>*>(k) && !isPointClosure(k))
+      if (const std::string why = JointConstraints::refusal(*k); !why.empty()) throw std::invalid_argument(who + why);
+      if (!dynamic_cast<const Rolling*>(k) && !dynamic_cast<const PlaneContact<Spatial>*>(k) && !isPointClosure(k) && !JointConstraints::isJointKind(*k))
         throw std::invalid_argument(who + "constraint " + std::to_string(c) + " (" + k->kind() +
                                     "): not yet (only rolling, plane_contact and point_closure)");
     }
@@ -308,6 +312,10 @@ struct BulletMechanism<Spatial>::Impl {
     for (std::size_t c = 0; c < model.constraints.size(); ++c) {
       if (isPointClosure(model.constraints[c].get())) {
         buildLoop(int(c));
+        continue;
+      }
+      if (JointConstraints::isJointKind(*model.constraints[c])) {
+        joint_constraints.add(*world.operator->(), *body, model, int(c), kImpulseCap, closures);
         continue;
       }
       if (const auto* pc = dynamic_cast<const PlaneContact<Spatial>*>(model.constraints[c].get())) {
@@ -401,6 +409,7 @@ struct BulletMechanism<Spatial>::Impl {
           << ", cone)";
     }
     if (!contacts.empty()) s << ", " << contacts.size() << " plane contact(s) as a sphere on a static plane";
+    s << joint_constraints.describe();
     if (!rotor_joint.empty()) s << ", " << rotor_joint.size() << " armature rotor(s) geared " << kRotorGear << ":1";
     if (!loops.empty()) {
       const auto welds = std::count_if(loops.begin(), loops.end(), [](const Loop& l) { return l.weld; });
@@ -495,6 +504,7 @@ struct BulletMechanism<Spatial>::Impl {
     for (const Loop& l : loops) force[std::size_t(l.constraint)] = loopForce(l);
     for (Wheel& w : wheels) force[std::size_t(w.constraint)] = w.noslip ? noSlipForce(w) : ballForce(w.ball, w.start_point);
     for (Contact& k : contacts) force[std::size_t(k.constraint)] = ballForce(k.ball, k.start_point);
+    joint_constraints.forces(*body, dt, force);
     // The books: the held torques along the step's displacement.
     VecN q1, v1;
     state(q1, v1);

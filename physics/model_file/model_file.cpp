@@ -54,12 +54,13 @@ void checkSupported(const std::string& file, const mjModel* m, const LoadOptions
   for (int j = 0; j < m->njnt; ++j)
     if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE)
       fail("joint '" + nameOf(m, mjOBJ_JOINT, j, "joint") + "' (body '" + nameOf(m, mjOBJ_BODY, m->jnt_bodyid[j], "body") +
-           "') is a " + kJoint[m->jnt_type[j]] + " joint; dynlab reads hinge and slide joints (URDF: revolute, continuous, prismatic, fixed)");
+           "') is a " + kJoint[m->jnt_type[j]] + " joint; dynlab reads hinge and slide joints (URDF: revolute, continuous, prismatic, fixed): " +
+           (m->jnt_type[j] == mjJNT_BALL ? "write it as three hinges about orthogonal axes" : "remove it to fix the body, or give it the hinges and slides it moves by"));
   if (m->nv == 0) fail("no hinge or slide joint: nothing moves (dynlab reads bodies moved by hinge and slide joints)");
   if (m->nv > kMaxDof) fail(std::to_string(m->nv) + " joints, more than dynlab's " + std::to_string(kMaxDof));
   for (int b = 1; b < m->nbody; ++b)
     if (m->body_mocapid[b] >= 0) fail("body '" + nameOf(m, mjOBJ_BODY, b, "body") + "' is a mocap body; dynlab reads bodies moved by their joints only");
-  if (m->ntendon > 0) fail("tendon '" + nameOf(m, mjOBJ_TENDON, 0, "tendon") + "': dynlab reads no tendons (joints, inertias and connect/weld equalities only)");
+  detail::checkTendons(file, m);
   for (int i = 0; i < m->nu; ++i) {
     const std::string a = "actuator '" + nameOf(m, mjOBJ_ACTUATOR, i, "actuator") + "'";
     if (m->actuator_dyntype[i] != mjDYN_NONE || m->actuator_gaintype[i] != mjGAIN_FIXED || m->actuator_biastype[i] != mjBIAS_NONE)
@@ -169,8 +170,6 @@ std::vector<Frame> readTree(const std::string& path, const mjModel* m, const mjD
       jt.type = hinge ? "hinge" : "slide";
       jt.limited = m->jnt_limited[j] && !(flags & mjDSBL_LIMIT);
       jt.lower = m->jnt_range[2 * j], jt.upper = m->jnt_range[2 * j + 1];
-      if (jt.limited)
-        out.notes.push_back("joint '" + jt.name + "': limit [" + num(jt.lower) + ", " + num(jt.upper) + "] " + (hinge ? "rad" : "m") + " read, not enforced");
       out.joints.push_back(jt);
     }
     frame[std::size_t(b)] = f;
@@ -264,8 +263,9 @@ void readEqualities(const std::string& path, const mjModel* m, const mjData* d, 
   if (!equalities && m->neq > 0) out.notes.push_back(std::to_string(m->neq) + " equalities off (<option><flag equality=\"disable\"/>)");
   for (int e = 0; equalities && e < m->neq; ++e) {
     const std::string name = nameOf(m, mjOBJ_EQUALITY, e, m->eq_type[e] == mjEQ_WELD ? "weld" : "connect");
+    if (m->eq_type[e] == mjEQ_JOINT || m->eq_type[e] == mjEQ_TENDON) continue;  // couplings: joint_elements.cpp
     if (m->eq_type[e] != mjEQ_CONNECT && m->eq_type[e] != mjEQ_WELD)
-      throw ModelFileError(path + ": equality '" + name + "' is a joint, tendon or distance coupling; dynlab reads <connect> and <weld>");
+      throw ModelFileError(path + ": equality '" + name + "' is a distance coupling; dynlab reads <connect>, <weld>, <joint> and <tendon> (fixed tendons)");
     if (!m->eq_active[e]) {
       out.notes.push_back("equality '" + name + "' is inactive in the file (active=\"false\"): not held");
       continue;
@@ -445,6 +445,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
     keepIndependentRows(path, ties.list, extentOf(frame, ties.list), out);
     reachLoopAnchors(out);
   }
+  detail::addJointElements(path, m, options, out);
   addElementsAndFreedom(path, m, d, frame, options, out);
   return out;
 }

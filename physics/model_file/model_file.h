@@ -7,7 +7,10 @@
 //                file's reference pose qpos0, so X_tree = (R(a, q0), o_i − o_parent) for a hinge and
 //                (1, o_i − o_parent − a q0) for a slide; coordinates are MuJoCo's qpos (θ = qpos)
 //   inertias     body_mass, xipos, ximat, body_inertia at qpos0, summed over fused bodies
-//   joints       stiffness / springref, damping, frictionloss (as Coulomb smoothed over a rate width)
+//   joints       stiffness / springref, damping, frictionloss (as Coulomb smoothed over a rate width);
+//                range limits as one-sided rows with events (joint_limit.h), after the closures
+//   couplings    <equality> joint and tendon (fixed tendons) as one row each, MuJoCo's polycoef form
+//                (coupling.h); spatial tendons, tendon actuators and muscles refused
 //   closures     <equality> connect (3 translation rows) and weld (6 rows) as point closures, with the
 //                rows that are identically dependent on the others (a planar loop's out-of-plane
 //                rows) dropped and named
@@ -82,12 +85,16 @@ struct Closure {
   Eigen::Vector3d point1 = Eigen::Vector3d::Zero(), point2 = Eigen::Vector3d::Zero();  // in their frames
 };
 
-// dynlab's own constraint elements, given beside the file (GivenRolling, GivenContact below): a rolling
-// wheel (physics/constraints/rolling.h) or a ball against a plane (plane_contact.h, unilateral), as the
-// description holds them, after the closures.
+// The description's constraints after the closures, in order: the file's joint limits (joint_limit.h,
+// unilateral) and joint and fixed-tendon equalities (coupling.h), then dynlab's own elements given
+// beside the file (GivenRolling, GivenContact below): a rolling wheel (physics/constraints/rolling.h)
+// or a ball against a plane (plane_contact.h, unilateral).
 struct Contact {
   std::string name;
-  std::string kind;  // "rolling" or "plane_contact"
+  // "rolling" or "plane_contact" (given beside the file); from the file itself: "joint_limit" (one per
+  // limited side, body: the joint's), "joint_coupling" or "tendon_coupling" (an <equality> <joint> or
+  // <tendon>, body: its first joint's)
+  std::string kind;
   std::string body;  // the MuJoCo body (URDF link) it is on
   int link = -1;     // the tree body it moves with
   double mu = 0;     // rolling: the skid report's μ (and Bullet's friction model); plane: Bullet's friction
@@ -201,6 +208,9 @@ struct LoadOptions {
   std::vector<GivenClosure> closures;  // held after the file's own equalities, in this order
   std::vector<GivenRolling> rolling;   // then these, in this order
   std::vector<GivenContact> contacts;  // then these
+  // Joint range limits held as one-sided rows (joint_limit.h); false: read and noted, not held (the data
+  // labs, whose controllers keep their arms inside the range: their runs stay as they were).
+  bool joint_limits = true;
 };
 
 // Reads FILE (MJCF or URDF). Throws ModelFileError.

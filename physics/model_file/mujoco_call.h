@@ -97,6 +97,13 @@ void readDrawing(const mjModel* m, const mjData* d, const std::vector<int>& link
 void addElements(const std::string& path, const mjModel* m, const mjData* d, const std::vector<int>& link,
                  const std::vector<Eigen::Vector3d>& origin, const LoadOptions& options, LoadedModel& out);
 
+// Tendons and tendon or muscle actuators dynlab cannot hold, refused in one line (joint_elements.cpp).
+void checkTendons(const std::string& path, const mjModel* m);
+
+// The file's joint limits and joint and fixed-tendon equalities onto out's description, after its
+// closures, and into out.contacts (joint_elements.cpp).
+void addJointElements(const std::string& path, const mjModel* m, const LoadOptions& options, LoadedModel& out);
+
 }  // namespace dyn::model_file::detail
 
 // Runs the statement; a MuJoCo error inside it throws ModelFileError("<file>: MuJoCo: <message>").

@@ -26,6 +26,8 @@
 #include "labs/numbers.h"
 #include "labs/utf8.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/constraints/coupling.h"
+#include "physics/constraints/joint_limit.h"
 #include "physics/constraints/plane_contact.h"
 #include "physics/constraints/rolling.h"
 #include "physics/model_file/hand_engine.h"
@@ -81,6 +83,13 @@ std::string describe(const model_file::LoadedModel& m) {
       const auto& w = static_cast<const Rolling&>(k);
       o << "  rolling " << nameShown(c.name) << ": body " << nameShown(c.body) << ", radius " << fmt(w.radius()) << " m on the ground z = " << fmt(w.groundHeight())
         << ", 3 rows (x y: no slip, velocity-level; z: on the ground), mu " << fmt(w.mu()) << " for the skid margin\n";
+    } else if (const auto* jl = dynamic_cast<const JointLimit*>(&k)) {
+      o << "  limit " << nameShown(c.name) << ": joint stop at " << fmt(jl->bound()) << ", unilateral, rigid (plastic stops, release)\n";
+    } else if (const auto* cp = dynamic_cast<const Coupling*>(&k)) {
+      const auto& p = cp->poly();
+      o << "  coupling " << nameShown(c.name) << ": " << nameShown(c.kind) << ", 1 row, s1 = " << fmt(p[0]);
+      if (!cp->second().empty()) o << " + " << fmt(p[1]) << " s2 + " << fmt(p[2]) << " s2^2 + " << fmt(p[3]) << " s2^3 + " << fmt(p[4]) << " s2^4";
+      o << " (s: from the reference pose)\n";
     } else {
       const auto& p = static_cast<const PlaneContact<Spatial>&>(k);
       const Eigen::Vector3d nn = p.normal();
@@ -117,7 +126,7 @@ std::string report(const ModelRun& r, const std::string& engine, const model_fil
   const bool driven = !args.torques.empty();
   o << (driven ? "run with constant torques (" + shownLine(join(args.torques, ", ")) + "), " : std::string("passive run, ")) << engine << ", dt "
     << fmt(args.dt) << " s, " << fmt(args.duration) << " s from q0 at rest\n"
-    << "  " << (m.contacts.empty() ? "closure residual" : "constraint residual (closures, no-slip rows, contact depth)") << " max |φ|∞ "
+    << "  " << (m.contacts.empty() ? "closure residual" : "constraint residual (closures, couplings, no-slip rows, contact and joint-stop depth)") << " max |φ|∞ "
     << fmt(r.residual) << "\n"
     << "  energy E0 " << fmt(r.e0) << " J, max |E − E0 − " << (driven || anyImpacts(m) ? "W" : "W_friction") << "| " << fmt(r.balance)
     << " J (kinetic energy up to " << fmt(r.kinetic) << " J"
@@ -130,9 +139,14 @@ std::string report(const ModelRun& r, const std::string& engine, const model_fil
     for (const auto& c : m.contacts) {
       const std::string n = columnName(c.name);
       double extreme = c.kind == "rolling" ? 0.0 : INFINITY;
-      for (std::size_t row = 0; row < t.rows(); ++row)
+      const bool coupling = c.kind != "rolling" && c.kind != "plane_contact" && c.kind != "joint_limit";  // no gap column
+      for (std::size_t row = 0; row < t.rows() && !coupling; ++row)
         extreme = c.kind == "rolling" ? std::max(extreme, std::abs(t.at(row, "slip_" + n))) : std::min(extreme, t.at(row, "gap_" + n));
-      if (c.kind == "rolling")
+      if (c.kind == "joint_limit")
+        o << "  limit " << nameShown(c.name) << ": min gap " << fmt(extreme) << "; at the end f_normal " << fmt(t.at(last, "f_" + n + "_normal")) << "\n";
+      else if (coupling)
+        o << "  coupling " << nameShown(c.name) << ": at the end f " << fmt(t.at(last, "f_" + n)) << "\n";
+      else if (c.kind == "rolling")
         o << "  rolling " << nameShown(c.name) << ": max slip speed " << fmt(extreme) << " m/s; at the end f_long " << fmt(t.at(last, "f_" + n + "_long"))
           << ", f_lat " << fmt(t.at(last, "f_" + n + "_lat")) << ", f_normal " << fmt(t.at(last, "f_" + n + "_normal")) << " N\n";
       else
