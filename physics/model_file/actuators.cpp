@@ -2,6 +2,10 @@
 #include "physics/model_file/actuators.h"
 
 #include <algorithm>
+#include <complex>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/LU>
 #include <cstdio>
 
 namespace dyn::model_file {
@@ -61,6 +65,42 @@ std::string number(double x) {
 std::unique_ptr<ConstrainedSystem> withActuators(std::unique_ptr<ConstrainedSystem> engine, const LoadedModel& m) {
   if (m.actuators.empty()) return engine;
   return std::make_unique<Actuated>(std::move(engine), m.actuators, m.ctrl);
+}
+
+namespace {
+
+// RK4 follows x' = λ x at step h while |R(λ h)| ≤ 1.
+bool rk4Follows(std::complex<double> z) { return std::abs(1.0 + z + z * z / 2.0 + z * z * z / 6.0 + z * z * z * z / 24.0) <= 1.0 + 1e-12; }
+
+bool followsAt(const Eigen::VectorXcd& modes, double h) {
+  for (Eigen::Index i = 0; i < modes.size(); ++i)
+    if (!rk4Follows(modes[i] * h)) return false;
+  return true;
+}
+
+}  // namespace
+
+std::string stiffServoNote(const LoadedModel& m, const MatN& M, double dt) {
+  const Eigen::Index n = M.rows();
+  VecN k = VecN::Zero(n), c = VecN::Zero(n);
+  for (const Actuator& a : m.actuators) {
+    k[a.coordinate] -= a.gear * a.gear * a.bias[1];
+    c[a.coordinate] -= a.gear * a.gear * a.bias[2];
+  }
+  if (n == 0 || (k.maxCoeff() <= 0 && c.maxCoeff() <= 0)) return "";
+  // x = (q, v): x' = [0 1; −M⁻¹K −M⁻¹C] x.
+  const Eigen::MatrixXd Minv = Eigen::MatrixXd(M).inverse();
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  A.topRightCorner(n, n).setIdentity();
+  A.bottomLeftCorner(n, n) = -Minv * k.asDiagonal();
+  A.bottomRightCorner(n, n) = -Minv * c.asDiagonal();
+  const Eigen::VectorXcd modes = Eigen::EigenSolver<Eigen::MatrixXd>(A, false).eigenvalues();
+  if (!modes.allFinite() || followsAt(modes, dt)) return "";
+  double h = dt;
+  for (int halvings = 0; halvings < 60 && !followsAt(modes, h); ++halvings) h /= 2;
+  return "the servos (stiffness up to " + number(k.maxCoeff()) + ", damping up to " + number(c.maxCoeff()) + ", fastest mode " +
+         number(modes.cwiseAbs().maxCoeff()) + " 1/s at the start) are stiffer than RK4 follows at dt " + number(dt) +
+         " s: the run chatters; pass --dt " + number(h) + " or less (MuJoCo 3's implicit integrators take these terms implicitly)";
 }
 
 std::string describeControls(const LoadedModel& m) {

@@ -22,6 +22,14 @@ inline VecN actuatorTorques(const LoadedModel& m, const VecN& q, const VecN& v) 
 // their work with τ's; engine itself when the model has none.
 std::unique_ptr<ConstrainedSystem> withActuators(std::unique_ptr<ConstrainedSystem> engine, const LoadedModel& m);
 
+// Servos stiffer than RK4 at step dt can follow: the actuators' stiffness K = diag(−gear² bias[1]) and
+// damping C = diag(−gear² bias[2]) on M (at the run's start, armature included) make x = (q, v) move as
+// x' = [0 1; −M⁻¹K −M⁻¹C] x, whose modes λ RK4 follows only while |R(λ dt)| ≤ 1 (R(z) = 1 + z + z²/2 +
+// z³/6 + z⁴/24). A note naming the step they need (halvings of dt), or "" when RK4 follows them.
+// (MuJoCo 3's implicit integrators, which files such as Menagerie's Panda ask for, take these terms
+// implicitly; dynlab's RK4 does not.)
+std::string stiffServoNote(const LoadedModel& m, const MatN& M, double dt);
+
 // "2 actuators (servo_a, servo_b) at ctrl (0.5, 0)" for summaries; "" when none.
 std::string describeControls(const LoadedModel& m);
 

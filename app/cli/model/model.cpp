@@ -300,6 +300,7 @@ int model(const ModelArgs& asked) {
   }
   ConstrainedMechanism<Spatial> mech(m.mechanism);
   std::string text = describe(m) + crossCheck(m, mech);
+  if (const std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), args.dt); !stiff.empty()) text += "  note: " + shownLine(stiff) + "\n";
   const bool hand = args.engine != "bullet", bullet = args.engine != "hand";
   ModelRun h, b;
   if (hand) h = m.contacts.empty() ? runHand(m, mech, args.dt, args.duration, tau) : runHandElements(m, mech, args.dt, args.duration, tau);

@@ -5,6 +5,7 @@
 //  * from its keyframe, the hand engine's RK4 run equals MuJoCo's mj_step with RK4 at the same step
 //    (the same equations at the same order: only rounding apart), and a control past its range runs
 //    as the range's end;
+//  * servos too stiff for RK4 at the run's step are named with a step that follows them;
 //  * a keyframe that opens a loop, an unknown keyframe and actuators outside the law are one line;
 //  * geoms that may collide load, noted once (--ignore-contacts: not noted).
 #include <doctest/doctest.h>
@@ -132,6 +133,13 @@ TEST_CASE("servo_arm.xml from keyframe 'reach': the hand engine's RK4 run is MuJ
   }
   CHECK(qa == qb);
   CHECK((qa - m.start_q).cwiseAbs().maxCoeff() > 1e-2);  // it moved
+  // The servos' fastest mode (the wrist's 80 N/m and 8 N·s/m on 0.2 kg: about 40 1/s) is within RK4's
+  // reach at 1 ms, not at 0.1 s: a note names a step that is.
+  ConstrainedMechanism<Spatial> mech(m.mechanism);
+  const MatN M = mech.massMatrix(m.start_q);
+  CHECK(model_file::stiffServoNote(m, M, 1e-3).empty());
+  const std::string stiff = model_file::stiffServoNote(m, M, 0.1);
+  CHECK(stiff.find("are stiffer than RK4 follows at dt 0.1 s: the run chatters; pass --dt ") != std::string::npos);
 }
 
 TEST_CASE("a four-bar with colliding capsules and a crank servo: keyframes checked against the loop, names listed") {
@@ -183,4 +191,11 @@ TEST_CASE("actuators outside the affine law on a joint, and collision geoms' not
   model_file::LoadOptions quiet;
   quiet.ignore_contacts = true;
   CHECK(model_file::load(plain.string(), quiet).notes.empty());
+  // A <contact><pair> between geoms that filter each other out: noted, not refused.
+  const std::string paired = "<mujoco><default><geom size=\"0.1\" contype=\"0\" conaffinity=\"0\"/></default><worldbody>"
+                             "<body><joint/><geom name=\"a\"/></body><body pos=\"1 0 0\"><joint/><geom name=\"c\"/></body></worldbody>"
+                             "<contact><pair name=\"touch\" geom1=\"a\" geom2=\"c\"/></contact></mujoco>";
+  const auto pair_notes = model_file::load(writeFile(dir, "pair.xml", paired).string()).notes;
+  REQUIRE(pair_notes.size() == 1);
+  CHECK(pair_notes[0].find("1 <contact><pair> (e.g. 'touch') collide in MuJoCo but not here: dynlab has no geom–geom contact") == 0);
 }
