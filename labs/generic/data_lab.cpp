@@ -11,6 +11,7 @@
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
+#include "physics/model_file/closure_rows.h"
 
 namespace dyn::generic {
 namespace {
@@ -22,7 +23,7 @@ using Mech = ConstrainedMechanism<Spatial>;
 class Hooks final : public StepHooks {
  public:
   explicit Hooks(const DataSettings& s)
-      : s_(s), ctrl_(s.controller, s.model, s.actuated, s.tool, s.q0, s.step.dt) {
+      : s_(s), ctrl_(s.controller, s.model, s.actuated, s.tool, s.q0, s.step.dt), every_(*s.plant) {
     if (s_.path) s_.path->at(0.0, ref_.x, ref_.xd, ref_.xdd), ref_.joint = s_.path->joint();
     if (!s.passive.empty()) loads_mech_ = std::make_unique<Mech>(s.plant->mechanism);
   }
@@ -67,7 +68,8 @@ class Hooks final : public StepHooks {
       for (int i = 0; i < x.size(); ++i) out.push_back(ref_.x[i] + xi_[i]);
       for (int i = 0; i < x.size(); ++i) out.push_back(x[i] - ref_.x[i] - xi_[i]);
     }
-    out.push_back(r.energy), out.push_back(r.work), out.push_back(r.residual);
+    // |φ| over every closure row, the ones the description drops too (closure_rows.h).
+    out.push_back(r.energy), out.push_back(r.work), out.push_back(std::max(r.residual, every_.residual(r.q)));
     const auto& closures = s_.plant->closures;
     for (std::size_t c = 0; c < closures.size(); ++c)
       for (const auto& row : closures[c].kept) out.push_back(r.forces[c][model_file::rowIndex(row)]);
@@ -112,6 +114,7 @@ class Hooks final : public StepHooks {
   controllers::Controller ctrl_;
   controllers::Reference ref_;
   std::unique_ptr<Mech> loads_mech_;  // the plant, for the passive joints' loads
+  model_file::EveryClosureRow every_;  // the plant's closures, every row
   std::vector<Spatial::Vec> loads_;
   VecN xi_, xid_;  // the target's ξ, ξ' at t_target_
   double t_target_ = 0;

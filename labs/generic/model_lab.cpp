@@ -56,7 +56,8 @@ class ReplaySimulation final : public Simulation {
     return true;
   }
   std::string failure() const override {
-    return next_ >= run_.trace.rows() && !run_.ok ? "the run stopped (the projection failed or the state became non-finite)" : "";
+    if (next_ < run_.trace.rows() || run_.ok) return "";
+    return run_.stopped.empty() ? "the run stopped (the projection failed or the state became non-finite)" : "the run stopped: " + run_.stopped;
   }
 
  private:

@@ -10,6 +10,7 @@
 #include "physics/constraints/plane_contact.h"
 #include "physics/constraints/rolling.h"
 #include "physics/model_file/actuators.h"
+#include "physics/model_file/closure_rows.h"
 #include "physics/model_file/hand_engine.h"
 
 namespace dyn::app {
@@ -31,6 +32,16 @@ void record(ModelRun& run, ConstrainedMechanism<Spatial>& mech, double t, const 
   run.residual = std::max(run.residual, phi);
   run.balance = std::max(run.balance, std::abs(e - run.e0 - work));
   run.kinetic = std::max(run.kinetic, mech.kineticEnergy(q, v));
+}
+
+// The hand engine holds the kept rows; a dropped row past kDroppedRowDrift is a loop opening: the run
+// stops there, saying which (true).
+bool stopIfOpened(ModelRun& run, model_file::EveryClosureRow& every, const VecN& q) {
+  std::string why = every.opened(q);
+  if (why.empty()) return false;
+  run.ok = false;
+  run.stopped = std::move(why);
+  return true;
 }
 
 }  // namespace
@@ -103,11 +114,13 @@ ModelRun runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>
   // The books (friction's work) integrated with the motion, at RK4's order (integrate.h).
   engine->setTime(0);
   engine->books() = Books{};
+  model_file::EveryClosureRow every(m);
   for (int k = 0; k <= steps; ++k) {
     const auto s = mech.solve(q, v, tau + model_file::actuatorTorques(m, q, v));
     const Books b = engine->books();
-    record(run, mech, k * dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()), mech.residual(q));
-    if (k == steps) break;
+    record(run, mech, k * dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()),
+           std::max(mech.residual(q), every.residual(q)));
+    if (stopIfOpened(run, every, q) || k == steps) break;
     if (!(run.ok = step(*engine, o, tau, q, v) && q.allFinite() && v.allFinite())) break;
   }
   return run;
@@ -132,6 +145,7 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
   ConstrainedMechanism<Spatial> engine(m.mechanism);
   engine.setTime(0);
   engine.books() = Books{};
+  model_file::EveryClosureRow every(m);
   VecN q = m.start_q, v = m.start_v;
   for (int k = 0; k <= steps; ++k) {
     // The file's actuators at the step's start, held over it (as a lab's controller's torques are).
@@ -161,8 +175,8 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
       const double P = stepped ? pc->normal().dot(Spatial::linear(engine.impactImpulse(int(closures + i)))) : 0.0;
       row.insert(row.end(), {r[1] + P / dt, 0.0, r[0]});
     }
-    record(run, desc, k * dt, q_row, v_row, b.work + b.friction - loss, row, elementResidual(m, desc, q_row, v_row));
-    if (k == steps || !run.ok) break;
+    record(run, desc, k * dt, q_row, v_row, b.work + b.friction - loss, row, std::max(elementResidual(m, desc, q_row, v_row), every.residual(q_row)));
+    if (stopIfOpened(run, every, q_row) || k == steps || !run.ok) break;
   }
   return run;
 }
@@ -183,6 +197,7 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
   auto inflow = [&](const VecN& p, const VecN& w) { return driven(p, w).dot(w) - frictionPower(m.mechanism, w); };
   double work = 0, power = inflow(q, v);
   std::vector<double> forces;
+  model_file::EveryClosureRow every(m);  // |φ| over every row (Bullet's drift is its own: reported, not stopped)
   for (int k = 0; k <= steps; ++k) {
     VecN qn = q, vn = v;
     if (k < steps) {
@@ -210,7 +225,7 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
         }
       }
     }
-    record(run, mech, k * dt, q, v, work, forces, m.contacts.empty() ? mech.residual(q) : elementResidual(m, mech, q, v));
+    record(run, mech, k * dt, q, v, work, forces, std::max(m.contacts.empty() ? mech.residual(q) : elementResidual(m, mech, q, v), every.residual(q)));
     if (k == steps) break;
     if (!(run.ok = qn.allFinite() && vn.allFinite())) break;
     const double p = inflow(qn, vn);

@@ -15,9 +15,10 @@ namespace dyn::app {
 // One engine's run: the trace and what the summary reports.
 struct ModelRun {
   Trace trace;
-  double e0 = 0, residual = 0, balance = 0, kinetic = 0;  // E0, max |φ|∞, max |E − E0 − W|, max kinetic energy
+  double e0 = 0, residual = 0, balance = 0, kinetic = 0;  // E0, max |φ|∞ (every closure row), max |E − E0 − W|, max kinetic energy
   bool ok = true;
   std::string summary;
+  std::string stopped;  // why the run stopped early, when it says (a loop closure that opened)
 };
 
 // The trace's columns: t, q_JOINT, v_JOINT, energy, work, constraint_residual, f_CLOSURE_ROW, then

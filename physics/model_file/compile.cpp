@@ -13,6 +13,7 @@
 #include <memory>
 
 #include "physics/model_file/fence.h"
+#include "physics/model_file/mjcf3.h"
 #include "physics/model_file/mujoco_call.h"
 
 namespace dyn::model_file::detail {
@@ -40,22 +41,28 @@ std::string mib(std::size_t bytes) { return std::to_string((bytes + (1u << 20) -
 
 // In the child: the text's sizes, MuJoCo's parse of the virtual files, the data it needs; the reply
 // is the warnings' length (4 bytes), the warnings, then the compiled model.
-std::string parse(const std::string& path, const std::string& bytes, const mjVFS* vfs, const std::vector<std::string>& missing) {
+std::string parse(const std::string& path, const std::string& bytes, mjVFS* vfs, const std::vector<std::string>& missing) {
   mju_user_malloc = allocate;
   mju_user_free = std::free;
   checkSizes(path, bytes, vfs);
   char error[1024] = "";
-  mjModel* m = nullptr;
   MujocoGuard guard;
-  MUJOCO_CALL(path, m = mj_loadXML(path.c_str(), vfs, error, sizeof error));
-  if (!m) {
+  Mjcf3 translation;
+  auto load = [&] {
+    mjModel* m = nullptr;
+    MUJOCO_CALL(path, m = mj_loadXML(path.c_str(), vfs, error, sizeof error));
+    if (m) return m;
     // A file the model names and dynlab did not find is the likely cause: named first, with where it was looked for.
     std::string why = path + ": ";
     for (std::size_t i = 0; i < missing.size() && i < 3; ++i) why += (i ? "; " : "file ") + missing[i];
     if (missing.size() > 3) why += "; and " + std::to_string(missing.size() - 3) + " more";
     if (!missing.empty()) why += "; then ";
-    throw ModelFileError(why + "MuJoCo's parser: " + oneLine(error[0] ? error : "no model"));
-  }
+    throw ModelFileError(why + "MuJoCo's parser: " + translation.ownLines(oneLine(error[0] ? error : "no model")));
+  };
+  // MuJoCo 3 syntax into 2.2.2's, in the virtual files (mjcf3.cpp), then the model MuJoCo compiles.
+  translateMjcf3(path, bytes, vfs, load, translation);
+  const std::string& notes = translation.notes;
+  mjModel* m = load();
   mjData* d = nullptr;
   MUJOCO_CALL(path, d = mj_makeData(m));
   if (!d) throw ModelFileError(path + ": MuJoCo could not make its data");
@@ -65,7 +72,8 @@ std::string parse(const std::string& path, const std::string& bytes, const mjVFS
     throw ModelFileError(path + ": MuJoCo's data for this model takes " + mib(data) + ", more than " + mib(kMaxDataBytes) +
                          " (<size> nstack, njmax, nconmax: leave them to MuJoCo)");
   const int size = mj_sizeModel(m);
-  const std::string warnings = oneLine(std::string(error) + " " + guard.warnings());
+  const std::string said = oneLine(std::string(error) + " " + guard.warnings());
+  const std::string warnings = notes.empty() ? said : said.empty() ? notes : notes + "; " + said;
   const auto n = std::uint32_t(warnings.size());
   std::string reply(reinterpret_cast<const char*>(&n), 4);
   reply += warnings;

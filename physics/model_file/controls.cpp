@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "physics/constrained_mechanism.h"
+#include "physics/model_file/closure_rows.h"
 #include "physics/model_file/mujoco_call.h"
 
 namespace dyn::model_file::detail {
@@ -115,6 +116,9 @@ void readStart(const std::string& path, const mjModel* m, const std::string& key
     if (const double gap = mech.residual(int(i), out.start_q); !(gap <= 1e-9))
       throw ModelFileError(where + ": its qpos opens closure '" + out.closures[i].name + "' (gap " + num(gap) +
                            "); a keyframe must hold the file's loops");
+  // Every row, the dropped ones too (closure_rows.h): a keyframe in another plane than the loop's.
+  if (const std::string why = EveryClosureRow(out).opened(out.start_q); !why.empty())
+    throw ModelFileError(where + ": its qpos opens a loop (" + why + "); a keyframe must hold the file's loops");
   if (out.contacts.empty())
     if (const double gap = mech.residual(out.start_q, out.start_v); !(gap <= 1e-9))
       throw ModelFileError(where + ": its qvel moves the loops apart (|G v| " + num(gap) + "); a keyframe's qvel must keep them closed");

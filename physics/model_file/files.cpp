@@ -212,6 +212,8 @@ std::vector<std::string> addReferencedFiles(const std::string& path, const std::
         return ext == ".xml" || ext == ".urdf";
       }();
       std::string data = readRegular(real.string(), xml ? kMaxFileBytes : kMaxAssetBytes, who, xml ? "an included model file" : "a mesh, texture or height field");
+      // (MuJoCo's file table takes no empty file: its error would stop the process.)
+      if (data.empty()) throw ModelFileError(who + ": empty (expected " + (xml ? "an included MJCF file" : "a mesh, texture or height field") + ")");
       total += data.size();
       if (total > kMaxAssetsBytes)
         throw ModelFileError(who + ": the files the model names pass " + std::to_string(kMaxAssetsBytes) + " bytes in all");

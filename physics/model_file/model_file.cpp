@@ -17,6 +17,7 @@
 
 #include "physics/constrained_mechanism.h"
 #include "physics/constraints/point_closure.h"
+#include "physics/model_file/closure_rows.h"
 #include "physics/model_file/mujoco_call.h"
 
 namespace dyn::model_file {
@@ -196,6 +197,7 @@ struct Tie {
   Vec3 pa, pb;
   bool weld;
   std::string where;
+  Vec3 p1 = Vec3::Zero(), p2 = Vec3::Zero();  // the anchors, world, at qpos0
 };
 
 // The ties read so far, each also a Closure for the report (out.closures, in the same order).
@@ -211,7 +213,7 @@ struct Ties {
     if (f1.link == f2.link)
       throw ModelFileError(where + " ties body '" + nameOf(m, mjOBJ_BODY, b1, "body") + "' to '" + nameOf(m, mjOBJ_BODY, b2, "body") +
                            "', which no joint separates (they move as one body)");
-    list.push_back({ref(f1.link), ref(f2.link), p1 - f1.origin, p2 - f2.origin, rotation, where});
+    list.push_back({ref(f1.link), ref(f2.link), p1 - f1.origin, p2 - f2.origin, rotation, where, p1, p2});
     Closure c;
     c.name = name;
     c.kind = weld ? "weld" : "connect";
@@ -290,42 +292,48 @@ int rank(const Eigen::MatrixXd& A) {
   return int(lu.rank());
 }
 
+// The model's extent L at qpos0: the diagonal of the box around its moving bodies' frames and its loop
+// anchors (closure_rows.h scales the rows' units by it; a point model counts as 1 m).
+double extentOf(const std::vector<Frame>& frame, const std::vector<Tie>& ties) {
+  Eigen::AlignedBox3d box;
+  for (const Frame& f : frame)
+    if (f.link >= 0) box.extend(f.origin);
+  for (const Tie& t : ties) box.extend(t.p1), box.extend(t.p2);
+  const double L = box.isEmpty() ? 0.0 : box.diagonal().norm();
+  return L > 1e-9 ? L : 1.0;
+}
+
 // Each loop closes at qpos0 (MuJoCo places connect's second anchor there; a weld's relpose was
-// checked); the description keeps each tie's rows that are not identically dependent on the rows
-// before them (a planar loop's out-of-plane rows), a closure left with none noted and dropped.
-void keepIndependentRows(const std::vector<Tie>& ties, int n, LoadedModel& out) {
+// checked); the description keeps the rows closure_rows.h chooses (a planar loop's out-of-plane rows
+// dropped, in whatever plane it lies), a closure left with none noted and not held twice. Every row
+// of every closure stays in out.every_closure_row for the runs' check.
+void keepIndependentRows(const std::string& path, const std::vector<Tie>& ties, double extent, LoadedModel& out) {
   MechanismModel<Spatial>& mech = out.mechanism;
   ConstrainedMechanism<Spatial> full(mech);
   for (std::size_t i = 0; i < ties.size(); ++i)
     if (const double gap = full.residual(int(i), out.q0); !(gap <= 1e-9))
       throw ModelFileError(ties[i].where + " does not hold at the reference pose (gap " + num(gap) +
                            "); write the file in its closed pose");
-  // J at seeded configurations around q0, side by side; a row is kept when it raises the rank.
-  constexpr int kSamples = 4;
-  const int rows = full.rows();
-  Eigen::MatrixXd stacked(rows, n * kSamples);
-  std::mt19937_64 rng(29);
-  std::uniform_real_distribution<double> u(-0.5, 0.5);
-  for (int s = 0; s < kSamples; ++s) {
-    VecN q = out.q0, phi;
-    for (int i = 0; i < n; ++i) q[i] += u(rng);
-    MatN G;
-    full.constraint(q, phi, G);
-    stacked.middleCols(s * n, n) = G;
+  RowCandidates rows;
+  rows.extent = extent;
+  for (const Joint& j : out.joints) rows.slide.push_back(j.type == "slide");
+  for (std::size_t i = 0; i < ties.size(); ++i) {
+    rows.names.push_back(out.closures[i].name);
+    const auto all = rowsOf(ties[i].weld);
+    for (int k = 0; k < 6; ++k)
+      if (all[std::size_t(k)]) rows.translation.push_back(k >= 3), rows.closure.push_back(int(i));
   }
-  Eigen::MatrixXd kept(0, stacked.cols());
+  const std::vector<bool> kept = chooseIndependentRows(full, out.q0, rows, path);
   std::vector<std::array<bool, 6>> masks(ties.size());
   for (std::size_t i = 0, r = 0; i < ties.size(); ++i) {
     const auto all = rowsOf(ties[i].weld);
     for (int k = 0; k < 6; ++k) {
       if (!all[std::size_t(k)]) continue;
-      Eigen::MatrixXd with(kept.rows() + 1, kept.cols());
-      with << kept, stacked.row(Eigen::Index(r++));
-      const bool independent = rank(with) > kept.rows();
+      const bool independent = kept[r++];
       masks[i][std::size_t(k)] = independent;
       (independent ? out.closures[i].kept : out.closures[i].dropped).push_back(kRowNames[k]);
-      if (independent) kept = with;
     }
+    out.every_closure_row.push_back({out.closures[i].name, mech.constraints[i], out.closures[i].dropped});
   }
   mech.constraints.clear();
   std::vector<Closure> closures;
@@ -405,7 +413,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   for (const Tie& t : ties.list) mech.constraints.push_back(std::make_shared<PointClosure<Spatial>>(t.a, t.pa, t.b, t.pb, rowsOf(t.weld)));
   if (const std::string why = mech.validate(); !why.empty()) throw ModelFileError(path + ": " + why);
   if (!ties.list.empty()) {
-    keepIndependentRows(ties.list, m->nv, out);
+    keepIndependentRows(path, ties.list, extentOf(frame, ties.list), out);
     reachLoopAnchors(out);
   }
   addElementsAndFreedom(path, m, d, frame, options, out);

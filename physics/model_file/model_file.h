@@ -142,6 +142,13 @@ struct Actuator {
   double ctrl_lower = 0, ctrl_upper = 0, force_lower = 0, force_upper = 0;
 };
 
+// A closure with every one of its rows, the dropped ones too (what a run measures: closure_rows.h).
+struct EveryRow {
+  std::string name;
+  ConstraintPtr<Spatial> rows;
+  std::vector<std::string> dropped;  // row names
+};
+
 namespace detail {
 struct Compiled;  // MuJoCo's compiled model (mujoco_call.h)
 }
@@ -156,6 +163,7 @@ struct LoadedModel {
   std::vector<Joint> joints;       // per coordinate
   std::vector<std::string> bodies;  // per MuJoCo body that moves (the world and fused bodies left out)
   std::vector<Closure> closures;   // per mechanism constraint, first
+  std::vector<EveryRow> every_closure_row;  // per closure of the file (one whose rows all repeat others' too)
   std::vector<Contact> contacts;   // per mechanism constraint after the closures (rolling, plane contacts)
   std::vector<std::string> notes;  // what is read but not enforced (limits, unused motors, ...)
   Drawing drawing;                  // what the renderer draws (beside the description, never in it)

@@ -170,8 +170,8 @@ std::string report(const ModelRun& r, const std::string& engine, const model_fil
     }
   }
   if (!r.ok)
-    o << "  the run stopped at t = " << fmt(double(r.trace.rows() - 1) * args.dt)
-      << " s: the projection failed or the state left the finite numbers\n";
+    o << "  the run stopped at t = " << fmt(double(r.trace.rows() - 1) * args.dt) << " s: "
+      << (r.stopped.empty() ? "the projection failed or the state left the finite numbers" : shownLine(r.stopped)) << "\n";
   return o.str();
 }
 

@@ -96,6 +96,10 @@ TEST_CASE("what a model file names: hostile files get one line naming the file, 
   CHECK(errorOf(write("model/big.xml", mjcf("<mesh name=\"m\" file=\"big.stl\"/>", "m"))).find("104857600 bytes, more than the 16777216") !=
         std::string::npos);
   fs::remove(big);
+  // An empty mesh: MuJoCo's file table takes no empty file (its error waited for Enter on stdin).
+  write("model/meshes/empty.stl", "");
+  CHECK(errorOf(write("model/empty.xml", mjcf("<mesh name=\"m\" file=\"empty.stl\"/>", "m"))).find("file 'empty.stl': empty (expected a mesh") !=
+        std::string::npos);
   write("model/latin1_part.xml", "<mujoco model=\"caf\xE9\"/>");
   CHECK(errorOf(write("model/latin1_main.xml", "<mujoco><include file=\"latin1_part.xml\"/></mujoco>")).find("not valid UTF-8") != std::string::npos);
   // Two files of one name: MuJoCo would read the first for both.
