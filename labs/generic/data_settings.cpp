@@ -116,6 +116,11 @@ model_file::LoadedModel loadModel(const JsonView& mf, const std::string& folder,
     mf.fail(std::string("a model file dynlab reads (") + e.what() + ")");
   }
   if (!file.mechanism.payloads.empty()) mf.fail("a model without free payload bodies");
+  // The controller drives the joints: a servo's law (its bias) would not act here.
+  for (const model_file::Actuator& a : file.actuators)
+    if (a.bias[0] != 0 || a.bias[1] != 0 || a.bias[2] != 0)
+      mf.fail("a model file whose actuators are motors (actuator '" + a.name + "' is a servo, force = gain ctrl + bias; a data lab's "
+              "controller drives the joints in /actuated with torques: leave the servo out, or run the file with `dynlab model`)");
   return file;
 }
 
@@ -143,9 +148,12 @@ void parseActuated(const JsonView& c, const model_file::LoadedModel& file, DataS
   std::vector<std::string> joint_names;
   for (const auto& j : file.joints) joint_names.push_back(j.name);
   for (std::size_t i = 0, n = act.size(0, file.joints.size()); i < n; ++i) {
-    const std::string jn = act.at(i).string();
+    std::string jn = act.at(i).string();
+    // A file's motor names its joint.
+    for (const model_file::Actuator& a : file.actuators)
+      if (a.name == jn && std::find(joint_names.begin(), joint_names.end(), jn) == joint_names.end()) jn = a.joint;
     const auto it = std::find(joint_names.begin(), joint_names.end(), jn);
-    if (it == joint_names.end()) act.at(i).fail("expected a joint of the model file (" + list(joint_names) + ")");
+    if (it == joint_names.end()) act.at(i).fail("expected a joint or motor of the model file (" + list(joint_names) + ")");
     const int index = int(it - joint_names.begin());
     if (std::find(s.actuated.begin(), s.actuated.end(), index) != s.actuated.end()) act.at(i).fail("expected each joint once");
     s.actuated.push_back(index), s.actuated_names.push_back(jn);

@@ -10,6 +10,7 @@
 #include "labs/model_scene.h"
 #include "physics/bullet/bullet_mechanism.h"
 #include "labs/trace.h"
+#include "physics/model_file/actuators.h"
 #include "physics/model_file/model_file.h"
 
 namespace dyn::app {
@@ -39,7 +40,7 @@ class ReplaySimulation final : public Simulation {
       const VecN q = traceQ(run_.trace, r, n);
       VecN v(n);
       for (int i = 0; i < n; ++i) v[i] = run_.trace.at(r, 1 + n + i);
-      desc.jointLoads(q, v, desc.solve(q, v, tau), loads);
+      desc.jointLoads(q, v, desc.solve(q, v, tau + model_file::actuatorTorques(m, q, v)), loads);
       std::vector<double> extra;
       for (int j = 0; j < n; ++j)
         for (int a = 3; a < 6; ++a) extra.push_back(loads[std::size_t(j)][a]);
@@ -153,6 +154,7 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, 
   model_file::LoadOptions options;
   options.ignore_contacts = flags.ignore_contacts;
   options.package_paths = flags.package_paths;
+  options.key = flags.key;
   auto m = std::make_shared<model_file::LoadedModel>();
   try {
     if (const std::string beside = loopsBeside(file); !beside.empty()) readBeside(beside, options);

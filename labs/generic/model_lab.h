@@ -15,10 +15,11 @@
 namespace dyn::app {
 
 // What the command line adds to a model file's load (dynlab model, run, figure, bench: --ignore-contacts,
-// --package-path DIR).
+// --package-path DIR, --key NAME).
 struct ModelFileFlags {
-  bool ignore_contacts = false;            // geoms that may collide: loaded, contacts ignored (noted)
+  bool ignore_contacts = false;            // geoms that may collide: not noted (they load either way)
   std::vector<std::string> package_paths;  // folders holding package://NAME/… packages
+  std::string key;                         // a keyframe of the file to start from (its qpos, qvel, ctrl)
 };
 
 // True when LAB names a model file (ends in .xml or .urdf, any case): no lab's name does.

@@ -10,6 +10,7 @@
 #include "physics/constraints/joint_limit.h"
 #include "physics/constraints/plane_contact.h"
 #include "physics/constraints/rolling.h"
+#include "physics/model_file/actuators.h"
 #include "physics/model_file/closure_rows.h"
 #include "physics/model_file/hand_engine.h"
 
@@ -115,15 +116,16 @@ ModelRun runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>
   run.trace = modelColumns(m);
   StepOptions o;
   o.dt = dt;
-  const int steps = int(std::lround(duration / dt)), n = mech.n();
-  VecN q = m.q0, v = VecN::Zero(n);
-  const std::unique_ptr<ConstrainedSystem> engine = model_file::handEngine(m.mechanism, &run.summary);
+  const int steps = int(std::lround(duration / dt));
+  VecN q = m.start_q, v = m.start_v;
+  // The file's actuators evaluated at each stage of the step (actuators.h).
+  const std::unique_ptr<ConstrainedSystem> engine = model_file::withActuators(model_file::handEngine(m.mechanism, &run.summary), m);
   // The books (friction's work) integrated with the motion, at RK4's order (integrate.h).
   engine->setTime(0);
   engine->books() = Books{};
   model_file::EveryClosureRow every(m);
   for (int k = 0; k <= steps; ++k) {
-    const auto s = mech.solve(q, v, tau);
+    const auto s = mech.solve(q, v, tau + model_file::actuatorTorques(m, q, v));
     const Books b = engine->books();
     record(run, mech, k * dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()),
            std::max(mech.residual(q), every.residual(q)));
@@ -144,7 +146,7 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
   run.summary = "dynamic sizes; contacts closed and opened between steps, touchdowns located";
   StepOptions o;
   o.dt = dt;
-  const int steps = int(std::lround(duration / dt)), n = desc.n();
+  const int steps = int(std::lround(duration / dt));
   const std::size_t closures = m.closures.size();
   int closure_rows = 0;
   for (const auto& c : m.closures) closure_rows += int(c.kept.size());
@@ -153,10 +155,12 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
   engine.setTime(0);
   engine.books() = Books{};
   model_file::EveryClosureRow every(m);
-  VecN q = m.q0, v = VecN::Zero(n);
+  VecN q = m.start_q, v = m.start_v;
   for (int k = 0; k <= steps; ++k) {
-    engine.updateContacts(q, v, tau);
-    const auto s = engine.solve(q, v, tau);
+    // The file's actuators at the step's start, held over it (as a lab's controller's torques are).
+    const VecN driven = tau + model_file::actuatorTorques(m, q, v);
+    engine.updateContacts(q, v, driven);
+    const auto s = engine.solve(q, v, driven);
     std::vector<double> row(s.eta.data(), s.eta.data() + closure_rows);
     const double loss = engine.impactLoss();
     if (impacts) row.push_back(loss);
@@ -166,7 +170,7 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
     const VecN q_row = q, v_row = v;
     bool stepped = false;
     if (k < steps) {
-      stepped = engine.stepLocatingContacts(o, tau, q, v) && q.allFinite() && v.allFinite();
+      stepped = engine.stepLocatingContacts(o, driven, q, v) && q.allFinite() && v.allFinite();
       run.ok = stepped;
     }
     for (std::size_t i = 0; i < m.contacts.size(); ++i) {
@@ -201,20 +205,22 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
 ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, double dt, double duration, const VecN& tau) {
   ModelRun run;
   run.trace = modelColumns(m);
-  const int steps = int(std::lround(duration / dt)), n = mech.n();
-  VecN q = m.q0, v = VecN::Zero(n);
+  const int steps = int(std::lround(duration / dt));
+  VecN q = m.start_q, v = m.start_v;
   bullet::BulletMechanism<Spatial> bt(m.mechanism, dt, q, v);
   run.summary = bt.describe();
   const bool impacts = anyImpacts(m);
+  // The torques: τ and the file's actuators at the state (held over Bullet's step from its start).
+  auto driven = [&](const VecN& p, const VecN& w) { return VecN(tau + model_file::actuatorTorques(m, p, w)); };
   // The power flowing in: the torques' τ·v less what damping and friction take.
-  auto inflow = [&](const VecN& w) { return tau.dot(w) - frictionPower(m.mechanism, w); };
-  double work = 0, power = inflow(v);
+  auto inflow = [&](const VecN& p, const VecN& w) { return driven(p, w).dot(w) - frictionPower(m.mechanism, w); };
+  double work = 0, power = inflow(q, v);
   std::vector<double> forces;
   model_file::EveryClosureRow every(m);  // |φ| over every row (Bullet's drift is its own: reported, not stopped)
   for (int k = 0; k <= steps; ++k) {
     VecN qn = q, vn = v;
     if (k < steps) {
-      bt.step(tau);
+      bt.step(driven(q, v));
       bt.state(qn, vn);
       forces.clear();
       for (std::size_t c = 0; c < m.closures.size(); ++c)
@@ -245,7 +251,7 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
     record(run, mech, k * dt, q, v, work, forces, std::max(m.contacts.empty() ? mech.residual(q) : elementResidual(m, mech, q, v), every.residual(q)));
     if (k == steps) break;
     if (!(run.ok = qn.allFinite() && vn.allFinite())) break;
-    const double p = inflow(vn);
+    const double p = inflow(qn, vn);
     work += 0.5 * (power + p) * dt;
     power = p;
     q = qn, v = vn;

@@ -61,41 +61,10 @@ void checkSupported(const std::string& file, const mjModel* m, const LoadOptions
   for (int b = 1; b < m->nbody; ++b)
     if (m->body_mocapid[b] >= 0) fail("body '" + nameOf(m, mjOBJ_BODY, b, "body") + "' is a mocap body; dynlab reads bodies moved by their joints only");
   detail::checkTendons(file, m);
-  for (int i = 0; i < m->nu; ++i) {
-    const std::string a = "actuator '" + nameOf(m, mjOBJ_ACTUATOR, i, "actuator") + "'";
-    if (m->actuator_dyntype[i] != mjDYN_NONE || m->actuator_gaintype[i] != mjGAIN_FIXED || m->actuator_biastype[i] != mjBIAS_NONE)
-      fail(a + " has activation dynamics, a variable gain or a bias (a servo): dynlab runs model files passive and reads plain motors only");
-    notes.push_back(a + ": a motor, read but not driven (passive run)");
-  }
   if (m->opt.density != 0 || m->opt.viscosity != 0 || m->opt.wind[0] != 0 || m->opt.wind[1] != 0 || m->opt.wind[2] != 0)
     fail("<option> density/viscosity/wind: dynlab has no fluid forces (leave them 0)");
-  const int flags = m->opt.disableflags;
-  if (flags & (mjDSBL_CONTACT | mjDSBL_CONSTRAINT) || opt.ignore_contacts) {
-    if (opt.ignore_contacts) notes.push_back("contacts between geoms ignored (--ignore-contacts)");
-    return;
-  }
-  if (m->npair > 0) fail("<contact><pair> '" + nameOf(m, mjOBJ_PAIR, 0, "pair") + "': dynlab has no contacts between geoms");
-  // Geoms that could touch (MuJoCo's filter: different rigid bodies, not parent and child unless one
-  // is the world, contype/conaffinity compatible, not excluded).
-  const std::unordered_set<int> exclusions(m->exclude_signature, m->exclude_signature + m->nexclude);
-  auto excluded = [&](int b1, int b2) {
-    return exclusions.count(((b1 + 1) << 16) + b2 + 1) > 0 || exclusions.count(((b2 + 1) << 16) + b1 + 1) > 0;
-  };
-  const bool filterparent = !(flags & mjDSBL_FILTERPARENT);
-  for (int g1 = 0; g1 < m->ngeom; ++g1)
-    for (int g2 = g1 + 1; g2 < m->ngeom; ++g2) {
-      const int b1 = m->geom_bodyid[g1], b2 = m->geom_bodyid[g2];
-      const int w1 = m->body_weldid[b1], w2 = m->body_weldid[b2];
-      if (w1 == w2) continue;
-      const int p1 = m->body_weldid[m->body_parentid[w1]], p2 = m->body_weldid[m->body_parentid[w2]];
-      if (filterparent && w1 != 0 && w2 != 0 && (w1 == p2 || w2 == p1)) continue;
-      if (!(m->geom_contype[g1] & m->geom_conaffinity[g2]) && !(m->geom_contype[g2] & m->geom_conaffinity[g1])) continue;
-      if (excluded(b1, b2)) continue;
-      fail("geoms '" + nameOf(m, mjOBJ_GEOM, g1, "geom") + "' (body '" + nameOf(m, mjOBJ_BODY, b1, "body") + "') and '" +
-           nameOf(m, mjOBJ_GEOM, g2, "geom") + "' (body '" + nameOf(m, mjOBJ_BODY, b2, "body") +
-           "') may collide; dynlab has no contacts between geoms: set contype=\"0\" conaffinity=\"0\", exclude the pair, "
-           "add <option><flag contact=\"disable\"/></option>, or pass --ignore-contacts");
-    }
+  // Geoms that may collide: noted, not refused (contacts.cpp).
+  if (!opt.ignore_contacts) detail::noteContacts(m, notes);
 }
 
 // Every number the description reads, finite and within ±kLargest: a mass of 1e308 or an infinite
@@ -420,6 +389,8 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   const mjModel* m = out.compiled->m;
   if (!warnings.empty() && warnings != " ") out.notes.push_back("MuJoCo: " + warnings);
   checkSupported(path, m, options, out.notes);
+  // dynlab has no geom-geom contact: MuJoCo's copies (cross-check, bench) run without it too.
+  out.compiled->m->opt.disableflags |= mjDSBL_CONTACT;
   // The reference pose: MuJoCo's kinematics at qpos0 (anchors, axes, centres of mass, principal axes).
   detail::MujocoGuard guard;
   DataPtr data;
@@ -447,6 +418,9 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   }
   detail::addJointElements(path, m, options, out);
   addElementsAndFreedom(path, m, d, frame, options, out);
+  // The file's actuators and the run's start: q0 at rest, or the keyframe asked for (actuators.cpp).
+  detail::readActuators(path, m, out);
+  detail::readStart(path, m, options.key, out);
   return out;
 }
 

@@ -137,6 +137,20 @@ struct Joint {
   double lower = 0, upper = 0;
 };
 
+// An actuator as the file writes it (MuJoCo's <motor>, <position>, <velocity>, <general> on a hinge or
+// slide joint, without activation dynamics), read from the compiled model: MuJoCo's affine law
+//   u = ctrl clamped to [ctrl_lower, ctrl_upper] when ctrl_limited,  l = gear q,  l' = gear q'
+//   force = gain u + bias[0] + bias[1] l + bias[2] l'  clamped to [force_lower, force_upper] when force_limited
+// and the torque on its joint's coordinate gear · force (actuators.h applies it).
+struct Actuator {
+  std::string name, joint;
+  int coordinate = 0;
+  double gear = 1, gain = 0;
+  std::array<double, 3> bias{0, 0, 0};
+  bool ctrl_limited = false, force_limited = false;
+  double ctrl_lower = 0, ctrl_upper = 0, force_lower = 0, force_upper = 0;
+};
+
 // A closure with every one of its rows, the dropped ones too (what a run measures: closure_rows.h).
 struct EveryRow {
   std::string name;
@@ -163,6 +177,12 @@ struct LoadedModel {
   std::vector<std::string> notes;  // what is read but not enforced (limits, unused motors, ...)
   Drawing drawing;                  // what the renderer draws (beside the description, never in it)
   double timestep = 0;             // the file's <option timestep>
+  std::vector<Actuator> actuators;  // the file's, driven by ctrl (actuators.h)
+  std::vector<std::string> keyframes;  // the file's keyframes' names (LoadOptions::key picks one)
+  // Where a run starts and the controls it holds: q0 at rest with every control 0, or the keyframe
+  // chosen (its qpos, qvel and ctrl; key names it).
+  VecN start_q, start_v, ctrl;
+  std::string key;
   int dof = 0;                     // coordinates minus independent closure and rolling rows at q0 (contacts,
                                    // unilateral, not counted)
 };
@@ -201,7 +221,10 @@ struct GivenContact {
 };
 
 struct LoadOptions {
-  bool ignore_contacts = false;  // load a file whose geoms may collide, ignoring contacts (noted)
+  // Geoms that may collide load all the same (dynlab has no geom-geom contact; MuJoCo's copies run
+  // with contact disabled); false: that is noted once, true: not noted (--ignore-contacts).
+  bool ignore_contacts = false;
+  std::string key;  // a keyframe's name: runs start from it (LoadedModel::start_q, start_v, ctrl); "": q0 at rest
   // Folders holding the packages package://NAME/… names (DIR/NAME, or DIR itself named NAME), searched
   // before the folders above the file and ROS_PACKAGE_PATH's (--package-path)
   std::vector<std::string> package_paths;
@@ -227,6 +250,8 @@ class MujocoReference {
   int nv() const;
   MatN massMatrix(const VecN& q);
   VecN bias(const VecN& q, const VecN& v);
+  // MuJoCo's actuator forces on the coordinates (qfrc_actuator) at (q, v) with controls ctrl.
+  VecN actuation(const VecN& q, const VecN& v, const VecN& ctrl);
 
  private:
   struct Impl;
@@ -235,10 +260,12 @@ class MujocoReference {
 
 // MuJoCo's own simulation of the same compiled model (mj_step), for the bench: its constraint solver and soft
 // equalities as the file sets them, at a given step and with the semi-implicit Euler integrator
-// (MuJoCo's default, first order), from a state in the same coordinates as LoadedModel.
+// (MuJoCo's default, first order) or RK4 (rk4: for tests at the hand engine's order), from a state in
+// the same coordinates as LoadedModel, its controls held at the model's ctrl; contacts between geoms
+// off (dynlab has none).
 class MujocoSimulation {
  public:
-  MujocoSimulation(const LoadedModel& model, double dt);
+  MujocoSimulation(const LoadedModel& model, double dt, bool rk4 = false);
   ~MujocoSimulation();
   MujocoSimulation(const MujocoSimulation&) = delete;
   MujocoSimulation& operator=(const MujocoSimulation&) = delete;

@@ -136,16 +136,27 @@ VecN MujocoReference::bias(const VecN& q, const VecN& v) {
   return out;
 }
 
-// The bench's simulation: the model at the given step with the Euler integrator.
+VecN MujocoReference::actuation(const VecN& q, const VecN& v, const VecN& ctrl) {
+  Impl& x = *impl_;
+  std::copy(ctrl.data(), ctrl.data() + std::min<Eigen::Index>(ctrl.size(), x.m->nu), x.d->ctrl);
+  x.at(q, &v);
+  MUJOCO_CALL(x.file, mj_fwdActuation(x.m, x.d));
+  return Eigen::Map<const VecN>(x.d->qfrc_actuator, x.m->nv);
+}
+
+// The bench's simulation: the model at the given step with the Euler (or RK4) integrator, its controls
+// the model's.
 struct MujocoSimulation::Impl : OwnedModel {
-  Impl(const LoadedModel& model, double dt)
-      : OwnedModel(model, [dt](mjModel* m) {
+  Impl(const LoadedModel& model, double dt, bool rk4)
+      : OwnedModel(model, [dt, rk4](mjModel* m) {
           m->opt.timestep = dt;
-          m->opt.integrator = mjINT_EULER;
-        }) {}
+          m->opt.integrator = rk4 ? mjINT_RK4 : mjINT_EULER;
+        }),
+        ctrl(model.ctrl) {}
+  VecN ctrl;
 };
 
-MujocoSimulation::MujocoSimulation(const LoadedModel& model, double dt) : impl_(new Impl(model, dt)) {}
+MujocoSimulation::MujocoSimulation(const LoadedModel& model, double dt, bool rk4) : impl_(new Impl(model, dt, rk4)) {}
 
 MujocoSimulation::~MujocoSimulation() { delete impl_; }
 
@@ -154,6 +165,7 @@ void MujocoSimulation::reset(const VecN& q, const VecN& v) {
   MUJOCO_CALL(impl_->file, mj_resetData(impl_->m, d));
   std::copy(q.data(), q.data() + impl_->m->nq, d->qpos);
   std::copy(v.data(), v.data() + impl_->m->nv, d->qvel);
+  std::copy(impl_->ctrl.data(), impl_->ctrl.data() + std::min<Eigen::Index>(impl_->ctrl.size(), impl_->m->nu), d->ctrl);
 }
 
 bool MujocoSimulation::step() {
@@ -170,7 +182,8 @@ void MujocoSimulation::state(VecN& q, VecN& v) const {
 std::string MujocoSimulation::describe() const {
   static const char* const kSolver[3] = {"PGS", "CG", "Newton"};
   const int solver = impl_->m->opt.solver;
-  return std::string("MuJoCo ") + mj_versionString() + " mj_step, Euler, soft equalities, " +
+  const bool rk4 = impl_->m->opt.integrator == mjINT_RK4;
+  return std::string("MuJoCo ") + mj_versionString() + " mj_step, " + (rk4 ? "RK4" : "Euler") + ", soft equalities, " +
          (solver >= 0 && solver < 3 ? kSolver[solver] : "?") + " solver (" + std::to_string(impl_->m->opt.iterations) + " iterations)";
 }
 

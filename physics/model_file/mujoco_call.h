@@ -104,6 +104,15 @@ void checkTendons(const std::string& path, const mjModel* m);
 // closures, and into out.contacts (joint_elements.cpp).
 void addJointElements(const std::string& path, const mjModel* m, const LoadOptions& options, LoadedModel& out);
 
+// Geoms that may collide in MuJoCo, as one note (contacts.cpp); nothing when the file disables contact.
+void noteContacts(const mjModel* m, std::vector<std::string>& notes);
+
+// The file's actuators into out.actuators (refused in one line unless they fit Actuator's law), then
+// the run's start into out.start_q, start_v and ctrl: the keyframe named `key` (checked against the
+// loops) or q0 at rest (controls.cpp).
+void readActuators(const std::string& path, const mjModel* m, LoadedModel& out);
+void readStart(const std::string& path, const mjModel* m, const std::string& key, LoadedModel& out);
+
 }  // namespace dyn::model_file::detail
 
 // Runs the statement; a MuJoCo error inside it throws ModelFileError("<file>: MuJoCo: <message>").

@@ -21,8 +21,9 @@ MujocoReference::~MujocoReference() = default;
 int MujocoReference::nv() const { return 0; }
 MatN MujocoReference::massMatrix(const VecN&) { refuse("MujocoReference"); }
 VecN MujocoReference::bias(const VecN&, const VecN&) { refuse("MujocoReference"); }
+VecN MujocoReference::actuation(const VecN&, const VecN&, const VecN&) { refuse("MujocoReference"); }
 
-MujocoSimulation::MujocoSimulation(const LoadedModel& model, double) : impl_(nullptr) { refuse(model.file); }
+MujocoSimulation::MujocoSimulation(const LoadedModel& model, double, bool) : impl_(nullptr) { refuse(model.file); }
 MujocoSimulation::~MujocoSimulation() = default;
 void MujocoSimulation::reset(const VecN&, const VecN&) { refuse("MujocoSimulation"); }
 bool MujocoSimulation::step() { refuse("MujocoSimulation"); }

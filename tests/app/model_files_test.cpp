@@ -1,8 +1,8 @@
 // Model files as users have them, through the real binary on every command that takes one (model, run,
 // figure, bench; issue 40): a URDF in robot/urdf/ whose meshes are package://robot/meshes/… loads; a
 // package found only through --package-path is a one-line refusal naming where dynlab looked until
-// the option names it; --ignore-contacts, which the contact refusal advises, is taken by each command
-// (and refused in one line for a lab); a file's <option timestep> is the step the run takes, `run
+// the option names it; a file whose geoms collide loads on each command without a flag (noted once;
+// --ignore-contacts silences the note, and is refused in one line for a lab); a file's <option timestep> is the step the run takes, `run
 // --dt` another, checked. Never exit 3. The files are written here, at run time.
 #include <doctest/doctest.h>
 
@@ -86,24 +86,64 @@ TEST_CASE("a package found only through --package-path: one line naming where dy
   CHECK(ros.code == 0);
 }
 
-TEST_CASE("--ignore-contacts, which the contact refusal advises, is taken by model, run, figure and bench; a lab refuses it in one line") {
+TEST_CASE("a file whose geoms collide loads on model, run, figure and bench without a flag, noted once; --ignore-contacts silences it") {
   TempDir dir("model_files_contacts");
   writeFile(dir / "floor.xml", pendulum("timestep=\"0.001\"", "<geom name=\"floor\" type=\"plane\" size=\"1 1 0.1\" pos=\"0 0 0.5\"/>"));
-  const Result refused = dynlab(dir, {"model", "floor.xml", "--out", (dir / "o").string()});
-  CHECK(refused.code == 2);
-  CHECK(refused.err.find("or pass --ignore-contacts") != std::string::npos);
-  std::vector<std::vector<std::string>> all = commands(dir, "floor.xml", {"--ignore-contacts"});
+  std::vector<std::vector<std::string>> all = commands(dir, "floor.xml", {});
   all[2][5] = "q_swing";  // figure's --plot
   for (const auto& args : all) {
     const Result r = dynlab(dir, args);
     INFO(shown(args), "\n", r.err);
     CHECK(r.code == 0);
+    CHECK(r.err.find("--ignore-contacts") == std::string::npos);  // no advice of an option
   }
+  const std::string summary = readFile(dir / "o_model/summary.txt");
+  const std::string note = "2 geoms collide in MuJoCo but not here (e.g. 'floor' and 'geom #1'): dynlab has no geom–geom contact";
+  CHECK(summary.find(note) != std::string::npos);
+  CHECK(summary.find(note, summary.find(note) + 1) == std::string::npos);  // once
+  const Result quiet = dynlab(dir, {"model", "floor.xml", "--duration", "0.05", "--ignore-contacts", "--out", (dir / "q").string()});
+  CHECK(quiet.code == 0);
+  CHECK(readFile(dir / "q/summary.txt").find("collide in MuJoCo") == std::string::npos);
   for (const std::string command : {"run", "figure", "bench"}) {
     const Result r = dynlab(dir, {command, "slider_crank", "--ignore-contacts", "--out", (dir / "lab").string()});
     INFO(command, "\n", r.err);
     checkRefused(r, {"--ignore-contacts", "slider_crank"});
   }
+}
+
+TEST_CASE("a file's servos drive model, run, figure and bench; --key NAME starts each from its keyframe, an unknown name is one line") {
+  TempDir dir("model_files_key");
+  writeFile(dir / "arm.xml", readFile(fs::path(DYNLAB_SOURCE_DIR) / "tests/physics/model_file/files/servo_arm.xml"));
+  std::vector<std::vector<std::string>> all = commands(dir, "arm.xml", {"--key", "reach"});
+  all[2][5] = "q_shoulder";  // figure's --plot
+  for (const auto& args : all) {
+    const Result r = dynlab(dir, args);
+    INFO(shown(args), "\n", r.err);
+    CHECK(r.code == 0);
+  }
+  // The run starts at the keyframe's qpos and holds its controls (the shoulder's 0.9 clamped to 0.5 where it acts).
+  const Csv trace = readCsv(dir / "o_model/trace.csv");
+  REQUIRE(!trace.rows.empty());
+  CHECK(trace.rows[0][1] == 0.2);
+  CHECK(trace.rows[0][2] == -0.4);
+  const std::string summary = readFile(dir / "o_model/summary.txt");
+  CHECK(summary.find("run with 4 actuators (shoulder_servo, shoulder_motor, elbow_servo, wrist_drive) at ctrl (0.9, 0.2, -1, 0.03)") !=
+        std::string::npos);
+  CHECK(summary.find("from keyframe reach") != std::string::npos);
+  CHECK(summary.find("actuator shoulder_servo on joint shoulder: force = 40 ctrl − 40 length, gear 1, ctrl in [-0.5, 0.5]") != std::string::npos);
+  CHECK(summary.find("max |Δτ_actuators| ") != std::string::npos);
+  // From q0 at rest the servos hold their controls at 0: the arm still moves (gravity), from q0.
+  REQUIRE(dynlab(dir, {"model", "arm.xml", "--duration", "0.05", "--out", (dir / "rest").string()}).code == 0);
+  CHECK(readCsv(dir / "rest/trace.csv").rows[0][1] == 0);
+  for (auto args : commands(dir, "arm.xml", {"--key", "home"})) {
+    if (args[0] == "figure") args[5] = "q_shoulder";
+    const Result r = dynlab(dir, args);
+    INFO(shown(args), "\n", r.err);
+    CHECK(r.code == 2);
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    CHECK(r.err.find("--key 'home': no such keyframe; the file's keyframes: 'reach'") != std::string::npos);
+  }
+  checkRefused(dynlab(dir, {"run", "slider_crank", "--key", "reach", "--out", (dir / "lab").string()}), {"--key", "slider_crank"});
 }
 
 TEST_CASE("a model file runs at its own <option timestep>; run --dt sets another, checked") {

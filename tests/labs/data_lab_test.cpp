@@ -18,6 +18,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <vector>
 
 #include "labs/controllers/controller.h"
@@ -237,6 +238,17 @@ TEST_CASE("a data lab's JSON: each bad field is one line naming its path") {
   const auto s = generic::parseDataSettings(JsonView(fivebarConfig(), "fivebar.json"), "fivebar", dir.string());
   CHECK(s.columns.front() == "t");
   CHECK(std::find(s.columns.begin(), s.columns.end(), "f_pin_C_z") != s.columns.end());
+  // The file's actuators: a motor names its joint in /actuated; a servo, whose law the lab would not apply, is refused.
+  std::ifstream in(dir / "fivebar.xml");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t end = text.rfind("</mujoco>");
+  REQUIRE(end != std::string::npos);
+  std::ofstream(dir / "motor.xml") << text.substr(0, end) + "<actuator><motor name=\"left_motor\" joint=\"left_crank\"/></actuator></mujoco>";
+  std::ofstream(dir / "servo.xml") << text.substr(0, end) + "<actuator><position name=\"lift\" joint=\"left_crank\" kp=\"10\"/></actuator></mujoco>";
+  const json motor = mergePatch(fivebarConfig(), json::parse(R"({"model_file": "motor.xml", "actuated": ["left_motor", "right_crank"]})"));
+  CHECK(generic::parseDataSettings(JsonView(motor, "fivebar.json"), "fivebar", dir.string()).actuated_names[0] == "left_crank");
+  checkRefused(fivebarConfig(), {{R"({"model_file": "servo.xml"})", "/model_file", "actuator 'lift' is a servo"}}, "fivebar.json", "fivebar",
+               dir.string());
   fs::remove_all(dir);
 }
 

@@ -28,6 +28,7 @@
 #include "labs/utf8.h"
 #include "physics/bullet/bullet_mechanism.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/model_file/actuators.h"
 #include "physics/model_file/hand_engine.h"
 #include "physics/model_file/closure_rows.h"
 #include "physics/model_file/model_file.h"
@@ -64,38 +65,40 @@ struct Engines {
 // located (labs/mechanism_simulation.h's step); restarted as a new mechanism (its contacts open).
 Engine handWithElements(const model_file::LoadedModel& m, const char* scheme, std::unique_ptr<ConstrainedMechanism<Spatial>>* mech,
                         VecN* q, VecN* v, StepOptions o) {
-  const int n = int(m.q0.size());
   Engine x;
   x.name = "hand";
   x.scheme = std::string(scheme) + " (dynamic sizes; contacts closed and opened between steps, touchdowns located)";
-  x.step = [=, tau = VecN(VecN::Zero(n))] {
+  x.step = [=, &m] {
+    // The file's actuators at the step's start, held over it (labs/generic/model_run.cpp's runHandElements).
+    const VecN tau = model_file::actuatorTorques(m, *q, *v);
     (*mech)->updateContacts(*q, *v, tau);
     return (*mech)->stepLocatingContacts(o, tau, *q, *v) && q->allFinite() && v->allFinite();
   };
-  x.restart = [=, &m] { *mech = std::make_unique<ConstrainedMechanism<Spatial>>(m.mechanism), *q = m.q0, *v = VecN::Zero(n); };
+  x.restart = [=, &m] { *mech = std::make_unique<ConstrainedMechanism<Spatial>>(m.mechanism), *q = m.start_q, *v = m.start_v; };
   x.state = [=](VecN& qo, VecN& vo) { qo = *q, vo = *v; };
   return x;
 }
 
 void build(const model_file::LoadedModel& m, double dt, bool beside, Engines& e) {
   const int n = int(m.q0.size());
-  const VecN zero = VecN::Zero(n);
+  const VecN q0 = m.start_q, v0 = m.start_v;
   StepOptions euler;
   euler.dt = dt;
   euler.integrator = Integrator::SemiImplicitEuler;
   euler.drift.kind = Drift::Baumgarte;
   StepOptions rk4;
   rk4.dt = dt;
-  e.euler_mech = model_file::handEngine(m.mechanism, &e.sizes);
-  e.rk4_mech = model_file::handEngine(m.mechanism);
-  e.q_euler = e.q_rk4 = m.q0, e.v_euler = e.v_rk4 = zero;
+  // The file's actuators evaluated at each stage (actuators.h); the engines themselves without any.
+  e.euler_mech = model_file::withActuators(model_file::handEngine(m.mechanism, &e.sizes), m);
+  e.rk4_mech = model_file::withActuators(model_file::handEngine(m.mechanism), m);
+  e.q_euler = e.q_rk4 = q0, e.v_euler = e.v_rk4 = v0;
   auto hand = [&, n](const char* scheme, ConstrainedSystem* mech, VecN* q, VecN* v, StepOptions o) {
     Engine x;
     x.name = "hand";
     x.scheme = std::string(scheme) + " (" + e.sizes + ")";
     // The zero torque made once: a step allocates nothing (as a lab's engine step).
     x.step = [=, tau = VecN(VecN::Zero(n))] { return step(*mech, o, tau, *q, *v) && q->allFinite() && v->allFinite(); };
-    x.restart = [=, q0 = m.q0] { *q = q0, *v = VecN::Zero(n), mech->setTime(0); };
+    x.restart = [=] { *q = q0, *v = v0, mech->setTime(0); };
     x.state = [=](VecN& qo, VecN& vo) { qo = *q, vo = *v; };
     return x;
   };
@@ -106,27 +109,34 @@ void build(const model_file::LoadedModel& m, double dt, bool beside, Engines& e)
     e.list.push_back(handWithElements(m, "semi-implicit Euler + Baumgarte", &e.euler_el, &e.q_euler, &e.v_euler, euler));
     e.list.push_back(handWithElements(m, "RK4 + projection", &e.rk4_el, &e.q_rk4, &e.v_rk4, rk4));
   }
-  e.bullet = std::make_unique<bullet::BulletMechanism<Spatial>>(m.mechanism, dt, m.q0, zero);
+  e.bullet = std::make_unique<bullet::BulletMechanism<Spatial>>(m.mechanism, dt, q0, v0);
   Engine b;
   b.name = "Bullet";
   b.scheme = e.bullet->describe() + ", semi-implicit Euler";
   auto* bt = &e.bullet;
-  b.step = [bt, tau = VecN(VecN::Zero(n))] {
-    (*bt)->step(tau);
+  // Bullet: the zero torque made once (a step allocates nothing); with actuators, theirs at the step's start.
+  b.step = [bt, &m, tau = VecN(VecN::Zero(n))] {
+    if (m.actuators.empty()) {
+      (*bt)->step(tau);
+      return true;
+    }
+    VecN q, v;
+    (*bt)->state(q, v);
+    (*bt)->step(model_file::actuatorTorques(m, q, v));
     return true;
   };
-  b.restart = [bt, &m, dt, zero] { *bt = std::make_unique<bullet::BulletMechanism<Spatial>>(m.mechanism, dt, m.q0, zero); };
+  b.restart = [bt, &m, dt, q0, v0] { *bt = std::make_unique<bullet::BulletMechanism<Spatial>>(m.mechanism, dt, q0, v0); };
   b.state = [bt](VecN& q, VecN& v) { (*bt)->state(q, v); };
   e.list.push_back(b);
   if (beside) return;  // MuJoCo's run of the file would not hold what is beside it
   e.mujoco = std::make_unique<model_file::MujocoSimulation>(m, dt);
   model_file::MujocoSimulation* mj = e.mujoco.get();
-  mj->reset(m.q0, zero);
+  mj->reset(q0, v0);
   Engine u;
   u.name = "MuJoCo";
   u.scheme = mj->describe();
   u.step = [mj] { return mj->step(); };
-  u.restart = [mj, &m, zero] { mj->reset(m.q0, zero); };
+  u.restart = [mj, q0, v0] { mj->reset(q0, v0); };
   u.state = [mj](VecN& q, VecN& v) { mj->state(q, v); };
   e.list.push_back(u);
 }
@@ -187,6 +197,7 @@ int benchModel(const BenchArgs& a) {
     model_file::LoadOptions options;
     options.ignore_contacts = a.model_files.ignore_contacts;
     options.package_paths = a.model_files.package_paths;
+    options.key = a.model_files.key;
     m = loadWithLoops(a.lab, "", options);
   } catch (const model_file::ModelFileError& e) {
     std::fprintf(stderr, "error: %s\n", termName(e.what(), 1000).c_str());
@@ -234,8 +245,11 @@ int benchModel(const BenchArgs& a) {
     return 0;
   }
   const std::string elements = beside.empty() ? "" : ", " + std::to_string(m.contacts.size()) + " wheels or contacts (" + beside + ")";
-  std::printf("%s: %d coordinates, %d closure rows%s, dt %g s (the file's), passive from its pose at rest\n", termName(m.file).c_str(),
-              int(m.q0.size()), rows, termText(elements).c_str(), dt);
+  const std::string controls = model_file::describeControls(m);
+  const std::string start = (controls.empty() ? "passive" : "with " + controls) + " from " + (m.key.empty() ? "its pose at rest" : "keyframe " + m.key);
+  std::printf("%s: %d coordinates, %d closure rows%s, dt %g s (the file's), %s\n", termName(m.file).c_str(), int(m.q0.size()), rows,
+              termText(elements).c_str(), dt, termName(start, 1000).c_str());
+  for (const std::string& note : m.notes) std::printf("  note: %s\n", termName(note, 1000).c_str());
   if (!beside.empty()) std::printf("  %s\n", termName(mujoco_left_out, 1000).c_str());
   std::printf("  %d steps per engine timed in blocks of %d, in turn; ratios block by block: median (middle half)\n", int(euler.all.size()), kBlock);
   std::printf("  engine             µs/step   over hand, 1st order   max |φ|∞     max |q − q_ref|∞ over 2 s (ref: hand RK4)\n");

@@ -30,6 +30,7 @@
 #include "physics/constraints/joint_limit.h"
 #include "physics/constraints/plane_contact.h"
 #include "physics/constraints/rolling.h"
+#include "physics/model_file/actuators.h"
 #include "physics/model_file/hand_engine.h"
 #include "physics/model_file/model_file.h"
 
@@ -100,6 +101,16 @@ std::string describe(const model_file::LoadedModel& m) {
         << ", frictionless in the hand engine" << (p.params().mu > 0 ? ", mu " + fmt(p.params().mu) + " in Bullet's" : "") << "\n";
     }
   }
+  for (const auto& a : m.actuators) {
+    o << "  actuator " << nameShown(a.name) << " on joint " << nameShown(a.joint) << ": force = " << fmt(a.gain) << " ctrl";
+    const char* const terms[3] = {"", " length", " velocity"};
+    for (int k = 0; k < 3; ++k)
+      if (a.bias[std::size_t(k)] != 0) o << (a.bias[std::size_t(k)] < 0 ? " − " : " + ") << fmt(std::abs(a.bias[std::size_t(k)])) << terms[k];
+    o << ", gear " << fmt(a.gear);
+    if (a.ctrl_limited) o << ", ctrl in [" << fmt(a.ctrl_lower) << ", " << fmt(a.ctrl_upper) << "]";
+    if (a.force_limited) o << ", force in [" << fmt(a.force_lower) << ", " << fmt(a.force_upper) << "]";
+    o << "\n";
+  }
   for (const auto& n : m.notes) o << "  note: " << shownLine(n) << "\n";
   for (const auto& n : m.drawing.notes) o << "  drawing: " << shownLine(n) << "\n";
   return o.str();
@@ -111,21 +122,28 @@ std::string crossCheck(const model_file::LoadedModel& m, ConstrainedMechanism<Sp
   std::mt19937_64 rng(29);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   const int n = mech.n();
-  double dM = 0, dh = 0;
+  double dM = 0, dh = 0, da = 0;
   for (int s = 0; s < 5; ++s) {
     VecN q = m.q0, v = VecN::Zero(n);
     for (int i = 0; s > 0 && i < n; ++i) q[i] += u(rng), v[i] = 2.0 * u(rng);
     dM = std::max(dM, (mech.massMatrix(q) - mj.massMatrix(q)).cwiseAbs().maxCoeff());
     dh = std::max(dh, (mech.inverseDynamics(q, v, VecN::Zero(n)) - mj.bias(q, v)).cwiseAbs().maxCoeff());
+    // The actuators' torques at controls spread past their ranges (the clamps included).
+    VecN ctrl = m.ctrl;
+    for (Eigen::Index i = 0; s > 0 && i < ctrl.size(); ++i) ctrl[i] = 2.0 * u(rng) * (1.0 + std::abs(m.actuators[std::size_t(i)].ctrl_upper));
+    if (!m.actuators.empty()) da = std::max(da, (model_file::actuatorTorques(m.actuators, ctrl, q, v) - mj.actuation(q, v, ctrl)).cwiseAbs().maxCoeff());
   }
-  return "  against MuJoCo (mj_fullM, qfrc_bias; q0 and 4 seeded states): max |ΔM| " + fmt(dM) + ", max |Δh| " + fmt(dh) + "\n";
+  return "  against MuJoCo (mj_fullM, qfrc_bias" + std::string(m.actuators.empty() ? "" : ", qfrc_actuator") + "; q0 and 4 seeded states): max |ΔM| " +
+         fmt(dM) + ", max |Δh| " + fmt(dh) + (m.actuators.empty() ? "" : ", max |Δτ_actuators| " + fmt(da)) + "\n";
 }
 
 std::string report(const ModelRun& r, const std::string& engine, const model_file::LoadedModel& m, const ModelArgs& args) {
   std::ostringstream o;
-  const bool driven = !args.torques.empty();
-  o << (driven ? "run with constant torques (" + shownLine(join(args.torques, ", ")) + "), " : std::string("passive run, ")) << engine << ", dt "
-    << fmt(args.dt) << " s, " << fmt(args.duration) << " s from q0 at rest\n"
+  const bool driven = !args.torques.empty() || !m.actuators.empty();
+  std::string how = args.torques.empty() ? "" : "constant torques (" + shownLine(join(args.torques, ", ")) + ")";
+  if (!m.actuators.empty()) how += (how.empty() ? "" : " and ") + shownLine(model_file::describeControls(m));
+  o << (how.empty() ? std::string("passive run, ") : "run with " + how + ", ") << engine << ", dt " << fmt(args.dt) << " s, " << fmt(args.duration)
+    << " s " << (m.key.empty() ? std::string("from q0 at rest") : "from keyframe " + nameShown(m.key)) << "\n"
     << "  " << (m.contacts.empty() ? "closure residual" : "constraint residual (closures, couplings, no-slip rows, contact and joint-stop depth)") << " max |φ|∞ "
     << fmt(r.residual) << "\n"
     << "  energy E0 " << fmt(r.e0) << " J, max |E − E0 − " << (driven || anyImpacts(m) ? "W" : "W_friction") << "| " << fmt(r.balance)
@@ -203,7 +221,10 @@ ModelCommand::ModelCommand(CLI::App& cli) {
 }
 
 void addModelFileOptions(CLI::App* command, ModelFileFlags& flags) {
-  command->add_flag("--ignore-contacts", flags.ignore_contacts, "A model file: load it though its geoms may collide, ignoring contacts (noted)");
+  command->add_flag("--ignore-contacts", flags.ignore_contacts, "A model file: leave out the note that its geoms collide in MuJoCo but not "
+                                                                "here (they load either way: dynlab has no geom-geom contact)");
+  command->add_option("--key", flags.key, "A model file: start from its keyframe NAME (qpos, qvel and the actuators' ctrl; default: qpos0 "
+                                          "at rest, controls 0)");
   command->add_option("--package-path", flags.package_paths, "A model file: a folder holding the packages its package://NAME/… paths name "
                                                             "(DIR/NAME, or DIR itself), repeatable; searched before the folders above "
                                                             "the file and ROS_PACKAGE_PATH")
@@ -211,9 +232,9 @@ void addModelFileOptions(CLI::App* command, ModelFileFlags& flags) {
 }
 
 int refuseModelFileFlags(const std::string& lab, const ModelFileFlags& flags) {
-  if (!flags.ignore_contacts && flags.package_paths.empty()) return 0;
+  if (!flags.ignore_contacts && flags.package_paths.empty() && flags.key.empty()) return 0;
   std::fprintf(stderr, "error: <command line>: %s: for a model file (.xml, .urdf); %s is a lab\n",
-               flags.ignore_contacts ? "--ignore-contacts" : "--package-path", nameShown(lab).c_str());
+               flags.ignore_contacts ? "--ignore-contacts" : !flags.key.empty() ? "--key" : "--package-path", nameShown(lab).c_str());
   return 2;
 }
 
@@ -261,6 +282,7 @@ int model(const ModelArgs& asked) {
     model_file::LoadOptions options;
     options.ignore_contacts = args.files.ignore_contacts;
     options.package_paths = args.files.package_paths;
+    options.key = args.files.key;
     m = loadWithLoops(args.file, args.loops, options);
   } catch (const model_file::ModelFileError& e) {
     std::fprintf(stderr, "error: %s\n", shownLine(e.what()).c_str());
@@ -292,6 +314,7 @@ int model(const ModelArgs& asked) {
   }
   ConstrainedMechanism<Spatial> mech(m.mechanism);
   std::string text = describe(m) + crossCheck(m, mech);
+  if (const std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), args.dt); !stiff.empty()) text += "  note: " + shownLine(stiff) + "\n";
   const bool hand = args.engine != "bullet", bullet = args.engine != "hand";
   ModelRun h, b;
   if (hand) h = m.contacts.empty() ? runHand(m, mech, args.dt, args.duration, tau) : runHandElements(m, mech, args.dt, args.duration, tau);

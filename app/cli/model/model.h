@@ -29,16 +29,16 @@ struct ModelArgs {
   std::string loops;  // closures beside the file (labs/generic/model_loops.h); "": STEM.loops.json when it exists
   double duration = 2.0;  // s
   double dt = 0;          // s; 0: the file's <option timestep>
-  ModelFileFlags files;   // --ignore-contacts, --package-path
+  ModelFileFlags files;   // --ignore-contacts, --package-path, --key
   bool video = false, frames = false;  // 30 frames per second of simulated time, 640×480
   std::vector<std::string> torques;    // "JOINT=VALUE": constant torques (N·m; N on a slide); none: passive
 };
 
-// --ignore-contacts and --package-path DIR (repeatable) on a command that reads model files (model, run,
+// --ignore-contacts, --key NAME and --package-path DIR (repeatable) on a command that reads model files (model, run,
 // figure, bench), into flags.
 void addModelFileOptions(CLI::App* command, ModelFileFlags& flags);
 
-// 0, or 2 after one line on stderr when model-file options (`--ignore-contacts`, `--package-path`) are
+// 0, or 2 after one line on stderr when model-file options (`--ignore-contacts`, `--key`, `--package-path`) are
 // given for a lab, not a model file.
 int refuseModelFileFlags(const std::string& lab, const ModelFileFlags& flags);
 
