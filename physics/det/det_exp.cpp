@@ -52,6 +52,13 @@ double splitLog(double x, int& k) {
   return fromBits(std::uint64_t(hx) << 32 | (ix & 0xffffffff));
 }
 
+// 2/(2n+1), the atanh series' coefficients (folded at compile time).
+constexpr std::array<double, 13> kAtanhSeries = [] {
+  std::array<double, 13> c{};
+  for (std::size_t n = 0; n < c.size(); ++n) c[n] = 2.0 / double(2 * n + 1);
+  return c;
+}();
+
 // ln m for √½ ≤ m < √2 in double-double: 2 atanh(s), s = (m−1)/(m+1), |s| ≤ 0.172; the series to
 // s^25 (the rest < 2^-66 of the sum), 2s and (2/3)s³ carried in double-double.
 DD logMantissa(double m) {
@@ -61,8 +68,8 @@ DD logMantissa(double m) {
   const DD p = twoProd(sh, d.hi);
   const DD s = fastTwoSum(sh, (((f - p.hi) - p.lo) - sh * d.lo) / d.hi);
   const DD z = ddMul(s, s);
-  double u = 2.0 / 25;
-  for (int n = 11; n >= 2; --n) u = 2.0 / (2 * n + 1) + z.hi * u;  // 2/5 + z (2/7 + z (… 2/25))
+  double u = kAtanhSeries[12];
+  for (std::size_t n = 11; n >= 2; --n) u = kAtanhSeries[n] + z.hi * u;  // 2/5 + z (2/7 + z (… 2/25))
   const DD t = fastTwoSum(0.6666666666666666, z.hi * u + 3.700743415417188e-17);  // 2/3 + z u
   return ddAdd({2.0 * s.hi, 2.0 * s.lo}, ddMul(ddMul(s, z), t));
 }
