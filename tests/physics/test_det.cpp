@@ -57,10 +57,10 @@ TEST_CASE("det's functions are within their documented ulps of long double") {
   CHECK(worst([](double x) { return det::log2(x); }, [](L x) { return log2l(x); }, -700, 700, true) < 0.51);
   CHECK(worst([](double x) { return det::log10(x); }, [](L x) { return log10l(x); }, -700, 700, true) < 0.51);
   CHECK(worst([](double x) { return det::tanh(x); }, [](L x) { return tanhl(x); }, -3, 3) < 3.0);
-  CHECK(worst([](double x) { return det::atan2(x, 0.7); }, [](L x) { return atan2l(x, 0.7L); }, -10, 10) < 1.5);
-  CHECK(worst([](double x) { return det::hypot(x, 3.1); }, [](L x) { return sqrtl(x * x + 3.1L * 3.1L); }, -10, 10) < 0.51);
-  CHECK(worst([](double x) { return det::pow(1.7, x); }, [](L x) { return powl(1.7L, x); }, -100, 100) < 1.5);
-  CHECK(worst([](double x) { return det::pow(x, -2.3); }, [](L x) { return powl(x, -2.3L); }, 0.01, 100) < 1.5);
+  CHECK(worst([](double x) { return det::atan2(x, 0.7); }, [](L x) { return atan2l(x, (long double)0.7); }, -10, 10) < 1.5);
+  CHECK(worst([](double x) { return det::hypot(x, 3.1); }, [](L x) { return sqrtl(x * x + (long double)3.1 * (long double)3.1); }, -10, 10) < 0.51);
+  CHECK(worst([](double x) { return det::pow(1.7, x); }, [](L x) { return powl((long double)1.7, x); }, -100, 100) < 1.5);
+  CHECK(worst([](double x) { return det::pow(x, -2.3); }, [](L x) { return powl(x, (long double)-2.3); }, 0.01, 100) < 1.5);
 }
 
 TEST_CASE("det's special values are C99's, and exact cases stay exact") {
