@@ -13,6 +13,8 @@
 #include <cstdio>
 #include <stdexcept>
 
+#include "physics/det/det.h"
+
 namespace dyn::plot_detail {
 namespace {
 
@@ -95,7 +97,7 @@ void appendThinned(const std::vector<double>& x, const std::vector<double>& y, s
 // A "nice" tick step (1, 2 or 5 × 10^k) giving about `target` intervals over the span (the
 // thresholds are the geometric midpoints between 1, 2, 5 and 10).
 double niceStep(double span, double target) {
-  const double raw = span / target, mag = std::pow(10.0, std::floor(std::log10(raw))), r = raw / mag;
+  const double raw = span / target, mag = det::pow(10.0, std::floor(det::log10(raw))), r = raw / mag;
   return (r < 1.414 ? 1.0 : r < 3.162 ? 2.0 : r < 7.071 ? 5.0 : 10.0) * mag;
 }
 
@@ -112,7 +114,7 @@ struct TickFormat {
     } else if (max_abs >= 1e6 || step < 1e-4) {
       std::snprintf(buf, sizeof buf, "%.3g", v);
     } else {
-      const int decimals = std::max(0, -static_cast<int>(std::floor(std::log10(step) + 1e-9)));
+      const int decimals = std::max(0, -static_cast<int>(std::floor(det::log10(step) + 1e-9)));
       std::snprintf(buf, sizeof buf, "%.*f", decimals, v);
     }
     return buf;
@@ -181,7 +183,7 @@ bool wantsLog(const PlotSpec& spec) {
   std::nth_element(pos.begin(), pos.begin() + lo, pos.end());
   const double p5 = pos[lo];
   std::nth_element(pos.begin(), pos.begin() + hi, pos.end());
-  return std::log10(pos[hi] / p5) > kLogDecades;
+  return det::log10(pos[hi] / p5) > kLogDecades;
 }
 
 // y → log10 y (values ≤ 0 become gaps; a band's lower edge at or below 0 goes to the smallest
@@ -191,7 +193,7 @@ void toLog(PlotSpec& spec) {
   for (const auto& s : spec.series)
     for (double v : s.y)
       if (std::isfinite(v) && v > 0) smallest = std::min(smallest, v);
-  const auto lg = [](double v) { return std::isfinite(v) && v > 0 ? std::log10(v) : NAN; };
+  const auto lg = [](double v) { return std::isfinite(v) && v > 0 ? det::log10(v) : NAN; };
   for (auto& s : spec.series)
     for (double& v : s.y) v = lg(v);
   for (auto& b : spec.bands)

@@ -7,6 +7,7 @@
 
 #include "grading/grade.h"
 #include "labs/numbers.h"
+#include "physics/det/det.h"
 
 namespace dyn {
 
@@ -46,7 +47,7 @@ ScreenResult screenLoops(const Lab& lab) {
     }
     LoopAnalysis a = analyseLoop(loop);
     double size = 0;
-    for (const auto& p : a.poles) size = std::max(size, std::abs(p));
+    for (const auto& p : a.poles) size = std::max(size, det::abs(p));
     const bool marginal = std::abs(a.max_real) <= kMarginal * size;  // the slowest pole on the axis
     if (marginal) a.stable = false;
     // A loop that is not stable has no damping to award (real poles in the right half plane

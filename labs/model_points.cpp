@@ -7,6 +7,7 @@
 
 #include "labs/model_scene.h"
 #include "labs/run_bounds.h"
+#include "physics/det/det.h"
 
 namespace dyn {
 namespace {
@@ -61,7 +62,7 @@ void ball(const Vec3& c, double r, Points& out) {
 void rim(const Vec3& c, const Vec3& x, const Vec3& y, double r, Points& out) {
   for (int k = 0; k < 16; ++k) {
     const double a = 2 * std::numbers::pi * k / 16;
-    out.push_back(c + r / std::cos(std::numbers::pi / 16) * (std::cos(a) * x + std::sin(a) * y));
+    out.push_back(c + r / det::cos(std::numbers::pi / 16) * (det::cos(a) * x + det::sin(a) * y));
   }
 }
 

@@ -7,6 +7,7 @@
 #include <numbers>
 
 #include "labs/run_bounds.h"
+#include "physics/det/det.h"
 
 namespace dyn {
 namespace {
@@ -28,7 +29,7 @@ Color colorOf(const model_file::Geom& g) {
 
 // A round step near x: 1, 2 or 5 × 10^k.
 double niceStep(double x) {
-  const double p = std::pow(10.0, std::floor(std::log10(std::max(x, 1e-9))));
+  const double p = det::pow(10.0, std::floor(det::log10(std::max(x, 1e-9))));
   const double f = x / p;
   return (f < 1.5 ? 1 : f < 3.5 ? 2 : f < 7.5 ? 5 : 10) * p;
 }
@@ -256,8 +257,8 @@ void ModelPicture::stage(Scene& s) const {
     if (!s.framing.points.empty())
       for (const double z : {0.0, -height})
         for (int k = 0; k < 16; ++k) {  // the column's ends, as rings of 16 round its circle
-          const double a = 2 * std::numbers::pi * k / 16, r = radius / std::cos(std::numbers::pi / 16);
-          s.framing.points.push_back(top + z * up_ + r * (std::cos(a) * R.col(0) + std::sin(a) * R.col(1)));
+          const double a = 2 * std::numbers::pi * k / 16, r = radius / det::cos(std::numbers::pi / 16);
+          s.framing.points.push_back(top + z * up_ + r * (det::cos(a) * R.col(0) + det::sin(a) * R.col(1)));
         }
   }
 }
@@ -293,7 +294,7 @@ void modelOverlay(const std::string& title, const std::string& engines, const Tr
   Series e{"E − E0 − W (mJ)", {}, {0.23f, 0.42f, 0.68f, 1.0f}}, phi{"log₁₀ |φ|", {}, {0.90f, 0.45f, 0.10f, 1.0f}};
   for (std::size_t r = liveWindowStart(row, 2.0, dt); r <= row; ++r) {
     e.values.push_back(float(1e3 * balance(r)));
-    phi.values.push_back(float(std::log10(std::max(tr.at(r, "constraint_residual"), 1e-17))));
+    phi.values.push_back(float(det::log10(std::max(tr.at(r, "constraint_residual"), 1e-17))));
   }
   o.plots = {e, phi};
 }

@@ -13,6 +13,7 @@
 #include <utility>
 #include <vector>
 
+#include "physics/det/det.h"
 #include "physics/triangle_mesh.h"
 
 namespace dyn {
@@ -232,7 +233,7 @@ inline Eigen::Matrix3d axisSpin(const Eigen::Vector3d& axis, double spin) {
   if (ref.norm() < 0.02) ref = Eigen::Vector3d::UnitX() - z.x() * z;
   const Eigen::Vector3d x0 = ref.normalized(), y0 = z.cross(x0);
   Eigen::Matrix3d r;
-  r.col(0) = std::cos(spin) * x0 + std::sin(spin) * y0;
+  r.col(0) = det::cos(spin) * x0 + det::sin(spin) * y0;
   r.col(1) = z.cross(r.col(0));
   r.col(2) = z;
   return r;
@@ -292,7 +293,7 @@ inline void Camera::lookAtBox(const Eigen::Vector3d& lo, const Eigen::Vector3d& 
   }
   // Perspective: the distance at which every corner is inside both half-angles (tan_x, tan_y),
   // then the target slides so the corners' picture is centred; a few rounds settle it.
-  const double tan_y = std::tan(fov_y_deg * std::numbers::pi / 360.0) / margin, tan_x = tan_y * aspect;
+  const double tan_y = det::tan(fov_y_deg * std::numbers::pi / 360.0) / margin, tan_x = tan_y * aspect;
   auto fitDistance = [&] {
     double d = 0;
     for (const auto& c : corners) {

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "physics/det/det.h"
+
 namespace dyn {
 
 template <class S>
@@ -51,7 +53,7 @@ void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
       // A revolute joint about a coordinate axis: X_world = X_J ∘ (X_tree ∘ X_world,parent) turns two
       // rows, and its world axis is a row of E (spatial.h turnAbout, coordinateAxisInWorld).
       if (b.joint == JointType::Revolute && b.coordinate_axis >= 0) {
-        const double c = std::cos(q[i]), s = std::sin(q[i]);
+        const double c = det::cos(q[i]), s = det::sin(q[i]);
         const int k = b.coordinate_axis;
         if constexpr (kParentFrames) S::turnAbout(k, c, s, b.X_tree, nullptr, data.X_up[i]);
         S::turnAbout(k, c, s, b.X_tree, b.parent < 0 ? nullptr : &data.X_world[b.parent], data.X_world[i]);

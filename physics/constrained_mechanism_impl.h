@@ -12,6 +12,7 @@
 #include "physics/chain_world.h"
 #include "physics/constrained_mechanism.h"
 #include "physics/constrained_mechanism_contacts.h"
+#include "physics/det/det.h"
 
 namespace dyn {
 
@@ -73,7 +74,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
   kin_.theta_rate = VecN::Zero(n());
   // Planar: the fixed part of each link's angle, its placement's rotation (X_tree.E = rotation(angle)).
   if constexpr (S::kDim == 3)
-    for (const auto& b : model_.tree.bodies) tree_angle_.push_back(std::atan2(b.X_tree.E(0, 1), b.X_tree.E(0, 0)));
+    for (const auto& b : model_.tree.bodies) tree_angle_.push_back(det::atan2(b.X_tree.E(0, 1), b.X_tree.E(0, 0)));
   // The payloads' M_c = diag(I, m, m) on their free coordinates, and G_c = −m g: constant.
   const int kk = k();
   problem_.Mc = MatN::Zero(kk, kk);
@@ -124,7 +125,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
     const Payload& p = model_.payloads[i];
     for (std::size_t c = 0; c < 3; ++c) kin_.payload_pose[i][Eigen::Index(c)] = p.free[c] ? q[Eigen::Index(off++)] : p.pose0[Eigen::Index(c)];
     const double psi = kin_.payload_pose[i][0];
-    kin_.payload_cs[i] = p.free[0] || psi != 0.0 ? Eigen::Vector2d(std::cos(psi), std::sin(psi)) : Eigen::Vector2d(1.0, 0.0);
+    kin_.payload_cs[i] = p.free[0] || psi != 0.0 ? Eigen::Vector2d(det::cos(psi), det::sin(psi)) : Eigen::Vector2d(1.0, 0.0);
   }
   // Every constraint's φ, J and A rows, then eq. (2) factored at this configuration.
   setZeroAt<Nr, Nj>(J_full_, rows_, nn);

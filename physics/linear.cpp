@@ -7,13 +7,15 @@
 #include <functional>
 #include <stdexcept>
 
+#include "physics/det/det.h"
+
 namespace dyn {
 namespace {
 
 // e^M by scaling and squaring a Taylor series (‖M / 2^s‖ ≤ ½: twenty terms are exact to rounding).
 Eigen::MatrixXd expm(const Eigen::MatrixXd& M) {
   const double norm = M.cwiseAbs().rowwise().sum().maxCoeff();
-  const int s = norm > 0.5 ? int(std::ceil(std::log2(norm / 0.5))) : 0;
+  const int s = norm > 0.5 ? int(std::ceil(det::log2(norm / 0.5))) : 0;
   const Eigen::MatrixXd X = M / std::ldexp(1.0, s);
   Eigen::MatrixXd E = Eigen::MatrixXd::Identity(M.rows(), M.cols()), term = E;
   for (int k = 1; k <= 20; ++k) {
@@ -38,11 +40,11 @@ struct Crossing {
 // Every crossover of |L(ω)| = 1 on a log grid over [w_lo, w_hi], refined by bisection.
 std::vector<Crossing> crossings(const std::function<std::complex<double>(double)>& L, double w_lo, double w_hi) {
   std::vector<Crossing> out;
-  auto g = [&](double w) { return std::abs(L(w)) - 1.0; };
+  auto g = [&](double w) { return det::abs(L(w)) - 1.0; };
   const int grid = 900;
   double prev_w = w_lo, prev_g = g(w_lo);
   for (int i = 1; i <= grid; ++i) {
-    const double w = w_lo * std::pow(w_hi / w_lo, double(i) / grid), gw = g(w);
+    const double w = w_lo * det::pow(w_hi / w_lo, double(i) / grid), gw = g(w);
     if ((prev_g > 0) != (gw > 0)) {
       double lo = prev_w, hi = w;
       for (int it = 0; it < 60; ++it) {
@@ -50,7 +52,7 @@ std::vector<Crossing> crossings(const std::function<std::complex<double>(double)
         ((g(mid) > 0) == (prev_g > 0) ? lo : hi) = mid;
       }
       const double wc = std::sqrt(lo * hi);
-      double pm = M_PI + std::arg(L(wc));
+      double pm = M_PI + det::arg(L(wc));
       if (pm > M_PI) pm -= 2 * M_PI;
       out.push_back({wc, pm});
     }
@@ -76,7 +78,7 @@ void summarise(LoopAnalysis& a) {
   a.min_damping = 1;
   for (const auto& p : a.poles) {
     a.max_real = std::max(a.max_real, p.real());
-    if (std::abs(p.imag()) > 1e-9 && std::abs(p) > 0) a.min_damping = std::min(a.min_damping, -p.real() / std::abs(p));
+    if (std::abs(p.imag()) > 1e-9 && det::abs(p) > 0) a.min_damping = std::min(a.min_damping, -p.real() / det::abs(p));
   }
   a.stable = a.max_real < 0;
 }
@@ -94,7 +96,7 @@ void analyseSampled(const LinearLoop& loop, LoopAnalysis& a) {
   den.insert(den.begin(), std::size_t(N), 0.0);  // × z^N
   a.poles.clear();
   for (const auto& z : polyRoots(polyAdd(den, num)))
-    if (std::abs(z) > 1e-300) a.poles.push_back(std::log(z) / T);  // z = 0: a mode gone in one step
+    if (det::abs(z) > 1e-300) a.poles.push_back(det::log(z) / T);  // z = 0: a mode gone in one step
   std::sort(a.poles.begin(), a.poles.end(), [](auto x, auto y) { return x.real() != y.real() ? x.real() > y.real() : x.imag() > y.imag(); });
   summarise(a);
   // The margin from the loop without its N whole steps (their phase is ωNT exactly): crossovers on the
@@ -102,13 +104,13 @@ void analyseSampled(const LinearLoop& loop, LoopAnalysis& a) {
   // T/2, an Euler integrator's) is already in L's phase: margin = that + PM/ω_c, above the stated
   // delay exactly when NT < PM/ω_c, i.e. when the loop is stable.
   const auto L = [&](double w) {
-    const std::complex<double> z = std::polar(1.0, w * T);
+    const std::complex<double> z = det::polar(1.0, w * T);
     return polyEval(num, z) / polyEval(den_free, z);
   };
   const std::vector<Crossing> cs = crossings(L, 1e-3, M_PI / T * (1 - 1e-9));
   const double base = loop.delay - N * T;
   if (a.stable) {
-    const double extra = cs.empty() ? (std::abs(L(M_PI / T)) < 1.0 ? kUnboundedDelay : 0.0) : extraDelay(cs);
+    const double extra = cs.empty() ? (det::abs(L(M_PI / T)) < 1.0 ? kUnboundedDelay : 0.0) : extraDelay(cs);
     a.delay_margin = std::min(kUnboundedDelay, base + extra);
   } else {
     // Past its margin (or unstable without the delay: no margin at all); never above the stated delay.
@@ -167,7 +169,7 @@ Poly padeDenominator(double T, int n) {
   Poly p(std::size_t(n) + 1);
   double c = 1.0;
   for (int k = 0; k <= n; ++k) {
-    p[std::size_t(k)] = c * std::pow(T, k);
+    p[std::size_t(k)] = c * det::pow(T, k);
     c *= double(n - k) / (double(2 * n - k) * double(k + 1));
   }
   return p;
@@ -241,7 +243,7 @@ LoopAnalysis analyseLoop(const LinearLoop& loop, int order) {
     }
   }
   // No crossover: a loop gain below 1 everywhere tolerates any delay; above 1 at high frequency, none.
-  if (cs.empty()) best = std::abs(L(w_hi)) < 1.0 ? kUnboundedDelay : 0.0;
+  if (cs.empty()) best = det::abs(L(w_hi)) < 1.0 ? kUnboundedDelay : 0.0;
   // A loop that is unstable without any delay has no delay margin at all.
   for (const auto& p : polyRoots(polyAdd(loop.den, loop.num)))
     if (p.real() >= 0) best = 0.0;

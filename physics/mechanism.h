@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "physics/chain.h"
+#include "physics/det/det.h"
 
 namespace dyn {
 
@@ -54,7 +55,7 @@ struct JointProperties {
   double friction(double rate) const {
     if (coulomb == 0) return viscous * rate;
     const double x = rate / (coulomb_width > 0 ? coulomb_width : 1e-12);
-    return viscous * rate + coulomb * (std::abs(x) < 20.0 ? std::tanh(x) : std::copysign(1.0, x));
+    return viscous * rate + coulomb * (std::abs(x) < 20.0 ? det::tanh(x) : std::copysign(1.0, x));
   }
 };
 

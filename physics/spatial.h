@@ -9,6 +9,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "physics/det/det.h"
+
 // The spatial operations the tree algorithms call in their inner loops: inlined always, so their
 // 6-vectors stay in registers (a call returns them through memory, stored 8 bytes at a time and
 // reloaded 16 at a time: a store-forwarding stall that was a third of CRBA).
@@ -34,7 +36,7 @@ struct Planar {
   // both the shortest code and faster than SIMD packets, whose 16-byte loads of values just stored
   // 8 bytes at a time stall the CPU (store-to-load forwarding fails).
   static Rot rotation(double angle) {  // rotates A-coords into B-coords for B turned by angle
-    const double c = std::cos(angle), s = std::sin(angle);
+    const double c = det::cos(angle), s = det::sin(angle);
     return (Rot() << c, s, -s, c).finished();
   }
   static double crossScalar(const Pos& a, const Pos& b) { return a.x() * b.y() - a.y() * b.x(); }
@@ -361,7 +363,7 @@ struct Spatial {
   // Revolute: E = R(a, q)ᵀ = c 1 + (1 − c) a aᵀ − s [a]× (Rodrigues, transposed); prismatic: r = a q.
   DYN_INLINE static Transform jointTransform(bool revolute, const Axis& a, double q) {
     if (!revolute) return {Rot::Identity(), a * q, false};
-    const double c = std::cos(q), s = std::sin(q), t = 1.0 - c;
+    const double c = det::cos(q), s = det::sin(q), t = 1.0 - c;
     const double x = a[0], y = a[1], z = a[2];
     Rot E;
     E(0, 0) = c + t * x * x, E(0, 1) = t * x * y + s * z, E(0, 2) = t * x * z - s * y;

@@ -47,6 +47,7 @@
 #include "labs/controllers/laws.h"
 #include "physics/closed_chain.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/det/normal.h"
 
 namespace dyn::controllers {
 
@@ -141,7 +142,7 @@ class Controller {
   };
   std::deque<Reading> readings_;  // (q, v, the sensed force) of the last delay+1 steps, newest last
   std::mt19937_64 rng_;
-  std::normal_distribution<double> normal_{0.0, 1.0};
+  det::Normal normal_;  // Marsaglia polar over rng_ (physics/det/normal.h)
   VecN q_ik_, integral_, e_u_, tau_u_, tau_;  // integral_: pid's u_I (N·m); e_u_: the last joint error
   VecN u0_;                                     // the actuated coordinates at the start (the posture)
   VecN x_des_, v_des_;                          // impedance_joint: the impedance model's state

@@ -11,6 +11,7 @@
 
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
+#include "physics/det/det.h"
 #include "physics/model_file/closure_rows.h"
 
 namespace dyn::generic {
@@ -311,19 +312,19 @@ void DataLab::overlay(const Trace& tr, std::size_t row, Overlay& o) const {
   const std::string unit = !joint_path ? "mm" : slides == 0 ? "mrad" : slides == s_.actuated.size() ? "mm" : "mrad, mm";
   auto norm = [&](std::size_t r) {
     double e = 0;
-    for (const auto& c : errors) e += std::pow(tr.at(r, c), 2);
+    for (const auto& c : errors) e += det::pow(tr.at(r, c), 2);
     return 1e3 * std::sqrt(e);
   };
   o.lines = {{"t", fmt("%.3f s", tr.at(row, "t"))}, {"tracking |e|", fmt("%.2f ", norm(row)) + unit}};
   // What is graded: the tool's distance from the target's response (an impedance exercise), else |e|.
   auto off = [&](std::size_t r) {
     double d = 0;
-    for (const auto& a : s_.axis_names) d += std::pow(tr.at(r, "dev_" + a), 2);
+    for (const auto& a : s_.axis_names) d += det::pow(tr.at(r, "dev_" + a), 2);
     return 1e3 * std::sqrt(d);
   };
   // An impedance exercise: the push and the tool's distance from the target's response.
   if (s_.push) {
-    const double F = std::sqrt(std::pow(tr.at(row, "push_x"), 2) + std::pow(tr.at(row, "push_y"), 2) + std::pow(tr.at(row, "push_z"), 2));
+    const double F = std::sqrt(det::pow(tr.at(row, "push_x"), 2) + det::pow(tr.at(row, "push_y"), 2) + det::pow(tr.at(row, "push_z"), 2));
     o.lines.push_back({"push |F|", fmt("%.1f N", F)});
   }
   if (s_.target.k > 0) o.lines.push_back({"off target", fmt("%.2f mm", off(row))});

@@ -7,6 +7,7 @@
 #include <cstdio>
 
 #include "physics/closed_chain.h"
+#include "physics/det/det.h"
 
 namespace dyn::generic {
 namespace {
@@ -66,7 +67,7 @@ void checkReach(const JsonView& trajectory, const TaskPath& path, const Mechanis
       if (!trial.allFinite()) at[keyOf(at)].fail(where + " is out of the mechanism's reach (inverse kinematics diverges there)");
       const Eigen::Vector3d p = mech.pointPosition(tool.link, tool.point, trial);
       double miss = 0;
-      for (int a = 0; a < d; ++a) miss += std::pow(p[tool.axes[std::size_t(a)] - 3] - x[a], 2);
+      for (int a = 0; a < d; ++a) miss += det::pow(p[tool.axes[std::size_t(a)] - 3] - x[a], 2);
       miss = std::sqrt(miss);
       if (miss > kReached)
         at[keyOf(at)].fail(where + " is out of the mechanism's reach (the controller's inverse kinematics brings the tool no nearer than " +

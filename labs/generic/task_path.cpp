@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "physics/det/det.h"
+
 namespace dyn::generic {
 namespace {
 
@@ -61,10 +63,10 @@ TaskPath::TaskPath(const JsonView& j, const VecN& start, double max) : start_(st
       const VecN r = here - seg.to;
       seg.radius = r.norm();
       if (seg.radius < 1e-6) s["circle"].fail("expected a centre away from the path's current point");
-      seg.psi0 = std::atan2(r[1], r[0]);
+      seg.psi0 = det::atan2(r[1], r[0]);
       // Where the circle ends.
       const double psi = seg.psi0 + seg.sweep;
-      here = seg.to + seg.radius * VecN((VecN(2) << std::cos(psi), std::sin(psi)).finished());
+      here = seg.to + seg.radius * VecN((VecN(2) << det::cos(psi), det::sin(psi)).finished());
     } else if (joint_) {
       s.fail("expected a joint segment {\"move_deg\": [...], \"time\": T}, {\"move\": [...], \"time\": T} or {\"hold\": T}");
     } else {
@@ -96,7 +98,7 @@ void TaskPath::at(double t, VecN& x, VecN& xd, VecN& xdd) const {
       case Segment::Kind::Circle: {
         // x = c + r (cos ψ, sin ψ), ψ = ψ0 + sweep s.
         const double psi = seg.psi0 + seg.sweep * s, w = seg.sweep * sd, a = seg.sweep * sdd;
-        const double c = std::cos(psi), sn = std::sin(psi), r = seg.radius;
+        const double c = det::cos(psi), sn = det::sin(psi), r = seg.radius;
         x = seg.to, x[0] += r * c, x[1] += r * sn;
         xd[0] = -r * sn * w, xd[1] = r * c * w;
         xdd[0] = -r * (c * w * w + sn * a), xdd[1] = r * (-sn * w * w + c * a);

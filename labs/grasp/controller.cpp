@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "physics/det/det.h"
+
 namespace dyn::grasp {
 namespace {
 constexpr double kSwingPeak = 1.299038105676658;  // 3√3/4, the peak of sin u − sin 2u / 2
@@ -26,9 +28,9 @@ void Reference::at(double t, Eigen::Vector3d& pose, Eigen::Vector3d& rate, Eigen
   const double t1 = lift_time + hold;
   if (t > t1 && t < t1 + period) {
     const double w = 2 * M_PI / period, u = w * (t - t1);
-    const double g = (std::sin(u) - 0.5 * std::sin(2 * u)) / kSwingPeak;
-    const double gd = w * (std::cos(u) - std::cos(2 * u)) / kSwingPeak;
-    const double gdd = w * w * (-std::sin(u) + 2 * std::sin(2 * u)) / kSwingPeak;
+    const double g = (det::sin(u) - 0.5 * det::sin(2 * u)) / kSwingPeak;
+    const double gd = w * (det::cos(u) - det::cos(2 * u)) / kSwingPeak;
+    const double gdd = w * w * (-det::sin(u) + 2 * det::sin(2 * u)) / kSwingPeak;
     pose[0] += tilt * g, rate[0] = tilt * gd, accel[0] = tilt * gdd;
     pose[1] += sideways * g, rate[1] = sideways * gd, accel[1] = sideways * gdd;
   }

@@ -18,6 +18,7 @@
 
 #include "labs/delay_line.h"
 #include "labs/grasp/mechanism.h"
+#include "physics/det/normal.h"
 
 namespace dyn::grasp {
 
@@ -84,7 +85,7 @@ class Controller {
   VecN tangent_;                   // f̄_t,i: each contact's measured tangential force, low-passed
   double integral_ = 0, squeeze_ = 0;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> noise_{0.0, 1.0};
+  det::Normal noise_;  // Marsaglia polar over rng_ (physics/det/normal.h)
 };
 
 }  // namespace dyn::grasp

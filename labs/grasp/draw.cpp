@@ -8,6 +8,7 @@
 #include "labs/grasp/lab.h"
 #include "labs/numbers.h"
 #include "labs/run_bounds.h"
+#include "physics/det/rotation.h"
 
 namespace dyn::grasp {
 namespace {
@@ -20,7 +21,7 @@ constexpr double kConeLength = 0.035;  // m, the drawn friction cones
 
 Eigen::Vector3d at(const Eigen::Vector2d& p, double z = 0) { return {p.x(), p.y(), z}; }
 
-Eigen::Matrix3d rotZ(double a) { return Eigen::AngleAxisd(a, Eigen::Vector3d::UnitZ()).toRotationMatrix(); }
+Eigen::Matrix3d rotZ(double a) { return det::rotationZ(a); }
 
 VecN stateAt(const Trace& tr, std::size_t r, int m) {
   VecN q(2 * m + 3);
@@ -108,7 +109,7 @@ void GraspLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene
     const Eigen::Vector2d n = mech.contactNormal(i, pose[0]);
     const double f_n = tr.at(row, f + "_n"), f_t = tr.at(row, f + "_t");
     const double used = f_n > 0 ? std::abs(f_t) / (mu * f_n) : 1.0;
-    s.cones.push_back({at(p, 0.02), at(n), std::atan(mu), kConeLength, mix(kInside, kEdge, (used - 0.5) / 0.5)});
+    s.cones.push_back({at(p, 0.02), at(n), det::atan(mu), kConeLength, mix(kInside, kEdge, (used - 0.5) / 0.5)});
     const Eigen::Vector2d force(tr.at(row, f + "_x"), tr.at(row, f + "_y"));
     if (force.norm() > 1e-9) {
       const Eigen::Vector2d v = force * s_.arrow_scale;

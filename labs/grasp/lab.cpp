@@ -10,6 +10,7 @@
 #include "labs/numbers.h"
 #include "labs/settings.h"
 #include "physics/constraints/point_contact.h"
+#include "physics/det/det.h"
 #include "physics/forces.h"
 
 namespace dyn::grasp {
@@ -260,7 +261,7 @@ json GraspLab::metrics(const Trace& tr) const {
   for (int j = 1; j <= 2 * fingers(); ++j) tau_cols.push_back(tr.column("tau" + std::to_string(j)));
   for (std::size_t r = 0; r < tr.rows(); ++r) {
     const double ex = tr.at(r, "x_o") - tr.at(r, "x_d"), ey = tr.at(r, "y_o") - tr.at(r, "y_d");
-    ep.push_back(std::hypot(ex, ey));
+    ep.push_back(det::hypot(ex, ey));
     ep_max = std::max(ep_max, ep.back());
     epsi.push_back(tr.at(r, "psi_o") - tr.at(r, "psi_d"));
     if (tr.at(r, "t") >= s_.settle_time) ef.push_back(tr.at(r, "f_int") - tr.at(r, "f_int_d"));
@@ -283,7 +284,7 @@ json GraspLab::differences(const Trace& a, const Trace& b, std::size_t n) const 
   const int m = fingers();
   for (std::size_t r = 0; r < n; ++r) {
     for (int j = 1; j <= 2 * m; ++j) dq = std::max(dq, std::abs(a.at(r, "q" + std::to_string(j)) - b.at(r, "q" + std::to_string(j))));
-    dpos = std::max(dpos, std::hypot(a.at(r, "x_o") - b.at(r, "x_o"), a.at(r, "y_o") - b.at(r, "y_o")));
+    dpos = std::max(dpos, det::hypot(a.at(r, "x_o") - b.at(r, "x_o"), a.at(r, "y_o") - b.at(r, "y_o")));
     dpsi = std::max(dpsi, std::abs(a.at(r, "psi_o") - b.at(r, "psi_o")));
     // The net force on the object is determined by its motion; the squeeze only by the fingers' dynamics.
     Eigen::Vector2d net = Eigen::Vector2d::Zero();

@@ -6,12 +6,13 @@
 #include <cmath>
 
 #include "physics/constraints/point_contact.h"
+#include "physics/det/det.h"
 
 namespace dyn::grasp {
 namespace {
 
 Eigen::Vector2d rotate(double a, const Eigen::Vector2d& p) {
-  const double c = std::cos(a), s = std::sin(a);
+  const double c = det::cos(a), s = det::sin(a);
   return {c * p.x() - s * p.y(), s * p.x() + c * p.y()};
 }
 
@@ -75,12 +76,12 @@ bool Mechanism::assemble(const Eigen::Vector3d& pose, const Eigen::Vector3d& rat
                       " m from its base; its links reach " + std::to_string(std::abs(l1 - l2)) + " to " + std::to_string(l1 + l2) + " m)";
       return false;
     }
-    const double th2 = (f.elbow >= 0 ? 1.0 : -1.0) * std::acos(c2);
-    const double th1 = std::atan2(d.y(), d.x()) - std::atan2(l2 * std::sin(th2), l1 + l2 * std::cos(th2));
+    const double th2 = (f.elbow >= 0 ? 1.0 : -1.0) * det::acos(c2);
+    const double th1 = det::atan2(d.y(), d.x()) - det::atan2(l2 * det::sin(th2), l1 + l2 * det::cos(th2));
     q[joint(i)] = th1;
     q[joint(i) + 1] = th2;
     // Rates: the tip moves with the object's contact point, J_i θ_i' = v_o + ω × r_i.
-    const double s1 = std::sin(th1), s12 = std::sin(th1 + th2), c1 = std::cos(th1), c12 = std::cos(th1 + th2);
+    const double s1 = det::sin(th1), s12 = det::sin(th1 + th2), c1 = det::cos(th1), c12 = det::cos(th1 + th2);
     Eigen::Matrix2d J;
     J << -l1 * s1 - l2 * s12, -l2 * s12, l1 * c1 + l2 * c12, l2 * c12;
     const Eigen::Vector2d r = p - pose.tail<2>();
@@ -109,8 +110,8 @@ bool Mechanism::recoverDependent(VecN& q, VecN& v) {
 std::vector<Eigen::Vector2d> Mechanism::fingerPoints(int i, const VecN& q) const {
   const Finger& f = params_.fingers[std::size_t(i)];
   const double a1 = q[joint(i)], a12 = a1 + q[joint(i) + 1];
-  const Eigen::Vector2d elbow = f.base + f.links[0].length * Eigen::Vector2d(std::cos(a1), std::sin(a1));
-  return {f.base, elbow, elbow + f.links[1].length * Eigen::Vector2d(std::cos(a12), std::sin(a12))};
+  const Eigen::Vector2d elbow = f.base + f.links[0].length * Eigen::Vector2d(det::cos(a1), det::sin(a1));
+  return {f.base, elbow, elbow + f.links[1].length * Eigen::Vector2d(det::cos(a12), det::sin(a12))};
 }
 
 void Mechanism::graspMap(const Eigen::Vector3d& pose, MatN& G, VecN& d) const {

@@ -15,6 +15,8 @@
 #include "labs/numbers.h"
 #include "labs/settings.h"
 #include "physics/constraints/plane_contact.h"
+#include "physics/det/det.h"
+#include "physics/det/normal.h"
 #include "physics/forces.h"
 
 namespace dyn::impedance {
@@ -113,7 +115,7 @@ class Hooks final : public StepHooks {
   void observe(const StepRecord& r) override {
     (void)r;
     // The force sensor: what it reads now arrives `delay` later, with noise.
-    std::normal_distribution<double> n(0.0, 1.0);
+    det::Normal n;  // Marsaglia polar over rng_ (physics/det/normal.h)
     const double nx = s_.noise > 0 ? s_.noise * n(rng_) : 0, ny = s_.noise > 0 ? s_.noise * n(rng_) : 0;
     fx_.push(f_total_[0] + nx), fy_.push(f_total_[1] + ny);
   }
@@ -195,12 +197,12 @@ Eigen::Vector3d tipPose(const Params& p, const Eigen::Vector3d& th) {
 
 bool inverseKinematics(const Params& p, const Eigen::Vector3d& x, const Eigen::Vector3d& like, Eigen::Vector3d& th) {
   const double l1 = p.links[0].length, l2 = p.links[1].length, l3 = p.links[2].length;
-  const Eigen::Vector2d w(x[0] - l3 * std::cos(x[2]), x[1] - l3 * std::sin(x[2]));
+  const Eigen::Vector2d w(x[0] - l3 * det::cos(x[2]), x[1] - l3 * det::sin(x[2]));
   const double c2 = (w.squaredNorm() - l1 * l1 - l2 * l2) / (2 * l1 * l2);
   if (!(std::abs(c2) <= 1)) return false;
   const double s2 = (like[1] >= 0 ? 1 : -1) * std::sqrt(1 - c2 * c2);
-  th[1] = std::atan2(s2, c2);
-  th[0] = std::atan2(w.y(), w.x()) - std::atan2(l2 * s2, l1 + l2 * c2);
+  th[1] = det::atan2(s2, c2);
+  th[0] = det::atan2(w.y(), w.x()) - det::atan2(l2 * s2, l1 + l2 * c2);
   th[2] = x[2] - th[0] - th[1];
   // Keep the angles on the branch nearest `like` (continuity across ±π).
   for (int i = 0; i < 3; i += 2) th[i] += 2 * M_PI * std::round((like[i] - th[i]) / (2 * M_PI));
@@ -233,7 +235,7 @@ Settings parseSettings(const JsonView& c) {
   s.model.payload = md["payload"].inRange(0, kMaxMass);
   s.pose = parse3(c["pose_deg"], -360, 360, M_PI / 180);
   // The task Jacobian must be square and invertible at the reference pose (away from singularities).
-  if (std::abs(std::sin(s.pose[1])) < 1e-3)
+  if (std::abs(det::sin(s.pose[1])) < 1e-3)
     c["pose_deg"].fail("a pose away from the task Jacobian's singularity (elbow angle not 0° or 180°)");
 
   const JsonView env = c["environment"];

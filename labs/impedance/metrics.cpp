@@ -21,6 +21,7 @@
 
 #include "labs/impedance/lab.h"
 #include "labs/numbers.h"
+#include "physics/det/det.h"
 
 namespace dyn::impedance {
 
@@ -29,11 +30,11 @@ double unitStep(double w, double z, double t) {
   if (t <= 0) return 0;
   if (z < 1 - 1e-9) {
     const double wd = w * std::sqrt(1 - z * z);
-    return 1 - std::exp(-z * w * t) * (std::cos(wd * t) + z * w / wd * std::sin(wd * t));
+    return 1 - det::exp(-z * w * t) * (det::cos(wd * t) + z * w / wd * det::sin(wd * t));
   }
-  if (z <= 1 + 1e-9) return 1 - std::exp(-w * t) * (1 + w * t);
+  if (z <= 1 + 1e-9) return 1 - det::exp(-w * t) * (1 + w * t);
   const double r = w * std::sqrt(z * z - 1), s1 = -z * w + r, s2 = -z * w - r;
-  return 1 + (s2 * std::exp(s1 * t) - s1 * std::exp(s2 * t)) / (s1 - s2);
+  return 1 + (s2 * det::exp(s1 * t) - s1 * det::exp(s2 * t)) / (s1 - s2);
 }
 
 namespace {
@@ -50,7 +51,7 @@ Fit fitStep(const std::vector<double>& t, const std::vector<double>& d, double d
   Fit best;
   auto costEvery = [&](double w, double z, std::size_t stride) {
     double c = 0;
-    for (std::size_t i = 0; i < t.size(); i += stride) c += std::pow(d[i] - ds * unitStep(w, z, t[i]), 2);
+    for (std::size_t i = 0; i < t.size(); i += stride) c += det::pow(d[i] - ds * unitStep(w, z, t[i]), 2);
     return c;
   };
   auto cost = [&](double w, double z) { return costEvery(w, z, 1); };
@@ -58,7 +59,7 @@ Fit fitStep(const std::vector<double>& t, const std::vector<double>& d, double d
   double grid_best = 1e300;
   for (int i = 0; i <= 60; ++i)
     for (int j = 0; j <= 40; ++j) {
-      const double w = w0 * std::pow(10.0, -1.0 + 2.0 * i / 60), z = 0.02 * std::pow(150.0, j / 40.0);
+      const double w = w0 * det::pow(10.0, -1.0 + 2.0 * i / 60), z = 0.02 * det::pow(150.0, j / 40.0);
       if (const double c = costEvery(w, z, stride); c < grid_best) grid_best = c, best = {w, z, 0};
     }
   best.cost = cost(best.w, best.z);

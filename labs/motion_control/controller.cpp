@@ -5,6 +5,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "physics/det/det.h"
+
 namespace dyn::motion_control {
 namespace {
 
@@ -29,9 +31,9 @@ void Trajectory::at(double t, Eigen::VectorXd& q, Eigen::VectorXd& qd, Eigen::Ve
     q = folded - s * d, qd = -sd / move_time * d, qdd = -sdd / (move_time * move_time) * d;
   } else {
     const double w = 2 * M_PI / period, tau = t - t4();
-    q = outstretched + 0.5 * (1 - std::cos(w * tau)) * amplitude;
-    qd = 0.5 * w * std::sin(w * tau) * amplitude;
-    qdd = 0.5 * w * w * std::cos(w * tau) * amplitude;
+    q = outstretched + 0.5 * (1 - det::cos(w * tau)) * amplitude;
+    qd = 0.5 * w * det::sin(w * tau) * amplitude;
+    qdd = 0.5 * w * w * det::cos(w * tau) * amplitude;
   }
 }
 
@@ -72,7 +74,7 @@ Eigen::VectorXd Controller::torque(double t, const Eigen::VectorXd& th, const Ei
       tau = model_->inverseDynamics(VecN(th), VecN(thd), VecN(a));
       for (int i = 0; i < n; ++i)
         tau[i] += fr[std::size_t(i)].viscous * thd[i] +
-                  fr[std::size_t(i)].coulomb * std::tanh(thd[i] / std::max(model_params_.coulomb_width, 1e-12));
+                  fr[std::size_t(i)].coulomb * det::tanh(thd[i] / std::max(model_params_.coulomb_width, 1e-12));
       break;
     }
     case Kind::PdGravity:

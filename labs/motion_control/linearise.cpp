@@ -22,6 +22,7 @@
 
 #include "labs/motion_control/lab.h"
 #include "labs/numbers.h"
+#include "physics/det/det.h"
 
 namespace dyn::motion_control {
 namespace {
@@ -58,9 +59,9 @@ FlexibleJoint flexibleJoint(const Params& plant, const Eigen::VectorXd& theta, i
 Mode leastDampedMode(const LoopAnalysis& a) {
   Mode m;
   for (const auto& p : a.poles) {
-    if (p.imag() <= 1e-9 * std::abs(p)) continue;  // one of each pair, complex only
-    const double zeta = -p.real() / std::abs(p);
-    if (!m.found || zeta < m.damping) m = {true, std::abs(p), p.imag(), zeta};
+    if (p.imag() <= 1e-9 * det::abs(p)) continue;  // one of each pair, complex only
+    const double zeta = -p.real() / det::abs(p);
+    if (!m.found || zeta < m.damping) m = {true, det::abs(p), p.imag(), zeta};
   }
   return m;
 }

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "physics/constrained_mechanism_impl.h"
+#include "physics/det/det.h"
 
 namespace dyn {
 template class ConstrainedMechanism<Planar, 3, 0, 0>;
@@ -101,7 +102,7 @@ std::vector<Eigen::Vector2d> jointPoints(const Params& p, const Eigen::VectorXd&
   double angle = 0;
   for (int i = 0; i < p.n(); ++i) {
     angle += th[i];
-    pts.push_back(pts.back() + p.links[std::size_t(i)].length * Eigen::Vector2d(std::cos(angle), std::sin(angle)));
+    pts.push_back(pts.back() + p.links[std::size_t(i)].length * Eigen::Vector2d(det::cos(angle), det::sin(angle)));
   }
   return pts;
 }

@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "physics/det/det.h"
+
 namespace dyn::pen_on_table {
 
 void Circle::angle(double t, double& psi, double& rate, double& accel) const {
@@ -26,7 +28,7 @@ void Circle::angle(double t, double& psi, double& rate, double& accel) const {
 void Circle::sample(double t, Eigen::Vector2d& p, Eigen::Vector2d& v, Eigen::Vector2d& a) const {
   double psi, rate, accel;
   angle(t, psi, rate, accel);
-  const Eigen::Vector2d radial(std::cos(psi), std::sin(psi)), along(-std::sin(psi), std::cos(psi));
+  const Eigen::Vector2d radial(det::cos(psi), det::sin(psi)), along(-det::sin(psi), det::cos(psi));
   p = centre + radius * radial;
   v = radius * rate * along;
   a = radius * accel * along - radius * rate * rate * radial;

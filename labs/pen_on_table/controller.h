@@ -22,6 +22,7 @@
 
 #include "labs/delay_line.h"
 #include "labs/pen_on_table/mechanism.h"
+#include "physics/det/normal.h"
 
 namespace dyn::pen_on_table {
 
@@ -85,7 +86,7 @@ class Controller {
   DelayLine sensor_;
   Target target_;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> noise_{0.0, 1.0};
+  det::Normal noise_;  // Marsaglia polar over rng_ (physics/det/normal.h)
 };
 
 }  // namespace dyn::pen_on_table

@@ -8,6 +8,7 @@
 
 #include "labs/numbers.h"
 #include "labs/pen_on_table/lab.h"
+#include "physics/det/det.h"
 
 namespace dyn::pen_on_table {
 namespace {
@@ -23,8 +24,8 @@ struct Pose {
 };
 
 Pose pose(const Params& p, double q1, double q2, double q3) {
-  const Eigen::Vector3d out(std::cos(q1), std::sin(q1), 0);
-  auto along = [&](double pitch) { return Eigen::Vector3d(std::cos(pitch) * out + Eigen::Vector3d(0, 0, -std::sin(pitch))); };
+  const Eigen::Vector3d out(det::cos(q1), det::sin(q1), 0);
+  auto along = [&](double pitch) { return Eigen::Vector3d(det::cos(pitch) * out + Eigen::Vector3d(0, 0, -det::sin(pitch))); };
   Pose a;
   a.base = Eigen::Vector3d::Zero();
   a.shoulder = Eigen::Vector3d(0, 0, p.links[0].length);
@@ -83,7 +84,7 @@ void PenOnTableLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, 
   Polyline circle{{}, 1.5, kRef};
   for (int k = 0; k <= 96; ++k) {
     const double a = 2 * M_PI * k / 96;
-    circle.points.push_back(c + r * Eigen::Vector3d(std::cos(a), std::sin(a), 0));
+    circle.points.push_back(c + r * Eigen::Vector3d(det::cos(a), det::sin(a), 0));
   }
   s.polylines.push_back(std::move(circle));
   // The ink: the tip's path while it touched the table, up to this row.

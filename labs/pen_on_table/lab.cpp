@@ -9,6 +9,7 @@
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
 #include "labs/settings.h"
+#include "physics/det/det.h"
 
 namespace dyn::pen_on_table {
 namespace {
@@ -122,8 +123,8 @@ Link parseLink(const JsonView& j) {
 
 // Where the circle (or the start point) leaves the workspace: empty if nowhere, else the reason.
 std::string outOfReach(const Params& p, const Eigen::Vector3d& tip) {
-  const double R = std::hypot(tip.x(), tip.y());
-  const double d = std::hypot(R, tip.z() + p.tip_radius - p.links[0].length);
+  const double R = det::hypot(tip.x(), tip.y());
+  const double d = det::hypot(R, tip.z() + p.tip_radius - p.links[0].length);
   if (R < kMinAxisDistance) return "is " + fmt("%.3g", R) + " m from the base axis (at least 0.05 m keeps θ1 defined)";
   if (elbowSine(p, tip) < kMinElbowSine)
     return "is " + fmt("%.3g", d) + " m from the shoulder (the arm reaches " + fmt("%.3g", std::abs(p.links[1].length - p.links[2].length)) +
@@ -175,7 +176,7 @@ Settings parseSettings(const JsonView& c) {
     ref["centre"].fail("expected the circle's centre within the arm's workspace on the table: it " + why);
   for (int k = 0; k < 72; ++k) {
     const double a = 2 * M_PI * k / 72;
-    const Eigen::Vector3d pt = centre + circle.radius * Eigen::Vector3d(std::cos(a), std::sin(a), 0);
+    const Eigen::Vector3d pt = centre + circle.radius * Eigen::Vector3d(det::cos(a), det::sin(a), 0);
     if (const std::string why = outOfReach(p, pt); !why.empty())
       ref["radius"].fail("expected a circle inside the arm's workspace: its point at " + fmt("%.0f", 360.0 * k / 72) + "° " + why);
   }

@@ -5,6 +5,7 @@
 
 #include "physics/constrained_mechanism_impl.h"
 #include "physics/constraints/plane_contact.h"
+#include "physics/det/det.h"
 
 namespace dyn {
 template class ConstrainedMechanism<Spatial, 3, 1, 0>;
@@ -66,27 +67,27 @@ void Mechanism::tipJacobian(const VecN& q, const VecN& v, Eigen::Vector3d& p, Ei
 
 Eigen::Vector3d forwardKinematics(const Params& p, const Eigen::Vector3d& th) {
   const double l2 = p.links[1].length, l3 = p.links[2].length;
-  const double R = l2 * std::cos(th[1]) + l3 * std::cos(th[1] + th[2]);
-  const double Z = -l2 * std::sin(th[1]) - l3 * std::sin(th[1] + th[2]);
-  return {R * std::cos(th[0]), R * std::sin(th[0]), p.links[0].length + Z - p.tip_radius};
+  const double R = l2 * det::cos(th[1]) + l3 * det::cos(th[1] + th[2]);
+  const double Z = -l2 * det::sin(th[1]) - l3 * det::sin(th[1] + th[2]);
+  return {R * det::cos(th[0]), R * det::sin(th[0]), p.links[0].length + Z - p.tip_radius};
 }
 
 bool inverseKinematics(const Params& p, const Eigen::Vector3d& tip, Eigen::Vector3d& th) {
   const double l2 = p.links[1].length, l3 = p.links[2].length;
-  const double R = std::hypot(tip.x(), tip.y()), Z = tip.z() + p.tip_radius - p.links[0].length;
+  const double R = det::hypot(tip.x(), tip.y()), Z = tip.z() + p.tip_radius - p.links[0].length;
   if (!(R > 1e-9)) return false;
   const double c3 = (R * R + Z * Z - l2 * l2 - l3 * l3) / (2 * l2 * l3);
   if (!(std::abs(c3) <= 1)) return false;
   // Angles up from the horizontal: φ3 < 0 puts the elbow above the shoulder–tip line.
-  const double phi3 = -std::acos(c3);
-  const double phi2 = std::atan2(Z, R) - std::atan2(l3 * std::sin(phi3), l2 + l3 * std::cos(phi3));
-  th << std::atan2(tip.y(), tip.x()), -phi2, -phi3;
+  const double phi3 = -det::acos(c3);
+  const double phi2 = det::atan2(Z, R) - det::atan2(l3 * det::sin(phi3), l2 + l3 * det::cos(phi3));
+  th << det::atan2(tip.y(), tip.x()), -phi2, -phi3;
   return true;
 }
 
 double elbowSine(const Params& p, const Eigen::Vector3d& tip) {
   const double l2 = p.links[1].length, l3 = p.links[2].length;
-  const double R = std::hypot(tip.x(), tip.y()), Z = tip.z() + p.tip_radius - p.links[0].length;
+  const double R = det::hypot(tip.x(), tip.y()), Z = tip.z() + p.tip_radius - p.links[0].length;
   const double c3 = (R * R + Z * Z - l2 * l2 - l3 * l3) / (2 * l2 * l3);
   return std::abs(c3) >= 1 ? 0.0 : std::sqrt(1 - c3 * c3);
 }

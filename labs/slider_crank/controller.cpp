@@ -4,13 +4,15 @@
 #include <algorithm>
 #include <cmath>
 
+#include "physics/det/det.h"
+
 namespace dyn::slider_crank {
 
 double Reference::position(double t) const {
-  return x0 + 0.5 * amplitude * (1.0 - std::cos(2.0 * M_PI * t / period));
+  return x0 + 0.5 * amplitude * (1.0 - det::cos(2.0 * M_PI * t / period));
 }
 double Reference::velocity(double t) const {
-  return 0.5 * amplitude * (2.0 * M_PI / period) * std::sin(2.0 * M_PI * t / period);
+  return 0.5 * amplitude * (2.0 * M_PI / period) * det::sin(2.0 * M_PI * t / period);
 }
 
 Controller::Controller(const ControllerConfig& c, const Reference& r, const Params& model, double dt)

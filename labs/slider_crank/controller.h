@@ -14,6 +14,7 @@
 
 #include "labs/delay_line.h"
 #include "labs/slider_crank/mechanism.h"
+#include "physics/det/normal.h"
 
 namespace dyn::slider_crank {
 
@@ -66,7 +67,7 @@ class Controller {
   DelayLine sensor_;  // f_Ty as measured (noise included), `delay` late
   double integral_ = 0;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> noise_{0.0, 1.0};
+  det::Normal noise_;  // Marsaglia polar over rng_ (physics/det/normal.h)
 };
 
 }  // namespace dyn::slider_crank

@@ -7,6 +7,7 @@
 #include "labs/mechanism_simulation.h"
 #include "labs/numbers.h"
 #include "labs/settings.h"
+#include "physics/det/det.h"
 
 namespace dyn::slider_crank {
 namespace {
@@ -92,7 +93,7 @@ Settings parseSettings(const JsonView& c) {
   s.theta1_rate = init.has("theta1_rate") ? init["theta1_rate"].inRange(-kMaxRate, kMaxRate) : 0.0;
   if (init.has("branch")) s.branch = init["branch"].oneOf({"cos_positive", "cos_negative"}) == "cos_positive" ? 1 : -1;
   const auto& L = s.params.links;
-  if (std::abs(L[0].length * std::sin(s.theta1)) > L[1].length)
+  if (std::abs(L[0].length * det::sin(s.theta1)) > L[1].length)
     init["theta1_deg"].fail("expected a crank angle the rod can reach (|l1 sin θ1| ≤ l2)");
 
   const SimulationSettings sim = parseSimulation(c["simulation"], IndependentForm::Yes);  // recoverDependent from θ1

@@ -6,6 +6,7 @@
 
 #include "physics/constrained_mechanism_impl.h"
 #include "physics/constraints/point_closure.h"
+#include "physics/det/det.h"
 
 namespace dyn {
 template class ConstrainedMechanism<Planar, 3, 3, 1>;
@@ -49,11 +50,11 @@ Mechanism::Mechanism(const Params& p) : ConstrainedMechanism(describe(p)), param
 
 bool Mechanism::recoverDependent(VecN& q, VecN& v) {
   const auto& L = params_.links;
-  const double s12 = -L[0].length * std::sin(q[0]) / L[1].length;
+  const double s12 = -L[0].length * det::sin(q[0]) / L[1].length;
   if (std::abs(s12) > 1.0) return false;
   // Stay on the current branch of cos(θ1+θ2).
-  const double branch = std::cos(q[0] + q[1]) >= 0 ? 1.0 : -1.0;
-  const double th12 = std::atan2(s12, branch * std::sqrt(1.0 - s12 * s12));
+  const double branch = det::cos(q[0] + q[1]) >= 0 ? 1.0 : -1.0;
+  const double th12 = det::atan2(s12, branch * std::sqrt(1.0 - s12 * s12));
   q[1] = th12 - q[0];
   q[2] = -th12;
   q[3] = tip(q.head(3)).x();
@@ -72,14 +73,14 @@ bool Mechanism::recoverDependent(VecN& q, VecN& v) {
 
 bool Mechanism::initialState(double theta1, double rate1, int branch, VecN& q, VecN& v) const {
   const auto& L = params_.links;
-  const double s12 = -L[0].length * std::sin(theta1) / L[1].length;
+  const double s12 = -L[0].length * det::sin(theta1) / L[1].length;
   if (std::abs(s12) > 1.0) return false;
   q.resize(4);
   v.resize(4);
   q << theta1, 0, 0, 0;
   v << rate1, 0, 0, 0;
   // The branch is read from cos(θ1+θ2) of the guess: seed it with the requested sign.
-  q[1] = (branch >= 0 ? std::asin(s12) : M_PI - std::asin(s12)) - theta1;
+  q[1] = (branch >= 0 ? det::asin(s12) : M_PI - det::asin(s12)) - theta1;
   return const_cast<Mechanism*>(this)->recoverDependent(q, v);
 }
 
@@ -91,7 +92,7 @@ std::array<Eigen::Vector2d, 4> Mechanism::jointPoints(const Eigen::Vector3d& th)
   double angle = 0;
   for (int i = 0; i < 3; ++i) {
     angle += th[i];
-    p[std::size_t(i) + 1] = p[std::size_t(i)] + params_.links[std::size_t(i)].length * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    p[std::size_t(i) + 1] = p[std::size_t(i)] + params_.links[std::size_t(i)].length * Eigen::Vector2d(det::cos(angle), det::sin(angle));
   }
   return p;
 }

@@ -3,6 +3,8 @@
 
 #include <cmath>
 
+#include "physics/det/det.h"
+
 namespace dyn::unicycle {
 
 Controller::Controller(const ControllerConfig& config, const Path& path, const ReferenceSettings& reference, double radius, double dt)
@@ -13,7 +15,7 @@ VecN Controller::torque(double t, const VecN& q, const VecN& v) {
   (void)t;
   // The leader's point and the wheel's cross-track error from it.
   const Path::Sample ref = leader_.sample();
-  const Eigen::Vector2d n_d(-std::sin(ref.heading), std::cos(ref.heading));
+  const Eigen::Vector2d n_d(-det::sin(ref.heading), det::cos(ref.heading));
   target_ = {ref.p, ref.heading, ref.curvature * leader_.speed(), leader_.speed(), (Eigen::Vector2d(q[X], q[Y]) - ref.p).dot(n_d), leader_.s()};
   measured_ = v[Theta] + (config_.speed_noise > 0 ? config_.speed_noise * noise_(rng_) : 0.0);
   double tau_y = 0, tau_z = 0;
@@ -28,7 +30,7 @@ VecN Controller::torque(double t, const VecN& q, const VecN& v) {
       const double e_v = target_.speed / radius_ - measured_;
       integral_ += e_v * dt_;
       tau_y = g.kp_speed * e_v + g.ki_speed * integral_;
-      const double heading_c = target_.heading - std::atan(g.k_cross * target_.cross_track);
+      const double heading_c = target_.heading - det::atan(g.k_cross * target_.cross_track);
       tau_z = g.kp_heading * std::remainder(heading_c - q[Phi], 2 * M_PI) + g.kd_heading * (target_.heading_rate - v[Phi]);
       break;
     }

@@ -15,6 +15,7 @@
 #include "labs/delay_line.h"
 #include "labs/unicycle/mechanism.h"
 #include "labs/unicycle/path.h"
+#include "physics/det/normal.h"
 
 namespace dyn::unicycle {
 
@@ -60,7 +61,7 @@ class Controller {
   double integral_ = 0, measured_ = 0;
   Target target_;
   std::mt19937_64 rng_;
-  std::normal_distribution<double> noise_{0.0, 1.0};
+  det::Normal noise_;  // Marsaglia polar over rng_ (physics/det/normal.h)
 };
 
 }  // namespace dyn::unicycle

@@ -10,6 +10,7 @@
 
 #include "labs/numbers.h"
 #include "labs/unicycle/lab.h"
+#include "physics/det/det.h"
 
 namespace dyn::unicycle {
 namespace {
@@ -22,7 +23,7 @@ Eigen::Vector3d on(double x, double y, double z = 0) { return {x, y, z}; }
 
 // A wheel at (x, y) heading φ, spun by θ: its axle is the horizontal (−sin φ, cos φ).
 void drawWheel(double r, double x, double y, double phi, double theta, Color c, Scene& s) {
-  const Eigen::Vector3d axle(-std::sin(phi), std::cos(phi), 0);
+  const Eigen::Vector3d axle(-det::sin(phi), det::cos(phi), 0);
   s.cylinders.push_back({on(x, y, r), axisSpin(axle, -theta), r, 0.12 * r, c, 6, {0.1f, 0.1f, 0.12f, c.a}});
 }
 
@@ -57,19 +58,19 @@ void UnicycleLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Sc
   // keeps its size on screen and the leader stays in the picture.
   double lead = 0;
   for (std::size_t k = 0; k < tr.rows(); k += stride)
-    lead = std::max(lead, std::hypot(tr.at(k, "x_d") - tr.at(k, "x"), tr.at(k, "y_d") - tr.at(k, "y")));
+    lead = std::max(lead, det::hypot(tr.at(k, "x_d") - tr.at(k, "x"), tr.at(k, "y_d") - tr.at(k, "y")));
   const double half = std::clamp(lead + 2 * r, 3.5 * r, 10 * r);
   const double x = tr.at(row, "x"), y = tr.at(row, "y"), phi = tr.at(row, "phi");
   // Seen from behind and to the right of the leader's heading φ_d (smooth, unlike the wheel's own
   // when it wobbles): the wheel's face, the lateral force along its axle and the leader ahead of it
   // all show whichever way the course turns; the map keeps the course's fixed orientation.
   const double psi = tr.at(row, "phi_d");
-  const Eigen::Vector3d heading(std::cos(psi), std::sin(psi), 0), left(-std::sin(psi), std::cos(psi), 0);
+  const Eigen::Vector3d heading(det::cos(psi), det::sin(psi), 0), left(-det::sin(psi), det::cos(psi), 0);
   const Eigen::Vector3d from = -0.75 * heading - 0.65 * left + Eigen::Vector3d(0, 0, 0.7);
   // The framed box is axis-aligned: seen along a diagonal it looks √2 wider than square on, so
   // it shrinks as the view turns off the axes and the wheel keeps its size (a disk of radius half
   // round the wheel always shows).
-  const double diagonal = std::abs(from.x()) + std::abs(from.y()), square = std::hypot(from.x(), from.y());
+  const double diagonal = std::abs(from.x()) + std::abs(from.y()), square = det::hypot(from.x(), from.y());
   const double side = half * std::sqrt(2.0) * square / diagonal;
   const Eigen::AlignedBox3d view(on(x - side, y - side), on(x + side, y + side, 2 * r));
   s.framePerspective(view, from);
@@ -103,7 +104,7 @@ void UnicycleLab::scene(const Trace& tr, std::size_t row, const Trace* ghost, Sc
   // The lateral ground force at the contact, along the axle.
   const double f_lat = tr.at(row, "f_lat");
   if (std::abs(f_lat) > 1e-9) {
-    const Eigen::Vector3d axle(-std::sin(phi), std::cos(phi), 0);
+    const Eigen::Vector3d axle(-det::sin(phi), det::cos(phi), 0);
     s.arrows.push_back({on(x, y, 0.01), axle * (f_lat * s_.arrow_scale), 0.012, tr.at(row, "skid_margin") < 0 ? kSkid : kForce});
   }
 

@@ -9,6 +9,7 @@
 #include "labs/numbers.h"
 #include "labs/settings.h"
 #include "physics/constraints/rolling.h"
+#include "physics/det/det.h"
 
 namespace dyn::unicycle {
 namespace {
@@ -25,7 +26,7 @@ const std::vector<std::string> kColumns = {
 
 // The contact force's wheel-axes parts and skid margin (f on the wheel, world axes) at heading φ.
 void wheelForces(const Eigen::Vector3d& f, double phi, double mu, double out[4]) {
-  Rolling::contactAxes(f, Eigen::Vector3d(-std::sin(phi), std::cos(phi), 0), mu, out);
+  Rolling::contactAxes(f, Eigen::Vector3d(-det::sin(phi), det::cos(phi), 0), mu, out);
 }
 
 // Bullet's friction-contact wheel, stepped beside the Bullet run with its own controller.
@@ -199,7 +200,7 @@ json UnicycleLab::metrics(const Trace& tr) const {
   for (std::size_t r = 0; r < tr.rows(); ++r) {
     ect.push_back(tr.at(r, "cross_track"));
     ect_max = std::max(ect_max, std::abs(ect.back()));
-    epos.push_back(std::hypot(tr.at(r, "x") - tr.at(r, "x_d"), tr.at(r, "y") - tr.at(r, "y_d")));
+    epos.push_back(det::hypot(tr.at(r, "x") - tr.at(r, "x_d"), tr.at(r, "y") - tr.at(r, "y_d")));
     ev.push_back(tr.at(r, "speed") - tr.at(r, "v_d"));
     if (tr.at(r, "skid_margin") < margin) margin = tr.at(r, "skid_margin"), margin_t = tr.at(r, "t");
     f_lat = std::max(f_lat, std::abs(tr.at(r, "f_lat")));
@@ -219,14 +220,14 @@ json UnicycleLab::metrics(const Trace& tr) const {
 json UnicycleLab::differences(const Trace& a, const Trace& b, std::size_t n) const {
   double dpos = 0, dphi = 0, drate = 0, dlat = 0, dnormal = 0, slip = 0, slip_fric = 0, dpos_fric = 0;
   for (std::size_t r = 0; r < n; ++r) {
-    dpos = std::max(dpos, std::hypot(a.at(r, "x") - b.at(r, "x"), a.at(r, "y") - b.at(r, "y")));
+    dpos = std::max(dpos, det::hypot(a.at(r, "x") - b.at(r, "x"), a.at(r, "y") - b.at(r, "y")));
     dphi = std::max(dphi, std::abs(a.at(r, "phi") - b.at(r, "phi")));
     drate = std::max(drate, std::abs(a.at(r, "theta_rate") - b.at(r, "theta_rate")));
     dlat = std::max(dlat, std::abs(a.at(r, "f_lat") - b.at(r, "f_lat")));
     dnormal = std::max(dnormal, std::abs(a.at(r, "f_normal") - b.at(r, "f_normal")));
     slip = std::max(slip, b.at(r, "slip"));
     slip_fric = std::max(slip_fric, b.at(r, "slip_fric"));
-    dpos_fric = std::max(dpos_fric, std::hypot(a.at(r, "x") - b.at(r, "x_fric"), a.at(r, "y") - b.at(r, "y_fric")));
+    dpos_fric = std::max(dpos_fric, det::hypot(a.at(r, "x") - b.at(r, "x_fric"), a.at(r, "y") - b.at(r, "y_fric")));
   }
   return {{"max_dpos", dpos},        {"max_dphi", dphi},              {"max_dtheta_rate", drate},
           {"max_df_lat", dlat},      {"max_df_normal", dnormal},      {"bullet_max_slip", slip},

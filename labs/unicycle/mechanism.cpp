@@ -5,6 +5,7 @@
 
 #include "physics/constrained_mechanism_impl.h"
 #include "physics/constraints/rolling.h"
+#include "physics/det/det.h"
 
 namespace dyn {
 template class ConstrainedMechanism<Spatial, 5, 3, 0>;
@@ -36,13 +37,13 @@ void Mechanism::state(double x, double y, double phi, double theta, double phi_r
   q.resize(5);
   v.resize(5);
   q << x, y, r, phi, theta;
-  v << r * std::cos(phi) * theta_rate, r * std::sin(phi) * theta_rate, 0.0, phi_rate, theta_rate;
+  v << r * det::cos(phi) * theta_rate, r * det::sin(phi) * theta_rate, 0.0, phi_rate, theta_rate;
 }
 
 double Mechanism::slipSpeed(const VecN& q, const VecN& v) const {
   // The contact's material velocity: the centre's, less r θ' along the heading (ω × (−r ẑ)).
-  const double r = params_.radius, c = std::cos(q[Phi]), s = std::sin(q[Phi]);
-  return std::hypot(v[X] - r * c * v[Theta], v[Y] - r * s * v[Theta]);
+  const double r = params_.radius, c = det::cos(q[Phi]), s = det::sin(q[Phi]);
+  return det::hypot(v[X] - r * c * v[Theta], v[Y] - r * s * v[Theta]);
 }
 
 }  // namespace dyn::unicycle

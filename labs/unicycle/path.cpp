@@ -4,6 +4,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "physics/det/det.h"
+
 namespace dyn::unicycle {
 
 Path::Path(std::vector<Eigen::Vector2d> points, int samples_per_segment) : points_(std::move(points)) {
@@ -25,7 +27,7 @@ Path::Path(std::vector<Eigen::Vector2d> points, int samples_per_segment) : point
       const Eigen::Vector2d p = 0.5 * (2 * p1 + a * u + b * u * u + c * u * u * u);
       const Eigen::Vector2d d1 = 0.5 * (a + 2 * b * u + 3 * c * u * u), d2 = 0.5 * (2 * b + 6 * c * u);
       const double speed = std::max(d1.norm(), 1e-12);
-      double heading = std::atan2(d1.y(), d1.x());
+      double heading = det::atan2(d1.y(), d1.x());
       if (!s_.empty()) heading = last_heading + std::remainder(heading - last_heading, 2 * M_PI);
       s += (p - last_p).norm();
       s_.push_back(s);

@@ -4,6 +4,8 @@
 #include <Eigen/Geometry>
 #include <cmath>
 
+#include "physics/det/rotation.h"
+
 namespace dyn {
 
 template <class S>
@@ -38,8 +40,7 @@ void PointClosure<S>::position(const MechanismKinematics<S>& k, int row, VecN& p
     // A pin holds no rotation row: no rotation vector to build (a 3×3 product and an atan2).
     err.template head<3>().setZero();
     if (turns_) {
-      const Eigen::AngleAxisd rel(k.rotation(at_.a) * k.rotation(at_.b).transpose());
-      err.template head<3>() = rel.angle() * rel.axis();
+      err.template head<3>() = det::rotationVector(k.rotation(at_.a) * k.rotation(at_.b).transpose());
     }
     err.template tail<3>() = pa - pb;
   }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "physics/det/det.h"
+
 namespace dyn {
 namespace {
 const Spatial::Pos kUp(0, 0, 1);
@@ -92,14 +94,14 @@ void Rolling::contactAxes(const Pos& f, const Pos& axle_world, double mu, double
   out[0] = fw.x();
   out[1] = fw.y();
   out[2] = fw.z();
-  out[3] = mu * fw.z() - std::hypot(fw.x(), fw.y());
+  out[3] = mu * fw.z() - det::hypot(fw.x(), fw.y());
 }
 
 void Rolling::report(const MechanismKinematics<Spatial>& k, const double* eta, double* out) const {
   const Geometry g = geometry(k);
   contactAxes(Spatial::linear(force(k, eta)), g.a, mu_, out);
   const Pos v = Spatial::linear(k.pointVelocity(wheel_, g.P));
-  out[4] = std::hypot(v.x(), v.y());
+  out[4] = det::hypot(v.x(), v.y());
 }
 
 }  // namespace dyn

@@ -23,6 +23,7 @@
 // left out (MuJoCo resolves the defaults, classes and frames, not dynlab). Everything else 2.2.2's
 // schema lacks is refused by mjcf3_schema.cpp in one line naming the file, line and attribute.
 #include "physics/model_file/mjcf3.h"
+#include "physics/det/det.h"
 
 #include <algorithm>
 #include <cctype>
@@ -240,10 +241,10 @@ void Translation::placeTie(const mjModel* m, const mjData* d, const Tie& t) {
   const std::string what = std::string("<") + e->Name() + " site1='" + e->Attribute("site1") + "' site2='" + e->Attribute("site2") + "'>";
   // The sites at the reference pose: apart by `gap`, turned by `angle` (a weld's frames).
   double gap2 = 0, R[9];
-  for (int k = 0; k < 3; ++k) gap2 += std::pow(d->site_xpos[3 * s[0] + k] - d->site_xpos[3 * s[1] + k], 2);
+  for (int k = 0; k < 3; ++k) { const double dk = d->site_xpos[3 * s[0] + k] - d->site_xpos[3 * s[1] + k]; gap2 += dk * dk; }
   mju_mulMatTMat(R, d->site_xmat + 9 * s[0], d->site_xmat + 9 * s[1], 3, 3, 3);
-  const double sine = 0.5 * std::sqrt(std::pow(R[7] - R[5], 2) + std::pow(R[2] - R[6], 2) + std::pow(R[3] - R[1], 2));
-  const double gap = std::sqrt(gap2), angle = weld ? std::atan2(sine, 0.5 * (R[0] + R[4] + R[8] - 1)) : 0.0;
+  const double sine = 0.5 * std::sqrt((R[7] - R[5]) * (R[7] - R[5]) + (R[2] - R[6]) * (R[2] - R[6]) + (R[3] - R[1]) * (R[3] - R[1]));
+  const double gap = std::sqrt(gap2), angle = weld ? det::atan2(sine, 0.5 * (R[0] + R[4] + R[8] - 1)) : 0.0;
   const double tolerance = 1e-4 * std::max(1e-3, double(m->stat.extent));
   if (gap > tolerance || angle > 1e-4)
     throw ModelFileError(docs.where(e) + ": " + what + ": the loop is not closed at the reference pose (site2 is " + shortNum(gap) + " m from site1" +

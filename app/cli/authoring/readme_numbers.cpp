@@ -6,6 +6,7 @@
 #include <regex>
 
 #include "labs/numbers.h"
+#include "physics/det/det.h"
 
 namespace dyn {
 
@@ -31,7 +32,7 @@ bool agreesAsWritten(const std::string& written, double measured) {
   const int exponent = e == std::string::npos ? 0 : std::atoi(written.c_str() + e + 1);
   const std::size_t dot = mantissa.find('.');
   const int decimals = dot == std::string::npos ? 0 : int(mantissa.size() - dot - 1);
-  const double last = std::pow(10.0, exponent - decimals);
+  const double last = det::pow(10.0, exponent - decimals);
   return std::abs(measured - w) <= 0.5 * last * (1 + 1e-9);
 }
 

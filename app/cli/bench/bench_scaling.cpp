@@ -32,6 +32,7 @@
 #include "labs/file_write.h"
 #include "physics/bullet/bullet_chain.h"
 #include "physics/chain.h"
+#include "physics/det/det.h"
 #include "render/image.h"
 
 namespace fs = std::filesystem;
@@ -152,9 +153,9 @@ Image drawFigure(const std::vector<Row>& rows, int width, int height) {
   std::vector<unsigned char> pixels(image.rgba.size(), 255);
   double ylo = INFINITY, yhi = -INFINITY;
   for (const Row& r : rows)
-    for (double u : r.us) ylo = std::min(ylo, std::log10(u)), yhi = std::max(yhi, std::log10(u));
+    for (double u : r.us) ylo = std::min(ylo, det::log10(u)), yhi = std::max(yhi, det::log10(u));
   ylo = std::floor(ylo - 0.1), yhi = std::ceil(yhi + 0.1);
-  const double xlo = std::log10(2.0), xhi = std::log10(1500.0);
+  const double xlo = det::log10(2.0), xhi = det::log10(1500.0);
   PLINT previous, mine;
   plgstrm(&previous);
   plmkstrm(&mine);
@@ -184,8 +185,8 @@ Image drawFigure(const std::vector<Row>& rows, int width, int height) {
     plmtex("t", 1.5, 0.5, 0.5, "Step cost of an open planar chain, dt = 1 ms, first order");
     // Guides through the ABA line's first point (∝ N) and the CRBA line's last point (∝ N³).
     const double gx[2] = {xlo, xhi};
-    const double a0 = std::log10(rows.front().us[kAba]) - std::log10(double(rows.front().n));
-    const double c0 = std::log10(rows.back().us[kCrba]) - 3 * std::log10(double(rows.back().n));
+    const double a0 = det::log10(rows.front().us[kAba]) - det::log10(double(rows.front().n));
+    const double c0 = det::log10(rows.back().us[kCrba]) - 3 * det::log10(double(rows.back().n));
     const double ga[2] = {a0 + gx[0], a0 + gx[1]}, gc[2] = {c0 + 3 * gx[0], c0 + 3 * gx[1]};
     plcol0(kAxis);
     pllsty(3);
@@ -196,7 +197,7 @@ Image drawFigure(const std::vector<Row>& rows, int width, int height) {
     std::vector<double> x, y;
     for (int e = 0; e < kEngines; ++e) {
       x.clear(), y.clear();
-      for (const Row& r : rows) x.push_back(std::log10(double(r.n))), y.push_back(std::log10(r.us[e]));
+      for (const Row& r : rows) x.push_back(det::log10(double(r.n))), y.push_back(det::log10(r.us[e]));
       plcol0(kLine0 + e);
       plwidth(2.5);
       plline(PLINT(x.size()), x.data(), y.data());

@@ -14,6 +14,8 @@
 #include <iterator>
 #include <stdexcept>
 
+#include "physics/det/det.h"
+
 namespace dyn::app {
 namespace {
 
@@ -168,13 +170,13 @@ struct Ticks {
 };
 Ticks ticksFor(double lo, double hi) {
   Ticks t;
-  const double rough = (hi - lo) / 6, decade = std::pow(10.0, std::floor(std::log10(rough)));
+  const double rough = (hi - lo) / 6, decade = det::pow(10.0, std::floor(det::log10(rough)));
   for (double f : {1.0, 2.0, 5.0, 10.0})
     if (f * decade >= rough * (1 - 1e-9)) {
       t.step = f * decade;
       break;
     }
-  const int decimals = std::max(0, int(std::ceil(-std::log10(t.step) - 1e-9)));
+  const int decimals = std::max(0, int(std::ceil(-det::log10(t.step) - 1e-9)));
   for (double k = std::ceil(lo / t.step - 1e-9); k * t.step <= hi + 1e-9 * t.step; k += 1) {
     char b[64];
     std::snprintf(b, sizeof b, "%.*f", decimals, std::abs(k) < 0.5 ? 0.0 : k * t.step);
