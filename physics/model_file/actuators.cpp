@@ -8,6 +8,8 @@
 #include <Eigen/LU>
 #include <cstdio>
 
+#include "physics/model_file/number_text.h"
+
 namespace dyn::model_file {
 
 VecN actuatorTorques(const std::vector<Actuator>& actuators, const VecN& ctrl, const VecN& q, const VecN& v) {
@@ -54,11 +56,7 @@ class Actuated final : public ConstrainedSystem {
   VecN ctrl_;
 };
 
-std::string number(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", x);
-  return b;
-}
+std::string number(double x) { return detail::numberText(x, 6); }
 
 }  // namespace
 

@@ -9,11 +9,12 @@
 #include <random>
 
 #include "physics/model_file/model_file.h"
+#include "physics/model_file/number_text.h"
 
 namespace dyn::model_file {
 namespace {
 
-std::string num(double x) { char b[32]; std::snprintf(b, sizeof b, "%.3g", x); return b; }
+std::string num(double x) { return detail::numberText(x, 3); }
 
 // Ĝ(q) = D_r G(q) D_c: translation rows ÷ L, slide columns × L.
 Eigen::MatrixXd scaledJacobian(ConstrainedMechanism<Spatial>& mech, const VecN& q, const RowCandidates& rows) {

@@ -8,6 +8,7 @@
 #include "physics/constrained_mechanism.h"
 #include "physics/model_file/closure_rows.h"
 #include "physics/model_file/mujoco_call.h"
+#include "physics/model_file/number_text.h"
 
 namespace dyn::model_file::detail {
 
@@ -18,11 +19,7 @@ std::string named(const mjModel* m, int type, int id, const char* what) {
   return n && *n ? std::string(n) : std::string(what) + " #" + std::to_string(id);
 }
 
-std::string num(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", x);
-  return b;
-}
+std::string num(double x) { return detail::numberText(x, 6); }
 
 constexpr double kLargest = 1e9;  // as model_file.cpp's checkNumbers
 

@@ -14,6 +14,7 @@
 #include <memory>
 
 #include "physics/model_file/mujoco_call.h"
+#include "physics/model_file/number_text.h"
 
 namespace dyn::model_file::detail {
 namespace {
@@ -106,11 +107,7 @@ std::vector<bool> duplicates(const mjModel* m) {
   return out;
 }
 
-std::string num(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.3g", x);
-  return b;
-}
+std::string num(double x) { return detail::numberText(x, 3); }
 
 }  // namespace
 

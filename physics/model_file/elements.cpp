@@ -10,6 +10,7 @@
 #include "physics/constraints/plane_contact.h"
 #include "physics/constraints/rolling.h"
 #include "physics/model_file/mujoco_call.h"
+#include "physics/model_file/number_text.h"
 
 namespace dyn::model_file::detail {
 namespace {
@@ -17,11 +18,7 @@ namespace {
 using Vec3 = Eigen::Vector3d;
 using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 
-std::string num(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", x);
-  return b;
-}
+std::string num(double x) { return detail::numberText(x, 6); }
 
 // The place of an element's body: its MuJoCo body's pose at q0 and the tree body it moves with.
 struct Place {

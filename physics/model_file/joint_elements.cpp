@@ -9,6 +9,7 @@
 #include "physics/constraints/coupling.h"
 #include "physics/constraints/joint_limit.h"
 #include "physics/model_file/mujoco_call.h"
+#include "physics/model_file/number_text.h"
 
 namespace dyn::model_file::detail {
 namespace {
@@ -25,12 +26,7 @@ Coupling::Form tendonForm(const mjModel* m, int t) {
   return f;
 }
 
-// A number as the errors show it (6 significant digits).
-std::string num(double x) {
-  char text[32];
-  std::snprintf(text, sizeof text, "%.6g", x);
-  return text;
-}
+std::string num(double x) { return detail::numberText(x, 6); }
 
 }  // namespace
 

@@ -33,6 +33,7 @@
 #include <sstream>
 
 #include "physics/model_file/mujoco_call.h"
+#include "physics/model_file/number_text.h"
 
 namespace dyn::model_file::detail {
 namespace {
@@ -41,11 +42,7 @@ using tinyxml2::XMLElement;
 
 bool is(const XMLElement* e, const char* name) { return std::strcmp(e->Name(), name) == 0; }
 
-std::string num(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.17g", x);
-  return b;
-}
+std::string num(double x) { return detail::numberText(x, 17); }
 
 std::string shortNum(double x) {
   char b[32];

@@ -19,6 +19,7 @@
 #include "physics/constraints/point_closure.h"
 #include "physics/model_file/closure_rows.h"
 #include "physics/model_file/mujoco_call.h"
+#include "physics/model_file/number_text.h"
 
 namespace dyn::model_file {
 
@@ -33,11 +34,7 @@ struct DataDeleter {
 };
 using DataPtr = std::unique_ptr<mjData, DataDeleter>;
 
-std::string num(double x) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%g", x);
-  return b;
-}
+std::string num(double x) { return detail::numberText(x, 6); }
 
 std::string nameOf(const mjModel* m, int type, int id, const char* what) {
   const char* n = mj_id2name(m, type, id);
