@@ -68,9 +68,10 @@ Engine handWithElements(const model_file::LoadedModel& m, const char* scheme, st
   Engine x;
   x.name = "hand";
   x.scheme = std::string(scheme) + " (dynamic sizes; contacts closed and opened between steps, touchdowns located)";
-  x.step = [=, &m] {
-    // The file's actuators at the step's start, held over it (labs/generic/model_run.cpp's runHandElements).
-    const VecN tau = model_file::actuatorTorques(m, *q, *v);
+  // The zero torque made once (a step allocates nothing); with actuators, theirs at the step's start,
+  // held over it (labs/generic/model_run.cpp's runHandElements).
+  x.step = [=, &m, tau = VecN(VecN::Zero(m.q0.size()))]() mutable {
+    if (!m.actuators.empty()) tau = model_file::actuatorTorques(m, *q, *v);
     (*mech)->updateContacts(*q, *v, tau);
     return (*mech)->stepLocatingContacts(o, tau, *q, *v) && q->allFinite() && v->allFinite();
   };
