@@ -8,24 +8,17 @@
 
 #include <Eigen/Geometry>
 #include <cstdio>
-#include <fstream>
 #include <regex>
 #include <sstream>
 
 #include "fixtures.h"
+#include "tests/test_files.h"
 #include "labs/generic/model_run.h"
 #include "physics/constrained_mechanism.h"
 #include "physics/model_file/closure_rows.h"
 
 namespace dyn::test_model_file {
 namespace {
-
-std::string readText(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 std::string g17(double x) {
   char b[40];
@@ -94,7 +87,7 @@ TEST_CASE("every example loop, turned and moved anywhere, stays closed and moves
     for (const auto& [r, p] : poses) {
       CAPTURE(name);
       CAPTURE(index);
-      const std::filesystem::path file = writeFile(dir, "turned_" + std::to_string(index++) + "_" + name, turned(readText(model(name)), r, p));
+      const std::filesystem::path file = writeFile(dir, "turned_" + std::to_string(index++) + "_" + name, turned(test::readBytes(model(name)), r, p));
       const Run t = passive(file.string(), 0.5);
       CHECK(t.model.dof == as_written.model.dof);
       CHECK(t.model.closures.size() == as_written.model.closures.size());
@@ -122,7 +115,7 @@ TEST_CASE("every example loop, turned and moved anywhere, stays closed and moves
 
 TEST_CASE("the issue's four-bar: both roots a quarter turn about z keeps y and z, drops x") {
   const std::filesystem::path dir = scratchFolder("closure_rows_issue");
-  std::string text = readText(model("fourbar.xml"));
+  std::string text = test::readBytes(model("fourbar.xml"));
   const std::string quat = " quat=\"0.7071067811865476 0 0 0.7071067811865475\"";
   text.replace(text.find("<body name=\"crank\""), std::string("<body name=\"crank\"").size(), "<body name=\"crank\"" + quat);
   text.replace(text.find("<body name=\"rocker\" pos=\"0.5 0 0\""), std::string("<body name=\"rocker\" pos=\"0.5 0 0\"").size(),
