@@ -161,7 +161,7 @@ int runLab(const RunArgs& a) {
       staging.write(std::string("trace_") + engine + ".csv", (*r)->trace.csv());
       // A stopped run's trace is kept (it shows the blow-up) but its metrics are omitted (engineSummary).
       summary["engines"][engine] = engineSummary(lab, **r);
-      if (!(*r)->failure.empty()) status += (status.empty() ? "" : "; ") + std::string(engine) + ": " + (*r)->failure;
+      if (!(*r)->failure.empty()) status += (status.empty() ? "" : "; ") + std::string(engine) + ": " + termText((*r)->failure);
     }
     if (status.empty()) status = "ok";
     if (hand && bullet && hand->failure.empty() && bullet->failure.empty())
@@ -191,7 +191,7 @@ int runLab(const RunArgs& a) {
       const char* engine = r == &hand ? "hand" : "bullet";
       std::printf("  %-6s trace    %s\n", engine, (out / (std::string("trace_") + engine + ".csv")).c_str());
       if (!(*r)->failure.empty())
-        std::printf("  %-6s STOPPED  %s (trace up to there; metrics omitted)\n", engine, (*r)->failure.c_str());
+        std::printf("  %-6s STOPPED  %s (trace up to there; metrics omitted)\n", engine, termText((*r)->failure).c_str());
     }
     std::printf("  summary         %s\n", (out / "summary.json").c_str());
     if (a.video) std::printf("  video           %s (%d frames)\n", (out / "video.mp4").c_str(), frames);
