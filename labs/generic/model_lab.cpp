@@ -103,7 +103,7 @@ class ModelFileLab final : public Lab {
       drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
       residual = std::max(residual, tr.at(r, "constraint_residual"));
     }
-    return {{"energy_drift", drift}, {"max_constraint_residual", residual}, {"steps", tr.rows()}};
+    return {{"energy_drift", drift}, {"max_constraint_residual", residual}, {"steps", tr.steps()}};
   }
   json agreement(const Trace& a, const Trace& b) const override {
     double dq = 0, df = 0;
