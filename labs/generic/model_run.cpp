@@ -75,6 +75,14 @@ double frictionPower(const MechanismModel<Spatial>& d, const VecN& v) {
 }
 
 
+std::vector<std::string> modelNotes(const model_file::LoadedModel& m, double dt) {
+  std::vector<std::string> notes = m.notes;
+  for (const std::string& n : m.drawing.notes) notes.push_back("drawing: " + n);
+  ConstrainedMechanism<Spatial> mech(m.mechanism);
+  if (std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), dt); !stiff.empty()) notes.push_back(std::move(stiff));
+  return notes;
+}
+
 // A rigid plane contact among the model's elements: its touchdowns are plastic impacts.
 bool anyImpacts(const model_file::LoadedModel& m) {
   for (std::size_t i = 0; i < m.contacts.size(); ++i)
@@ -151,15 +159,16 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
   int closure_rows = 0;
   for (const auto& c : m.closures) closure_rows += int(c.kept.size());
   const bool impacts = anyImpacts(m);
-  ConstrainedMechanism<Spatial> engine(m.mechanism);
+  // The file's actuators and tendons evaluated at each stage of the step, as runHand's engine does
+  // (actuators.h); the step's contact updates see them at its start.
+  model_file::DrivenMechanism engine(m);
   engine.setTime(0);
   engine.books() = Books{};
   model_file::EveryClosureRow every(m);
   VecN q = m.start_q, v = m.start_v;
   for (int k = 0; k <= steps; ++k) {
-    // The file's actuators at the step's start, held over it (as a lab's controller's torques are).
-    const VecN driven = tau + model_file::actuatorTorques(m, q, v);
-    engine.updateContacts(q, v, driven);
+    VecN driven = engine.hold(q, v, tau);
+    if (engine.updateContacts(q, v, driven) > 0) driven = engine.hold(q, v, tau);  // an impact changed v
     const auto s = engine.solve(q, v, driven);
     std::vector<double> row(s.eta.data(), s.eta.data() + closure_rows);
     const double loss = engine.impactLoss();

@@ -37,6 +37,11 @@ double frictionPower(const MechanismModel<Spatial>& d, const VecN& v);
 // its plane. desc: the model's description as a mechanism (its contacts open: gaps read, not held).
 double elementResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, const VecN& q, const VecN& v);
 
+// What a run of the model at step dt should say once, beside its numbers: the loader's notes (geoms that
+// collide in MuJoCo but not here, limits read and not held, tendon friction, ...), what is drawn other
+// than as written, and servos stiffer than RK4 follows at dt (actuators.h's stiffServoNote).
+std::vector<std::string> modelNotes(const model_file::LoadedModel& m, double dt);
+
 // The runs, `duration` s at fixed step dt, τ held (n joint torques). mech/desc: the model's
 // description as a mechanism (energy, residual and the rows' solves). runHand steps loops only (the
 // sized engine, hand_engine.h); runHandElements a model with wheels or contacts; runBullet either.

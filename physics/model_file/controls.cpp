@@ -113,6 +113,13 @@ void readStart(const std::string& path, const mjModel* m, const std::string& key
     checkFinite(where, "ctrl", m->key_ctrl + chosen * m->nu, m->nu);
     out.ctrl = Eigen::Map<const VecN>(m->key_ctrl + chosen * m->nu, m->nu);
   }
+  // The joints' stops held (joint_elements.cpp) must not be passed there.
+  for (const Contact& c : out.contacts) {
+    if (c.kind != "joint_limit") continue;
+    if (const Joint& jt = out.joints[std::size_t(c.link)]; !(out.start_q[c.link] >= jt.lower - 1e-9 && out.start_q[c.link] <= jt.upper + 1e-9))
+      throw ModelFileError(where + ": its qpos puts joint '" + jt.name + "' at " + num(out.start_q[c.link]) + ", outside its range [" + num(jt.lower) +
+                           ", " + num(jt.upper) + "]; a keyframe must start inside the joints' ranges");
+  }
   // The loops must hold there (as at q0: 1e-9), and their velocity form with qvel.
   ConstrainedMechanism<Spatial> mech(out.mechanism);
   for (std::size_t i = 0; i < out.closures.size(); ++i)

@@ -46,6 +46,8 @@ void checkTendons(const std::string& path, const mjModel* m) {
     const std::string tendon = "tendon '" + named(m, mjOBJ_TENDON, t, "tendon") + "'";
     for (int w = m->tendon_adr[t]; w < m->tendon_adr[t] + m->tendon_num[t]; ++w)
       if (m->wrap_type[w] != mjWRAP_JOINT) fail(tendon + " is a spatial tendon (it wraps sites or geoms); " + held);
+      else if (!std::isfinite(m->wrap_prm[w]) || std::abs(m->wrap_prm[w]) > 1e9)
+        fail(tendon + "'s coef is " + num(m->wrap_prm[w]) + "; dynlab reads finite values within ±1e+09");
     if (m->tendon_limited[t]) fail(tendon + " has a range (limited); " + held + ", not tendon limits (limit its joints instead)");
     const double numbers[4] = {m->tendon_stiffness[t], m->tendon_lengthspring[t], m->tendon_damping[t], m->tendon_frictionloss[t]};
     for (const double x : numbers)
@@ -85,10 +87,12 @@ void addJointElements(const std::string& path, const mjModel* m, const LoadOptio
       out.notes.push_back("joint '" + jt.name + "': limit [" + num(jt.lower) + ", " + num(jt.upper) + "] " + (jt.type == "hinge" ? "rad" : "m") + " read, not enforced (a data lab: its controller keeps the joint inside)");
       continue;
     }
+    // A run from a keyframe starts there (controls.cpp's readStart checks it); else from q0.
     const double q0 = out.q0[j];
-    if (!(q0 >= jt.lower - 1e-9 && q0 <= jt.upper + 1e-9))
+    if (options.key.empty() && !(q0 >= jt.lower - 1e-9 && q0 <= jt.upper + 1e-9))
       throw ModelFileError(path + ": joint '" + jt.name + "' starts at " + num(q0) + ", outside its range [" + num(jt.lower) + ", " + num(jt.upper) +
-                           "] (its ref, or 0); expected the reference pose inside the range");
+                           "] (its ref, or 0); expected the reference pose inside the range" +
+                           (m->nkey > 0 ? std::string(", or a keyframe that starts inside it (--key NAME)") : ""));
     const int parent = mech.tree.bodies[std::size_t(j)].parent;
     for (const JointLimit::Side side : {JointLimit::Side::Lower, JointLimit::Side::Upper}) {
       const bool lower = side == JointLimit::Side::Lower;

@@ -6,7 +6,7 @@
 //  * from the keyframe, the hand engine's RK4 run is MuJoCo's RK4 run to rounding (and parts from it at
 //    once without the tendons' forces);
 //  * a tendon's frictionloss is read and noted (Coulomb smoothed as a joint's); a tendon limit stays
-//    refused in one line.
+//    refused in one line, and so does a coefficient past ±1e9.
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -104,4 +104,6 @@ TEST_CASE("a tendon's frictionloss is read as smoothed Coulomb friction and note
   CHECK(tau[1] == doctest::Approx(-0.4));
   const std::string ranged = arm + R"(<tendon><fixed name="t" range="-1 1"><joint joint="a" coef="1"/></fixed></tendon></mujoco>)";
   CHECK(errorOf(writeFile(dir, "ranged.xml", ranged)).find("tendon 't' has a range (limited); dynlab reads fixed tendons") != std::string::npos);
+  const std::string huge = arm + R"(<tendon><fixed name="t"><joint joint="a" coef="1e300"/></fixed></tendon></mujoco>)";
+  CHECK(errorOf(writeFile(dir, "huge.xml", huge)).find("tendon 't''s coef is 1e+300; dynlab reads finite values") != std::string::npos);
 }
