@@ -8,6 +8,7 @@
 
 #include "labs/trace.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/model_file/closure_rows.h"
 #include "physics/model_file/model_file.h"
 
 namespace dyn::app {
@@ -28,6 +29,11 @@ Trace modelColumns(const model_file::LoadedModel& m);
 
 // A rigid plane contact among the model's elements: its touchdowns are plastic impacts.
 bool anyImpacts(const model_file::LoadedModel& m);
+
+// |φ|∞ a run of the model reports at a state: the rows the description holds (the closures' kept rows; with
+// dynlab's elements, elementResidual) and every closure row, the dropped ones too (closure_rows.h).
+double runResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q,
+                   const VecN& v);
 
 // The power the joints' damping and friction take out of the mechanism (≥ 0), by the description's law.
 double frictionPower(const MechanismModel<Spatial>& d, const VecN& v);

@@ -99,6 +99,8 @@ struct Contact {
   std::string body;  // the MuJoCo body (URDF link) it is on
   int link = -1;     // the tree body it moves with
   double mu = 0;     // rolling: the skid report's μ (and Bullet's friction model); plane: Bullet's friction
+  // A coupling row (an <equality> joint or tendon): its trace column is η, its generalised force.
+  bool coupling() const { return kind == "joint_coupling" || kind == "tendon_coupling"; }
 };
 
 // What the file draws (drawing only: the dynamics never reads it). Each shape is fixed to a tree body

@@ -174,7 +174,7 @@ std::vector<Accuracy> accuracy(std::vector<Engine>& engines, const model_file::L
         break;
       }
       path[i].push_back(q);
-      out[i].residual = std::max({out[i].residual, m.contacts.empty() ? mech.residual(q) : elementResidual(m, mech, q, v), every.residual(q)});
+      out[i].residual = std::max(out[i].residual, runResidual(m, mech, every, q, v));
       if (k < steps && !e.step()) {
         out[i].complete = false;
         break;

@@ -158,7 +158,7 @@ std::string report(const ModelRun& r, const std::string& engine, const model_fil
     for (const auto& c : m.contacts) {
       const std::string n = columnName(c.name);
       double extreme = c.kind == "rolling" ? 0.0 : INFINITY;
-      const bool coupling = c.kind != "rolling" && c.kind != "plane_contact" && c.kind != "joint_limit";  // no gap column
+      const bool coupling = c.coupling();  // no gap column
       for (std::size_t row = 0; row < t.rows() && !coupling; ++row)
         extreme = c.kind == "rolling" ? std::max(extreme, std::abs(t.at(row, "slip_" + n))) : std::min(extreme, t.at(row, "gap_" + n));
       if (c.kind == "joint_limit")
