@@ -133,7 +133,7 @@ class ModelFileLab final : public Lab {
   }
   void overlay(const Trace& tr, std::size_t row, Overlay& o) const override {
     o.title = title_;
-    modelOverlay(o.title, "passive (τ = 0)", tr, row, dt_, nullptr, o);
+    modelOverlay(o.title, m_->actuators.empty() ? "passive (τ = 0)" : "the file's actuators, ctrl held", tr, row, dt_, nullptr, o);
   }
 
  private:
