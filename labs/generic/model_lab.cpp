@@ -133,7 +133,7 @@ class ModelFileLab final : public Lab {
   }
   void overlay(const Trace& tr, std::size_t row, Overlay& o) const override {
     o.title = title_;
-    modelOverlay(o.title, "passive (τ = 0)", tr, row, dt_, nullptr, o);
+    modelOverlay(o.title, m_->actuators.empty() ? "passive (τ = 0)" : "the file's actuators, ctrl held", tr, row, dt_, nullptr, o);
   }
 
  private:
@@ -150,7 +150,7 @@ class ModelFileLab final : public Lab {
 
 }  // namespace
 
-LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, const ModelFileFlags& flags) {
+LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, const ModelFileFlags& flags, std::vector<std::string>* notes) {
   model_file::LoadOptions options;
   options.ignore_contacts = flags.ignore_contacts;
   options.package_paths = flags.package_paths;
@@ -173,6 +173,7 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, 
     throw InputError(file, "<option timestep>", problem);
   };
   if (const std::string problem = runBoundProblem(dt, duration.value_or(2.0), 0, step); !problem.empty()) refuse(problem);
+  if (notes) *notes = modelNotes(*m, dt);
   // Its figures: the coordinates, the energy books, each closure's force, each wheel's and contact's.
   std::vector<std::string> q, f, c;
   for (const auto& j : m->joints) q.push_back("q_" + columnName(j.name));

@@ -97,8 +97,14 @@ void readDrawing(const mjModel* m, const mjData* d, const std::vector<int>& link
 void addElements(const std::string& path, const mjModel* m, const mjData* d, const std::vector<int>& link,
                  const std::vector<Eigen::Vector3d>& origin, const LoadOptions& options, LoadedModel& out);
 
-// Tendons and tendon or muscle actuators dynlab cannot hold, refused in one line (joint_elements.cpp).
+// Tendons and muscle actuators dynlab cannot hold, refused in one line (joint_elements.cpp).
 void checkTendons(const std::string& path, const mjModel* m);
+
+// Fixed tendon t's length as a linear form of the coordinates (joint_elements.cpp).
+std::vector<TendonTerm> fixedTendonPath(const mjModel* m, int t);
+
+// The fixed tendons with stiffness, damping or frictionloss into out.tendons, each noted (joint_elements.cpp).
+void readTendons(const mjModel* m, LoadedModel& out);
 
 // The file's joint limits and joint and fixed-tendon equalities onto out's description, after its
 // closures, and into out.contacts (joint_elements.cpp).
