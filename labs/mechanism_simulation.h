@@ -177,16 +177,19 @@ class MechanismSimulation final : public Simulation {
     return true;
   }
 
-  // The row at t = duration: the state the last step reached, its energy, residual and work, the torque
-  // of the last step (held up to this instant) and the constraint forces with it there. No step follows:
-  // the controller is not sampled again and its sensors see nothing more.
+  // The row at t = duration, written as every row is but with no step after it: the state the last step
+  // reached, its energy, residual and work, the controller's τ there and the constraint forces with it
+  // (the hand engine solves eq. (2) at that state; Bullet's stay its last step's impulses / dt). The
+  // sensors see nothing more (no observe) and no watchdog runs.
   bool closingRow(std::vector<double>& row) {
     closed_ = true;
-    stepper_->setTime(double(steps_) * dt_);
+    const double t = double(steps_) * dt_;
+    tau_ = hooks_->torque(t, q_, v_);
+    stepper_->setTime(t);
     stepper_->forcesNow(tau_);
     const double energy = model_->energy(q_, v_);
     const double residual = model_->holonomic() ? model_->residual(q_) : model_->residual(q_, v_);
-    const StepRecord r{engine_, double(steps_) * dt_, q_, v_, tau_, stepper_->forces(), energy, residual, work_};
+    const StepRecord r{engine_, t, q_, v_, tau_, stepper_->forces(), energy, residual, work_};
     hooks_->row(r, row);
     return true;
   }
