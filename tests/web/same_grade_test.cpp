@@ -7,6 +7,8 @@
 // descriptions). Skipped (DYNLAB_TEST_SKIPPED) when scripts/web has not been run or node is missing.
 #include <doctest/doctest.h>
 
+#include <iostream>
+
 #include "tests/app/cli_run.h"
 #include "tests/app/lab_examples.h"
 
