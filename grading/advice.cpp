@@ -159,7 +159,8 @@ std::vector<AdviceEntry> parseAdvice(const JsonView& v, const JsonView& config) 
 bool adviceApplies(const AdviceEntry& entry, const AdviceContext& c) {
   const json options = c.config.value("submission_options", json::object());
   for (const auto& [key, want] : entry.when.items()) {
-    const auto in = [&](const std::string& x) {
+    // want by name: clang 14 (emscripten's, app/web) cannot capture a structured binding.
+    const auto in = [&want = want](const std::string& x) {
       for (const auto& w : want)
         if (w == x) return true;
       return false;

@@ -199,9 +199,9 @@ double JsonView::inRange(double lo, double hi) const {
   return x;
 }
 
-long JsonView::integer(long lo, long hi) const {
+long long JsonView::integer(long long lo, long long hi) const {
   if (!value_->is_number_integer()) fail("expected an integer" + got());
-  const long x = value_->get<long>();
+  const long long x = value_->get<long long>();
   if (x < lo || x > hi)
     fail("expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]" + got());
   return x;

@@ -64,7 +64,7 @@ class JsonView {
   double positive(double max) const;  // in (0, max]
   double nonNegative() const;
   double inRange(double lo, double hi) const;
-  long integer(long lo, long hi) const;
+  long long integer(long long lo, long long hi) const;  // long long: 64 bits in WebAssembly too
   bool boolean() const;
   std::string string() const;
   std::string oneOf(std::initializer_list<const char*> choices) const;

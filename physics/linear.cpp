@@ -105,7 +105,7 @@ void analyseSampled(const LinearLoop& loop, LoopAnalysis& a) {
   // delay exactly when NT < PM/ω_c, i.e. when the loop is stable.
   const auto L = [&](double w) {
     const std::complex<double> z = det::polar(1.0, w * T);
-    return polyEval(num, z) / polyEval(den_free, z);
+    return det::div(polyEval(num, z), polyEval(den_free, z));
   };
   const std::vector<Crossing> cs = crossings(L, 1e-3, M_PI / T * (1 - 1e-9));
   const double base = loop.delay - N * T;
@@ -230,7 +230,7 @@ LoopAnalysis analyseLoop(const LinearLoop& loop, int order) {
   summarise(a);
 
   // Gain crossovers of the delay-free loop; the delay margin is the least over them.
-  const auto L = [&](double w) { return polyEval(loop.num, {0, w}) / polyEval(loop.den, {0, w}); };
+  const auto L = [&](double w) { return det::div(polyEval(loop.num, {0, w}), polyEval(loop.den, {0, w})); };
   const double w_lo = 1e-3, w_hi = 1e6;
   const std::vector<Crossing> cs = crossings(L, w_lo, w_hi);
   double best = kUnboundedDelay;

@@ -303,7 +303,7 @@ void parseController(const JsonView& ctl, DataSettings& s) {
     nz.onlyKeys({"angle", "rate", "force", "seed"});
     cs.noise_angle = nz["angle"].inRange(0, 1), cs.noise_rate = nz["rate"].inRange(0, 100);
     cs.noise_force = nz.has("force") ? nz["force"].inRange(0, kMaxForce) : 0.0;
-    cs.seed = std::uint64_t(nz["seed"].integer(0, 1L << 53));
+    cs.seed = std::uint64_t(nz["seed"].integer(0, 1LL << 53));
   }
   cs.constant = VecN::Zero(m);
   if (ctl.has("constant")) {

@@ -179,7 +179,7 @@ Settings parseSettings(const JsonView& c) {
   }
   cc.delay = ctl.has("delay") ? ctl["delay"].inRange(0, 1) : 0.0;
   cc.noise_std = ctl.has("noise_std") ? ctl["noise_std"].inRange(0, kMaxForce) : 0.0;
-  cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1L << 53)) : 1;
+  cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1LL << 53)) : 1;
   const auto g = parseGains(c["gains"], {"kp_pos", "kd_pos", "kp_psi", "kd_psi", "f_squeeze", "ki_int", "k_cone"});
   cc.gains = {g.at("kp_pos"), g.at("kd_pos"), g.at("kp_psi"), g.at("kd_psi"), g.at("f_squeeze"), g.at("ki_int"), g.at("k_cone")};
 

@@ -211,7 +211,7 @@ Settings parseSettings(const JsonView& c) {
   if (!(cc.f_zd < 0)) ctl["force_setpoint"].fail("expected a set point f_zd < 0 (N): the force the pen applies to the table, negative pressing");
   cc.delay = ctl["delay"].inRange(0, 1);
   cc.noise = ctl.has("noise") ? ctl["noise"].inRange(0, kMaxForce) : 0.0;
-  cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1L << 53)) : 1;
+  cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1LL << 53)) : 1;
   cc.table_assumed = ctl.has("table_height_assumed") ? ctl["table_height_assumed"].inRange(-kMaxLength, kMaxLength) : p.table_height;
   cc.approach_speed = ctl["approach_speed"].positive(10.0);
   if (cc.kind == ControllerKind::Constant) {

@@ -109,7 +109,7 @@ Settings parseSettings(const JsonView& c) {
   cc.f_des = ctl["force_setpoint"].inRange(-1e4, 1e4);
   cc.delay = ctl["delay"].inRange(0, 1);
   cc.noise_std = ctl.has("noise_std") ? ctl["noise_std"].inRange(0, 1e4) : 0.0;
-  cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1L << 53)) : 1;
+  cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1LL << 53)) : 1;
 
   // Gains: declared with value and bounds (the submission schema comes from here).
   const auto g = parseGains(c["gains"], {"kp_x", "kd_x", "kp_f", "ki_f"});

@@ -149,7 +149,7 @@ Settings parseSettings(const JsonView& c) {
   }
   cc.delay = ctl.has("delay") ? ctl["delay"].inRange(0, 1) : 0.0;
   cc.speed_noise = ctl.has("speed_noise") ? ctl["speed_noise"].inRange(0, kMaxRate) : 0.0;
-  cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1L << 53)) : 1;
+  cc.seed = ctl.has("seed") ? std::uint64_t(ctl["seed"].integer(0, 1LL << 53)) : 1;
   const auto g = parseGains(c["gains"], {"kp_speed", "ki_speed", "kp_heading", "kd_heading", "k_cross", "a_lat"});
   cc.gains = {g.at("kp_speed"), g.at("ki_speed"), g.at("kp_heading"), g.at("kd_heading"), g.at("k_cross"), g.at("a_lat")};
   if (!(cc.gains.a_lat > 0)) c["gains"]["a_lat"].fail("expected a cornering limit a_lat > 0 (m/s²): the leader must be able to turn");

@@ -32,5 +32,8 @@ inline double abs(std::complex<double> z) { return hypot(z.real(), z.imag()); }
 inline double arg(std::complex<double> z) { return atan2(z.imag(), z.real()); }
 inline std::complex<double> polar(double r, double theta) { return {r * cos(theta), r * sin(theta)}; }
 inline std::complex<double> log(std::complex<double> z) { return {log(abs(z)), arg(z)}; }
+// n / d as g++'s libgcc divides (__divdc3, Smith's ratio with its scalings: the native bits), written
+// out so libc++'s own algorithm (logb/scalbn scaling, WebAssembly) is never used (det_complex.cpp).
+std::complex<double> div(std::complex<double> n, std::complex<double> d);
 
 }  // namespace det

@@ -4,11 +4,26 @@
 
 #include <bit>
 #include <cstdint>
+#include <cstring>
 
 namespace det::internal {
 
+// The same bits by memcpy where the library has no std::bit_cast (libc++ 14: emscripten 3.1.6, app/web).
+#if defined(__cpp_lib_bit_cast)
 inline std::uint64_t bits(double x) { return std::bit_cast<std::uint64_t>(x); }
 inline double fromBits(std::uint64_t b) { return std::bit_cast<double>(b); }
+#else
+inline std::uint64_t bits(double x) {
+  std::uint64_t b;
+  std::memcpy(&b, &x, sizeof b);
+  return b;
+}
+inline double fromBits(std::uint64_t b) {
+  double x;
+  std::memcpy(&x, &b, sizeof x);
+  return x;
+}
+#endif
 inline int biasedExponent(double x) { return int((bits(x) >> 52) & 0x7ff); }
 
 // A value hi + lo with |lo| ≤ ulp(hi)/2.

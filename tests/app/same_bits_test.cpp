@@ -4,9 +4,8 @@
 // writes the same trace. Before physics/det, 0 of the 29 examples agreed.
 #include <doctest/doctest.h>
 
-#include <regex>
-
 #include "tests/app/cli_run.h"
+#include "tests/app/lab_examples.h"
 
 using namespace dyn::test::cli;
 
@@ -14,22 +13,11 @@ namespace {
 
 const std::pair<std::string, std::string> kNoFma = {"GLIBC_TUNABLES", "glibc.cpu.hwcaps=-AVX2_Usable,-FMA_Usable,-AVX2,-FMA"};
 
-// results.json without its one line that may differ between two runs (the wall time).
-std::string withoutTime(const fs::path& results) {
-  return std::regex_replace(readFile(results), std::regex(R"("execution_time": [^,\n]*)"), "\"execution_time\": _");
-}
-
-std::vector<fs::path> examples(const std::string& lab) {
-  std::vector<fs::path> out;
-  for (const auto& e : fs::directory_iterator(fs::path(DYNLAB_SOURCE_DIR) / "labs" / lab / "examples"))
-    if (e.path().extension() == ".json") out.push_back(e.path());
-  std::sort(out.begin(), out.end());
-  return out;
-}
+std::string withoutTime(const fs::path& results) { return dyn::test::withoutExecutionTime(readFile(results)); }
 
 void checkLab(const std::string& lab) {
   TempDir dir("same_bits_" + lab);
-  const auto files = examples(lab);
+  const auto files = dyn::test::labExamples(lab);
   REQUIRE(!files.empty());
   for (const fs::path& ex : files) {
     CAPTURE(ex);
