@@ -224,6 +224,7 @@ struct BulletMechanism<Spatial>::Impl {
     if (!model.bullet.cut_joints.empty()) throw std::invalid_argument(who + "cut joints: not yet");
     if (const std::string why = model.validate(); !why.empty()) throw std::invalid_argument(who + why);
     if (model.tree.bodies.empty()) throw std::invalid_argument(who + "the mechanism has no tree bodies");
+    if (!model.tree.balls.empty()) throw std::invalid_argument(who + "ball and free joints are not mapped onto Bullet's multibody yet");
     if (model.bullet.solver_iterations < 1) throw std::invalid_argument(who + "solver_iterations must be ≥ 1");
     const int n = model.treeDof();
     if (q0.size() != n || v0.size() != n)

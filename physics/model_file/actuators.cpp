@@ -18,7 +18,7 @@ VecN actuatorTorques(const std::vector<Actuator>& actuators, const VecN& ctrl, c
     const Actuator& a = actuators[i];
     double u = ctrl[Eigen::Index(i)];
     if (a.ctrl_limited) u = std::clamp(u, a.ctrl_lower, a.ctrl_upper);
-    const double length = a.gear * q[a.coordinate], rate = a.gear * v[a.coordinate];
+    const double length = a.gear * q[a.qpos], rate = a.gear * v[a.coordinate];
     double force = a.gain * u + a.bias[0] + a.bias[1] * length + a.bias[2] * rate;
     if (a.force_limited) force = std::clamp(force, a.force_lower, a.force_upper);
     tau[a.coordinate] += a.gear * force;
@@ -41,6 +41,10 @@ class Actuated final : public ConstrainedSystem {
     inner_->derivatives(q, v, tau + actuatorTorques(actuators_, ctrl_, q, v), stab, a, work, friction);
   }
   int nq() const override { return inner_->nq(); }
+  int nv() const override { return inner_->nv(); }
+  void configurationRate(const VecN& q, const VecN& v, VecN& qdot) override { inner_->configurationRate(q, v, qdot); }
+  void integrateConfiguration(VecN& q, const VecN& dx, double h) override { inner_->integrateConfiguration(q, dx, h); }
+  void normalizeConfiguration(VecN& q) override { inner_->normalizeConfiguration(q); }
   void accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a) override {
     inner_->accelerations(q, v, tau + actuatorTorques(actuators_, ctrl_, q, v), stab, a);
   }

@@ -46,7 +46,9 @@ Actuator readActuator(const std::string& path, const mjModel* m, int i) {
     throw ModelFileError(where + " has a muscle or user bias; " + kSupported);
   const int j = m->actuator_trnid[2 * i];
   a.joint = named(m, mjOBJ_JOINT, j, "joint");
+  if (m->jnt_type[j] == mjJNT_BALL || m->jnt_type[j] == mjJNT_FREE) throw ModelFileError(where + " drives a ball or free joint; " + kSupported);
   a.coordinate = m->jnt_dofadr[j];
+  a.qpos = m->jnt_qposadr[j];
   checkFinite(where, "gear", m->actuator_gear + 6 * i, 1);
   checkFinite(where, "gain", m->actuator_gainprm + mjNGAIN * i, 1);
   a.gear = m->actuator_gear[6 * i];

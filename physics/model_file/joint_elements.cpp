@@ -61,7 +61,7 @@ void addJointElements(const std::string& path, const mjModel* m, const LoadOptio
       out.notes.push_back("joint '" + jt.name + "': limit [" + num(jt.lower) + ", " + num(jt.upper) + "] " + (jt.type == "hinge" ? "rad" : "m") + " read, not enforced (a data lab: its controller keeps the joint inside)");
       continue;
     }
-    const double q0 = out.q0[j];
+    const double q0 = out.q0[jt.qpos];
     if (!(q0 >= jt.lower - 1e-9 && q0 <= jt.upper + 1e-9))
       throw ModelFileError(path + ": joint '" + jt.name + "' starts at " + num(q0) + ", outside its range [" + num(jt.lower) + ", " + num(jt.upper) +
                            "] (its ref, or 0); expected the reference pose inside the range");

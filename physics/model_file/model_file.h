@@ -130,9 +130,11 @@ struct Drawing {
   std::vector<std::string> notes;  // what is drawn other than as written (an ellipsoid as its bounding capsule, ...)
 };
 
-// A joint as the file names it (one per coordinate, in coordinate order).
+// A joint as the file names it (one per rate, in v's order: a ball joint's three rates NAME_wx, NAME_wy,
+// NAME_wz, a free joint's six NAME_x … NAME_wz).
 struct Joint {
-  std::string name, body, type;  // type: "hinge" or "slide"
+  std::string name, body, type;  // type: "hinge", "slide", "ball" or "free"
+  int qpos = 0;                  // its coordinate in q (a ball's or free joint's rotation rates: the quaternion's w)
   bool limited = false;
   double lower = 0, upper = 0;
 };
@@ -144,7 +146,8 @@ struct Joint {
 // and the torque on its joint's coordinate gear · force (actuators.h applies it).
 struct Actuator {
   std::string name, joint;
-  int coordinate = 0;
+  int coordinate = 0;  // its joint's rate in v (and torque in τ)
+  int qpos = 0;        // its joint's coordinate in q (after a ball's or free joint's quaternion: not coordinate)
   double gear = 1, gain = 0;
   std::array<double, 3> bias{0, 0, 0};
   bool ctrl_limited = false, force_limited = false;
@@ -169,6 +172,7 @@ struct LoadedModel {
   std::shared_ptr<const detail::Compiled> compiled;
   MechanismModel<Spatial> mechanism;
   VecN q0;                         // the file's reference pose qpos0 (closed: every loop holds there)
+  std::vector<std::string> coordinates;  // per entry of q: its name (a quaternion's: NAME_qw … NAME_qz)
   std::vector<Joint> joints;       // per coordinate
   std::vector<std::string> bodies;  // per MuJoCo body that moves (the world and fused bodies left out)
   std::vector<Closure> closures;   // per mechanism constraint, first
