@@ -9,36 +9,27 @@
 
 #include "physics/model_file/mujoco_call.h"
 #include "physics/model_file/model_file.h"
+#include "physics/model_file/number_text.h"
 
 namespace dyn::model_file::detail {
 
-namespace {
-
 using Mat3 = Eigen::Matrix3d;
 using Vec3 = Eigen::Vector3d;
-using RowMat3 = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
 
-std::string named(const mjModel* m, int type, int id, const char* what) {
-  const char* n = mj_id2name(m, type, id);
-  return n && *n ? std::string(n) : std::string(what) + " #" + std::to_string(id);
-}
-
-}  // namespace
-
-void checkBallJoint(const std::string& path, const mjModel* m, int j) {
+void checkBallJoint(const std::string& path, const mjModel* m, int j, const std::string& name, const std::string& body) {
   const bool free = m->jnt_type[j] == mjJNT_FREE;
-  const std::string where = path + ": joint '" + named(m, mjOBJ_JOINT, j, "joint") + "' (" + (free ? "free" : "ball") + ")";
+  const std::string where = path + ": joint '" + name + "' (body '" + body + "') is a " + (free ? "free" : "ball") + " joint";
   if (m->jnt_stiffness[j] != 0 && !(m->opt.disableflags & mjDSBL_PASSIVE))
-    throw ModelFileError(where + " has stiffness " + std::to_string(m->jnt_stiffness[j]) +
-                         "; dynlab holds springs on hinge and slide joints only (leave a ball's or free joint's stiffness 0)");
+    throw ModelFileError(where + " with stiffness " + detail::numberText(m->jnt_stiffness[j], 6) +
+                         "; dynlab holds springs on hinge and slide joints only (leave its stiffness 0)");
   if (!free && m->jnt_limited[j] && !(m->opt.disableflags & mjDSBL_LIMIT))
-    throw ModelFileError(where + " is limited (a cone); dynlab limits hinge and slide joints only (leave the ball joint unlimited)");
+    throw ModelFileError(where + " with a range (a cone); dynlab holds limits on hinge and slide joints only (leave the ball joint unlimited)");
 }
 
-void addBallJoint(const mjModel* m, const mjData* d, int b, int j, int& link, Vec3& origin, LoadedModel& out) {
+void addBallJoint(const mjModel* m, const mjData* d, int b, int j, const std::string& name, const std::string& body, int& link, Vec3& origin,
+                  LoadedModel& out) {
   MechanismModel<Spatial>& mech = out.mechanism;
   const bool free = m->jnt_type[j] == mjJNT_FREE;
-  const std::string name = named(m, mjOBJ_JOINT, j, "joint"), body = named(m, mjOBJ_BODY, b, "body");
   const int qadr = m->jnt_qposadr[j];
   auto entry = [&](const char* suffix, int qpos) {
     Joint jt;
@@ -64,7 +55,7 @@ void addBallJoint(const mjModel* m, const mjData* d, int b, int j, int& link, Ve
   }
   // The ball about the anchor: R0 the body's orientation at qpos0 (where a ball's Q is 1; a free
   // joint's Q0 gives it: pre = R0 R(Q0)ᵀ = 1).
-  const Mat3 R0 = Mat3(Eigen::Map<const RowMat3>(d->xmat + 9 * b));
+  const Mat3 R0 = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(d->xmat + 9 * b);
   const int qball = qadr + (free ? 3 : 0);
   const Mat3 pre = free ? Mat3::Identity() : R0;
   link = mech.tree.addBall(link, Spatial::Transform{Mat3::Identity(), o - origin, false}, pre, R0, Spatial::Mat::Zero());

@@ -48,7 +48,8 @@ std::string nameOf(const mjModel* m, int type, int id, const char* what) {
 void checkSupported(const std::string& file, const mjModel* m, const LoadOptions& opt, std::vector<std::string>& notes) {
   auto fail = [&](const std::string& what) { throw ModelFileError(file + ": " + what); };
   for (int j = 0; j < m->njnt; ++j)
-    if (m->jnt_type[j] == mjJNT_BALL || m->jnt_type[j] == mjJNT_FREE) detail::checkBallJoint(file, m, j);
+    if (m->jnt_type[j] == mjJNT_BALL || m->jnt_type[j] == mjJNT_FREE)
+      detail::checkBallJoint(file, m, j, nameOf(m, mjOBJ_JOINT, j, "joint"), nameOf(m, mjOBJ_BODY, m->jnt_bodyid[j], "body"));
   if (m->nv == 0) fail("no joint: nothing moves (dynlab reads bodies moved by hinge, slide, ball and free joints)");
   if (m->nq > kMaxDof) fail(std::to_string(m->nq) + " coordinates (qpos), more than dynlab's " + std::to_string(kMaxDof));
   for (int b = 1; b < m->nbody; ++b)
@@ -117,7 +118,7 @@ std::vector<Frame> readTree(const std::string& path, const mjModel* m, const mjD
       if (m->jnt_qposadr[j] != mech.tree.nq() || m->jnt_dofadr[j] != mech.tree.dof())
         throw ModelFileError(path + ": joint '" + nameOf(m, mjOBJ_JOINT, j, "joint") + "': coordinates out of MuJoCo's usual order");
       if (m->jnt_type[j] == mjJNT_BALL || m->jnt_type[j] == mjJNT_FREE) {
-        detail::addBallJoint(m, d, b, j, f.link, f.origin, out);
+        detail::addBallJoint(m, d, b, j, nameOf(m, mjOBJ_JOINT, j, "joint"), nameOf(m, mjOBJ_BODY, b, "body"), f.link, f.origin, out);
         inertia.resize(std::size_t(mech.tree.dof()), Spatial::Mat::Zero());
         continue;
       }

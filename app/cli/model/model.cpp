@@ -323,13 +323,9 @@ int model(const ModelArgs& asked) {
   ConstrainedMechanism<Spatial> mech(m.mechanism);
   std::string text = describe(m) + crossCheck(m, mech);
   if (const std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), args.dt); !stiff.empty()) text += "  note: " + shownLine(stiff) + "\n";
-  const bool hand = args.engine != "bullet";
-  bool bullet = args.engine != "hand";
-  // Ball and free joints: the hand engine only, for now (Bullet's builder refuses them in one line).
-  if (bullet && hand && !m.mechanism.tree.balls.empty()) {
-    bullet = false;
-    text += "  Bullet: unavailable (ball and free joints are not mapped onto Bullet's multibody yet): the hand engine alone\n";
-  }
+  // Ball and free joints: the hand engine alone when both are asked (Bullet's builder refuses them in one line).
+  const bool hand = args.engine != "bullet", balls = !m.mechanism.tree.balls.empty(), bullet = args.engine != "hand" && !(balls && hand);
+  if (balls && hand && args.engine != "hand") text += "  Bullet: unavailable (ball and free joints are not mapped onto Bullet's multibody yet): the hand engine alone\n";
   ModelRun h, b;
   if (hand) h = m.contacts.empty() ? runHand(m, mech, args.dt, args.duration, tau) : runHandElements(m, mech, args.dt, args.duration, tau);
   if (bullet) {
