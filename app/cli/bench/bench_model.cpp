@@ -80,9 +80,8 @@ Engine handWithElements(const model_file::LoadedModel& m, const char* scheme, st
   return x;
 }
 
-// Bullet's engine, unless the file has ball or free joints (not mapped onto its multibody yet).
+// Bullet's engine.
 void addBullet(const model_file::LoadedModel& m, double dt, Engines& e) {
-  if (!m.mechanism.tree.balls.empty()) return;
   const int n = int(m.joints.size());
   const VecN q0 = m.start_q, v0 = m.start_v;
   e.bullet = std::make_unique<bullet::BulletMechanism<Spatial>>(m.mechanism, dt, q0, v0);
@@ -260,7 +259,6 @@ int benchModel(const BenchArgs& a) {
               termText(elements).c_str(), dt, termName(start, 1000).c_str());
   for (const std::string& note : m.notes) std::printf("  note: %s\n", termName(note, 1000).c_str());
   if (!beside.empty()) std::printf("  %s\n", termName(mujoco_left_out, 1000).c_str());
-  if (!m.mechanism.tree.balls.empty()) std::printf("  Bullet not timed: ball and free joints are not mapped onto Bullet's multibody yet\n");
   std::printf("  %d steps per engine timed in blocks of %d, in turn; ratios block by block: median (middle half)\n", int(euler.all.size()), kBlock);
   std::printf("  engine             µs/step   over hand, 1st order   max |φ|∞     max |q − q_ref|∞ over 2 s (ref: hand RK4)\n");
   for (std::size_t i = 0; i < list.size(); ++i) {

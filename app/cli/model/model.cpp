@@ -323,9 +323,7 @@ int model(const ModelArgs& asked) {
   ConstrainedMechanism<Spatial> mech(m.mechanism);
   std::string text = describe(m) + crossCheck(m, mech);
   if (const std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), args.dt); !stiff.empty()) text += "  note: " + shownLine(stiff) + "\n";
-  // Ball and free joints: the hand engine alone when both are asked (Bullet's builder refuses them in one line).
-  const bool hand = args.engine != "bullet", balls = !m.mechanism.tree.balls.empty(), bullet = args.engine != "hand" && !(balls && hand);
-  if (balls && hand && args.engine != "hand") text += "  Bullet: unavailable (ball and free joints are not mapped onto Bullet's multibody yet): the hand engine alone\n";
+  const bool hand = args.engine != "bullet", bullet = args.engine != "hand";
   ModelRun h, b;
   if (hand) h = m.contacts.empty() ? runHand(m, mech, args.dt, args.duration, tau) : runHandElements(m, mech, args.dt, args.duration, tau);
   if (bullet) {
@@ -340,7 +338,7 @@ int model(const ModelArgs& asked) {
   if (bullet) text += report(b, b.summary + ", semi-implicit Euler", m, args);
   if (hand && bullet) {
     double dq = 0;
-    const int n = mech.n();
+    const int n = int(m.q0.size());  // every coordinate (a ball's quaternion too)
     for (std::size_t r = 0; r < std::min(h.trace.rows(), b.trace.rows()); ++r)
       for (int i = 0; i < n; ++i) dq = std::max(dq, std::abs(h.trace.at(r, 1 + i) - b.trace.at(r, 1 + i)));
     text += "agreement: max |q_hand − q_bullet|∞ " + fmt(dq) + " (Bullet's step is first order)\n";
