@@ -13,7 +13,7 @@
 namespace dyn::model_file {
 
 VecN actuatorTorques(const std::vector<Actuator>& actuators, const VecN& ctrl, const VecN& q, const VecN& v) {
-  VecN tau = VecN::Zero(q.size());
+  VecN tau = VecN::Zero(v.size());  // one per rate (a ball's quaternion has one more coordinate)
   for (std::size_t i = 0; i < actuators.size(); ++i) {
     const Actuator& a = actuators[i];
     double u = ctrl[Eigen::Index(i)];
