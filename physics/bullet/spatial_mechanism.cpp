@@ -229,7 +229,8 @@ struct BulletMechanism<Spatial>::Impl {
     if (model.bullet.solver_iterations < 1) throw std::invalid_argument(who + "solver_iterations must be ≥ 1");
     const int n = model.treeDof();
     if (q0.size() != model.tree.nq() || v0.size() != n)
-      throw std::invalid_argument(who + "q0 and v0 need " + std::to_string(model.tree.nq()) + " and " + std::to_string(n) + " coordinates");
+      throw std::invalid_argument(who + "q0 and v0 need " + (model.tree.nq() == n ? std::to_string(n) + " coordinates (one per tree joint)" :
+                                                             std::to_string(model.tree.nq()) + " and " + std::to_string(n) + " coordinates (a quaternion per ball)"));
     for (int i = 0; i < int(model.joints.size()); ++i)
       if (model.tree.bodies[std::size_t(i)].joint == JointType::Ball && model.joints[std::size_t(i)].armature != 0)
         throw std::invalid_argument(who + "armature on a ball joint: not yet");
