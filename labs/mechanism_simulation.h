@@ -7,6 +7,8 @@
 //     forces plus the joint friction's, integrated by the hand engine with the motion's own RK4 stages,
 //     estimated by Bullet's as force held × displacement per step) → the controller observes
 //   → a non-finite state or row ends the run with a plain sentence.
+// A run of duration T = N dt has N + 1 rows, t = 0 … T: the last one is the state the last step reached
+// (closingRow), as a model file's trace has it.
 // The engine's clock is set to t_k = k dt before each step: external forces (mechanism.h) are functions
 // of time and motion that the engines evaluate inside the step, unlike τ, which the controller samples.
 #pragma once
@@ -32,6 +34,9 @@ class MechanismEngine {
   virtual bool step(const VecN& tau, bool with_forces = true) = 0;
   // The force of each constraint over the last step (body a on body b, world axes at its point).
   virtual const std::vector<VecN>& forces() const = 0;
+  // The forces at the present state with τ held, no step taken (the trace's last row). Bullet keeps the
+  // last step's (its forces are impulses over a step); the hand engine solves eq. (2) there.
+  virtual void forcesNow(const VecN& tau) { (void)tau; }
   virtual std::string failure() const { return {}; }
   // The time of the state the next step starts from.
   virtual void setTime(double t) = 0;
@@ -61,6 +66,10 @@ class HandEngine final : public MechanismEngine {
     return failure_.empty();
   }
   const std::vector<VecN>& forces() const override { return forces_; }
+  void forcesNow(const VecN& tau) override {
+    const auto sol = mech_.solve(q_, v_, tau);
+    for (std::size_t i = 0; i < forces_.size(); ++i) forces_[i] = mech_.constraintForce(int(i), sol);
+  }
   std::string failure() const override { return failure_; }
   void setTime(double t) override { mech_.setTime(t); }
   Books books() const override { return mech_.books(); }
@@ -136,6 +145,7 @@ class MechanismSimulation final : public Simulation {
   }
 
   bool step(std::vector<double>& row) override {
+    if (k_ == steps_ && k_ > 0 && failure_.empty() && !closed_) return closingRow(row);
     if (k_ >= steps_ || !failure_.empty()) return false;
     const double t = double(k_) * dt_;
     tau_ = hooks_->torque(t, q_, v_);
@@ -167,6 +177,20 @@ class MechanismSimulation final : public Simulation {
     return true;
   }
 
+  // The row at t = duration: the state the last step reached, its energy, residual and work, the torque
+  // of the last step (held up to this instant) and the constraint forces with it there. No step follows:
+  // the controller is not sampled again and its sensors see nothing more.
+  bool closingRow(std::vector<double>& row) {
+    closed_ = true;
+    stepper_->setTime(double(steps_) * dt_);
+    stepper_->forcesNow(tau_);
+    const double energy = model_->energy(q_, v_);
+    const double residual = model_->holonomic() ? model_->residual(q_) : model_->residual(q_, v_);
+    const StepRecord r{engine_, double(steps_) * dt_, q_, v_, tau_, stepper_->forces(), energy, residual, work_};
+    hooks_->row(r, row);
+    return true;
+  }
+
   bool advanceEngine() override {
     if (k_ >= steps_ || !failure_.empty()) return false;
     advance(false, double(k_) * dt_);
@@ -191,6 +215,7 @@ class MechanismSimulation final : public Simulation {
   std::vector<std::string> columns_;
   double dt_;
   long steps_, k_ = 0;
+  bool closed_ = false;  // the row at t = duration written
   VecN q_, v_, tau_;
   double work_ = 0;
   std::string failure_;

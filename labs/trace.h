@@ -21,6 +21,8 @@ struct Trace {
   std::vector<double> data;  // row-major
 
   std::size_t rows() const { return columns.empty() ? 0 : data.size() / columns.size(); }
+  // The steps between its first row (t = 0) and its last (t = duration for a whole run).
+  std::size_t steps() const { return rows() > 0 ? rows() - 1 : 0; }
   int column(const std::string& name) const;  // −1 if absent
   double at(std::size_t row, int col) const { return data[row * columns.size() + std::size_t(col)]; }
   // By name: a column the trace lacks throws std::out_of_range naming it (never a stray read).

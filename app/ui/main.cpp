@@ -29,6 +29,7 @@ using namespace dyn::ui;
 struct Args {
   std::string lab, config, gains, scenario, student, engine = "both", size = "1320x720", save, screenshot, state;
   std::vector<std::string> set, labs;
+  app::ModelFileFlags files;  // a model file's --key, --ignore-contacts, --package-path
   double speed = 1.0;
   bool paused = false;
   long frames = -1;  // scripted: this many frames, then exit
@@ -105,7 +106,8 @@ json frameState(const TuningSession& s, const WindowContext& ctx, const Layout& 
           {"viewport", {{"x", l.scene_x}, {"y", l.scene_y}, {"width", l.scene_w}, {"height", l.scene_h}}},
           {"gl", ctx.description()},
           {"gain_sliders", widgets},
-          {"panel_right", st.window_right * scale}};
+          {"panel_right", st.window_right * scale},
+          {"notes", s.notes()}};
 }
 
 bool writeText(const std::string& path, const std::string& text) {
@@ -125,7 +127,15 @@ int run(const Args& a) {
   if (model)
     for (const auto& [given, option] : {std::pair{!a.config.empty(), "--config"}, {!a.gains.empty(), "--gains"}, {!a.scenario.empty(), "--scenario"}, {!a.student.empty(), "--student"}})
       if (given) throw InputError("<command line>", option, "a model file runs passive, without a lab's config, gains or scenario");
-  TuningSession session = model ? TuningSession(app::loadModelLab(a.lab, std::nullopt)) : TuningSession(a.lab, a.config, a.gains, a.scenario, studentPlant(a.student));
+  if (!model)
+    for (const auto& [given, option] : {std::pair{a.files.ignore_contacts, "--ignore-contacts"}, {!a.files.key.empty(), "--key"}, {!a.files.package_paths.empty(), "--package-path"}})
+      if (given) throw InputError("<command line>", option, "for a model file (.xml, .urdf); " + termName(a.lab) + " is a lab");
+  // A model file's notes (its load's, servos stiffer than its step): said once, on stderr and in the panel.
+  std::vector<std::string> notes;
+  TuningSession session = model ? TuningSession(app::loadModelLab(a.lab, std::nullopt, a.files, &notes))
+                                : TuningSession(a.lab, a.config, a.gains, a.scenario, studentPlant(a.student));
+  for (const std::string& n : notes) std::cerr << "note: " << termName(n, 1000) << "\n";
+  session.setNotes(std::move(notes));
   for (const auto& s : a.set) session.set(s);
   session.setEngine(parseEngineChoice(a.engine));
   session.restart();
@@ -256,6 +266,10 @@ int main(int argc, char** argv) {
                      ->check(CLI::Range(1L, 1000000L));
   cli.add_option("--screenshot", a.screenshot, "With --frames: PNG of the whole window at the last frame")->needs(frames);
   cli.add_option("--state", a.state, "With --frames: JSON of what the last frame shows (row, t, values, scene viewport)")->needs(frames);
+  cli.add_option("--key", a.files.key, "A model file: start from its keyframe NAME (qpos, qvel and the actuators' ctrl; default: qpos0 at rest, controls 0)");
+  cli.add_flag("--ignore-contacts", a.files.ignore_contacts, "A model file: leave out the note that its geoms collide in MuJoCo but not here");
+  cli.add_option("--package-path", a.files.package_paths, "A model file: a folder holding the packages its package://NAME/… paths name (repeatable)")
+      ->allow_extra_args(false);
   try {
     cli.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

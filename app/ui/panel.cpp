@@ -322,6 +322,10 @@ void drawTuningPanel(TuningSession& session, PanelState& st, float x, float widt
   const bool tunable = !session.gainSpecs().empty() || !session.optionSpecs().empty();
   if (tunable) gainsSection(session, st);
   else ImGui::TextWrapped("Passive: nothing to tune here. Watch the engines agree, or not.");
+  if (!session.notes().empty()) {
+    ImGui::TextColored(kMuted, "Notes on the model file");
+    for (const std::string& note : session.notes()) ImGui::TextWrapped("%s", shown(note, 1000).c_str());
+  }
   plotsSection(session, st);
   metricsSection(session);
   if (tunable) submissionSection(session, st);

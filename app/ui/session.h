@@ -99,6 +99,9 @@ class TuningSession {
   // One sentence per linearised loop (grading's screening), computed at restart().
   const std::vector<std::string>& screening() const { return screen_notes_; }
   bool screeningUnstable() const { return screen_unstable_; }
+  // What the lab's loading said once (a model file's notes: collision geoms, stiff servos, ...).
+  void setNotes(std::vector<std::string> notes) { notes_ = std::move(notes); }
+  const std::vector<std::string>& notes() const { return notes_; }
 
  private:
   struct Run {
@@ -129,7 +132,7 @@ class TuningSession {
   std::vector<Run> runs_;  // [0] primary, [1] ghost
   Trace empty_;
   std::string problem_, ghost_problem_;
-  std::vector<std::string> screen_notes_;
+  std::vector<std::string> screen_notes_, notes_;
   bool screen_unstable_ = false;
   long generation_ = 0;  // counts restarts: a new run is never mistaken for the cached one
   struct {

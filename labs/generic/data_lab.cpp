@@ -207,7 +207,7 @@ json DataLab::metrics(const Trace& tr) const {
   }
   out["energy_drift"] = drift;
   out["max_constraint_residual"] = residual;
-  out["steps"] = tr.rows();
+  out["steps"] = tr.steps();
   return out;
 }
 

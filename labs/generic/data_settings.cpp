@@ -151,7 +151,10 @@ void parseActuated(const JsonView& c, const model_file::LoadedModel& file, DataS
     std::string jn = act.at(i).string();
     // A file's motor names its joint.
     for (const model_file::Actuator& a : file.actuators)
-      if (a.name == jn && std::find(joint_names.begin(), joint_names.end(), jn) == joint_names.end()) jn = a.joint;
+      if (a.name == jn && std::find(joint_names.begin(), joint_names.end(), jn) == joint_names.end()) {
+        if (!a.tendon.empty()) act.at(i).fail("expected a joint or a joint's motor (motor '" + a.name + "' pulls tendon '" + a.tendon + "': name its joints)");
+        jn = a.joint;
+      }
     const auto it = std::find(joint_names.begin(), joint_names.end(), jn);
     if (it == joint_names.end()) act.at(i).fail("expected a joint or motor of the model file (" + list(joint_names) + ")");
     const int index = int(it - joint_names.begin());

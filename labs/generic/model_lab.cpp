@@ -103,7 +103,7 @@ class ModelFileLab final : public Lab {
       drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
       residual = std::max(residual, tr.at(r, "constraint_residual"));
     }
-    return {{"energy_drift", drift}, {"max_constraint_residual", residual}, {"steps", tr.rows()}};
+    return {{"energy_drift", drift}, {"max_constraint_residual", residual}, {"steps", tr.steps()}};
   }
   json agreement(const Trace& a, const Trace& b) const override {
     double dq = 0, df = 0;
@@ -117,7 +117,7 @@ class ModelFileLab final : public Lab {
   }
   std::string agreementUnit(const std::string& key) const override { return key == "max_dq" ? "rad" : key == "max_df" ? "N, N·m" : ""; }
   std::string referenceEngine() const override {
-    return bullet::BulletMechanism<Spatial>(m_->mechanism, dt_, m_->q0, VecN::Zero(m_->q0.size())).describe();
+    return bullet::BulletMechanism<Spatial>(m_->mechanism, dt_, m_->q0, VecN::Zero(Eigen::Index(m_->joints.size()))).describe();
   }
   void scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene& out) const override {
     const int n = int(m_->joints.size());
@@ -133,7 +133,7 @@ class ModelFileLab final : public Lab {
   }
   void overlay(const Trace& tr, std::size_t row, Overlay& o) const override {
     o.title = title_;
-    modelOverlay(o.title, "passive (τ = 0)", tr, row, dt_, nullptr, o);
+    modelOverlay(o.title, m_->actuators.empty() ? "passive (τ = 0)" : "the file's actuators, ctrl held", tr, row, dt_, nullptr, o);
   }
 
  private:
@@ -150,7 +150,7 @@ class ModelFileLab final : public Lab {
 
 }  // namespace
 
-LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, const ModelFileFlags& flags) {
+LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, const ModelFileFlags& flags, std::vector<std::string>* notes) {
   model_file::LoadOptions options;
   options.ignore_contacts = flags.ignore_contacts;
   options.package_paths = flags.package_paths;
@@ -173,6 +173,7 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, 
     throw InputError(file, "<option timestep>", problem);
   };
   if (const std::string problem = runBoundProblem(dt, duration.value_or(2.0), 0, step); !problem.empty()) refuse(problem);
+  if (notes) *notes = modelNotes(*m, dt);
   // Its figures: the coordinates, the energy books, each closure's force, each wheel's and contact's.
   std::vector<std::string> q, f, c;
   for (const auto& j : m->joints) q.push_back("q_" + columnName(j.name));

@@ -28,8 +28,10 @@ bool isModelFile(const std::string& name);
 // The model file as a lab, passive, for `duration` s (default 2 s), with the closures, wheels and
 // contacts beside it; its figures are the coordinates, the energy books (with the touchdowns' losses),
 // each closure's force and each wheel's or contact's.
-// Throws InputError (one line, naming the file) on bad input.
-LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, const ModelFileFlags& flags = {});
+// Throws InputError (one line, naming the file) on bad input. notes, when given: what a run of it should
+// say once (model_run.h's modelNotes at the file's step).
+LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, const ModelFileFlags& flags = {},
+                       std::vector<std::string>* notes = nullptr);
 
 // Names joined by sep ("q_crank, q_rocker"; "x z"): a model's columns and rows in figures and summaries.
 std::string join(const std::vector<std::string>& v, const char* sep = " ");

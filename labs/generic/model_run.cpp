@@ -62,6 +62,10 @@ double elementResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Sp
   return phi;
 }
 
+double runResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q, const VecN& v) {
+  return std::max(m.contacts.empty() ? desc.residual(q) : elementResidual(m, desc, q, v), every.residual(q));
+}
+
 // The power the joints' damping and friction take out of the mechanism (≥ 0), by the description's
 // law (JointProperties::friction), for Bullet's books; the hand engine integrates its own (Books).
 double frictionPower(const MechanismModel<Spatial>& d, const VecN& v) {
@@ -74,6 +78,14 @@ double frictionPower(const MechanismModel<Spatial>& d, const VecN& v) {
   return p;
 }
 
+
+std::vector<std::string> modelNotes(const model_file::LoadedModel& m, double dt) {
+  std::vector<std::string> notes = m.notes;
+  for (const std::string& n : m.drawing.notes) notes.push_back("drawing: " + n);
+  ConstrainedMechanism<Spatial> mech(m.mechanism);
+  if (std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), dt); !stiff.empty()) notes.push_back(std::move(stiff));
+  return notes;
+}
 
 // A rigid plane contact among the model's elements: its touchdowns are plastic impacts.
 bool anyImpacts(const model_file::LoadedModel& m) {
@@ -104,7 +116,7 @@ Trace modelColumns(const model_file::LoadedModel& m) {
       t.columns.insert(t.columns.end(), {"f_" + n + "_long", "f_" + n + "_lat", "f_" + n + "_normal", "skid_margin_" + n, "slip_" + n});
     else if (c.kind == "joint_limit")  // the stop's force (N·m or N, ≥ 0) and the joint's distance to it
       t.columns.insert(t.columns.end(), {"f_" + n + "_normal", "gap_" + n});
-    else if (c.kind != "plane_contact")  // a coupling: η, its generalised force
+    else if (c.coupling())  // η, its generalised force
       t.columns.push_back("f_" + n);
     else
       t.columns.insert(t.columns.end(), {"f_" + n + "_normal", "f_" + n + "_tangent", "gap_" + n});
@@ -132,7 +144,7 @@ ModelRun runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>
     const auto s = mech.solve(q, v, tau + model_file::actuatorTorques(m, q, v));
     const Books b = engine->books();
     record(run, mech, k * dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()),
-           std::max(mech.residual(q), every.residual(q)));
+           runResidual(m, mech, every, q, v));
     if (stopIfOpened(run, every, q) || k == steps) break;
     if (!(run.ok = step(*engine, o, tau, q, v) && q.allFinite() && v.allFinite())) break;
   }
@@ -155,15 +167,16 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
   int closure_rows = 0;
   for (const auto& c : m.closures) closure_rows += int(c.kept.size());
   const bool impacts = anyImpacts(m);
-  ConstrainedMechanism<Spatial> engine(m.mechanism);
+  // The file's actuators and tendons evaluated at each stage of the step, as runHand's engine does
+  // (actuators.h); the step's contact updates see them at its start.
+  model_file::DrivenMechanism engine(m);
   engine.setTime(0);
   engine.books() = Books{};
   model_file::EveryClosureRow every(m);
   VecN q = m.start_q, v = m.start_v;
   for (int k = 0; k <= steps; ++k) {
-    // The file's actuators at the step's start, held over it (as a lab's controller's torques are).
-    const VecN driven = tau + model_file::actuatorTorques(m, q, v);
-    engine.updateContacts(q, v, driven);
+    VecN driven = engine.hold(q, v, tau);
+    if (engine.updateContacts(q, v, driven) > 0) driven = engine.hold(q, v, tau);  // an impact changed v
     const auto s = engine.solve(q, v, driven);
     std::vector<double> row(s.eta.data(), s.eta.data() + closure_rows);
     const double loss = engine.impactLoss();
@@ -189,7 +202,7 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
         row.insert(row.end(), {r[1] + P / dt, r[0]});
         continue;
       }
-      if (m.contacts[i].kind != "plane_contact") {  // a coupling: its η
+      if (m.contacts[i].coupling()) {  // its η
         row.push_back(s.eta[engine.rowOffset(int(closures + i))]);
         continue;
       }
@@ -198,7 +211,7 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
       const double P = stepped ? pc->normal().dot(Spatial::linear(engine.impactImpulse(int(closures + i)))) : 0.0;
       row.insert(row.end(), {r[1] + P / dt, 0.0, r[0]});
     }
-    record(run, desc, k * dt, q_row, v_row, b.work + b.friction - loss, row, std::max(elementResidual(m, desc, q_row, v_row), every.residual(q_row)));
+    record(run, desc, k * dt, q_row, v_row, b.work + b.friction - loss, row, runResidual(m, desc, every, q_row, v_row));
     if (stopIfOpened(run, every, q_row) || k == steps || !run.ok) break;
   }
   return run;
@@ -239,7 +252,7 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
         const Constraint<Spatial>& k_c = *m.mechanism.constraints[std::size_t(c)];
         if (const auto* jl = dynamic_cast<const JointLimit*>(&k_c)) {
           forces.insert(forces.end(), {jl->along(mech.kinematics(), f), jl->gap(mech.kinematics())});
-        } else if (m.contacts[i].kind != "rolling" && m.contacts[i].kind != "plane_contact") {
+        } else if (m.contacts[i].coupling()) {
           forces.push_back(f[0]);  // a coupling: Bullet's gear impulse / dt (builder: constraintForce's first entry)
         } else if (m.contacts[i].kind == "rolling") {
           double r[5];
@@ -252,7 +265,7 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
         }
       }
     }
-    record(run, mech, k * dt, q, v, work, forces, std::max(m.contacts.empty() ? mech.residual(q) : elementResidual(m, mech, q, v), every.residual(q)));
+    record(run, mech, k * dt, q, v, work, forces, runResidual(m, mech, every, q, v));
     if (k == steps) break;
     if (!(run.ok = qn.allFinite() && vn.allFinite())) break;
     const double p = inflow(qn, vn);

@@ -8,6 +8,7 @@
 
 #include "labs/trace.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/model_file/closure_rows.h"
 #include "physics/model_file/model_file.h"
 
 namespace dyn::app {
@@ -29,6 +30,11 @@ Trace modelColumns(const model_file::LoadedModel& m);
 // A rigid plane contact among the model's elements: its touchdowns are plastic impacts.
 bool anyImpacts(const model_file::LoadedModel& m);
 
+// |φ|∞ a run of the model reports at a state: the rows the description holds (the closures' kept rows; with
+// dynlab's elements, elementResidual) and every closure row, the dropped ones too (closure_rows.h).
+double runResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q,
+                   const VecN& v);
+
 // The power the joints' damping and friction take out of the mechanism (≥ 0), by the description's law.
 double frictionPower(const MechanismModel<Spatial>& d, const VecN& v);
 
@@ -36,6 +42,11 @@ double frictionPower(const MechanismModel<Spatial>& d, const VecN& v);
 // velocity forms (a wheel's x, y rows have only the latter: its slip), and each contact's depth past
 // its plane. desc: the model's description as a mechanism (its contacts open: gaps read, not held).
 double elementResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, const VecN& q, const VecN& v);
+
+// What a run of the model at step dt should say once, beside its numbers: the loader's notes (geoms that
+// collide in MuJoCo but not here, limits read and not held, tendon friction, ...), what is drawn other
+// than as written, and servos stiffer than RK4 follows at dt (actuators.h's stiffServoNote).
+std::vector<std::string> modelNotes(const model_file::LoadedModel& m, double dt);
 
 // The runs, `duration` s at fixed step dt, τ held (n joint torques). mech/desc: the model's
 // description as a mechanism (energy, residual and the rows' solves). runHand steps loops only (the

@@ -276,7 +276,7 @@ json GraspLab::metrics(const Trace& tr) const {
           {"cone_margin_time", margin_t}, {"f_int_rms", rms(ef)},
           {"tau_max", tau_max},          {"energy_drift", drift},
           {"energy_initial", e0},        {"max_constraint_residual", residual},
-          {"steps", tr.rows()},          {"settle_time", s_.settle_time}};
+          {"steps", tr.steps()},          {"settle_time", s_.settle_time}};
 }
 
 json GraspLab::differences(const Trace& a, const Trace& b, std::size_t n) const {

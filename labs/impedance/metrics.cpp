@@ -111,7 +111,7 @@ json ImpedanceLab::metrics(const Trace& tr) const {
   }
   double d_static = 0;
   for (double x : last) d_static += x / double(std::max<std::size_t>(1, last.size()));
-  json m = {{"energy_drift", drift}, {"max_constraint_residual", 0.0}, {"steps", tr.rows()}};
+  json m = {{"energy_drift", drift}, {"max_constraint_residual", 0.0}, {"steps", tr.steps()}};
   m["stiffness_target"] = k_des;
   m["omega_target"] = std::sqrt(k_des / m_des);
   m["zeta_target"] = d_des / (2 * std::sqrt(k_des * m_des));

@@ -281,7 +281,7 @@ json MotionControlLab::metrics(const Trace& tr) const {
           {"e_rms_outstretched", rms(out)}, {"overshoot", std::max(0.0, overshoot)}, {"tau_peak", tau_peak},
           {"tau_variation", tau_tv},    {"saturated_time", sat_time}, {"energy_drift", drift},
           {"energy_initial", e0},       {"V_max_rise", v_rise},   {"max_deflection", defl_max},
-          {"max_constraint_residual", 0.0}, {"steps", tr.rows()}};
+          {"max_constraint_residual", 0.0}, {"steps", tr.steps()}};
 }
 
 json MotionControlLab::differences(const Trace& a, const Trace& b, std::size_t rows) const {

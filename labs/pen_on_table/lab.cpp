@@ -330,7 +330,7 @@ json PenOnTableLab::metrics(const Trace& tr) const {
           {"energy_drift", drift},
           {"energy_initial", e0},
           {"max_constraint_residual", residual},
-          {"steps", n}};
+          {"steps", tr.steps()}};
 }
 
 json PenOnTableLab::differences(const Trace& a, const Trace& b, std::size_t n) const {

@@ -173,7 +173,7 @@ json SliderCrankLab::metrics(const Trace& tr) const {
           {"f_rms", rms(ef)},          {"f_max_error", ef_max},
           {"tau_max", tau_max},        {"energy_drift", drift},
           {"energy_initial", e0},      {"max_constraint_residual", residual},
-          {"steps", tr.rows()},        {"settle_time", s_.settle_time}};
+          {"steps", tr.steps()},        {"settle_time", s_.settle_time}};
 }
 
 json SliderCrankLab::differences(const Trace& a, const Trace& b, std::size_t n) const {

@@ -214,7 +214,7 @@ json UnicycleLab::metrics(const Trace& tr) const {
           {"speed_rms", rms(ev)},        {"skid_margin_min", tr.rows() ? margin : 0.0}, {"skid_margin_time", margin_t},
           {"f_lat_max", f_lat},          {"tau_drive_max", tau_y},      {"tau_steer_max", tau_z},
           {"progress", progress},        {"energy_drift", drift},      {"energy_initial", e0},
-          {"max_constraint_residual", residual}, {"steps", tr.rows()}};
+          {"max_constraint_residual", residual}, {"steps", tr.steps()}};
 }
 
 json UnicycleLab::differences(const Trace& a, const Trace& b, std::size_t n) const {

@@ -1,5 +1,5 @@
 // What drives a model file's run, read from the compiled model: its actuators (MuJoCo's <motor>,
-// <position>, <velocity> and <general> on a hinge or slide joint, no activation dynamics: the affine
+// <position>, <velocity> and <general> on a hinge or slide joint or a fixed tendon, no activation dynamics: the affine
 // law of model_file.h's Actuator) and where the run starts (q0 at rest with every control 0, or a
 // keyframe's qpos, qvel and ctrl, which must hold the file's loops). Everything else an actuator may
 // be is refused in one line naming it and what is supported.
@@ -29,7 +29,7 @@ void checkFinite(const std::string& where, const char* what, const mjtNum* x, in
       throw ModelFileError(where + "'s " + what + " is " + num(x[i]) + "; dynlab reads finite values within ±" + num(kLargest));
 }
 
-constexpr const char* kSupported = "dynlab reads motor, position, velocity and general actuators on a hinge or slide joint "
+constexpr const char* kSupported = "dynlab reads motor, position, velocity and general actuators on a hinge or slide joint or a fixed tendon "
                                    "(fixed gain, affine or no bias, no activation dynamics)";
 
 // Actuator i as the affine law; anything else refused.
@@ -39,16 +39,21 @@ Actuator readActuator(const std::string& path, const mjModel* m, int i) {
   const std::string where = path + ": actuator '" + a.name + "'";
   if (m->actuator_dyntype[i] != mjDYN_NONE)
     throw ModelFileError(where + " has activation dynamics (dyntype integrator, filter, muscle or user); " + kSupported);
-  if (m->actuator_trntype[i] != mjTRN_JOINT && m->actuator_trntype[i] != mjTRN_JOINTINPARENT)
-    throw ModelFileError(where + " drives a tendon, a site, a body or a slider-crank; " + kSupported);
+  const int trn = m->actuator_trntype[i];
+  if (trn != mjTRN_JOINT && trn != mjTRN_JOINTINPARENT && trn != mjTRN_TENDON)
+    throw ModelFileError(where + " drives a site, a body or a slider-crank; " + kSupported);
   if (m->actuator_gaintype[i] != mjGAIN_FIXED) throw ModelFileError(where + " has a muscle or user gain; " + kSupported);
   if (m->actuator_biastype[i] != mjBIAS_NONE && m->actuator_biastype[i] != mjBIAS_AFFINE)
     throw ModelFileError(where + " has a muscle or user bias; " + kSupported);
-  const int j = m->actuator_trnid[2 * i];
-  a.joint = named(m, mjOBJ_JOINT, j, "joint");
-  if (m->jnt_type[j] == mjJNT_BALL || m->jnt_type[j] == mjJNT_FREE) throw ModelFileError(where + " drives a ball or free joint; " + kSupported);
-  a.coordinate = m->jnt_dofadr[j];
-  a.qpos = m->jnt_qposadr[j];
+  const int id = m->actuator_trnid[2 * i];
+  if (trn == mjTRN_TENDON) {  // fixed: checkTendons refused spatial ones
+    a.tendon = named(m, mjOBJ_TENDON, id, "tendon");
+    a.path = fixedTendonPath(m, id);
+  } else {
+    a.joint = named(m, mjOBJ_JOINT, id, "joint");
+    if (m->jnt_type[id] == mjJNT_BALL || m->jnt_type[id] == mjJNT_FREE) throw ModelFileError(where + " drives a ball or free joint; " + kSupported);
+    a.path = {{m->jnt_dofadr[id], 1.0, m->jnt_qposadr[id]}};
+  }
   checkFinite(where, "gear", m->actuator_gear + 6 * i, 1);
   checkFinite(where, "gain", m->actuator_gainprm + mjNGAIN * i, 1);
   a.gear = m->actuator_gear[6 * i];
@@ -108,6 +113,13 @@ void readStart(const std::string& path, const mjModel* m, const std::string& key
   if (!out.actuators.empty()) {
     checkFinite(where, "ctrl", m->key_ctrl + chosen * m->nu, m->nu);
     out.ctrl = Eigen::Map<const VecN>(m->key_ctrl + chosen * m->nu, m->nu);
+  }
+  // The joints' stops held (joint_elements.cpp) must not be passed there.
+  for (const Contact& c : out.contacts) {
+    if (c.kind != "joint_limit") continue;
+    if (const Joint& jt = out.joints[std::size_t(c.link)]; !(out.start_q[c.link] >= jt.lower - 1e-9 && out.start_q[c.link] <= jt.upper + 1e-9))
+      throw ModelFileError(where + ": its qpos puts joint '" + jt.name + "' at " + num(out.start_q[c.link]) + ", outside its range [" + num(jt.lower) +
+                           ", " + num(jt.upper) + "]; a keyframe must start inside the joints' ranges");
   }
   // The loops must hold there (as at q0: 1e-9), and their velocity form with qvel.
   ConstrainedMechanism<Spatial> mech(out.mechanism);

@@ -423,6 +423,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   addElementsAndFreedom(path, m, d, frame, options, out);
   // The file's actuators and the run's start: q0 at rest, or the keyframe asked for (actuators.cpp).
   detail::readActuators(path, m, out);
+  detail::readTendons(m, out);
   detail::readStart(path, m, options.key, out);
   return out;
 }

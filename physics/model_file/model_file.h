@@ -10,7 +10,8 @@
 //   joints       stiffness / springref, damping, frictionloss (as Coulomb smoothed over a rate width);
 //                range limits as one-sided rows with events (joint_limit.h), after the closures
 //   couplings    <equality> joint and tendon (fixed tendons) as one row each, MuJoCo's polycoef form
-//                (coupling.h); spatial tendons, tendon actuators and muscles refused
+//                (coupling.h); fixed tendons also drive actuators and carry their own springs and
+//                dampers (actuators.h); spatial tendons, tendon limits and muscles refused
 //   closures     <equality> connect (3 translation rows) and weld (6 rows) as point closures, with the
 //                rows that are identically dependent on the others (a planar loop's out-of-plane
 //                rows) dropped and named
@@ -98,6 +99,8 @@ struct Contact {
   std::string body;  // the MuJoCo body (URDF link) it is on
   int link = -1;     // the tree body it moves with
   double mu = 0;     // rolling: the skid report's μ (and Bullet's friction model); plane: Bullet's friction
+  // A coupling row (an <equality> joint or tendon): its trace column is η, its generalised force.
+  bool coupling() const { return kind == "joint_coupling" || kind == "tendon_coupling"; }
 };
 
 // What the file draws (drawing only: the dynamics never reads it). Each shape is fixed to a tree body
@@ -139,19 +142,36 @@ struct Joint {
   double lower = 0, upper = 0;
 };
 
+// A fixed tendon's length as a linear form of the coordinates (MuJoCo's ten_length over qpos): l = Σ coef_k q_k.
+struct TendonTerm {
+  int coordinate = 0;  // the joint's rate in v (its torque in τ)
+  double coef = 1;
+  int qpos = -1;       // its coordinate in q when that differs (after a ball's quaternion); −1: coordinate
+  bool operator==(const TendonTerm&) const = default;
+};
+
 // An actuator as the file writes it (MuJoCo's <motor>, <position>, <velocity>, <general> on a hinge or
-// slide joint, without activation dynamics), read from the compiled model: MuJoCo's affine law
-//   u = ctrl clamped to [ctrl_lower, ctrl_upper] when ctrl_limited,  l = gear q,  l' = gear q'
-//   force = gain u + bias[0] + bias[1] l + bias[2] l'  clamped to [force_lower, force_upper] when force_limited
-// and the torque on its joint's coordinate gear · force (actuators.h applies it).
+// slide joint or a fixed tendon, without activation dynamics), read from the compiled model: MuJoCo's
+// affine law on its path's length l = Σ coef_k q_k (a joint: its coordinate, coef 1)
+//   u = ctrl clamped to [ctrl_lower, ctrl_upper] when ctrl_limited,  l_a = gear l,  l_a' = gear l'
+//   force = gain u + bias[0] + bias[1] l_a + bias[2] l_a'  clamped to [force_lower, force_upper] when force_limited
+// and the torque on each coordinate of its path gear · coef_k · force (actuators.h applies it).
 struct Actuator {
-  std::string name, joint;
-  int coordinate = 0;  // its joint's rate in v (and torque in τ)
-  int qpos = 0;        // its joint's coordinate in q (after a ball's or free joint's quaternion: not coordinate)
+  std::string name, joint, tendon;  // what it drives: a joint or a fixed tendon (the other "")
+  std::vector<TendonTerm> path;
   double gear = 1, gain = 0;
   std::array<double, 3> bias{0, 0, 0};
   bool ctrl_limited = false, force_limited = false;
   double ctrl_lower = 0, ctrl_upper = 0, force_lower = 0, force_upper = 0;
+};
+
+// A fixed tendon's own spring, damper and friction (MuJoCo's passive tendon forces, its frictionloss as a
+// joint's: Coulomb smoothed over a rate width, JointProperties::friction) on its length l = Σ coef_k q_k:
+//   f = stiffness (rest − l) − damping l' − frictionloss tanh(l'/w),  on each coordinate coef_k f.
+struct TendonSpring {
+  std::string name;
+  std::vector<TendonTerm> path;
+  double stiffness = 0, rest = 0, damping = 0, frictionloss = 0, friction_width = 1e-2;
 };
 
 // A closure with every one of its rows, the dropped ones too (what a run measures: closure_rows.h).
@@ -182,6 +202,7 @@ struct LoadedModel {
   Drawing drawing;                  // what the renderer draws (beside the description, never in it)
   double timestep = 0;             // the file's <option timestep>
   std::vector<Actuator> actuators;  // the file's, driven by ctrl (actuators.h)
+  std::vector<TendonSpring> tendons;  // the file's fixed tendons with stiffness, damping or frictionloss (actuators.h)
   std::vector<std::string> keyframes;  // the file's keyframes' names (LoadOptions::key picks one)
   // Where a run starts and the controls it holds: q0 at rest with every control 0, or the keyframe
   // chosen (its qpos, qvel and ctrl; key names it).
@@ -256,6 +277,8 @@ class MujocoReference {
   VecN bias(const VecN& q, const VecN& v);
   // MuJoCo's actuator forces on the coordinates (qfrc_actuator) at (q, v) with controls ctrl.
   VecN actuation(const VecN& q, const VecN& v, const VecN& ctrl);
+  // MuJoCo's passive forces on the coordinates (qfrc_passive: joints' and tendons' springs and dampers).
+  VecN passive(const VecN& q, const VecN& v);
 
  private:
   struct Impl;

@@ -144,6 +144,11 @@ VecN MujocoReference::actuation(const VecN& q, const VecN& v, const VecN& ctrl) 
   return Eigen::Map<const VecN>(x.d->qfrc_actuator, x.m->nv);
 }
 
+VecN MujocoReference::passive(const VecN& q, const VecN& v) {
+  impl_->at(q, &v);
+  return Eigen::Map<const VecN>(impl_->d->qfrc_passive, impl_->m->nv);
+}
+
 // The bench's simulation: the model at the given step with the Euler (or RK4) integrator, its controls
 // the model's.
 struct MujocoSimulation::Impl : OwnedModel {

@@ -105,8 +105,14 @@ void checkBallJoint(const std::string& path, const mjModel* m, int j, const std:
 void addBallJoint(const mjModel* m, const mjData* d, int b, int j, const std::string& name, const std::string& body, int& link,
                   Eigen::Vector3d& origin, LoadedModel& out);
 
-// Tendons and tendon or muscle actuators dynlab cannot hold, refused in one line (joint_elements.cpp).
+// Tendons and muscle actuators dynlab cannot hold, refused in one line (joint_elements.cpp).
 void checkTendons(const std::string& path, const mjModel* m);
+
+// Fixed tendon t's length as a linear form of the coordinates (joint_elements.cpp).
+std::vector<TendonTerm> fixedTendonPath(const mjModel* m, int t);
+
+// The fixed tendons with stiffness, damping or frictionloss into out.tendons, each noted (joint_elements.cpp).
+void readTendons(const mjModel* m, LoadedModel& out);
 
 // The file's joint limits and joint and fixed-tendon equalities onto out's description, after its
 // closures, and into out.contacts (joint_elements.cpp).

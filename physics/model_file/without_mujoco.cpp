@@ -22,6 +22,7 @@ int MujocoReference::nv() const { return 0; }
 MatN MujocoReference::massMatrix(const VecN&) { refuse("MujocoReference"); }
 VecN MujocoReference::bias(const VecN&, const VecN&) { refuse("MujocoReference"); }
 VecN MujocoReference::actuation(const VecN&, const VecN&, const VecN&) { refuse("MujocoReference"); }
+VecN MujocoReference::passive(const VecN&, const VecN&) { refuse("MujocoReference"); }
 
 MujocoSimulation::MujocoSimulation(const LoadedModel& model, double, bool) : impl_(nullptr) { refuse(model.file); }
 MujocoSimulation::~MujocoSimulation() = default;

@@ -68,9 +68,9 @@ TEST_CASE("dynlab run writes both traces and a summary that agrees with them") {
     for (const char* c : {"t", "q1", "q2", "q3", "x_c", "v_c", "f_Tx", "f_Ty", "tau_T", "tau1", "tau2", "tau3",
                           "energy", "constraint_residual"})
       CHECK_MESSAGE(csv.col(c) >= 0, "column " << c);
-    // One row per step, on the grid t = k dt.
-    REQUIRE(csv.rows.size() == std::size_t(std::lround(0.5 / dt)));
-    CHECK(csv.rows.size() == 500);
+    // One row per step and one at the end, on the grid t = k dt: t = 0 … duration.
+    REQUIRE(csv.rows.size() == std::size_t(std::lround(0.5 / dt)) + 1);
+    CHECK(csv.rows.size() == 501);
     for (std::size_t k = 0; k < csv.rows.size(); ++k) REQUIRE(std::abs(csv.at(k, "t") - double(k) * dt) < 1e-12);
     const json& engine_summary = summary.at("engines").at(engine);
     CHECK(engine_summary.at("status") == "ok");
@@ -123,7 +123,7 @@ TEST_CASE("dynlab run --engine hand writes only the hand trace") {
   CHECK(summary.at("engines").size() == 1);
   CHECK(summary.at("engines").contains("hand"));
   CHECK_FALSE(summary.contains("agreement"));
-  CHECK(readCsv(dir / "out/trace_hand.csv").rows.size() == 200);
+  CHECK(readCsv(dir / "out/trace_hand.csv").rows.size() == 201);  // t = 0 … 0.2 s
 }
 
 TEST_CASE("dynlab run --frames --video: 30 frames per second of simulated time, H.264 yuv420p") {
@@ -132,7 +132,8 @@ TEST_CASE("dynlab run --frames --video: 30 frames per second of simulated time, 
   const Result r = dynlab(dir, {"run", "slider_crank", "--out", "out", "--duration", "0.5", "--frames", "--video"});
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   REQUIRE(r.code == 0);
-  const int expected = int(std::lround(30 * duration));
+  // Frames at k/30 s from t = 0 to the run's last row at t = duration, both included.
+  const int expected = int(std::lround(30 * duration)) + 1;
   std::vector<std::string> frames;
   for (const auto& e : fs::directory_iterator(dir / "out/frames")) frames.push_back(e.path().filename().string());
   std::sort(frames.begin(), frames.end());

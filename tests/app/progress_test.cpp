@@ -92,7 +92,7 @@ TEST_CASE("dynlab run --frames and figure: a bar on a terminal, nothing of it wh
   INFO(run);
   REQUIRE(run_code == 0);
   CHECK(run.find("\rframes [") != std::string::npos);
-  CHECK(run.find("] 9/9 100 %") != std::string::npos);  // 0.3 s at 30 fps: frames at 0, 1/30, ..., 0.267 s
+  CHECK(run.find("] 10/10 100 %") != std::string::npos);  // 0.3 s at 30 fps: frames at 0, 1/30, ..., 0.3 s
   CHECK(run.size() >= 4);
   CHECK(run.substr(run.size() - 4) == "\r\033[K");
   CHECK(readFile(dir / "terminal.stdout").find("frames") != std::string::npos);  // the report, on stdout as before

@@ -51,11 +51,15 @@ class LabFixture {
     return "accepted";
   }
 
-  // The whole run on one engine: no failure, and one row a step of the lab's duration.
+  // The whole run on one engine: no failure, and one row a step of the lab's duration and one at its end
+  // (t = 0, dt, …, duration).
   static Trace run(const Lab& lab, Engine engine) {
     RunResult r = runEngine(lab, engine);
     REQUIRE_MESSAGE(r.failure.empty(), r.failure);
-    REQUIRE(r.trace.rows() == std::size_t(std::lround(lab.duration() / lab.dt())));
+    const long steps = std::lround(lab.duration() / lab.dt());
+    REQUIRE(r.trace.rows() == std::size_t(steps + 1));
+    REQUIRE(r.trace.at(0, "t") == 0.0);
+    REQUIRE(std::abs(r.trace.at(r.trace.rows() - 1, "t") - double(steps) * lab.dt()) <= 1e-12 * lab.duration());
     return std::move(r.trace);
   }
 };

@@ -35,7 +35,7 @@ json constantTorques(double tau_y, double tau_z, double duration, double dt) {
 
 TEST_CASE("unicycle: from rest under constant torques the hand run is the closed form") {
   const double tau_y = 0.04, tau_z = 0.003, T = 5.0;
-  const auto lab = fixture.makeLab(constantTorques(tau_y, tau_z, T + 1e-3, 1e-3));
+  const auto lab = fixture.makeLab(constantTorques(tau_y, tau_z, T, 1e-3));
   const Trace tr = fixture.run(*lab, Engine::Hand);
   const Params& p = dynamic_cast<const UnicycleLab&>(*lab).settings().params;
   const double th_dd = tau_y / (p.axle_inertia + p.mass * p.radius * p.radius), ph_dd = tau_z / p.steer_inertia;

@@ -53,7 +53,7 @@ struct Engine {
 // The engines from the file's pose at rest.
 struct Engines {
   std::unique_ptr<ConstrainedSystem> euler_mech, rk4_mech;
-  std::unique_ptr<ConstrainedMechanism<Spatial>> euler_el, rk4_el;  // with elements beside the file
+  std::unique_ptr<model_file::DrivenMechanism> euler_el, rk4_el;  // with elements beside the file
   std::string sizes;
   std::unique_ptr<bullet::BulletMechanism<Spatial>> bullet;
   std::unique_ptr<model_file::MujocoSimulation> mujoco;
@@ -63,19 +63,19 @@ struct Engines {
 
 // A hand engine for a file with elements beside it: contacts updated at each step's start, touchdowns
 // located (labs/mechanism_simulation.h's step); restarted as a new mechanism (its contacts open).
-Engine handWithElements(const model_file::LoadedModel& m, const char* scheme, std::unique_ptr<ConstrainedMechanism<Spatial>>* mech,
+Engine handWithElements(const model_file::LoadedModel& m, const char* scheme, std::unique_ptr<model_file::DrivenMechanism>* mech,
                         VecN* q, VecN* v, StepOptions o) {
   Engine x;
   x.name = "hand";
   x.scheme = std::string(scheme) + " (dynamic sizes; contacts closed and opened between steps, touchdowns located)";
-  // The zero torque made once (a step allocates nothing); with actuators, theirs at the step's start,
-  // held over it (labs/generic/model_run.cpp's runHandElements).
-  x.step = [=, &m, tau = VecN(VecN::Zero(Eigen::Index(m.joints.size())))]() mutable {
-    if (!m.actuators.empty()) tau = model_file::actuatorTorques(m, *q, *v);
+  // The zero torque made once (a step allocates nothing); with actuators or tendons, evaluated at each
+  // stage (labs/generic/model_run.cpp's runHandElements).
+  x.step = [=, zero = VecN(VecN::Zero(Eigen::Index(m.joints.size()))), tau = VecN(VecN::Zero(Eigen::Index(m.joints.size())))]() mutable {
+    if (!(*mech)->empty()) tau = (*mech)->hold(*q, *v, zero);
     (*mech)->updateContacts(*q, *v, tau);
     return (*mech)->stepLocatingContacts(o, tau, *q, *v) && q->allFinite() && v->allFinite();
   };
-  x.restart = [=, &m] { *mech = std::make_unique<ConstrainedMechanism<Spatial>>(m.mechanism), *q = m.start_q, *v = m.start_v; };
+  x.restart = [=, &m] { *mech = std::make_unique<model_file::DrivenMechanism>(m), *q = m.start_q, *v = m.start_v; };
   x.state = [=](VecN& qo, VecN& vo) { qo = *q, vo = *v; };
   return x;
 }
@@ -91,7 +91,7 @@ void addBullet(const model_file::LoadedModel& m, double dt, Engines& e) {
   auto* bt = &e.bullet;
   // Bullet: the zero torque made once (a step allocates nothing); with actuators, theirs at the step's start.
   b.step = [bt, &m, tau = VecN(VecN::Zero(n))] {
-    if (m.actuators.empty()) {
+    if (m.actuators.empty() && m.tendons.empty()) {
       (*bt)->step(tau);
       return true;
     }
@@ -181,7 +181,7 @@ std::vector<Accuracy> accuracy(std::vector<Engine>& engines, const model_file::L
         break;
       }
       path[i].push_back(q);
-      out[i].residual = std::max({out[i].residual, m.contacts.empty() ? mech.residual(q) : elementResidual(m, mech, q, v), every.residual(q)});
+      out[i].residual = std::max(out[i].residual, runResidual(m, mech, every, q, v));
       if (k < steps && !e.step()) {
         out[i].complete = false;
         break;

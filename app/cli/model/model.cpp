@@ -107,7 +107,7 @@ std::string describe(const model_file::LoadedModel& m) {
     }
   }
   for (const auto& a : m.actuators) {
-    o << "  actuator " << nameShown(a.name) << " on joint " << nameShown(a.joint) << ": force = " << fmt(a.gain) << " ctrl";
+    o << "  actuator " << nameShown(a.name) << " on " << shownLine(model_file::describePath(m, a)) << ": force = " << fmt(a.gain) << " ctrl";
     const char* const terms[3] = {"", " length", " velocity"};
     for (int k = 0; k < 3; ++k)
       if (a.bias[std::size_t(k)] != 0) o << (a.bias[std::size_t(k)] < 0 ? " − " : " + ") << fmt(std::abs(a.bias[std::size_t(k)])) << terms[k];
@@ -116,6 +116,7 @@ std::string describe(const model_file::LoadedModel& m) {
     if (a.force_limited) o << ", force in [" << fmt(a.force_lower) << ", " << fmt(a.force_upper) << "]";
     o << "\n";
   }
+  for (const auto& t : m.tendons) o << "  " << shownLine(model_file::describeTendon(m, t)) << "\n";
   for (const auto& n : m.notes) o << "  note: " << shownLine(n) << "\n";
   for (const auto& n : m.drawing.notes) o << "  drawing: " << shownLine(n) << "\n";
   return o.str();
@@ -165,7 +166,7 @@ std::string report(const ModelRun& r, const std::string& engine, const model_fil
     for (const auto& c : m.contacts) {
       const std::string n = columnName(c.name);
       double extreme = c.kind == "rolling" ? 0.0 : INFINITY;
-      const bool coupling = c.kind != "rolling" && c.kind != "plane_contact" && c.kind != "joint_limit";  // no gap column
+      const bool coupling = c.coupling();  // no gap column
       for (std::size_t row = 0; row < t.rows() && !coupling; ++row)
         extreme = c.kind == "rolling" ? std::max(extreme, std::abs(t.at(row, "slip_" + n))) : std::min(extreme, t.at(row, "gap_" + n));
       if (c.kind == "joint_limit")

@@ -337,3 +337,37 @@ TEST_CASE("every gain slider shows its whole name and its value's digits: a thin
     CHECK(dark > 20);
   }
 }
+
+TEST_CASE("dynlab ui FILE --key NAME: the run starts from the keyframe, and the file's notes are said once") {
+  const std::string file = std::string(DYNLAB_SOURCE_DIR) + "/tests/physics/model_file/files/servo_arm.xml";
+  const fs::path dir = test::scratchDir("dynlab_ui_window", "model_key");
+  // A lab takes no --key; a keyframe the file lacks is one line naming those it has (no display needed).
+  Result bad = noDisplay(dir, DYNLAB_UI_BIN, {"slider_crank", "--key", "reach"});
+  CHECK(bad.code == 2);
+  CHECK(bad.err == "error: <command line>: --key: for a model file (.xml, .urdf); slider_crank is a lab\n");
+  bad = noDisplay(dir, DYNLAB_UI_BIN, {file, "--key", "home"});
+  CHECK(bad.code == 2);
+  CHECK(bad.err.find("--key 'home': no such keyframe; the file's keyframes: 'reach'") != std::string::npos);
+  CHECK(std::count(bad.err.begin(), bad.err.end(), '\n') == 1);
+  if (!haveXvfb()) return;
+  const Result r = inXvfb(dir, DYNLAB_BIN, {"ui", file, "--key", "reach", "--engine", "hand", "--frames", "3", "--state", "state.json"});
+  INFO(r.out << r.err);
+  REQUIRE(r.code == 0);
+  const json state = loadJsonFile((dir / "state.json").string());
+  // The collision geoms' note, on stderr and in the panel, once.
+  const std::string contact = "geoms collide in MuJoCo but not here";
+  CHECK(r.err.find(contact) != std::string::npos);
+  CHECK(r.err.find(contact) == r.err.rfind(contact));
+  int in_panel = 0;
+  for (const auto& n : state["notes"]) in_panel += n.get<std::string>().find(contact) != std::string::npos;
+  CHECK(in_panel == 1);
+  // The row on screen is the keyframe run's (qpos, qvel and ctrl from 'reach'), not the run from q0.
+  app::ModelFileFlags key;
+  key.key = "reach";
+  const LoadedLab from_key = app::loadModelLab(file, std::nullopt, key), from_q0 = app::loadModelLab(file, std::nullopt);
+  const RunResult hand = runEngine(*from_key.lab, Engine::Hand), plain = runEngine(*from_q0.lab, Engine::Hand);
+  const std::size_t row = state["row"].get<std::size_t>();
+  REQUIRE(row > 0);
+  CHECK(state["values"]["q_elbow"].get<double>() == hand.trace.at(row, "q_elbow"));
+  CHECK(std::abs(hand.trace.at(row, "q_elbow") - plain.trace.at(row, "q_elbow")) > 0.1);
+}

@@ -17,6 +17,7 @@
 #include "physics/model_file/hand_engine.h"
 #include "physics/model_file/model_file.h"
 #include "tests/physics/model_file/fixtures.h"
+#include "tests/physics/model_file/rk4_compare.h"
 
 using namespace dyn;
 using namespace dyn::test_model_file;
@@ -41,28 +42,6 @@ std::string keyError(const std::string& file, const std::string& key) {
   return "";
 }
 
-// The largest |q_hand − q_mujoco|∞ over `steps` RK4 steps of dt from the model's start; the hand
-// engine with the file's actuators (or without: actuated false).
-double rk4Difference(const model_file::LoadedModel& m, double dt, int steps, bool actuated = true) {
-  model_file::MujocoSimulation mj(m, dt, true);
-  REQUIRE(mj.describe().find("RK4") != std::string::npos);
-  mj.reset(m.start_q, m.start_v);
-  auto engine = model_file::handEngine(m.mechanism);
-  if (actuated) engine = model_file::withActuators(std::move(engine), m);
-  StepOptions o;
-  o.dt = dt;
-  VecN q = m.start_q, v = m.start_v, qm, vm;
-  const VecN zero = VecN::Zero(q.size());
-  double worst = 0;
-  for (int k = 0; k < steps; ++k) {
-    REQUIRE(mj.step());
-    REQUIRE(step(*engine, o, zero, q, v));
-    mj.state(qm, vm);
-    worst = std::max(worst, (q - qm).cwiseAbs().maxCoeff());
-  }
-  return worst;
-}
-
 }  // namespace
 
 TEST_CASE("servo_arm.xml: position, velocity, general and motor actuators as MuJoCo applies them (qfrc_actuator, clamps included)") {
@@ -70,7 +49,8 @@ TEST_CASE("servo_arm.xml: position, velocity, general and motor actuators as MuJ
   REQUIRE(m.actuators.size() == 4);
   const model_file::Actuator& pos = m.actuators[0];
   CHECK(pos.name == "shoulder_servo");
-  CHECK(pos.coordinate == 0);
+  CHECK(pos.joint == "shoulder");
+  CHECK(pos.path == std::vector<model_file::TendonTerm>{{0, 1.0}});
   CHECK(pos.gain == 40);
   CHECK(pos.bias[1] == -40);
   CHECK(pos.ctrl_limited);
@@ -78,7 +58,7 @@ TEST_CASE("servo_arm.xml: position, velocity, general and motor actuators as MuJ
   CHECK(m.actuators[1].gear == 3);
   CHECK(m.actuators[2].bias[2] == -3);
   CHECK(m.actuators[2].force_limited);
-  CHECK(m.actuators[3].coordinate == 2);
+  CHECK(m.actuators[3].path == std::vector<model_file::TendonTerm>{{2, 1.0}});
   CHECK(m.actuators[3].gear == 2);
   // At rest from q0 with every control 0 unless a keyframe is chosen.
   CHECK(m.ctrl == VecN::Zero(4));
@@ -169,7 +149,7 @@ TEST_CASE("a four-bar with colliding capsules and a crank servo: keyframes check
 
 TEST_CASE("actuators outside the affine law on a joint, and collision geoms' note: one line each") {
   static const fs::path dir = scratchFolder("actuators");
-  const std::string arm = "<mujoco><worldbody><body name=\"b\"><joint name=\"j\"/><geom size=\"0.1\"/></body>"
+  const std::string arm = "<mujoco><worldbody><body name=\"b\"><joint name=\"j\"/><geom size=\"0.1\"/><site name=\"s\"/></body>"
                           "<body name=\"c\" pos=\"1 0 0\"><joint name=\"k\"/><geom size=\"0.1\"/></body></worldbody>";
   auto with = [&](const std::string& name, const std::string& actuators) {
     return writeFile(dir, name, arm + "<actuator>" + actuators + "</actuator></mujoco>");
@@ -177,10 +157,8 @@ TEST_CASE("actuators outside the affine law on a joint, and collision geoms' not
   CHECK(errorOf(with("filter.xml", "<general name=\"slow\" joint=\"j\" dyntype=\"filter\" dynprm=\"0.1\"/>"))
             .find("actuator 'slow' has activation dynamics (dyntype integrator, filter, muscle or user); dynlab reads motor, position, "
                   "velocity and general actuators on a hinge or slide joint") != std::string::npos);
-  const std::string tendon = arm + "<tendon><fixed name=\"t\"><joint joint=\"j\" coef=\"1\"/></fixed></tendon>"
-                                   "<actuator><motor name=\"pull\" tendon=\"t\"/></actuator></mujoco>";
-  const std::string pull = errorOf(writeFile(dir, "tendon.xml", tendon));
-  CHECK((pull.find("actuator 'pull' drives a tendon") != std::string::npos || pull.find("tendon 't'") != std::string::npos));
+  CHECK(errorOf(with("site.xml", "<general name=\"crank\" site=\"s\" gear=\"1 0 0 0 0 0\"/>")).find("actuator 'crank' drives a site, a body or a slider-crank") !=
+        std::string::npos);
   CHECK(errorOf(with("huge.xml", "<motor name=\"m\" joint=\"j\" gear=\"1e300\"/>")).find("actuator 'm''s gear is 1e+300") != std::string::npos);
   // Two spheres that may touch: one note naming them; --ignore-contacts: none.
   const fs::path plain = with("plain.xml", "<motor name=\"m\" joint=\"j\"/>");
