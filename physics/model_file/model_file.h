@@ -147,7 +147,8 @@ struct TendonTerm {
   int coordinate = 0;  // the joint's rate in v (its torque in τ)
   double coef = 1;
   int qpos = -1;       // its coordinate in q when that differs (after a ball's quaternion); −1: coordinate
-  bool operator==(const TendonTerm&) const = default;
+  // The same joint and coefficient (qpos follows from the joint).
+  bool operator==(const TendonTerm& o) const { return coordinate == o.coordinate && coef == o.coef; }
 };
 
 // An actuator as the file writes it (MuJoCo's <motor>, <position>, <velocity>, <general> on a hinge or
