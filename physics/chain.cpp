@@ -14,9 +14,9 @@ template <class S>
 typename TreeModel<S>::Vec TreeModel<S>::motionSubspace(int i) const {
   const Body& b = bodies[i];
   if constexpr (S::kDim == 3) {
-    return b.joint == JointType::Revolute ? S::revoluteAxis() : S::prismaticAxis(b.axis);
+    return b.joint != JointType::Prismatic ? S::revoluteAxis() : S::prismaticAxis(b.axis);
   } else {
-    return b.joint == JointType::Revolute ? S::revoluteAxis(b.axis) : S::prismaticAxis(b.axis);
+    return b.joint != JointType::Prismatic ? S::revoluteAxis(b.axis) : S::prismaticAxis(b.axis);
   }
 }
 
@@ -43,6 +43,29 @@ void TreeData<S>::resize(int n) {
 
 namespace {
 
+// A ball's sub-body i: the first turns by pre R(Q/|Q|) R0ᵀ after its placement, the other two sit on
+// it (identity placement).
+template <bool kParentFrames, class S>
+void ballKinematics(const TreeModel<S>& model, int i, const VecIn& q, TreeData<S>& data) {
+  const auto& b = model.bodies[std::size_t(i)];
+  typename S::Transform X_up;
+  if constexpr (S::kDim == 6) {
+    const auto& ball = model.balls[std::size_t(b.ball)];
+    if (i == ball.first) {
+      const int k = b.q_index;
+      const Eigen::Quaterniond Q(q[k], q[k + 1], q[k + 2], q[k + 3]);
+      // E rotates parent coordinates into the body's: the transpose of the relative rotation.
+      const typename S::Rot E = ball.post * Q.normalized().toRotationMatrix().transpose() * ball.pre.transpose();
+      X_up = S::compose(typename S::Transform{E, S::Pos::Zero(), true}, b.X_tree);
+    } else {
+      X_up = S::translation(S::Pos::Zero());
+    }
+  }
+  if constexpr (kParentFrames) data.X_up[i] = X_up;
+  data.X_world[i] = b.parent < 0 ? X_up : S::compose(X_up, data.X_world[b.parent]);
+  data.S_w[i] = S::motionInverse(data.X_world[i], b.subspace);
+}
+
 // positionKinematics, and with kParentFrames false its world part alone (X_world, S_w).
 template <bool kParentFrames, class S>
 void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
@@ -53,7 +76,7 @@ void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
       // A revolute joint about a coordinate axis: X_world = X_J ∘ (X_tree ∘ X_world,parent) turns two
       // rows, and its world axis is a row of E (spatial.h turnAbout, coordinateAxisInWorld).
       if (b.joint == JointType::Revolute && b.coordinate_axis >= 0) {
-        const double c = det::cos(q[i]), s = det::sin(q[i]);
+        const double c = det::cos(q[b.q_index]), s = det::sin(q[b.q_index]);
         const int k = b.coordinate_axis;
         if constexpr (kParentFrames) S::turnAbout(k, c, s, b.X_tree, nullptr, data.X_up[i]);
         S::turnAbout(k, c, s, b.X_tree, b.parent < 0 ? nullptr : &data.X_world[b.parent], data.X_world[i]);
@@ -61,8 +84,12 @@ void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
         continue;
       }
     }
+    if (b.joint == JointType::Ball) {
+      ballKinematics<kParentFrames>(model, i, q, data);
+      continue;
+    }
     // Joint placement then joint motion: X_up = X_J(θ_i) X_tree.
-    const typename S::Transform X_up = S::compose(S::jointTransform(b.joint == JointType::Revolute, b.axis, q[i]), b.X_tree);
+    const typename S::Transform X_up = S::compose(S::jointTransform(b.joint == JointType::Revolute, b.axis, q[b.q_index]), b.X_tree);
     if constexpr (kParentFrames) data.X_up[i] = X_up;
     data.X_world[i] = b.parent < 0 ? X_up : S::compose(X_up, data.X_world[b.parent]);
     data.S_w[i] = S::motionInverse(data.X_world[i], b.subspace);
@@ -90,8 +117,14 @@ void velocityKinematics(const TreeModel<S>& model, const VecIn& qd, TreeData<S>&
     const Vec vJ = data.S_i[i] * qd[i];
     if (p < 0) data.v[i] = vJ;
     else data.v[i] = S::motion(data.X_up[i], data.v[p]) + vJ;
-    // Velocity-product acceleration of the joint: c_i = V_i ×m S_i θ'_i.
-    data.c[i] = S::crossMotion(data.v[i], vJ);
+    // Velocity-product acceleration of the joint: c_i = V_i ×m S_i θ'_i; a ball's sub-body: the
+    // parent's velocity carried to it, without its siblings' rates (chain.h).
+    if (model.bodies[i].joint == JointType::Ball) {
+      const int first = model.balls[std::size_t(model.bodies[i].ball)].first, pf = model.bodies[std::size_t(first)].parent;
+      data.c[i] = pf < 0 ? Vec(Vec::Zero()) : S::crossMotion(S::motion(data.X_up[first], data.v[pf]), vJ);
+    } else {
+      data.c[i] = S::crossMotion(data.v[i], vJ);
+    }
   }
 }
 

@@ -9,6 +9,18 @@
 //   pointJacobian      J (position stage) and J'θ' (velocity stage) of a world-aligned frame at a
 //                      point of a link
 //   springTorque       K θ, K tridiagonal: P_K = Σ K_i/2 (θ_i − θ_{i−1})²
+// Ball joints (spatial, addBall): three consecutive tree bodies, the first two massless carriers,
+// turning about the three axes of the child's own frame (MuJoCo's local body frame at q0, columns of
+// R0, in dynlab's world-aligned body axes), so that the rates are MuJoCo's qvel of a ball (ω in the
+// local frame) and every body's frame stays world-aligned at q0: the relative rotation is
+// pre R(Q) R0ᵀ for the joint's unit quaternion Q (w x y z, MuJoCo's qpos, stored once: 4 numbers) —
+// pre = R0 for a ball (Q0 = 1), pre = 1 for a free joint's ball (R0 = R(Q0)). The carriers' frames
+// coincide with the body's (identity placements), so velocities, M and τ are those of a spherical
+// joint; its velocity-product acceleration is v_parent ×m (S ω) as one joint (chained 1-dof joints
+// would add the sibling cross terms S_a ω_a ×m S_b ω_b: chain.cpp and chain_world.cpp leave them
+// out). A free joint is three slides along world x, y, z (MuJoCo's qpos position, qvel the origin's
+// world velocity) then a ball. So q has nq() numbers (a quaternion per ball) and θ' has dof();
+// each body reads q[q_index] (chain_configuration.cpp: q̇ = N(q) θ', q ⊕ h θ', normalisation).
 // Model (fixed) and Data (per-state scratch) are kept apart, as in MuJoCo.
 // Any size: vectors come in as VecIn (a VecN, an Eigen::VectorXd or a contiguous head() binds without
 // a copy) and go out into a caller-sized Eigen::Ref<Eigen::VectorXd>; the VecN-returning forms (and
@@ -62,7 +74,7 @@ class VecIn {
   std::unique_ptr<double[]> large_;  // or more (large chains only)
 };
 
-enum class JointType { Revolute, Prismatic };
+enum class JointType { Revolute, Prismatic, Ball };
 
 template <class S>
 struct TreeModel {
@@ -80,16 +92,26 @@ struct TreeModel {
     // Spatial: 0, 1 or 2 when the axis is that coordinate axis (set by addBody), else −1.
     int coordinate_axis = -1;
     bool massless = false;           // zero inertia: a carrier (set by addBody)
+    int q_index = 0;                 // where its coordinate sits in q (a ball's three: its quaternion's w)
+    int ball = -1;                   // a ball's sub-body: index into balls
+  };
+  // A ball joint's three bodies first..first+2 and its rotation pre R(Q) R0ᵀ (see the top).
+  struct Ball {
+    int first = 0;
+    typename S::Rot pre, post;       // pre and R0
   };
   std::vector<Body> bodies;
+  std::vector<Ball> balls;
   Vec gravity = Vec::Zero();         // spatial acceleration of gravity in world coordinates
 
   int dof() const { return int(bodies.size()); }
+  int nq() const { return nq_; }     // dof() plus one per ball joint
   int addBody(int parent, JointType joint, const typename S::Axis& axis,
               const typename S::Transform& X_tree, const Mat& inertia) {
     // Spatial: a unit axis, and placements that do not turn marked so (spatial.h: E is skipped there).
     if constexpr (S::kDim == 6) bodies.push_back({parent, joint, axis.normalized(), S::marked(X_tree), inertia});
     else bodies.push_back({parent, joint, axis, X_tree, inertia});
+    bodies.back().q_index = nq_++;
     bodies.back().subspace = motionSubspace(int(bodies.size()) - 1);
     bodies.back().central = S::central(inertia);
     bodies.back().massless = S::massless(inertia);
@@ -98,7 +120,26 @@ struct TreeModel {
         if (bodies.back().axis == S::Axis::Unit(k)) bodies.back().coordinate_axis = k;
     return int(bodies.size()) - 1;
   }
+  // A ball joint (spatial): three bodies about the columns of R0 (`post`), the last carrying
+  // `inertia`, the first placed by X_tree (which does not turn: frames are world-aligned at q0).
+  // Returns the last body's index.
+  int addBall(int parent, const typename S::Transform& X_tree, const typename S::Rot& pre, const typename S::Rot& post,
+              const Mat& inertia) {
+    const int q = nq_;
+    for (int k = 0; k < 3; ++k) {
+      typename S::Transform X = k == 0 ? X_tree : typename S::Transform{};
+      const int i = addBody(k == 0 ? parent : int(bodies.size()) - 1, JointType::Ball, post.col(k), X, k == 2 ? inertia : Mat::Zero());
+      bodies[std::size_t(i)].q_index = q;
+      bodies[std::size_t(i)].ball = int(balls.size());
+    }
+    balls.push_back({int(bodies.size()) - 3, pre, post});
+    nq_ = q + 4;
+    return int(bodies.size()) - 1;
+  }
   Vec motionSubspace(int i) const;
+
+ private:
+  int nq_ = 0;
 };
 
 template <class S>
@@ -173,6 +214,17 @@ void pointJacobian(const TreeModel<S>& model, const TreeData<S>& data, int body,
 template <class S>
 void pointJacobianDot(const TreeModel<S>& model, const TreeData<S>& data, int body,
                       const typename S::Pos& point, VecN& Jdot_qd);
+
+// Configuration operations (chain_configuration.cpp), identity maps for hinges and slides:
+//   configurationRate     q̇ = N(q) θ' (a ball: Q̇ = ½ Q ⊗ (0, ω)), into qdot (sized nq)
+//   integrateConfiguration q ← q ⊕ h θ' (a ball: Q ← Q ⊗ exp(h ω / 2), MuJoCo's mj_integratePos)
+//   normalizeConfiguration each ball's Q ← Q / |Q|
+template <class S>
+void configurationRate(const TreeModel<S>& model, const VecIn& q, const VecIn& qd, Eigen::Ref<Eigen::VectorXd> qdot);
+template <class S>
+void integrateConfiguration(const TreeModel<S>& model, Eigen::Ref<Eigen::VectorXd> q, const VecIn& qd, double h);
+template <class S>
+void normalizeConfiguration(const TreeModel<S>& model, Eigen::Ref<Eigen::VectorXd> q);
 
 // World position of a point given in body coordinates.
 template <class S>

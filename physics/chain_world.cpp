@@ -44,8 +44,11 @@ void biasForcesWorld(const TreeModel<S>& model, TreeData<S>& data, const VecN& q
     const auto& b = model.bodies[std::size_t(i)];
     const Vec vJ = data.S_w[i] * qd[i];
     data.v_w[i] = b.parent < 0 ? vJ : Vec(data.v_w[b.parent] + vJ);
-    // (A root's V_i ×m S_i θ'_i is S_i θ'_i × itself: zero.)
-    const Vec c = b.parent < 0 ? Vec(Vec::Zero()) : S::crossMotion(data.v_w[i], vJ);
+    // (A root's V_i ×m S_i θ'_i is S_i θ'_i × itself: zero. A ball's sub-body: V_parent ×m S_i θ'_i,
+    // without its siblings' rates: chain.h.)
+    int anchor = i;
+    if (b.joint == JointType::Ball) anchor = model.bodies[std::size_t(model.balls[std::size_t(b.ball)].first)].parent;
+    const Vec c = b.parent < 0 || anchor < 0 ? Vec(Vec::Zero()) : S::crossMotion(data.v_w[anchor], vJ);
     data.a_w[i] = b.parent < 0 ? c : Vec(data.a_w[b.parent] + c);
     if (b.massless) {
       data.f[i].setZero();

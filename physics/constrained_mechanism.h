@@ -44,7 +44,13 @@ class ConstrainedMechanism : public ConstrainedSystem {
   }
 
   // ConstrainedSystem
-  int nq() const override { return n() + k(); }
+  // q: the trees' configuration (nq numbers: a quaternion per ball, chain.h) then the payloads'; v: n + k rates.
+  int nqTree() const { return Nj == Eigen::Dynamic ? model_.tree.nq() : Nj; }
+  int nq() const override { return nqTree() + k(); }
+  int nv() const override { return n() + k(); }
+  void configurationRate(const VecN& q, const VecN& v, VecN& qdot) override;
+  void integrateConfiguration(VecN& q, const VecN& dx, double h) override;
+  void normalizeConfiguration(VecN& q) override;
   void accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a) override;
   void constraint(const VecN& q, VecN& phi, MatN& G) override;
   void baumgarteTerm(const VecN& q, const VecN& v, double zeta, double omega, VecN& s) override;

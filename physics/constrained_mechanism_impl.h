@@ -70,7 +70,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
   kin_.payload_rate.assign(model_.payloads.size(), Eigen::Vector3d::Zero());
   kin_.payload_cs.assign(model_.payloads.size(), Eigen::Vector2d(1, 0));
   kin_.link_angle.assign(std::size_t(n()), 0.0);
-  kin_.theta = VecN::Zero(n());
+  kin_.theta = VecN::Zero(nqTree());
   kin_.theta_rate = VecN::Zero(n());
   // Planar: the fixed part of each link's angle, its placement's rotation (X_tree.E = rotation(angle)).
   if constexpr (S::kDim == 3)
@@ -100,11 +100,11 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
 
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
-  const int nn = n(), kk = k();
+  const int nn = n(), kk = k(), nqt = nqTree();
   // World transforms and joint axes, unless a controller's query just staged the whole tree at θ (the
   // parent frames are treeStage's, for the body-frame queries).
-  if (!have_tree_ || q.head(nn) != tree_q_) {
-    worldKinematics(model_.tree, q.head(nn), data_);
+  if (!have_tree_ || q.head(nqt) != tree_q_) {
+    worldKinematics(model_.tree, q.head(nqt), data_);
     have_tree_ = false;
   }
   have_velocity_ = false;
@@ -112,7 +112,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   problem_.M.resize(nn, nn);
   crbaWorld(model_.tree, data_, problem_.M);
   addArmature(problem_.M);
-  kin_.theta = q.head(nn);
+  kin_.theta = q.head(nqt);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
   if constexpr (S::kDim == 3)
     for (int i = 0; i < nn; ++i) {
@@ -121,7 +121,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
                                         (b.joint == JointType::Revolute ? q[i] : 0.0);
     }
   // Payload poses: the free coordinates from q, the others where they were put.
-  for (std::size_t i = 0, off = std::size_t(nn); i < model_.payloads.size(); ++i) {
+  for (std::size_t i = 0, off = std::size_t(nqt); i < model_.payloads.size(); ++i) {
     const Payload& p = model_.payloads[i];
     for (std::size_t c = 0; c < 3; ++c) kin_.payload_pose[i][Eigen::Index(c)] = p.free[c] ? q[Eigen::Index(off++)] : p.pose0[Eigen::Index(c)];
     const double psi = kin_.payload_pose[i][0];
@@ -154,9 +154,9 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
 
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::treeStage(const VecN& q) {
-  if (have_tree_ && q.head(n()) == tree_q_) return;
-  positionKinematics(model_.tree, q.head(n()), data_);
-  tree_q_ = q.head(n());
+  if (have_tree_ && q.head(nqTree()) == tree_q_) return;
+  positionKinematics(model_.tree, q.head(nqTree()), data_);
+  tree_q_ = q.head(nqTree());
   have_tree_ = true;
   have_position_ = have_velocity_ = false;  // data_ no longer holds the stages' configuration
 }
@@ -179,7 +179,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
     for (int i = 0; i < nn; ++i) {
       const JointProperties& j = model_.joints[std::size_t(i)];
       const double f = j.friction(qd[i]);
-      problem_.h[i] += j.stiffness * (staged_q_[i] - j.rest) + f;
+      problem_.h[i] += j.stiffness * (staged_q_[model_.tree.bodies[std::size_t(i)].q_index] - j.rest) + f;
       friction_power_ -= f * qd[i];
     }
   // Payload rates: the free coordinates' rates, zero for the held ones.
@@ -332,6 +332,34 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::derivatives(const VecN& q, const VecN&
 }
 
 template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::configurationRate(const VecN& q, const VecN& v, VecN& qdot) {
+  if (model_.tree.balls.empty()) {
+    qdot = v;
+    return;
+  }
+  const int nqt = nqTree(), kk = k();
+  qdot.resize(nqt + kk);
+  dyn::configurationRate(model_.tree, q.head(nqt), v.head(n()), qdot.head(nqt));
+  qdot.tail(kk) = v.tail(kk);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::integrateConfiguration(VecN& q, const VecN& dx, double h) {
+  if (model_.tree.balls.empty()) {
+    q += h * dx;
+    return;
+  }
+  const int nqt = nqTree(), kk = k();
+  dyn::integrateConfiguration(model_.tree, q.head(nqt), dx.head(n()), h);
+  q.tail(kk) += h * dx.tail(kk);
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::normalizeConfiguration(VecN& q) {
+  if (!model_.tree.balls.empty()) dyn::normalizeConfiguration(model_.tree, q.head(nqTree()));
+}
+
+template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::constraint(const VecN& q, VecN& phi, MatN& G) {
   positionStage(q);
   phi = phi_;
@@ -448,7 +476,7 @@ double ConstrainedMechanism<S, Nj, Nr, Nl>::potentialEnergy(const VecN& q) {
     for (std::size_t i = 0; i < model_.payloads.size(); ++i)
       U -= model_.payloads[i].mass * (model_.tree.gravity[1] * kin_.payload_pose[i][1] + model_.tree.gravity[2] * kin_.payload_pose[i][2]);
   for (std::size_t i = 0; i < model_.joints.size(); ++i) {
-    const double d = q[Eigen::Index(i)] - model_.joints[i].rest;
+    const double d = q[Eigen::Index(model_.tree.bodies[i].q_index)] - model_.joints[i].rest;
     U += 0.5 * model_.joints[i].stiffness * d * d;
   }
   return U;

@@ -54,6 +54,21 @@ class ConstrainedSystem {
   Books& books() { return books_; }
   const Books& books() const { return books_; }
   virtual int nq() const = 0;
+  // Configurations with unit quaternions (ball and free joints: chain.h) have more coordinates than
+  // rates: nv() velocity coordinates (also the size of a, G's columns, W, dx), nq() configuration
+  // numbers. Then step() integrates q̇ = N(q) v (configurationRate) and moves q by q ⊕ h dx
+  // (integrateConfiguration, the exponential map) and normalizes it (normalizeConfiguration): RK4 in
+  // the embedding, the quaternions renormalised at the step's end (still 4th order: the exact flow
+  // keeps |Q| = 1, so the normalisation moves q by the step's own O(dt⁵) error); semi-implicit Euler
+  // v⁺ = v + dt a, q⁺ = q ⊕ dt v⁺ (MuJoCo's); the projection's Newton steps q ⊕ (−dx).
+  // The defaults are a system whose q and v have the same size: identity maps.
+  virtual int nv() const { return nq(); }
+  virtual void configurationRate(const VecN& q, const VecN& v, VecN& qdot) {
+    (void)q;
+    qdot = v;
+  }
+  virtual void integrateConfiguration(VecN& q, const VecN& dx, double h) { q += h * dx; }
+  virtual void normalizeConfiguration(VecN& q) { (void)q; }
   // Accelerations a = (θ'', α_c) from the solve (2)/(3); stab is the Baumgarte term or null.
   virtual void accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab,
                              VecN& a) = 0;

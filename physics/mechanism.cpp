@@ -32,6 +32,8 @@ std::string MechanismModel<S>::validate() const {
   const int n = tree.dof();
   if (!joints.empty() && int(joints.size()) != n) return "joint properties are given for " + std::to_string(joints.size()) + " of " + std::to_string(n) + " joints";
   for (std::size_t i = 0; i < joints.size(); ++i)
+    if (tree.bodies[i].joint == JointType::Ball && joints[i].stiffness != 0) return "joint " + std::to_string(i) + " is a ball joint's: no spring on it";
+  for (std::size_t i = 0; i < joints.size(); ++i)
     if (!(joints[i].armature >= 0) || !std::isfinite(joints[i].armature))
       return "joint " + std::to_string(i) + "'s armature must be a finite number ≥ 0";
   if constexpr (S::kDim != 3) {
@@ -58,7 +60,7 @@ std::string MechanismModel<S>::validate() const {
   }
   for (int j : bullet.cut_joints)
     if (j < 0 || j >= n) return "Bullet cut joint " + std::to_string(j) + " is not a joint of the trees";
-  if (n + payloadDof() > kMaxDof || rows() > kMaxDof) return "the mechanism is larger than kMaxDof (" + std::to_string(kMaxDof) + ")";
+  if (tree.nq() + payloadDof() > kMaxDof || rows() > kMaxDof) return "the mechanism is larger than kMaxDof (" + std::to_string(kMaxDof) + ")";
   return {};
 }
 

@@ -117,7 +117,7 @@ class ModelFileLab final : public Lab {
   }
   std::string agreementUnit(const std::string& key) const override { return key == "max_dq" ? "rad" : key == "max_df" ? "N, N·m" : ""; }
   std::string referenceEngine() const override {
-    return bullet::BulletMechanism<Spatial>(m_->mechanism, dt_, m_->q0, VecN::Zero(m_->q0.size())).describe();
+    return bullet::BulletMechanism<Spatial>(m_->mechanism, dt_, m_->q0, VecN::Zero(Eigen::Index(m_->joints.size()))).describe();
   }
   void scene(const Trace& tr, std::size_t row, const Trace* ghost, Scene& out) const override {
     const int n = int(m_->joints.size());

@@ -16,7 +16,8 @@
 //             leaves out must be identically satisfied there (as the model-file loader's dropped
 //             rows are: out-of-plane rows of a planar loop). Its force: B's share of the impulses
 //             / dt (point-to-point +λ, fixed −λ, rows written for A; moment rows 3..5), at the pivot.
-// Other constraint kinds, cut joints and payloads are refused (std::invalid_argument: "not yet").
+// Ball and free joints: spherical_links.h (a ball a spherical link, a free joint three prismatic links then
+// one, on the fixed base). Other constraint kinds, cut joints and payloads are refused (std::invalid_argument: "not yet").
 // External forces (description.forces): evaluated at the step's start (time t; the point's place p and
 // spatial velocity V from the description's kinematics at (θ, θ')) and applied to the body's Bullet link
 // as the force f at its centre of mass and the torque τ + (p − c) × f, world axes (Bullet maps them to
@@ -76,6 +77,7 @@
 #include "physics/bullet/contact_balls.h"
 #include "physics/bullet/joint_constraints.h"
 #include "physics/bullet/rolling_constraint.h"
+#include "physics/bullet/spherical_links.h"
 #include "physics/constraints/plane_contact.h"
 #include "physics/constraints/point_closure.h"
 #include "physics/constraints/rolling.h"
@@ -226,8 +228,12 @@ struct BulletMechanism<Spatial>::Impl {
     if (model.tree.bodies.empty()) throw std::invalid_argument(who + "the mechanism has no tree bodies");
     if (model.bullet.solver_iterations < 1) throw std::invalid_argument(who + "solver_iterations must be ≥ 1");
     const int n = model.treeDof();
-    if (q0.size() != n || v0.size() != n)
-      throw std::invalid_argument(who + "q0 and v0 need " + std::to_string(n) + " coordinates (one per tree joint)");
+    if (q0.size() != model.tree.nq() || v0.size() != n)
+      throw std::invalid_argument(who + "q0 and v0 need " + (model.tree.nq() == n ? std::to_string(n) + " coordinates (one per tree joint)" :
+                                                             std::to_string(model.tree.nq()) + " and " + std::to_string(n) + " coordinates (a quaternion per ball)"));
+    for (int i = 0; i < int(model.joints.size()); ++i)
+      if (model.tree.bodies[std::size_t(i)].joint == JointType::Ball && model.joints[std::size_t(i)].armature != 0)
+        throw std::invalid_argument(who + "armature on a ball joint: not yet");
     for (int i = 0; i < n; ++i) {
       const auto& b = model.tree.bodies[std::size_t(i)];
       if (b.parent >= i) throw std::invalid_argument(who + "body " + std::to_string(i) + " comes before its parent");
@@ -257,7 +263,11 @@ struct BulletMechanism<Spatial>::Impl {
       const btQuaternion rot = quaternion(l.E_p * b.X_tree.E * p.E_p.transpose());
       const btVector3 axis = bt(l.E_p * b.axis.normalized());
       const btVector3 e = bt(p.E_p * (b.X_tree.r - p.com)), d = bt(l.E_p * l.com);
-      if (b.joint == JointType::Revolute)
+      if (b.joint == JointType::Ball) {  // spherical_links.h: carriers fixed at the pivot, the body spherical
+        const auto& ball = model.tree.balls[std::size_t(b.ball)];
+        if (ballCarrier(model.tree, i)) body->setupFixed(i, l.mass, bt(l.inertia), b.parent, rot, e, d, true);
+        else body->setupSpherical(i, l.mass, bt(l.inertia), b.parent, quaternion(l.E_p * ball.post * ball.pre.transpose() * p.E_p.transpose()), e, d, true);
+      } else if (b.joint == JointType::Revolute)
         body->setupRevolute(i, l.mass, bt(l.inertia), b.parent, rot, axis, e, d, true);
       else
         body->setupPrismatic(i, l.mass, bt(l.inertia), b.parent, rot, axis, e, d, true);
@@ -419,10 +429,21 @@ struct BulletMechanism<Spatial>::Impl {
     summary = s.str();
   }
 
+  // A ball's A = E_p post (spherical_links.h), at its spherical link i.
+  Mat3 sphericalAxes(int i) const { return frames[std::size_t(i)].E_p * model.tree.balls[std::size_t(model.tree.bodies[std::size_t(i)].ball)].post; }
+
   void setState(const VecN& q, const VecN& v) {
     for (int i = 0; i < model.treeDof(); ++i) {
-      body->setJointPos(i, q[i]);
-      body->setJointVel(i, v[i]);
+      const auto& b = model.tree.bodies[std::size_t(i)];
+      if (b.joint != JointType::Ball) {
+        body->setJointPos(i, q[b.q_index]);
+        body->setJointVel(i, v[i]);
+      } else if (!ballCarrier(model.tree, i)) {
+        double qb[4], wb[3];
+        sphericalToBullet(sphericalAxes(i), q.data() + b.q_index, v.data() + i - 2, qb, wb);
+        body->setJointPosMultiDof(i, qb);
+        body->setJointVelMultiDof(i, wb);
+      }
     }
     for (std::size_t k = 0; k < rotor_joint.size(); ++k) {  // each rotor turning with its gear
       body->setJointPos(model.treeDof() + int(k), 0.0);
@@ -440,6 +461,7 @@ struct BulletMechanism<Spatial>::Impl {
     TreeData<Spatial> data(model.tree);
     positionKinematics(model.tree, q, data);
     for (int i = 0; i < model.treeDof(); ++i) {
+      if (ballCarrier(model.tree, i)) continue;  // fixed in Bullet, turning in the description: both massless
       const LinkFrame& l = frames[std::size_t(i)];
       const Pos c = pointPosition(data, i, l.com);
       const Mat3 R = data.X_world[std::size_t(i)].E.transpose() * l.E_p.transpose();  // link → world
@@ -456,11 +478,16 @@ struct BulletMechanism<Spatial>::Impl {
 
   void state(VecN& q, VecN& v) const {
     const int n = model.treeDof();
-    q.resize(n);
+    q.resize(model.tree.nq());
     v.resize(n);
     for (int i = 0; i < n; ++i) {
-      q[i] = body->getJointPos(i);
-      v[i] = body->getJointVel(i);
+      const auto& b = model.tree.bodies[std::size_t(i)];
+      if (b.joint != JointType::Ball) {
+        q[b.q_index] = body->getJointPos(i);
+        v[i] = body->getJointVel(i);
+      } else if (!ballCarrier(model.tree, i)) {
+        sphericalFromBullet(sphericalAxes(i), body->getJointPosMultiDof(i), body->getJointVelMultiDof(i), q.data() + b.q_index, v.data() + i - 2);
+      }
     }
   }
 
@@ -492,9 +519,12 @@ struct BulletMechanism<Spatial>::Impl {
     state(q, v);
     const VecN pushed = applyForces(t, q, v);  // pitfall 3: cleared after every step, like the torques
     VecN friction = VecN::Zero(n);
-    for (int i = 0; i < n; ++i) {
-      const double tau = heldTorque(model.joints, i, tau_in[i], q[i], v[i], friction[i]);
-      body->addJointTorque(i, tau);  // pitfall 3: cleared after every step
+    VecN held(n);
+    for (int i = 0; i < n; ++i) held[i] = heldTorque(model.joints, i, tau_in[i], q[model.tree.bodies[std::size_t(i)].q_index], v[i], friction[i]);
+    for (int i = 0; i < n; ++i) {  // pitfall 3: cleared after every step
+      if (model.tree.bodies[std::size_t(i)].joint != JointType::Ball) body->addJointTorque(i, held[i]);
+      else if (!ballCarrier(model.tree, i))  // the ball's three torques on Bullet's axes (spherical_links.h)
+        for (int k = 0; const double t : Pos(sphericalAxes(i) * held.segment<3>(i - 2))) body->addJointTorqueMultiDof(i, k++, t);
     }
     for (Wheel& w : wheels)
       w.start_point = rimContact(*body, w.link, w.centre, w.axle, w.rolling->radius()).point;
@@ -509,8 +539,11 @@ struct BulletMechanism<Spatial>::Impl {
     VecN q1, v1;
     state(q1, v1);
     for (int i = 0; i < n; ++i) {
-      books.work += (tau_in[i] + pushed[i]) * (q1[i] - q[i]);
-      books.friction -= friction[i] * (q1[i] - q[i]);
+      // A ball's rates have no coordinate of their own: its displacement dt ω⁺ (Bullet's own first-order step).
+      const int k = model.tree.bodies[std::size_t(i)].q_index;
+      const double dq = model.tree.bodies[std::size_t(i)].joint == JointType::Ball ? dt * v1[i] : q1[k] - q[k];
+      books.work += (tau_in[i] + pushed[i]) * dq;
+      books.friction -= friction[i] * dq;
     }
   }
   Books books;

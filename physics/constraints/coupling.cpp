@@ -18,7 +18,10 @@ Coupling::Coupling(const char* kind, Form first, Form second, const std::array<d
 
 double Coupling::value(const MechanismKinematics<Spatial>& k, const Form& f) const {
   double s = 0;
-  for (const Term& t : f) s += t.coef * (k.theta[t.joint] - q0_[t.joint]);
+  for (const Term& t : f) {
+    const int qi = k.model ? k.model->tree.bodies[std::size_t(t.joint)].q_index : t.joint;  // its coordinate in q (after any quaternion)
+    s += t.coef * (k.theta[qi] - q0_[qi]);
+  }
   return s;
 }
 

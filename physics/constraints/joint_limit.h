@@ -43,7 +43,7 @@ class JointLimit final : public Constraint<Spatial> {
   void report(const MechanismKinematics<Spatial>& k, const double* eta, double* out) const override;
 
   // g at a state's kinematics (position stage).
-  double gap(const MechanismKinematics<Spatial>& k) const { return sign() * (k.theta[joint_] - bound_); }
+  double gap(const MechanismKinematics<Spatial>& k) const { return sign() * (k.theta[k.model ? k.model->tree.bodies[std::size_t(joint_)].q_index : joint_] - bound_); }
   // η from a spatial force this limit applies (force()'s inverse: σ a · the moment or force).
   double along(const MechanismKinematics<Spatial>& k, const Vec& f) const;
   int joint() const { return joint_; }

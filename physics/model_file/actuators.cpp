@@ -14,9 +14,10 @@ namespace dyn::model_file {
 
 namespace {
 
-double lengthOf(const std::vector<TendonTerm>& path, const VecN& x) {
+// Σ coef_k x_k over a path: its length from q (position: each term's coordinate in q) or its rate from v.
+double lengthOf(const std::vector<TendonTerm>& path, const VecN& x, bool position = false) {
   double l = 0;
-  for (const TendonTerm& t : path) l += t.coef * x[t.coordinate];
+  for (const TendonTerm& t : path) l += t.coef * x[position && t.qpos >= 0 ? t.qpos : t.coordinate];
   return l;
 }
 
@@ -27,12 +28,12 @@ void spread(const std::vector<TendonTerm>& path, double force, VecN& tau) {
 }  // namespace
 
 VecN actuatorTorques(const std::vector<Actuator>& actuators, const VecN& ctrl, const VecN& q, const VecN& v) {
-  VecN tau = VecN::Zero(q.size());
+  VecN tau = VecN::Zero(v.size());  // one per rate (a ball's quaternion has one more coordinate)
   for (std::size_t i = 0; i < actuators.size(); ++i) {
     const Actuator& a = actuators[i];
     double u = ctrl[Eigen::Index(i)];
     if (a.ctrl_limited) u = std::clamp(u, a.ctrl_lower, a.ctrl_upper);
-    const double length = a.gear * lengthOf(a.path, q), rate = a.gear * lengthOf(a.path, v);
+    const double length = a.gear * lengthOf(a.path, q, true), rate = a.gear * lengthOf(a.path, v);
     double force = a.gain * u + a.bias[0] + a.bias[1] * length + a.bias[2] * rate;
     if (a.force_limited) force = std::clamp(force, a.force_lower, a.force_upper);
     spread(a.path, a.gear * force, tau);
@@ -41,13 +42,13 @@ VecN actuatorTorques(const std::vector<Actuator>& actuators, const VecN& ctrl, c
 }
 
 VecN tendonTorques(const std::vector<TendonSpring>& tendons, const VecN& q, const VecN& v) {
-  VecN tau = VecN::Zero(q.size());
+  VecN tau = VecN::Zero(v.size());  // one per rate
   for (const TendonSpring& t : tendons) {
     JointProperties loss;  // the damper and friction as a joint's law (mechanism.h), on the tendon's rate
     loss.viscous = t.damping;
     loss.coulomb = t.frictionloss;
     loss.coulomb_width = t.friction_width;
-    spread(t.path, t.stiffness * (t.rest - lengthOf(t.path, q)) - loss.friction(lengthOf(t.path, v)), tau);
+    spread(t.path, t.stiffness * (t.rest - lengthOf(t.path, q, true)) - loss.friction(lengthOf(t.path, v)), tau);
   }
   return tau;
 }
@@ -81,6 +82,10 @@ class Actuated final : public ConstrainedSystem {
     inner_->derivatives(q, v, tau + drive_.torques(q, v), stab, a, work, friction);
   }
   int nq() const override { return inner_->nq(); }
+  int nv() const override { return inner_->nv(); }
+  void configurationRate(const VecN& q, const VecN& v, VecN& qdot) override { inner_->configurationRate(q, v, qdot); }
+  void integrateConfiguration(VecN& q, const VecN& dx, double h) override { inner_->integrateConfiguration(q, dx, h); }
+  void normalizeConfiguration(VecN& q) override { inner_->normalizeConfiguration(q); }
   void accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a) override {
     inner_->accelerations(q, v, tau + drive_.torques(q, v), stab, a);
   }

@@ -48,7 +48,7 @@ std::unique_ptr<ConstrainedSystem> withActuators(std::unique_ptr<ConstrainedSyst
 // Stepped without hold, τ is taken as the plain τ (each stage adds the whole drive).
 class DrivenMechanism final : public ConstrainedMechanism<Spatial> {
  public:
-  explicit DrivenMechanism(const LoadedModel& m) : ConstrainedMechanism<Spatial>(m.mechanism), drive_(m), held_(VecN::Zero(m.q0.size())) {}
+  explicit DrivenMechanism(const LoadedModel& m) : ConstrainedMechanism<Spatial>(m.mechanism), drive_(m), held_(VecN::Zero(Eigen::Index(m.joints.size()))) {}
   VecN hold(const VecN& q, const VecN& v, const VecN& tau) {
     if (drive_.empty()) return tau;
     held_ = drive_.torques(q, v);

@@ -38,9 +38,13 @@ int absoluteRank(const Eigen::MatrixXd& g) {
 }
 
 // A pose near q0 where every row holds: q0 + δ moved back onto φ = 0 by Gauss–Newton with
-// minimum-norm steps (the rows may be redundant). False if it does not converge from this δ.
+// minimum-norm steps (the rows may be redundant). False if it does not converge from this δ. With ball
+// joints δ and the steps are rates (G's columns): q0 ⊕ δ, q ⊕ (−step).
 bool assemble(ConstrainedMechanism<Spatial>& mech, const VecN& q0, const VecN& delta, const RowCandidates& rows, VecN& q) {
-  q = q0 + delta;
+  const bool sphere = mech.nq() != mech.nv();
+  q = q0;
+  if (sphere) mech.integrateConfiguration(q, delta, 1.0);
+  else q = q0 + delta;
   VecN phi;
   MatN G;
   for (int it = 0; it < 50; ++it) {
@@ -54,7 +58,8 @@ bool assemble(ConstrainedMechanism<Spatial>& mech, const VecN& q0, const VecN& d
     cod.compute(G);
     const VecN step = cod.solve(Eigen::VectorXd(phi));
     if (!step.allFinite()) return false;
-    q -= step;
+    if (sphere) mech.integrateConfiguration(q, step, -1.0);
+    else q -= step;
   }
   return false;
 }
@@ -65,7 +70,7 @@ std::vector<Eigen::MatrixXd> poses(ConstrainedMechanism<Spatial>& mech, const Ve
   std::vector<Eigen::MatrixXd> out{scaledJacobian(mech, q0, rows)};
   std::mt19937_64 rng(29);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
-  const Eigen::Index n = q0.size();
+  const Eigen::Index n = mech.nv();  // (the rates: q0.size() less one per ball)
   for (int s = 0; s < 3; ++s) {
     VecN direction(n), q;
     for (Eigen::Index i = 0; i < n; ++i) direction[i] = u(rng) * (rows.slide[std::size_t(i)] ? rows.extent : 1.0);

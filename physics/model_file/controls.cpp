@@ -51,7 +51,8 @@ Actuator readActuator(const std::string& path, const mjModel* m, int i) {
     a.path = fixedTendonPath(m, id);
   } else {
     a.joint = named(m, mjOBJ_JOINT, id, "joint");
-    a.path = {{m->jnt_dofadr[id], 1.0}};
+    if (m->jnt_type[id] == mjJNT_BALL || m->jnt_type[id] == mjJNT_FREE) throw ModelFileError(where + " drives a ball or free joint; " + kSupported);
+    a.path = {{m->jnt_dofadr[id], 1.0, m->jnt_qposadr[id]}};
   }
   checkFinite(where, "gear", m->actuator_gear + 6 * i, 1);
   checkFinite(where, "gain", m->actuator_gainprm + mjNGAIN * i, 1);

@@ -34,7 +34,7 @@ std::string num(double x) { return detail::numberText(x, 6); }
 
 std::vector<TendonTerm> fixedTendonPath(const mjModel* m, int t) {
   std::vector<TendonTerm> path;
-  for (int w = m->tendon_adr[t]; w < m->tendon_adr[t] + m->tendon_num[t]; ++w) path.push_back({m->jnt_dofadr[m->wrap_objid[w]], m->wrap_prm[w]});
+  for (int w = m->tendon_adr[t]; w < m->tendon_adr[t] + m->tendon_num[t]; ++w) path.push_back({m->jnt_dofadr[m->wrap_objid[w]], m->wrap_prm[w], m->jnt_qposadr[m->wrap_objid[w]]});
   return path;
 }
 
@@ -88,7 +88,7 @@ void addJointElements(const std::string& path, const mjModel* m, const LoadOptio
       continue;
     }
     // A run from a keyframe starts there (controls.cpp's readStart checks it); else from q0.
-    const double q0 = out.q0[j];
+    const double q0 = out.q0[jt.qpos];
     if (options.key.empty() && !(q0 >= jt.lower - 1e-9 && q0 <= jt.upper + 1e-9))
       throw ModelFileError(path + ": joint '" + jt.name + "' starts at " + num(q0) + ", outside its range [" + num(jt.lower) + ", " + num(jt.upper) +
                            "] (its ref, or 0); expected the reference pose inside the range" +

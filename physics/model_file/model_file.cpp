@@ -47,14 +47,11 @@ std::string nameOf(const mjModel* m, int type, int id, const char* what) {
 // but does not enforce, as notes.
 void checkSupported(const std::string& file, const mjModel* m, const LoadOptions& opt, std::vector<std::string>& notes) {
   auto fail = [&](const std::string& what) { throw ModelFileError(file + ": " + what); };
-  static const char* const kJoint[4] = {"free", "ball", "slide", "hinge"};
   for (int j = 0; j < m->njnt; ++j)
-    if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE)
-      fail("joint '" + nameOf(m, mjOBJ_JOINT, j, "joint") + "' (body '" + nameOf(m, mjOBJ_BODY, m->jnt_bodyid[j], "body") +
-           "') is a " + kJoint[m->jnt_type[j]] + " joint; dynlab reads hinge and slide joints (URDF: revolute, continuous, prismatic, fixed): " +
-           (m->jnt_type[j] == mjJNT_BALL ? "write it as three hinges about orthogonal axes" : "remove it to fix the body, or give it the hinges and slides it moves by"));
-  if (m->nv == 0) fail("no hinge or slide joint: nothing moves (dynlab reads bodies moved by hinge and slide joints)");
-  if (m->nv > kMaxDof) fail(std::to_string(m->nv) + " joints, more than dynlab's " + std::to_string(kMaxDof));
+    if (m->jnt_type[j] == mjJNT_BALL || m->jnt_type[j] == mjJNT_FREE)
+      detail::checkBallJoint(file, m, j, nameOf(m, mjOBJ_JOINT, j, "joint"), nameOf(m, mjOBJ_BODY, m->jnt_bodyid[j], "body"));
+  if (m->nv == 0) fail("no joint: nothing moves (dynlab reads bodies moved by hinge, slide, ball and free joints)");
+  if (m->nq > kMaxDof) fail(std::to_string(m->nq) + " coordinates (qpos), more than dynlab's " + std::to_string(kMaxDof));
   for (int b = 1; b < m->nbody; ++b)
     if (m->body_mocapid[b] >= 0) fail("body '" + nameOf(m, mjOBJ_BODY, b, "body") + "' is a mocap body; dynlab reads bodies moved by their joints only");
   detail::checkTendons(file, m);
@@ -118,8 +115,13 @@ std::vector<Frame> readTree(const std::string& path, const mjModel* m, const mjD
     Frame f = frame[std::size_t(m->body_parentid[b])];
     for (int k = 0; k < m->body_jntnum[b]; ++k) {
       const int j = m->body_jntadr[b] + k;
-      if (m->jnt_qposadr[j] != j || m->jnt_dofadr[j] != j || j != mech.tree.dof())
+      if (m->jnt_qposadr[j] != mech.tree.nq() || m->jnt_dofadr[j] != mech.tree.dof())
         throw ModelFileError(path + ": joint '" + nameOf(m, mjOBJ_JOINT, j, "joint") + "': coordinates out of MuJoCo's usual order");
+      if (m->jnt_type[j] == mjJNT_BALL || m->jnt_type[j] == mjJNT_FREE) {
+        detail::addBallJoint(m, d, b, j, nameOf(m, mjOBJ_JOINT, j, "joint"), nameOf(m, mjOBJ_BODY, b, "body"), f.link, f.origin, out);
+        inertia.resize(std::size_t(mech.tree.dof()), Spatial::Mat::Zero());
+        continue;
+      }
       const Vec3 o(d->xanchor + 3 * j), a = Vec3(d->xaxis + 3 * j).normalized();
       const bool hinge = m->jnt_type[j] == mjJNT_HINGE;
       const double q0 = m->qpos0[m->jnt_qposadr[j]];
@@ -136,7 +138,9 @@ std::vector<Frame> readTree(const std::string& path, const mjModel* m, const mjD
       jt.type = hinge ? "hinge" : "slide";
       jt.limited = m->jnt_limited[j] && !(flags & mjDSBL_LIMIT);
       jt.lower = m->jnt_range[2 * j], jt.upper = m->jnt_range[2 * j + 1];
+      jt.qpos = m->jnt_qposadr[j];
       out.joints.push_back(jt);
+      out.coordinates.push_back(jt.name);
     }
     frame[std::size_t(b)] = f;
     if (m->body_jntnum[b] > 0) out.bodies.push_back(nameOf(m, mjOBJ_BODY, b, "body"));
@@ -171,9 +175,11 @@ void readJointProperties(const mjModel* m, LoadedModel& out) {
   mech.joints.resize(std::size_t(m->nv));
   for (int j = 0; j < m->nv; ++j) {
     JointProperties& p = mech.joints[std::size_t(j)];
+    const int jnt = m->dof_jntid[j];  // (a ball's or free joint's stiffness is refused: checkBallJoint)
+    const bool scalar = m->jnt_type[jnt] == mjJNT_HINGE || m->jnt_type[jnt] == mjJNT_SLIDE;
     if (!(flags & mjDSBL_PASSIVE)) {
-      p.stiffness = m->jnt_stiffness[j];
-      p.rest = m->qpos_spring[m->jnt_qposadr[j]];
+      p.stiffness = scalar ? m->jnt_stiffness[jnt] : 0.0;
+      p.rest = scalar ? m->qpos_spring[m->jnt_qposadr[jnt]] : 0.0;
       p.viscous = m->dof_damping[j];
     }
     if (!(flags & (mjDSBL_FRICTIONLOSS | mjDSBL_CONSTRAINT))) p.coulomb = m->dof_frictionloss[j];
@@ -313,7 +319,7 @@ void keepIndependentRows(const std::string& path, const std::vector<Tie>& ties, 
                            "); write the file in its closed pose");
   RowCandidates rows;
   rows.extent = extent;
-  for (const Joint& j : out.joints) rows.slide.push_back(j.type == "slide");
+  for (const auto& body : out.mechanism.tree.bodies) rows.slide.push_back(body.joint == JointType::Prismatic);
   for (std::size_t i = 0; i < ties.size(); ++i) {
     rows.names.push_back(out.closures[i].name);
     const auto all = rowsOf(ties[i].weld);

@@ -133,18 +133,22 @@ struct Drawing {
   std::vector<std::string> notes;  // what is drawn other than as written (an ellipsoid as its bounding capsule, ...)
 };
 
-// A joint as the file names it (one per coordinate, in coordinate order).
+// A joint as the file names it (one per rate, in v's order: a ball joint's three rates NAME_wx, NAME_wy,
+// NAME_wz, a free joint's six NAME_x … NAME_wz).
 struct Joint {
-  std::string name, body, type;  // type: "hinge" or "slide"
+  std::string name, body, type;  // type: "hinge", "slide", "ball" or "free"
+  int qpos = 0;                  // its coordinate in q (a ball's or free joint's rotation rates: the quaternion's w)
   bool limited = false;
   double lower = 0, upper = 0;
 };
 
 // A fixed tendon's length as a linear form of the coordinates (MuJoCo's ten_length over qpos): l = Σ coef_k q_k.
 struct TendonTerm {
-  int coordinate = 0;
+  int coordinate = 0;  // the joint's rate in v (its torque in τ)
   double coef = 1;
-  bool operator==(const TendonTerm&) const = default;
+  int qpos = -1;       // its coordinate in q when that differs (after a ball's quaternion); −1: coordinate
+  // The same joint and coefficient (qpos follows from the joint).
+  bool operator==(const TendonTerm& o) const { return coordinate == o.coordinate && coef == o.coef; }
 };
 
 // An actuator as the file writes it (MuJoCo's <motor>, <position>, <velocity>, <general> on a hinge or
@@ -189,6 +193,7 @@ struct LoadedModel {
   std::shared_ptr<const detail::Compiled> compiled;
   MechanismModel<Spatial> mechanism;
   VecN q0;                         // the file's reference pose qpos0 (closed: every loop holds there)
+  std::vector<std::string> coordinates;  // per entry of q: its name (a quaternion's: NAME_qw … NAME_qz)
   std::vector<Joint> joints;       // per coordinate
   std::vector<std::string> bodies;  // per MuJoCo body that moves (the world and fused bodies left out)
   std::vector<Closure> closures;   // per mechanism constraint, first

@@ -97,6 +97,14 @@ void readDrawing(const mjModel* m, const mjData* d, const std::vector<int>& link
 void addElements(const std::string& path, const mjModel* m, const mjData* d, const std::vector<int>& link,
                  const std::vector<Eigen::Vector3d>& origin, const LoadOptions& options, LoadedModel& out);
 
+// A ball or free joint (ball_joints.cpp): refused in one line if it has a spring or (a ball) a limit;
+// added after tree body `link` (frame origin `origin`, both updated to the joint's last body), with its
+// Joint entries (one per rate) and coordinate names (one per qpos).
+// (name, body: the joint's and its body's names as errors and columns show them.)
+void checkBallJoint(const std::string& path, const mjModel* m, int j, const std::string& name, const std::string& body);
+void addBallJoint(const mjModel* m, const mjData* d, int b, int j, const std::string& name, const std::string& body, int& link,
+                  Eigen::Vector3d& origin, LoadedModel& out);
+
 // Tendons and muscle actuators dynlab cannot hold, refused in one line (joint_elements.cpp).
 void checkTendons(const std::string& path, const mjModel* m);
 

@@ -87,7 +87,7 @@ TEST_CASE("dynlab model: hostile and unsupported files get one line and exit 2, 
   TempDir dir("model_bad");
   writeFile(dir / "latin1.xml", "<mujoco model=\"caf\xE9\"/>");
   checkBadInput(dir, {"model", "latin1.xml", "--out", "o"}, {"latin1.xml", "not valid UTF-8"}, dir / "o");
-  writeFile(dir / "ball.xml", "<mujoco><worldbody><body name=\"b\"><joint name=\"s\" type=\"ball\"/>"
+  writeFile(dir / "ball.xml", "<mujoco><worldbody><body name=\"b\"><joint name=\"s\" type=\"ball\" limited=\"true\" range=\"0 30\"/>"
                               "<geom size=\"0.1\"/></body></worldbody></mujoco>");
   checkBadInput(dir, {"model", "ball.xml", "--out", "o"}, {"ball.xml", "joint 's'", "ball joint", "hinge and slide"}, dir / "o");
   checkBadInput(dir, {"model", "missing.xml", "--out", "o"}, {"missing.xml", "no such file"}, dir / "o");

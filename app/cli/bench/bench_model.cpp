@@ -70,7 +70,7 @@ Engine handWithElements(const model_file::LoadedModel& m, const char* scheme, st
   x.scheme = std::string(scheme) + " (dynamic sizes; contacts closed and opened between steps, touchdowns located)";
   // The zero torque made once (a step allocates nothing); with actuators or tendons, evaluated at each
   // stage (labs/generic/model_run.cpp's runHandElements).
-  x.step = [=, zero = VecN(VecN::Zero(m.q0.size())), tau = VecN(VecN::Zero(m.q0.size()))]() mutable {
+  x.step = [=, zero = VecN(VecN::Zero(Eigen::Index(m.joints.size()))), tau = VecN(VecN::Zero(Eigen::Index(m.joints.size())))]() mutable {
     if (!(*mech)->empty()) tau = (*mech)->hold(*q, *v, zero);
     (*mech)->updateContacts(*q, *v, tau);
     return (*mech)->stepLocatingContacts(o, tau, *q, *v) && q->allFinite() && v->allFinite();
@@ -80,8 +80,33 @@ Engine handWithElements(const model_file::LoadedModel& m, const char* scheme, st
   return x;
 }
 
+// Bullet's engine.
+void addBullet(const model_file::LoadedModel& m, double dt, Engines& e) {
+  const int n = int(m.joints.size());
+  const VecN q0 = m.start_q, v0 = m.start_v;
+  e.bullet = std::make_unique<bullet::BulletMechanism<Spatial>>(m.mechanism, dt, q0, v0);
+  Engine b;
+  b.name = "Bullet";
+  b.scheme = e.bullet->describe() + ", semi-implicit Euler";
+  auto* bt = &e.bullet;
+  // Bullet: the zero torque made once (a step allocates nothing); with actuators, theirs at the step's start.
+  b.step = [bt, &m, tau = VecN(VecN::Zero(n))] {
+    if (m.actuators.empty() && m.tendons.empty()) {
+      (*bt)->step(tau);
+      return true;
+    }
+    VecN q, v;
+    (*bt)->state(q, v);
+    (*bt)->step(model_file::actuatorTorques(m, q, v));
+    return true;
+  };
+  b.restart = [bt, &m, dt, q0, v0] { *bt = std::make_unique<bullet::BulletMechanism<Spatial>>(m.mechanism, dt, q0, v0); };
+  b.state = [bt](VecN& q, VecN& v) { (*bt)->state(q, v); };
+  e.list.push_back(b);
+}
+
 void build(const model_file::LoadedModel& m, double dt, bool beside, Engines& e) {
-  const int n = int(m.q0.size());
+  const int n = int(m.joints.size());  // rates (a ball's quaternion has one more coordinate)
   const VecN q0 = m.start_q, v0 = m.start_v;
   StepOptions euler;
   euler.dt = dt;
@@ -110,25 +135,7 @@ void build(const model_file::LoadedModel& m, double dt, bool beside, Engines& e)
     e.list.push_back(handWithElements(m, "semi-implicit Euler + Baumgarte", &e.euler_el, &e.q_euler, &e.v_euler, euler));
     e.list.push_back(handWithElements(m, "RK4 + projection", &e.rk4_el, &e.q_rk4, &e.v_rk4, rk4));
   }
-  e.bullet = std::make_unique<bullet::BulletMechanism<Spatial>>(m.mechanism, dt, q0, v0);
-  Engine b;
-  b.name = "Bullet";
-  b.scheme = e.bullet->describe() + ", semi-implicit Euler";
-  auto* bt = &e.bullet;
-  // Bullet: the zero torque made once (a step allocates nothing); with actuators, theirs at the step's start.
-  b.step = [bt, &m, tau = VecN(VecN::Zero(n))] {
-    if (m.actuators.empty() && m.tendons.empty()) {
-      (*bt)->step(tau);
-      return true;
-    }
-    VecN q, v;
-    (*bt)->state(q, v);
-    (*bt)->step(model_file::actuatorTorques(m, q, v));
-    return true;
-  };
-  b.restart = [bt, &m, dt, q0, v0] { *bt = std::make_unique<bullet::BulletMechanism<Spatial>>(m.mechanism, dt, q0, v0); };
-  b.state = [bt](VecN& q, VecN& v) { (*bt)->state(q, v); };
-  e.list.push_back(b);
+  addBullet(m, dt, e);
   if (beside) return;  // MuJoCo's run of the file would not hold what is beside it
   e.mujoco = std::make_unique<model_file::MujocoSimulation>(m, dt);
   model_file::MujocoSimulation* mj = e.mujoco.get();

@@ -61,7 +61,12 @@ std::string describe(const model_file::LoadedModel& m) {
     double mass = 0;
     Eigen::Vector3d c;
     Spatial::massAndCom(mech.tree.bodies[i].inertia, mass, c);
-    o << "  joint " << nameShown(j.name) << " (" << nameShown(j.type) << ", body " << nameShown(j.body) << "): q0 " << fmt(m.q0[Eigen::Index(i)]);
+    o << "  joint " << nameShown(j.name) << " (" << nameShown(j.type) << ", body " << nameShown(j.body) << "): q0 " << fmt(m.q0[Eigen::Index(j.qpos)]);
+    // A ball's (or free joint's) rotation: its three rates share one quaternion (w x y z), shown once.
+    if (mech.tree.bodies[i].joint == JointType::Ball)
+      o << (mech.tree.bodies[i].ball >= 0 && mech.tree.balls[std::size_t(mech.tree.bodies[i].ball)].first == int(i)
+                ? " (quaternion w; x y z " + fmt(m.q0[j.qpos + 1]) + " " + fmt(m.q0[j.qpos + 2]) + " " + fmt(m.q0[j.qpos + 3]) + "), rate ω in the body's frame"
+                : ", rate ω in the body's frame");
     o << (mech.tree.bodies[i].massless ? ", a massless carrier" : ", carries " + fmt(mass) + " kg");
     if (!mech.joints.empty()) {
       const JointProperties& p = mech.joints[i];
@@ -127,6 +132,9 @@ std::string crossCheck(const model_file::LoadedModel& m, ConstrainedMechanism<Sp
   for (int s = 0; s < 5; ++s) {
     VecN q = m.q0, v = VecN::Zero(n);
     for (int i = 0; s > 0 && i < n; ++i) q[i] += u(rng), v[i] = 2.0 * u(rng);
+    // A ball's quaternion has one more entry than its rates: moved too, then back to unit length.
+    for (Eigen::Index i = n; s > 0 && i < q.size(); ++i) q[i] += u(rng);
+    normalizeConfiguration(m.mechanism.tree, q);
     dM = std::max(dM, (mech.massMatrix(q) - mj.massMatrix(q)).cwiseAbs().maxCoeff());
     dh = std::max(dh, (mech.inverseDynamics(q, v, VecN::Zero(n)) - mj.bias(q, v)).cwiseAbs().maxCoeff());
     // The actuators' torques at controls spread past their ranges (the clamps included).
@@ -331,7 +339,7 @@ int model(const ModelArgs& asked) {
   if (bullet) text += report(b, b.summary + ", semi-implicit Euler", m, args);
   if (hand && bullet) {
     double dq = 0;
-    const int n = mech.n();
+    const int n = int(m.q0.size());  // every coordinate (a ball's quaternion too)
     for (std::size_t r = 0; r < std::min(h.trace.rows(), b.trace.rows()); ++r)
       for (int i = 0; i < n; ++i) dq = std::max(dq, std::abs(h.trace.at(r, 1 + i) - b.trace.at(r, 1 + i)));
     text += "agreement: max |q_hand − q_bullet|∞ " + fmt(dq) + " (Bullet's step is first order)\n";

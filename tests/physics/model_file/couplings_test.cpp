@@ -212,11 +212,10 @@ TEST_CASE("tendons and actuators dynlab cannot hold are refused in one line nami
   const model_file::LoadedModel m = model_file::load(writeFile(dir, "defined.xml", file(fixed)).string());
   CHECK(m.contacts.empty());
   CHECK(m.dof == 2);
-  // Free and ball joints stay refused, the line naming what dynlab reads and what to change.
-  CHECK(refusal("ball.xml", R"(<mujoco><worldbody><body name="a"><joint name="shoulder" type="ball"/><geom type="sphere" size="0.1" mass="1"/>
+  // A ball joint's spring is refused, the line naming what dynlab reads and what to change.
+  CHECK(refusal("ball.xml", R"(<mujoco><worldbody><body name="a"><joint name="shoulder" type="ball" stiffness="2"/><geom type="sphere" size="0.1" mass="1"/>
     </body></worldbody></mujoco>)")
-            .find("joint 'shoulder' (body 'a') is a ball joint; dynlab reads hinge and slide joints (URDF: revolute, continuous, prismatic, fixed): "
-                  "write it as three hinges about orthogonal axes") != std::string::npos);
+            .find("joint 'shoulder' (body 'a') is a ball joint with stiffness 2; dynlab holds springs on hinge and slide joints only") != std::string::npos);
 }
 
 }  // namespace dyn
