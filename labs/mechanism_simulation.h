@@ -57,10 +57,7 @@ class HandEngine final : public MechanismEngine {
     // Unilateral contacts close (with an impact on v) or open at the step's start ...
     mech_.updateContacts(q_, v_, tau);
     // The constraint forces at the step's start: the solve the first RK4 stage reuses.
-    if (with_forces) {
-      const auto sol = mech_.solve(q_, v_, tau);
-      for (std::size_t i = 0; i < forces_.size(); ++i) forces_[i] = mech_.constraintForce(int(i), sol);
-    }
+    if (with_forces) forcesNow(tau);
     // ... and a touchdown inside the step is located and closed there (the step retaken to it).
     if (!mech_.stepLocatingContacts(options_, tau, q_, v_)) failure_ = "the constraint projection failed";
     return failure_.empty();
@@ -149,9 +146,7 @@ class MechanismSimulation final : public Simulation {
     if (k_ >= steps_ || !failure_.empty()) return false;
     const double t = double(k_) * dt_;
     tau_ = hooks_->torque(t, q_, v_);
-    // |φ(q)|, and for velocity-level kinds (rolling) |J θ' − A v_c| as well: they have no φ.
-    const double energy = model_->energy(q_, v_);
-    const double residual = model_->holonomic() ? model_->residual(q_) : model_->residual(q_, v_);
+    const double energy = model_->energy(q_, v_), residual = residualNow();
     const double work = work_;
     advance(true, t);
     const StepRecord r{engine_, t, q_, v_, tau_, stepper_->forces(), energy, residual, work};
@@ -187,9 +182,7 @@ class MechanismSimulation final : public Simulation {
     tau_ = hooks_->torque(t, q_, v_);
     stepper_->setTime(t);
     stepper_->forcesNow(tau_);
-    const double energy = model_->energy(q_, v_);
-    const double residual = model_->holonomic() ? model_->residual(q_) : model_->residual(q_, v_);
-    const StepRecord r{engine_, t, q_, v_, tau_, stepper_->forces(), energy, residual, work_};
+    const StepRecord r{engine_, t, q_, v_, tau_, stepper_->forces(), model_->energy(q_, v_), residualNow(), work_};
     hooks_->row(r, row);
     return true;
   }
@@ -207,6 +200,8 @@ class MechanismSimulation final : public Simulation {
   M& model() { return *model_; }
 
  private:
+  // |φ(q)| of the present state, and for velocity-level kinds (rolling) |J θ' − A v_c| as well: they have no φ.
+  double residualNow() const { return model_->holonomic() ? model_->residual(q_) : model_->residual(q_, v_); }
   void advance(bool with_forces, double t) {
     stepper_->setTime(t);
     if (!stepper_->step(tau_, with_forces) && failure_.empty()) failure_ = stepper_->failure();

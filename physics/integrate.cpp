@@ -49,8 +49,7 @@ bool projectPositions(ConstrainedSystem& sys, const DriftOptions& d, VecN& q) {
     sys.constraint(q, phi, G);
     if (phi.lpNorm<Eigen::Infinity>() <= d.tolerance) return true;
     if (!sys.correction(q, phi, dx)) return false;
-    if (sys.nq() == sys.nv()) q -= dx;  // Newton step on φ(q) = 0
-    else sys.integrateConfiguration(q, dx, -1.0);  // on the sphere: q ⊕ (−dx)
+    sys.integrateConfiguration(q, dx, -1.0);  // Newton step on φ(q) = 0: q − dx (a quaternion: q ⊕ (−dx))
   }
   sys.constraint(q, phi, G);
   return phi.lpNorm<Eigen::Infinity>() <= d.tolerance * 1e3;
@@ -75,71 +74,38 @@ namespace {
 // The last stage's time, just inside the step (see integrate.h).
 constexpr double kInside = 1.0 - 1e-9;
 
-// stepOnce's motion for a system with quaternions (nq > nv: integrate.h), the books as there.
-void stepOnSphere(ConstrainedSystem& sys, const StepOptions& o, double dt, const VecN& tau, VecN& q, VecN& v) {
-  const double t0 = sys.time();
-  VecN s, a1;
-  double w1, f1;
-  Books& books = sys.books();
-  sys.derivatives(q, v, tau, baumgarte(sys, o.drift, q, v, s), a1, w1, f1);
-  if (o.integrator == Integrator::SemiImplicitEuler) {
-    v += dt * a1;
-    sys.integrateConfiguration(q, v, dt);
-    books.work += dt * w1;
-    books.friction += dt * f1;
-    return;
-  }
-  // Classic RK4 on (q, v, W, D) with q̇ = N(q) v, each stage at its own time.
-  VecN a2, a3, a4, d1, d2, d3, d4;
-  double w2, w3, w4, f2, f3, f4;
-  sys.configurationRate(q, v, d1);
-  const VecN q2 = q + 0.5 * dt * d1, v2 = v + 0.5 * dt * a1;
-  sys.setTime(t0 + 0.5 * dt);
-  sys.derivatives(q2, v2, tau, baumgarte(sys, o.drift, q2, v2, s), a2, w2, f2);
-  sys.configurationRate(q2, v2, d2);
-  const VecN q3 = q + 0.5 * dt * d2, v3 = v + 0.5 * dt * a2;
-  sys.derivatives(q3, v3, tau, baumgarte(sys, o.drift, q3, v3, s), a3, w3, f3);
-  sys.configurationRate(q3, v3, d3);
-  const VecN q4 = q + dt * d3, v4 = v + dt * a3;
-  sys.setTime(t0 + kInside * dt);
-  sys.derivatives(q4, v4, tau, baumgarte(sys, o.drift, q4, v4, s), a4, w4, f4);
-  sys.configurationRate(q4, v4, d4);
-  q += dt / 6.0 * (d1 + 2.0 * d2 + 2.0 * d3 + d4);
-  sys.normalizeConfiguration(q);
-  v += dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
-  books.work += dt / 6.0 * (w1 + 2.0 * w2 + 2.0 * w3 + w4);
-  books.friction += dt / 6.0 * (f1 + 2.0 * f2 + 2.0 * f3 + f4);
-}
-
 // One step of dt from the clock's time t0: the motion, the books, the drift handling.
 bool stepOnce(ConstrainedSystem& sys, const StepOptions& o, double dt, const VecN& tau, VecN& q, VecN& v) {
   const double t0 = sys.time();
   VecN s, a;
   double w1, f1;
   Books& books = sys.books();
-  if (sys.nq() != sys.nv()) {
-    stepOnSphere(sys, o, dt, tau, q, v);
-  } else if (o.integrator == Integrator::SemiImplicitEuler) {
+  if (o.integrator == Integrator::SemiImplicitEuler) {
     sys.derivatives(q, v, tau, baumgarte(sys, o.drift, q, v, s), a, w1, f1);
     v += dt * a;
-    q += dt * v;
+    sys.integrateConfiguration(q, v, dt);  // q + dt v; a quaternion on the sphere (MuJoCo's)
     books.work += dt * w1;
     books.friction += dt * f1;
   } else {
-    // Classic RK4 on (q, v, W, D), each stage at its own time.
-    VecN a1, a2, a3, a4;
+    // Classic RK4 on (q, v, W, D) with q̇ = N(q) v (= v without quaternions), each stage at its own time;
+    // quaternions renormalised at the end (integrate.h).
+    VecN a1, a2, a3, a4, d1, d2, d3, d4;
     double w2, w3, w4, f2, f3, f4;
     sys.derivatives(q, v, tau, baumgarte(sys, o.drift, q, v, s), a1, w1, f1);
-    const VecN v1 = v;
-    const VecN q2 = q + 0.5 * dt * v1, v2 = v + 0.5 * dt * a1;
+    sys.configurationRate(q, v, d1);
+    const VecN q2 = q + 0.5 * dt * d1, v2 = v + 0.5 * dt * a1;
     sys.setTime(t0 + 0.5 * dt);
     sys.derivatives(q2, v2, tau, baumgarte(sys, o.drift, q2, v2, s), a2, w2, f2);
-    const VecN q3 = q + 0.5 * dt * v2, v3 = v + 0.5 * dt * a2;
+    sys.configurationRate(q2, v2, d2);
+    const VecN q3 = q + 0.5 * dt * d2, v3 = v + 0.5 * dt * a2;
     sys.derivatives(q3, v3, tau, baumgarte(sys, o.drift, q3, v3, s), a3, w3, f3);
-    const VecN q4 = q + dt * v3, v4 = v + dt * a3;
+    sys.configurationRate(q3, v3, d3);
+    const VecN q4 = q + dt * d3, v4 = v + dt * a3;
     sys.setTime(t0 + kInside * dt);
     sys.derivatives(q4, v4, tau, baumgarte(sys, o.drift, q4, v4, s), a4, w4, f4);
-    q += dt / 6.0 * (v1 + 2.0 * v2 + 2.0 * v3 + v4);
+    sys.configurationRate(q4, v4, d4);
+    q += dt / 6.0 * (d1 + 2.0 * d2 + 2.0 * d3 + d4);
+    sys.normalizeConfiguration(q);
     v += dt / 6.0 * (a1 + 2.0 * a2 + 2.0 * a3 + a4);
     books.work += dt / 6.0 * (w1 + 2.0 * w2 + 2.0 * w3 + w4);
     books.friction += dt / 6.0 * (f1 + 2.0 * f2 + 2.0 * f3 + f4);
