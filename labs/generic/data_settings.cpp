@@ -116,6 +116,11 @@ model_file::LoadedModel loadModel(const JsonView& mf, const std::string& folder,
     mf.fail(std::string("a model file dynlab reads (") + e.what() + ")");
   }
   if (!file.mechanism.payloads.empty()) mf.fail("a model without free payload bodies");
+  // The controllers read a coordinate per joint: a ball's or free joint's quaternion is not one.
+  for (const model_file::Joint& j : file.joints)
+    if (j.type != "hinge" && j.type != "slide")
+      mf.fail("a model file whose joints are hinges and slides (joint '" + j.name + "' is part of a " + j.type +
+              " joint; a data lab's controllers read one angle per joint: run the file with `dynlab model` or `dynlab run`)");
   // The controller drives the joints: a servo's law (its bias) would not act here.
   for (const model_file::Actuator& a : file.actuators)
     if (a.bias[0] != 0 || a.bias[1] != 0 || a.bias[2] != 0)

@@ -175,8 +175,8 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, 
   if (const std::string problem = runBoundProblem(dt, duration.value_or(2.0), 0, step); !problem.empty()) refuse(problem);
   if (notes) *notes = modelNotes(*m, dt);
   // Its figures: the coordinates, the energy books, each closure's force, each wheel's and contact's.
-  std::vector<std::string> q, f, c;
-  for (const auto& j : m->joints) q.push_back("q_" + columnName(j.name));
+  const std::vector<std::string> q = coordinateColumns(*m);
+  std::vector<std::string> f, c;
   for (const auto& k : m->closures)
     for (const auto& r : k.kept) f.push_back("f_" + columnName(k.name) + "_" + r);
   for (const auto& k : m->contacts)

@@ -95,14 +95,21 @@ bool anyImpacts(const model_file::LoadedModel& m) {
   return false;
 }
 
+std::vector<std::string> coordinateColumns(const model_file::LoadedModel& m) {
+  std::vector<std::string> q;
+  if (m.coordinates.size() == std::size_t(m.q0.size()))
+    for (const auto& c : m.coordinates) q.push_back("q_" + columnName(c));
+  else
+    for (const auto& j : m.joints) q.push_back("q_" + columnName(j.name));
+  return q;
+}
+
 Trace modelColumns(const model_file::LoadedModel& m) {
   Trace t;
   t.columns.push_back("t");
   // q's entries by name (a ball's quaternion: NAME_qw … NAME_qz), then the rates (NAME_wx … for a ball).
-  if (m.coordinates.size() == std::size_t(m.q0.size()))
-    for (const auto& c : m.coordinates) t.columns.push_back("q_" + columnName(c));
-  else
-    for (const auto& j : m.joints) t.columns.push_back("q_" + columnName(j.name));
+  const std::vector<std::string> q = coordinateColumns(m);
+  t.columns.insert(t.columns.end(), q.begin(), q.end());
   for (const auto& j : m.joints) t.columns.push_back("v_" + columnName(j.name));
   t.columns.insert(t.columns.end(), {"energy", "work", "constraint_residual"});
   for (const auto& c : m.closures)

@@ -25,6 +25,8 @@ struct ModelRun {
 // The trace's columns: t, q_JOINT, v_JOINT, energy, work, constraint_residual, f_CLOSURE_ROW, then
 // with a rigid contact `impacts`, then each wheel's f_NAME_long|lat|normal, skid_margin_NAME,
 // slip_NAME and each contact's f_NAME_normal|tangent, gap_NAME (an empty trace).
+// The trace columns of q, one per entry: q_NAME per hinge or slide, q_NAME_qw … q_NAME_qz per ball's quaternion.
+std::vector<std::string> coordinateColumns(const model_file::LoadedModel& m);
 Trace modelColumns(const model_file::LoadedModel& m);
 
 // A rigid plane contact among the model's elements: its touchdowns are plastic impacts.

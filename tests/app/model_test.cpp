@@ -163,6 +163,26 @@ TEST_CASE("dynlab figure FILE: plots and stills of the file's passive run, as fo
   checkBadInput(dir, {"figure", "missing.xml", "--out", "o"}, {"missing.xml", "no such file"}, dir / "o");
 }
 
+TEST_CASE("a file with a ball joint: figure plots its quaternion; a data lab on it is one line") {
+  TempDir dir("model_ball");
+  const std::string ball = std::string(DYNLAB_SOURCE_DIR) + "/tests/physics/model_file/models/ball_loop.xml";
+  const Result r = dynlab(dir, {"figure", ball, "--duration", "0.2", "--out", "fig"});
+  INFO(r.out, r.err);
+  REQUIRE(r.code == 0);
+  // q's columns as the trace names them: the hinges' angles and the ball's quaternion (4 numbers).
+  CHECK(fs::file_size(dir / "fig/plot_q_crank+q_rod_ball_qw+q_rod_ball_qx+q_rod_ball_qy+q_rod_ball_qz+q_rocker.pdf") > 1000);
+  CHECK(drawnRightOfPanel(dir / "fig/still_0.200.png") > 5000);
+  // A data lab's controllers read one angle per joint: a ball joint is refused where the lab names the file.
+  fs::create_directories(dir / "labs/balllab");
+  fs::copy_file(ball, dir / "labs/balllab/ball_loop.xml");
+  writeFile(dir / "labs/balllab/balllab.json",
+            R"({"lab": "balllab", "title": "ball", "model_file": "ball_loop.xml", "actuated": ["crank"], "torque_limit": [5],
+               "initial": {"actuated_deg": [0]}, "simulation": {"dt": 0.001, "duration": 0.2, "integrator": "rk4", "drift": "projection"},
+               "controller": {"kind": "none", "control_period": 0.001}, "gains": {}})");
+  checkBadInput(dir, {"run", "balllab", "--labs", (dir / "labs").string(), "--out", "o"}, {"balllab.json", "/model_file", "ball joint"},
+                dir / "o");
+}
+
 TEST_CASE("dynlab run FILE: a lab's options and a missing file are bad input (one line, exit 2)") {
   TempDir dir("model_run_bad");
   writeFile(dir / "g.json", R"({"gains": {}})");
