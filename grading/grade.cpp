@@ -148,8 +148,9 @@ GradeOutcome gradeSubmission(const json& sub, const std::string& file, const Gra
       const json cfg = scenarioConfig(applied, rubric, sc, lab_name, config_file);
       const auto lab = buildLab(*entry, cfg, config_file + " (scenario " + sc.name + ")");
       ScenarioRun run = runScenario(*lab, rubric.watchdog, deadline, config_file, opt.stop);
-      trajectories += hashHex(std::to_string(run.trace.hash()));
-      rep.scenarios.push_back({sc, lab->dt(), run.trace.hash(), run.failure, run.failure_time, run.screen.notes,
+      const std::uint64_t trace_hash = run.trace.hash();  // once: a pass over every number of the run
+      trajectories += hashHex(std::to_string(trace_hash));
+      rep.scenarios.push_back({sc, lab->dt(), trace_hash, run.failure, run.failure_time, run.screen.notes,
                                run.metrics, run.out_of_time});
       runs.emplace(sc.name, std::move(run));
     }

@@ -499,7 +499,9 @@ void drawData(const Prepared& p, const Range& xr, const Range& yr, double frame_
   plbox("g", tick_x.step, 0, "g", tick_y.step, 0);
   if (!spec.parametric)
     for (const auto& s : spec.spans) drawSpan(s, xr, yr, scale);
-  const size_t budget = std::max<size_t>(400, static_cast<size_t>(2 * frame_w / kMmPerPx));
+  // Points per series: a bucket of two pixel columns keeps its min and max, about one point per
+  // pixel column; more points draw the same picture and cost the stroker its time.
+  const size_t budget = std::max<size_t>(400, static_cast<size_t>(frame_w / kMmPerPx));
   for (size_t i = 0; i < spec.series.size(); ++i)
     if (p.faint[i]) drawSeries(spec.series[i], true, budget, scale);
   for (const auto& b : spec.bands) drawBand(b, budget);

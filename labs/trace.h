@@ -7,7 +7,9 @@
 
 namespace dyn {
 
-// FNV-1a 64 of n bytes: trace fingerprints, and the grader's config and submission hashes.
+// FNV-1a 64 of n bytes: trace fingerprints, and the grader's config and submission hashes. Its
+// offset basis is 1469598103934665603, a digit short of FNV's published 14695981039346656037 (a
+// slip kept: every recorded fingerprint and per-student draw depends on it; any basis hashes as well).
 std::uint64_t fnv1a(const void* bytes, std::size_t n);
 
 // A name from elsewhere (a model file's joint) as a column name part: letters, digits, '_', '-', '.';
@@ -28,6 +30,15 @@ struct Trace {
   // By name: a column the trace lacks throws std::out_of_range naming it (never a stray read).
   double at(std::size_t row, const std::string& name) const { return at(row, require(name)); }
   int require(const std::string& name) const;
+  // A column looked up once and read by row, for loops over the rows (a lookup by name compares
+  // strings): `const auto x = tr.col("x");` then `x[r]`. Throws as require() does, once there is a
+  // row to read (as at(row, name) would).
+  struct Column {
+    const Trace* trace;
+    int index;
+    double operator[](std::size_t row) const { return trace->at(row, index); }
+  };
+  Column col(const std::string& name) const { return {this, rows() ? require(name) : column(name)}; }
   std::vector<double> series(const std::string& name) const;
   void append(const std::vector<double>& row) { data.insert(data.end(), row.begin(), row.end()); }
 

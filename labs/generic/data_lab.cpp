@@ -200,10 +200,11 @@ json DataLab::metrics(const Trace& tr) const {
   json out = json::object();
   for (const auto& [name, spec] : s_.metrics) out[name] = evaluate(spec, tr);
   double drift = 0, residual = 0;
+  const auto energy = tr.col("energy"), work = tr.col("work"), residual_col = tr.col("constraint_residual");
   const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
   for (std::size_t r = 0; r < tr.rows(); ++r) {
-    drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
-    residual = std::max(residual, tr.at(r, "constraint_residual"));
+    drift = std::max(drift, std::abs(energy[r] - e0 - work[r]));
+    residual = std::max(residual, residual_col[r]);
   }
   out["energy_drift"] = drift;
   out["max_constraint_residual"] = residual;

@@ -256,20 +256,24 @@ std::unique_ptr<Simulation> GraspLab::simulate(Engine engine) const {
 json GraspLab::metrics(const Trace& tr) const {
   std::vector<double> ep, epsi, ef;
   double margin = INFINITY, margin_t = 0, tau_max = 0, drift = 0, residual = 0, ep_max = 0;
+  const auto t_col = tr.col("t"), x_o = tr.col("x_o"), x_d = tr.col("x_d"), y_o = tr.col("y_o"), y_d = tr.col("y_d");
+  const auto psi_o = tr.col("psi_o"), psi_d = tr.col("psi_d"), f_int = tr.col("f_int"), f_int_d = tr.col("f_int_d");
+  const auto cone_margin = tr.col("cone_margin"), energy = tr.col("energy"), work = tr.col("work");
+  const auto residual_col = tr.col("constraint_residual");
   const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
   std::vector<int> tau_cols;
   for (int j = 1; j <= 2 * fingers(); ++j) tau_cols.push_back(tr.column("tau" + std::to_string(j)));
   for (std::size_t r = 0; r < tr.rows(); ++r) {
-    const double ex = tr.at(r, "x_o") - tr.at(r, "x_d"), ey = tr.at(r, "y_o") - tr.at(r, "y_d");
+    const double ex = x_o[r] - x_d[r], ey = y_o[r] - y_d[r];
     ep.push_back(det::hypot(ex, ey));
     ep_max = std::max(ep_max, ep.back());
-    epsi.push_back(tr.at(r, "psi_o") - tr.at(r, "psi_d"));
-    if (tr.at(r, "t") >= s_.settle_time) ef.push_back(tr.at(r, "f_int") - tr.at(r, "f_int_d"));
-    if (tr.at(r, "cone_margin") < margin) margin = tr.at(r, "cone_margin"), margin_t = tr.at(r, "t");
+    epsi.push_back(psi_o[r] - psi_d[r]);
+    if (t_col[r] >= s_.settle_time) ef.push_back(f_int[r] - f_int_d[r]);
+    if (cone_margin[r] < margin) margin = cone_margin[r], margin_t = t_col[r];
     for (int c : tau_cols) tau_max = std::max(tau_max, std::abs(tr.data[r * tr.columns.size() + std::size_t(c)]));
     // Energy balance: E − E0 − ∫ (τ·θ' + push·v_o) dt (zero for exact dynamics).
-    drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
-    residual = std::max(residual, tr.at(r, "constraint_residual"));
+    drift = std::max(drift, std::abs(energy[r] - e0 - work[r]));
+    residual = std::max(residual, residual_col[r]);
   }
   return {{"pos_rms", rms(ep)},          {"pos_max_error", ep_max},
           {"psi_rms", rms(epsi)},        {"cone_margin_min", tr.rows() ? margin : 0.0},

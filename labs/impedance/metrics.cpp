@@ -92,18 +92,21 @@ json ImpedanceLab::metrics(const Trace& tr) const {
   double d_max = 0, off_max = 0, drift = 0, wall_settled = 0, miss = 0;
   std::size_t settled_rows = 0;
   std::vector<double> late_wall;  // the wall force over the push's last 20 %
+  const auto t_col = tr.col("t"), x_col = tr.col("x"), y_col = tr.col("y"), x_ref = tr.col("x_ref"), y_ref = tr.col("y_ref");
+  const auto x_target = tr.col("x_target"), y_target = tr.col("y_target"), F_ext_x = tr.col("F_ext_x");
+  const auto energy = tr.col("energy"), work = tr.col("work");
   const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
   for (std::size_t r = 0; r < tr.rows(); ++r) {
-    const double t = tr.at(r, "t");
-    const Eigen::Vector2d e(tr.at(r, "x") - tr.at(r, "x_ref"), tr.at(r, "y") - tr.at(r, "y_ref"));
-    drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
+    const double t = t_col[r];
+    const Eigen::Vector2d e(x_col[r] - x_ref[r], y_col[r] - y_ref[r]);
+    drift = std::max(drift, std::abs(energy[r] - e0 - work[r]));
     // The wall's normal push on the tip (it pushes −x): the row's F_ext_x less the applied force.
-    if (s_.wall.enabled) wall.push_back(-tr.at(r, "F_ext_x") + f.at(t).x());
+    if (s_.wall.enabled) wall.push_back(-F_ext_x[r] + f.at(t).x());
     if (t < f.start || t >= t_end) continue;
     if (s_.wall.enabled && t >= t_end - 0.2 * (t_end - f.start)) wall_settled += wall.back(), ++settled_rows, late_wall.push_back(wall.back());
     ts.push_back(t - f.start - f.rise / 2);
     ds.push_back(u.dot(e));
-    const Eigen::Vector2d e_t(tr.at(r, "x_target") - tr.at(r, "x_ref"), tr.at(r, "y_target") - tr.at(r, "y_ref"));
+    const Eigen::Vector2d e_t(x_target[r] - x_ref[r], y_target[r] - y_ref[r]);
     miss = std::max(miss, std::abs(u.dot(e - e_t)));
     d_max = std::max(d_max, std::abs(u.dot(e)));
     off_max = std::max(off_max, std::abs(v.dot(e)));

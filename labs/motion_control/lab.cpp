@@ -255,27 +255,32 @@ json MotionControlLab::metrics(const Trace& tr) const {
   double e_final = 0, tau_peak = 0, tau_tv = 0, drift = 0, v_rise = 0, overshoot = 0, sat_time = 0, defl_max = 0;
   const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
   const Eigen::VectorXd d = T.folded - T.outstretched;
+  const auto t_col = tr.col("t"), tau_sat = tr.col("tau_sat"), energy = tr.col("energy"), work = tr.col("work"), V = tr.col("V");
+  std::vector<Trace::Column> e_c, tau_c, defl_c, q_c;  // joint i's columns
+  for (int i = 0; i < n; ++i)
+    e_c.push_back(tr.col(col("e", i))), tau_c.push_back(tr.col(col("tau", i))), defl_c.push_back(tr.col(col("defl", i))),
+        q_c.push_back(tr.col(col("q", i)));
   for (std::size_t r = 0; r < tr.rows(); ++r) {
-    const double t = tr.at(r, "t");
+    const double t = t_col[r];
     double e2 = 0;
     for (int i = 0; i < n; ++i) {
-      const double e = tr.at(r, col("e", i));
+      const double e = e_c[i][r];
       e2 += e * e;
       all.push_back(e);
-      const double tau = tr.at(r, col("tau", i));
+      const double tau = tau_c[i][r];
       tau_peak = std::max(tau_peak, std::abs(tau));
-      if (r > 0) tau_tv += std::abs(tau - tr.at(r - 1, col("tau", i)));
-      defl_max = std::max(defl_max, std::abs(tr.at(r, col("defl", i))));
+      if (r > 0) tau_tv += std::abs(tau - tau_c[i][r - 1]);
+      defl_max = std::max(defl_max, std::abs(defl_c[i][r]));
       // Overshoot past the folded target while holding there, as a share of the move.
       if (t >= T.t1() && t < T.t2() && std::abs(d[i]) > 1e-9)
-        overshoot = std::max(overshoot, (d[i] > 0 ? 1 : -1) * (tr.at(r, col("q", i)) - T.folded[i]) / std::abs(d[i]));
+        overshoot = std::max(overshoot, (d[i] > 0 ? 1 : -1) * (q_c[i][r] - T.folded[i]) / std::abs(d[i]));
     }
     if (t >= T.t1() && t < T.t2()) folded.push_back(std::sqrt(e2 / n));
     if (t >= T.t3() && t < T.t4()) out.push_back(std::sqrt(e2 / n));
     if (r + 1 == tr.rows()) e_final = std::sqrt(e2 / n);
-    sat_time += tr.at(r, "tau_sat") * s_.step.dt;
-    drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
-    if (r > 0) v_rise = std::max(v_rise, tr.at(r, "V") - tr.at(r - 1, "V"));
+    sat_time += tau_sat[r] * s_.step.dt;
+    drift = std::max(drift, std::abs(energy[r] - e0 - work[r]));
+    if (r > 0) v_rise = std::max(v_rise, V[r] - V[r - 1]);
   }
   return {{"e_rms", rms(all)},          {"e_final", e_final},     {"e_rms_folded", rms(folded)},
           {"e_rms_outstretched", rms(out)}, {"overshoot", std::max(0.0, overshoot)}, {"tau_peak", tau_peak},

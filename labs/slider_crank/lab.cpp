@@ -154,20 +154,23 @@ std::unique_ptr<Simulation> SliderCrankLab::simulate(Engine engine) const {
 json SliderCrankLab::metrics(const Trace& tr) const {
   std::vector<double> ex, ef;
   double ex_max = 0, ef_max = 0, tau_max = 0, drift = 0, residual = 0;
-  const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
+  const auto t = tr.col("t"), x_c = tr.col("x_c"), x_d = tr.col("x_d"), f_Ty = tr.col("f_Ty"), f_des = tr.col("f_des");
+  const auto energy = tr.col("energy"), work = tr.col("work"), residual_col = tr.col("constraint_residual");
+  const Trace::Column taus[] = {tr.col("tau1"), tr.col("tau2"), tr.col("tau3")};
+  const double e0 = tr.rows() ? energy[0] : 0;
   for (std::size_t r = 0; r < tr.rows(); ++r) {
-    const double e = tr.at(r, "x_c") - tr.at(r, "x_d");
+    const double e = x_c[r] - x_d[r];
     ex.push_back(e);
     ex_max = std::max(ex_max, std::abs(e));
-    if (tr.at(r, "t") >= s_.settle_time) {
-      const double f = tr.at(r, "f_Ty") - tr.at(r, "f_des");
+    if (t[r] >= s_.settle_time) {
+      const double f = f_Ty[r] - f_des[r];
       ef.push_back(f);
       ef_max = std::max(ef_max, std::abs(f));
     }
-    for (const char* c : {"tau1", "tau2", "tau3"}) tau_max = std::max(tau_max, std::abs(tr.at(r, c)));
+    for (const auto& tau : taus) tau_max = std::max(tau_max, std::abs(tau[r]));
     // Energy balance: E − E0 − ∫ τ·θ' dt (zero for exact dynamics, with or without control).
-    drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
-    residual = std::max(residual, tr.at(r, "constraint_residual"));
+    drift = std::max(drift, std::abs(energy[r] - e0 - work[r]));
+    residual = std::max(residual, residual_col[r]);
   }
   return {{"x_rms", rms(ex)},          {"x_max_error", ex_max},
           {"f_rms", rms(ef)},          {"f_max_error", ef_max},

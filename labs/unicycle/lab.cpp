@@ -196,18 +196,23 @@ std::unique_ptr<Simulation> UnicycleLab::simulate(Engine engine) const {
 json UnicycleLab::metrics(const Trace& tr) const {
   std::vector<double> ect, epos, ev;
   double margin = INFINITY, margin_t = 0, f_lat = 0, tau_y = 0, tau_z = 0, drift = 0, residual = 0, ect_max = 0;
+  const auto t_col = tr.col("t"), cross_track = tr.col("cross_track"), x = tr.col("x"), x_d = tr.col("x_d");
+  const auto y = tr.col("y"), y_d = tr.col("y_d"), speed = tr.col("speed"), v_d = tr.col("v_d");
+  const auto skid_margin = tr.col("skid_margin"), f_lat_col = tr.col("f_lat"), tau_drive = tr.col("tau_drive");
+  const auto tau_steer = tr.col("tau_steer"), energy = tr.col("energy"), work = tr.col("work");
+  const auto residual_col = tr.col("constraint_residual");
   const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
   for (std::size_t r = 0; r < tr.rows(); ++r) {
-    ect.push_back(tr.at(r, "cross_track"));
+    ect.push_back(cross_track[r]);
     ect_max = std::max(ect_max, std::abs(ect.back()));
-    epos.push_back(det::hypot(tr.at(r, "x") - tr.at(r, "x_d"), tr.at(r, "y") - tr.at(r, "y_d")));
-    ev.push_back(tr.at(r, "speed") - tr.at(r, "v_d"));
-    if (tr.at(r, "skid_margin") < margin) margin = tr.at(r, "skid_margin"), margin_t = tr.at(r, "t");
-    f_lat = std::max(f_lat, std::abs(tr.at(r, "f_lat")));
-    tau_y = std::max(tau_y, std::abs(tr.at(r, "tau_drive")));
-    tau_z = std::max(tau_z, std::abs(tr.at(r, "tau_steer")));
-    drift = std::max(drift, std::abs(tr.at(r, "energy") - e0 - tr.at(r, "work")));
-    residual = std::max(residual, tr.at(r, "constraint_residual"));
+    epos.push_back(det::hypot(x[r] - x_d[r], y[r] - y_d[r]));
+    ev.push_back(speed[r] - v_d[r]);
+    if (skid_margin[r] < margin) margin = skid_margin[r], margin_t = t_col[r];
+    f_lat = std::max(f_lat, std::abs(f_lat_col[r]));
+    tau_y = std::max(tau_y, std::abs(tau_drive[r]));
+    tau_z = std::max(tau_z, std::abs(tau_steer[r]));
+    drift = std::max(drift, std::abs(energy[r] - e0 - work[r]));
+    residual = std::max(residual, residual_col[r]);
   }
   const double progress = tr.rows() ? tr.at(tr.rows() - 1, "s_d") / path_.length() : 0.0;
   return {{"cross_track_rms", rms(ect)}, {"cross_track_max", ect_max},  {"pos_rms", rms(epos)},
