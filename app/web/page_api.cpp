@@ -3,7 +3,9 @@
 // grader's code, grading/grade.h), the handout (app/cli/course's, the same text `dynlab handout`
 // writes), the list of labs.
 #include <emscripten.h>
+#include <sys/stat.h>
 
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <fstream>
@@ -92,11 +94,14 @@ EMSCRIPTEN_KEEPALIVE const char* dynlab_labs() {
   return keep(out, dyn::dumpJson({{"labs", labs}, {"open", p.lab}, {"error", p.load_error}}));
 }
 
-// Loads a submission or gains JSON the student chose (its text): "" or the one line that says why not
-// (the run and gains already open stay).
-EMSCRIPTEN_KEEPALIVE const char* dynlab_load_gains(const char* text) {
+// Loads a submission or gains JSON the student chose (its file name and text): "" or the one line that
+// says why not, naming the file (the run and gains already open stay).
+EMSCRIPTEN_KEEPALIVE const char* dynlab_load_gains(const char* name, const char* text) {
   static std::string out;
-  const std::string path = "/tmp/uploaded_gains.json";
+  std::string base;
+  for (const char* c = name; *c && base.size() < 80; ++c) base += std::isalnum(static_cast<unsigned char>(*c)) || *c == '.' || *c == '-' ? *c : '_';
+  ::mkdir("/uploads", 0755);
+  const std::string path = "/uploads/" + (base.empty() || base[0] == '.' ? "gains.json" : base);
   {
     std::ofstream f(path, std::ios::binary | std::ios::trunc);
     f << text;

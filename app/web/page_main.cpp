@@ -154,11 +154,9 @@ int main(int argc, char** argv) {
   p.load_error = openLab(p.lab, gains);
   if (!p.load_error.empty()) std::printf("dynlab page: %s\n", p.load_error.c_str());
   if (p.bench && p.session) benchmark(*p.session);
-  if (p.grade_at_load && p.session) {
-    // The link's submission as it was given (not re-written by the session): the grade a staff member
-    // sees for "open this submission".
-    gradeAndPrint(gains.empty() ? "" : gains);
-  }
+  // The link's submission as it was given (not re-written by the session): the grade a staff member
+  // sees for "open this submission", a refused one included (its results.json says why, as dynlab grade's).
+  if (p.grade_at_load && (!gains.empty() || p.session)) gradeAndPrint(gains);
   try {
     p.ctx = makeWindowContext({width, height, "dynlab", true});
     ui::setupImGui(p.ctx->window(), *p.ctx);
