@@ -1,12 +1,17 @@
-// Internal to render/: GL declarations (prototypes resolved against libOSMesa), shader programs,
+// Internal to render/: GL declarations (prototypes resolved against libOSMesa or libGL; OpenGL ES 3.0
+// = WebGL 2 under emscripten), shader programs,
 // unit meshes, the scene's primitives as mesh draws, and the Dear ImGui overlay panel used by
 // renderer.cpp.
 #pragma once
+#ifdef __EMSCRIPTEN__
+#include <GLES3/gl3.h>
+#else
 #ifndef GL_GLEXT_PROTOTYPES
 #define GL_GLEXT_PROTOTYPES 1
 #endif
 #include <GL/gl.h>
 #include <GL/glext.h>
+#endif
 
 #include <Eigen/Core>
 #include <cstddef>
@@ -16,6 +21,7 @@
 
 #include "labs/scene.h"
 #include "render/framing.h"
+#include "render/gl_context.h"
 
 struct ImGuiContext;  // Dear ImGui (global namespace)
 
@@ -35,8 +41,9 @@ struct LineProgram {
   GLuint id = 0;
   GLint view_proj = -1, viewport = -1, half_width = -1, color = -1;
 };
-ShadedProgram makeShadedProgram();  // throws std::runtime_error with the compile log
-LineProgram makeLineProgram();
+// In the context's GLSL (GlContext::glsl): the same program text after its header.
+ShadedProgram makeShadedProgram(Glsl dialect);  // throws std::runtime_error with the compile log
+LineProgram makeLineProgram(Glsl dialect);
 
 // ---- meshes.cpp ---------------------------------------------------------------------------
 
@@ -140,7 +147,7 @@ void collectDrawList(const Scene& scene, const Camera& camera, const Meshes& mes
 // The Dear ImGui panel in the top-left corner: title, label/value lines, plots.
 class OverlayPanel {
  public:
-  OverlayPanel(int width, int height);
+  OverlayPanel(int width, int height, Glsl dialect);
   ~OverlayPanel();
   OverlayPanel(const OverlayPanel&) = delete;
   OverlayPanel& operator=(const OverlayPanel&) = delete;

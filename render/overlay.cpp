@@ -67,7 +67,7 @@ struct KeepImGuiContext {
 };
 }  // namespace
 
-OverlayPanel::OverlayPanel(int width, int height) {
+OverlayPanel::OverlayPanel(int width, int height, Glsl dialect) {
   const KeepImGuiContext keep;
   context_ = ImGui::CreateContext();
   ImGui::SetCurrentContext(context_);
@@ -89,7 +89,7 @@ OverlayPanel::OverlayPanel(int width, int height) {
   }
   applyStyle();
   ImGui::GetStyle().ScaleAllSizes(scale_);
-  if (!ImGui_ImplOpenGL3_Init("#version 330 core")) {
+  if (!ImGui_ImplOpenGL3_Init(glslVersion(dialect))) {
     ImGui::DestroyContext(context_);
     throw std::runtime_error("render: Dear ImGui OpenGL3 backend failed to initialise");
   }

@@ -52,8 +52,8 @@ struct Renderer::Impl {
       : context(c), options(o), width(o.width > 0 ? o.width : c.width()),
         height(o.height > 0 ? o.height : c.height()) {
     createFramebuffers();
-    shaded = gl::makeShadedProgram();
-    line = gl::makeLineProgram();
+    shaded = gl::makeShadedProgram(c.glsl());
+    line = gl::makeLineProgram(c.glsl());
     meshes.create();
     // Polyline stream: attributes 0 position, 1 other end, 2 side.
     glGenVertexArrays(1, &line_vao);
@@ -279,7 +279,7 @@ struct Renderer::Impl {
     const bool show_panel = options.show_overlay && panel;
     panel_rect = {};
     if (show_panel) {
-      if (!overlay) overlay = std::make_unique<gl::OverlayPanel>(width, height);
+      if (!overlay) overlay = std::make_unique<gl::OverlayPanel>(width, height, context.glsl());
       panel_rect = overlay->layout(*panel);
     }
     camera = scene.camera;

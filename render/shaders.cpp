@@ -1,5 +1,6 @@
-// GLSL 3.30 core programs: lit meshes (directional light + ambient + soft specular) and
-// constant-width polylines expanded to quads in screen space.
+// The renderer's programs: lit meshes (directional light + ambient + soft specular) and
+// constant-width polylines expanded to quads in screen space. One text each, compiled as GLSL 3.30
+// core (OSMesa, a desktop window) or GLSL ES 3.00 (WebGL 2) after the header the context names.
 #include <stdexcept>
 #include <string>
 
@@ -8,8 +9,7 @@
 namespace dyn::gl {
 namespace {
 
-const char* kShadedVertex = R"(#version 330 core
-layout(location = 0) in vec3 a_position;
+const char* kShadedVertex = R"(layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in float a_end;
 uniform mat4 u_view_proj;
@@ -27,8 +27,7 @@ void main() {
 }
 )";
 
-const char* kShadedFragment = R"(#version 330 core
-in vec3 v_normal;
+const char* kShadedFragment = R"(in vec3 v_normal;
 in vec3 v_world;
 uniform vec4 u_color;
 uniform vec3 u_light_dir;  // towards the light, world space, unit
@@ -52,8 +51,7 @@ void main() {
 }
 )";
 
-const char* kLineVertex = R"(#version 330 core
-layout(location = 0) in vec3 a_position;  // this end of the segment
+const char* kLineVertex = R"(layout(location = 0) in vec3 a_position;  // this end of the segment
 layout(location = 1) in vec3 a_other;     // the other end
 layout(location = 2) in float a_side;     // +1 / -1: which edge of the quad
 uniform mat4 u_view_proj;
@@ -73,8 +71,7 @@ void main() {
 }
 )";
 
-const char* kLineFragment = R"(#version 330 core
-uniform vec4 u_color;
+const char* kLineFragment = R"(uniform vec4 u_color;
 out vec4 frag_color;
 void main() { frag_color = u_color; }
 )";
@@ -102,10 +99,11 @@ GLuint compileStage(GLenum type, const char* source, const char* name) {
   return shader;
 }
 
-// Links a vertex + fragment program; throws with the info log on failure.
-GLuint linkProgram(const char* vertex, const char* fragment, const char* name) {
-  GLuint vs = compileStage(GL_VERTEX_SHADER, vertex, name);
-  GLuint fs = compileStage(GL_FRAGMENT_SHADER, fragment, name);
+// Links a vertex + fragment program (each body after the dialect's header); throws with the info log.
+GLuint linkProgram(Glsl dialect, const char* vertex, const char* fragment, const char* name) {
+  const std::string header = glslHeader(dialect);
+  GLuint vs = compileStage(GL_VERTEX_SHADER, (header + vertex).c_str(), name);
+  GLuint fs = compileStage(GL_FRAGMENT_SHADER, (header + fragment).c_str(), name);
   GLuint program = glCreateProgram();
   glAttachShader(program, vs);
   glAttachShader(program, fs);
@@ -119,9 +117,9 @@ GLuint linkProgram(const char* vertex, const char* fragment, const char* name) {
 
 }  // namespace
 
-ShadedProgram makeShadedProgram() {
+ShadedProgram makeShadedProgram(Glsl dialect) {
   ShadedProgram p;
-  p.id = linkProgram(kShadedVertex, kShadedFragment, "shaded");
+  p.id = linkProgram(dialect, kShadedVertex, kShadedFragment, "shaded");
   p.view_proj = glGetUniformLocation(p.id, "u_view_proj");
   p.model = glGetUniformLocation(p.id, "u_model");
   p.normal_matrix = glGetUniformLocation(p.id, "u_normal_matrix");
@@ -135,9 +133,9 @@ ShadedProgram makeShadedProgram() {
   return p;
 }
 
-LineProgram makeLineProgram() {
+LineProgram makeLineProgram(Glsl dialect) {
   LineProgram p;
-  p.id = linkProgram(kLineVertex, kLineFragment, "line");
+  p.id = linkProgram(dialect, kLineVertex, kLineFragment, "line");
   p.view_proj = glGetUniformLocation(p.id, "u_view_proj");
   p.viewport = glGetUniformLocation(p.id, "u_viewport");
   p.half_width = glGetUniformLocation(p.id, "u_half_width");
@@ -146,3 +144,13 @@ LineProgram makeLineProgram() {
 }
 
 }  // namespace dyn::gl
+
+namespace dyn {
+
+const char* glslHeader(Glsl dialect) {
+  return dialect == Glsl::Es300 ? "#version 300 es\nprecision highp float;\n" : "#version 330 core\n";
+}
+
+const char* glslVersion(Glsl dialect) { return dialect == Glsl::Es300 ? "#version 300 es" : "#version 330 core"; }
+
+}  // namespace dyn

@@ -1,5 +1,7 @@
 // GLFW window context: an OpenGL 3.3 core profile window (forward compatible, double buffered, no
 // MSAA in the window itself: the renderer resolves its own 4x samples and blits the frame in).
+// Built by emscripten (app/web) the same code is the page's canvas: emscripten's GLFW over WebGL 2
+// (OpenGL ES 3.0, GLSL ES 3.00), opaque, no MSAA of its own either.
 #include "render/window_context.h"
 
 #define GLFW_INCLUDE_NONE
@@ -14,9 +16,13 @@ namespace dyn {
 namespace {
 
 std::string lastGlfwError() {
+#ifdef __EMSCRIPTEN__
+  return "this browser gave no WebGL 2 context";  // emscripten's GLFW has no glfwGetError
+#else
   const char* what = nullptr;
   glfwGetError(&what);
   return what ? what : "unknown GLFW error";
+#endif
 }
 
 class GlfwWindowContext final : public WindowContext {
@@ -25,10 +31,17 @@ class GlfwWindowContext final : public WindowContext {
     if (!glfwInit())
       throw std::runtime_error("cannot open a window: " + lastGlfwError() +
                                " (no display? run under xvfb-run -a, or set DISPLAY)");
+#ifdef __EMSCRIPTEN__
+    glfwWindowHint(GLFW_CLIENT_API, GLFW_OPENGL_ES_API);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+    glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 0);
+    glfwWindowHint(GLFW_ALPHA_BITS, 0);  // an opaque canvas: the page behind never shows through
+#else
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
     glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+#endif
     glfwWindowHint(GLFW_SAMPLES, 0);
     window_ = glfwCreateWindow(o.width, o.height, o.title.c_str(), nullptr, nullptr);
     if (!window_) {
@@ -37,7 +50,9 @@ class GlfwWindowContext final : public WindowContext {
       throw std::runtime_error("cannot open an OpenGL 3.3 core window: " + why);
     }
     glfwMakeContextCurrent(window_);
-    glfwSwapInterval(o.vsync ? 1 : 0);
+#ifndef __EMSCRIPTEN__
+    glfwSwapInterval(o.vsync ? 1 : 0);  // the page's frames are the browser's (requestAnimationFrame)
+#endif
     auto str = [](GLenum name) {
       const auto* s = reinterpret_cast<const char*>(glGetString(name));
       return std::string(s ? s : "?");
@@ -53,6 +68,9 @@ class GlfwWindowContext final : public WindowContext {
   int width() const override { return framebuffer().first; }
   int height() const override { return framebuffer().second; }
   std::string description() const override { return description_; }
+#ifdef __EMSCRIPTEN__
+  Glsl glsl() const override { return Glsl::Es300; }
+#endif
   GLFWwindow* window() const override { return window_; }
   bool shouldClose() const override { return glfwWindowShouldClose(window_); }
   void pollEvents() override { glfwPollEvents(); }

@@ -3,8 +3,6 @@
 // the offscreen renderer and blit it in, then the tuning panel on the right. Its own executable:
 // it links libGL (GLFW), and dynlab links OSMesa; the two never meet in one process.
 #include <imgui.h>
-#include <imgui_impl_glfw.h>
-#include <imgui_impl_opengl3.h>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -13,11 +11,10 @@
 #include <iostream>
 
 #include "labs/generic/model_lab.h"
-#include "app/ui/panel.h"
+#include "app/ui/frame.h"
 #include "grading/student.h"
 #include "labs/generic/lab_folders.h"
 #include "labs/utf8.h"
-#include "render/fonts.h"
 #include "render/renderer.h"
 #include "render/window_context.h"
 
@@ -34,51 +31,6 @@ struct Args {
   bool paused = false;
   long frames = -1;  // scripted: this many frames, then exit
 };
-
-// Where the scene goes in the window: all of it left of the panel (the renderer fits the lab's
-// scene into whatever that leaves beside the overlay panel).
-struct Layout {
-  int scene_x = 0, scene_y = 0, scene_w = 0, scene_h = 0;  // framebuffer pixels, y from the top
-  int panel_x = 0, panel_w = 0;
-};
-
-Layout layout(int fb_w, int fb_h) {
-  Layout l;
-  l.panel_w = std::min(std::clamp(int(fb_w * 0.34), 380, 520), fb_w);
-  l.panel_x = fb_w - l.panel_w;
-  l.scene_w = l.panel_x & ~1;
-  l.scene_h = fb_h & ~1;
-  return l;
-}
-
-void setupImGui(GLFWwindow* window) {
-  ImGui::CreateContext();
-  ImGuiIO& io = ImGui::GetIO();
-  io.IniFilename = nullptr;  // nothing written next to the student's files
-  // The overlay's font (render/fonts.h): Greek, ±, ≤, −, x₁, … in the notes and units; a missing
-  // font file is a one-line error.
-  addUiFont(*io.Fonts, 15.0f);
-  ImGui::StyleColorsLight();
-  ImGuiStyle& style = ImGui::GetStyle();
-  style.WindowRounding = 0.0f;
-  style.FrameRounding = 3.0f;
-  style.Colors[ImGuiCol_WindowBg] = ImVec4(0.97f, 0.97f, 0.98f, 1.0f);
-  style.Colors[ImGuiCol_TitleBgActive] = style.Colors[ImGuiCol_TitleBg] = ImVec4(0.22f, 0.29f, 0.38f, 1.0f);
-  style.Colors[ImGuiCol_Text] = ImVec4(0.12f, 0.14f, 0.17f, 1.0f);
-  // A slider's knob is a thin, light bar: the value's digits drawn over it stay readable.
-  style.GrabMinSize = 4.0f;
-  style.GrabRounding = 1.0f;
-  style.Colors[ImGuiCol_SliderGrab] = ImVec4(0.26f, 0.59f, 0.98f, 0.55f);
-  style.Colors[ImGuiCol_SliderGrabActive] = ImVec4(0.26f, 0.59f, 0.98f, 0.75f);
-  ImGui_ImplGlfw_InitForOpenGL(window, true);
-  if (!ImGui_ImplOpenGL3_Init("#version 330 core")) throw std::runtime_error("Dear ImGui OpenGL3 backend failed to initialise");
-}
-
-void shutdownImGui() {
-  ImGui_ImplOpenGL3_Shutdown();
-  ImGui_ImplGlfw_Shutdown();
-  ImGui::DestroyContext();
-}
 
 // What the last frame showed, for scripted runs and their tests.
 json frameState(const TuningSession& s, const WindowContext& ctx, const Layout& l, long frame, const PanelState& st) {
@@ -156,9 +108,9 @@ int run(const Args& a) {
     std::cerr << "error: " << termName(e.what(), 1000) << "\n";
     return 1;
   }
-  setupImGui(ctx->window());
-  std::unique_ptr<Renderer> renderer;
-  double last = ctx->seconds(), carry = 0;
+  setupImGui(ctx->window(), *ctx);
+  TuningFrame tuning;
+  double last = ctx->seconds();
   int code = 0;
   for (long frame = 0; !ctx->shouldClose() && (!scripted || frame < a.frames); ++frame) {
     ctx->pollEvents();
@@ -166,54 +118,8 @@ int run(const Args& a) {
     const double now = ctx->seconds();
     const double wall = scripted ? 1.0 / 60.0 : std::min(now - last, 0.1);
     last = now;
-    if (st.playing && session.lab() && !session.finished()) {
-      carry += st.speed * wall / session.lab()->dt();
-      const long n = long(carry);
-      carry -= double(n);
-      session.advance(n);
-    } else {
-      carry = 0;
-    }
-    if (st.loop && session.finished() && session.problem().empty()) session.restart();
-
-    const Layout l = layout(ctx->width(), ctx->height());
-    std::string scene_error;
-    Scene scene;
-    Overlay overlay;
-    if (session.hasRows()) {
-      try {
-        session.lab()->scene(session.primary(), session.row(), session.ghost(), scene);
-        session.lab()->overlay(session.primary(), session.row(), overlay);
-      } catch (const std::exception& e) {
-        scene_error = std::string("cannot draw the scene: ") + e.what();
-      }
-    }
-    ctx->clear(scene.background);  // the letterbox around the scene matches it
-    if (session.hasRows() && scene_error.empty() && l.scene_w >= 16 && l.scene_h >= 16) {
-      try {
-        if (!renderer || renderer->width() != l.scene_w || renderer->height() != l.scene_h) {
-          RenderOptions o;
-          o.width = l.scene_w;
-          o.height = l.scene_h;
-          renderer.reset();
-          renderer = std::make_unique<Renderer>(*ctx, o);
-        }
-        renderer->draw(scene, &overlay);
-        renderer->present(l.scene_x, l.scene_y, ctx->height());
-      } catch (const std::exception& e) {
-        scene_error = std::string("cannot draw the scene: ") + e.what();
-      }
-    }
-    ImGui_ImplOpenGL3_NewFrame();
-    ImGui_ImplGlfw_NewFrame();
-    ImGui::NewFrame();
-    const float scale = std::max(ImGui::GetIO().DisplayFramebufferScale.x, 1e-3f);
-    const std::string shown = !scene_error.empty() ? scene_error : !session.hasRows() ? "no run: " + session.problem() : "";
-    if (!shown.empty())
-      ImGui::GetBackgroundDrawList()->AddText(ImVec2(20, 20), IM_COL32(160, 30, 20, 255), shown.c_str());
-    drawTuningPanel(session, st, float(l.panel_x) / scale, float(l.panel_w) / scale, float(ctx->height()) / scale);
-    ImGui::Render();
-    ImGui_ImplOpenGL3_RenderDrawData(ImGui::GetDrawData());
+    tuning.advance(session, st, wall);
+    const Layout l = tuning.draw(session, st, *ctx);
 
     if (scripted && frame + 1 == a.frames) {
       if (!a.screenshot.empty() && !writePng(a.screenshot, ctx->screenshot())) {
@@ -236,7 +142,7 @@ int run(const Args& a) {
     }
     ctx->swap();
   }
-  renderer.reset();
+  tuning.release();
   shutdownImGui();
   return code;
 }

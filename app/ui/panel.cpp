@@ -286,6 +286,7 @@ void saveGains(TuningSession& session, PanelState& st) {
     st.saved_path = st.save_path;
     st.status = "Saved " + st.save_path + (st.pending_changes ? " (with gains the current run does not use yet)" : "");
     st.status_is_error = false;
+    if (st.saved) st.saved(st.save_path);
   } catch (const std::exception& e) {
     st.status = e.what();
     st.status_is_error = true;

@@ -3,6 +3,7 @@
 // screening, problems in plain words, and "Save gains…" with the command that grades the file.
 // It reads and changes a TuningSession only; the window loop (main.cpp) owns time and drawing.
 #pragma once
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,8 @@ struct PanelState {
   std::string save_path;           // what "Save gains…" writes
   std::string saved_path;          // the last file written ("" until then)
   std::string status;              // last save result
+  // Called with the path after "Save gains…" wrote it (the page offers the file as a download).
+  std::function<void(const std::string& path)> saved;
   bool status_is_error = false;
   int plot_column = -1;            // extra live plot: a trace column chosen by the student
   // Where the last frame drew each gain's slider (window pixels: frame, then its name's text),

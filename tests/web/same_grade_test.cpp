@@ -23,11 +23,14 @@ const fs::path kGrader = fs::path(DYNLAB_SOURCE_DIR) / "build" / "web" / "dynlab
 // A source of the web build changed after it was built ("" when none did): the wasm would grade old code.
 std::string newerSource() {
   const auto built = fs::last_write_time(kGrader);
-  for (const char* dir : {"physics", "labs", "grading", "app/web"})
+  for (const char* dir : {"physics", "labs", "grading"})
     for (const auto& e : fs::recursive_directory_iterator(fs::path(DYNLAB_SOURCE_DIR) / dir)) {
       const std::string ext = e.path().extension().string();
       if (e.is_regular_file() && (ext == ".cpp" || ext == ".h") && e.last_write_time() > built) return e.path().string();
     }
+  // app/web's own sources of the grader (not the page's: they do not relink it).
+  for (const char* file : {"grade_main.cpp", "web_no_plots.cpp", "node_env.js"})
+    if (const fs::path p = fs::path(DYNLAB_SOURCE_DIR) / "app" / "web" / file; fs::last_write_time(p) > built) return p.string();
   return "";
 }
 
