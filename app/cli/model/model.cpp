@@ -341,8 +341,8 @@ int model(const ModelArgs& asked) {
   std::string text = describe(m) + crossCheck(m, mech);
   // The servos at the sub-step the runs take (stiff_steps.h): a note when even that is too coarse.
   const model_file::FastestMode fastest = model_file::fastestMode(m);
-  const double h = args.dt / model_file::stiffSubsteps(fastest.rate, args.dt);
-  if (const std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), h); !stiff.empty()) text += "  note: " + shownLine(stiff) + "\n";
+  const double sub_step = args.dt / model_file::stiffSubsteps(fastest.rate, args.dt);
+  if (const std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), sub_step); !stiff.empty()) text += "  note: " + shownLine(stiff) + "\n";
   if (const std::string sub = model_file::stiffStepNote(fastest, args.dt); !sub.empty()) text += "  note: " + shownLine(sub) + "\n";
   const bool hand = args.engine != "bullet", bullet = args.engine != "hand";
   ModelRun h, b;
