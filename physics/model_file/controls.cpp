@@ -107,7 +107,7 @@ void closeKeyframe(const std::string& where, LoadedModel& out) {
   if (!v.allFinite()) return;
   const double moved = (q - out.start_q).cwiseAbs().maxCoeff();
   out.start_q = q, out.start_v = v;
-  out.notes.push_back(where.substr(where.find("keyframe")) + ": its qpos opens closure '" + name + "' by " + num(gap) +
+  out.notes.push_back(where.substr(where.find("keyframe")) + ": its qpos opens closure '" + name + "' by |φ|∞ " + num(gap) +
                       " (MuJoCo's soft equalities hold a loop only so tightly): runs start from the nearest closed pose (mass-weighted), |Δq|∞ " + num(moved));
 }
 
