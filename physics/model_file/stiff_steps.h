@@ -1,9 +1,11 @@
 // The sub-steps a model file's run takes so that RK4 (and Bullet's Euler) follow its fastest mode. Real
-// files carry modes far faster than their motion: Cassie's foot crank has a damper of 1 N·m·s on a
-// crank and rod of 1.8e-4 kg·m² (a rate b/I ≈ 5,600 1/s), its Achilles rod spins about its own axis with
-// 0.01 N·m·s on 3.8e-6 kg·m² (2,700 1/s). At the file's 0.5 ms the first sits at RK4's stability edge
-// on the real axis (|λ| h = 2.8 against 2.785): the books drift 1e-3 J where a 0.25 ms step holds them
-// to 1e-9 J, and Bullet's explicit damper (|1 − λh| = 1.8) blows up. MuJoCo's own Euler takes joint
+// files carry modes far faster than their motion: in Cassie's leg the foot crank's damper of 1 N·m·s
+// acts on a crank and plantar rod of ~1.9e-4 kg·m² (|λ| ≈ 5,300–5,600 1/s), the Achilles rod spins
+// about its own axis with 0.01 N·m·s on 3.8e-6 kg·m² (2,660 1/s; the fastest in the whole robot, where
+// the crank's loop ties it to the foot). At the file's 0.5 ms the crank's mode sits at RK4's stability
+// edge on the real axis (|λ| h = 2.66–2.8 against 2.785): one step multiplies it by R(−2.66) = 0.83
+// where it decays by e^−2.66 = 0.07, the books drift 3e-3 J where three sub-steps hold them to 2e-6 J,
+// and Bullet's explicit damper (|1 − λh| = 1.7) blows up. MuJoCo's own Euler takes joint
 // damping implicitly for this reason. Here the mode is found where it lives — the motion linearised at
 // the start state, x = (δq, v), x' = A x by central differences of the engine's accelerations (loops,
 // springs, dampers, armature, servos: every term the run integrates) — and the step is cut into equal
