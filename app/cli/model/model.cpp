@@ -162,6 +162,17 @@ std::string mujocoClosure(const model_file::LoadedModel& m, const ModelRun& r) {
   return gap < 0 ? "" : "  MuJoCo's own measure of the file's loops at this trace (its kinematics: xpos + xmat of each connect's anchors) max |p1 − p2|∞ " + fmt(gap) + " m\n";
 }
 
+// The notes on the step: the sub-steps the model's fastest mode asks for (stiff_steps.h), and servos
+// stiffer than RK4 follows even at that sub-step.
+std::string stepNotes(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, double dt) {
+  const model_file::FastestMode fastest = model_file::fastestMode(m);
+  const double sub_step = dt / model_file::stiffSubsteps(fastest.rate, dt);
+  std::string text;
+  if (const std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), sub_step); !stiff.empty()) text += "  note: " + shownLine(stiff) + "\n";
+  if (const std::string sub = model_file::stiffStepNote(fastest, dt); !sub.empty()) text += "  note: " + shownLine(sub) + "\n";
+  return text;
+}
+
 std::string report(const ModelRun& r, const std::string& engine, const model_file::LoadedModel& m, const ModelArgs& args) {
   std::ostringstream o;
   const bool driven = !args.torques.empty() || !m.actuators.empty();
@@ -339,11 +350,7 @@ int model(const ModelArgs& asked) {
   }
   ConstrainedMechanism<Spatial> mech(m.mechanism);
   std::string text = describe(m) + crossCheck(m, mech);
-  // The servos at the sub-step the runs take (stiff_steps.h): a note when even that is too coarse.
-  const model_file::FastestMode fastest = model_file::fastestMode(m);
-  const double sub_step = args.dt / model_file::stiffSubsteps(fastest.rate, args.dt);
-  if (const std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), sub_step); !stiff.empty()) text += "  note: " + shownLine(stiff) + "\n";
-  if (const std::string sub = model_file::stiffStepNote(fastest, args.dt); !sub.empty()) text += "  note: " + shownLine(sub) + "\n";
+  text += stepNotes(m, mech, args.dt);
   const bool hand = args.engine != "bullet", bullet = args.engine != "hand";
   ModelRun h, b;
   if (hand) h = m.contacts.empty() ? runHand(m, mech, args.dt, args.duration, tau) : runHandElements(m, mech, args.dt, args.duration, tau);
