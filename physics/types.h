@@ -5,7 +5,7 @@
 
 namespace dyn {
 
-inline constexpr int kMaxDof = 24;
+inline constexpr int kMaxDof = 48;
 using VecN = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxDof, 1>;
 using MatN = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxDof, kMaxDof>;
 

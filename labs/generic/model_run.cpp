@@ -13,6 +13,7 @@
 #include "physics/model_file/actuators.h"
 #include "physics/model_file/closure_rows.h"
 #include "physics/model_file/hand_engine.h"
+#include "physics/model_file/stiff_steps.h"
 
 namespace dyn::app {
 namespace {
@@ -83,7 +84,11 @@ std::vector<std::string> modelNotes(const model_file::LoadedModel& m, double dt)
   std::vector<std::string> notes = m.notes;
   for (const std::string& n : m.drawing.notes) notes.push_back("drawing: " + n);
   ConstrainedMechanism<Spatial> mech(m.mechanism);
-  if (std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), dt); !stiff.empty()) notes.push_back(std::move(stiff));
+  // The servos at the sub-step the runs take (stiff_steps.h): a note when even that is too coarse.
+  const model_file::FastestMode fastest = model_file::fastestMode(m);
+  const double h = dt / model_file::stiffSubsteps(fastest.rate, dt);
+  if (std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), h); !stiff.empty()) notes.push_back(std::move(stiff));
+  if (std::string sub = model_file::stiffStepNote(fastest, dt); !sub.empty()) notes.push_back(std::move(sub));
   return notes;
 }
 
@@ -139,6 +144,7 @@ ModelRun runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>
   run.trace = modelColumns(m);
   StepOptions o;
   o.dt = dt;
+  o.substeps = model_file::stiffSubsteps(model_file::fastestMode(m).rate, dt);  // the model's stiffest mode (stiff_steps.h)
   const int steps = int(std::lround(duration / dt));
   VecN q = m.start_q, v = m.start_v;
   // The file's actuators evaluated at each stage of the step (actuators.h).
@@ -169,6 +175,7 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
   run.summary = "dynamic sizes; contacts closed and opened between steps, touchdowns located";
   StepOptions o;
   o.dt = dt;
+  o.substeps = model_file::stiffSubsteps(model_file::fastestMode(m).rate, dt);
   const int steps = int(std::lround(duration / dt));
   const std::size_t closures = m.closures.size();
   int closure_rows = 0;
@@ -231,8 +238,11 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
   run.trace = modelColumns(m);
   const int steps = int(std::lround(duration / dt));
   VecN q = m.start_q, v = m.start_v;
-  bullet::BulletMechanism<Spatial> bt(m.mechanism, dt, q, v);
-  run.summary = bt.describe();
+  // Bullet's explicit dampers and springs need the sub-steps the hand engine takes (stiff_steps.h): the
+  // same h = dt / s for both, each of Bullet's a step of its own, the torques held over the row's step.
+  const int substeps = model_file::stiffSubsteps(model_file::fastestMode(m).rate, dt);
+  bullet::BulletMechanism<Spatial> bt(m.mechanism, dt / substeps, q, v);
+  run.summary = bt.describe() + (substeps > 1 ? ", " + std::to_string(substeps) + " steps of dt/" + std::to_string(substeps) + " per row" : "");
   const bool impacts = anyImpacts(m);
   // The torques: τ and the file's actuators at the state (held over Bullet's step from its start).
   auto driven = [&](const VecN& p, const VecN& w) { return VecN(tau + model_file::actuatorTorques(m, p, w)); };
@@ -244,7 +254,8 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
   for (int k = 0; k <= steps; ++k) {
     VecN qn = q, vn = v;
     if (k < steps) {
-      bt.step(driven(q, v));
+      const VecN held = driven(q, v);
+      for (int sub = 0; sub < substeps; ++sub) bt.step(held);
       bt.state(qn, vn);
       forces.clear();
       for (std::size_t c = 0; c < m.closures.size(); ++c)

@@ -112,15 +112,30 @@ Eigen::MatrixXd keptRowsOf(const Eigen::MatrixXd& g, const std::vector<bool>& ke
   return out;
 }
 
+// True when, at every pose, the rows kept are independent and every other row depends on them.
+bool holdsAtEveryPose(const std::vector<Eigen::MatrixXd>& g, const std::vector<bool>& kept) {
+  const int count = int(std::count(kept.begin(), kept.end(), true));
+  for (const Eigen::MatrixXd& gs : g)
+    if (absoluteRank(keptRowsOf(gs, kept)) != count || absoluteRank(gs) != count) return false;
+  return true;
+}
+
 }  // namespace
 
 std::vector<bool> chooseIndependentRows(ConstrainedMechanism<Spatial>& mech, const VecN& q0, const RowCandidates& rows,
                                         const std::string& where) {
   const std::vector<Eigen::MatrixXd> g = poses(mech, q0, rows);
-  const std::vector<bool> kept = pivotRows(g);
+  // The rows independent over every pose together: right for a loop whose plane stays put in the world
+  // (the dependent combination of world rows is the same at every pose).
+  std::vector<bool> kept = pivotRows(g);
+  // A loop carried by moving bodies (a planar loop in a leg that the hip turns: Cassie's plantar rod) has
+  // its dependent combination n(q)·φ ≡ 0 turning with them: over several poses every world row counts, so
+  // the stacked choice keeps them all. Then the rows independent at q0 (the world rows least aligned with
+  // n(q0)), checked at every pose: they hold while the loop's plane turns less than the angle that would
+  // lay a dropped world axis in it (the run stops, naming the loop, if a dropped row drifts: EveryClosureRow).
+  if (!holdsAtEveryPose(g, kept)) kept = pivotRows({g.front()});
   const int count = int(std::count(kept.begin(), kept.end(), true));
-  for (const Eigen::MatrixXd& gs : g) {
-    if (absoluteRank(keptRowsOf(gs, kept)) == count && absoluteRank(gs) == count) continue;
+  if (!holdsAtEveryPose(g, kept)) {
     // Name the closures involved: those with a dropped row.
     std::string names;
     for (std::size_t r = 0; r < kept.size(); ++r)

@@ -9,7 +9,10 @@
 //   poses           q0 and assembled poses near it (Gauss–Newton on every row, minimum-norm steps)
 //   choice          greedy pivoting over [Ĝ(q0) Ĝ(q1) …]: the row with the largest part orthogonal
 //                   to the rows kept so far, while that part exceeds an ABSOLUTE tolerance τ — a
-//                   round-off row (1e-17) never counts, a real row (O(1), however few) always does
+//                   round-off row (1e-17) never counts, a real row (O(1), however few) always does.
+//                   A loop whose plane turns with the bodies carrying it (a leg's planar linkage)
+//                   has a dependent combination of world rows that changes with the pose: the
+//                   stacked choice fails the check below, and the choice is made on Ĝ(q0) alone
 //   check           at every pose, rank Ĝ_kept = rank Ĝ_all = the rows kept; otherwise which rows
 //                   depend on which changes with the pose (a singular reference pose, an
 //                   over-constrained spatial loop): refused, naming the loop

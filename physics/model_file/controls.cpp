@@ -84,6 +84,35 @@ void readActuators(const std::string& path, const mjModel* m, LoadedModel& out) 
   }
   for (int i = 0; i < m->nu; ++i) out.actuators.push_back(readActuator(path, m, i));
 }
+namespace {
+
+// A keyframe saved from MuJoCo's own run holds the loops only as tightly as its soft equalities do
+// (Menagerie's Cassie 'home': its plantar rods 1.5 mm open). Within kKeyframeGap the start is moved onto
+// the loops, to the nearest closed pose in the mass metric (integrate.h's projection, the closures' rows
+// alone), its rates projected likewise, and that is noted; past it the checks below refuse it.
+constexpr double kKeyframeGap = 1e-2;  // m (rad for a weld's rotation rows)
+void closeKeyframe(const std::string& where, LoadedModel& out) {
+  MechanismModel<Spatial> loops = out.mechanism;
+  loops.constraints.resize(out.closures.size());
+  if (loops.constraints.empty()) return;
+  ConstrainedMechanism<Spatial> mech(loops);
+  double gap = 0;
+  std::string name;
+  for (std::size_t i = 0; i < out.closures.size(); ++i)
+    if (const double g = mech.residual(int(i), out.start_q); !(g <= gap)) gap = g, name = out.closures[i].name;
+  if (!(gap > 1e-9 && gap <= kKeyframeGap)) return;
+  VecN q = out.start_q, v = out.start_v;
+  if (!projectPositions(mech, DriftOptions{}, q) || !q.allFinite()) return;
+  projectVelocities(mech, q, v);
+  if (!v.allFinite()) return;
+  const double moved = (q - out.start_q).cwiseAbs().maxCoeff();
+  out.start_q = q, out.start_v = v;
+  out.notes.push_back(where.substr(where.find("keyframe")) + ": its qpos opens closure '" + name + "' by |φ|∞ " + num(gap) +
+                      " (MuJoCo's soft equalities hold a loop only so tightly): runs start from the nearest closed pose (mass-weighted), |Δq|∞ " + num(moved));
+}
+
+}  // namespace
+
 
 void readStart(const std::string& path, const mjModel* m, const std::string& key, LoadedModel& out) {
   const int nq = m->nq, nv = m->nv;
@@ -117,10 +146,13 @@ void readStart(const std::string& path, const mjModel* m, const std::string& key
   // The joints' stops held (joint_elements.cpp) must not be passed there.
   for (const Contact& c : out.contacts) {
     if (c.kind != "joint_limit") continue;
-    if (const Joint& jt = out.joints[std::size_t(c.link)]; !(out.start_q[c.link] >= jt.lower - 1e-9 && out.start_q[c.link] <= jt.upper + 1e-9))
-      throw ModelFileError(where + ": its qpos puts joint '" + jt.name + "' at " + num(out.start_q[c.link]) + ", outside its range [" + num(jt.lower) +
+    // The joint's coordinate in qpos (after a ball's quaternion it is not its rate's index c.link).
+    const Joint& jt = out.joints[std::size_t(c.link)];
+    if (!(out.start_q[jt.qpos] >= jt.lower - 1e-9 && out.start_q[jt.qpos] <= jt.upper + 1e-9))
+      throw ModelFileError(where + ": its qpos puts joint '" + jt.name + "' at " + num(out.start_q[jt.qpos]) + ", outside its range [" + num(jt.lower) +
                            ", " + num(jt.upper) + "]; a keyframe must start inside the joints' ranges");
   }
+  closeKeyframe(where, out);
   // The loops must hold there (as at q0: 1e-9), and their velocity form with qvel.
   ConstrainedMechanism<Spatial> mech(out.mechanism);
   for (std::size_t i = 0; i < out.closures.size(); ++i)

@@ -280,6 +280,10 @@ class MujocoReference {
   VecN actuation(const VecN& q, const VecN& v, const VecN& ctrl);
   // MuJoCo's passive forces on the coordinates (qfrc_passive: joints' and tendons' springs and dampers).
   VecN passive(const VecN& q, const VecN& v);
+  // MuJoCo's own measure of the loops at q: |p1 − p2|∞ (m) over the file's active connects (and welds'
+  // points) from its own kinematics (xpos, xmat) — a closure checked by the other engine's geometry; −1
+  // when the file has none (loops given beside it are not MuJoCo's).
+  double closure(const VecN& q);
 
  private:
   struct Impl;

@@ -149,6 +149,28 @@ VecN MujocoReference::passive(const VecN& q, const VecN& v) {
   return Eigen::Map<const VecN>(impl_->d->qfrc_passive, impl_->m->nv);
 }
 
+double MujocoReference::closure(const VecN& q) {
+  impl_->at(q, nullptr);
+  const mjModel* m = impl_->m;
+  const mjData* d = impl_->d;
+  double gap = -1;
+  for (int e = 0; e < m->neq; ++e) {
+    if (!m->eq_active[e] || (m->eq_type[e] != mjEQ_CONNECT && m->eq_type[e] != mjEQ_WELD)) continue;
+    // MuJoCo 2.2.2's data: a connect's (anchor in body1, anchor in body2), a weld's (anchor in body2,
+    // relpose's point in body1, ...). The world points from its own kinematics: xpos + xmat p.
+    const int b[2] = {m->eq_obj1id[e], m->eq_obj2id[e]};
+    const bool weld = m->eq_type[e] == mjEQ_WELD;
+    const mjtNum* point[2] = {m->eq_data + mjNEQDATA * e + (weld ? 3 : 0), m->eq_data + mjNEQDATA * e + (weld ? 0 : 3)};
+    Eigen::Vector3d p[2];
+    for (int k = 0; k < 2; ++k) {
+      const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> R(d->xmat + 9 * b[k]);
+      p[k] = Eigen::Map<const Eigen::Vector3d>(d->xpos + 3 * b[k]) + R * Eigen::Map<const Eigen::Vector3d>(point[k]);
+    }
+    gap = std::max(gap, (p[0] - p[1]).cwiseAbs().maxCoeff());
+  }
+  return gap;
+}
+
 // The bench's simulation: the model at the given step with the Euler (or RK4) integrator, its controls
 // the model's.
 struct MujocoSimulation::Impl : OwnedModel {

@@ -23,6 +23,7 @@ MatN MujocoReference::massMatrix(const VecN&) { refuse("MujocoReference"); }
 VecN MujocoReference::bias(const VecN&, const VecN&) { refuse("MujocoReference"); }
 VecN MujocoReference::actuation(const VecN&, const VecN&, const VecN&) { refuse("MujocoReference"); }
 VecN MujocoReference::passive(const VecN&, const VecN&) { refuse("MujocoReference"); }
+double MujocoReference::closure(const VecN&) { refuse("MujocoReference"); }
 
 MujocoSimulation::MujocoSimulation(const LoadedModel& model, double, bool) : impl_(nullptr) { refuse(model.file); }
 MujocoSimulation::~MujocoSimulation() = default;

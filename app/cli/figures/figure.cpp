@@ -11,6 +11,7 @@
 // named by its file (grading/plot_curves.h runSeries); stills need one run.
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <set>
@@ -77,7 +78,17 @@ std::string fileStem(const std::vector<PlotCurve>& curves) {
   std::vector<std::string> parts;
   for (const auto& c : curves)
     parts.push_back((c.x == "t" ? c.y : c.y + "-vs-" + c.x) + (c.mask.empty() ? "" : "-where-" + c.mask));
-  return "plot_" + join(parts, "+");
+  std::string stem = "plot_" + join(parts, "+");
+  // A model file with many coordinates (Cassie: 35 q columns) would pass the file system's 255-byte name:
+  // the first curve, how many more, and a hash of the whole (FNV-1a) keep it short and distinct.
+  if (stem.size() > 120) {
+    std::uint32_t h = 2166136261u;
+    for (unsigned char ch : stem) h = (h ^ ch) * 16777619u;
+    char tail[32];
+    std::snprintf(tail, sizeof tail, "+%zu_more_%08x", parts.size() - 1, unsigned(h));
+    stem = "plot_" + parts.front().substr(0, 60) + tail;
+  }
+  return stem;
 }
 
 // The plots the lab's rubric draws (each response with its reference), with the rubric's y label

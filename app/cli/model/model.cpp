@@ -33,6 +33,7 @@
 #include "physics/model_file/actuators.h"
 #include "physics/model_file/hand_engine.h"
 #include "physics/model_file/model_file.h"
+#include "physics/model_file/stiff_steps.h"
 
 namespace dyn::app {
 namespace {
@@ -146,6 +147,32 @@ std::string crossCheck(const model_file::LoadedModel& m, ConstrainedMechanism<Sp
          fmt(dM) + ", max |Δh| " + fmt(dh) + (m.actuators.empty() ? "" : ", max |Δτ_actuators| " + fmt(da)) + "\n";
 }
 
+// MuJoCo's own measure of the file's loops along a run's trace (MujocoReference::closure at each row's q):
+// the closure checked by the other engine's kinematics, not dynlab's. "" without a connect or weld in the file.
+std::string mujocoClosure(const model_file::LoadedModel& m, const ModelRun& r) {
+  if (m.closures.empty() || r.trace.rows() == 0) return "";
+  model_file::MujocoReference mj(m);
+  const Eigen::Index nq = m.q0.size();
+  double gap = -1;
+  VecN q(nq);
+  for (std::size_t row = 0; row < r.trace.rows(); ++row) {
+    for (Eigen::Index i = 0; i < nq; ++i) q[i] = r.trace.at(row, std::size_t(1 + i));
+    gap = std::max(gap, mj.closure(q));
+  }
+  return gap < 0 ? "" : "  MuJoCo's own measure of the file's loops at this trace (its kinematics: xpos + xmat of each connect's anchors) max |p1 − p2|∞ " + fmt(gap) + " m\n";
+}
+
+// The notes on the step: the sub-steps the model's fastest mode asks for (stiff_steps.h), and servos
+// stiffer than RK4 follows even at that sub-step.
+std::string stepNotes(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, double dt) {
+  const model_file::FastestMode fastest = model_file::fastestMode(m);
+  const double sub_step = dt / model_file::stiffSubsteps(fastest.rate, dt);
+  std::string text;
+  if (const std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), sub_step); !stiff.empty()) text += "  note: " + shownLine(stiff) + "\n";
+  if (const std::string sub = model_file::stiffStepNote(fastest, dt); !sub.empty()) text += "  note: " + shownLine(sub) + "\n";
+  return text;
+}
+
 std::string report(const ModelRun& r, const std::string& engine, const model_file::LoadedModel& m, const ModelArgs& args) {
   std::ostringstream o;
   const bool driven = !args.torques.empty() || !m.actuators.empty();
@@ -154,7 +181,7 @@ std::string report(const ModelRun& r, const std::string& engine, const model_fil
   o << (how.empty() ? std::string("passive run, ") : "run with " + how + ", ") << engine << ", dt " << fmt(args.dt) << " s, " << fmt(args.duration)
     << " s " << (m.key.empty() ? std::string("from q0 at rest") : "from keyframe " + nameShown(m.key)) << "\n"
     << "  " << (m.contacts.empty() ? "closure residual" : "constraint residual (closures, couplings, no-slip rows, contact and joint-stop depth)") << " max |φ|∞ "
-    << fmt(r.residual) << "\n"
+    << fmt(r.residual) << "\n" << mujocoClosure(m, r)
     << "  energy E0 " << fmt(r.e0) << " J, max |E − E0 − " << (driven || anyImpacts(m) ? "W" : "W_friction") << "| " << fmt(r.balance)
     << " J (kinetic energy up to " << fmt(r.kinetic) << " J"
     << (driven ? "; W: the torques' work and friction's" : anyImpacts(m) ? "; W: friction's and, in the hand engine's books, the touchdowns'" : "")
@@ -323,7 +350,7 @@ int model(const ModelArgs& asked) {
   }
   ConstrainedMechanism<Spatial> mech(m.mechanism);
   std::string text = describe(m) + crossCheck(m, mech);
-  if (const std::string stiff = model_file::stiffServoNote(m, mech.massMatrix(m.start_q), args.dt); !stiff.empty()) text += "  note: " + shownLine(stiff) + "\n";
+  text += stepNotes(m, mech, args.dt);
   const bool hand = args.engine != "bullet", bullet = args.engine != "hand";
   ModelRun h, b;
   if (hand) h = m.contacts.empty() ? runHand(m, mech, args.dt, args.duration, tau) : runHandElements(m, mech, args.dt, args.duration, tau);
