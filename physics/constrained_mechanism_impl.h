@@ -154,49 +154,6 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   have_position_ = true;
 }
 
-// While some rows are released (a model file's joint limits away from their stops, contacts open),
-// the solve at dynamic sizes holds only the closed rows: J̃ = H̃ J, Ã = H̃ A with H̃ the rows of the
-// identity at the closed rows, in order (constrained_solve.h's contact form, H̃ given); η = 0 on the
-// released rows. The same θ'', α_c and η bit for bit as the solve over every row with the released
-// ones zeroed at unit compliance (each of those adds 0 · 0 to the closed rows' sums), without their
-// rows × rows share of Λ: the PUMA file's twelve limit rows, mostly open, cost nothing. A fixed
-// instantiation keeps its Nr rows (a lab's sizes). True when the rows were selected (selected_).
-template <class S, int Nj, int Nr, int Nl>
-bool ConstrainedMechanism<S, Nj, Nr, Nl>::selectClosedRows() {
-  selected_ = false;
-  if constexpr (Nr == Eigen::Dynamic) {
-    if (problem_.Ht.size()) problem_.Ht.resize(0, 0);
-    if (!any_released_kind_) return false;
-    closed_rows_.clear();
-    for (std::size_t i = 0; i < model_.constraints.size(); ++i)
-      if (!released_[i])
-        for (int r = offsets_[i]; r < offsets_[i] + model_.constraints[i]->rows(); ++r) closed_rows_.push_back(r);
-    const int m = int(closed_rows_.size()), nn = n(), kk = k();
-    if (m == rows_) return false;
-    problem_.Ht.setZero(m, rows_);
-    J_closed_.resize(m, nn);
-    A_closed_.resize(m, kk);
-    for (int i = 0; i < m; ++i) {
-      const int r = closed_rows_[std::size_t(i)];
-      problem_.Ht(i, r) = 1.0;
-      J_closed_.row(i) = problem_.J.row(r);
-      if (kk) A_closed_.row(i) = problem_.A.row(r);
-    }
-    problem_.compliance.resize(0);  // the released rows are out of the solve
-    selected_ = true;
-  }
-  return selected_;
-}
-
-// η and f over every row from a solve on the closed rows (selectClosedRows): zero on the released ones.
-template <class S, int Nj, int Nr, int Nl>
-void ConstrainedMechanism<S, Nj, Nr, Nl>::scatterClosedRows(Solution& s) const {
-  const auto eta = s.eta;
-  s.eta.setZero(rows_);
-  for (std::size_t i = 0; i < closed_rows_.size(); ++i) s.eta[closed_rows_[i]] = eta[Eigen::Index(i)];
-  s.f = s.eta;
-}
-
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::treeStage(const VecN& q) {
   if (have_tree_ && q.head(nqTree()) == tree_q_) return;
