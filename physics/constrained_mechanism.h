@@ -189,6 +189,13 @@ class ConstrainedMechanism : public ConstrainedSystem {
   Problem problem_;
   ConstrainedFactorT<Nj, Nr, Nl> factor_;
   bool factored_ = false;
+  // The closed rows alone in the solve while some are released (dynamic sizes): selectClosedRows.
+  bool selectClosedRows();
+  void scatterClosedRows(Solution& s) const;
+  bool selected_ = false;          // the factor holds the closed rows alone (problem_.Ht selects them)
+  std::vector<int> closed_rows_;   // their rows, in order
+  MatRC<Nr, Nj> J_closed_;         // J̃ = H̃ J and Ã = H̃ A: the closed rows of J and A
+  MatRC<Nr, Nl> A_closed_;
   VecN phi_;
   VecN gravity_bc_;    // b_c + G_c of the payloads without external forces (b_c = 0: world axes at the centre of mass)
   VecN staged_q_;      // the configuration of the position stage

@@ -7,6 +7,7 @@
 //   lift-off   while a closed row's η < 0 (it would pull), the row pulling most opens, and solve again
 //   locating   a step that ends past a plane is retaken to the crossing h, φ(h) = 0, by regula falsi
 //              (Illinois) on h; the contact closes there and the rest of the step follows.
+//   solving    at dynamic sizes the closed rows alone (H̃ selects them), η = 0 on the open ones.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -23,6 +24,49 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::setClosed(int i, bool closed) {
     throw std::invalid_argument("ConstrainedMechanism::setClosed: constraint " + std::to_string(i) + " is not a rigid unilateral contact");
   released_[std::size_t(i)] = char(!closed);
   invalidate();
+}
+
+// While some rows are released (a model file's joint limits away from their stops, contacts open),
+// the solve at dynamic sizes holds only the closed rows: J̃ = H̃ J, Ã = H̃ A with H̃ the rows of the
+// identity at the closed rows, in order (constrained_solve.h's contact form, H̃ given); η = 0 on the
+// released rows. The same θ'', α_c and η bit for bit as the solve over every row with the released
+// ones zeroed at unit compliance (each of those adds 0 · 0 to the closed rows' sums), without their
+// rows × rows share of Λ: the PUMA file's twelve limit rows, mostly open, cost nothing. A fixed
+// instantiation keeps its Nr rows (a lab's sizes). True when the rows were selected (selected_).
+template <class S, int Nj, int Nr, int Nl>
+bool ConstrainedMechanism<S, Nj, Nr, Nl>::selectClosedRows() {
+  selected_ = false;
+  if constexpr (Nr == Eigen::Dynamic) {
+    if (problem_.Ht.size()) problem_.Ht.resize(0, 0);
+    if (!any_released_kind_) return false;
+    closed_rows_.clear();
+    for (std::size_t i = 0; i < model_.constraints.size(); ++i)
+      if (!released_[i])
+        for (int r = offsets_[i]; r < offsets_[i] + model_.constraints[i]->rows(); ++r) closed_rows_.push_back(r);
+    const int m = int(closed_rows_.size()), nn = n(), kk = k();
+    if (m == rows_) return false;
+    problem_.Ht.setZero(m, rows_);
+    J_closed_.resize(m, nn);
+    A_closed_.resize(m, kk);
+    for (int i = 0; i < m; ++i) {
+      const int r = closed_rows_[std::size_t(i)];
+      problem_.Ht(i, r) = 1.0;
+      J_closed_.row(i) = problem_.J.row(r);
+      if (kk) A_closed_.row(i) = problem_.A.row(r);
+    }
+    problem_.compliance.resize(0);  // the released rows are out of the solve
+    selected_ = true;
+  }
+  return selected_;
+}
+
+// η and f over every row from a solve on the closed rows (selectClosedRows): zero on the released ones.
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::scatterClosedRows(Solution& s) const {
+  const auto eta = s.eta;
+  s.eta.setZero(rows_);
+  for (std::size_t i = 0; i < closed_rows_.size(); ++i) s.eta[closed_rows_[i]] = eta[Eigen::Index(i)];
+  s.f = s.eta;
 }
 
 // A contact at or past its plane closes unless it separates faster than this (m/s): rounding-size

@@ -57,6 +57,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
     any_released_kind_ = any_released_kind_ || released;
     any_rigid_contact_ = any_rigid_contact_ || rigid_contact_.back();
   }
+  closed_rows_.reserve(std::size_t(rows_));  // selectClosedRows: no allocation in a step
   auto fits = [](int fixed, int actual) { return fixed == Eigen::Dynamic || fixed == actual; };
   const int dof = model_.treeDof(), payload = model_.payloadDof();
   if (!fits(Nj, dof) || !fits(Nr, rows_) || !fits(Nl, payload))
@@ -147,7 +148,8 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
           problem_.compliance[r] = 1.0;
         }
   }
-  factored_ = factor_.factor(problem_, problem_.J, problem_.A);
+  if (selectClosedRows()) factored_ = factor_.factor(problem_, J_closed_, A_closed_);
+  else factored_ = factor_.factor(problem_, problem_.J, problem_.A);
   setFixed<kState>(staged_q_, q);
   have_position_ = true;
 }
@@ -266,13 +268,14 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
   Solution s;
   if (!factored_) s = solveConstrainedBlockLU(problem_);
   else factor_.solve(problem_, s, with_qdd);
+  if (selected_) scatterClosedRows(s);
   // A compliant contact's η is its force, not the solve's (its row is released).
   if (any_compliant_)
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
       if (compliant_[i]) {
         const int r = offsets_[i];
         s.eta[r] = compliant_eta_[r];
-        if (problem_.Ht.size() == 0) s.f[r] = compliant_eta_[r];
+        if (problem_.Ht.size() == 0 || selected_) s.f[r] = compliant_eta_[r];
       }
   return s;
 }
@@ -407,7 +410,9 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::impulseResponse(const VecN& e, Solutio
   impulse.tau.setZero(n());
   impulse.h.setZero(n());
   impulse.Jdot_qd = -e;
+  if (selected_) impulse.Ht = problem_.Ht;  // the closed rows the factor holds
   factor_.solve(impulse, s);
+  if (selected_) scatterClosedRows(s);
   dx.resize(n() + k());
   dx.head(n()) = s.qdd;
   dx.tail(k()) = s.alpha_c;

@@ -46,9 +46,12 @@ std::unique_ptr<ConstrainedSystem> withActuators(std::unique_ptr<ConstrainedSyst
 // τ plus the drive there, which the step's own contact updates (a touchdown located inside it) see;
 // each stage at (q', v') then adds the drive's change since, d(q', v') − d(q, v) (zero at the first).
 // Stepped without hold, τ is taken as the plain τ (each stage adds the whole drive).
-class DrivenMechanism final : public ConstrainedMechanism<Spatial> {
+// Mechanism: the dynamically sized one (DrivenMechanism), or one with the joints fixed (hand_engine.h's
+// SizedElements: the PUMA 560's six joints, its limit rows dynamic).
+template <class Mechanism = ConstrainedMechanism<Spatial>>
+class DrivenMechanismT final : public Mechanism {
  public:
-  explicit DrivenMechanism(const LoadedModel& m) : ConstrainedMechanism<Spatial>(m.mechanism), drive_(m), held_(VecN::Zero(Eigen::Index(m.joints.size()))) {}
+  explicit DrivenMechanismT(const LoadedModel& m) : Mechanism(m.mechanism), drive_(m), held_(VecN::Zero(Eigen::Index(m.joints.size()))) {}
   VecN hold(const VecN& q, const VecN& v, const VecN& tau) {
     if (drive_.empty()) return tau;
     held_ = drive_.torques(q, v);
@@ -57,12 +60,12 @@ class DrivenMechanism final : public ConstrainedMechanism<Spatial> {
   bool empty() const { return drive_.empty(); }
   // (Without a drive, τ passes through untouched: a step allocates nothing.)
   void derivatives(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a, double& work, double& friction) override {
-    if (drive_.empty()) return ConstrainedMechanism<Spatial>::derivatives(q, v, tau, stab, a, work, friction);
-    ConstrainedMechanism<Spatial>::derivatives(q, v, staged(q, v, tau), stab, a, work, friction);
+    if (drive_.empty()) return Mechanism::derivatives(q, v, tau, stab, a, work, friction);
+    Mechanism::derivatives(q, v, staged(q, v, tau), stab, a, work, friction);
   }
   void accelerations(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, VecN& a) override {
-    if (drive_.empty()) return ConstrainedMechanism<Spatial>::accelerations(q, v, tau, stab, a);
-    ConstrainedMechanism<Spatial>::accelerations(q, v, staged(q, v, tau), stab, a);
+    if (drive_.empty()) return Mechanism::accelerations(q, v, tau, stab, a);
+    Mechanism::accelerations(q, v, staged(q, v, tau), stab, a);
   }
 
  private:
@@ -70,6 +73,7 @@ class DrivenMechanism final : public ConstrainedMechanism<Spatial> {
   Drive drive_;
   VecN held_;
 };
+using DrivenMechanism = DrivenMechanismT<>;
 
 // Servos stiffer than RK4 at step dt can follow: the actuators' stiffness K = Σ −gear² bias[1] c cᵀ and
 // damping C = Σ −gear² bias[2] c cᵀ (c: the path's coefficients on the coordinates) on M (at the run's start, armature included) make x = (q, v) move as

@@ -9,9 +9,14 @@ namespace dyn {
 template class ConstrainedMechanism<Spatial, 3, 2, 0>;
 template class ConstrainedMechanism<Spatial, 4, 2, 0>;
 template class ConstrainedMechanism<Spatial, 4, 3, 0>;
+template class ConstrainedMechanism<Spatial, 6, Eigen::Dynamic, 0>;
 }  // namespace dyn
 
 namespace dyn::model_file {
+
+bool sixJointsFixed(const MechanismModel<Spatial>& model) {
+  return model.treeDof() == 6 && model.tree.nq() == 6 && model.payloads.empty();
+}
 
 std::unique_ptr<ConstrainedSystem> handEngine(const MechanismModel<Spatial>& model, std::string* sizes) {
   const int n = model.treeDof(), r = model.rows();

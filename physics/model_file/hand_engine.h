@@ -8,6 +8,7 @@
 #include <memory>
 #include <string>
 
+#include "physics/constrained_mechanism.h"
 #include "physics/integrate.h"
 #include "physics/mechanism.h"
 
@@ -16,5 +17,13 @@ namespace dyn::model_file {
 // Throws std::invalid_argument as ConstrainedMechanism does. sizes, when given, says which was built
 // ("fixed sizes 4 joints, 2 rows" or "dynamic sizes").
 std::unique_ptr<ConstrainedSystem> handEngine(const MechanismModel<Spatial>& model, std::string* sizes = nullptr);
+
+// With elements beside the file (joint limits, contacts: rows closed and opened between steps), six
+// hinge or slide joints fixed (the PUMA 560's file and its twelve limit rows) and the rows dynamic: the
+// closed rows alone are solved (constrained_mechanism.h), the tree's loops unrolled. The same steps bit
+// for bit as the dynamically sized mechanism (tests/physics/model_file/hand_engine_test.cpp). (Compiled
+// in hand_engine.cpp; sixJointsFixed says whether a description fits it.)
+using SixJoints = ConstrainedMechanism<Spatial, 6, Eigen::Dynamic, 0>;
+bool sixJointsFixed(const MechanismModel<Spatial>& model);
 
 }  // namespace dyn::model_file

@@ -18,6 +18,7 @@
 #include <functional>
 #include <iostream>
 #include <memory>
+#include <type_traits>
 
 #include "app/cli/bench/bench.h"
 #include "app/cli/commands.h"
@@ -54,6 +55,7 @@ struct Engine {
 struct Engines {
   std::unique_ptr<ConstrainedSystem> euler_mech, rk4_mech;
   std::unique_ptr<model_file::DrivenMechanism> euler_el, rk4_el;  // with elements beside the file
+  std::unique_ptr<model_file::DrivenMechanismT<model_file::SixJoints>> euler_six, rk4_six;  // the same, six joints fixed
   std::string sizes;
   std::unique_ptr<bullet::BulletMechanism<Spatial>> bullet;
   std::unique_ptr<model_file::MujocoSimulation> mujoco;
@@ -63,11 +65,14 @@ struct Engines {
 
 // A hand engine for a file with elements beside it: contacts updated at each step's start, touchdowns
 // located (labs/mechanism_simulation.h's step); restarted as a new mechanism (its contacts open).
-Engine handWithElements(const model_file::LoadedModel& m, const char* scheme, std::unique_ptr<model_file::DrivenMechanism>* mech,
-                        VecN* q, VecN* v, StepOptions o) {
+template <class Mechanism>
+Engine handWithElements(const model_file::LoadedModel& m, const char* scheme, std::unique_ptr<Mechanism>* mech, VecN* q, VecN* v,
+                        StepOptions o) {
   Engine x;
   x.name = "hand";
-  x.scheme = std::string(scheme) + " (dynamic sizes; contacts closed and opened between steps, touchdowns located)";
+  const bool six = !std::is_same_v<Mechanism, model_file::DrivenMechanism>;
+  x.scheme = std::string(scheme) + (six ? " (fixed sizes 6 joints, the closed rows solved;" : " (dynamic sizes;") +
+             " contacts closed and opened between steps, touchdowns located)";
   // The zero torque made once (a step allocates nothing); with actuators or tendons, evaluated at each
   // stage (labs/generic/model_run.cpp's runHandElements).
   x.step = [=, zero = VecN(VecN::Zero(Eigen::Index(m.joints.size()))), tau = VecN(VecN::Zero(Eigen::Index(m.joints.size())))]() mutable {
@@ -75,7 +80,7 @@ Engine handWithElements(const model_file::LoadedModel& m, const char* scheme, st
     (*mech)->updateContacts(*q, *v, tau);
     return (*mech)->stepLocatingContacts(o, tau, *q, *v) && q->allFinite() && v->allFinite();
   };
-  x.restart = [=, &m] { *mech = std::make_unique<model_file::DrivenMechanism>(m), *q = m.start_q, *v = m.start_v; };
+  x.restart = [=, &m] { *mech = std::make_unique<Mechanism>(m), *q = m.start_q, *v = m.start_v; };
   x.state = [=](VecN& qo, VecN& vo) { qo = *q, vo = *v; };
   return x;
 }
@@ -131,6 +136,9 @@ void build(const model_file::LoadedModel& m, double dt, bool beside, Engines& e)
   if (m.contacts.empty()) {
     e.list.push_back(hand("semi-implicit Euler + Baumgarte", e.euler_mech.get(), &e.q_euler, &e.v_euler, euler));
     e.list.push_back(hand("RK4 + projection", e.rk4_mech.get(), &e.q_rk4, &e.v_rk4, rk4));
+  } else if (model_file::sixJointsFixed(m.mechanism)) {
+    e.list.push_back(handWithElements(m, "semi-implicit Euler + Baumgarte", &e.euler_six, &e.q_euler, &e.v_euler, euler));
+    e.list.push_back(handWithElements(m, "RK4 + projection", &e.rk4_six, &e.q_rk4, &e.v_rk4, rk4));
   } else {
     e.list.push_back(handWithElements(m, "semi-implicit Euler + Baumgarte", &e.euler_el, &e.q_euler, &e.v_euler, euler));
     e.list.push_back(handWithElements(m, "RK4 + projection", &e.rk4_el, &e.q_rk4, &e.v_rk4, rk4));

@@ -1,0 +1,49 @@
+// The hand engine for files with elements at fixed sizes (physics/model_file/hand_engine.h SixJoints:
+// six joints fixed, the rows dynamic, the closed rows alone solved) steps the PUMA 560's file with its
+// twelve joint-limit rows exactly as the dynamically sized mechanism does, bit for bit, through a run
+// that falls onto a stop (a row closed, its impact, the lift-off checks) and with every row open.
+#include <doctest/doctest.h>
+
+#include "physics/model_file/actuators.h"
+#include "physics/model_file/hand_engine.h"
+#include "physics/model_file/model_file.h"
+#include "tests/physics/model_file/fixtures.h"
+
+using namespace dyn;
+using dyn::test_model_file::model;
+
+TEST_CASE("the six-joint engine with limits steps the PUMA file as the dynamically sized mechanism, bit for bit") {
+  const model_file::LoadedModel m = model_file::load(model("puma560.urdf"));
+  REQUIRE(model_file::sixJointsFixed(m.mechanism));
+  REQUIRE(m.contacts.size() == 12);  // both sides of six joints
+  for (Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::RK4}) {
+    INFO(int(integrator));
+    StepOptions o;
+    o.dt = m.timestep;
+    o.integrator = integrator;
+    if (integrator == Integrator::SemiImplicitEuler) o.drift.kind = Drift::Baumgarte;
+    model_file::DrivenMechanism dynamic(m);
+    model_file::DrivenMechanismT<model_file::SixJoints> sized(m);
+    const VecN tau = VecN::Zero(6);
+    VecN q1 = m.start_q, v1 = m.start_v, q2 = q1, v2 = v1;
+    int closed_steps = 0;
+    for (int k = 0; k < 1500; ++k) {
+      dynamic.updateContacts(q1, v1, tau);
+      sized.updateContacts(q2, v2, tau);
+      REQUIRE(dynamic.stepLocatingContacts(o, tau, q1, v1));
+      REQUIRE(sized.stepLocatingContacts(o, tau, q2, v2));
+      bool any = false;
+      for (int i = 0; i < 12; ++i) {
+        REQUIRE(dynamic.closed(i) == sized.closed(i));
+        any = any || dynamic.closed(i);
+      }
+      closed_steps += any;
+      REQUIRE(q1 == q2);
+      REQUIRE(v1 == v2);
+    }
+    CHECK(closed_steps > 100);         // it came to rest on a stop
+    CHECK(closed_steps < 1500);        // and fell freely before
+    CHECK(dynamic.impactLoss() > 0);   // with an impact
+    CHECK(dynamic.impactLoss() == sized.impactLoss());
+  }
+}
