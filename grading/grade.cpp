@@ -148,10 +148,9 @@ GradeOutcome gradeSubmission(const json& sub, const std::string& file, const Gra
       const json cfg = scenarioConfig(applied, rubric, sc, lab_name, config_file);
       const auto lab = buildLab(*entry, cfg, config_file + " (scenario " + sc.name + ")");
       ScenarioRun run = runScenario(*lab, rubric.watchdog, deadline, config_file, opt.stop);
-      const std::uint64_t trace_hash = run.trace.hash();  // once: a pass over every number of the run
-      trajectories += hashHex(std::to_string(trace_hash));
-      rep.scenarios.push_back({sc, lab->dt(), trace_hash, run.failure, run.failure_time, run.screen.notes,
+      rep.scenarios.push_back({sc, lab->dt(), run.trace.hash(), run.failure, run.failure_time, run.screen.notes,
                                run.metrics, run.out_of_time});
+      trajectories += hashHex(std::to_string(rep.scenarios.back().trace_hash));  // hashed once: a pass over every number
       runs.emplace(sc.name, std::move(run));
     }
     rep.fingerprint["trajectory_hash"] = hashHex(trajectories);
