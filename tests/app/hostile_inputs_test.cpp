@@ -1,6 +1,7 @@
 // Hostile input through the real binary: a corpus built per test (UTF-16, Latin-1, cut UTF-8, a
 // NUL, duplicate keys, a FIFO, a directory, a symlink to /etc/passwd, 20 MB, deep nesting, an empty
-// file, odd file names) given to grade, grade --replay, run --gains/--config and figure --gains.
+// file, odd file names) given to grade, grade --replay, run --gains/--config, figure --gains and, as a
+// model description, to run.
 // Every case runs under a 20 s timeout (a hang is a kill, a failure here), and must give exit 2,
 // one line of valid UTF-8 on stderr naming the file and what was wrong, nothing written by
 // run/figure, and for grade a results.json that `dynlab check-results` accepts with score 0.
@@ -120,6 +121,19 @@ TEST_CASE("hostile files given to run --gains/--config and figure --gains: exit 
       CHECK(r.out.empty());
       CHECK_FALSE(fs::exists(dir / "out"));
     }
+  }
+}
+
+// The same corpus named where a model file goes (a description: labs/generic/model_description.h):
+// `dynlab run FILE.json` reads it as one, and refuses each in one line naming it.
+TEST_CASE("hostile files given as a model description to run: exit 2, one line, nothing written") {
+  TempDir dir("hostile_description");
+  for (const Hostile& h : buildCorpus(dir)) {
+    INFO("dynlab run ", h.shown, " --duration 0.2");
+    const Result r = timedDynlab(dir, {"run", h.name, "--duration", "0.2", "--out", "out"});
+    checkMessage(r, h, h.shown);
+    CHECK(r.out.empty());
+    CHECK_FALSE(fs::exists(dir / "out"));
   }
 }
 
