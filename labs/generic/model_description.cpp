@@ -31,7 +31,7 @@ void readJoints(const JsonView& j, LoadedModel& m) {
     model_file::Joint jt;
     jt.name = name(x["name"]), jt.body = name(x["body"]), jt.type = x["type"].oneOf({"hinge", "slide", "ball", "free"});
     jt.qpos = index(x["qpos"], 0, nq - 1), jt.limited = x["limited"].boolean(), jt.lower = num(x["lower"]), jt.upper = num(x["upper"]);
-    if (jt.limited && !(jt.lower <= jt.upper)) x["upper"].fail("an upper limit ≥ the lower one");
+    if (jt.limited && !(jt.lower <= jt.upper)) x["upper"].fail("expected an upper limit ≥ the lower one");
     m.joints.push_back(jt);
   }
 }
@@ -46,13 +46,13 @@ void readLoops(const JsonView& root, LoadedModel& m) {
     const JsonView x = cl.at(i);
     x.onlyKeys({"name", "kind", "body1", "body2", "kept", "dropped", "link1", "link2", "point1", "point2"});
     if (std::string(constraints[i]->kind()) != "point_closure")
-      x.fail("a closure for each point_closure of /mechanism/constraints, first (constraint " + std::to_string(i) + " is a " + constraints[i]->kind() + ")");
+      x.fail("expected a closure for each point_closure of /mechanism/constraints, first (constraint " + std::to_string(i) + " is a " + constraints[i]->kind() + ")");
     model_file::Closure c;
     c.name = name(x["name"]), c.kind = x["kind"].oneOf({"connect", "weld"}), c.body1 = name(x["body1"]), c.body2 = name(x["body2"]);
     c.kept = names(x["kept"], 6), c.dropped = names(x["dropped"], 6);
     for (const JsonView& rows : {x["kept"], x["dropped"]})
       for (std::size_t k = 0; k < rows.size(); ++k)
-        if (model_file::rowIndex(rows.at(k).string()) < 0) rows.at(k).fail("a row name: wx wy wz x y z");
+        if (model_file::rowIndex(rows.at(k).string()) < 0) rows.at(k).fail("expected a row name: wx wy wz x y z");
     c.link1 = index(x["link1"], -1, dof - 1), c.link2 = index(x["link2"], -1, dof - 1);
     c.point1 = matrix<Vec3>(x["point1"]), c.point2 = matrix<Vec3>(x["point2"]);
     m.closures.push_back(c);
@@ -62,7 +62,7 @@ void readLoops(const JsonView& root, LoadedModel& m) {
     const JsonView x = every.at(i);
     x.onlyKeys({"name", "rows", "dropped"});
     model_file::EveryRow e{name(x["name"]), readConstraint(x["rows"], m.mechanism.tree, nq), names(x["dropped"], 6)};
-    if (std::string(e.rows->kind()) != "point_closure") x["rows"]["kind"].fail("\"point_closure\" (every row of a closure)");
+    if (std::string(e.rows->kind()) != "point_closure") x["rows"]["kind"].fail("expected \"point_closure\" (every row of a closure)");
     m.every_closure_row.push_back(e);
   }
   const JsonView co = root["contacts"];
@@ -74,8 +74,8 @@ void readLoops(const JsonView& root, LoadedModel& m) {
     model_file::Contact c{name(x["name"]), x["kind"].oneOf({"rolling", "plane_contact", "joint_limit", "joint_coupling", "tendon_coupling"}),
                           name(x["body"]), index(x["link"], -1, dof - 1), num(x["mu"], 0, 10)};
     const ConstraintPtr<Spatial>& k = constraints[m.closures.size() + i];
-    if (c.kind != k->kind()) x["kind"].fail("\"" + std::string(k->kind()) + "\", constraint " + std::to_string(m.closures.size() + i) + "'s kind");
-    if (c.kind == "joint_limit" && !(c.link >= 0 && m.joints[std::size_t(c.link)].limited)) x["link"].fail("the limited joint the stop is on");
+    if (c.kind != k->kind()) x["kind"].fail("expected \"" + std::string(k->kind()) + "\", constraint " + std::to_string(m.closures.size() + i) + "'s kind");
+    if (c.kind == "joint_limit" && !(c.link >= 0 && m.joints[std::size_t(c.link)].limited)) x["link"].fail("expected the limited joint the stop is on");
     m.contacts.push_back(c);
   }
 }
@@ -150,9 +150,9 @@ void readDrawing(const JsonView& d, LoadedModel& m) {
     model_file::Geom g;
     g.shape = shapeOf(x["shape"]), g.name = name(x["name"]), g.body = name(x["body"]), g.link = index(x["link"], -1, dof - 1);
     g.pos = matrix<Vec3>(x["pos"]), g.rot = matrix<Eigen::Matrix3d>(x["rot"]), g.size = matrix<Vec3>(x["size"]);
-    if (!(g.size.minCoeff() >= 0)) x["size"].fail("sizes ≥ 0 (m)");
+    if (!(g.size.minCoeff() >= 0)) x["size"].fail("expected sizes ≥ 0 (m)");
     const bool mesh = g.shape == model_file::Geom::Shape::Mesh;
-    if (mesh != !x["mesh"].raw().is_null()) x["mesh"].fail(mesh ? "the index of its mesh in /drawing/meshes" : "null (not a mesh)");
+    if (mesh != !x["mesh"].raw().is_null()) x["mesh"].fail(mesh ? "expected the index of its mesh in /drawing/meshes" : "expected null (not a mesh)");
     if (mesh) g.mesh = meshes[std::size_t(index(x["mesh"], 0, int(meshes.size()) - 1))];
     const JsonView rgba = x["rgba"];
     for (std::size_t k = 0, n = rgba.size(4, 4); k < n; ++k) g.rgba[k] = float(num(rgba.at(k), 0, 1));
@@ -203,9 +203,9 @@ void applyOptions(const std::string& file, const model_file::LoadOptions& option
 LoadedModel readRoot(const JsonView& r, const std::string& file) {
   r.requireObject();
   if (!r.has("format") || !r["format"].raw().is_string() || r["format"].string() != kDescriptionFormat)
-    r["format"].fail(std::string("\"") + kDescriptionFormat + "\" (a file `dynlab model FILE --export DESC.json` writes)");
+    r["format"].fail(std::string("expected \"") + kDescriptionFormat + "\" (a file `dynlab model FILE --export DESC.json` writes)");
   if (r["version"].integer(0, 1LL << 40) != kDescriptionVersion)
-    r["version"].fail("format version " + std::to_string(kDescriptionVersion) + ", the one this dynlab reads; export the model file again with this dynlab");
+    r["version"].fail("expected format version " + std::to_string(kDescriptionVersion) + ", the one this dynlab reads; export the model file again with this dynlab");
   r.onlyKeys({"format", "version", "source", "timestep", "dof", "q0", "coordinates", "joints", "bodies", "mechanism", "closures",
               "every_closure_row", "contacts", "actuators", "tendons", "keyframes", "start", "notes", "drawing"});
   LoadedModel m;
@@ -215,7 +215,7 @@ LoadedModel readRoot(const JsonView& r, const std::string& file) {
   m.q0 = vector(r["q0"], 1, kMaxDof);
   m.mechanism = readMechanism(r["mechanism"], int(m.q0.size()));
   m.coordinates = names(r["coordinates"], kMaxDof);
-  if (m.coordinates.size() != std::size_t(m.q0.size())) r["coordinates"].fail("one name per entry of /q0 (" + std::to_string(m.q0.size()) + ")");
+  if (m.coordinates.size() != std::size_t(m.q0.size())) r["coordinates"].fail("expected one name per entry of /q0 (" + std::to_string(m.q0.size()) + ")");
   readJoints(r["joints"], m);
   m.bodies = names(r["bodies"], kMaxDof);
   readLoops(r, m);

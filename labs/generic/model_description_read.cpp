@@ -32,7 +32,7 @@ int index(const JsonView& j, int lo, int hi) {
 
 std::string name(const JsonView& j) {
   const std::string s = j.string();
-  if (s.size() > kMaxName) j.fail("a name of at most " + std::to_string(kMaxName) + " bytes");
+  if (s.size() > kMaxName) j.fail("expected a name of at most " + std::to_string(kMaxName) + " bytes");
   return s;
 }
 
@@ -82,7 +82,7 @@ Spatial::Mat inertia(const JsonView& j) {
     ok = p[0] >= -tol && p[0] + p[1] >= p[2] - 1e-6 * scale;
   }
   if (!ok)
-    j.fail("a body's spatial inertia (36 numbers, row by row: symmetric, mass m ≥ 0 on the force block's diagonal, positive "
+    j.fail("expected a body's spatial inertia (36 numbers, row by row: symmetric, mass m ≥ 0 on the force block's diagonal, positive "
            "semidefinite, principal moments about the centre of mass meeting the triangle inequality)");
   return I;
 }
@@ -108,12 +108,12 @@ void setBody(TreeModel<Spatial>& tree, int i, const Vec3& axis, const Spatial::M
 // A ball's three bodies first..first+2 (first carries the placement, the last the inertia).
 void addBall(TreeModel<Spatial>& tree, const JsonView& bodies, const JsonView& ball, int first, int parent, const Spatial::Transform& X) {
   const int n = int(bodies.size());
-  if (first + 2 >= n) ball["first"].fail("a ball joint's first of three bodies (bodies " + std::to_string(first) + " to " + std::to_string(first + 2) + ")");
+  if (first + 2 >= n) ball["first"].fail("expected a ball joint's first of three bodies (bodies " + std::to_string(first) + " to " + std::to_string(first + 2) + ")");
   for (int k = 1; k < 3; ++k) {
     const JsonView b = bodies.at(std::size_t(first + k));
     if (jointType(b["joint"]) != JointType::Ball || index(b["parent"], -1, n) != first + k - 1 ||
         !(matrix<Mat3>(b["E"]) == Mat3::Identity()) || !(matrix<Vec3>(b["r"]) == Vec3::Zero()))
-      b.fail("a ball joint's body " + std::to_string(k + 1) + " of 3: joint \"ball\", parent the body before, E the identity, r zero");
+      b.fail("expected a ball joint's body " + std::to_string(k + 1) + " of 3: joint \"ball\", parent the body before, E the identity, r zero");
   }
   const Mat3 pre = rotation(ball["pre"]), post = rotation(ball["post"]);
   tree.addBall(parent, X, pre, post, Spatial::Mat::Zero());
@@ -138,10 +138,10 @@ TreeModel<Spatial> readTree(const JsonView& t, int nq) {
       --ball_left;  // made with its ball's first body (addBall checked it)
     } else if (type == JointType::Ball) {
       // A ball's first body: the next ball of /balls starts here.
-      if (next_ball >= nballs) balls.fail("a ball joint (first, pre, post) for each ball's three bodies; body " + std::to_string(i) + " starts one more");
+      if (next_ball >= nballs) balls.fail("expected a ball joint (first, pre, post) for each ball's three bodies; body " + std::to_string(i) + " starts one more");
       const JsonView ball = balls.at(std::size_t(next_ball++));
       ball.onlyKeys({"first", "pre", "post"});
-      if (index(ball["first"], 0, n - 1) != i) ball["first"].fail("the index of the ball's first body, " + std::to_string(i));
+      if (index(ball["first"], 0, n - 1) != i) ball["first"].fail("expected the index of the ball's first body, " + std::to_string(i));
       addBall(tree, bodies, ball, i, parent, X);
       ball_left = 2;
     } else {
@@ -149,8 +149,8 @@ TreeModel<Spatial> readTree(const JsonView& t, int nq) {
     }
     setBody(tree, i, axis, I);
   }
-  if (next_ball != nballs) balls.fail("one entry per ball joint of /mechanism/tree/bodies (" + std::to_string(next_ball) + ")");
-  if (tree.nq() != nq) bodies.fail("a tree whose coordinates match /q0's " + std::to_string(nq) + " (these bodies make " + std::to_string(tree.nq()) + ")");
+  if (next_ball != nballs) balls.fail("expected one entry per ball joint of /mechanism/tree/bodies (" + std::to_string(next_ball) + ")");
+  if (tree.nq() != nq) bodies.fail("expected a tree whose coordinates match /q0's " + std::to_string(nq) + " (these bodies make " + std::to_string(tree.nq()) + ")");
   tree.gravity = matrix<Spatial::Vec>(t["gravity"]);
   return tree;
 }
@@ -182,16 +182,16 @@ ConstraintPtr<Spatial> makeConstraint(const JsonView& j, const TreeModel<Spatial
     PointClosure<Spatial>::Rows rows{};
     int count = 0;
     for (std::size_t k = 0, n = j["rows"].size(6, 6); k < n; ++k) count += rows[k] = j["rows"].at(k).boolean();
-    if (count == 0) j["rows"].fail("at least one row held (six booleans: wx wy wz x y z)");
+    if (count == 0) j["rows"].fail("expected at least one row held (six booleans: wx wy wz x y z)");
     const BodyRef a = link(j["a"], dof, true), b = link(j["b"], dof, true);
-    if (a == b) j["b"].fail("a body other than a (a closure ties two bodies)");
+    if (a == b) j["b"].fail("expected a body other than a (a closure ties two bodies)");
     return std::make_shared<PointClosure<Spatial>>(a, matrix<Vec3>(j["point_a"]), b, matrix<Vec3>(j["point_b"]), rows);
   }
   if (kind == "joint_limit") {
     j.onlyKeys({"kind", "joint", "parent", "side", "bound"});
     const int joint = index(j["joint"], 0, dof - 1);
     if (index(j["parent"], -1, dof - 1) != tree.bodies[std::size_t(joint)].parent)
-      j["parent"].fail("the joint's parent in the tree (" + std::to_string(tree.bodies[std::size_t(joint)].parent) + ")");
+      j["parent"].fail("expected the joint's parent in the tree (" + std::to_string(tree.bodies[std::size_t(joint)].parent) + ")");
     const auto side = j["side"].oneOf({"lower", "upper"}) == std::string("lower") ? JointLimit::Side::Lower : JointLimit::Side::Upper;
     return std::make_shared<JointLimit>(joint, tree.bodies[std::size_t(joint)].parent, side, num(j["bound"]));
   }
@@ -223,7 +223,7 @@ ConstraintPtr<Spatial> readConstraint(const JsonView& j, const TreeModel<Spatial
   try {
     return makeConstraint(j, tree, nq);
   } catch (const std::invalid_argument& e) {
-    j.fail(std::string("a constraint its kind can hold (") + e.what() + ")");
+    j.fail(std::string("expected a constraint its kind can hold (") + e.what() + ")");
   }
 }
 
@@ -234,7 +234,7 @@ MechanismModel<Spatial> readMechanism(const JsonView& j, int nq) {
   const int dof = mech.tree.dof();
   const JsonView joints = j["joints"];
   const std::size_t nj = joints.size(0, std::size_t(dof));
-  if (nj != 0 && int(nj) != dof) joints.fail("none, or one entry per tree body (" + std::to_string(dof) + ")");
+  if (nj != 0 && int(nj) != dof) joints.fail("expected none, or one entry per tree body (" + std::to_string(dof) + ")");
   for (std::size_t i = 0; i < nj; ++i) {
     const JsonView p = joints.at(i);
     p.onlyKeys({"stiffness", "rest", "viscous", "coulomb", "coulomb_width", "armature"});
@@ -245,13 +245,13 @@ MechanismModel<Spatial> readMechanism(const JsonView& j, int nq) {
   }
   const JsonView cs = j["constraints"];
   for (std::size_t i = 0, n = cs.size(0, 4 * kMaxDof); i < n; ++i) mech.constraints.push_back(readConstraint(cs.at(i), mech.tree, nq));
-  if (mech.rows() > kMaxDof) cs.fail("at most " + std::to_string(kMaxDof) + " constraint rows in all (these make " + std::to_string(mech.rows()) + ")");
+  if (mech.rows() > kMaxDof) cs.fail("expected at most " + std::to_string(kMaxDof) + " constraint rows in all (these make " + std::to_string(mech.rows()) + ")");
   const JsonView b = j["bullet"];
   b.onlyKeys({"cut_joints", "solver_iterations", "rolling"});
   for (std::size_t i = 0, n = b["cut_joints"].size(0, std::size_t(dof)); i < n; ++i) mech.bullet.cut_joints.push_back(index(b["cut_joints"].at(i), 0, dof - 1));
   mech.bullet.solver_iterations = index(b["solver_iterations"], 1, 10000);
   mech.bullet.rolling = b["rolling"].oneOf({"no_slip", "friction"}) == std::string("no_slip") ? RollingModel::NoSlip : RollingModel::Friction;
-  if (const std::string why = mech.validate(); !why.empty()) j.fail("a mechanism dynlab can run (" + why + ")");
+  if (const std::string why = mech.validate(); !why.empty()) j.fail("expected a mechanism dynlab can run (" + why + ")");
   return mech;
 }
 
