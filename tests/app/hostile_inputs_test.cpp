@@ -130,11 +130,16 @@ TEST_CASE("hostile files given as a model description to run: exit 2, one line, 
   TempDir dir("hostile_description");
   for (const Hostile& h : buildCorpus(dir)) {
     INFO("dynlab run ", h.shown, " --duration 0.2");
-    const Result r = timedDynlab(dir, {"run", h.name, "--duration", "0.2", "--out", "out"});
-    checkMessage(r, h, h.shown);
+    // (after "--": a name that starts with a dash is the file's)
+    const Result r = timedDynlab(dir, {"run", "--duration", "0.2", "--out", "out", "--", h.name});
+    // A description may be larger than a submission (64 MB: meshes): 20 MB is read, and is not one.
+    checkMessage(r, h.name == "big.json" ? Hostile{h.name, h.shown, {"/: ", "missing key \"format\""}} : h, h.shown);
     CHECK(r.out.empty());
     CHECK_FALSE(fs::exists(dir / "out"));
   }
+  writeFile(dir / "huge.json", R"({"format": ")" + std::string(65u << 20, 'x') + "\"}");
+  const Result r = timedDynlab(dir, {"run", "huge.json", "--out", "out"});
+  checkMessage(r, {"huge.json", "huge.json", {"expected at most", "bytes"}}, "huge.json");
 }
 
 TEST_CASE("hostile submissions graded: exit 2, a valid results.json with score 0 and the message; replay agrees") {
