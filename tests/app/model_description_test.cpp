@@ -72,6 +72,21 @@ TEST_CASE("every model file: its description reads back to the same text, M and 
   CHECK(meshes);  // the mesh arm's triangles went through the description too
 }
 
+// A data lab loads its model with the joint limits read, not held (puma_motion, puma_impedance): the
+// description, exported with them held, gives the same mechanism without them.
+TEST_CASE("a description read as a data lab reads its model: the joint limits left out, as the file's load does") {
+  const std::string file = (kSource / "assets/models/puma560.urdf").string();
+  dyn::model_file::LoadOptions data;
+  data.joint_limits = false;
+  const dyn::model_file::LoadedModel held = dyn::app::loadWithLoops(file, ""), free = dyn::app::loadWithLoops(file, "", data);
+  REQUIRE(held.contacts.size() > free.contacts.size());
+  const dyn::model_file::LoadedModel d = dyn::app::readDescriptionText(dyn::app::descriptionText(held), "puma.json", data);
+  const json a = dyn::app::describeModel(free), b = dyn::app::describeModel(d);
+  CHECK(a["mechanism"] == b["mechanism"]);
+  CHECK(a["contacts"] == b["contacts"]);
+  CHECK(a["notes"].size() == b["notes"].size());
+}
+
 TEST_CASE("every model file: dynlab run of its description writes the file's trace bytes") {
   TempDir dir("model_description_runs");
   for (const fs::path& file : modelFiles()) {
