@@ -72,10 +72,12 @@ void readLoops(const JsonView& root, LoadedModel& m) {
     const JsonView x = co.at(i);
     x.onlyKeys({"name", "kind", "body", "link", "mu"});
     model_file::Contact c{name(x["name"]), x["kind"].oneOf({"rolling", "plane_contact", "joint_limit", "joint_coupling", "tendon_coupling"}),
-                          name(x["body"]), index(x["link"], -1, dof - 1), num(x["mu"], 0, 10)};
+                          name(x["body"]), index(x["link"], 0, dof - 1), num(x["mu"], 0, 10)};
     const ConstraintPtr<Spatial>& k = constraints[m.closures.size() + i];
     if (c.kind != k->kind()) x["kind"].fail("expected \"" + std::string(k->kind()) + "\", constraint " + std::to_string(m.closures.size() + i) + "'s kind");
-    if (c.kind == "joint_limit" && !(c.link >= 0 && m.joints[std::size_t(c.link)].limited)) x["link"].fail("expected the limited joint the stop is on");
+    if (c.link != k->attachment().b.index) x["link"].fail("expected " + std::to_string(k->attachment().b.index) + ", the body constraint " +
+                                                           std::to_string(m.closures.size() + i) + " acts on");
+    if (c.kind == "joint_limit" && !m.joints[std::size_t(c.link)].limited) x["link"].fail("expected the limited joint the stop is on");
     m.contacts.push_back(c);
   }
 }
@@ -162,7 +164,7 @@ void readDrawing(const JsonView& d, LoadedModel& m) {
   for (std::size_t i = 0, n = d["bones"].size(0, kMaxItems); i < n; ++i) {
     const JsonView x = d["bones"].at(i);
     x.onlyKeys({"link", "from", "to"});
-    m.drawing.bones.push_back({index(x["link"], -1, dof - 1), matrix<Vec3>(x["from"]), matrix<Vec3>(x["to"])});
+    m.drawing.bones.push_back({index(x["link"], 0, dof - 1), matrix<Vec3>(x["from"]), matrix<Vec3>(x["to"])});
   }
   m.drawing.notes = names(d["notes"]);
 }
