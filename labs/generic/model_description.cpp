@@ -32,6 +32,13 @@ void readJoints(const JsonView& j, LoadedModel& m) {
     jt.name = name(x["name"]), jt.body = name(x["body"]), jt.type = x["type"].oneOf({"hinge", "slide", "ball", "free"});
     jt.qpos = index(x["qpos"], 0, nq - 1), jt.limited = x["limited"].boolean(), jt.lower = num(x["lower"]), jt.upper = num(x["upper"]);
     if (jt.limited && !(jt.lower <= jt.upper)) x["upper"].fail("expected an upper limit ≥ the lower one");
+    // Its coordinate and kind are the tree body's (a ball's rates read the quaternion from q[qpos]).
+    const auto& body = m.mechanism.tree.bodies[std::size_t(i)];
+    if (jt.qpos != body.q_index) x["qpos"].fail("expected " + std::to_string(body.q_index) + ", the tree body's coordinate in q");
+    const JointType t = body.joint;
+    const bool fits = jt.type == "hinge" ? t == JointType::Revolute : jt.type == "slide" ? t == JointType::Prismatic
+                    : jt.type == "ball"  ? t == JointType::Ball      : t != JointType::Revolute;
+    if (!fits) x["type"].fail("expected the type of tree body " + std::to_string(i) + "'s joint");
     m.joints.push_back(jt);
   }
 }

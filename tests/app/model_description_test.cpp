@@ -145,6 +145,8 @@ TEST_CASE("hostile descriptions: one line naming the file, the JSON path and wha
       {"/q0", json::array({0.0}), "/mechanism/tree/bodies", "match /q0"},
       {"/coordinates", json::array({"a"}), "/coordinates", "expected one name per entry of /q0"},
       {"/joints/0/qpos", 40, "/joints/0/qpos", "expected an integer in [0, 3]"},
+      {"/joints/1/qpos", 3, "/joints/1/qpos", "expected 1, the tree body's coordinate"},
+      {"/joints/1/type", "slide", "/joints/1/type", "expected the type of tree body 1's joint"},
       {"/closures/0/kept/0", "up", "/closures/0/kept/0", "expected a row name"},
       {"/start/q", json::array({0.0, 0.0}), "/start/q", "expected an array of 4 elements"},
       {"/drawing/geoms/0/rgba/0", 7.0, "/drawing/geoms/0/rgba/0", "expected a number in [0, 1]"},
