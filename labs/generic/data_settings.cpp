@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "labs/generic/data_lab.h"
+#include "labs/generic/model_description.h"
 #include "labs/generic/reach.h"
 #include "labs/settings.h"
 #include "physics/closed_chain.h"
@@ -111,7 +112,7 @@ model_file::LoadedModel loadModel(const JsonView& mf, const std::string& folder,
   model_file::LoadOptions held = options;
   held.joint_limits = false;  // the controller keeps the arm inside its range: limits noted, not held
   try {
-    file = model_file::load(checkedModelPath(mf, folder), held);
+    file = app::loadModelOrDescription(checkedModelPath(mf, folder), held);
   } catch (const model_file::ModelFileError& e) {
     mf.fail(std::string("a model file dynlab reads (") + e.what() + ")");
   }

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "labs/generic/model_loops.h"
+#include "labs/generic/model_description.h"
 #include "labs/generic/model_run.h"
 #include "labs/model_scene.h"
 #include "physics/bullet/bullet_mechanism.h"
@@ -158,7 +159,7 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, 
   auto m = std::make_shared<model_file::LoadedModel>();
   try {
     if (const std::string beside = loopsBeside(file); !beside.empty()) readBeside(beside, options);
-    *m = model_file::load(file, options);
+    *m = loadModelOrDescription(file, options);
   } catch (const model_file::ModelFileError& e) {
     throw InputError(file, "/", std::string("a model file dynlab reads (") + e.what() + ")");
   }
@@ -218,7 +219,7 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, 
 bool isModelFile(const std::string& name) {
   std::string ext = std::filesystem::path(name).extension().string();
   for (char& c : ext) c = char(std::tolower(static_cast<unsigned char>(c)));
-  return ext == ".xml" || ext == ".urdf";
+  return ext == ".xml" || ext == ".urdf" || isDescription(name);
 }
 
 }  // namespace dyn::app

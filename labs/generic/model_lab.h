@@ -22,7 +22,8 @@ struct ModelFileFlags {
   std::string key;                         // a keyframe of the file to start from (its qpos, qvel, ctrl)
 };
 
-// True when LAB names a model file (ends in .xml or .urdf, any case): no lab's name does.
+// True when LAB names a model file (ends in .xml or .urdf, any case) or its description (.json:
+// model_description.h): no lab's name does.
 bool isModelFile(const std::string& name);
 
 // The model file as a lab, passive, for `duration` s (default 2 s), with the closures, wheels and

@@ -10,6 +10,8 @@
 #include <set>
 #include <sstream>
 
+#include "labs/generic/model_description.h"
+
 namespace dyn::app {
 namespace {
 
@@ -193,7 +195,7 @@ std::string loopsBeside(const std::string& model) {
 model_file::LoadedModel loadWithLoops(const std::string& model, const std::string& loops, model_file::LoadOptions options) {
   const std::string given = loops.empty() ? loopsBeside(model) : loops;
   if (!given.empty()) readBeside(given, options);
-  model_file::LoadedModel m = model_file::load(model, options);
+  model_file::LoadedModel m = loadModelOrDescription(model, options);
   if (!given.empty())
     m.notes.push_back((options.rolling.empty() && options.contacts.empty() ? "loop closures from " : "closures, rolling wheels and contacts from ") + given);
   return m;

@@ -8,7 +8,8 @@ namespace {
 
 [[noreturn]] void refuse(const std::string& path) {
   throw ModelFileError(path + ": this dynlab was built without MuJoCo's parser (configured with -DDYNLAB_WITH_MUJOCO=OFF), "
-                              "so it reads no MJCF/URDF file; build it where libmujoco-dev is installed");
+                              "so it reads no MJCF/URDF file; build it where libmujoco-dev is installed, or give it the file's description "
+                              "(a .json: `dynlab model FILE --export FILE.json` with a dynlab that has MuJoCo)");
 }
 
 }  // namespace

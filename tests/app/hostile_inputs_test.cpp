@@ -1,6 +1,7 @@
 // Hostile input through the real binary: a corpus built per test (UTF-16, Latin-1, cut UTF-8, a
 // NUL, duplicate keys, a FIFO, a directory, a symlink to /etc/passwd, 20 MB, deep nesting, an empty
-// file, odd file names) given to grade, grade --replay, run --gains/--config and figure --gains.
+// file, odd file names) given to grade, grade --replay, run --gains/--config, figure --gains and, as a
+// model description, to run.
 // Every case runs under a 20 s timeout (a hang is a kill, a failure here), and must give exit 2,
 // one line of valid UTF-8 on stderr naming the file and what was wrong, nothing written by
 // run/figure, and for grade a results.json that `dynlab check-results` accepts with score 0.
@@ -121,6 +122,24 @@ TEST_CASE("hostile files given to run --gains/--config and figure --gains: exit 
       CHECK_FALSE(fs::exists(dir / "out"));
     }
   }
+}
+
+// The same corpus named where a model file goes (a description: labs/generic/model_description.h):
+// `dynlab run FILE.json` reads it as one, and refuses each in one line naming it.
+TEST_CASE("hostile files given as a model description to run: exit 2, one line, nothing written") {
+  TempDir dir("hostile_description");
+  for (const Hostile& h : buildCorpus(dir)) {
+    INFO("dynlab run ", h.shown, " --duration 0.2");
+    // (after "--": a name that starts with a dash is the file's)
+    const Result r = timedDynlab(dir, {"run", "--duration", "0.2", "--out", "out", "--", h.name});
+    // A description may be larger than a submission (64 MB: meshes): 20 MB is read, and is not one.
+    checkMessage(r, h.name == "big.json" ? Hostile{h.name, h.shown, {"/: ", "missing key \"format\""}} : h, h.shown);
+    CHECK(r.out.empty());
+    CHECK_FALSE(fs::exists(dir / "out"));
+  }
+  writeFile(dir / "huge.json", R"({"format": ")" + std::string(65u << 20, 'x') + "\"}");
+  const Result r = timedDynlab(dir, {"run", "huge.json", "--out", "out"});
+  checkMessage(r, {"huge.json", "huge.json", {"expected at most", "bytes"}}, "huge.json");
 }
 
 TEST_CASE("hostile submissions graded: exit 2, a valid results.json with score 0 and the message; replay agrees") {

@@ -1,10 +1,11 @@
-// The same grade in WebAssembly as natively (issues 46 and 42): every shipped example of every lab
-// with C++ code, noisy scenarios included, graded by the native `dynlab grade --no-plots` and by the
+// The same grade in WebAssembly as natively (issues 46 and 42): every shipped example of every lab,
+// noisy scenarios included, graded by the native `dynlab grade --no-plots` and by the
 // core compiled with emscripten (build/web/dynlab-grade.js, run by node), gives the same results.json
 // bytes but execution_time. results.json carries each scenario's trace_hash and the fingerprint's
-// trajectory_hash, so the traces are compared too. The model-file labs need MuJoCo's parser, which the
-// web build leaves out: the wasm grader refuses them in one line (until issue 42 item 4's exported
-// descriptions). Skipped (DYNLAB_TEST_SKIPPED) when scripts/web has not been run or node is missing.
+// trajectory_hash, so the traces are compared too. The model-file labs (fivebar, puma_motion,
+// puma_impedance) too: the web build has no MuJoCo parser and reads their models' descriptions, which
+// scripts/web exports with the native dynlab (docs/model_descriptions.md). Skipped (DYNLAB_TEST_SKIPPED)
+// when scripts/web has not been run or node is missing.
 #include <doctest/doctest.h>
 
 #include <iostream>
@@ -75,26 +76,38 @@ void checkLab(const std::string& lab) {
 
 }  // namespace
 
-// The six labs with C++ code (a difference is a failed check, never the end of the loop).
-TEST_CASE("every C++ lab: the same results.json in WebAssembly") {
+// All nine labs: the six with C++ code and the three model-file labs, whose models the wasm grader reads
+// from the descriptions scripts/web exported (a difference is a failed check, never the end of the loop).
+TEST_CASE("every lab: the same results.json in WebAssembly") {
   if (skipped()) return;
-  for (const std::string lab : {"slider_crank", "pen_on_table", "unicycle", "grasp", "impedance", "motion_control"}) {
+  for (const std::string lab : {"slider_crank", "pen_on_table", "unicycle", "grasp", "impedance", "motion_control", "fivebar", "puma_motion",
+                                "puma_impedance"}) {
     CAPTURE(lab);
     checkLab(lab);
   }
 }
 
-// fivebar, puma_motion, puma_impedance are a JSON and a model file: without MuJoCo's parser the wasm
-// grader refuses them as the native build without MuJoCo does, in one line naming the lab's model
-// file, exit 3 (the lab's file, not the submission, cannot be read: an internal error).
-TEST_CASE("model-file labs: refused in one line by the web grader") {
+// A lab whose model file has no exported description (a copy of fivebar under DYNLAB_HOME naming its
+// model by another name): the wasm grader has no MuJoCo parser, and refuses it in one line saying how to
+// export it, exit 3 (the lab's file, not the submission, cannot be read: an internal error).
+TEST_CASE("a model file without a description: refused in one line by the web grader, saying how to export it") {
   if (skipped()) return;
   TempDir dir("web_same_grade_models");
-  for (const std::string lab : {"fivebar", "puma_motion", "puma_impedance"}) {
-    CAPTURE(lab);
-    const Result web = webGrade(dir, lab, labExamples(lab).front());
-    CHECK(web.code == 3);
-    CHECK(std::count(web.err.begin(), web.err.end(), '\n') == 1);
-    CHECK(web.err.find("without MuJoCo's parser") != std::string::npos);
-  }
+  const fs::path home = dir / "home", lab = home / "labs" / "fivebar";
+  fs::create_directories(lab.parent_path());
+  fs::copy(fs::path(DYNLAB_SOURCE_DIR) / "labs" / "fivebar", lab, fs::copy_options::recursive);
+  fs::rename(lab / "fivebar.xml", lab / "other_fivebar.xml");
+  std::string config = readFile(lab / "fivebar.json");
+  const std::string named = "\"model_file\": \"fivebar.xml\"";
+  REQUIRE(config.find(named) != std::string::npos);
+  config.replace(config.find(named), named.size(), "\"model_file\": \"other_fivebar.xml\"");
+  writeFile(lab / "fivebar.json", config);
+  ProcessOptions o = withEnv({{"DYNLAB_HOME", home.string()}});
+  o.timeout_s = 600;
+  const Result web = run(dir, {"node", kGrader.string(), "fivebar", labExamples("fivebar").front().string()}, o);
+  CAPTURE(web.err);
+  CHECK(web.code == 3);
+  CHECK(std::count(web.err.begin(), web.err.end(), '\n') == 1);
+  CHECK(web.err.find("other_fivebar.xml: not a dynlab model description") != std::string::npos);
+  CHECK(web.err.find("--export") != std::string::npos);
 }

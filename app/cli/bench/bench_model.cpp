@@ -144,7 +144,7 @@ void build(const model_file::LoadedModel& m, double dt, bool beside, Engines& e)
     e.list.push_back(handWithElements(m, "RK4 + projection", &e.rk4_el, &e.q_rk4, &e.v_rk4, rk4));
   }
   addBullet(m, dt, e);
-  if (beside) return;  // MuJoCo's run of the file would not hold what is beside it
+  if (beside || !m.compiled) return;  // MuJoCo's run of the file would not hold what is beside it; a description holds no MuJoCo model
   e.mujoco = std::make_unique<model_file::MujocoSimulation>(m, dt);
   model_file::MujocoSimulation* mj = e.mujoco.get();
   mj->reset(q0, v0);

@@ -15,6 +15,8 @@
 
 #include "app/cli/commands.h"
 #include "app/cli/isolated_draw.h"
+#include "labs/file_write.h"
+#include "labs/generic/model_description.h"
 #include "labs/generic/model_loops.h"
 #include "labs/generic/model_run.h"
 #include "labs/generic/data_lab.h"
@@ -150,7 +152,7 @@ std::string crossCheck(const model_file::LoadedModel& m, ConstrainedMechanism<Sp
 // MuJoCo's own measure of the file's loops along a run's trace (MujocoReference::closure at each row's q):
 // the closure checked by the other engine's kinematics, not dynlab's. "" without a connect or weld in the file.
 std::string mujocoClosure(const model_file::LoadedModel& m, const ModelRun& r) {
-  if (m.closures.empty() || r.trace.rows() == 0) return "";
+  if (m.closures.empty() || r.trace.rows() == 0 || !m.compiled) return "";  // a description has no MuJoCo model
   model_file::MujocoReference mj(m);
   const Eigen::Index nq = m.q0.size();
   double gap = -1;
@@ -225,6 +227,28 @@ std::string report(const ModelRun& r, const std::string& engine, const model_fil
   return o.str();
 }
 
+// --export: the description, read back before it is written (every field must come back to the same
+// text: the same bits), then written whole (file_write.h). 0, or 2 after one line on stderr.
+int exportDescription(const model_file::LoadedModel& m, const std::string& path) {
+  std::string text;
+  try {
+    text = descriptionText(m);
+    model_file::LoadedModel back = readDescriptionText(text, path);
+    back.file = m.file;  // (the source's name the description records)
+    if (descriptionText(back) != text)
+      throw std::runtime_error("the description does not read back to the same numbers (a dynlab bug: please report it)");
+    writeFileChecked(path, text);
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s: --export %s: %s\n", nameShown(m.file).c_str(), nameShown(path).c_str(), shownLine(e.what()).c_str());
+    return 2;
+  }
+  std::printf("wrote %s: dynlab's description of %s (%d tree bodies, %zu constraints, %zu geoms; format version %d)\n", nameShown(path).c_str(),
+              nameShown(m.file).c_str(), m.mechanism.tree.dof(), m.mechanism.constraints.size(), m.drawing.geoms.size(), kDescriptionVersion);
+  return 0;
+}
+
 // The step the run takes: --dt, else the file's own <option timestep> within --dt's bounds; 0 after
 // one line on stderr.
 double runStep(const ModelArgs& args, const model_file::LoadedModel& m) {
@@ -252,6 +276,8 @@ ModelCommand::ModelCommand(CLI::App& cli) {
       ->allow_extra_args(false);
   command_->add_option("--loops", a.loops, "Loop closures beside the file (JSON; default: STEM.loops.json beside FILE when it exists)");
   addModelFileOptions(command_, a.files);
+  command_->add_option("--export", a.export_to, "Write dynlab's own description of the file to DESC.json (read without MuJoCo, the "
+                                               "same runs bit for bit: docs/model_descriptions.md) and run nothing");
   command_->add_flag("--video", a.video, "Write video.mp4 of the run drawn from the file's geoms (H.264, 30 fps; the Bullet run as a ghost)");
   command_->add_flag("--frames", a.frames, "Write frames/NNNNN.png (30 fps)");
 }
@@ -282,7 +308,7 @@ int runModelFile(const RunArgs& r) {
       return 2;
     }
   ModelArgs a{.file = r.lab, .out = r.out, .engine = r.engine, .loops = r.loops, .files = r.model_files,
-              .video = r.video, .frames = r.frames, .torques = r.torques};
+              .video = r.video, .frames = r.frames, .torques = r.torques, .export_to = ""};
   if (r.dt) {
     if (!(*r.dt >= kMinDt && *r.dt <= kMaxDt)) {
       std::fprintf(stderr, "error: <command line>: --dt: expected a step in [%g, %g] s for a model file, got %s\n", kMinDt, kMaxDt,
@@ -324,6 +350,7 @@ int model(const ModelArgs& asked) {
     std::fprintf(stderr, "error: %s\n", shownLine(e.what()).c_str());
     return 2;
   }
+  if (!args.export_to.empty()) return exportDescription(m, args.export_to);
   if ((args.dt = runStep(args, m)) == 0) return 2;
   if (const std::string problem = runBoundProblem(args.dt, args.duration, modelColumns(m).columns.size()); !problem.empty())
     return refuse("--duration", problem);
@@ -349,7 +376,8 @@ int model(const ModelArgs& asked) {
     tau[it - names.begin()] = value;
   }
   ConstrainedMechanism<Spatial> mech(m.mechanism);
-  std::string text = describe(m) + crossCheck(m, mech);
+  // A description holds no MuJoCo model to check against.
+  std::string text = describe(m) + (m.compiled ? crossCheck(m, mech) : "  against MuJoCo: not checked (a description: no MuJoCo model in it)\n");
   text += stepNotes(m, mech, args.dt);
   const bool hand = args.engine != "bullet", bullet = args.engine != "hand";
   ModelRun h, b;

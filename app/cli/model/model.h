@@ -8,7 +8,8 @@
 // With dynlab's own elements beside the file (STEM.loops.json: rolling wheels, plane contacts) the hand
 // engine steps as the labs do (contacts closed and opened, touchdowns located) and the trace names each
 // element's forces (normal, tangential or wheel-axes components), gap or slip, and the touchdowns' energy.
-// `dynlab run FILE.xml|FILE.urdf` (a model file where a lab name goes) is the same command.
+// `dynlab run FILE.xml|FILE.urdf` (a model file where a lab name goes) is the same command. FILE may be a
+// description (DESC.json) that `dynlab model FILE --export DESC.json` wrote: read without MuJoCo, the same runs.
 // Registered on the command line by ModelCommand, so main.cpp only constructs it and asks it to run.
 #pragma once
 #include <CLI/CLI.hpp>
@@ -32,6 +33,7 @@ struct ModelArgs {
   ModelFileFlags files;   // --ignore-contacts, --package-path, --key
   bool video = false, frames = false;  // 30 frames per second of simulated time, 640×480
   std::vector<std::string> torques;    // "JOINT=VALUE": constant torques (N·m; N on a slide); none: passive
+  std::string export_to;  // --export DESC.json: write the description (labs/generic/model_description.h) and run nothing
 };
 
 // --ignore-contacts, --key NAME and --package-path DIR (repeatable) on a command that reads model files (model, run,
