@@ -307,7 +307,8 @@ TEST_CASE("a free 100-link chain conserves energy under RK4 + ABA, converging at
 }
 
 TEST_CASE("VecIn views vectors in place and evaluates expressions (on the stack up to kMaxDof)") {
-  Eigen::VectorXd big = Eigen::VectorXd::LinSpaced(40, 0, 1);
+  const int m = kMaxDof + 16;  // longer than the stack buffer: evaluated on the heap
+  Eigen::VectorXd big = Eigen::VectorXd::LinSpaced(m, 0, 1);
   const VecIn whole(big);
   CHECK(whole.data() == big.data());
   const VecIn head(big.head(10));
@@ -318,12 +319,13 @@ TEST_CASE("VecIn views vectors in place and evaluates expressions (on the stack 
   CHECK(expr.size() == 5);
   CHECK(expr[4] == 2.0);
   const VecIn large(2 * big);
-  CHECK(large.size() == 40);
-  CHECK(large[39] == 2.0);
+  CHECK(large.size() == m);
+  CHECK(large[m - 1] == 2.0);
   // pointJacobian's J (a MatN) cannot hold more than kMaxDof columns: it says so.
-  const TreeModel<Planar> chain = uniformPlanarChain(30, 0.1, 1.0);
+  const int n = kMaxDof + 6;
+  const TreeModel<Planar> chain = uniformPlanarChain(n, 0.1, 1.0);
   TreeData<Planar> data(chain);
-  positionKinematics(chain, Eigen::VectorXd::Zero(30), data);
+  positionKinematics(chain, Eigen::VectorXd::Zero(n), data);
   MatN J;
-  CHECK_THROWS_AS(pointJacobian(chain, data, 29, Planar::Pos(0.1, 0.0), J), std::length_error);
+  CHECK_THROWS_AS(pointJacobian(chain, data, n - 1, Planar::Pos(0.1, 0.0), J), std::length_error);
 }
