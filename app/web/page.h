@@ -22,7 +22,7 @@ struct Page {
 Page& page();
 
 // Opens LAB (with the gains or submission file when given) as the page's session; "" or the one
-// line that says why not (a model-file lab without its exported description: "not yet in the page").
+// line that says why not (e.g. a model-file lab without its exported description).
 std::string openLab(const std::string& lab, const std::string& gains_file);
 // Replaces the session (engines: both, the Bullet ghost drawn) and starts its run.
 void useSession(std::unique_ptr<ui::TuningSession> session);

@@ -25,14 +25,13 @@ std::string openLab(const std::string& lab, const std::string& gains_file) {
     useSession(std::make_unique<ui::TuningSession>(lab, "", gains_file));
     return "";
   } catch (const InputError& e) {
-    // A model-file lab: the page has no MuJoCo parser, it reads the file's exported description
-    // (issue 42 item 4) once the lab ships one.
-    if (e.path() == "/model_file") return lab + " is not yet in the page (its model file has no exported description here): " + e.what();
+    // The lab's model file (or its description) cannot be read here: the lab's fault, not the gains'.
+    if (e.path() == "/model_file") return lab + " cannot open in the page: " + e.what();
     return std::string("error: ") + e.what();
   } catch (const std::exception& e) {
-    // A model-file lab without its exported description (no MuJoCo in the page), or another lab
-    // that cannot run here: one line, the lab stays listed.
-    return lab + " is not yet in the page: " + e.what();
+    // A lab that cannot run here (e.g. a model file without its exported description: the page has no
+    // MuJoCo parser): one line, the lab stays listed.
+    return lab + " cannot open in the page: " + e.what();
   }
 }
 

@@ -4,7 +4,8 @@
 // the link (?lab=NAME&gains=…&grade=1) and starts the program with
 //   LAB [--size WxH] [--gains FILE] [--grade] [--bench] [--probe]
 // (FILE written into the page's memory file system first). What the page's buttons call (grade,
-// handout, upload) is in page_api.cpp.
+// handout, upload) is in page_api.cpp. The model-file labs read their models' exported descriptions
+// (/dynlab/models in dynlab.data, docs/web.md "Model descriptions").
 #include "app/web/page.h"
 
 #include <emscripten.h>
@@ -18,6 +19,7 @@
 #include <vector>
 
 #include "labs/generic/lab_folders.h"
+#include "labs/generic/model_description.h"
 #include "labs/utf8.h"
 
 namespace dyn::web {
@@ -149,6 +151,9 @@ int main(int argc, char** argv) {
     else if (args[i] == "--probe") p.probe = true;
   }
   generic::useLabsFolders({});
+  // The model-file labs (fivebar, puma_*): no MuJoCo parser here, their models' descriptions instead,
+  // exported by scripts/web and packed into dynlab.data (FOLDER/REL.json for the model file at /dynlab/REL).
+  app::setDescriptionsFolder("/dynlab/models");
   p.st.save_path = p.lab + "_gains.json";  // the memory file system's; offered as a download once written
   p.st.saved = [](const std::string& path) { offerDownload(path.c_str()); };
   p.load_error = openLab(p.lab, gains);

@@ -1,9 +1,11 @@
 // The page in a real browser (issue 42 items 3, 5, 7): build/web/index.html served locally and opened
 // in Debian's headless Chromium (SwiftShader WebGL 2) by tests/web/page_check.js (node: a static
-// server and the DevTools protocol on a pipe). For every lab with C++ code the canvas is not blank (the
-// page counts, inside its frame, the scene's pixels that differ from the background), and every
-// shipped example opened as ?lab=LAB&gains=<the file's JSON>&grade=1 prints one console line
-// "dynlab results.json: {...}" equal to the native `dynlab grade`'s results.json but execution_time.
+// server and the DevTools protocol on a pipe). For every lab — the six with C++ code and the three
+// model-file labs, whose models the page reads from the descriptions scripts/web packs into dynlab.data —
+// the canvas is not blank (the page counts, inside its frame, the scene's pixels that differ from the
+// background), and every shipped example opened as ?lab=LAB&gains=<the file's JSON>&grade=1 prints one
+// console line "dynlab results.json: {...}" equal to the native `dynlab grade`'s results.json but
+// execution_time.
 // Skipped (DYNLAB_TEST_SKIPPED) without node, Chromium or a current build/web (scripts/web).
 #include <doctest/doctest.h>
 
@@ -25,7 +27,8 @@ namespace {
 
 const fs::path kSite = fs::path(DYNLAB_SOURCE_DIR) / "build" / "web";
 const fs::path kCheck = fs::path(DYNLAB_SOURCE_DIR) / "tests" / "web" / "page_check.js";
-const char* const kCppLabs[] = {"slider_crank", "pen_on_table", "unicycle", "grasp", "impedance", "motion_control"};
+const char* const kLabs[] = {"slider_crank", "pen_on_table", "unicycle",    "grasp",         "impedance",
+                             "motion_control", "fivebar",   "puma_motion", "puma_impedance"};
 
 std::string chromium() {
   for (const char* name : {"chromium", "chromium-browser"})
@@ -101,18 +104,19 @@ json withoutTime(json results) {
 
 }  // namespace
 
-TEST_CASE("the page draws every C++ lab's mechanism in WebGL 2") {
+TEST_CASE("the page draws every lab's mechanism in WebGL 2, the model-file labs' too") {
   if (skipped()) return;
   TempDir dir("web_page_canvas");
   std::vector<std::string> queries;
-  for (const char* lab : kCppLabs) queries.push_back(std::string("?lab=") + lab + "&probe=1");
+  for (const char* lab : kLabs) queries.push_back(std::string("?lab=") + lab + "&probe=1");
   const auto pages = openPages(dir, queries);
-  for (const char* lab : kCppLabs) {
+  for (const char* lab : kLabs) {
     CAPTURE(lab);
     const json& page = pages.at(std::string("?lab=") + lab + "&probe=1");
     CAPTURE(page.dump());
     CHECK(page.at("exceptions").empty());
     CHECK(page.at("done").get<bool>());
+    CHECK(lineAfter(page, "dynlab page: ").empty());  // the lab opened (a model-file lab: its description read)
     // "LAB N of M scene pixels drawn (WxH canvas)": a blank canvas draws none.
     long drawn = 0, area = 0;
     const std::string probe = lineAfter(page, "dynlab canvas: ");
@@ -124,12 +128,12 @@ TEST_CASE("the page draws every C++ lab's mechanism in WebGL 2") {
   }
 }
 
-TEST_CASE("?lab=&gains=&grade=1 prints the native grade of every C++ lab's examples") {
+TEST_CASE("?lab=&gains=&grade=1 prints the native grade of every lab's examples") {
   if (skipped()) return;
   TempDir dir("web_page_grade");
   std::vector<std::pair<std::string, fs::path>> cases;
   std::vector<std::string> queries;
-  for (const char* lab : kCppLabs)
+  for (const char* lab : kLabs)
     for (const fs::path& ex : labExamples(lab)) {
       cases.emplace_back(lab, ex);
       queries.push_back(std::string("?lab=") + lab + "&gains=" + percentEncoded(readFile(ex)) + "&grade=1");
