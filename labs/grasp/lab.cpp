@@ -261,8 +261,8 @@ json GraspLab::metrics(const Trace& tr) const {
   const auto cone_margin = tr.col("cone_margin"), energy = tr.col("energy"), work = tr.col("work");
   const auto residual_col = tr.col("constraint_residual");
   const double e0 = tr.rows() ? tr.at(0, "energy") : 0;
-  std::vector<int> tau_cols;
-  for (int j = 1; j <= 2 * fingers(); ++j) tau_cols.push_back(tr.column("tau" + std::to_string(j)));
+  std::vector<Trace::Column> taus;
+  for (int j = 1; j <= 2 * fingers(); ++j) taus.push_back(tr.col("tau" + std::to_string(j)));
   for (std::size_t r = 0; r < tr.rows(); ++r) {
     const double ex = x_o[r] - x_d[r], ey = y_o[r] - y_d[r];
     ep.push_back(det::hypot(ex, ey));
@@ -270,7 +270,7 @@ json GraspLab::metrics(const Trace& tr) const {
     epsi.push_back(psi_o[r] - psi_d[r]);
     if (t_col[r] >= s_.settle_time) ef.push_back(f_int[r] - f_int_d[r]);
     if (cone_margin[r] < margin) margin = cone_margin[r], margin_t = t_col[r];
-    for (int c : tau_cols) tau_max = std::max(tau_max, std::abs(tr.data[r * tr.columns.size() + std::size_t(c)]));
+    for (const auto& tau : taus) tau_max = std::max(tau_max, std::abs(tau[r]));
     // Energy balance: E − E0 − ∫ (τ·θ' + push·v_o) dt (zero for exact dynamics).
     drift = std::max(drift, std::abs(energy[r] - e0 - work[r]));
     residual = std::max(residual, residual_col[r]);
