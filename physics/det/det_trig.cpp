@@ -55,7 +55,7 @@ int reduce(double x, double& y0, double& y1) {
     }
   }
   y1 = (r - y0) - w;
-  return int(std::fmod(fn, 4.0)) & 3;
+  return int(static_cast<long long>(fn) & 3);  // fn is an integer below 2^21: n mod 4 without a call to fmod
 }
 
 // sin(x + y) for |x + y| ≤ π/4, y a tail below ulp(x) (used when tail is set).
