@@ -282,6 +282,19 @@ void drawBand(const PlotBand& b, size_t budget) {
   }
 }
 
+// A noise-like (faint) series stroked as pieces of kPieceSegments segments that share their end
+// points. Cairo's scan converter keeps every edge of one path active over the rows it spans, so a
+// zigzag of ~600 segments across the whole frame cost it 20 ms, two thirds of its plot; in pieces it
+// costs ~3 ms and looks the same (the joins inside a piece are as before; between pieces, at 0.8 px,
+// the missing bevel is below a pixel).
+constexpr size_t kPieceSegments = 16;
+void strokeInPieces(const std::vector<PLFLT>& px, const std::vector<PLFLT>& py) {
+  for (size_t k = 0; k + 1 < px.size(); k += kPieceSegments) {
+    const size_t points = std::min(kPieceSegments + 1, px.size() - k);
+    plline(static_cast<PLINT>(points), px.data() + k, py.data() + k);
+  }
+}
+
 void drawSeries(const PlotSeries& s, bool faint, size_t budget, double scale) {
   plcol0(seriesColour(s.color, faint));
   pllsty(seriesStyle(s.style));
@@ -293,6 +306,8 @@ void drawSeries(const PlotSeries& s, bool faint, size_t budget, double scale) {
     for (auto& v : py) v = clampHuge(v);
     if (px.size() == 1) {
       plpoin(1, px.data(), py.data(), 17);  // an isolated finite sample: a dot
+    } else if (faint && s.style == PlotSeries::Style::Solid) {  // a dash pattern would restart per piece
+      strokeInPieces(px, py);
     } else {
       plline(static_cast<PLINT>(px.size()), px.data(), py.data());
     }
