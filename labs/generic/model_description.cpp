@@ -9,6 +9,7 @@
 #include "labs/generic/model_description_json.h"
 #include "labs/lab.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/model_file/closure_rows.h"
 #include "physics/model_file/number_text.h"
 
 namespace dyn::app {
@@ -237,6 +238,19 @@ LoadedModel readRoot(const JsonView& r, const std::string& file) {
   return m;
 }
 
+// The start must hold the loops, as a model file's keyframe must (controls.cpp): every row of every
+// closure, the dropped ones too, and their velocity form with the start's rates. An export always
+// does; an edited description that does not is refused here rather than stopping its first run.
+void checkStart(const std::string& file, const LoadedModel& m, ConstrainedMechanism<Spatial>& mech) {
+  if (m.closures.empty()) return;
+  if (const std::string why = model_file::EveryClosureRow(m).opened(m.start_q); !why.empty())
+    throw ModelFileError(file + ": /start/q: expected a pose that holds the model's loops (" + why + "); export the model file again");
+  if (m.contacts.empty())
+    if (const double gap = mech.residual(m.start_q, m.start_v); !(gap <= 1e-9))
+      throw ModelFileError(file + ": /start/v: expected rates that keep the loops closed (|G v| " + model_file::detail::numberText(gap) +
+                           "); export the model file again");
+}
+
 }  // namespace
 
 bool isDescription(const std::string& path) {
@@ -252,6 +266,7 @@ LoadedModel readDescriptionText(const std::string& text, const std::string& file
     applyOptions(file, options, m);
     // The engines' own checks (sizes, bodies named) before anything runs.
     ConstrainedMechanism<Spatial> check(m.mechanism);
+    checkStart(file, m, check);
     return m;
   } catch (const InputError& e) {
     throw ModelFileError(e.what());

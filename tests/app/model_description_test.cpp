@@ -149,6 +149,8 @@ TEST_CASE("hostile descriptions: one line naming the file, the JSON path and wha
       {"/joints/1/type", "slide", "/joints/1/type", "expected the type of tree body 1's joint"},
       {"/closures/0/kept/0", "up", "/closures/0/kept/0", "expected a row name"},
       {"/start/q", json::array({0.0, 0.0}), "/start/q", "expected an array of 4 elements"},
+      {"/start/q/0", 0.5, "/start/q", "expected a pose that holds the model's loops (loop closure"},
+      {"/start/v/0", 1.0, "/start/v", "expected rates that keep the loops closed"},
       {"/drawing/geoms/0/rgba/0", 7.0, "/drawing/geoms/0/rgba/0", "expected a number in [0, 1]"},
       {"/timestep", "1e999", "/", "expected valid JSON"},
       {"/dof", nullptr, "/", "missing key \"dof\"", true},
