@@ -1,10 +1,10 @@
 // Drawing a plot on a PLplot stream; see plot_draw.h.
 // Sized in pixels at 72 dpi, white background, light grid, Okabe–Ito colours. Layers, bottom to
-// top: hatched spans, faint (noisy) series, bands, solid series, dashed series, markers, frame.
-// The legend goes right of the frame when it is narrow, else below it: never over the data.
-// Every number PLplot sees is finite: the data are split into finite runs before drawing.
-// An x–y plot has no spans or markers (x is not time); equal aspect widens one range to the
-// frame's shape, then trims the frame so a unit is as long along x as along y.
+// top: hatched spans, faint (noisy) series, bands, solid series, dashed series, markers, frame; the
+// legend right of the frame when it is narrow, else below it: never over the data.
+// Every number PLplot sees is finite (the data are split into finite runs). An x–y plot has no
+// spans or markers (x is not time); equal aspect widens one range to the frame's shape, then trims
+// the frame so a unit is as long along x as along y.
 #include "grading/plot_draw.h"
 
 #include <plplot/plplot.h>
@@ -282,17 +282,10 @@ void drawBand(const PlotBand& b, size_t budget) {
   }
 }
 
-// A noise-like (faint) series stroked as pieces of kPieceSegments segments that share their end
-// points. Cairo's scan converter keeps every edge of one path active over the rows it spans, so a
-// zigzag of ~600 segments across the whole frame cost it 20 ms, two thirds of its plot; in pieces it
-// costs ~3 ms and looks the same (the joins inside a piece are as before; between pieces, at 0.8 px,
-// the missing bevel is below a pixel).
-constexpr size_t kPieceSegments = 16;
+// A noise-like series as pieces of 16 segments sharing end points: cairo keeps each edge of a path
+// active over the rows it spans, and one zigzag across the frame cost two thirds of its plot.
 void strokeInPieces(const std::vector<PLFLT>& px, const std::vector<PLFLT>& py) {
-  for (size_t k = 0; k + 1 < px.size(); k += kPieceSegments) {
-    const size_t points = std::min(kPieceSegments + 1, px.size() - k);
-    plline(static_cast<PLINT>(points), px.data() + k, py.data() + k);
-  }
+  for (size_t k = 0; k + 1 < px.size(); k += 16) plline(PLINT(std::min<size_t>(17, px.size() - k)), px.data() + k, py.data() + k);
 }
 
 void drawSeries(const PlotSeries& s, bool faint, size_t budget, double scale) {
@@ -302,8 +295,7 @@ void drawSeries(const PlotSeries& s, bool faint, size_t budget, double scale) {
   for (auto [b, e] : runs(s.x.size(), [&](size_t i) { return finitePoint(s, i); })) {
     std::vector<PLFLT> px, py;
     appendThinned(s.x, s.y, b, e, std::max<size_t>(4, budget * (e - b) / s.x.size()), px, py);
-    for (auto& v : px) v = clampHuge(v);
-    for (auto& v : py) v = clampHuge(v);
+    for (size_t i = 0; i < px.size(); ++i) px[i] = clampHuge(px[i]), py[i] = clampHuge(py[i]);
     if (px.size() == 1) {
       plpoin(1, px.data(), py.data(), 17);  // an isolated finite sample: a dot
     } else if (faint && s.style == PlotSeries::Style::Solid) {  // a dash pattern would restart per piece
