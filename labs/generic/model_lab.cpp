@@ -161,7 +161,10 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, 
     if (const std::string beside = loopsBeside(file); !beside.empty()) readBeside(beside, options);
     *m = loadModelOrDescription(file, options);
   } catch (const model_file::ModelFileError& e) {
-    throw InputError(file, "/", std::string("a model file dynlab reads (") + e.what() + ")");
+    // The loader's line starts with the file's name: said once.
+    std::string why = e.what();
+    if (why.rfind(file + ": ", 0) == 0) why.erase(0, file.size() + 2);
+    throw InputError(file, "/", "a model file dynlab reads (" + why + ")");
   }
   const std::filesystem::path path(file);
   const std::string stem = path.stem().string();
