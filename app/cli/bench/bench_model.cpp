@@ -33,6 +33,7 @@
 #include "physics/model_file/hand_engine.h"
 #include "physics/model_file/closure_rows.h"
 #include "physics/model_file/model_file.h"
+#include "physics/model_file/stiff_steps.h"
 
 namespace dyn::app {
 namespace {
@@ -246,6 +247,8 @@ int benchModel(const BenchArgs& a) {
   if (a.json) {
     json out = {{"model", m.file}, {"dt", dt}, {"steps_timed", a.steps}, {"closure_rows", rows}, {"accuracy_run_s", kAccuracyRun}};
     if (!beside.empty()) out["beside"] = {{"file", beside}, {"elements", m.contacts.size()}, {"note", mujoco_left_out}};
+    // Whole steps of dt here; model and run take this many per step on a stiff file (stiff_steps.h).
+    out["model_run_substeps"] = model_file::stiffSubsteps(model_file::fastestMode(m).rate, dt);
     for (std::size_t i = 0; i < list.size(); ++i) {
       const Ratio r = ratio(list[i].blocks, euler.blocks);
       out["engines"].push_back({{"engine", list[i].name},
@@ -266,6 +269,12 @@ int benchModel(const BenchArgs& a) {
   std::printf("%s: %d coordinates, %d closure rows%s, dt %g s (the file's), %s\n", termName(m.file).c_str(), int(m.q0.size()), rows,
               termText(elements).c_str(), dt, termName(start, 1000).c_str());
   for (const std::string& note : m.notes) std::printf("  note: %s\n", termName(note, 1000).c_str());
+  // A stiff file: the bench steps whole steps of dt, where model and run take sub-steps (stiff_steps.h).
+  const model_file::FastestMode fastest = model_file::fastestMode(m);
+  if (const int sub = model_file::stiffSubsteps(fastest.rate, dt); sub > 1)
+    std::printf("  note: every engine here takes whole steps of dt, without the %d sub-steps per step `dynlab model` and `run` take on this file "
+                "(|λ| dt %.3g, joint '%s'): their hand RK4 costs %d times the row below\n",
+                sub, fastest.rate * dt, termName(fastest.joint).c_str(), sub);
   if (!beside.empty()) std::printf("  %s\n", termName(mujoco_left_out, 1000).c_str());
   std::printf("  %d steps per engine timed in blocks of %d, in turn; ratios block by block: median (middle half)\n", int(euler.all.size()), kBlock);
   std::printf("  engine             µs/step   over hand, 1st order   max |φ|∞     max |q − q_ref|∞ over 2 s (ref: hand RK4)\n");
