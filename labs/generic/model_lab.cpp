@@ -32,9 +32,17 @@ class ReplaySimulation final : public Simulation {
   ReplaySimulation(const model_file::LoadedModel& m, Engine engine, double dt, double duration) {
     ConstrainedMechanism<Spatial> desc(m.mechanism);
     const VecN tau = VecN::Zero(desc.n());
-    run_ = engine == Engine::Bullet ? runBullet(m, desc, dt, duration, tau)
-           : m.contacts.empty()     ? runHand(m, desc, dt, duration, tau)
-                                    : runHandElements(m, desc, dt, duration, tau);
+    if (engine == Engine::Bullet) {
+      try {
+        run_ = runBullet(m, desc, dt, duration, tau);
+      } catch (const std::bad_alloc&) {
+        throw;
+      } catch (const std::exception& e) {  // a description the Bullet builder cannot model: the file's input, named
+        throw InputError(m.file, "/", std::string("a model Bullet can build (Bullet: ") + e.what() + ")");
+      }
+    } else {
+      run_ = m.contacts.empty() ? runHand(m, desc, dt, duration, tau) : runHandElements(m, desc, dt, duration, tau);
+    }
     const int n = desc.n();
     std::vector<Spatial::Vec> loads;
     for (std::size_t r = 0; r < run_.trace.rows(); ++r) {

@@ -59,6 +59,7 @@ struct Engines {
   std::unique_ptr<model_file::DrivenMechanismT<model_file::SixJoints>> euler_six, rk4_six;  // the same, six joints fixed
   std::string sizes;
   std::unique_ptr<bullet::BulletMechanism<Spatial>> bullet;
+  std::string bullet_left_out;  // why Bullet is not timed (a description its builder cannot model), or empty
   std::unique_ptr<model_file::MujocoSimulation> mujoco;
   VecN q_euler, v_euler, q_rk4, v_rk4;
   std::vector<Engine> list;
@@ -144,7 +145,13 @@ void build(const model_file::LoadedModel& m, double dt, bool beside, Engines& e)
     e.list.push_back(handWithElements(m, "semi-implicit Euler + Baumgarte", &e.euler_el, &e.q_euler, &e.v_euler, euler));
     e.list.push_back(handWithElements(m, "RK4 + projection", &e.rk4_el, &e.q_rk4, &e.v_rk4, rk4));
   }
-  addBullet(m, dt, e);
+  try {
+    addBullet(m, dt, e);
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& x) {  // a description the Bullet builder cannot model: the others are timed
+    e.bullet_left_out = x.what();
+  }
   if (beside || !m.compiled) return;  // MuJoCo's run of the file would not hold what is beside it; a description holds no MuJoCo model
   e.mujoco = std::make_unique<model_file::MujocoSimulation>(m, dt);
   model_file::MujocoSimulation* mj = e.mujoco.get();
@@ -247,6 +254,7 @@ int benchModel(const BenchArgs& a) {
   if (a.json) {
     json out = {{"model", m.file}, {"dt", dt}, {"steps_timed", a.steps}, {"closure_rows", rows}, {"accuracy_run_s", kAccuracyRun}};
     if (!beside.empty()) out["beside"] = {{"file", beside}, {"elements", m.contacts.size()}, {"note", mujoco_left_out}};
+    if (!engines.bullet_left_out.empty()) out["bullet_left_out"] = engines.bullet_left_out;
     // Whole steps of dt here; model and run take this many per step on a stiff file (stiff_steps.h).
     out["model_run_substeps"] = model_file::stiffSubsteps(model_file::fastestMode(m).rate, dt);
     for (std::size_t i = 0; i < list.size(); ++i) {
@@ -269,6 +277,7 @@ int benchModel(const BenchArgs& a) {
   std::printf("%s: %d coordinates, %d closure rows%s, dt %g s (the file's), %s\n", termName(m.file).c_str(), int(m.q0.size()), rows,
               termText(elements).c_str(), dt, termName(start, 1000).c_str());
   for (const std::string& note : m.notes) std::printf("  note: %s\n", termName(note, 1000).c_str());
+  if (!engines.bullet_left_out.empty()) std::printf("  note: Bullet not timed: %s\n", termName(engines.bullet_left_out, 1000).c_str());
   // A stiff file: the bench steps whole steps of dt, where model and run take sub-steps (stiff_steps.h).
   const model_file::FastestMode fastest = model_file::fastestMode(m);
   if (const int sub = model_file::stiffSubsteps(fastest.rate, dt); sub > 1)
