@@ -7,6 +7,7 @@
 #include <doctest/doctest.h>
 #include <stdlib.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -108,4 +109,16 @@ TEST_CASE("a URDF's visual and collision meshes of one file name: the collision'
   CHECK(has(kept, "another file named 'body.stl' is named too (MuJoCo finds files by name alone: rename one)"));
   CHECK(kept.find('\n') == std::string::npos);
   fs::remove_all(folder() / "twin");
+}
+
+TEST_CASE("a URDF's <mimic> is said to be not held, with the way to hold it") {
+  std::string u = meshArmUrdf("meshes/collision/body.stl");
+  write("mimic/meshes/collision/body.stl", tetrahedronStl(0.1f));
+  u.insert(u.find("</joint>"), "<mimic joint=\"j0\"/>");
+  const model_file::LoadedModel m = model_file::load(write("mimic/arm.urdf", u).string());
+  const auto note = std::find_if(m.notes.begin(), m.notes.end(), [](const std::string& n) { return has(n, "URDF <mimic> element(s) not held"); });
+  REQUIRE(note != m.notes.end());
+  CHECK(has(*note, "1 URDF <mimic>"));
+  CHECK(has(*note, "<equality><joint joint1 joint2 polycoef"));
+  fs::remove_all(folder() / "mimic");
 }
