@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "tests/app/cli_run.h"
 #include "tests/physics/model_file/mesh_files.h"
 
@@ -98,6 +100,15 @@ TEST_CASE("a gripper whose fingers a fixed tendon couples, with joint limits, ru
   const TempDir dir("model_kinds_tendon");
   runsEverywhere(dir, testModel("tendon_gripper.xml"), "q_wrist");
   CHECK(has(readFile(dir / "o_model/summary.txt"), "1 btMultiBodyGearConstraint joint coupling(s)"));
+  // bench --json gives each engine's residual at the positions beside the one with the rows' rates.
+  const Result j = dynlab(dir, {"bench", testModel("tendon_gripper.xml"), "--steps", "100", "--json"});
+  REQUIRE(j.code == 0);
+  const auto out = nlohmann::json::parse(j.out);
+  REQUIRE(out["engines"].size() >= 3);
+  for (const auto& e : out["engines"]) {
+    INFO(e.dump());
+    CHECK(e["max_position_residual"].get<double>() <= e["max_closure_residual"].get<double>());
+  }
 }
 
 TEST_CASE("an arm on a slider with stops runs on every command") {
