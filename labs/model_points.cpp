@@ -110,7 +110,8 @@ void ModelPicture::shapePoints(const VecN& q, std::vector<Vec3>& out) const {
   for (const auto& [link, points] : local_points_)
     for (const Vec3& p : points) out.push_back(point(link, p));
   for (const auto& b : model_.drawing.bones) ball(point(b.link, b.from), rod_radius_, out), ball(point(b.link, b.to), rod_radius_, out);
-  for (const auto& X : data_.X_world) ball(X.r, joint_radius_, out);
+  for (std::size_t i = 0; i < data_.X_world.size(); ++i)
+    if (marked(i)) ball(data_.X_world[i].r, joint_radius_, out);
 }
 
 std::vector<Vec3> runPoints(const ModelPicture& picture, int n, const Trace& trace, const Trace* ghost) {
@@ -118,15 +119,18 @@ std::vector<Vec3> runPoints(const ModelPicture& picture, int n, const Trace& tra
   // The farthest points from the start's centre along 218 directions, over the rows runBounds takes:
   // the fit may miss the outline by a few per cent of the robot's size, inside the frame's margin.
   static const Points dirs = directions(3);
+  // A picture that follows its floating base: the points about the base (ModelPicture::follows).
   Points row;
-  picture.shapePoints(traceQ(trace, 0, n), row);
+  const VecN q0 = traceQ(trace, 0, n);
+  picture.shapePoints(q0, row);
   Eigen::AlignedBox3d start;
-  for (const Vec3& p : row) start.extend(p);
+  for (const Vec3& p : row) start.extend(picture.follows() ? Vec3(p - picture.base(q0)) : p);
   Farthest far(dirs, start.center());
   forBoundsRows(trace, ghost, [&](const Trace& run, std::size_t r) {
     row.clear();
-    picture.shapePoints(traceQ(run, r, n), row);
-    for (const Vec3& p : row) far.add(p);
+    const VecN q = traceQ(run, r, n);
+    picture.shapePoints(q, row);
+    for (const Vec3& p : row) far.add(picture.follows() ? Vec3(p - picture.base(q)) : p);
   });
   return far.points();
 }

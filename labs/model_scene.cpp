@@ -62,6 +62,11 @@ void extendShape(Box3& box, const Vec3& c, const Mat3& R, const model_file::Geom
 
 ModelPicture::ModelPicture(const model_file::LoadedModel& model) : model_(model), data_(model.mechanism.tree) {
   const auto& tree = model.mechanism.tree;
+  for (const auto& j : model.joints)
+    if (j.type == "free") {
+      base_qpos_ = j.qpos;
+      break;
+    }
   // Up against gravity (world z without it).
   const Vec3 g = tree.gravity.tail<3>();
   up_ = g.norm() > 1e-9 ? Vec3(-g.normalized()) : Vec3::UnitZ();
@@ -100,6 +105,12 @@ bool ModelPicture::groundPivot(std::size_t i) const {
   return b.parent < 0 && b.joint == JointType::Revolute;
 }
 
+// A free joint's three slides carry its body from the world's origin: their frames are no joints the
+// robot has (left behind as it falls), so no ball marks them.
+bool ModelPicture::marked(std::size_t i) const {
+  return !(i < model_.joints.size() && model_.joints[i].type == "free" && model_.mechanism.tree.bodies[i].joint == JointType::Prismatic);
+}
+
 void ModelPicture::place(const VecN& q) const { worldKinematics(model_.mechanism.tree, q, data_); }
 
 Vec3 ModelPicture::point(int link, const Vec3& p) const {
@@ -119,7 +130,9 @@ std::vector<Vec3> ModelPicture::anchors(const VecN& q) const {
 
 Box3 ModelPicture::bounds(const VecN& q) const {
   Box3 box, fixed;
-  for (const Vec3& p : anchors(q)) extend(box, p, joint_radius_);  // anchors() placed the frames at q
+  const std::vector<Vec3> at = anchors(q);  // (placed the frames at q)
+  for (std::size_t i = 0; i < at.size(); ++i)
+    if (marked(i)) extend(box, at[i], joint_radius_);
   for (const auto& g : model_.drawing.geoms)
     if (g.shape != Shape::Plane) extendShape(g.link < 0 ? fixed : box, point(g.link, g.pos), rotation(g.link) * g.rot, g);
   for (const auto& b : model_.drawing.bones) extend(box, point(b.link, b.to), rod_radius_);
@@ -165,12 +178,15 @@ void ModelPicture::drawBodies(bool ghost, Scene& s) const {
       if (groundPivot(i))
         s.boxes.push_back({data_.X_world[i].r - 1.2 * r * view.up - 1.2 * r * view.back, Vec3(1.7 * r, 0.9 * r, 0.5 * r), R, kWorld});
   }
-  for (const auto& X : data_.X_world) s.spheres.push_back({X.r, joint_radius_, kJoint});
+  for (std::size_t i = 0; i < data_.X_world.size(); ++i)
+    if (marked(i)) s.spheres.push_back({data_.X_world[i].r, joint_radius_, kJoint});
   for (const auto& c : model_.closures) s.spheres.push_back({point(c.link1, c.point1), 0.85 * joint_radius_, kClosure});
 }
 
+Vec3 ModelPicture::base(const VecN& q) const { return follows() ? Vec3(q.segment<3>(base_qpos_)) : Vec3(Vec3::Zero()); }
+
 void ModelPicture::scene(const VecN& q, const VecN* ghost, const Box3& frame, Scene& s, const std::vector<Vec3>& points) const {
-  const Box3 box = frame.isEmpty() ? bounds(q) : frame;
+  const Box3 box = frame.isEmpty() ? bounds(q) : follows() ? frame.translated(base(q)) : frame;
   // The camera's direction; the renderer fits the box beside the panel (Scene::framing).
   if (planar_) {
     Vec3 up = up_ - up_.dot(axis_) * axis_;
@@ -204,6 +220,8 @@ void ModelPicture::scene(const VecN& q, const VecN* ghost, const Box3& frame, Sc
   s.framing.fit = true;
   s.framing.bounds = box;
   s.framing.points = points;
+  if (follows() && !frame.isEmpty())
+    for (Vec3& p : s.framing.points) p += base(q);
   // Floors: under the framed box, about as large as it, slabs so a side-on view shows their edge.
   const double reach = box.isEmpty() ? 1.0 : 0.75 * box.diagonal().norm();
   for (const auto& g : model_.drawing.geoms) {
@@ -271,7 +289,10 @@ VecN traceQ(const Trace& trace, std::size_t row, int n) {
 
 Box3 runBounds(const ModelPicture& picture, int n, const Trace& trace, const Trace* ghost) {
   Box3 box;
-  forBoundsRows(trace, ghost, [&](const Trace& run, std::size_t r) { box.extend(picture.bounds(traceQ(run, r, n))); });
+  forBoundsRows(trace, ghost, [&](const Trace& run, std::size_t r) {
+    const VecN q = traceQ(run, r, n);
+    box.extend(picture.follows() ? picture.bounds(q).translated(-picture.base(q)) : picture.bounds(q));
+  });
   return box;
 }
 

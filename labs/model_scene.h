@@ -40,6 +40,12 @@ class ModelPicture {
   // after scene(). Nothing for a planar model (its ground mounts show where it is fixed) or one with a
   // floor of its own. A scene fitted to points gets the pedestal's among them, not the floor's.
   void stage(Scene& out) const;
+  // A floating base (the first free joint's body): the camera follows it, its frames framed by the space
+  // the robot moves through about the base (runBounds, runPoints) placed at the base's position at each
+  // row, so a robot that falls or walks stays framed rather than a speck in the box of its whole path.
+  bool follows() const { return base_qpos_ >= 0; }
+  // The floating base's position at q (a free joint's x y z), else 0.
+  Eigen::Vector3d base(const VecN& q) const;
   // True when every hinge turns about one axis and every slide moves across it: drawn side-on.
   bool planar() const { return planar_; }
   // True when its frames are fitted to shapePoints: a spatial model drawing geoms of its own (a
@@ -52,6 +58,7 @@ class ModelPicture {
   Eigen::Matrix3d rotation(int link) const;
   void drawBodies(bool ghost, Scene& out) const;
   bool groundPivot(std::size_t link) const;  // a hinge on the world: drawn on a mount
+  bool marked(std::size_t link) const;       // its joint drawn as a ball: not a free joint's slide carrier
   void keepShapePoints();                     // local_points_, once (model_points.cpp)
 
   const model_file::LoadedModel& model_;
@@ -59,6 +66,7 @@ class ModelPicture {
   bool planar_ = false;
   Eigen::Vector3d axis_ = Eigen::Vector3d::UnitY(), up_ = Eigen::Vector3d::UnitZ();
   double joint_radius_ = 0.01, rod_radius_ = 0.005;
+  int base_qpos_ = -1;  // the followed free joint's x in q, or −1
   // Per drawn geom (floors aside) its link and the points shapePoints places, in the link's frame.
   std::vector<std::pair<int, std::vector<Eigen::Vector3d>>> local_points_;
 };
@@ -67,7 +75,8 @@ class ModelPicture {
 VecN traceQ(const Trace& trace, std::size_t row, int n);
 
 // The space a run moves through: the box of what is drawn over its rows (and the ghost's), so the
-// camera holds still from frame to frame, as in every lab.
+// camera holds still from frame to frame, as in every lab; for a picture that follows its floating
+// base, about the base (scene() places it there).
 Eigen::AlignedBox3d runBounds(const ModelPicture& picture, int n, const Trace& trace, const Trace* ghost);
 // The same space as points (shapePoints over the rows runBounds takes, thinned to those farthest along
 // 218 directions), for ModelPicture::scene; none unless the picture fitsPoints().

@@ -32,9 +32,17 @@ class ReplaySimulation final : public Simulation {
   ReplaySimulation(const model_file::LoadedModel& m, Engine engine, double dt, double duration) {
     ConstrainedMechanism<Spatial> desc(m.mechanism);
     const VecN tau = VecN::Zero(desc.n());
-    run_ = engine == Engine::Bullet ? runBullet(m, desc, dt, duration, tau)
-           : m.contacts.empty()     ? runHand(m, desc, dt, duration, tau)
-                                    : runHandElements(m, desc, dt, duration, tau);
+    if (engine == Engine::Bullet) {
+      try {
+        run_ = runBullet(m, desc, dt, duration, tau);
+      } catch (const std::bad_alloc&) {
+        throw;
+      } catch (const std::exception& e) {  // a description the Bullet builder cannot model: the file's input, named
+        throw InputError(m.file, "/", std::string("a model Bullet can build (Bullet: ") + e.what() + ")");
+      }
+    } else {
+      run_ = m.contacts.empty() ? runHand(m, desc, dt, duration, tau) : runHandElements(m, desc, dt, duration, tau);
+    }
     const int n = desc.n();
     std::vector<Spatial::Vec> loads;
     for (std::size_t r = 0; r < run_.trace.rows(); ++r) {
@@ -161,7 +169,10 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, 
     if (const std::string beside = loopsBeside(file); !beside.empty()) readBeside(beside, options);
     *m = loadModelOrDescription(file, options);
   } catch (const model_file::ModelFileError& e) {
-    throw InputError(file, "/", std::string("a model file dynlab reads (") + e.what() + ")");
+    // The loader's line starts with the file's name: said once.
+    std::string why = e.what();
+    if (why.rfind(file + ": ", 0) == 0) why.erase(0, file.size() + 2);
+    throw InputError(file, "/", "a model file dynlab reads (" + why + ")");
   }
   const std::filesystem::path path(file);
   const std::string stem = path.stem().string();

@@ -22,7 +22,7 @@ namespace {
 // at this state) and each closure's force on its kept rows, then the elements' columns; the run's
 // extremes follow.
 void record(ModelRun& run, ConstrainedMechanism<Spatial>& mech, double t, const VecN& q, const VecN& v, double work,
-            const std::vector<double>& forces, double phi) {
+            const std::vector<double>& forces, double phi, double phi_q) {
   const double e = mech.energy(q, v);
   if (run.trace.rows() == 0) run.e0 = e;
   std::vector<double> row{t};
@@ -32,6 +32,7 @@ void record(ModelRun& run, ConstrainedMechanism<Spatial>& mech, double t, const 
   row.insert(row.end(), forces.begin(), forces.end());
   run.trace.append(row);
   run.residual = std::max(run.residual, phi);
+  run.position_residual = std::max(run.position_residual, phi_q);
   run.balance = std::max(run.balance, std::abs(e - run.e0 - work));
   run.kinetic = std::max(run.kinetic, mech.kineticEnergy(q, v));
 }
@@ -51,9 +52,10 @@ bool stopIfOpened(ModelRun& run, model_file::EveryClosureRow& every, const VecN&
 // |φ|∞ of a model with dynlab's elements at a state: the closures' and wheels' rows, position and
 // velocity forms (a wheel's x, y rows have only the latter: its slip), and each contact's depth past
 // its plane (the description's mechanism, whose contacts stay open: their gaps are read, not held).
-double elementResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, const VecN& q, const VecN& v) {
-  double phi = desc.residual(q, v);
-  desc.stage(q);
+namespace {
+// The largest depth of a rigid contact or a joint stop past its bound at the state desc was staged at.
+double elementDepth(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc) {
+  double phi = 0;
   for (std::size_t i = 0; i < m.contacts.size(); ++i)
     if (const auto* pc = dynamic_cast<const PlaneContact<Spatial>*>(m.mechanism.constraints[m.closures.size() + i].get())) {
       if (!pc->compliant()) phi = std::max(phi, -pc->gap(desc.kinematics()));
@@ -62,9 +64,25 @@ double elementResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Sp
     }
   return phi;
 }
+}  // namespace
+
+double elementResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, const VecN& q, const VecN& v) {
+  const double phi = desc.residual(q, v);
+  desc.stage(q);
+  return std::max(phi, elementDepth(m, desc));
+}
 
 double runResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q, const VecN& v) {
   return std::max(m.contacts.empty() ? desc.residual(q) : elementResidual(m, desc, q, v), every.residual(q));
+}
+
+double runPositionResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q) {
+  double phi = desc.residual(q);
+  if (!m.contacts.empty()) {
+    desc.stage(q);
+    phi = std::max(phi, elementDepth(m, desc));
+  }
+  return std::max(phi, every.residual(q));
 }
 
 // The power the joints' damping and friction take out of the mechanism (≥ 0), by the description's
@@ -157,7 +175,7 @@ ModelRun runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>
     const auto s = mech.solve(q, v, tau + model_file::actuatorTorques(m, q, v));
     const Books b = engine->books();
     record(run, mech, k * dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()),
-           runResidual(m, mech, every, q, v));
+           runResidual(m, mech, every, q, v), runPositionResidual(m, mech, every, q));
     if (stopIfOpened(run, every, q) || k == steps) break;
     if (!(run.ok = step(*engine, o, tau, q, v) && q.allFinite() && v.allFinite())) break;
   }
@@ -225,7 +243,8 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
       const double P = stepped ? pc->normal().dot(Spatial::linear(engine.impactImpulse(int(closures + i)))) : 0.0;
       row.insert(row.end(), {r[1] + P / dt, 0.0, r[0]});
     }
-    record(run, desc, k * dt, q_row, v_row, b.work + b.friction - loss, row, runResidual(m, desc, every, q_row, v_row));
+    record(run, desc, k * dt, q_row, v_row, b.work + b.friction - loss, row, runResidual(m, desc, every, q_row, v_row),
+           runPositionResidual(m, desc, every, q_row));
     if (stopIfOpened(run, every, q_row) || k == steps || !run.ok) break;
   }
   return run;
@@ -239,8 +258,10 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
   const int steps = int(std::lround(duration / dt));
   VecN q = m.start_q, v = m.start_v;
   // Bullet's explicit dampers and springs need the sub-steps the hand engine takes (stiff_steps.h): the
-  // same h = dt / s for both, each of Bullet's a step of its own, the torques held over the row's step.
+  // same h = dt / s for both, each of Bullet's a step of its own, the torques (a servo's damping among
+  // them) evaluated at each sub-step's start and their work summed over the sub-steps (trapezoid rule).
   const int substeps = model_file::stiffSubsteps(model_file::fastestMode(m).rate, dt);
+  const double h = dt / substeps;
   bullet::BulletMechanism<Spatial> bt(m.mechanism, dt / substeps, q, v);
   run.summary = bt.describe() + (substeps > 1 ? ", " + std::to_string(substeps) + " steps of dt/" + std::to_string(substeps) + " per row" : "");
   const bool impacts = anyImpacts(m);
@@ -253,9 +274,17 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
   model_file::EveryClosureRow every(m);  // |φ| over every row (Bullet's drift is its own: reported, not stopped)
   for (int k = 0; k <= steps; ++k) {
     VecN qn = q, vn = v;
+    const double row_work = work;  // the books at the row; work and power run on through the sub-steps
     if (k < steps) {
-      const VecN held = driven(q, v);
-      for (int sub = 0; sub < substeps; ++sub) bt.step(held);
+      for (int sub = 0; sub < substeps; ++sub) {
+        if (sub > 0) {  // the sub-step's start: its torques, and the work of the one before
+          bt.state(qn, vn);
+          const double p = inflow(qn, vn);
+          work += 0.5 * (power + p) * h;
+          power = p;
+        }
+        bt.step(driven(qn, vn));
+      }
       bt.state(qn, vn);
       forces.clear();
       for (std::size_t c = 0; c < m.closures.size(); ++c)
@@ -283,11 +312,11 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
         }
       }
     }
-    record(run, mech, k * dt, q, v, work, forces, runResidual(m, mech, every, q, v));
+    record(run, mech, k * dt, q, v, row_work, forces, runResidual(m, mech, every, q, v), runPositionResidual(m, mech, every, q));
     if (k == steps) break;
     if (!(run.ok = qn.allFinite() && vn.allFinite())) break;
     const double p = inflow(qn, vn);
-    work += 0.5 * (power + p) * dt;
+    work += 0.5 * (power + p) * h;
     power = p;
     q = qn, v = vn;
   }

@@ -17,6 +17,7 @@ namespace dyn::app {
 struct ModelRun {
   Trace trace;
   double e0 = 0, residual = 0, balance = 0, kinetic = 0;  // E0, max |φ|∞ (every closure row), max |E − E0 − W|, max kinetic energy
+  double position_residual = 0;  // max |φ|∞ of the positions alone (residual less the velocity rows: a coupling's rate, a wheel's slip)
   bool ok = true;
   std::string summary;
   std::string stopped;  // why the run stopped early, when it says (a loop closure that opened)
@@ -36,6 +37,9 @@ bool anyImpacts(const model_file::LoadedModel& m);
 // dynlab's elements, elementResidual) and every closure row, the dropped ones too (closure_rows.h).
 double runResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q,
                    const VecN& v);
+
+// The same at the positions alone: the rows' φ, contacts' and joint stops' depths, every closure row (no velocity form).
+double runPositionResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q);
 
 // The power the joints' damping and friction take out of the mechanism (≥ 0), by the description's law.
 double frictionPower(const MechanismModel<Spatial>& d, const VecN& v);

@@ -6,7 +6,10 @@
 #include <BulletDynamics/Featherstone/btMultiBodyGearConstraint.h>
 #include <BulletDynamics/Featherstone/btMultiBodyJointLimitConstraint.h>
 
+#include <optional>
 #include <tuple>
+#include <utility>
+#include <vector>
 
 #include "physics/constraints/coupling.h"
 #include "physics/constraints/joint_limit.h"
@@ -15,6 +18,29 @@ namespace dyn::bullet {
 namespace {
 constexpr double kGearErp = 0.2;     // the coupling's position error pulled back per step (Bullet's m_erp)
 constexpr double kUnlimited = 1e30;  // a side the description does not limit
+
+// A coupling a gear holds: linear (c₂ = c₃ = c₄ = 0) in exactly two joints, whatever its forms (a joint
+// against a joint, or a fixed tendon over two joints held to its length): φ = α (θ_a − θ₀_a) + β (θ_b −
+// θ₀_b), so θ_a + (β/α) θ_b stays at its value at θ₀. The two joints and β/α; none when it is not so.
+struct GearForm {
+  int a = -1, b = -1;
+  double ratio = 0;
+};
+std::optional<GearForm> gearForm(const Coupling& c) {
+  const auto& p = c.poly();
+  if (p[2] != 0 || p[3] != 0 || p[4] != 0) return std::nullopt;
+  std::vector<std::pair<int, double>> coef;  // (joint, its coefficient in φ), in the forms' order
+  auto add = [&](int joint, double x) {
+    for (auto& [j, c] : coef)
+      if (j == joint) return void(c += x);
+    coef.emplace_back(joint, x);
+  };
+  for (const Coupling::Term& t : c.first()) add(t.joint, t.coef);
+  for (const Coupling::Term& t : c.second()) add(t.joint, -p[1] * t.coef);
+  std::erase_if(coef, [](const auto& jc) { return jc.second == 0; });
+  if (coef.size() != 2) return std::nullopt;
+  return GearForm{coef[0].first, coef[1].first, coef[1].second / coef[0].second};
+}
 }  // namespace
 
 bool JointConstraints::isJointKind(const Constraint<Spatial>& k) {
@@ -23,8 +49,8 @@ bool JointConstraints::isJointKind(const Constraint<Spatial>& k) {
 
 std::string JointConstraints::refusal(const Constraint<Spatial>& k) {
   const auto* c = dynamic_cast<const Coupling*>(&k);
-  if (!c || c->linearPair()) return {};
-  return std::string(k.kind()) + ": Bullet holds a linear coupling of two joints only (polycoef \"0 c1 0 0 0\" between <joint> elements); "
+  if (!c || gearForm(*c)) return {};
+  return std::string(k.kind()) + ": Bullet holds a linear coupling of two joints only (polycoef \"0 c1 0 0 0\" between two <joint>s, or a fixed tendon over two joints); "
          "it runs in the hand engine alone (--engine hand on model, run and figure)";
 }
 
@@ -45,13 +71,12 @@ void JointConstraints::add(btMultiBodyDynamicsWorld& world, btMultiBody& body, c
     limits_.push_back({jl->joint(), lower ? c : -1, lower ? -1 : c, made.get()});
   } else {
     const auto& cp = static_cast<const Coupling&>(k);
-    const Coupling::Term a = cp.first().front(), b = cp.second().front();
-    const double r = -cp.poly()[1] * b.coef / a.coef;
-    auto gear = std::make_unique<btMultiBodyGearConstraint>(&body, a.joint, &body, b.joint, btVector3(0, 0, 0), btVector3(0, 0, 0),
+    const GearForm g = *gearForm(cp);  // refusal() turned away the rest
+    auto gear = std::make_unique<btMultiBodyGearConstraint>(&body, g.a, &body, g.b, btVector3(0, 0, 0), btVector3(0, 0, 0),
                                                             btMatrix3x3::getIdentity(), btMatrix3x3::getIdentity());
-    gear->setGearRatio(r);
+    gear->setGearRatio(g.ratio);
     gear->setErp(kGearErp);
-    gear->setRelativePositionTarget(cp.reference()[a.joint] + r * cp.reference()[b.joint]);
+    gear->setRelativePositionTarget(cp.reference()[g.a] + g.ratio * cp.reference()[g.b]);
     made = std::move(gear);
     gears_.push_back({c, made.get()});
   }

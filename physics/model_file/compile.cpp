@@ -90,6 +90,14 @@ Compiled::~Compiled() {
   if (m) mj_deleteModel(m);
 }
 
+namespace {
+std::size_t countOf(const std::string& text, const std::string& what) {
+  std::size_t n = 0;
+  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
+  return n;
+}
+}  // namespace
+
 std::shared_ptr<const Compiled> compile(const std::string& path, std::string* warnings, const std::vector<std::string>& package_paths) {
   const std::string bytes = readChecked(path);
   const std::string name = std::filesystem::path(path).filename().string();
@@ -114,6 +122,11 @@ std::shared_ptr<const Compiled> compile(const std::string& path, std::string* wa
   MujocoGuard guard;
   MUJOCO_CALL(path, out->m = mj_loadModel("model.mjb", binary.get()));
   if (!out->m) throw ModelFileError(path + ": MuJoCo could not read back the model it compiled");
+  // A URDF's <mimic> (a finger following another, as Bullet's and ROS's Panda write it): MuJoCo 2.2.2's
+  // URDF reader drops it, so the joint moves on its own; said, with the way to hold it.
+  if (const std::size_t mimics = countOf(bytes, "<mimic"); mimics > 0)
+    out->notes.push_back(std::to_string(mimics) + " URDF <mimic> element(s) not held (MuJoCo 2.2.2's URDF reader ignores them: each such joint moves "
+                         "on its own); to couple them, write the robot as MJCF with <equality><joint joint1 joint2 polycoef=\"0 1 0 0 0\"/>");
   return out;
 }
 

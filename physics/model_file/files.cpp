@@ -102,11 +102,31 @@ bool unescape(const std::string& in, std::string& out) {
   return true;
 }
 
+std::string vfsKeyExtension(std::string ext) {
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  return ext;
+}
+
 bool isNameChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == ':' || c == '.'; }
 
+// Inside a URDF <visual> element at byte `at` (lexically: its last <visual opened after its last </visual>).
+bool inVisual(const std::string& text, std::size_t at) {
+  const std::size_t open = text.rfind("<visual", at), close = text.rfind("</visual", at);
+  return open != std::string::npos && (close == std::string::npos || open > close);
+}
+
+// A URDF MuJoCo reads without its visuals (its default; `discardvisual="false"` keeps them).
+bool discardsVisuals(const std::string& path, const std::string& text) {
+  const std::size_t dot = path.find_last_of('.');
+  const bool urdf = dot != std::string::npos && vfsKeyExtension(path.substr(dot)) == ".urdf";
+  return urdf && text.find("discardvisual=\"false\"") == std::string::npos && text.find("discardvisual='false'") == std::string::npos;
+}
+
 // Every `name = "value"` (or '…') in the text whose name starts with "file" (files) or is meshdir,
-// texturedir or assetdir (folders), values unescaped. One pass over the text.
-void scanNames(const std::string& text, const std::string& who, std::vector<std::string>& files, std::vector<std::string>& dirs) {
+// texturedir or assetdir (folders), values unescaped. One pass over the text. With `visuals`, the
+// names inside a URDF <visual> go there instead of `files`.
+void scanNames(const std::string& text, const std::string& who, std::vector<std::string>& files, std::vector<std::string>& dirs,
+               std::vector<std::string>* visuals = nullptr) {
   for (std::size_t eq = text.find('='); eq != std::string::npos; eq = text.find('=', eq + 1)) {
     std::size_t e = eq;
     while (e > 0 && std::isspace(static_cast<unsigned char>(text[e - 1]))) --e;
@@ -125,7 +145,9 @@ void scanNames(const std::string& text, const std::string& who, std::vector<std:
     if (!unescape(text.substr(v + 1, close - v - 1), value))
       throw ModelFileError(who + ": " + name + "=\"" + oneLine(text.substr(v + 1, std::min<std::size_t>(close - v - 1, 80))) +
                            "\" holds an entity dynlab does not expand (write the file's name plainly)");
-    if (!value.empty()) (file ? files : dirs).push_back(value);
+    if (value.empty()) continue;
+    if (file && visuals && inVisual(text, b)) visuals->push_back(value);
+    else (file ? files : dirs).push_back(value);
   }
 }
 
@@ -171,12 +193,19 @@ std::vector<std::string> addReferencedFiles(const std::string& path, const std::
   std::vector<std::string> missing;
   std::size_t total = 0;
   for (std::size_t t = 0; t < texts.size(); ++t) {
-    std::vector<std::string> files;
+    std::vector<std::string> files, visuals;
     std::vector<std::string> more_dirs;
-    scanNames(texts[t].second, texts[t].first, files, more_dirs);
+    // A URDF's discarded visuals come last: MuJoCo's URDF reader keys meshes by file name and reads the
+    // collision's, so a visual of the same name (meshes/visual/link1.obj beside meshes/collision/
+    // link1.obj) is checked and left out rather than refused.
+    const bool discard = t == 0 && discardsVisuals(path, texts[t].second);
+    scanNames(texts[t].second, texts[t].first, files, more_dirs, discard ? &visuals : nullptr);
+    const std::size_t visual_from = files.size();
+    files.insert(files.end(), visuals.begin(), visuals.end());
     for (const std::string& d : more_dirs)
       if (std::find(dirs.begin(), dirs.end(), d) == dirs.end()) dirs.push_back(d);
-    for (const std::string& name : files) {
+    for (std::size_t n = 0; n < files.size(); ++n) {
+      const std::string& name = files[n];
       if (!seen.insert(name).second) continue;
       if (seen.size() > std::size_t(kMaxAssetFiles))
         throw ModelFileError(path + ": names more than " + std::to_string(kMaxAssetFiles) + " files (meshes, textures, includes)");
@@ -204,7 +233,7 @@ std::vector<std::string> addReferencedFiles(const std::string& path, const std::
                              " (dynlab reads the files a model names from its folder, the ROS package it is in, "
                              "the packages its package:// names find and --package-path folders)");
       if (const auto it = taken.find(key); it != taken.end()) {
-        if (it->second == real) continue;  // the same file, already there
+        if (it->second == real || n >= visual_from) continue;  // the same file, or a discarded visual's: already there
         throw ModelFileError(who + ": another file named '" + key + "' is named too (MuJoCo finds files by name alone: rename one)");
       }
       const bool xml = [&] {

@@ -77,6 +77,21 @@ void readTendons(const mjModel* m, LoadedModel& out) {
   }
 }
 
+namespace {
+// For a refusal: the file's named keyframes that start joint jt inside its range, as the option to take
+// ("--key home"), or that a keyframe is the way when none is named or inside.
+std::string keysInside(const mjModel* m, const Joint& jt) {
+  if (m->nkey == 0) return "";
+  std::string keys;
+  for (int k = 0; k < m->nkey; ++k) {
+    const char* n = mj_id2name(m, mjOBJ_KEY, k);
+    const double q = m->key_qpos[std::size_t(k) * std::size_t(m->nq) + std::size_t(jt.qpos)];
+    if (n && *n && q >= jt.lower - 1e-9 && q <= jt.upper + 1e-9) keys += std::string(keys.empty() ? "" : " or ") + "--key " + oneLine(n);
+  }
+  return keys.empty() ? ", or a keyframe that starts inside it (--key NAME)" : ", or a keyframe of the file that does (" + keys + ")";
+}
+}  // namespace
+
 void addJointElements(const std::string& path, const mjModel* m, const LoadOptions& options, LoadedModel& out) {
   MechanismModel<Spatial>& mech = out.mechanism;
   // Limits: each limited hinge or slide, its two sides (MuJoCo's jnt_range), never starting outside.
@@ -92,7 +107,7 @@ void addJointElements(const std::string& path, const mjModel* m, const LoadOptio
     if (options.key.empty() && !(q0 >= jt.lower - 1e-9 && q0 <= jt.upper + 1e-9))
       throw ModelFileError(path + ": joint '" + jt.name + "' starts at " + num(q0) + ", outside its range [" + num(jt.lower) + ", " + num(jt.upper) +
                            "] (its ref, or 0); expected the reference pose inside the range" +
-                           (m->nkey > 0 ? std::string(", or a keyframe that starts inside it (--key NAME)") : ""));
+                           keysInside(m, jt));
     const int parent = mech.tree.bodies[std::size_t(j)].parent;
     for (const JointLimit::Side side : {JointLimit::Side::Lower, JointLimit::Side::Upper}) {
       const bool lower = side == JointLimit::Side::Lower;

@@ -391,6 +391,7 @@ LoadedModel load(const std::string& path, const LoadOptions& options) {
   out.compiled = detail::compile(path, &warnings, options.package_paths);
   const mjModel* m = out.compiled->m;
   if (!warnings.empty() && warnings != " ") out.notes.push_back("MuJoCo: " + warnings);
+  out.notes.insert(out.notes.end(), out.compiled->notes.begin(), out.compiled->notes.end());
   checkSupported(path, m, options, out.notes);
   // dynlab has no geom-geom contact: MuJoCo's copies (cross-check, bench) run without it too.
   out.compiled->m->opt.disableflags |= mjDSBL_CONTACT;

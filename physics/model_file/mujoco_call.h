@@ -37,6 +37,7 @@ std::string oneLine(const std::string& text);
 // A model compiled by MuJoCo (LoadedModel::compiled): owned, read only once made.
 struct Compiled {
   mjModel* m = nullptr;
+  std::vector<std::string> notes;  // what the file writes that MuJoCo 2.2.2 reads as nothing (a URDF's <mimic>)
   Compiled() = default;
   ~Compiled();
   Compiled(const Compiled&) = delete;

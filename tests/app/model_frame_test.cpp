@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdlib>
 
+#include "labs/generic/model_run.h"
 #include "labs/model_scene.h"
 #include "physics/constrained_mechanism.h"
 #include "physics/integrate.h"
@@ -108,5 +109,31 @@ TEST_CASE("a spatial arm is drawn in perspective, its joints inked, and a URDF w
     for (std::size_t i = 0; i < anchors.size(); ++i) checkInkAt(image, scene, renderer, anchors[i], m.joints[i].name.c_str());
     const PixelRect box = projectedBox(renderer.camera(), 640, 480, scene.framing.bounds), free = renderer.sceneRect();
     CHECK(std::max(box.w / free.w, box.h / free.h) > 0.8);
+  }
+}
+
+TEST_CASE("a falling floating base is framed on the robot, not on the box of its whole fall") {
+  // The Cassie-style leg (tests' leg_loops.xml) falls 1.8 m in 0.6 s: a picture framed on that whole
+  // path shows the leg at a third of the frame's height; one that follows the base, nearly all of it.
+  const model_file::LoadedModel m = model_file::load(std::string(DYNLAB_SOURCE_DIR) + "/tests/physics/model_file/models/leg_loops.xml");
+  const ModelPicture picture(m);
+  REQUIRE(picture.follows());
+  ConstrainedMechanism<Spatial> mech(m.mechanism);
+  const app::ModelRun run = app::runHand(m, mech, m.timestep, 0.6, VecN::Zero(mech.nv()));
+  REQUIRE(run.ok);
+  const int n = int(m.q0.size());
+  const VecN first = traceQ(run.trace, 0, n), last = traceQ(run.trace, run.trace.rows() - 1, n);
+  REQUIRE(picture.base(first).z() - picture.base(last).z() > 1.5);
+  const Eigen::AlignedBox3d bounds = runBounds(picture, n, run.trace, nullptr);
+  auto context = makeOffscreenContext(640, 480);
+  Renderer renderer(*context);
+  for (const VecN& q : {first, last}) {
+    Scene scene;
+    picture.scene(q, nullptr, bounds, scene);
+    renderer.render(scene, nullptr);
+    // The leg as drawn at this row fills the free part of the frame in one direction.
+    const PixelRect box = projectedBox(renderer.camera(), 640, 480, picture.bounds(q)), free = renderer.sceneRect();
+    MESSAGE("the leg's box over the free frame: " << box.w / free.w << " wide, " << box.h / free.h << " high");
+    CHECK(std::max(box.w / free.w, box.h / free.h) > 0.6);
   }
 }

@@ -209,11 +209,14 @@ TEST_CASE("a data lab's JSON: each bad field is one line naming its path") {
   fs::create_directories(dir);
   fs::copy_file(std::string(DYNLAB_SOURCE_DIR) + "/labs/fivebar/fivebar.xml", dir / "fivebar.xml");
   std::ofstream(dir / "broken.xml") << "<mujoco><worldbody><body";
+  fs::copy_file(std::string(DYNLAB_SOURCE_DIR) + "/tests/physics/model_file/models/ball_loop.xml", dir / "ball_loop.xml");
   const std::vector<Case> cases = {
       {R"({"model_file": "../fivebar.xml"})", "/model_file", "without \"..\""},
       {R"({"model_file": "/etc/passwd"})", "/model_file", "relative path"},
       {R"({"model_file": "broken.xml"})", "/model_file", "a model file dynlab reads"},
       {R"({"model_file": "missing.xml"})", "/model_file", "not found"},
+      // A ball joint's quaternion is no angle a controller reads: the line names the command that runs it.
+      {R"({"model_file": "ball_loop.xml"})", "/model_file", "run the file with `dynlab model` or `dynlab run`"},
       {R"({"actuated": ["left_crank", "nope"]})", "/actuated/1", "left_crank, left_elbow, right_crank, right_elbow"},
       {R"({"actuated": ["left_crank", "left_crank"]})", "/actuated/1", "each joint once"},
       {R"({"torque_limit": [1.0]})", "/torque_limit", ""},

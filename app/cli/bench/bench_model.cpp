@@ -33,6 +33,7 @@
 #include "physics/model_file/hand_engine.h"
 #include "physics/model_file/closure_rows.h"
 #include "physics/model_file/model_file.h"
+#include "physics/model_file/stiff_steps.h"
 
 namespace dyn::app {
 namespace {
@@ -58,6 +59,7 @@ struct Engines {
   std::unique_ptr<model_file::DrivenMechanismT<model_file::SixJoints>> euler_six, rk4_six;  // the same, six joints fixed
   std::string sizes;
   std::unique_ptr<bullet::BulletMechanism<Spatial>> bullet;
+  std::string bullet_left_out;  // why Bullet is not timed (a description its builder cannot model), or empty
   std::unique_ptr<model_file::MujocoSimulation> mujoco;
   VecN q_euler, v_euler, q_rk4, v_rk4;
   std::vector<Engine> list;
@@ -143,7 +145,13 @@ void build(const model_file::LoadedModel& m, double dt, bool beside, Engines& e)
     e.list.push_back(handWithElements(m, "semi-implicit Euler + Baumgarte", &e.euler_el, &e.q_euler, &e.v_euler, euler));
     e.list.push_back(handWithElements(m, "RK4 + projection", &e.rk4_el, &e.q_rk4, &e.v_rk4, rk4));
   }
-  addBullet(m, dt, e);
+  try {
+    addBullet(m, dt, e);
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& x) {  // a description the Bullet builder cannot model: the others are timed
+    e.bullet_left_out = x.what();
+  }
   if (beside || !m.compiled) return;  // MuJoCo's run of the file would not hold what is beside it; a description holds no MuJoCo model
   e.mujoco = std::make_unique<model_file::MujocoSimulation>(m, dt);
   model_file::MujocoSimulation* mj = e.mujoco.get();
@@ -171,6 +179,7 @@ void timeBlocks(std::vector<Engine>& engines, int steps) {
 // engine's state, over every closure row) and the largest |q − q_ref|∞ against the reference run's states.
 struct Accuracy {
   double residual = 0, error = 0;
+  double position = 0;  // the residual at the positions alone (no velocity form J v)
   bool complete = true;
 };
 std::vector<Accuracy> accuracy(std::vector<Engine>& engines, const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& mech, int steps,
@@ -190,6 +199,7 @@ std::vector<Accuracy> accuracy(std::vector<Engine>& engines, const model_file::L
       }
       path[i].push_back(q);
       out[i].residual = std::max(out[i].residual, runResidual(m, mech, every, q, v));
+      out[i].position = std::max(out[i].position, runPositionResidual(m, mech, every, q));
       if (k < steps && !e.step()) {
         out[i].complete = false;
         break;
@@ -246,6 +256,9 @@ int benchModel(const BenchArgs& a) {
   if (a.json) {
     json out = {{"model", m.file}, {"dt", dt}, {"steps_timed", a.steps}, {"closure_rows", rows}, {"accuracy_run_s", kAccuracyRun}};
     if (!beside.empty()) out["beside"] = {{"file", beside}, {"elements", m.contacts.size()}, {"note", mujoco_left_out}};
+    if (!engines.bullet_left_out.empty()) out["bullet_left_out"] = engines.bullet_left_out;
+    // Whole steps of dt here; model and run take this many per step on a stiff file (stiff_steps.h).
+    out["model_run_substeps"] = model_file::stiffSubsteps(model_file::fastestMode(m).rate, dt);
     for (std::size_t i = 0; i < list.size(); ++i) {
       const Ratio r = ratio(list[i].blocks, euler.blocks);
       out["engines"].push_back({{"engine", list[i].name},
@@ -254,6 +267,7 @@ int benchModel(const BenchArgs& a) {
                                 {"over_hand_first_order", r.median},
                                 {"over_hand_first_order_quartiles", {r.low, r.high}},
                                 {"max_closure_residual", acc[i].residual},
+                                {"max_position_residual", acc[i].position},
                                 {"max_q_error_vs_hand_rk4", acc[i].error},
                                 {"complete", acc[i].complete}});
     }
@@ -266,6 +280,13 @@ int benchModel(const BenchArgs& a) {
   std::printf("%s: %d coordinates, %d closure rows%s, dt %g s (the file's), %s\n", termName(m.file).c_str(), int(m.q0.size()), rows,
               termText(elements).c_str(), dt, termName(start, 1000).c_str());
   for (const std::string& note : m.notes) std::printf("  note: %s\n", termName(note, 1000).c_str());
+  if (!engines.bullet_left_out.empty()) std::printf("  note: Bullet not timed: %s\n", termName(engines.bullet_left_out, 1000).c_str());
+  // A stiff file: the bench steps whole steps of dt, where model and run take sub-steps (stiff_steps.h).
+  const model_file::FastestMode fastest = model_file::fastestMode(m);
+  if (const int sub = model_file::stiffSubsteps(fastest.rate, dt); sub > 1)
+    std::printf("  note: every engine here takes whole steps of dt, without the %d sub-steps per step `dynlab model` and `run` take on this file "
+                "(|λ| dt %.3g, joint '%s'): their hand RK4 costs %d times the row below\n",
+                sub, fastest.rate * dt, termName(fastest.joint).c_str(), sub);
   if (!beside.empty()) std::printf("  %s\n", termName(mujoco_left_out, 1000).c_str());
   std::printf("  %d steps per engine timed in blocks of %d, in turn; ratios block by block: median (middle half)\n", int(euler.all.size()), kBlock);
   std::printf("  engine             µs/step   over hand, 1st order   max |φ|∞     max |q − q_ref|∞ over 2 s (ref: hand RK4)\n");
@@ -279,6 +300,11 @@ int benchModel(const BenchArgs& a) {
     std::printf("  %-16s %9.2f   %-22s %-12.2g %.2g%s\n", label.c_str(), median(e.all), text, acc[i].residual, acc[i].error,
                 acc[i].complete ? "" : " (the 2 s run stopped: non-finite state)");
   }
+  // A residual whose rows' velocity form is the larger share (Bullet's gear row on the 2F-85): the positions' own.
+  for (std::size_t i = 0; i < list.size(); ++i)
+    if (acc[i].residual > 2 * acc[i].position && acc[i].residual > 1e-12)
+      std::printf("  %s: its max |φ|∞ is its rows' velocity form J v (a loop's or a coupling's rate); at the positions (rows, stops' depths): %.2g\n",
+                  (list[i].name + (i == 0 ? ", Euler" : i == 1 ? ", RK4" : "")).c_str(), acc[i].position);
   for (const Engine& e : list) std::printf("  %-8s %s\n", (e.name + ":").c_str(), e.scheme.c_str());
   return 0;
 }

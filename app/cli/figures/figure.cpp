@@ -430,6 +430,9 @@ int figure(const FigureArgs& a) {
     return status == "ok" ? 0 : 1;
   } catch (const std::bad_alloc&) {
     throw;  // main's one line for it (app/cli/main.cpp)
+  } catch (const InputError& e) {  // found only once a run starts (a model file Bullet cannot build): bad input
+    std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
+    return 2;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "error: %s\n", termText(e.what()).c_str());
     return 1;

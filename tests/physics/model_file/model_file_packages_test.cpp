@@ -7,6 +7,7 @@
 #include <doctest/doctest.h>
 #include <stdlib.h>
 
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -83,4 +84,41 @@ TEST_CASE("meshes beside a URDF's folder load inside a ROS package; file:// is a
   CHECK(has(errorOf(write("pkg/urdf/dev.urdf", meshArmUrdf("package://dev/zero"))), "no package folder 'dev'"));
   CHECK(has(errorOf(write("pkg/urdf/etc.urdf", meshArmUrdf("package://etc/passwd"))), "no package folder 'etc'"));
   fs::remove_all(folder());
+}
+
+namespace {
+
+// A URDF arm whose link has a visual mesh and a collision mesh of the same file name in two folders
+// (meshes/visual/body.stl, meshes/collision/body.stl: how Bullet's and ROS's Panda ship), with `extra`
+// inside <robot>.
+std::string visualAndCollisionUrdf(const std::string& extra) {
+  std::string u = meshArmUrdf("meshes/collision/body.stl");
+  u.replace(u.find("<collision>"), 0, "<visual><geometry><mesh filename=\"meshes/visual/body.stl\"/></geometry></visual>");
+  return u.replace(u.find("<link"), 0, extra);
+}
+
+}  // namespace
+
+TEST_CASE("a URDF's visual and collision meshes of one file name: the collision's is read while MuJoCo discards visuals") {
+  write("twin/meshes/collision/body.stl", tetrahedronStl(0.1f));
+  write("twin/meshes/visual/body.stl", tetrahedronStl(0.3f));
+  const double collision = drawnSize(write("twin/arm.urdf", visualAndCollisionUrdf("")));
+  CHECK(collision == doctest::Approx(drawnSize(write("twin/plain.urdf", meshArmUrdf("meshes/collision/body.stl")))));
+  // Kept visuals: MuJoCo would read one file for both names, so the file is refused in one line.
+  const std::string kept = errorOf(write("twin/kept.urdf", visualAndCollisionUrdf("<mujoco><compiler discardvisual=\"false\"/></mujoco>")));
+  CHECK(has(kept, "another file named 'body.stl' is named too (MuJoCo finds files by name alone: rename one)"));
+  CHECK(kept.find('\n') == std::string::npos);
+  fs::remove_all(folder() / "twin");
+}
+
+TEST_CASE("a URDF's <mimic> is said to be not held, with the way to hold it") {
+  std::string u = meshArmUrdf("meshes/collision/body.stl");
+  write("mimic/meshes/collision/body.stl", tetrahedronStl(0.1f));
+  u.insert(u.find("</joint>"), "<mimic joint=\"j0\"/>");
+  const model_file::LoadedModel m = model_file::load(write("mimic/arm.urdf", u).string());
+  const auto note = std::find_if(m.notes.begin(), m.notes.end(), [](const std::string& n) { return has(n, "URDF <mimic> element(s) not held"); });
+  REQUIRE(note != m.notes.end());
+  CHECK(has(*note, "1 URDF <mimic>"));
+  CHECK(has(*note, "<equality><joint joint1 joint2 polycoef"));
+  fs::remove_all(folder() / "mimic");
 }

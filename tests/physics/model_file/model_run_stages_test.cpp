@@ -98,8 +98,10 @@ TEST_CASE("a joint range that leaves out the reference pose (the Panda's joint4)
   };
   // q0 = 0 lies outside [0.2, 3]: refused from q0, naming the way out; the keyframe's 0.3 is inside.
   CHECK(error("outside.xml", R"(range="0.2 3")", "").find("joint 'shoulder' starts at 0, outside its range [0.2, 3] (its ref, or 0); expected the reference pose "
-                                                          "inside the range, or a keyframe that starts inside it (--key NAME)") != std::string::npos);
+                                                          "inside the range, or a keyframe of the file that does (--key start)") != std::string::npos);
   CHECK(error("outside.xml", R"(range="0.2 3")", "start").empty());
+  // No keyframe of the file inside the range: the option named in general.
+  CHECK(error("past.xml", R"(range="0.5 3")", "").find("inside the range, or a keyframe that starts inside it (--key NAME)") != std::string::npos);
   // A keyframe past a stop: one line naming the joint.
   CHECK(error("past.xml", R"(range="0.5 3")", "start").find("keyframe 'start': its qpos puts joint 'shoulder' at 0.3, outside its range [0.5, 3]") !=
         std::string::npos);
