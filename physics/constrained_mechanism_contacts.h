@@ -27,37 +27,43 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::setClosed(int i, bool closed) {
 }
 
 // While some rows are released (a model file's joint limits away from their stops, contacts open),
-// the solve at dynamic sizes holds only the closed rows: J̃ = H̃ J, Ã = H̃ A with H̃ the rows of the
-// identity at the closed rows, in order (constrained_solve.h's contact form, H̃ given); η = 0 on the
-// released rows. The same θ'', α_c and η bit for bit as the solve over every row with the released
-// ones zeroed at unit compliance (each of those adds 0 · 0 to the closed rows' sums), without their
-// rows × rows share of Λ: the PUMA file's twelve limit rows, mostly open, cost nothing. A fixed
+// the solve at dynamic sizes holds only the closed rows, compacted: problem_'s J̃ = H̃ J, Ã = H̃ A, J'θ'
+// and the Baumgarte term are the closed rows' alone (H̃ the rows of the identity at the closed rows, in
+// order, closed_rows_; constrained_solve.h with J̃ given and no H̃), η = 0 on the released rows. The same
+// θ'', α_c and η as the solve over every row with the released ones zeroed at unit compliance (each of
+// those adds 0 · 0 to the closed rows' sums), without their rows × rows share of Λ nor their bias and
+// Baumgarte rows: the PUMA file's twelve limit rows, mostly open, cost nothing in the solve. A fixed
 // instantiation keeps its Nr rows (a lab's sizes). True when the rows were selected (selected_).
 template <class S, int Nj, int Nr, int Nl>
 bool ConstrainedMechanism<S, Nj, Nr, Nl>::selectClosedRows() {
   selected_ = false;
   if constexpr (Nr == Eigen::Dynamic) {
-    if (problem_.Ht.size()) problem_.Ht.resize(0, 0);
     if (!any_released_kind_) return false;
     closed_rows_.clear();
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
       if (!released_[i])
-        for (int r = offsets_[i]; r < offsets_[i] + model_.constraints[i]->rows(); ++r) closed_rows_.push_back(r);
+        for (int r = offsets_[i]; r < offsets_[i] + row_count_[i]; ++r) closed_rows_.push_back(r);
     const int m = int(closed_rows_.size()), nn = n(), kk = k();
     if (m == rows_) return false;
-    problem_.Ht.setZero(m, rows_);
-    J_closed_.resize(m, nn);
-    A_closed_.resize(m, kk);
+    problem_.J.resize(m, nn);
+    problem_.A.resize(m, kk);
     for (int i = 0; i < m; ++i) {
       const int r = closed_rows_[std::size_t(i)];
-      problem_.Ht(i, r) = 1.0;
-      J_closed_.row(i) = problem_.J.row(r);
-      if (kk) A_closed_.row(i) = problem_.A.row(r);
+      for (int j = 0; j < nn; ++j) problem_.J(i, j) = J_full_(r, j);
+      for (int j = 0; j < kk; ++j) problem_.A(i, j) = A_full_(r, j);
     }
     problem_.compliance.resize(0);  // the released rows are out of the solve
     selected_ = true;
   }
   return selected_;
+}
+
+// out = the closed rows of a vector over every row (selectClosedRows), in order.
+template <class S, int Nj, int Nr, int Nl>
+template <class Out>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::gatherClosedRows(const VecN& all, Out& out) const {
+  out.resize(Eigen::Index(closed_rows_.size()));
+  for (std::size_t i = 0; i < closed_rows_.size(); ++i) out[Eigen::Index(i)] = all[closed_rows_[i]];
 }
 
 // η and f over every row from a solve on the closed rows (selectClosedRows): zero on the released ones.
@@ -84,8 +90,9 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
   for (std::size_t i = 0; i < count; ++i) {
     if (!rigid(i) || !released_[i]) continue;
     const int r = offsets_[i];
+    if (!(phi_full_[r] >= 0.0)) continue;  // short of its plane (or stop)
     const double approach = J_full_.row(r).dot(v.head(n())) - (k() ? A_full_.row(r).dot(v.tail(k())) : 0.0);
-    if (phi_full_[r] >= 0.0 && approach >= -kSeparating) {
+    if (approach >= -kSeparating) {
       released_[i] = 0;
       ++changes;
     }

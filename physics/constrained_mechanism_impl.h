@@ -47,6 +47,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
   if (const std::string why = model_.validate(); !why.empty()) throw std::invalid_argument(why);
   for (const auto& c : model_.constraints) {
     offsets_.push_back(rows_);
+    row_count_.push_back(c->rows());
     rows_ += c->rows();
     // Rigid unilateral contacts start open (updateContacts closes them); compliant ones never close.
     const bool released = c->unilateral() || c->compliant();
@@ -133,6 +134,18 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   setZeroAt<Nr, Nl>(A_full_, rows_, kk);
   for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->position(kin_, offsets_[i], phi_full_, J_full_, A_full_);
   setFixed<Nr>(phi_, phi_full_);
+  // Some rows released at dynamic sizes: the closed rows alone, compacted (selectClosedRows); φ = 0 on
+  // the released ones.
+  if (selectClosedRows()) {
+    // (A one-row constraint's entry stored alone: GCC makes a loop over a few doubles a memset call.)
+    for (std::size_t i = 0; i < model_.constraints.size(); ++i)
+      if (released_[i] && row_count_[i] == 1) phi_[offsets_[i]] = 0.0;
+      else if (released_[i]) phi_.segment(offsets_[i], row_count_[i]).setZero();
+    factored_ = factor_.factor(problem_, problem_.J, problem_.A);
+    setFixed<kState>(staged_q_, q);
+    have_position_ = true;
+    return;
+  }
   problem_.J = J_full_;
   problem_.A = A_full_;
   // Released rows (open or compliant contacts) are zeroed in the solve (the full rows stay for gaps
@@ -141,15 +154,14 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
     setZeroAt<Nr, 1>(problem_.compliance, rows_, 1);
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
       if (released_[i])
-        for (int r = offsets_[i]; r < offsets_[i] + model_.constraints[i]->rows(); ++r) {
+        for (int r = offsets_[i]; r < offsets_[i] + row_count_[i]; ++r) {
           phi_[r] = 0.0;
           problem_.J.row(r).setZero();
           if (kk) problem_.A.row(r).setZero();
           problem_.compliance[r] = 1.0;
         }
   }
-  if (selectClosedRows()) factored_ = factor_.factor(problem_, J_closed_, A_closed_);
-  else factored_ = factor_.factor(problem_, problem_.J, problem_.A);
+  factored_ = factor_.factor(problem_, problem_.J, problem_.A);
   setFixed<kState>(staged_q_, q);
   have_position_ = true;
 }
@@ -211,9 +223,11 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
       if (kk) external_bc_.noalias() += Ap.transpose() * F;
     }
   }
-  // J'θ' − A'v_c of every constraint.
+  // J'θ' − A'v_c of every constraint (of the closed ones alone, compacted, when the rows are selected:
+  // the released rows' bias is not solved for).
   VecN bias(rows_);
-  for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->bias(kin_, offsets_[i], bias);
+  for (std::size_t i = 0; i < model_.constraints.size(); ++i)
+    if (!selected() || !released_[i]) model_.constraints[i]->bias(kin_, offsets_[i], bias);
   // Released rows: no bias; a compliant contact's force enters as −Jᵀη on the tree (h += Jᵀη) and
   // Aᵀη on the payloads.
   if (any_released_kind_) {
@@ -224,7 +238,8 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
     for (std::size_t i = 0; i < model_.constraints.size(); ++i) {
       if (!released_[i]) continue;
       const auto& c = *model_.constraints[i];
-      for (int r = offsets_[i]; r < offsets_[i] + c.rows(); ++r) bias[r] = 0.0;
+      if (!selected())  // (selected: the released rows' bias is not gathered)
+        for (int r = offsets_[i]; r < offsets_[i] + row_count_[i]; ++r) bias[r] = 0.0;
       if (!compliant_[i]) continue;
       const int r = offsets_[i];
       const double eta = c.compliantForce(kin_);
@@ -233,7 +248,8 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
       if (k()) compliant_bc_ -= eta * A_full_.row(r).transpose();
     }
   }
-  problem_.Jdot_qd = bias;
+  if (selected()) gatherClosedRows(bias, problem_.Jdot_qd);
+  else problem_.Jdot_qd = bias;
   setFixed<kState>(staged_v_, v);
   have_velocity_ = true;
 }
@@ -264,18 +280,19 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
     if (has_forces_ && k()) problem_.bc_Gc += external_bc_;
   }
   if (!stab) problem_.stab.resize(0);
+  else if (selected()) gatherClosedRows(*stab, problem_.stab);
   else setFixed<Nr>(problem_.stab, *stab);
   Solution s;
   if (!factored_) s = solveConstrainedBlockLU(problem_);
   else factor_.solve(problem_, s, with_qdd);
-  if (selected_) scatterClosedRows(s);
+  if (selected()) scatterClosedRows(s);
   // A compliant contact's η is its force, not the solve's (its row is released).
   if (any_compliant_)
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
       if (compliant_[i]) {
         const int r = offsets_[i];
         s.eta[r] = compliant_eta_[r];
-        if (problem_.Ht.size() == 0 || selected_) s.f[r] = compliant_eta_[r];
+        s.f[r] = compliant_eta_[r];
       }
   return s;
 }
@@ -366,10 +383,20 @@ template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::constraint(const VecN& q, VecN& phi, MatN& G) {
   positionStage(q);
   phi = phi_;
-  // G = [J, −A]: G v = J θ' − A v_c.
+  // G = [J, −A]: G v = J θ' − A v_c (the released rows zero: −0 in the −A part, as −A of a zero row).
   G.resize(rows_, n() + k());
-  G.leftCols(n()) = problem_.J;
-  if (k()) G.rightCols(k()) = -MatN(problem_.A);
+  if (!selected()) {
+    G.leftCols(n()) = problem_.J;
+    if (k()) G.rightCols(k()) = -MatN(problem_.A);
+    return;
+  }
+  G.leftCols(n()).setZero();
+  if (k()) G.rightCols(k()).setConstant(-0.0);
+  for (std::size_t i = 0; i < closed_rows_.size(); ++i) {
+    const int r = closed_rows_[i];
+    G.row(r).head(n()) = J_full_.row(r);
+    if (k()) G.row(r).tail(k()) = -A_full_.row(r);
+  }
 }
 
 template <class S, int Nj, int Nr, int Nl>
@@ -379,10 +406,15 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::baumgarteTerm(const VecN& q, const Vec
   // loops unrolled at fixed sizes.
   const int nn = Nj == Eigen::Dynamic ? n() : Nj, kk = Nl == Eigen::Dynamic ? k() : Nl, rows = Nr == Eigen::Dynamic ? rows_ : Nr;
   s.resize(rows);
-  for (int r = 0; r < rows; ++r) {
+  // With the closed rows selected: problem_.J's row i is row closed_rows_[i]; the released rows' s is
+  // not solved for (0).
+  const int m = selected() ? int(closed_rows_.size()) : rows;
+  if (selected()) s.setZero();
+  for (int i = 0; i < m; ++i) {
+    const int r = selected() ? closed_rows_[std::size_t(i)] : i;
     double gv = 0.0;
-    for (int j = 0; j < nn; ++j) gv += problem_.J(r, j) * v[j];
-    for (int j = 0; j < kk; ++j) gv -= problem_.A(r, j) * v[nn + j];
+    for (int j = 0; j < nn; ++j) gv += problem_.J(i, j) * v[j];
+    for (int j = 0; j < kk; ++j) gv -= problem_.A(i, j) * v[nn + j];
     s[r] = -2.0 * zeta * omega * gv - omega * omega * phi_[r];
   }
 }
@@ -409,10 +441,14 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::impulseResponse(const VecN& e, Solutio
   Problem impulse;
   impulse.tau.setZero(n());
   impulse.h.setZero(n());
-  impulse.Jdot_qd = -e;
-  if (selected_) impulse.Ht = problem_.Ht;  // the closed rows the factor holds
+  if (selected()) {  // the closed rows the factor holds
+    impulse.Jdot_qd.resize(Eigen::Index(closed_rows_.size()));
+    for (std::size_t i = 0; i < closed_rows_.size(); ++i) impulse.Jdot_qd[Eigen::Index(i)] = -e[closed_rows_[i]];
+  } else {
+    impulse.Jdot_qd = -e;
+  }
   factor_.solve(impulse, s);
-  if (selected_) scatterClosedRows(s);
+  if (selected()) scatterClosedRows(s);
   dx.resize(n() + k());
   dx.head(n()) = s.qdd;
   dx.tail(k()) = s.alpha_c;
@@ -503,7 +539,11 @@ double ConstrainedMechanism<S, Nj, Nr, Nl>::residual(const VecN& q, const VecN& 
   positionStage(q);
   if (!rows_) return 0.0;
   // Velocity form J θ' − A v_c as well: a velocity-level kind has only this one.
-  const VecN gv = MatN(problem_.J) * v.head(n()) - MatN(problem_.A) * v.tail(k());
+  VecN phi;
+  MatN G;
+  if (selected()) constraint(q, phi, G);  // the rows over every constraint (problem_ holds the closed ones)
+  const MatN J = selected() ? MatN(G.leftCols(n())) : MatN(problem_.J), A = selected() ? MatN(-G.rightCols(k())) : MatN(problem_.A);
+  const VecN gv = J * v.head(n()) - A * v.tail(k());
   return std::max(phi_.lpNorm<Eigen::Infinity>(), gv.lpNorm<Eigen::Infinity>());
 }
 

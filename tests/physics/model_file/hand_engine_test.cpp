@@ -1,9 +1,12 @@
 // The hand engine for files with elements at fixed sizes (physics/model_file/hand_engine.h SixJoints:
 // six joints fixed, the rows dynamic, the closed rows alone solved) steps the PUMA 560's file with its
 // twelve joint-limit rows exactly as the dynamically sized mechanism does, bit for bit, through a run
-// that falls onto a stop (a row closed, its impact, the lift-off checks) and with every row open.
+// that falls onto a stop (a row closed, its impact, the lift-off checks) and with every row open; and
+// the solve on the closed rows alone (compacted: J̃, J'θ' and the Baumgarte term of those rows only)
+// gives what the solve over all twelve rows gives with the open ones zeroed at unit compliance.
 #include <doctest/doctest.h>
 
+#include "physics/constrained_mechanism_impl.h"
 #include "physics/model_file/actuators.h"
 #include "physics/model_file/hand_engine.h"
 #include "physics/model_file/model_file.h"
@@ -45,5 +48,46 @@ TEST_CASE("the six-joint engine with limits steps the PUMA file as the dynamical
     CHECK(closed_steps < 1500);        // and fell freely before
     CHECK(dynamic.impactLoss() > 0);   // with an impact
     CHECK(dynamic.impactLoss() == sized.impactLoss());
+  }
+}
+
+// Twelve rows fixed: every row in the solve, the open ones zeroed at unit compliance (η = 0 there).
+template class dyn::ConstrainedMechanism<Spatial, 6, 12, 0>;
+
+TEST_CASE("the PUMA file's closed rows solved alone step as every row solved with the open ones zeroed, bit for bit") {
+  const model_file::LoadedModel m = model_file::load(model("puma560.urdf"));
+  REQUIRE(m.actuators.empty());
+  for (Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::RK4}) {
+    INFO(int(integrator));
+    StepOptions o;
+    o.dt = m.timestep;
+    o.integrator = integrator;
+    if (integrator == Integrator::SemiImplicitEuler) o.drift.kind = Drift::Baumgarte;
+    model_file::SixJoints selected(m.mechanism);
+    ConstrainedMechanism<Spatial, 6, 12, 0> every(m.mechanism);
+    const VecN tau = VecN::Zero(6);
+    VecN q1 = m.start_q, v1 = m.start_v, q2 = q1, v2 = v1;
+    int closed_steps = 0;
+    for (int k = 0; k < 1500; ++k) {
+      selected.updateContacts(q1, v1, tau);
+      every.updateContacts(q2, v2, tau);
+      REQUIRE(selected.stepLocatingContacts(o, tau, q1, v1));
+      REQUIRE(every.stepLocatingContacts(o, tau, q2, v2));
+      bool any = false;
+      for (int i = 0; i < 12; ++i) {
+        REQUIRE(selected.closed(i) == every.closed(i));
+        any = any || selected.closed(i);
+      }
+      closed_steps += any;
+      REQUIRE(q1 == q2);
+      REQUIRE(v1 == v2);
+      // The solved forces too, over every row (0 on the open ones).
+      const auto s1 = selected.solve(q1, v1, tau), s2 = every.solve(q2, v2, tau);
+      REQUIRE(s1.eta.size() == 12);
+      REQUIRE(s1.eta == s2.eta);
+      REQUIRE(s1.qdd == s2.qdd);
+    }
+    CHECK(closed_steps > 100);
+    CHECK(selected.impactLoss() == every.impactLoss());
   }
 }
