@@ -7,7 +7,8 @@
 //   lift-off   while a closed row's η < 0 (it would pull), the row pulling most opens, and solve again
 //   locating   a step that ends past a plane is retaken to the crossing h, φ(h) = 0, by regula falsi
 //              (Illinois) on h; the contact closes there and the rest of the step follows.
-//   solving    at dynamic sizes the closed rows alone (H̃ selects them), η = 0 on the open ones.
+//   solving    at dynamic sizes the closed rows alone, compacted (J̃ = H̃ J, their J'θ' and Baumgarte
+//              rows), η = 0 on the open ones; G and the Baumgarte term over every row from them.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -73,6 +74,48 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::scatterClosedRows(Solution& s) const {
   s.eta.setZero(rows_);
   for (std::size_t i = 0; i < closed_rows_.size(); ++i) s.eta[closed_rows_[i]] = eta[Eigen::Index(i)];
   s.f = s.eta;
+}
+
+// The rows as the integrators see them (G = [J, −A] over every row, and the Baumgarte term), from the
+// closed rows problem_ holds when they are selected.
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::constraint(const VecN& q, VecN& phi, MatN& G) {
+  positionStage(q);
+  phi = phi_;
+  // G = [J, −A]: G v = J θ' − A v_c (the released rows zero: −0 in the −A part, as −A of a zero row).
+  G.resize(rows_, n() + k());
+  if (!selected()) {
+    G.leftCols(n()) = problem_.J;
+    if (k()) G.rightCols(k()) = -MatN(problem_.A);
+    return;
+  }
+  G.leftCols(n()).setZero();
+  if (k()) G.rightCols(k()).setConstant(-0.0);
+  for (std::size_t i = 0; i < closed_rows_.size(); ++i) {
+    const int r = closed_rows_[i];
+    G.row(r).head(n()) = J_full_.row(r);
+    if (k()) G.row(r).tail(k()) = -A_full_.row(r);
+  }
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::baumgarteTerm(const VecN& q, const VecN& v, double zeta, double omega, VecN& s) {
+  positionStage(q);
+  // s = −2ζω (J θ' − A v_c) − ω² φ from the stage's own J and A (released rows are zero there); the
+  // loops unrolled at fixed sizes.
+  const int nn = Nj == Eigen::Dynamic ? n() : Nj, kk = Nl == Eigen::Dynamic ? k() : Nl, rows = Nr == Eigen::Dynamic ? rows_ : Nr;
+  s.resize(rows);
+  // With the closed rows selected: problem_.J's row i is row closed_rows_[i]; the released rows' s is
+  // not solved for (0).
+  const int m = selected() ? int(closed_rows_.size()) : rows;
+  if (selected()) s.setZero();
+  for (int i = 0; i < m; ++i) {
+    const int r = selected() ? closed_rows_[std::size_t(i)] : i;
+    double gv = 0.0;
+    for (int j = 0; j < nn; ++j) gv += problem_.J(i, j) * v[j];
+    for (int j = 0; j < kk; ++j) gv -= problem_.A(i, j) * v[nn + j];
+    s[r] = -2.0 * zeta * omega * gv - omega * omega * phi_[r];
+  }
 }
 
 // A contact at or past its plane closes unless it separates faster than this (m/s): rounding-size
