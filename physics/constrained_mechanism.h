@@ -183,7 +183,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
 
   MechanismModel<S> model_;
   int rows_ = 0;
-  std::vector<int> offsets_;
+  std::vector<int> offsets_, row_count_;  // per constraint: its first row, its rows (Constraint::rows)
   TreeData<S> data_;
   MechanismKinematics<S> kin_;
   Problem problem_;
@@ -192,10 +192,11 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // The closed rows alone in the solve while some are released (dynamic sizes): selectClosedRows.
   bool selectClosedRows();
   void scatterClosedRows(Solution& s) const;
-  bool selected_ = false;          // the factor holds the closed rows alone (problem_.Ht selects them)
+  template <class Out>
+  void gatherClosedRows(const VecN& all, Out& out) const;
+  bool selected_ = false;          // problem_ holds the closed rows alone (J̃ = H̃ J, Ã = H̃ A, J'θ', s)
+  bool selected() const { return Nr == Eigen::Dynamic && selected_; }  // never at fixed rows (a lab's)
   std::vector<int> closed_rows_;   // their rows, in order
-  MatRC<Nr, Nj> J_closed_;         // J̃ = H̃ J and Ã = H̃ A: the closed rows of J and A
-  MatRC<Nr, Nl> A_closed_;
   VecN phi_;
   VecN gravity_bc_;    // b_c + G_c of the payloads without external forces (b_c = 0: world axes at the centre of mass)
   VecN staged_q_;      // the configuration of the position stage

@@ -7,7 +7,8 @@
 //   lift-off   while a closed row's η < 0 (it would pull), the row pulling most opens, and solve again
 //   locating   a step that ends past a plane is retaken to the crossing h, φ(h) = 0, by regula falsi
 //              (Illinois) on h; the contact closes there and the rest of the step follows.
-//   solving    at dynamic sizes the closed rows alone (H̃ selects them), η = 0 on the open ones.
+//   solving    at dynamic sizes the closed rows alone, compacted (J̃ = H̃ J, their J'θ' and Baumgarte
+//              rows), η = 0 on the open ones; G and the Baumgarte term over every row from them.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -27,37 +28,43 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::setClosed(int i, bool closed) {
 }
 
 // While some rows are released (a model file's joint limits away from their stops, contacts open),
-// the solve at dynamic sizes holds only the closed rows: J̃ = H̃ J, Ã = H̃ A with H̃ the rows of the
-// identity at the closed rows, in order (constrained_solve.h's contact form, H̃ given); η = 0 on the
-// released rows. The same θ'', α_c and η bit for bit as the solve over every row with the released
-// ones zeroed at unit compliance (each of those adds 0 · 0 to the closed rows' sums), without their
-// rows × rows share of Λ: the PUMA file's twelve limit rows, mostly open, cost nothing. A fixed
+// the solve at dynamic sizes holds only the closed rows, compacted: problem_'s J̃ = H̃ J, Ã = H̃ A, J'θ'
+// and the Baumgarte term are the closed rows' alone (H̃ the rows of the identity at the closed rows, in
+// order, closed_rows_; constrained_solve.h with J̃ given and no H̃), η = 0 on the released rows. The same
+// θ'', α_c and η as the solve over every row with the released ones zeroed at unit compliance (each of
+// those adds 0 · 0 to the closed rows' sums), without their rows × rows share of Λ nor their bias and
+// Baumgarte rows: the PUMA file's twelve limit rows, mostly open, cost nothing in the solve. A fixed
 // instantiation keeps its Nr rows (a lab's sizes). True when the rows were selected (selected_).
 template <class S, int Nj, int Nr, int Nl>
 bool ConstrainedMechanism<S, Nj, Nr, Nl>::selectClosedRows() {
   selected_ = false;
   if constexpr (Nr == Eigen::Dynamic) {
-    if (problem_.Ht.size()) problem_.Ht.resize(0, 0);
     if (!any_released_kind_) return false;
     closed_rows_.clear();
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
       if (!released_[i])
-        for (int r = offsets_[i]; r < offsets_[i] + model_.constraints[i]->rows(); ++r) closed_rows_.push_back(r);
+        for (int r = offsets_[i]; r < offsets_[i] + row_count_[i]; ++r) closed_rows_.push_back(r);
     const int m = int(closed_rows_.size()), nn = n(), kk = k();
     if (m == rows_) return false;
-    problem_.Ht.setZero(m, rows_);
-    J_closed_.resize(m, nn);
-    A_closed_.resize(m, kk);
+    problem_.J.resize(m, nn);
+    problem_.A.resize(m, kk);
     for (int i = 0; i < m; ++i) {
       const int r = closed_rows_[std::size_t(i)];
-      problem_.Ht(i, r) = 1.0;
-      J_closed_.row(i) = problem_.J.row(r);
-      if (kk) A_closed_.row(i) = problem_.A.row(r);
+      for (int j = 0; j < nn; ++j) problem_.J(i, j) = J_full_(r, j);
+      for (int j = 0; j < kk; ++j) problem_.A(i, j) = A_full_(r, j);
     }
     problem_.compliance.resize(0);  // the released rows are out of the solve
     selected_ = true;
   }
   return selected_;
+}
+
+// out = the closed rows of a vector over every row (selectClosedRows), in order.
+template <class S, int Nj, int Nr, int Nl>
+template <class Out>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::gatherClosedRows(const VecN& all, Out& out) const {
+  out.resize(Eigen::Index(closed_rows_.size()));
+  for (std::size_t i = 0; i < closed_rows_.size(); ++i) out[Eigen::Index(i)] = all[closed_rows_[i]];
 }
 
 // η and f over every row from a solve on the closed rows (selectClosedRows): zero on the released ones.
@@ -67,6 +74,48 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::scatterClosedRows(Solution& s) const {
   s.eta.setZero(rows_);
   for (std::size_t i = 0; i < closed_rows_.size(); ++i) s.eta[closed_rows_[i]] = eta[Eigen::Index(i)];
   s.f = s.eta;
+}
+
+// The rows as the integrators see them (G = [J, −A] over every row, and the Baumgarte term), from the
+// closed rows problem_ holds when they are selected.
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::constraint(const VecN& q, VecN& phi, MatN& G) {
+  positionStage(q);
+  phi = phi_;
+  // G = [J, −A]: G v = J θ' − A v_c (the released rows zero: −0 in the −A part, as −A of a zero row).
+  G.resize(rows_, n() + k());
+  if (!selected()) {
+    G.leftCols(n()) = problem_.J;
+    if (k()) G.rightCols(k()) = -MatN(problem_.A);
+    return;
+  }
+  G.leftCols(n()).setZero();
+  if (k()) G.rightCols(k()).setConstant(-0.0);
+  for (std::size_t i = 0; i < closed_rows_.size(); ++i) {
+    const int r = closed_rows_[i];
+    G.row(r).head(n()) = J_full_.row(r);
+    if (k()) G.row(r).tail(k()) = -A_full_.row(r);
+  }
+}
+
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::baumgarteTerm(const VecN& q, const VecN& v, double zeta, double omega, VecN& s) {
+  positionStage(q);
+  // s = −2ζω (J θ' − A v_c) − ω² φ from the stage's own J and A (released rows are zero there); the
+  // loops unrolled at fixed sizes.
+  const int nn = Nj == Eigen::Dynamic ? n() : Nj, kk = Nl == Eigen::Dynamic ? k() : Nl, rows = Nr == Eigen::Dynamic ? rows_ : Nr;
+  s.resize(rows);
+  // With the closed rows selected: problem_.J's row i is row closed_rows_[i]; the released rows' s is
+  // not solved for (0).
+  const int m = selected() ? int(closed_rows_.size()) : rows;
+  if (selected()) s.setZero();
+  for (int i = 0; i < m; ++i) {
+    const int r = selected() ? closed_rows_[std::size_t(i)] : i;
+    double gv = 0.0;
+    for (int j = 0; j < nn; ++j) gv += problem_.J(i, j) * v[j];
+    for (int j = 0; j < kk; ++j) gv -= problem_.A(i, j) * v[nn + j];
+    s[r] = -2.0 * zeta * omega * gv - omega * omega * phi_[r];
+  }
 }
 
 // A contact at or past its plane closes unless it separates faster than this (m/s): rounding-size
@@ -84,8 +133,9 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
   for (std::size_t i = 0; i < count; ++i) {
     if (!rigid(i) || !released_[i]) continue;
     const int r = offsets_[i];
+    if (!(phi_full_[r] >= 0.0)) continue;  // short of its plane (or stop)
     const double approach = J_full_.row(r).dot(v.head(n())) - (k() ? A_full_.row(r).dot(v.tail(k())) : 0.0);
-    if (phi_full_[r] >= 0.0 && approach >= -kSeparating) {
+    if (approach >= -kSeparating) {
       released_[i] = 0;
       ++changes;
     }

@@ -3,7 +3,8 @@
 //   template class dyn::ConstrainedMechanism<dyn::Planar, 3, 3, 1>;
 // physics/constrained_mechanism.cpp instantiates the bounded (Dynamic) sizes for both algebras. Here:
 // construction, the two stages, the solve, the integrator's interface, energy and the controllers'
-// queries; the rigid contacts' touchdowns, impacts and lift-offs are in constrained_mechanism_contacts.h.
+// queries; the rigid contacts' touchdowns, impacts and lift-offs, and the rows the integrators see (G,
+// the Baumgarte term), are in constrained_mechanism_contacts.h.
 #pragma once
 #include <algorithm>
 #include <cmath>
@@ -47,6 +48,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
   if (const std::string why = model_.validate(); !why.empty()) throw std::invalid_argument(why);
   for (const auto& c : model_.constraints) {
     offsets_.push_back(rows_);
+    row_count_.push_back(c->rows());
     rows_ += c->rows();
     // Rigid unilateral contacts start open (updateContacts closes them); compliant ones never close.
     const bool released = c->unilateral() || c->compliant();
@@ -133,6 +135,18 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   setZeroAt<Nr, Nl>(A_full_, rows_, kk);
   for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->position(kin_, offsets_[i], phi_full_, J_full_, A_full_);
   setFixed<Nr>(phi_, phi_full_);
+  // Some rows released at dynamic sizes: the closed rows alone, compacted (selectClosedRows); φ = 0 on
+  // the released ones.
+  if (selectClosedRows()) {
+    // (A one-row constraint's entry stored alone: GCC makes a loop over a few doubles a memset call.)
+    for (std::size_t i = 0; i < model_.constraints.size(); ++i)
+      if (released_[i] && row_count_[i] == 1) phi_[offsets_[i]] = 0.0;
+      else if (released_[i]) phi_.segment(offsets_[i], row_count_[i]).setZero();
+    factored_ = factor_.factor(problem_, problem_.J, problem_.A);
+    setFixed<kState>(staged_q_, q);
+    have_position_ = true;
+    return;
+  }
   problem_.J = J_full_;
   problem_.A = A_full_;
   // Released rows (open or compliant contacts) are zeroed in the solve (the full rows stay for gaps
@@ -141,15 +155,14 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
     setZeroAt<Nr, 1>(problem_.compliance, rows_, 1);
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
       if (released_[i])
-        for (int r = offsets_[i]; r < offsets_[i] + model_.constraints[i]->rows(); ++r) {
+        for (int r = offsets_[i]; r < offsets_[i] + row_count_[i]; ++r) {
           phi_[r] = 0.0;
           problem_.J.row(r).setZero();
           if (kk) problem_.A.row(r).setZero();
           problem_.compliance[r] = 1.0;
         }
   }
-  if (selectClosedRows()) factored_ = factor_.factor(problem_, J_closed_, A_closed_);
-  else factored_ = factor_.factor(problem_, problem_.J, problem_.A);
+  factored_ = factor_.factor(problem_, problem_.J, problem_.A);
   setFixed<kState>(staged_q_, q);
   have_position_ = true;
 }
@@ -211,9 +224,11 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
       if (kk) external_bc_.noalias() += Ap.transpose() * F;
     }
   }
-  // J'θ' − A'v_c of every constraint.
+  // J'θ' − A'v_c of every constraint (of the closed ones alone, compacted, when the rows are selected:
+  // the released rows' bias is not solved for).
   VecN bias(rows_);
-  for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->bias(kin_, offsets_[i], bias);
+  for (std::size_t i = 0; i < model_.constraints.size(); ++i)
+    if (!selected() || !released_[i]) model_.constraints[i]->bias(kin_, offsets_[i], bias);
   // Released rows: no bias; a compliant contact's force enters as −Jᵀη on the tree (h += Jᵀη) and
   // Aᵀη on the payloads.
   if (any_released_kind_) {
@@ -224,7 +239,8 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
     for (std::size_t i = 0; i < model_.constraints.size(); ++i) {
       if (!released_[i]) continue;
       const auto& c = *model_.constraints[i];
-      for (int r = offsets_[i]; r < offsets_[i] + c.rows(); ++r) bias[r] = 0.0;
+      if (!selected())  // (selected: the released rows' bias is not gathered)
+        for (int r = offsets_[i]; r < offsets_[i] + row_count_[i]; ++r) bias[r] = 0.0;
       if (!compliant_[i]) continue;
       const int r = offsets_[i];
       const double eta = c.compliantForce(kin_);
@@ -233,7 +249,8 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
       if (k()) compliant_bc_ -= eta * A_full_.row(r).transpose();
     }
   }
-  problem_.Jdot_qd = bias;
+  if (selected()) gatherClosedRows(bias, problem_.Jdot_qd);
+  else problem_.Jdot_qd = bias;
   setFixed<kState>(staged_v_, v);
   have_velocity_ = true;
 }
@@ -264,18 +281,19 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
     if (has_forces_ && k()) problem_.bc_Gc += external_bc_;
   }
   if (!stab) problem_.stab.resize(0);
+  else if (selected()) gatherClosedRows(*stab, problem_.stab);
   else setFixed<Nr>(problem_.stab, *stab);
   Solution s;
   if (!factored_) s = solveConstrainedBlockLU(problem_);
   else factor_.solve(problem_, s, with_qdd);
-  if (selected_) scatterClosedRows(s);
+  if (selected()) scatterClosedRows(s);
   // A compliant contact's η is its force, not the solve's (its row is released).
   if (any_compliant_)
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
       if (compliant_[i]) {
         const int r = offsets_[i];
         s.eta[r] = compliant_eta_[r];
-        if (problem_.Ht.size() == 0 || selected_) s.f[r] = compliant_eta_[r];
+        s.f[r] = compliant_eta_[r];
       }
   return s;
 }
@@ -362,30 +380,6 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::normalizeConfiguration(VecN& q) {
   if (!model_.tree.balls.empty()) dyn::normalizeConfiguration(model_.tree, q.head(nqTree()));
 }
 
-template <class S, int Nj, int Nr, int Nl>
-void ConstrainedMechanism<S, Nj, Nr, Nl>::constraint(const VecN& q, VecN& phi, MatN& G) {
-  positionStage(q);
-  phi = phi_;
-  // G = [J, −A]: G v = J θ' − A v_c.
-  G.resize(rows_, n() + k());
-  G.leftCols(n()) = problem_.J;
-  if (k()) G.rightCols(k()) = -MatN(problem_.A);
-}
-
-template <class S, int Nj, int Nr, int Nl>
-void ConstrainedMechanism<S, Nj, Nr, Nl>::baumgarteTerm(const VecN& q, const VecN& v, double zeta, double omega, VecN& s) {
-  positionStage(q);
-  // s = −2ζω (J θ' − A v_c) − ω² φ from the stage's own J and A (released rows are zero there); the
-  // loops unrolled at fixed sizes.
-  const int nn = Nj == Eigen::Dynamic ? n() : Nj, kk = Nl == Eigen::Dynamic ? k() : Nl, rows = Nr == Eigen::Dynamic ? rows_ : Nr;
-  s.resize(rows);
-  for (int r = 0; r < rows; ++r) {
-    double gv = 0.0;
-    for (int j = 0; j < nn; ++j) gv += problem_.J(r, j) * v[j];
-    for (int j = 0; j < kk; ++j) gv -= problem_.A(r, j) * v[nn + j];
-    s[r] = -2.0 * zeta * omega * gv - omega * omega * phi_[r];
-  }
-}
 
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::metric(const VecN& q, MatN& W) {
@@ -409,10 +403,14 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::impulseResponse(const VecN& e, Solutio
   Problem impulse;
   impulse.tau.setZero(n());
   impulse.h.setZero(n());
-  impulse.Jdot_qd = -e;
-  if (selected_) impulse.Ht = problem_.Ht;  // the closed rows the factor holds
+  if (selected()) {  // the closed rows the factor holds
+    impulse.Jdot_qd.resize(Eigen::Index(closed_rows_.size()));
+    for (std::size_t i = 0; i < closed_rows_.size(); ++i) impulse.Jdot_qd[Eigen::Index(i)] = -e[closed_rows_[i]];
+  } else {
+    impulse.Jdot_qd = -e;
+  }
   factor_.solve(impulse, s);
-  if (selected_) scatterClosedRows(s);
+  if (selected()) scatterClosedRows(s);
   dx.resize(n() + k());
   dx.head(n()) = s.qdd;
   dx.tail(k()) = s.alpha_c;
@@ -503,7 +501,11 @@ double ConstrainedMechanism<S, Nj, Nr, Nl>::residual(const VecN& q, const VecN& 
   positionStage(q);
   if (!rows_) return 0.0;
   // Velocity form J θ' − A v_c as well: a velocity-level kind has only this one.
-  const VecN gv = MatN(problem_.J) * v.head(n()) - MatN(problem_.A) * v.tail(k());
+  VecN phi;
+  MatN G;
+  if (selected()) constraint(q, phi, G);  // the rows over every constraint (problem_ holds the closed ones)
+  const MatN J = selected() ? MatN(G.leftCols(n())) : MatN(problem_.J), A = selected() ? MatN(-G.rightCols(k())) : MatN(problem_.A);
+  const VecN gv = J * v.head(n()) - A * v.tail(k());
   return std::max(phi_.lpNorm<Eigen::Infinity>(), gv.lpNorm<Eigen::Infinity>());
 }
 

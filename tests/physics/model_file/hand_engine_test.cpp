@@ -1,9 +1,12 @@
 // The hand engine for files with elements at fixed sizes (physics/model_file/hand_engine.h SixJoints:
 // six joints fixed, the rows dynamic, the closed rows alone solved) steps the PUMA 560's file with its
 // twelve joint-limit rows exactly as the dynamically sized mechanism does, bit for bit, through a run
-// that falls onto a stop (a row closed, its impact, the lift-off checks) and with every row open.
+// that falls onto a stop (a row closed, its impact, the lift-off checks) and with every row open; and
+// the solve on the closed rows alone (compacted: J̃, J'θ' and the Baumgarte term of those rows only)
+// gives what the solve over all twelve rows gives with the open ones zeroed at unit compliance.
 #include <doctest/doctest.h>
 
+#include "physics/constrained_mechanism_impl.h"
 #include "physics/model_file/actuators.h"
 #include "physics/model_file/hand_engine.h"
 #include "physics/model_file/model_file.h"
@@ -12,38 +15,71 @@
 using namespace dyn;
 using dyn::test_model_file::model;
 
+namespace {
+// Steps two mechanisms side by side from the PUMA file's pose (contacts updated, touchdowns located),
+// requiring the same rows closed and the same (q, v) bit for bit at every step; with solutions, also
+// the same η (over every row) and θ'' solved there. Returns how many steps ended with a row closed.
+template <class A, class B>
+int lockstep(const model_file::LoadedModel& m, Integrator integrator, A& a, B& b, bool solutions) {
+  StepOptions o;
+  o.dt = m.timestep;
+  o.integrator = integrator;
+  if (integrator == Integrator::SemiImplicitEuler) o.drift.kind = Drift::Baumgarte;
+  const VecN tau = VecN::Zero(6);
+  VecN q1 = m.start_q, v1 = m.start_v, q2 = q1, v2 = v1;
+  int closed_steps = 0;
+  for (int k = 0; k < 1500; ++k) {
+    a.updateContacts(q1, v1, tau);
+    b.updateContacts(q2, v2, tau);
+    REQUIRE(a.stepLocatingContacts(o, tau, q1, v1));
+    REQUIRE(b.stepLocatingContacts(o, tau, q2, v2));
+    bool any = false;
+    for (int i = 0; i < 12; ++i) {
+      REQUIRE(a.closed(i) == b.closed(i));
+      any = any || a.closed(i);
+    }
+    closed_steps += any;
+    REQUIRE(q1 == q2);
+    REQUIRE(v1 == v2);
+    if (!solutions) continue;
+    const auto s1 = a.solve(q1, v1, tau);
+    const auto s2 = b.solve(q2, v2, tau);
+    REQUIRE(s1.eta.size() == 12);
+    REQUIRE(VecN(s1.eta) == VecN(s2.eta));  // 0 on the open rows
+    REQUIRE(VecN(s1.qdd) == VecN(s2.qdd));
+  }
+  return closed_steps;
+}
+}  // namespace
+
 TEST_CASE("the six-joint engine with limits steps the PUMA file as the dynamically sized mechanism, bit for bit") {
   const model_file::LoadedModel m = model_file::load(model("puma560.urdf"));
   REQUIRE(model_file::sixJointsFixed(m.mechanism));
   REQUIRE(m.contacts.size() == 12);  // both sides of six joints
   for (Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::RK4}) {
     INFO(int(integrator));
-    StepOptions o;
-    o.dt = m.timestep;
-    o.integrator = integrator;
-    if (integrator == Integrator::SemiImplicitEuler) o.drift.kind = Drift::Baumgarte;
     model_file::DrivenMechanism dynamic(m);
     model_file::DrivenMechanismT<model_file::SixJoints> sized(m);
-    const VecN tau = VecN::Zero(6);
-    VecN q1 = m.start_q, v1 = m.start_v, q2 = q1, v2 = v1;
-    int closed_steps = 0;
-    for (int k = 0; k < 1500; ++k) {
-      dynamic.updateContacts(q1, v1, tau);
-      sized.updateContacts(q2, v2, tau);
-      REQUIRE(dynamic.stepLocatingContacts(o, tau, q1, v1));
-      REQUIRE(sized.stepLocatingContacts(o, tau, q2, v2));
-      bool any = false;
-      for (int i = 0; i < 12; ++i) {
-        REQUIRE(dynamic.closed(i) == sized.closed(i));
-        any = any || dynamic.closed(i);
-      }
-      closed_steps += any;
-      REQUIRE(q1 == q2);
-      REQUIRE(v1 == v2);
-    }
+    const int closed_steps = lockstep(m, integrator, dynamic, sized, false);
     CHECK(closed_steps > 100);         // it came to rest on a stop
     CHECK(closed_steps < 1500);        // and fell freely before
     CHECK(dynamic.impactLoss() > 0);   // with an impact
     CHECK(dynamic.impactLoss() == sized.impactLoss());
+  }
+}
+
+// Twelve rows fixed: every row in the solve, the open ones zeroed at unit compliance (η = 0 there).
+template class dyn::ConstrainedMechanism<Spatial, 6, 12, 0>;
+
+TEST_CASE("the PUMA file's closed rows solved alone step as every row solved with the open ones zeroed, bit for bit") {
+  const model_file::LoadedModel m = model_file::load(model("puma560.urdf"));
+  REQUIRE(m.actuators.empty());
+  for (Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::RK4}) {
+    INFO(int(integrator));
+    model_file::SixJoints selected(m.mechanism);
+    ConstrainedMechanism<Spatial, 6, 12, 0> every(m.mechanism);
+    CHECK(lockstep(m, integrator, selected, every, true) > 100);
+    CHECK(selected.impactLoss() > 0);
+    CHECK(selected.impactLoss() == every.impactLoss());
   }
 }
