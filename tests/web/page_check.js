@@ -15,7 +15,8 @@ const os = require('os');
 const path = require('path');
 const { spawn } = require('child_process');
 
-const [site, chromium, timeoutText, ...rest] = process.argv.slice(2);
+const [siteArg, chromium, timeoutText, ...rest] = process.argv.slice(2);
+const site = path.resolve(siteArg || '.');  // a relative SITE_DIR too (the server compares resolved paths)
 const shots = rest.length && rest[0].startsWith('--screenshots=') ? rest.shift().substring(14) : '';
 const queries = rest;
 const timeoutMs = Number(timeoutText) * 1000;

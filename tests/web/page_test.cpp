@@ -6,7 +6,8 @@
 // background), and every shipped example opened as ?lab=LAB&gains=<the file's JSON>&grade=1 prints one
 // console line "dynlab results.json: {...}" equal to the native `dynlab grade`'s results.json but
 // execution_time.
-// Skipped (DYNLAB_TEST_SKIPPED) without node, Chromium or a current build/web (scripts/web).
+// Skipped (DYNLAB_TEST_SKIPPED) without node, Chromium or a current build/web (scripts/web); a failure
+// instead under DYNLAB_REQUIRE_WEB=1 (CI, tests/web/web_required.h).
 #include <doctest/doctest.h>
 
 #include <nlohmann/json.hpp>
@@ -18,6 +19,7 @@
 
 #include "tests/app/cli_run.h"
 #include "tests/app/lab_examples.h"
+#include "tests/web/web_required.h"
 
 using namespace dyn::test::cli;
 using dyn::test::labExamples;
@@ -53,11 +55,7 @@ std::string missing() {
   return "";
 }
 
-bool skipped() {
-  const std::string why = missing();
-  if (!why.empty()) std::cout << "DYNLAB_TEST_SKIPPED: " << why << "; the page was not checked\n";
-  return !why.empty();
-}
+bool skipped() { return dyn::test::webTestCannotRun(missing(), "the page was not checked"); }
 
 // Opens each query in the browser; what each page said, by query.
 std::map<std::string, json> openPages(const TempDir& dir, const std::vector<std::string>& queries) {

@@ -5,13 +5,14 @@
 // trajectory_hash, so the traces are compared too. The model-file labs (fivebar, puma_motion,
 // puma_impedance) too: the web build has no MuJoCo parser and reads their models' descriptions, which
 // scripts/web exports with the native dynlab (docs/model_descriptions.md). Skipped (DYNLAB_TEST_SKIPPED)
-// when scripts/web has not been run or node is missing.
+// when scripts/web has not been run or node is missing; a failure instead under DYNLAB_REQUIRE_WEB=1 (CI).
 #include <doctest/doctest.h>
 
 #include <iostream>
 
 #include "tests/app/cli_run.h"
 #include "tests/app/lab_examples.h"
+#include "tests/web/web_required.h"
 
 using namespace dyn::test::cli;
 using dyn::test::labExamples;
@@ -43,11 +44,7 @@ std::string missing() {
   return "";
 }
 
-bool skipped() {
-  const std::string why = missing();
-  if (!why.empty()) std::cout << "DYNLAB_TEST_SKIPPED: " << why << "; the web grade was not compared\n";
-  return !why.empty();
-}
+bool skipped() { return dyn::test::webTestCannotRun(missing(), "the web grade was not compared"); }
 
 Result webGrade(const TempDir& dir, const std::string& lab, const fs::path& submission) {
   ProcessOptions o;
