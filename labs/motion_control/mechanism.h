@@ -59,7 +59,7 @@ using FixedArm = ConstrainedMechanism<Planar, Nj, 0, 0>;
 // under gravity: the impedance lab's pushed arm). Both thresholds are rates, not per-step amounts, so the
 // steps refined are about the same at any dt and the run converges at RK4's fourth order.
 inline constexpr double kFrictionBandWidths = 5;
-inline constexpr int kFrictionSubsteps = 8;
+inline constexpr int kFrictionSubsteps = 4;
 
 // The arm as a lab's hand engine steps it: the mechanism M (FixedArm<N>, ArmMechanism, …), refined there.
 template <class M>
