@@ -74,8 +74,23 @@ namespace {
 // The last stage's time, just inside the step (see integrate.h).
 constexpr double kInside = 1.0 - 1e-9;
 
-// One step of dt from the clock's time t0: the motion, the books, the drift handling.
-bool stepOnce(ConstrainedSystem& sys, const StepOptions& o, double dt, const VecN& tau, VecN& q, VecN& v) {
+bool stepOnce(ConstrainedSystem& sys, const StepOptions& o, double dt, const VecN& tau, VecN& q, VecN& v, bool may_refine);
+
+// The step of dt from the clock's time t0 as o.refine_substeps equal RK4 steps (none refined again).
+bool refined(ConstrainedSystem& sys, const StepOptions& o, double dt, const VecN& tau, VecN& q, VecN& v) {
+  const double t0 = sys.time(), h = dt / o.refine_substeps;
+  bool ok = true;
+  for (int i = 0; i < o.refine_substeps; ++i) {
+    sys.setTime(t0 + i * h);
+    ok = stepOnce(sys, o, h, tau, q, v, false) && ok;
+  }
+  sys.setTime(t0 + dt);
+  return ok;
+}
+
+// One step of dt from the clock's time t0: the motion, the books, the drift handling (or, marked by
+// the system's refine() at its first stage, the same step in sub-steps).
+bool stepOnce(ConstrainedSystem& sys, const StepOptions& o, double dt, const VecN& tau, VecN& q, VecN& v, bool may_refine) {
   const double t0 = sys.time();
   VecN s, a;
   double w1, f1;
@@ -92,6 +107,7 @@ bool stepOnce(ConstrainedSystem& sys, const StepOptions& o, double dt, const Vec
     VecN a1, a2, a3, a4, d1, d2, d3, d4;
     double w2, w3, w4, f2, f3, f4;
     sys.derivatives(q, v, tau, baumgarte(sys, o.drift, q, v, s), a1, w1, f1);
+    if (may_refine && o.refine_substeps > 1 && sys.refine(q, v, a1, dt)) return refined(sys, o, dt, tau, q, v);
     sys.configurationRate(q, v, d1);
     const VecN q2 = q + 0.5 * dt * d1, v2 = v + 0.5 * dt * a1;
     sys.setTime(t0 + 0.5 * dt);
@@ -128,13 +144,13 @@ bool stepOnce(ConstrainedSystem& sys, const StepOptions& o, double dt, const Vec
 
 bool step(ConstrainedSystem& sys, const StepOptions& o, const VecN& tau, VecN& q, VecN& v) {
   const int n = std::max(1, o.substeps);
-  if (n == 1) return stepOnce(sys, o, o.dt, tau, q, v);
+  if (n == 1) return stepOnce(sys, o, o.dt, tau, q, v, true);
   // Sub-steps: the clock from t0 + i dt/n exactly (no sum of n rounded sub-steps).
   const double t0 = sys.time(), h = o.dt / n;
   bool ok = true;
   for (int i = 0; i < n; ++i) {
     sys.setTime(t0 + i * h);
-    ok = stepOnce(sys, o, h, tau, q, v) && ok;
+    ok = stepOnce(sys, o, h, tau, q, v, true) && ok;
   }
   sys.setTime(t0 + o.dt);
   return ok;

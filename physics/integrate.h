@@ -4,7 +4,11 @@
 // φ(q) = 0 with velocity form G(q) v = 0 (G = [J, −A] for the lecture's J θ' = A v_c).
 // Integrators:  semi-implicit Euler  v⁺ = v + dt a(q, v),  q⁺ = q + dt v⁺   (1st order, symplectic)
 //               RK4                  classic four-stage                     (4th order)
-//               either in `substeps` equal sub-steps of dt with τ held (stiff modes: ω dt/substeps small)
+//               either in `substeps` equal sub-steps of dt with τ held (stiff modes: ω dt/substeps small),
+//               and an RK4 step that the system marks at its first stage (ConstrainedSystem::refine: a
+//               stiff term near where it turns, e.g. friction about θ' = 0) retaken from its start as
+//               `refine_substeps` equal sub-steps: the decision a function of the step's start alone
+//               (deterministic), each sub-step an RK4 step of its own (fourth order either way)
 // The books: beside (q, v) step() integrates, with the same scheme and stage weights, the work W of τ
 // and of the external forces (power (τ + Q_ext)·v) and D, that of joint friction (≤ 0), so that
 // E − E0 − W − D is at the integrator's own error (τ held: its share is τ·Δq, exactly). The clock: each
@@ -91,6 +95,12 @@ class ConstrainedSystem {
     (void)v;
     return false;
   }
+  // Whether an RK4 step of h from (q, v), whose first stage gave the accelerations a, is to be taken
+  // in StepOptions::refine_substeps sub-steps (integrate.h, top). The default: never.
+  virtual bool refine(const VecN& q, const VecN& v, const VecN& a, double h) {
+    (void)q, (void)v, (void)a, (void)h;
+    return false;
+  }
 
  protected:
   double time_ = 0;
@@ -102,6 +112,7 @@ struct StepOptions {
   Integrator integrator = Integrator::RK4;
   DriftOptions drift;
   int substeps = 1;  // equal sub-steps of dt (each with its drift handling), τ held over all of them
+  int refine_substeps = 1;  // RK4: sub-steps of a (sub-)step the system's refine() marks (1: none asked)
 };
 
 // One fixed step of (q, v) with τ held, the system's clock and books advanced with it. Returns false if

@@ -24,6 +24,11 @@ namespace {
 
 using motion_control::Params;
 constexpr double kMaxLength = 100, kMaxMass = 1e6, kMaxForce = 1e5;
+// The hand engine's RK4 step in kSwingSubsteps sub-steps while a joint turns faster than kSwing
+// (motion_control::RefinedArm): the passive arm under gravity whips at up to 21 rad/s, where a 1 ms step
+// is 1.5e-6 m off the reference; the pushes and the controlled arm are far slower and keep one step.
+constexpr double kSwing = 8.0;  // rad/s
+constexpr int kSwingSubsteps = 2;
 
 Eigen::Vector3d parse3(const JsonView& j, double lo, double hi, double scale = 1.0) {
   j.size(3, 3);
@@ -259,6 +264,7 @@ Settings parseSettings(const JsonView& c) {
 
   const SimulationSettings sim = parseSimulation(c["simulation"]);
   s.step = sim.step;
+  s.step.refine_substeps = kSwingSubsteps;
   s.duration = sim.duration;
   if (s.wall.enabled && tipPose(s.plant, s.pose)[0] + s.wall.radius > s.wall.x)
     c["environment"]["wall"]["x"].fail("a wall to the right of the tip at the reference pose");
@@ -325,7 +331,8 @@ namespace {
 // A run on mechanism type M (its sizes fixed: every loop of the step unrolled).
 template <class M>
 std::unique_ptr<Simulation> run(const Settings& s, Engine engine, const std::vector<std::string>& columns) {
-  auto mech = std::make_unique<M>(describeWithWall(s));
+  auto mech = std::make_unique<motion_control::RefinedArm<M>>(describeWithWall(s));
+  mech->swing = kSwing;
   VecN q = VecN(s.pose), v = VecN::Zero(3);
   auto hooks = std::make_unique<Hooks>(s);
   if (engine == Engine::Hand && s.wall.enabled && s.wall.stiffness == 0)

@@ -172,8 +172,13 @@ Settings parseSettings(const JsonView& c) {
   const SimulationSettings sim = parseSimulation(c["simulation"]);
   s.step = sim.step;
   s.duration = sim.duration;
-  // Flexible joints: the hand engine sub-steps dt so that the fastest rotor–spring mode (over the
-  // trajectory's two poses) has ω dt/substeps ≤ kResolvedOmegaDt; the trace keeps one row per dt.
+  // Coulomb friction where it turns: those RK4 steps in kFrictionSubsteps sub-steps (mechanism.h RefinedArm).
+  // Flexible joints: the hand engine sub-steps dt so that the fastest rotor–spring mode has
+  // ω dt/substeps ≤ kResolvedOmegaDt; ω² the largest eigenvalue of K x = ω² M(θ) x (fastestMode: the
+  // springs' stiffness against the whole mass matrix, the rotors' inertia in it) at the trajectory's two
+  // poses (the outstretched one is the fastest pose of the arm: tests/labs/stiff_terms_test.cpp); the
+  // trace keeps one row per dt.
+  s.step.refine_substeps = kFrictionSubsteps;
   if (s.plant.flexible) {
     const double w = std::max(fastestMode(s.plant, T.outstretched), fastestMode(s.plant, T.folded));
     s.step.substeps = std::max(1, int(std::ceil(w * s.step.dt / kResolvedOmegaDt)));
@@ -243,9 +248,9 @@ std::string MotionControlLab::unit(const std::string& c) const {
 std::unique_ptr<Simulation> MotionControlLab::simulate(Engine engine) const {
   const int n = s_.plant.n();
   const auto cols = columns();
-  if (n == 3 && !s_.plant.flexible) return run<FixedArm<3>>(s_, engine, cols);
-  if (n == 3 && s_.plant.flexible) return run<FixedArm<6>>(s_, engine, cols);
-  return run<ArmMechanism>(s_, engine, cols);
+  if (n == 3 && !s_.plant.flexible) return run<RefinedArm<FixedArm<3>>>(s_, engine, cols);
+  if (n == 3 && s_.plant.flexible) return run<RefinedArm<FixedArm<6>>>(s_, engine, cols);
+  return run<RefinedArm<ArmMechanism>>(s_, engine, cols);
 }
 
 json MotionControlLab::metrics(const Trace& tr) const {

@@ -25,7 +25,7 @@ Eigen::VectorXd staticDeflection(const Params& plant, const Eigen::VectorXd& the
 // eigenvalue of M⁻¹K (K the springs on the deflections, motors free); 0 for a rigid arm.
 double fastestMode(const Params& plant, const Eigen::VectorXd& theta);
 // ω dt of the fastest mode that the hand engine's sub-steps keep (RK4's phase error per step ~ (ω dt)⁴/120).
-inline constexpr double kResolvedOmegaDt = 0.05;
+inline constexpr double kResolvedOmegaDt = 0.04;
 
 class MotionControlLab final : public SettingsLab<Settings> {
  public:

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "physics/constrained_mechanism.h"
+#include "physics/friction_band.h"
 
 namespace dyn::motion_control {
 
@@ -50,6 +51,28 @@ MechanismModel<Planar> describeRigid(const Params& params);
 // The hand engine's mechanism at the right sizes: fixed for 3 links (rigid 3, flexible 6 joints), else bounded.
 template <int Nj>
 using FixedArm = ConstrainedMechanism<Planar, Nj, 0, 0>;
+
+// Where the lab's hand engine refines an RK4 step (integrate.h ConstrainedSystem::refine: the step
+// retaken from its start in StepOptions::refine_substeps sub-steps, decided by the step's start alone):
+// a joint's Coulomb friction near its turn (physics/friction_band.h: |θ'| < kFrictionBandWidths·w +
+// 2|θ''|h), and, where a lab sets `swing`, a joint faster than `swing` rad/s (a passive arm whipping
+// under gravity: the impedance lab's pushed arm). Both thresholds are rates, not per-step amounts, so the
+// steps refined are about the same at any dt and the run converges at RK4's fourth order.
+inline constexpr double kFrictionBandWidths = 5;
+inline constexpr int kFrictionSubsteps = 4;
+
+// The arm as a lab's hand engine steps it: the mechanism M (FixedArm<N>, ArmMechanism, …), refined there.
+template <class M>
+class RefinedArm final : public M {
+ public:
+  using M::M;
+  double swing = 0;  // rad/s; 0: no refinement for speed
+  bool refine(const VecN& q, const VecN& v, const VecN& a, double h) override {
+    (void)q;
+    if (nearFrictionTurn(this->model().joints, v, a, h, kFrictionBandWidths)) return true;
+    return swing > 0 && v.head(this->n()).cwiseAbs().maxCoeff() > swing;
+  }
+};
 
 // Map between the tree's coordinates and the arm's (link-side angles, motor-side angles).
 struct ArmState {

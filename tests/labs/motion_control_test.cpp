@@ -2,7 +2,7 @@
 //  * τ = 0 without friction conserves energy to 1e-6 J in 1 s (RK4), rigid and flexible (springs included);
 //  * with friction and a controller, E − E0 equals the work of τ plus the friction's (the RK4 books);
 //  * with Coulomb friction (F_c tanh(θ'/w)) the PID run converges at fourth order (dt 0.25 → 0.125 ms; the clamp: second);
-//  * a passive flexible arm at the lab's default step (sub-stepped: ω dt ≤ 0.05) agrees with dt/4 to 1e-6 rad over 3 s;
+//  * a passive flexible arm at the lab's default step (sub-stepped: ω dt ≤ 0.04) agrees with dt/4 to 1e-6 rad over 3 s;
 //  * computed torque with an exact model (friction included): e(t) = (e0 + (e0' + ω e0) t) e^{−ωt}
 //    for ζ = 1, within 1e-3·|e0| at dt = 0.2 ms (the 1-step zero-order hold costs O(ω dt));
 //  * PD + gravity, set-point: V = ½θ'ᵀMθ' + ½eᵀK_p e never rises by more than 1e-9·V0 a step and the arm settles;
