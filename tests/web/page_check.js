@@ -36,7 +36,9 @@ const server = http.createServer((req, res) => {
 
 function main(port) {
   const profile = fs.mkdtempSync(path.join(os.tmpdir(), 'dynlab-page-check-'));
-  const browser = spawn(chromium, ['--headless', '--no-sandbox', '--enable-unsafe-swiftshader', '--use-angle=swiftshader',
+  // --disable-dev-shm-usage: shared memory in /tmp, where a container's /dev/shm (64 MB) is too small.
+  const browser = spawn(chromium, ['--headless', '--no-sandbox', '--disable-dev-shm-usage',
+    '--enable-unsafe-swiftshader', '--use-angle=swiftshader',
     '--remote-debugging-pipe', '--user-data-dir=' + profile, '--window-size=1400,800', '--no-first-run',
     '--disable-background-timer-throttling', '--disable-renderer-backgrounding', 'about:blank'],
   { stdio: ['ignore', 'ignore', 'ignore', 'pipe', 'pipe'] });
