@@ -236,19 +236,31 @@ PlotLayout writePlot(const std::string& path, const PlotSpec& spec, int width_px
 }
 
 void warmUpPlotting() {
+  // A full-size plot with every printable ASCII glyph in each of its fonts (title, labels, ticks,
+  // legend), drawn in memory: a forked grader inherits the loaded fonts and the glyphs' caches.
+  std::string glyphs;
+  for (char c = ' '; c <= '~'; ++c) glyphs += c;
+  PlotSpec spec;
+  spec.title = spec.xlabel = spec.ylabel = glyphs;
+  PlotSeries smooth{glyphs, {0, 1, 2, 3}, {0, 1, 0, 1}}, noisy{"noise", {}, {}};
+  for (int i = 0; i <= 400; ++i) noisy.x.push_back(i * 0.01), noisy.y.push_back(i % 2 ? 1.0 : -1.0);
+  spec.series = {noisy, smooth};
+  spec.bands = {{"band", {0, 4}, {-0.1, -0.1}, {0.1, 0.1}}};
+  spec.spans = {{"span", 0, 0.5}};
+  const int w = 640, h = 360;
   std::lock_guard<std::mutex> lock(plplot_mutex);
-  std::vector<unsigned char> pixels(64 * 64 * 4, 255);
+  std::vector<unsigned char> pixels(std::size_t(w) * h * 4, 255);
   try {
+    const plot_detail::Prepared prepared = plot_detail::prepare("warm-up", spec);
     plsexit(throwOnPlplotExit);
     Stream stream;
     plsdev("memcairo");
-    plsmema(64, 64, pixels.data());
-    plspage(kDpi, kDpi, 64, 64, 0, 0);
+    plsmema(w, h, pixels.data());
+    plspage(kDpi, kDpi, w, h, 0, 0);
+    plsfam(0, 0, 0);
+    plot_detail::setColours();
     plinit();
-    pladv(0);
-    plvpor(0, 1, 0, 1);
-    plwind(0, 1, 0, 1);
-    plmtex("t", -2, 0.5, 0.5, "0.5 N");
+    plot_detail::draw(prepared, w, h);
   } catch (const std::exception&) {
     // Nothing lost: the first plot loads it all instead.
   }
