@@ -154,6 +154,23 @@ std::string encodePng(const std::vector<unsigned char>& rgba, int width, int hei
   return png;
 }
 
+// One fresh PLplot stream drawing `prepared` at w × h pixels: device memcairo into `pixels`, any other
+// into `file`; size, colours, then the plot; ended (the file closed, the pixels written) on return.
+// The caller holds plplot_mutex.
+PlotLayout drawStream(const plot_detail::Prepared& prepared, const std::string& device, const std::string& file,
+                      std::vector<unsigned char>& pixels, int w, int h) {
+  plsexit(throwOnPlplotExit);
+  Stream stream;
+  plsdev(device.c_str());
+  if (device == "memcairo") plsmema(w, h, pixels.data());
+  else plsfnam(file.c_str());
+  plspage(kDpi, kDpi, w, h, 0, 0);
+  plsfam(0, 0, 0);
+  plot_detail::setColours();
+  plinit();
+  return plot_detail::draw(prepared, w, h);
+}
+
 }  // namespace
 
 PlotWindow equalAspect(const PlotWindow& w, double frame_width, double frame_height) {
@@ -185,29 +202,14 @@ PlotLayout writePlot(const std::string& path, const PlotSpec& spec, int width_px
     fail(path, std::string("cannot write ") + scratch + ": " + std::strerror(errno));
   }
 
-  // One fresh PLplot stream: device, file, size in pixels, colours; ended (file closed) on scope exit.
   // A PNG is drawn by memcairo into `pixels` and encoded here (pngcairo's writer is slow).
   const bool png = device == "pngcairo";
   std::vector<unsigned char> pixels(png ? std::size_t(width_px) * height_px * 4 : 0, 255);
   {
     std::lock_guard<std::mutex> lock(plplot_mutex);
     try {
-      plsexit(throwOnPlplotExit);
-      {
-        Stream stream;
-        if (png) {  // drawn into memory (on the paper colour), encoded below
-          plsdev("memcairo");
-          plsmema(width_px, height_px, pixels.data());
-        } else {
-          plsdev(device.c_str());
-          plsfnam(scratch.c_str());
-        }
-        plspage(kDpi, kDpi, width_px, height_px, 0, 0);
-        plsfam(0, 0, 0);
-        plot_detail::setColours();
-        plinit();
-        layout = plot_detail::draw(prepared, width_px, height_px);
-      }
+      // A PNG drawn into memory (on the paper colour), encoded below.
+      layout = drawStream(prepared, png ? "memcairo" : device, scratch, pixels, width_px, height_px);
       if (png) std::ofstream(scratch, std::ios::binary) << encodePng(pixels, width_px, height_px);
     } catch (const std::exception& e) {
       std::remove(scratch.c_str());
@@ -251,16 +253,7 @@ void warmUpPlotting() {
   std::lock_guard<std::mutex> lock(plplot_mutex);
   std::vector<unsigned char> pixels(std::size_t(w) * h * 4, 255);
   try {
-    const plot_detail::Prepared prepared = plot_detail::prepare("warm-up", spec);
-    plsexit(throwOnPlplotExit);
-    Stream stream;
-    plsdev("memcairo");
-    plsmema(w, h, pixels.data());
-    plspage(kDpi, kDpi, w, h, 0, 0);
-    plsfam(0, 0, 0);
-    plot_detail::setColours();
-    plinit();
-    plot_detail::draw(prepared, w, h);
+    drawStream(plot_detail::prepare("warm-up", spec), "memcairo", "", pixels, w, h);
   } catch (const std::exception&) {
     // Nothing lost: the first plot loads it all instead.
   }
