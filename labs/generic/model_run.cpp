@@ -22,17 +22,17 @@ namespace {
 // at this state) and each closure's force on its kept rows, then the elements' columns; the run's
 // extremes follow.
 void record(ModelRun& run, ConstrainedMechanism<Spatial>& mech, double t, const VecN& q, const VecN& v, double work,
-            const std::vector<double>& forces, double phi, double phi_q) {
+            const std::vector<double>& forces, const RunResidual& phi) {
   const double e = mech.energy(q, v);
   if (run.trace.rows() == 0) run.e0 = e;
   std::vector<double> row{t};
   row.insert(row.end(), q.data(), q.data() + q.size());
   row.insert(row.end(), v.data(), v.data() + v.size());
-  row.insert(row.end(), {e, work, phi});
+  row.insert(row.end(), {e, work, phi.all});
   row.insert(row.end(), forces.begin(), forces.end());
   run.trace.append(row);
-  run.residual = std::max(run.residual, phi);
-  run.position_residual = std::max(run.position_residual, phi_q);
+  run.residual = std::max(run.residual, phi.all);
+  run.position_residual = std::max(run.position_residual, phi.positions);
   run.balance = std::max(run.balance, std::abs(e - run.e0 - work));
   run.kinetic = std::max(run.kinetic, mech.kineticEnergy(q, v));
 }
@@ -49,9 +49,6 @@ bool stopIfOpened(ModelRun& run, model_file::EveryClosureRow& every, const VecN&
 
 }  // namespace
 
-// |φ|∞ of a model with dynlab's elements at a state: the closures' and wheels' rows, position and
-// velocity forms (a wheel's x, y rows have only the latter: its slip), and each contact's depth past
-// its plane (the description's mechanism, whose contacts stay open: their gaps are read, not held).
 namespace {
 // The largest depth of a rigid contact or a joint stop past its bound at the state desc was staged at.
 double elementDepth(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc) {
@@ -66,23 +63,24 @@ double elementDepth(const model_file::LoadedModel& m, ConstrainedMechanism<Spati
 }
 }  // namespace
 
+// The description's mechanism keeps its contacts open: their gaps are read, not held.
 double elementResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, const VecN& q, const VecN& v) {
   const double phi = desc.residual(q, v);
   desc.stage(q);
   return std::max(phi, elementDepth(m, desc));
 }
 
-double runResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q, const VecN& v) {
-  return std::max(m.contacts.empty() ? desc.residual(q) : elementResidual(m, desc, q, v), every.residual(q));
-}
-
-double runPositionResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q) {
-  double phi = desc.residual(q);
-  if (!m.contacts.empty()) {
-    desc.stage(q);
-    phi = std::max(phi, elementDepth(m, desc));
+RunResidual runResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q,
+                        const VecN& v) {
+  const double rows = every.residual(q);
+  if (m.contacts.empty()) {
+    const double phi = desc.residual(q);
+    return {std::max(phi, rows), std::max(phi, rows)};
   }
-  return std::max(phi, every.residual(q));
+  const double with_rates = desc.residual(q, v), at_positions = desc.residual(q);
+  desc.stage(q);
+  const double depth = elementDepth(m, desc);
+  return {std::max(std::max(with_rates, depth), rows), std::max(std::max(at_positions, depth), rows)};
 }
 
 // The power the joints' damping and friction take out of the mechanism (≥ 0), by the description's
@@ -175,7 +173,7 @@ ModelRun runHand(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>
     const auto s = mech.solve(q, v, tau + model_file::actuatorTorques(m, q, v));
     const Books b = engine->books();
     record(run, mech, k * dt, q, v, b.work + b.friction, std::vector<double>(s.eta.data(), s.eta.data() + s.eta.size()),
-           runResidual(m, mech, every, q, v), runPositionResidual(m, mech, every, q));
+           runResidual(m, mech, every, q, v));
     if (stopIfOpened(run, every, q) || k == steps) break;
     if (!(run.ok = step(*engine, o, tau, q, v) && q.allFinite() && v.allFinite())) break;
   }
@@ -243,8 +241,7 @@ ModelRun runHandElements(const model_file::LoadedModel& m, ConstrainedMechanism<
       const double P = stepped ? pc->normal().dot(Spatial::linear(engine.impactImpulse(int(closures + i)))) : 0.0;
       row.insert(row.end(), {r[1] + P / dt, 0.0, r[0]});
     }
-    record(run, desc, k * dt, q_row, v_row, b.work + b.friction - loss, row, runResidual(m, desc, every, q_row, v_row),
-           runPositionResidual(m, desc, every, q_row));
+    record(run, desc, k * dt, q_row, v_row, b.work + b.friction - loss, row, runResidual(m, desc, every, q_row, v_row));
     if (stopIfOpened(run, every, q_row) || k == steps || !run.ok) break;
   }
   return run;
@@ -262,7 +259,7 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
   // them) evaluated at each sub-step's start and their work summed over the sub-steps (trapezoid rule).
   const int substeps = model_file::stiffSubsteps(model_file::fastestMode(m).rate, dt);
   const double h = dt / substeps;
-  bullet::BulletMechanism<Spatial> bt(m.mechanism, dt / substeps, q, v);
+  bullet::BulletMechanism<Spatial> bt(m.mechanism, h, q, v);
   run.summary = bt.describe() + (substeps > 1 ? ", " + std::to_string(substeps) + " steps of dt/" + std::to_string(substeps) + " per row" : "");
   const bool impacts = anyImpacts(m);
   // The torques: τ and the file's actuators at the state (held over Bullet's step from its start).
@@ -312,7 +309,7 @@ ModelRun runBullet(const model_file::LoadedModel& m, ConstrainedMechanism<Spatia
         }
       }
     }
-    record(run, mech, k * dt, q, v, row_work, forces, runResidual(m, mech, every, q, v), runPositionResidual(m, mech, every, q));
+    record(run, mech, k * dt, q, v, row_work, forces, runResidual(m, mech, every, q, v));
     if (k == steps) break;
     if (!(run.ok = qn.allFinite() && vn.allFinite())) break;
     const double p = inflow(qn, vn);

@@ -33,13 +33,18 @@ Trace modelColumns(const model_file::LoadedModel& m);
 // A rigid plane contact among the model's elements: its touchdowns are plastic impacts.
 bool anyImpacts(const model_file::LoadedModel& m);
 
-// |φ|∞ a run of the model reports at a state: the rows the description holds (the closures' kept rows; with
-// dynlab's elements, elementResidual) and every closure row, the dropped ones too (closure_rows.h).
-double runResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q,
-                   const VecN& v);
-
-// The same at the positions alone: the rows' φ, contacts' and joint stops' depths, every closure row (no velocity form).
-double runPositionResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q);
+// |φ|∞ a run of the model reports at a state (all): the rows the description holds (the closures' kept
+// rows; with dynlab's elements, elementResidual) and every closure row, the dropped ones too
+// (closure_rows.h); and the same at the positions alone (positions: the rows' φ, contacts' and joint
+// stops' depths, every closure row; no velocity form J v, such as a coupling's rate or a wheel's slip).
+struct RunResidual {
+  double all = 0, positions = 0;
+};
+RunResidual runResidual(const model_file::LoadedModel& m, ConstrainedMechanism<Spatial>& desc, model_file::EveryClosureRow& every, const VecN& q,
+                        const VecN& v);
+// Whether a run's residual is mostly its rows' velocity form (over twice the positions' share, above
+// round-off): then the reports say the positions' share beside it (Bullet's gear row on the 2F-85).
+inline bool ratesDominate(double all, double positions) { return all > 2 * positions && all > 1e-12; }
 
 // The power the joints' damping and friction take out of the mechanism (≥ 0), by the description's law.
 double frictionPower(const MechanismModel<Spatial>& d, const VecN& v);

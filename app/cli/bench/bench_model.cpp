@@ -198,8 +198,9 @@ std::vector<Accuracy> accuracy(std::vector<Engine>& engines, const model_file::L
         break;
       }
       path[i].push_back(q);
-      out[i].residual = std::max(out[i].residual, runResidual(m, mech, every, q, v));
-      out[i].position = std::max(out[i].position, runPositionResidual(m, mech, every, q));
+      const RunResidual phi = runResidual(m, mech, every, q, v);
+      out[i].residual = std::max(out[i].residual, phi.all);
+      out[i].position = std::max(out[i].position, phi.positions);
       if (k < steps && !e.step()) {
         out[i].complete = false;
         break;
@@ -302,7 +303,7 @@ int benchModel(const BenchArgs& a) {
   }
   // A residual whose rows' velocity form is the larger share (Bullet's gear row on the 2F-85): the positions' own.
   for (std::size_t i = 0; i < list.size(); ++i)
-    if (acc[i].residual > 2 * acc[i].position && acc[i].residual > 1e-12)
+    if (ratesDominate(acc[i].residual, acc[i].position))
       std::printf("  %s: its max |φ|∞ is its rows' velocity form J v (a loop's or a coupling's rate); at the positions (rows, stops' depths): %.2g\n",
                   (list[i].name + (i == 0 ? ", Euler" : i == 1 ? ", RK4" : "")).c_str(), acc[i].position);
   for (const Engine& e : list) std::printf("  %-8s %s\n", (e.name + ":").c_str(), e.scheme.c_str());

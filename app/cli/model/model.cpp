@@ -179,7 +179,7 @@ std::string stepNotes(const model_file::LoadedModel& m, ConstrainedMechanism<Spa
 // slip), the positions' share when the rates' is the larger: Bullet's rows leave a rate error its ERP
 // never sees (the Robotiq 2F-85's gear row: 0.25 rad/s against 4e-3 of positions).
 std::string ratesApart(const ModelRun& r, const model_file::LoadedModel& m) {
-  if (m.contacts.empty() || !(r.residual > 2 * r.position_residual && r.residual > 1e-12)) return "";  // not at round-off
+  if (m.contacts.empty() || !ratesDominate(r.residual, r.position_residual)) return "";
   return " (the positions' rows, stops' and contacts' depths " + fmt(r.position_residual) + "; the rest the rows' velocity form J v: a loop's or a coupling's rate, a wheel's slip)";
 }
 
