@@ -148,3 +148,13 @@ TEST_CASE("a file that makes MuJoCo's parser exhaust its memory is refused in on
   refused(r, "field.xml", "MuJoCo's parser ran out of memory on this file (limit 1024 MiB)");
   CHECK_FALSE(fs::exists(dir.path / "o"));
 }
+
+TEST_CASE("a URDF that is not well-formed XML (a <mimic> and a visual mesh in it) is refused in one line, exit 2") {
+  Dir dir("broken_urdf");
+  write(dir.path / "broken.urdf",
+        "<robot name=\"a\"><link name=\"b\"><visual><geometry><mesh filename=\"m.stl\"/></geometry></visual>\n"
+        "<joint name=\"j\" type=\"revolute\"><parent link=\"b\"/><mimic joint=\"k\"/></joint></robot>");
+  const Run r = dynlab(dir.path, {"model", "broken.urdf", "--out", "o"}, 60);
+  refused(r, "broken.urdf", "XML parse error");
+  CHECK_FALSE(fs::exists(dir.path / "o"));
+}
