@@ -144,12 +144,15 @@ TEST_CASE("a URDF is read as XML: a <mimic> or </visual> in a comment or CDATA i
   CHECK(has(kept, "another file named 'body.stl' is named too"));
   CHECK(drawnSize(write("xml/kept_in_comment.urdf", visualAndCollisionUrdf("<!-- <mujoco><compiler discardvisual=\"false\"/></mujoco> -->"))) ==
         doctest::Approx(collision));
-  // Not well-formed (an element left open), with a <mimic> and twin meshes: one line naming the file.
+  // Not well-formed (an element left open), with a <mimic> and twin meshes: MuJoCo's parser says so, in
+  // one line naming the file (not the two meshes' names, which a broken file cannot tell apart).
   std::string broken = visualAndCollisionUrdf("");
   broken.insert(broken.find("</joint>"), "<mimic joint=\"j0\"/>");
   broken.erase(broken.find("</link>"), 7);
   const std::string error = errorOf(write("xml/broken.urdf", broken));
   CHECK(has(error, "broken.urdf"));
+  CHECK(has(error, "XML parse error"));
+  CHECK_FALSE(has(error, "another file named"));
   CHECK(error.find('\n') == std::string::npos);
   fs::remove_all(folder() / "xml");
 }
