@@ -24,6 +24,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::setClosed(int i, bool closed) {
   if (!c.unilateral() || c.compliant())
     throw std::invalid_argument("ConstrainedMechanism::setClosed: constraint " + std::to_string(i) + " is not a rigid unilateral contact");
   released_[std::size_t(i)] = char(!closed);
+  ++closed_version_;
   invalidate();
 }
 
@@ -40,6 +41,9 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::selectClosedRows() {
   selected_ = false;
   if constexpr (Nr == Eigen::Dynamic) {
     if (!any_released_kind_) return false;
+    // Only joint limits (J constant), the same rows closed as at the last selection: problem_ holds them.
+    if (only_limits_ && selected_version_ == closed_version_) return selected_ = true;
+    selected_version_ = -1;  // (problem_ is rewritten below, or by the unselected stage)
     closed_rows_.clear();
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
       if (!released_[i])
@@ -55,6 +59,7 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::selectClosedRows() {
     }
     problem_.compliance.resize(0);  // the released rows are out of the solve
     selected_ = true;
+    if (only_limits_) selected_version_ = closed_version_;
   }
   return selected_;
 }
@@ -137,6 +142,7 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
     const double approach = J_full_.row(r).dot(v.head(n())) - (k() ? A_full_.row(r).dot(v.tail(k())) : 0.0);
     if (approach >= -kSeparating) {
       released_[i] = 0;
+      ++closed_version_;
       ++changes;
     }
   }
@@ -179,6 +185,7 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
       if (rigid(i) && !released_[i] && s.eta[offsets_[i]] < most) most = s.eta[offsets_[i]], worst = i;
     if (worst == count) break;
     released_[worst] = 1;
+    ++closed_version_;
     invalidate();
     ++changes;
   }
