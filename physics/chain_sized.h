@@ -7,6 +7,7 @@
 #pragma once
 #include "physics/chain.h"
 #include "physics/det/det.h"
+#include "physics/det/sincos.h"
 
 namespace dyn::sized {
 
@@ -50,7 +51,8 @@ void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
       // A revolute joint about a coordinate axis: X_world = X_J ∘ (X_tree ∘ X_world,parent) turns two
       // rows, and its world axis is a row of E (spatial.h turnAbout, coordinateAxisInWorld).
       if (b.joint == JointType::Revolute && b.coordinate_axis >= 0) {
-        const double c = det::cos(q[b.q_index]), s = det::sin(q[b.q_index]);
+        double c, s;
+        det::sincos(q[b.q_index], s, c);  // det::cos and det::sin, one reduction
         const int k = b.coordinate_axis;
         if constexpr (kParentFrames) S::turnAbout(k, c, s, b.X_tree, nullptr, data.X_up[i]);
         S::turnAbout(k, c, s, b.X_tree, b.parent < 0 ? nullptr : &data.X_world[b.parent], data.X_world[i]);

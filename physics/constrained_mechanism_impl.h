@@ -528,15 +528,14 @@ double ConstrainedMechanism<S, Nj, Nr, Nl>::residual(const VecN& q, const VecN& 
   if (!rows_) return 0.0;
   // Velocity form J θ' − A v_c as well: a velocity-level kind has only this one.
   // (G v = J θ' − A v_c, taken on G's blocks where they lie: no copies.)
-  VecN gv;
-  if (selected()) {  // the rows over every constraint (problem_ holds the closed ones)
-    VecN phi;
+  auto rates = [&]() -> VecN {
+    if (!selected()) return problem_.J * v.head(n()) - problem_.A * v.tail(k());
+    VecN phi;  // the rows over every constraint (problem_ holds the closed ones)
     MatN G;
     constraint(q, phi, G);
-    gv = G.leftCols(n()) * v.head(n()) + G.rightCols(k()) * v.tail(k());
-  } else {
-    gv = problem_.J * v.head(n()) - problem_.A * v.tail(k());
-  }
+    return G.leftCols(n()) * v.head(n()) + G.rightCols(k()) * v.tail(k());
+  };
+  const VecN gv = rates();
   return std::max(phi_.lpNorm<Eigen::Infinity>(), gv.lpNorm<Eigen::Infinity>());
 }
 
