@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "physics/constrained_mechanism.h"
+#include "physics/constraints/joint_limit.h"
 
 namespace dyn {
 
@@ -26,6 +27,23 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::setClosed(int i, bool closed) {
   released_[std::size_t(i)] = char(!closed);
   ++closed_version_;
   invalidate();
+}
+
+// Joint limits alone (the PUMA file's rows): their constant J written once (constrained_mechanism.h
+// limit_rows_); the position stage computes their φ in place.
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::limitRows() {
+  limit_rows_.assign(model_.constraints.size(), LimitRow{});
+  if constexpr (S::kDim == 6)
+    for (std::size_t i = 0; i < model_.constraints.size(); ++i)
+      if (const auto* limit = dynamic_cast<const JointLimit*>(model_.constraints[i].get()))
+        limit_rows_[i] = {model_.tree.bodies[std::size_t(limit->joint())].q_index, limit->joint(), limit->sign(), limit->bound()};
+  only_limits_ = !limit_rows_.empty() && std::all_of(limit_rows_.begin(), limit_rows_.end(), [](const LimitRow& l) { return l.coordinate >= 0; });
+  if (!only_limits_) return;
+  // The rows' constant J (JointLimit::position's entries), A empty of entries.
+  J_full_.setZero(rows_, n());
+  A_full_.setZero(rows_, k());
+  for (std::size_t i = 0; i < limit_rows_.size(); ++i) J_full_(offsets_[i], limit_rows_[i].column) = -limit_rows_[i].sign;
 }
 
 // While some rows are released (a model file's joint limits away from their stops, contacts open),

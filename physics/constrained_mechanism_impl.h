@@ -14,7 +14,6 @@
 #include "physics/chain_world.h"
 #include "physics/constrained_mechanism.h"
 #include "physics/constrained_mechanism_contacts.h"
-#include "physics/constraints/joint_limit.h"
 #include "physics/det/det.h"
 
 namespace dyn {
@@ -102,21 +101,6 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
   problem_.A.setZero(rows_, kk);
   phi_.setZero(rows_);
   phi_full_.setZero(rows_);
-}
-
-template <class S, int Nj, int Nr, int Nl>
-void ConstrainedMechanism<S, Nj, Nr, Nl>::limitRows() {
-  limit_rows_.assign(model_.constraints.size(), LimitRow{});
-  if constexpr (S::kDim == 6)
-    for (std::size_t i = 0; i < model_.constraints.size(); ++i)
-      if (const auto* limit = dynamic_cast<const JointLimit*>(model_.constraints[i].get()))
-        limit_rows_[i] = {model_.tree.bodies[std::size_t(limit->joint())].q_index, limit->joint(), limit->sign(), limit->bound()};
-  only_limits_ = !limit_rows_.empty() && std::all_of(limit_rows_.begin(), limit_rows_.end(), [](const LimitRow& l) { return l.coordinate >= 0; });
-  if (!only_limits_) return;
-  // The rows' constant J (JointLimit::position's entries), A empty of entries.
-  J_full_.setZero(rows_, n());
-  A_full_.setZero(rows_, k());
-  for (std::size_t i = 0; i < limit_rows_.size(); ++i) J_full_(offsets_[i], limit_rows_[i].column) = -limit_rows_[i].sign;
 }
 
 template <class S, int Nj, int Nr, int Nl>
@@ -527,9 +511,10 @@ double ConstrainedMechanism<S, Nj, Nr, Nl>::residual(const VecN& q, const VecN& 
   positionStage(q);
   if (!rows_) return 0.0;
   // Velocity form J θ' − A v_c as well: a velocity-level kind has only this one.
-  // (G v = J θ' − A v_c, taken on G's blocks where they lie: no copies.)
+  // (G v = J θ' − A v_c; with the rows selected, taken on G's blocks where they lie, no copies: the
+  // same dynamically sized products as on copies of them.)
   auto rates = [&]() -> VecN {
-    if (!selected()) return problem_.J * v.head(n()) - problem_.A * v.tail(k());
+    if (!selected()) return MatN(problem_.J) * v.head(n()) - MatN(problem_.A) * v.tail(k());
     VecN phi;  // the rows over every constraint (problem_ holds the closed ones)
     MatN G;
     constraint(q, phi, G);
