@@ -253,6 +253,20 @@ std::unique_ptr<Simulation> GraspLab::simulate(Engine engine) const {
   return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::make_unique<Hooks>(s_, q, v), columns_, s_.duration);
 }
 
+MujocoTwin GraspLab::mujocoTwin() const {
+  MujocoTwin t;
+  t.file = "mujoco.xml";
+  t.stands_in = "the point contacts as MuJoCo connects (both ways, frictionless; soft)";
+  Mechanism mech(s_.params);
+  mech.assemble(s_.pose0, Eigen::Vector3d::Zero(), t.q, t.v);
+  // The file's object coordinates (x, y, ψ): slides before the hinge, whose axis they would turn.
+  const int n = int(t.q.size()) - 3;
+  for (int i = 0; i < n; ++i) t.order.push_back(i);
+  t.order.insert(t.order.end(), {n + 1, n + 2, n});
+  t.dynamics = handDynamics(describe(s_.params));
+  return t;
+}
+
 json GraspLab::metrics(const Trace& tr) const {
   std::vector<double> ep, epsi, ef;
   double margin = INFINITY, margin_t = 0, tau_max = 0, drift = 0, residual = 0, ep_max = 0;
