@@ -20,6 +20,9 @@ struct MujocoTwin {
   std::shared_ptr<const model_file::LoadedModel> loaded;
   // What MuJoCo cannot hold of the lab exactly and what the file holds instead (one clause; "" when nothing).
   std::string stands_in;
+  // MuJoCo's run keeps the file's geom contacts (the lab's contact written as geoms; dynlab's loader
+  // turns them off, its hand engine having no geom contact).
+  bool contacts = false;
   // The file's coordinate i is the lab's coordinate order[i] (q and v alike); empty: the same order.
   std::vector<int> order;
   VecN q, v;  // the lab's start, in the lab's coordinates

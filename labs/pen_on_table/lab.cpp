@@ -276,7 +276,8 @@ std::unique_ptr<Simulation> PenOnTableLab::simulate(Engine engine) const {
 MujocoTwin PenOnTableLab::mujocoTwin() const {
   MujocoTwin t;
   t.file = "mujoco.xml";
-  t.stands_in = "the arm passive above the table (its contact off, as dynlab runs MuJoCo)";
+  t.stands_in = "the pen tip on the table as MuJoCo's frictionless geom contact (soft); the arm falls onto it";
+  t.contacts = true;
   initialState(t.q, t.v);
   t.dynamics = handDynamics(describe(s_.params));
   return t;

@@ -196,7 +196,8 @@ std::unique_ptr<Simulation> UnicycleLab::simulate(Engine engine) const {
 MujocoTwin UnicycleLab::mujocoTwin() const {
   MujocoTwin t;
   t.file = "mujoco.xml";
-  t.stands_in = "rolling without slip as the wheel's height held (MuJoCo has no velocity-level row: the no-slip rows left out)";
+  t.stands_in = "rolling without slip as MuJoCo's frictional contact of the wheel on the ground (mu 0.8, soft: MuJoCo has no velocity-level row)";
+  t.contacts = true;
   Mechanism(s_.params).state(s_.x0, s_.y0, s_.phi0, 0.0, s_.phi_rate0, s_.theta_rate0, t.q, t.v);
   t.dynamics = handDynamics(describe(s_.params));
   return t;

@@ -42,7 +42,7 @@ MujocoRun mujocoRun(const Lab& lab, const std::string& config_file) {
       impl->own = model_file::load(path.string());
       model = &impl->own;
     }
-    impl->sim = std::make_unique<model_file::MujocoSimulation>(*model, lab.dt());
+    impl->sim = std::make_unique<model_file::MujocoSimulation>(*model, lab.dt(), false, twin.contacts);
   } catch (const model_file::ModelFileError& e) {  // MuJoCo not built in, or the file unreadable: the others are timed
     run.left_out = termName(e.what(), 1000);
     return run;
