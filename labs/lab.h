@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "labs/config.h"
+#include "labs/mujoco_twin.h"
 #include "labs/settings.h"
 #include "physics/linear.h"
 #include "labs/scene.h"
@@ -94,6 +95,10 @@ class Lab {
   // before simulating: poles, delay margin). The same loops for every submission option and gain:
   // a loop without feedback (open loop, zero gains) has a zero numerator and is reported as such.
   virtual std::vector<LinearLoop> linearise() const { return {}; }
+
+  // The lab's mechanism written for MuJoCo (labs/mujoco_twin.h): dynlab bench times MuJoCo's step on it
+  // beside the hand engine's and Bullet's. Empty (no file): the lab has none.
+  virtual MujocoTwin mujocoTwin() const { return {}; }
 };
 
 // The part of every lab's agreement() that says how well each engine kept its own books: the energy

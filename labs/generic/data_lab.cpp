@@ -196,6 +196,15 @@ std::unique_ptr<Simulation> DataLab::simulate(Engine engine) const {
   return runOn<Mech>(s_, engine);
 }
 
+MujocoTwin DataLab::mujocoTwin() const {
+  MujocoTwin t;
+  if (!s_.plant->compiled) return t;  // a description without a MuJoCo model
+  t.file = s_.plant->file;
+  t.loaded = s_.plant;
+  t.q = s_.q0, t.v = VecN::Zero(s_.plant->mechanism.treeDof());
+  return t;
+}
+
 json DataLab::metrics(const Trace& tr) const {
   json out = json::object();
   for (const auto& [name, spec] : s_.metrics) out[name] = evaluate(spec, tr);

@@ -91,6 +91,8 @@ class DataLab final : public SettingsLab<DataSettings> {
   std::string unit(const std::string& column) const override;
   // The run: the model file's mechanism assembled, a law of labs/controllers, the push (data_lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  // Its own model file, as MuJoCo compiled it at load (the plant's payloads are the hand engine's only).
+  MujocoTwin mujocoTwin() const override;
   // The grade: the JSON's metrics (metric_spec.h), the engines' agreement.
   json metrics(const Trace& trace) const override;
   json differences(const Trace& hand, const Trace& bullet, std::size_t rows) const override;

@@ -247,10 +247,26 @@ std::unique_ptr<Simulation> GraspLab::simulate(Engine engine) const {
     params.forces.push_back(std::make_shared<PushForce<Planar>>(BodyRef::payload(0), Planar::Pos::Zero(),
                                                                  Planar::Vec(0.0, s_.push.force.x(), s_.push.force.y()),
                                                                  ForceProfile{s_.push.start, 0.0, s_.push.duration}));
-  auto mech = std::make_unique<Mechanism>(params);
   VecN q, v;
-  mech->assemble(s_.pose0, Eigen::Vector3d::Zero(), q, v);
-  return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::make_unique<Hooks>(s_, q, v), columns_, s_.duration);
+  Mechanism(params).assemble(s_.pose0, Eigen::Vector3d::Zero(), q, v);
+  // Two fingers (the default) at fixed sizes: the step's loops unrolled (mechanism.h TwoFingers).
+  if (params.fingers.size() == 2)
+    return simulateMechanism(engine, std::make_unique<TwoFingers>(params), s_.step, q, v, std::make_unique<Hooks>(s_, q, v), columns_, s_.duration);
+  return simulateMechanism(engine, std::make_unique<Mechanism>(params), s_.step, q, v, std::make_unique<Hooks>(s_, q, v), columns_, s_.duration);
+}
+
+MujocoTwin GraspLab::mujocoTwin() const {
+  MujocoTwin t;
+  t.file = "mujoco.xml";
+  t.stands_in = "the point contacts as MuJoCo connects (both ways, frictionless; soft)";
+  Mechanism mech(s_.params);
+  mech.assemble(s_.pose0, Eigen::Vector3d::Zero(), t.q, t.v);
+  // The file's object coordinates (x, y, ψ): slides before the hinge, whose axis they would turn.
+  const int n = int(t.q.size()) - 3;
+  for (int i = 0; i < n; ++i) t.order.push_back(i);
+  t.order.insert(t.order.end(), {n + 1, n + 2, n});
+  t.dynamics = handDynamics(describe(s_.params));
+  return t;
 }
 
 json GraspLab::metrics(const Trace& tr) const {

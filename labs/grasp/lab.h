@@ -39,6 +39,8 @@ class GraspLab final : public SettingsLab<Settings> {
   std::string unit(const std::string& column) const override;
   // The run: fingers and object assembled at pose0, the object-level controller, the push (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  // The mechanism written for MuJoCo (mujoco.xml beside the JSON) and the lab's start (lab.cpp).
+  MujocoTwin mujocoTwin() const override;
   int fingers() const { return int(s_.params.fingers.size()); }
   // The grade: the object's tracking, the internal force, the friction cones' margin (lab.cpp);
   // the loops screened (linearise.cpp).

@@ -5,8 +5,13 @@
 #include <Eigen/LU>
 #include <cmath>
 
+#include "physics/constrained_mechanism_impl.h"
 #include "physics/constraints/point_contact.h"
 #include "physics/det/det.h"
+
+namespace dyn {
+template class ConstrainedMechanism<Planar, 4, 4, 3>;
+}
 
 namespace dyn::grasp {
 namespace {
@@ -50,6 +55,8 @@ MechanismModel<Planar> describe(const Params& p) {
 }
 
 Mechanism::Mechanism(const Params& p) : ConstrainedMechanism(describe(p)), params_(p) {}
+
+TwoFingers::TwoFingers(const Params& p) : ConstrainedMechanism(describe(p)), shape_(p) {}
 
 Eigen::Vector2d Mechanism::contactPoint(int i, const Eigen::Vector3d& pose) const {
   return pose.tail<2>() + rotate(pose[0], params_.fingers[std::size_t(i)].contact);

@@ -81,4 +81,15 @@ class Mechanism final : public ConstrainedMechanism<Planar> {
   Params params_;
 };
 
+// The plant at the default two fingers' sizes (4 joints, 4 contact rows, the object's 3 coordinates):
+// the step's loops unrolled, as the other labs fix theirs; its inverse kinematics Mechanism's.
+class TwoFingers final : public ConstrainedMechanism<Planar, 4, 4, 3> {
+ public:
+  explicit TwoFingers(const Params& params);
+  bool recoverDependent(VecN& q, VecN& v) override { return shape_.recoverDependent(q, v); }
+
+ private:
+  Mechanism shape_;
+};
+
 }  // namespace dyn::grasp

@@ -348,6 +348,15 @@ std::unique_ptr<Simulation> ImpedanceLab::simulate(Engine engine) const {
   return run<motion_control::FixedArm<3>>(s_, engine, columns_);
 }
 
+MujocoTwin ImpedanceLab::mujocoTwin() const {
+  MujocoTwin t;
+  t.file = "mujoco.xml";
+  t.stands_in = "the arm passive (no push; the wall's contact off, as dynlab runs MuJoCo)";
+  t.q = VecN(s_.pose), t.v = VecN::Zero(3);
+  t.dynamics = handDynamics(motion_control::describe(s_.plant));
+  return t;
+}
+
 DYNLAB_REGISTER_LAB(impedance, "Impedance control: make the hand feel like a given mass-spring-damper, three ways",
                     labFactory<ImpedanceLab>(parseSettings));
 

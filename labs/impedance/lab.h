@@ -74,6 +74,8 @@ class ImpedanceLab final : public SettingsLab<Settings> {
   explicit ImpedanceLab(Settings s);
   // The run: the arm at its pose, the impedance law of the kind chosen, the push and the wall (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  // The mechanism written for MuJoCo (mujoco.xml beside the JSON) and the lab's start (lab.cpp).
+  MujocoTwin mujocoTwin() const override;
   // The grade: the hand against the target's response, the wall's force (metrics.cpp); the loops
   // screened (linearise.cpp).
   json metrics(const Trace& trace) const override;

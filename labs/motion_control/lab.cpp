@@ -253,6 +253,16 @@ std::unique_ptr<Simulation> MotionControlLab::simulate(Engine engine) const {
   return run<RefinedArm<ArmMechanism>>(s_, engine, cols);
 }
 
+MujocoTwin MotionControlLab::mujocoTwin() const {
+  MujocoTwin t;
+  if (s_.plant.flexible || s_.plant.n() != 3) return t;  // the file is the default rigid 3-link arm
+  t.file = "mujoco.xml";
+  t.stands_in = "Coulomb friction as MuJoCo's frictionloss rows (the lab's is smooth: F_c tanh(θ'/w))";
+  treeState(s_.plant, s_.trajectory.outstretched, staticDeflection(s_.plant, s_.trajectory.outstretched), t.q, t.v);
+  t.dynamics = handDynamics(describe(s_.plant));
+  return t;
+}
+
 json MotionControlLab::metrics(const Trace& tr) const {
   const int n = s_.plant.n();
   const Trajectory& T = s_.trajectory;

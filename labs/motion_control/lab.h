@@ -35,6 +35,8 @@ class MotionControlLab final : public SettingsLab<Settings> {
   std::string unit(const std::string& column) const override;
   // The run: the arm (rigid or flexible) from the trajectory's start, its joint controller (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  // The mechanism written for MuJoCo (mujoco.xml beside the JSON) and the lab's start (lab.cpp).
+  MujocoTwin mujocoTwin() const override;
   // The grade: the joint errors over the move and the hold, torques, energy (lab.cpp); each joint's
   // loop at both poses, screened (linearise.cpp).
   json metrics(const Trace& trace) const override;

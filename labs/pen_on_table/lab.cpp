@@ -273,6 +273,16 @@ std::unique_ptr<Simulation> PenOnTableLab::simulate(Engine engine) const {
   return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::move(hooks), kColumns, s_.duration);
 }
 
+MujocoTwin PenOnTableLab::mujocoTwin() const {
+  MujocoTwin t;
+  t.file = "mujoco.xml";
+  t.stands_in = "the pen tip on the table as MuJoCo's frictionless geom contact (soft); the arm falls onto it";
+  t.contacts = true;
+  initialState(t.q, t.v);
+  t.dynamics = handDynamics(describe(s_.params));
+  return t;
+}
+
 json PenOnTableLab::metrics(const Trace& tr) const {
   const std::size_t n = tr.rows();
   const double dt = s_.step.dt, f_zd = s_.controller.f_zd, t_draw = drawingStart();

@@ -31,6 +31,8 @@ class PenOnTableLab final : public SettingsLab<Settings> {
   explicit PenOnTableLab(Settings s);
   // The run: the tip start_height above the circle's first point, the accommodation controller (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  // The mechanism written for MuJoCo (mujoco.xml beside the JSON) and the lab's start (lab.cpp).
+  MujocoTwin mujocoTwin() const override;
   // The initial state: at rest (or at rates0), the tip start_height above the circle's first point.
   void initialState(VecN& q, VecN& v) const;
   // The grade: the force's overshoot and RMS from touchdown, the circle's error, lift-offs (lab.cpp);

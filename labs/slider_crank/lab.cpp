@@ -151,6 +151,14 @@ std::unique_ptr<Simulation> SliderCrankLab::simulate(Engine engine) const {
   return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::make_unique<Hooks>(s_, q, v), kColumns, s_.duration);
 }
 
+MujocoTwin SliderCrankLab::mujocoTwin() const {
+  MujocoTwin t;
+  t.file = "mujoco.xml";
+  Mechanism(s_.params).initialState(s_.theta1, s_.theta1_rate, s_.branch, t.q, t.v);
+  t.dynamics = handDynamics(describe(s_.params));
+  return t;
+}
+
 json SliderCrankLab::metrics(const Trace& tr) const {
   std::vector<double> ex, ef;
   double ex_max = 0, ef_max = 0, tau_max = 0, drift = 0, residual = 0;

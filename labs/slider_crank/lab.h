@@ -32,6 +32,8 @@ class SliderCrankLab final : public SettingsLab<Settings> {
   explicit SliderCrankLab(Settings s);
   // The run: the arm and slider assembled at θ1 on their branch, the force controller (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  // The mechanism written for MuJoCo (mujoco.xml beside the JSON) and the lab's start (lab.cpp).
+  MujocoTwin mujocoTwin() const override;
   // The grade: x and f_Ty tracking, energy and residual (lab.cpp); the loops screened (linearise.cpp).
   json metrics(const Trace& trace) const override;
   json differences(const Trace& hand, const Trace& bullet, std::size_t rows) const override;

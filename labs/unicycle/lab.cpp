@@ -193,6 +193,16 @@ std::unique_ptr<Simulation> UnicycleLab::simulate(Engine engine) const {
   return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::make_unique<Hooks>(s_, path_, engine, q, v), kColumns, s_.duration);
 }
 
+MujocoTwin UnicycleLab::mujocoTwin() const {
+  MujocoTwin t;
+  t.file = "mujoco.xml";
+  t.stands_in = "rolling without slip as MuJoCo's frictional contact of the wheel on the ground (mu 0.8, soft: MuJoCo has no velocity-level row)";
+  t.contacts = true;
+  Mechanism(s_.params).state(s_.x0, s_.y0, s_.phi0, 0.0, s_.phi_rate0, s_.theta_rate0, t.q, t.v);
+  t.dynamics = handDynamics(describe(s_.params));
+  return t;
+}
+
 json UnicycleLab::metrics(const Trace& tr) const {
   std::vector<double> ect, epos, ev;
   double margin = INFINITY, margin_t = 0, f_lat = 0, tau_y = 0, tau_z = 0, drift = 0, residual = 0, ect_max = 0;

@@ -28,6 +28,8 @@ class UnicycleLab final : public SettingsLab<Settings> {
   // The run: the wheel rolling from its start pose, the path follower; Bullet also drives its
   // friction-contact wheel, which can skid (lab.cpp).
   std::unique_ptr<Simulation> simulate(Engine engine) const override;
+  // The mechanism written for MuJoCo (mujoco.xml beside the JSON) and the lab's start (lab.cpp).
+  MujocoTwin mujocoTwin() const override;
   const Path& path() const { return path_; }
   // The grade: cross-track, speed, skid margin, energy and residual (lab.cpp); the loops screened (linearise.cpp).
   json metrics(const Trace& trace) const override;

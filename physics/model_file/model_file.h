@@ -294,10 +294,10 @@ class MujocoReference {
 // equalities as the file sets them, at a given step and with the semi-implicit Euler integrator
 // (MuJoCo's default, first order) or RK4 (rk4: for tests at the hand engine's order), from a state in
 // the same coordinates as LoadedModel, its controls held at the model's ctrl; contacts between geoms
-// off (dynlab has none).
+// off (dynlab has none), or on (contacts: a lab's contact written as geoms for MuJoCo, labs/mujoco_twin.h).
 class MujocoSimulation {
  public:
-  MujocoSimulation(const LoadedModel& model, double dt, bool rk4 = false);
+  MujocoSimulation(const LoadedModel& model, double dt, bool rk4 = false, bool contacts = false);
   ~MujocoSimulation();
   MujocoSimulation(const MujocoSimulation&) = delete;
   MujocoSimulation& operator=(const MujocoSimulation&) = delete;

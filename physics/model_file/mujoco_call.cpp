@@ -174,16 +174,18 @@ double MujocoReference::closure(const VecN& q) {
 // The bench's simulation: the model at the given step with the Euler (or RK4) integrator, its controls
 // the model's.
 struct MujocoSimulation::Impl : OwnedModel {
-  Impl(const LoadedModel& model, double dt, bool rk4)
-      : OwnedModel(model, [dt, rk4](mjModel* m) {
+  Impl(const LoadedModel& model, double dt, bool rk4, bool contacts)
+      : OwnedModel(model, [dt, rk4, contacts](mjModel* m) {
           m->opt.timestep = dt;
           m->opt.integrator = rk4 ? mjINT_RK4 : mjINT_EULER;
+          if (contacts) m->opt.disableflags &= ~mjDSBL_CONTACT;  // as load found them (it turned them off)
         }),
         ctrl(model.ctrl) {}
   VecN ctrl;
 };
 
-MujocoSimulation::MujocoSimulation(const LoadedModel& model, double dt, bool rk4) : impl_(new Impl(model, dt, rk4)) {}
+MujocoSimulation::MujocoSimulation(const LoadedModel& model, double dt, bool rk4, bool contacts)
+    : impl_(new Impl(model, dt, rk4, contacts)) {}
 
 MujocoSimulation::~MujocoSimulation() { delete impl_; }
 

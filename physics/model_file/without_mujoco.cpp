@@ -26,7 +26,7 @@ VecN MujocoReference::actuation(const VecN&, const VecN&, const VecN&) { refuse(
 VecN MujocoReference::passive(const VecN&, const VecN&) { refuse("MujocoReference"); }
 double MujocoReference::closure(const VecN&) { refuse("MujocoReference"); }
 
-MujocoSimulation::MujocoSimulation(const LoadedModel& model, double, bool) : impl_(nullptr) { refuse(model.file); }
+MujocoSimulation::MujocoSimulation(const LoadedModel& model, double, bool, bool) : impl_(nullptr) { refuse(model.file); }
 MujocoSimulation::~MujocoSimulation() = default;
 void MujocoSimulation::reset(const VecN&, const VecN&) { refuse("MujocoSimulation"); }
 bool MujocoSimulation::step() { refuse("MujocoSimulation"); }

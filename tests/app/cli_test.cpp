@@ -261,6 +261,10 @@ TEST_CASE("dynlab bench --json: the fields of every lab, and speed with accuracy
                             "render_video_fps", "bullet_over_hand"})
       CHECK(j.at(key).get<double>() > 0);
     CHECK(j.at("lab").is_string());
+    // MuJoCo timed on every lab's mechanism written for it, its ratio at equal order from the same run.
+    for (const char* key : {"mujoco_us_per_step", "mujoco_over_hand_equal_order", "mujoco_hand_us_per_step"})
+      CHECK(j.at(key).get<double>() > 0);
+    CHECK(j.at("mujoco_hand_scheme") == "semi_implicit_euler + baumgarte");
     if (j.at("lab") != "slider_crank") continue;
     // Bullet and the hand engine at Bullet's order (semi-implicit Euler + Baumgarte, same dt), both
     // against the RK4 reference: first-order errors of the same size (Bullet is first order too,

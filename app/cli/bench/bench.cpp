@@ -20,6 +20,7 @@
 #include "app/cli/model/model.h"
 #include "app/shared/movie.h"
 #include "labs/run.h"
+#include "labs/utf8.h"
 #include "render/video.h"
 
 namespace fs = std::filesystem;
@@ -72,8 +73,15 @@ struct TimedRun {
 };
 constexpr int kBlock = 50;
 
-std::vector<StepTimes> stepMicros(const std::vector<TimedRun>& runs, int steps) {
+// With a MuJoCo run (mujoco timed()): its steps timed last in each round (both passes alike: it has
+// no controller), its times as out's last entry.
+std::vector<StepTimes> stepMicros(const std::vector<TimedRun>& runs, int steps, MujocoRun& mujoco) {
   const std::size_t count = runs.size();
+  std::vector<double> mj_all;
+  StepTimes mj;
+  auto mujocoBlock = [&](double clock, std::vector<double>& blocks) {
+    if (mujoco.timed()) blocks.push_back(timedBlock(kBlock, clock, mj_all, [] { return true; }, [&] { return mujoco.step(); }));
+  };
   std::vector<double> row;
   std::vector<StepTimes> out(count);
   std::vector<std::vector<double>> full(count), alone(count);
@@ -90,15 +98,25 @@ std::vector<StepTimes> stepMicros(const std::vector<TimedRun>& runs, int steps) 
     return timedBlock(kBlock, clock, all, [] { return true; }, [&] { return sims[i]->step(row) || (restart(i), false); });
   };
   const int rounds = std::max(1, steps / kBlock);
-  for (int r = 0; r < rounds; ++r)
+  for (int r = 0; r < rounds; ++r) {
     for (std::size_t i = 0; i < count; ++i) out[i].full_blocks.push_back(block(i, false, full[i]));
+    mujocoBlock(clock, mj.full_blocks);
+  }
   for (std::size_t i = 0; i < count; ++i) restart(i);
-  for (int r = 0; r < rounds; ++r)
+  if (mujoco.timed()) mujoco.restart();
+  for (int r = 0; r < rounds; ++r) {
     for (std::size_t i = 0; i < count; ++i) out[i].engine_blocks.push_back(block(i, true, alone[i]));
+    mujocoBlock(clock, mj.engine_blocks);
+  }
   for (std::size_t i = 0; i < count; ++i) {
     out[i].full = median(full[i]);
     out[i].engine = median(alone[i]);
     out[i].has_engine = !alone[i].empty();
+  }
+  if (mujoco.timed()) {
+    mj.full = mj.engine = median(mj_all);
+    mj.has_engine = true;
+    out.push_back(mj);
   }
   return out;
 }
@@ -164,6 +182,46 @@ json errorAgainst(const Lab& lab, const Trace& run, const Trace& reference) {
   return out;
 }
 
+// MuJoCo's step against the hand's at equal order: its median µs and the ratios block by block.
+struct MujocoTimes {
+  StepTimes mujoco, hand;  // hand: the first-order hand run (or the lab's own when it is first order)
+  bool alone = false;      // the hand's engine-alone blocks (else its full steps)
+  double us() const { return mujoco.full; }
+  double handUs() const { return alone ? hand.engine : hand.full; }
+  Ratio over() const {
+    return alone ? ratio(mujoco.engine_blocks, hand.engine_blocks) : ratio(mujoco.full_blocks, hand.full_blocks);
+  }
+};
+
+void addMujoco(const MujocoRun& run, const MujocoTimes& t, const std::string& hand_scheme, json& out) {
+  if (!run.timed()) {
+    out["mujoco_left_out"] = run.left_out;
+    return;
+  }
+  const Ratio r = t.over();
+  out["mujoco_file"] = run.file;
+  out["mujoco_scheme"] = run.scheme;
+  if (!run.stands_in.empty()) out["mujoco_stands_in"] = run.stands_in;
+  out["mujoco_us_per_step"] = t.us();
+  out["mujoco_hand_scheme"] = hand_scheme;
+  out["mujoco_hand_us_per_step"] = t.handUs();
+  out["mujoco_over_hand_equal_order"] = r.median;
+  out["mujoco_over_hand_equal_order_quartiles"] = {r.low, r.high};
+}
+
+// The MuJoCo line under the engines' (Bullet's ratio at the same order beside it, timed in the same run).
+void printMujoco(const MujocoRun& run, const MujocoTimes& t, const std::string& hand_scheme, const Ratio& bullet) {
+  if (!run.timed()) {
+    std::printf("  MuJoCo not timed: %s\n", run.left_out.c_str());
+    return;
+  }
+  const Ratio r = t.over();
+  std::printf("  at equal order  hand %s %.2f µs   MuJoCo %.2f µs   MuJoCo/hand %.1fx (blocks %.1f–%.1f)   Bullet/hand %.1fx (blocks %.1f–%.1f)\n",
+              hand_scheme.c_str(), t.handUs(), t.us(), r.median, r.low, r.high, bullet.median, bullet.low, bullet.high);
+  std::printf("    MuJoCo: %s on %s%s\n", run.scheme.c_str(), termName(run.file, 300).c_str(),
+              run.stands_in.empty() ? ", passive from the lab's start" : (", passive from the lab's start; stands in: " + run.stands_in).c_str());
+}
+
 }  // namespace
 
 int bench(const BenchArgs& a) {
@@ -191,7 +249,8 @@ int bench(const BenchArgs& a) {
     // Every engine timed in the same stretch of time, in turn (stepMicros).
     std::vector<TimedRun> runs{{&lab, Engine::Hand}, {&lab, Engine::Bullet}};
     if (first_order) runs.push_back({first_order.get(), Engine::Hand});
-    const std::vector<StepTimes> times = stepMicros(runs, a.steps);
+    MujocoRun mujoco = mujocoRun(lab, loaded.config_file);
+    const std::vector<StepTimes> times = stepMicros(runs, a.steps, mujoco);
     const StepTimes hand_t = times[0], bullet_t = times[1];
     const StepTimes first_t = first_order ? times[2] : StepTimes{};
     // The headline compares the engines alone, when the lab offers it.
@@ -208,6 +267,8 @@ int bench(const BenchArgs& a) {
     const Ratio speedup = ratio(blocks(bullet_t), blocks(hand_t));
     const Ratio speedup_full = ratio(bullet_t.full_blocks, hand_t.full_blocks);
     const Ratio speedup_first = first_order ? ratio(blocks(bullet_t), blocks(first_t)) : Ratio{};
+    // MuJoCo (Euler) against the hand at equal order (its first-order variant, or the lab's own when first order).
+    const MujocoTimes mj = mujoco.timed() ? MujocoTimes{times.back(), first_order ? first_t : hand_t, alone} : MujocoTimes{};
     const Fps fps = frameRates(lab, reference.trace, a.frames);
     const json grading = gradeThroughput(entry.name, 5);
     if (a.json) {
@@ -233,6 +294,7 @@ int bench(const BenchArgs& a) {
         out["bullet_over_hand_first_order_quartiles"] = {speedup_first.low, speedup_first.high};
         out["hand_first_order_error"] = first_error;
       }
+      addMujoco(mujoco, mj, first_order ? first_scheme : scheme, out);
       for (const auto& [k, v] : grading.items()) out[k] = v;
       std::cout << out.dump() << "\n";
     } else {
@@ -255,6 +317,7 @@ int bench(const BenchArgs& a) {
       const int pad = int(std::string(ratio_text).size()) - 2;  // "–" is 3 bytes, 1 column
       std::printf("    %-41s %6.2f µs   %*s   %s\n", lab.referenceEngine().c_str(), bullet, std::max(pad, 0), "",
                   describeAgreement(lab, bullet_error).c_str());
+      printMujoco(mujoco, mj, first_order ? first_scheme : scheme, speedup_first.median > 0 ? speedup_first : speedup);
       std::printf("  640x480 fps     render %.0f   +PNG %.0f   +video %.0f\n", fps.render, fps.png, fps.video);
       if (!grading.empty())
         std::printf("  grading         %.3f s CPU per full rubric (%.3f s with plots): %.0f per s per core, 1000 with plots on 2 cores in %.0f s\n",

@@ -1,7 +1,13 @@
 // Timing helpers shared by the bench commands (app/cli/bench/bench.cpp, app/cli/bench/bench_scaling.cpp, app/cli/bench/bench_model.cpp).
 #pragma once
 #include <chrono>
+#include <memory>
+#include <string>
 #include <vector>
+
+namespace dyn {
+class Lab;
+}
 
 namespace dyn::app {
 
@@ -35,6 +41,23 @@ double timedBlock(int calls, double clock, std::vector<double>& all, Before&& be
   all.insert(all.end(), times.begin(), times.end());
   return median(times);
 }
+
+// dynlab bench LAB's MuJoCo run (app/cli/bench/bench_mujoco.cpp): mj_step, Euler, at the lab's dt on the lab's
+// mechanism written for MuJoCo (Lab::mujocoTwin), passive from the lab's start.
+struct MujocoRun {
+  std::string file, scheme;  // the model file; "MuJoCo 2.2.2 mj_step, Euler, ..."
+  std::string stands_in;     // what the file holds instead of what MuJoCo cannot ("" when nothing)
+  std::string left_out;      // why MuJoCo is not timed ("" when it is)
+  bool timed() const { return impl_ != nullptr; }
+  bool step();     // one mj_step; false (and back to the start) when the state blew up
+  void restart();  // back to the lab's start
+  MujocoRun();
+  ~MujocoRun();
+  MujocoRun(MujocoRun&&) noexcept;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+MujocoRun mujocoRun(const dyn::Lab& lab, const std::string& config_file);
 
 struct BenchArgs;
 // dynlab bench FILE.xml|FILE.urdf: the hand step against Bullet's and MuJoCo's for a model file (app/cli/bench/bench_model.cpp).
