@@ -26,6 +26,7 @@
 #include "app/cli/commands.h"
 #include "app/cli/output.h"
 #include "labs/config.h"
+#include "labs/file_write.h"
 #include "labs/lab.h"
 #include "grading/escape.h"
 #include "grading/plot.h"
@@ -49,6 +50,7 @@ struct Job {
   Submission sub;
   fs::path out;  // OUT/<folder>
   Clock::time_point started;
+  bool isolated = false;  // graded again after its grader died: plots drawn in a child of the grader
 };
 
 // A job slot: its grader process (started when first needed, and again after one ended) and the
@@ -168,11 +170,13 @@ void assignPlants(const GradeArgs& args, const std::string& roster, batch::Found
 // (errno set) when no grader could be started.
 bool startJob(Slot& slot, Job job, const GradeArgs& args, const batch::Found& found, const fs::path& out,
               std::vector<Slot>& slots) {
+  const bool in_place = args.plots && !job.isolated;
+  if (slot.grader.running() && slot.grader.in_place != in_place) batch::stopGrader(slot.grader, false);
   for (int attempt = 0; attempt < 2; ++attempt) {
     if (!slot.grader.running()) {
       std::vector<batch::Grader*> others;
       for (Slot& s : slots) others.push_back(&s.grader);
-      slot.grader = batch::startGrader(args, found.submissions, out, others);
+      slot.grader = batch::startGrader(args, found.submissions, out, others, in_place);
       if (!slot.grader.running()) return false;
     }
     job.started = Clock::now();
@@ -188,8 +192,10 @@ bool startJob(Slot& slot, Job job, const GradeArgs& args, const batch::Found& fo
 
 // Waits (at most until the first deadline) for a grader to reply or end, and returns the rows of the
 // submissions that finished: graded, failed (its grader ended: a fresh one takes the next), or past
-// their deadline (the grader is killed).
-std::vector<Row> collect(std::vector<Slot>& slots, Clock::duration kill_after, double kill_s) {
+// their deadline (the grader is killed). A submission whose grader drew its plots in place and died
+// of a signal goes to `again`, to be graded by a grader that draws them in a child, as a lone
+// `dynlab grade` does (a plotting library that dies then costs the plots, not the grade).
+std::vector<Row> collect(std::vector<Slot>& slots, Clock::duration kill_after, double kill_s, std::vector<Job>& again) {
   std::vector<pollfd> fds;
   auto wait = std::chrono::milliseconds(1000);
   const auto now = Clock::now();
@@ -209,8 +215,14 @@ std::vector<Row> collect(std::vector<Slot>& slots, Clock::duration kill_after, d
       const int code = batch::readExitCode(s.grader);
       // A grade that ended in an internal error may leave its grader in a bad state: a fresh one.
       if (code < 0 || (code != 0 && code != 2 && code != 4)) {
+        const bool in_place = s.grader.in_place;
         const int status = batch::stopGrader(s.grader, false);
-        rows.push_back(finish(*s.job, code < 0 ? status : W_EXITCODE(code, 0), false, kill_s));
+        if (code < 0 && WIFSIGNALED(status) && in_place) {
+          again.push_back(*s.job);
+          again.back().isolated = true;
+        } else {
+          rows.push_back(finish(*s.job, code < 0 ? status : W_EXITCODE(code, 0), false, kill_s));
+        }
       } else {
         rows.push_back(finish(*s.job, W_EXITCODE(code, 0), false, kill_s));
       }
@@ -250,12 +262,19 @@ std::vector<Row> runGraders(const GradeArgs& args, const batch::Found& found, co
   const auto old_sigpipe = ::signal(SIGPIPE, SIG_IGN);
   std::vector<Slot> slots(std::size_t(std::max(1, args.jobs)));
   std::size_t next = 0, busy = 0;
-  while (next < total || busy > 0) {
+  std::vector<Job> again;  // to be graded again, plots isolated
+  while (next < total || busy > 0 || !again.empty()) {
     // Keep every slot busy; a submission with nothing to grade gets its row (and results.json) at once.
     for (Slot& slot : slots) {
-      while (!slot.job && next < total) {
-        Job j{next, found.submissions[next], out / found.submissions[next].folder, {}};
-        ++next;
+      while (!slot.job && (next < total || !again.empty())) {
+        Job j;
+        if (!again.empty()) {
+          j = std::move(again.back());
+          again.pop_back();
+        } else {
+          j = {next, found.submissions[next], out / found.submissions[next].folder, {}, false};
+          ++next;
+        }
         std::string problem;
         const int log_fd = prepareFolder(j.out, problem);
         if (log_fd >= 0) ::close(log_fd);
@@ -277,10 +296,12 @@ std::vector<Row> runGraders(const GradeArgs& args, const batch::Found& found, co
       }
     }
     if (busy == 0) continue;
-    for (Row& r : collect(slots, kill_after, kill_s)) {
+    const std::size_t retried = again.size();
+    for (Row& r : collect(slots, kill_after, kill_s, again)) {
       --busy;
       progress(std::move(r));
     }
+    busy -= again.size() - retried;
   }
   for (Slot& slot : slots)
     if (slot.grader.running()) batch::stopGrader(slot.grader, false);
@@ -335,6 +356,14 @@ int gradeBatch(const GradeArgs& a) {
   std::size_t problems = 0;
   const std::vector<Row> rows = runGraders(args, found, out, problems);
 
+  // The graders write without fsync (labs/file_write.h: deferDurability): one sync of OUT's file
+  // system puts every submission's results on disk before the gradebook that records them.
+  try {
+    syncFileSystem(out.string());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s: the results could not be put on disk (%s)\n", termText(out.string()).c_str(), termText(e.what()).c_str());
+    return 1;
+  }
   // The gradebook, and its summary beside it (score statistics, histogram, common failure reasons).
   const fs::path book = out / "gradebook.csv", summary = out / "gradebook.md";
   const double lab_max = batch::labMaxScore(args.lab, a.config, rows);

@@ -13,6 +13,8 @@
 #include <exception>
 #include <string>
 
+#include "grading/isolated.h"
+#include "labs/file_write.h"
 #include "labs/utf8.h"
 
 namespace fs = std::filesystem;
@@ -87,7 +89,7 @@ int gradeGuarded(const GradeArgs& a, const Submission& sub, const fs::path& fold
 }  // namespace
 
 Grader startGrader(const GradeArgs& args, const std::vector<Submission>& subs, const fs::path& out,
-                   const std::vector<Grader*>& others) {
+                   const std::vector<Grader*>& others, bool in_place) {
   int down[2], up[2];
   if (::pipe2(down, O_CLOEXEC) != 0) return {};
   if (::pipe2(up, O_CLOEXEC) != 0) {
@@ -112,10 +114,12 @@ Grader startGrader(const GradeArgs& args, const std::vector<Submission>& subs, c
     ::close(down[1]), ::close(up[0]);
     for (const Grader* g : others)
       if (g->running()) ::close(g->to), ::close(g->from);
+    setIsolateInPlace(in_place);
+    deferDurability(true);  // the batch syncs OUT once, before its gradebook (gradeBatch)
     serve(args, subs, out, down[0], up[1]);
   }
   ::close(down[0]), ::close(up[1]);
-  return {pid, down[1], up[0]};
+  return {pid, down[1], up[0], in_place};
 }
 
 bool sendSubmission(const Grader& g, std::size_t index) {

@@ -20,14 +20,17 @@ struct Grader {
   pid_t pid = -1;
   int to = -1;    // the batch's end of the pipe the grader reads submission indexes from
   int from = -1;  // the batch's end of the pipe the grader writes exit codes to (end of file: it ended)
+  bool in_place = false;  // draws plots in its own process (setIsolateInPlace), not in a forked child
   bool running() const { return pid > 0; }
 };
 
 // Forks a grader for subs (graded into out/<folder>, with args' lab, config, budget and plots). The
 // pipes of `others` (graders already running) are closed in it, so each grader's pipes have one
-// reader and one writer. pid < 0 when it could not be started (errno says why).
+// reader and one writer. in_place: the grader draws plots in its own process (it is disposable: a
+// submission it dies on is graded again by a grader that isolates them). pid < 0 when it could not be
+// started (errno says why).
 Grader startGrader(const GradeArgs& args, const std::vector<Submission>& subs, const std::filesystem::path& out,
-                   const std::vector<Grader*>& others);
+                   const std::vector<Grader*>& others, bool in_place);
 
 // Gives the grader subs[index] to grade; false when it is gone (its pipe is closed).
 bool sendSubmission(const Grader& g, std::size_t index);
