@@ -22,27 +22,25 @@ namespace fs = std::filesystem;
 namespace dyn::app::batch {
 namespace {
 
-// All n bytes, retrying interrupted and short transfers; false at end of file or on an error.
-bool readExactly(int fd, void* data, std::size_t n) {
-  auto* p = static_cast<char*>(data);
+// All n bytes through op (read or write), retrying interrupted and short transfers; false at end of
+// file or on an error.
+template <class Op>
+bool transferAll(Op op, char* p, std::size_t n) {
   while (n > 0) {
-    const ssize_t got = ::read(fd, p, n);
-    if (got < 0 && errno == EINTR) continue;
-    if (got <= 0) return false;
-    p += got, n -= std::size_t(got);
+    const ssize_t done = op(p, n);
+    if (done < 0 && errno == EINTR) continue;
+    if (done <= 0) return false;
+    p += done, n -= std::size_t(done);
   }
   return true;
 }
 
+bool readExactly(int fd, void* data, std::size_t n) {
+  return transferAll([fd](char* p, std::size_t k) { return ::read(fd, p, k); }, static_cast<char*>(data), n);
+}
+
 bool writeExactly(int fd, const void* data, std::size_t n) {
-  const auto* p = static_cast<const char*>(data);
-  while (n > 0) {
-    const ssize_t put = ::write(fd, p, n);
-    if (put < 0 && errno == EINTR) continue;
-    if (put <= 0) return false;
-    p += put, n -= std::size_t(put);
-  }
-  return true;
+  return transferAll([fd](char* p, std::size_t k) { return ::write(fd, p, k); }, static_cast<char*>(const_cast<void*>(data)), n);
 }
 
 // What `dynlab grade FILE --out OUT/<folder>` runs, with main()'s last word on what escapes it.
