@@ -1,6 +1,7 @@
 // Tree algorithms of lecture eq. (1) — RNEA, CRBA, ABA, point Jacobians — written once for
 // planar and spatial algebra and instantiated for both (see chain.h for the equations).
 #include "physics/chain.h"
+#include "physics/chain_sized.h"
 #include "physics/chain_world.h"
 
 #include <cmath>
@@ -41,71 +42,15 @@ void TreeData<S>::resize(int n) {
   u.resize(n);
 }
 
-namespace {
-
-// A ball's sub-body i: the first turns by pre R(Q/|Q|) R0ᵀ after its placement, the other two sit on
-// it (identity placement).
-template <bool kParentFrames, class S>
-void ballKinematics(const TreeModel<S>& model, int i, const VecIn& q, TreeData<S>& data) {
-  const auto& b = model.bodies[std::size_t(i)];
-  typename S::Transform X_up;
-  if constexpr (S::kDim == 6) {
-    const auto& ball = model.balls[std::size_t(b.ball)];
-    if (i == ball.first) {
-      const int k = b.q_index;
-      const Eigen::Quaterniond Q(q[k], q[k + 1], q[k + 2], q[k + 3]);
-      // E rotates parent coordinates into the body's: the transpose of the relative rotation.
-      const typename S::Rot E = ball.post * Q.normalized().toRotationMatrix().transpose() * ball.pre.transpose();
-      X_up = S::compose(typename S::Transform{E, S::Pos::Zero(), true}, b.X_tree);
-    } else {
-      X_up = S::translation(S::Pos::Zero());
-    }
-  }
-  if constexpr (kParentFrames) data.X_up[i] = X_up;
-  data.X_world[i] = b.parent < 0 ? X_up : S::compose(X_up, data.X_world[b.parent]);
-  data.S_w[i] = S::motionInverse(data.X_world[i], b.subspace);
-}
-
-// positionKinematics, and with kParentFrames false its world part alone (X_world, S_w).
-template <bool kParentFrames, class S>
-void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
-  for (int i = 0; i < model.dof(); ++i) {
-    const auto& b = model.bodies[i];
-    if constexpr (kParentFrames) data.S_i[i] = b.subspace;
-    if constexpr (S::kDim == 6) {
-      // A revolute joint about a coordinate axis: X_world = X_J ∘ (X_tree ∘ X_world,parent) turns two
-      // rows, and its world axis is a row of E (spatial.h turnAbout, coordinateAxisInWorld).
-      if (b.joint == JointType::Revolute && b.coordinate_axis >= 0) {
-        const double c = det::cos(q[b.q_index]), s = det::sin(q[b.q_index]);
-        const int k = b.coordinate_axis;
-        if constexpr (kParentFrames) S::turnAbout(k, c, s, b.X_tree, nullptr, data.X_up[i]);
-        S::turnAbout(k, c, s, b.X_tree, b.parent < 0 ? nullptr : &data.X_world[b.parent], data.X_world[i]);
-        S::coordinateAxisInWorld(k, data.X_world[i], data.S_w[i]);
-        continue;
-      }
-    }
-    if (b.joint == JointType::Ball) {
-      ballKinematics<kParentFrames>(model, i, q, data);
-      continue;
-    }
-    // Joint placement then joint motion: X_up = X_J(θ_i) X_tree.
-    const typename S::Transform X_up = S::compose(S::jointTransform(b.joint == JointType::Revolute, b.axis, q[b.q_index]), b.X_tree);
-    if constexpr (kParentFrames) data.X_up[i] = X_up;
-    data.X_world[i] = b.parent < 0 ? X_up : S::compose(X_up, data.X_world[b.parent]);
-    data.S_w[i] = S::motionInverse(data.X_world[i], b.subspace);
-  }
-}
-
-}  // namespace
 
 template <class S>
 void positionKinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
-  kinematics<true>(model, q, data);
+  sized::kinematics<true, Eigen::Dynamic>(model, q, data);
 }
 
 template <class S>
 void worldKinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
-  kinematics<false>(model, q, data);
+  sized::kinematics<false, Eigen::Dynamic>(model, q, data);
 }
 
 template <class S>

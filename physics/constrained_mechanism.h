@@ -191,10 +191,25 @@ class ConstrainedMechanism : public ConstrainedSystem {
   bool factored_ = false;
   // The closed rows alone in the solve while some are released (dynamic sizes): selectClosedRows.
   bool selectClosedRows();
+  void limitRows();  // the constructor's: limit_rows_, only_limits_ and their constant rows
   void scatterClosedRows(Solution& s) const;
   template <class Out>
   void gatherClosedRows(const VecN& all, Out& out) const;
   bool selected_ = false;          // problem_ holds the closed rows alone (J̃ = H̃ J, Ã = H̃ A, J'θ', s)
+  // Which rows are closed changes (released_ written): closed_version_ counts the changes; while every
+  // constraint is a joint limit (J constant), problem_'s J̃ and Ã stay those selected at
+  // selected_version_ (−1: problem_ holds something else).
+  int closed_version_ = 0, selected_version_ = -1;
+  // Joint limits (constraints/joint_limit.h: φ = −σ (θ_i − θ_bound), J = −σ e_iᵀ, constant): per
+  // constraint its coordinate in q and column, σ and the bound (coordinate −1: another kind). With
+  // only limits (the PUMA file's twelve rows), J_full_ and A_full_ are written once, at construction,
+  // and a position stage computes each row's φ alone, without a virtual call.
+  struct LimitRow {
+    int coordinate = -1, column = -1;
+    double sign = 0, bound = 0;
+  };
+  std::vector<LimitRow> limit_rows_;
+  bool only_limits_ = false;
   bool selected() const { return Nr == Eigen::Dynamic && selected_; }  // never at fixed rows (a lab's)
   std::vector<int> closed_rows_;   // their rows, in order
   VecN phi_;

@@ -15,6 +15,7 @@
 #include <stdexcept>
 
 #include "physics/constrained_mechanism.h"
+#include "physics/constraints/joint_limit.h"
 
 namespace dyn {
 
@@ -24,7 +25,25 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::setClosed(int i, bool closed) {
   if (!c.unilateral() || c.compliant())
     throw std::invalid_argument("ConstrainedMechanism::setClosed: constraint " + std::to_string(i) + " is not a rigid unilateral contact");
   released_[std::size_t(i)] = char(!closed);
+  ++closed_version_;
   invalidate();
+}
+
+// Joint limits alone (the PUMA file's rows): their constant J written once (constrained_mechanism.h
+// limit_rows_); the position stage computes their φ in place.
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::limitRows() {
+  limit_rows_.assign(model_.constraints.size(), LimitRow{});
+  if constexpr (S::kDim == 6)
+    for (std::size_t i = 0; i < model_.constraints.size(); ++i)
+      if (const auto* limit = dynamic_cast<const JointLimit*>(model_.constraints[i].get()))
+        limit_rows_[i] = {model_.tree.bodies[std::size_t(limit->joint())].q_index, limit->joint(), limit->sign(), limit->bound()};
+  only_limits_ = !limit_rows_.empty() && std::all_of(limit_rows_.begin(), limit_rows_.end(), [](const LimitRow& l) { return l.coordinate >= 0; });
+  if (!only_limits_) return;
+  // The rows' constant J (JointLimit::position's entries), A empty of entries.
+  J_full_.setZero(rows_, n());
+  A_full_.setZero(rows_, k());
+  for (std::size_t i = 0; i < limit_rows_.size(); ++i) J_full_(offsets_[i], limit_rows_[i].column) = -limit_rows_[i].sign;
 }
 
 // While some rows are released (a model file's joint limits away from their stops, contacts open),
@@ -40,6 +59,9 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::selectClosedRows() {
   selected_ = false;
   if constexpr (Nr == Eigen::Dynamic) {
     if (!any_released_kind_) return false;
+    // Only joint limits (J constant), the same rows closed as at the last selection: problem_ holds them.
+    if (only_limits_ && selected_version_ == closed_version_) return selected_ = true;
+    selected_version_ = -1;  // (problem_ is rewritten below, or by the unselected stage)
     closed_rows_.clear();
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
       if (!released_[i])
@@ -55,6 +77,7 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::selectClosedRows() {
     }
     problem_.compliance.resize(0);  // the released rows are out of the solve
     selected_ = true;
+    if (only_limits_) selected_version_ = closed_version_;
   }
   return selected_;
 }
@@ -137,6 +160,7 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
     const double approach = J_full_.row(r).dot(v.head(n())) - (k() ? A_full_.row(r).dot(v.tail(k())) : 0.0);
     if (approach >= -kSeparating) {
       released_[i] = 0;
+      ++closed_version_;
       ++changes;
     }
   }
@@ -179,6 +203,7 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
       if (rigid(i) && !released_[i] && s.eta[offsets_[i]] < most) most = s.eta[offsets_[i]], worst = i;
     if (worst == count) break;
     released_[worst] = 1;
+    ++closed_version_;
     invalidate();
     ++changes;
   }

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "physics/chain_sized.h"
 #include "physics/chain_world.h"
 #include "physics/constrained_mechanism.h"
 #include "physics/constrained_mechanism_contacts.h"
@@ -60,6 +61,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
     any_rigid_contact_ = any_rigid_contact_ || rigid_contact_.back();
   }
   closed_rows_.reserve(std::size_t(rows_));  // selectClosedRows: no allocation in a step
+  limitRows();
   auto fits = [](int fixed, int actual) { return fixed == Eigen::Dynamic || fixed == actual; };
   const int dof = model_.treeDof(), payload = model_.payloadDof();
   if (!fits(Nj, dof) || !fits(Nr, rows_) || !fits(Nl, payload))
@@ -107,13 +109,13 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   // World transforms and joint axes, unless a controller's query just staged the whole tree at θ (the
   // parent frames are treeStage's, for the body-frame queries).
   if (!have_tree_ || q.head(nqt) != tree_q_) {
-    worldKinematics(model_.tree, q.head(nqt), data_);
+    sized::kinematics<false, Nj>(model_.tree, q.head(nqt), data_);
     have_tree_ = false;
   }
   have_velocity_ = false;
   // M from world composite inertias; the world inertias stay for the velocity stage.
   problem_.M.resize(nn, nn);
-  crbaWorld(model_.tree, data_, problem_.M);
+  sized::crbaWorld<Nj>(model_.tree, data_, problem_.M);
   addArmature(problem_.M);
   kin_.theta = q.head(nqt);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
@@ -131,9 +133,17 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
     kin_.payload_cs[i] = p.free[0] || psi != 0.0 ? Eigen::Vector2d(det::cos(psi), det::sin(psi)) : Eigen::Vector2d(1.0, 0.0);
   }
   // Every constraint's φ, J and A rows, then eq. (2) factored at this configuration.
-  setZeroAt<Nr, Nj>(J_full_, rows_, nn);
-  setZeroAt<Nr, Nl>(A_full_, rows_, kk);
-  for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->position(kin_, offsets_[i], phi_full_, J_full_, A_full_);
+  // (Joint limits alone: φ = −gap of each, JointLimit::position's φ; their J rows are constant.)
+  if (only_limits_) {
+    for (std::size_t i = 0; i < limit_rows_.size(); ++i) {
+      const LimitRow& l = limit_rows_[i];
+      phi_full_[offsets_[i]] = -(l.sign * (kin_.theta[l.coordinate] - l.bound));
+    }
+  } else {
+    setZeroAt<Nr, Nj>(J_full_, rows_, nn);
+    setZeroAt<Nr, Nl>(A_full_, rows_, kk);
+    for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->position(kin_, offsets_[i], phi_full_, J_full_, A_full_);
+  }
   setFixed<Nr>(phi_, phi_full_);
   // Some rows released at dynamic sizes: the closed rows alone, compacted (selectClosedRows); φ = 0 on
   // the released ones.
@@ -187,7 +197,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   // Link velocities, each link's velocity-product acceleration and h = Cθ' + G, in world coordinates.
   problem_.h.resize(nn);
   kin_.theta_rate = qd.head(nn);
-  biasForcesWorld(model_.tree, data_, qd, problem_.h);
+  sized::biasForcesWorld<Nj>(model_.tree, data_, qd, problem_.h);
   // Joint springs and friction join h; friction's power for the books.
   friction_power_ = 0.0;
   if (!model_.joints.empty())
@@ -403,9 +413,9 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::impulseResponse(const VecN& e, Solutio
   Problem impulse;
   impulse.tau.setZero(n());
   impulse.h.setZero(n());
-  if (selected()) {  // the closed rows the factor holds
-    impulse.Jdot_qd.resize(Eigen::Index(closed_rows_.size()));
-    for (std::size_t i = 0; i < closed_rows_.size(); ++i) impulse.Jdot_qd[Eigen::Index(i)] = -e[closed_rows_[i]];
+  if (selected()) {  // the closed rows the factor holds (negated after the gather: exact)
+    gatherClosedRows(e, impulse.Jdot_qd);
+    impulse.Jdot_qd = -impulse.Jdot_qd;
   } else {
     impulse.Jdot_qd = -e;
   }
@@ -501,11 +511,16 @@ double ConstrainedMechanism<S, Nj, Nr, Nl>::residual(const VecN& q, const VecN& 
   positionStage(q);
   if (!rows_) return 0.0;
   // Velocity form J θ' − A v_c as well: a velocity-level kind has only this one.
-  VecN phi;
-  MatN G;
-  if (selected()) constraint(q, phi, G);  // the rows over every constraint (problem_ holds the closed ones)
-  const MatN J = selected() ? MatN(G.leftCols(n())) : MatN(problem_.J), A = selected() ? MatN(-G.rightCols(k())) : MatN(problem_.A);
-  const VecN gv = J * v.head(n()) - A * v.tail(k());
+  // (G v = J θ' − A v_c; with the rows selected, taken on G's blocks where they lie, no copies: the
+  // same dynamically sized products as on copies of them.)
+  auto rates = [&]() -> VecN {
+    if (!selected()) return MatN(problem_.J) * v.head(n()) - MatN(problem_.A) * v.tail(k());
+    VecN phi;  // the rows over every constraint (problem_ holds the closed ones)
+    MatN G;
+    constraint(q, phi, G);
+    return G.leftCols(n()) * v.head(n()) + G.rightCols(k()) * v.tail(k());
+  };
+  const VecN gv = rates();
   return std::max(phi_.lpNorm<Eigen::Infinity>(), gv.lpNorm<Eigen::Infinity>());
 }
 

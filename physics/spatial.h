@@ -242,10 +242,19 @@ struct Spatial {
     m.block<3, 3>(3, 3) = X.E;
     return m;
   }
+  // Entry by entry, each sum as Eigen's 3×3 products sum it (x0 + (x1 + x2)): the same bits as
+  // {bc.E ab.E, ab.r + ab.Eᵀ bc.r}, without the out-of-line product call.
   DYN_INLINE static Transform compose(const Transform& bc, const Transform& ab) {
     if (!ab.turned) return {bc.E, ab.r + bc.r, bc.turned};
-    if (!bc.turned) return {ab.E, ab.r + ab.E.transpose() * bc.r, true};
-    return {bc.E * ab.E, ab.r + ab.E.transpose() * bc.r, true};
+    Transform out;
+    for (int a = 0; a < 3; ++a) out.r[a] = ab.r[a] + (ab.E(0, a) * bc.r[0] + (ab.E(1, a) * bc.r[1] + ab.E(2, a) * bc.r[2]));
+    if (!bc.turned) {
+      out.E = ab.E;
+      return out;
+    }
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b) out.E(a, b) = bc.E(a, 0) * ab.E(0, b) + (bc.E(a, 1) * ab.E(1, b) + bc.E(a, 2) * ab.E(2, b));
+    return out;
   }
   DYN_INLINE static Transform inverse(const Transform& X) { return {X.E.transpose(), -X.E * X.r, X.turned}; }
   DYN_INLINE static Transform translation(const Pos& p) { return {Rot::Identity(), p, false}; }

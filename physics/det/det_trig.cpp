@@ -5,6 +5,7 @@
 // coefficients are those of Sun's fdlibm (published 1993, the basis of most C libraries); the code is
 // written here. Accuracy measured against x87 long double: docs/determinism.md.
 #include "physics/det/det.h"
+#include "physics/det/sincos.h"
 
 #include <cmath>
 #include <limits>
@@ -117,6 +118,28 @@ double cos(double x) {
     case 1: return -sinKernel(y0, y1, true);
     case 2: return -cosKernel(y0, y1);
     default: return sinKernel(y0, y1, true);
+  }
+}
+
+void sincos(double x, double& s, double& c) {
+  // As sin() and cos() each take it (the same branches, kernels and reduction), the reduction once.
+  if (std::abs(x) <= kPio4) {
+    s = std::abs(x) < 0x1p-26 ? x : sinKernel(x, 0.0, false);
+    c = std::abs(x) < 0x1p-27 ? 1.0 : cosKernel(x, 0.0);
+    return;
+  }
+  if (!std::isfinite(x)) {
+    s = c = x - x;
+    return;
+  }
+  double y0, y1;
+  const int n = reduce(x, y0, y1);
+  const double sk = sinKernel(y0, y1, true), ck = cosKernel(y0, y1);
+  switch (n) {
+    case 0: s = sk, c = ck; break;
+    case 1: s = ck, c = -sk; break;
+    case 2: s = -sk, c = -ck; break;
+    default: s = -ck, c = sk; break;
   }
 }
 

@@ -8,6 +8,7 @@
 #include <Eigen/LU>
 #include <cstdio>
 
+#include "physics/det/det.h"
 #include "physics/model_file/number_text.h"
 
 namespace dyn::model_file {
@@ -115,7 +116,14 @@ namespace {
 // decay (Re λ ≥ 0: a coordinate no servo holds, whose double zero the eigensolver returns as ±1e-8) is
 // the motion's own, not the servos'.
 bool rk4Follows(std::complex<double> z) {
-  return z.real() >= 0 || std::abs(1.0 + z + z * z / 2.0 + z * z * z / 6.0 + z * z * z * z / 24.0) <= 1.0 + 1e-12;
+  return z.real() >= 0 || det::abs(1.0 + z + z * z / 2.0 + z * z * z / 6.0 + z * z * z * z / 24.0) <= 1.0 + 1e-12;
+}
+
+// The largest |λ| (det::abs: the same bits on every machine, as the test above).
+double fastest(const Eigen::VectorXcd& modes) {
+  double r = 0;
+  for (Eigen::Index i = 0; i < modes.size(); ++i) r = std::max(r, det::abs(modes[i]));
+  return r;
 }
 
 bool followsAt(const Eigen::VectorXcd& modes, double h) {
@@ -148,7 +156,7 @@ std::string stiffServoNote(const LoadedModel& m, const MatN& M, double dt) {
   double h = dt;
   for (int halvings = 0; halvings < 60 && !followsAt(modes, h); ++halvings) h /= 2;
   return "the servos (stiffness up to " + number(k) + ", damping up to " + number(c) + ", fastest mode " +
-         number(modes.cwiseAbs().maxCoeff()) + " 1/s at the start) are stiffer than RK4 follows at dt " + number(dt) +
+         number(fastest(modes)) + " 1/s at the start) are stiffer than RK4 follows at dt " + number(dt) +
          " s: the run chatters; pass --dt " + number(h) + " or less (MuJoCo 3's implicit integrators take these terms implicitly)";
 }
 

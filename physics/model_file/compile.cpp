@@ -15,6 +15,7 @@
 #include "physics/model_file/fence.h"
 #include "physics/model_file/mjcf3.h"
 #include "physics/model_file/mujoco_call.h"
+#include "physics/model_file/urdf_read.h"
 
 namespace dyn::model_file::detail {
 namespace {
@@ -90,14 +91,6 @@ Compiled::~Compiled() {
   if (m) mj_deleteModel(m);
 }
 
-namespace {
-std::size_t countOf(const std::string& text, const std::string& what) {
-  std::size_t n = 0;
-  for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + what.size())) ++n;
-  return n;
-}
-}  // namespace
-
 std::shared_ptr<const Compiled> compile(const std::string& path, std::string* warnings, const std::vector<std::string>& package_paths) {
   const std::string bytes = readChecked(path);
   const std::string name = std::filesystem::path(path).filename().string();
@@ -124,7 +117,8 @@ std::shared_ptr<const Compiled> compile(const std::string& path, std::string* wa
   if (!out->m) throw ModelFileError(path + ": MuJoCo could not read back the model it compiled");
   // A URDF's <mimic> (a finger following another, as Bullet's and ROS's Panda write it): MuJoCo 2.2.2's
   // URDF reader drops it, so the joint moves on its own; said, with the way to hold it.
-  if (const std::size_t mimics = countOf(bytes, "<mimic"); mimics > 0)
+  // Its elements (urdf_read.cpp), not its text: a <mimic> commented out is none.
+  if (const std::size_t mimics = bytes.find("mimic") == std::string::npos ? 0 : readUrdfFacts(bytes).mimics; mimics > 0)
     out->notes.push_back(std::to_string(mimics) + " URDF <mimic> element(s) not held (MuJoCo 2.2.2's URDF reader ignores them: each such joint moves "
                          "on its own); to couple them, write the robot as MJCF with <equality><joint joint1 joint2 polycoef=\"0 1 0 0 0\"/>");
   return out;

@@ -7,7 +7,8 @@
 // the packages it names) or, when no such file exists, as a
 // one-byte stand-in that MuJoCo then reports as unreadable: MuJoCo never opens a FIFO, a device, a
 // link out of the folder or a file past the limits. The names are found by scanning the text for
-// attribute values (a lexical scan, not a parse: a name in a comment is checked too, harmlessly).
+// attribute values (a lexical scan, not a parse: a name in a comment is checked too, harmlessly); which
+// of a URDF's names are visuals MuJoCo discards is read from its parsed elements (urdf_read.cpp).
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -17,9 +18,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <map>
+#include <memory>
 #include <set>
 
 #include "physics/model_file/mujoco_call.h"
+#include "physics/model_file/urdf_read.h"
 #include "physics/util/utf8.h"
 
 namespace dyn::model_file::detail {
@@ -109,24 +112,32 @@ std::string vfsKeyExtension(std::string ext) {
 
 bool isNameChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-' || c == ':' || c == '.'; }
 
-// Inside a URDF <visual> element at byte `at` (lexically: its last <visual opened after its last </visual>).
-bool inVisual(const std::string& text, std::size_t at) {
-  const std::size_t open = text.rfind("<visual", at), close = text.rfind("</visual", at);
-  return open != std::string::npos && (close == std::string::npos || open > close);
-}
+// The names of a URDF's visuals MuJoCo discards (its default; `discardvisual="false"` keeps them):
+// those written only inside its <visual> elements (urdf_read.cpp); every name when the URDF is not
+// well-formed XML, so that MuJoCo's parser, not a clash of two names, says what is wrong with it.
+struct DiscardedVisuals {
+  bool every = false;
+  std::set<std::string> names;
+  bool has(const std::string& name) const { return every || names.count(name) > 0; }
+};
 
-// A URDF MuJoCo reads without its visuals (its default; `discardvisual="false"` keeps them).
-bool discardsVisuals(const std::string& path, const std::string& text) {
+// Null for a file other than a URDF, or a URDF that keeps its visuals.
+std::unique_ptr<DiscardedVisuals> discardedVisuals(const std::string& path, const std::string& text) {
   const std::size_t dot = path.find_last_of('.');
-  const bool urdf = dot != std::string::npos && vfsKeyExtension(path.substr(dot)) == ".urdf";
-  return urdf && text.find("discardvisual=\"false\"") == std::string::npos && text.find("discardvisual='false'") == std::string::npos;
+  if (dot == std::string::npos || vfsKeyExtension(path.substr(dot)) != ".urdf") return nullptr;
+  UrdfFacts facts = readUrdfFacts(text);
+  if (facts.well_formed && facts.keeps_visuals) return nullptr;
+  auto out = std::make_unique<DiscardedVisuals>();
+  out->every = !facts.well_formed;
+  out->names = std::move(facts.visual_only);
+  return out;
 }
 
 // Every `name = "value"` (or '…') in the text whose name starts with "file" (files) or is meshdir,
-// texturedir or assetdir (folders), values unescaped. One pass over the text. With `visuals`, the
-// names inside a URDF <visual> go there instead of `files`.
+// texturedir or assetdir (folders), values unescaped. One pass over the text. The names in
+// `visual_only` (a URDF's discarded visuals) go to `visuals` instead of `files`.
 void scanNames(const std::string& text, const std::string& who, std::vector<std::string>& files, std::vector<std::string>& dirs,
-               std::vector<std::string>* visuals = nullptr) {
+               std::vector<std::string>& visuals, const DiscardedVisuals* visual_only) {
   for (std::size_t eq = text.find('='); eq != std::string::npos; eq = text.find('=', eq + 1)) {
     std::size_t e = eq;
     while (e > 0 && std::isspace(static_cast<unsigned char>(text[e - 1]))) --e;
@@ -146,7 +157,7 @@ void scanNames(const std::string& text, const std::string& who, std::vector<std:
       throw ModelFileError(who + ": " + name + "=\"" + oneLine(text.substr(v + 1, std::min<std::size_t>(close - v - 1, 80))) +
                            "\" holds an entity dynlab does not expand (write the file's name plainly)");
     if (value.empty()) continue;
-    if (file && visuals && inVisual(text, b)) visuals->push_back(value);
+    if (file && visual_only && visual_only->has(value)) visuals.push_back(value);
     else (file ? files : dirs).push_back(value);
   }
 }
@@ -198,8 +209,8 @@ std::vector<std::string> addReferencedFiles(const std::string& path, const std::
     // A URDF's discarded visuals come last: MuJoCo's URDF reader keys meshes by file name and reads the
     // collision's, so a visual of the same name (meshes/visual/link1.obj beside meshes/collision/
     // link1.obj) is checked and left out rather than refused.
-    const bool discard = t == 0 && discardsVisuals(path, texts[t].second);
-    scanNames(texts[t].second, texts[t].first, files, more_dirs, discard ? &visuals : nullptr);
+    const std::unique_ptr<DiscardedVisuals> discard = t == 0 ? discardedVisuals(path, texts[t].second) : nullptr;
+    scanNames(texts[t].second, texts[t].first, files, more_dirs, visuals, discard.get());
     const std::size_t visual_from = files.size();
     files.insert(files.end(), visuals.begin(), visuals.end());
     for (const std::string& d : more_dirs)

@@ -4,6 +4,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 
+#include "physics/det/det.h"
 #include "physics/model_file/actuators.h"
 #include "physics/model_file/hand_engine.h"
 #include "physics/model_file/number_text.h"
@@ -37,11 +38,16 @@ FastestMode fastestMode(ConstrainedSystem& engine, const LoadedModel& m, const V
   const Eigen::EigenSolver<Eigen::MatrixXd> modes(A);
   FastestMode out;
   for (Eigen::Index i = 0; i < 2 * n; ++i) {
-    const double rate = std::abs(modes.eigenvalues()[i]);
+    // |λ| through det::hypot (std::abs of a complex is libm's hypot, whose last bit differs between
+    // libms): the sub-step count, ceil(|λ| dt / kStiffStep), is then the same on every machine.
+    const double rate = det::abs(modes.eigenvalues()[i]);
     if (!(rate > out.rate)) continue;
     out.rate = rate;
+    // The joint that moves most in it (det::abs again: a tie broken the same way everywhere).
     Eigen::Index most = 0;
-    modes.eigenvectors().col(i).tail(n).cwiseAbs().maxCoeff(&most);
+    const Eigen::VectorXcd shape = modes.eigenvectors().col(i).tail(n);
+    for (Eigen::Index k = 1; k < n; ++k)
+      if (det::abs(shape[k]) > det::abs(shape[most])) most = k;
     out.joint = std::size_t(most) < m.joints.size() ? m.joints[std::size_t(most)].name : "";
   }
   return out;

@@ -93,6 +93,15 @@ void refused(const Run& r, const std::string& file, const std::string& what) {
   CHECK(r.err.find(what) != std::string::npos);
 }
 
+// `dynlab model FILE` on a folder holding only FILE with this text: refused as above, nothing written.
+void refusesFile(const std::string& folder, const std::string& file, const std::string& text, const std::string& what) {
+  Dir dir(folder);
+  write(dir.path / file, text);
+  const Run r = dynlab(dir.path, {"model", file, "--out", "o"}, 60);
+  refused(r, file, what);
+  CHECK_FALSE(fs::exists(dir.path / "o"));
+}
+
 // A pendulum whose body sits in an included file.
 const char* kPendulum =
     "<mujoco model=\"pend\"><option><flag contact=\"disable\"/></option><worldbody><include file=\"arm.xml\"/></worldbody></mujoco>";
@@ -140,11 +149,15 @@ TEST_CASE("a model reached through a link: the load, the cross-check and bench's
 
 TEST_CASE("a file that makes MuJoCo's parser exhaust its memory is refused in one line, the limit named") {
   // A height field of 20000 x 20000 samples: 1.6 GB of floats MuJoCo's compiler would allocate.
-  Dir dir("memory");
-  write(dir.path / "field.xml",
-        "<mujoco><asset><hfield name=\"h\" nrow=\"20000\" ncol=\"20000\" size=\"1 1 1 1\"/></asset><worldbody><body><joint/>"
-        "<geom size=\"0.1\"/></body></worldbody></mujoco>");
-  const Run r = dynlab(dir.path, {"model", "field.xml", "--out", "o"}, 60);
-  refused(r, "field.xml", "MuJoCo's parser ran out of memory on this file (limit 1024 MiB)");
-  CHECK_FALSE(fs::exists(dir.path / "o"));
+  refusesFile("memory", "field.xml",
+              "<mujoco><asset><hfield name=\"h\" nrow=\"20000\" ncol=\"20000\" size=\"1 1 1 1\"/></asset><worldbody><body><joint/>"
+              "<geom size=\"0.1\"/></body></worldbody></mujoco>",
+              "MuJoCo's parser ran out of memory on this file (limit 1024 MiB)");
+}
+
+TEST_CASE("a URDF that is not well-formed XML (a <mimic> and a visual mesh in it) is refused in one line, exit 2") {
+  refusesFile("broken_urdf", "broken.urdf",
+              "<robot name=\"a\"><link name=\"b\"><visual><geometry><mesh filename=\"m.stl\"/></geometry></visual>\n"
+              "<joint name=\"j\" type=\"revolute\"><parent link=\"b\"/><mimic joint=\"k\"/></joint></robot>",
+              "XML parse error");
 }

@@ -3,7 +3,8 @@
 // twelve joint-limit rows exactly as the dynamically sized mechanism does, bit for bit, through a run
 // that falls onto a stop (a row closed, its impact, the lift-off checks) and with every row open; and
 // the solve on the closed rows alone (compacted: J̃, J'θ' and the Baumgarte term of those rows only)
-// gives what the solve over all twelve rows gives with the open ones zeroed at unit compliance.
+// gives what the solve over all twelve rows gives with the open ones zeroed at unit compliance; and
+// the limits' rows computed in place (only limits: J constant) give what their own position() gives.
 #include <doctest/doctest.h>
 
 #include "physics/constrained_mechanism_impl.h"
@@ -81,5 +82,39 @@ TEST_CASE("the PUMA file's closed rows solved alone step as every row solved wit
     CHECK(lockstep(m, integrator, selected, every, true) > 100);
     CHECK(selected.impactLoss() > 0);
     CHECK(selected.impactLoss() == every.impactLoss());
+  }
+}
+
+namespace {
+// A joint limit the mechanism does not recognise as one (it forwards every call): its rows are asked
+// for through the constraint's own position(), as any other kind's.
+class ForwardedLimit final : public Constraint<Spatial> {
+ public:
+  explicit ForwardedLimit(std::shared_ptr<const Constraint<Spatial>> limit) : limit_(std::move(limit)) {}
+  const char* kind() const override { return limit_->kind(); }
+  int rows() const override { return limit_->rows(); }
+  bool unilateral() const override { return limit_->unilateral(); }
+  void position(const MechanismKinematics<Spatial>& k, int row, VecN& phi, MatN& J, MatN& A) const override { limit_->position(k, row, phi, J, A); }
+  void bias(const MechanismKinematics<Spatial>& k, int row, VecN& b) const override { limit_->bias(k, row, b); }
+  Spatial::Vec force(const MechanismKinematics<Spatial>& k, const double* eta) const override { return limit_->force(k, eta); }
+  Spatial::Pos point(const MechanismKinematics<Spatial>& k) const override { return limit_->point(k); }
+  Attachment<Spatial> attachment() const override { return limit_->attachment(); }
+
+ private:
+  std::shared_ptr<const Constraint<Spatial>> limit_;
+};
+}  // namespace
+
+TEST_CASE("joint limits alone: their rows computed in place (J constant, the selection kept) step as the limits' own rows, bit for bit") {
+  const model_file::LoadedModel m = model_file::load(model("puma560.urdf"));
+  MechanismModel<Spatial> forwarded = m.mechanism;
+  for (auto& c : forwarded.constraints) c = std::make_shared<ForwardedLimit>(c);
+  for (Integrator integrator : {Integrator::SemiImplicitEuler, Integrator::RK4}) {
+    INFO(int(integrator));
+    model_file::SixJoints in_place(m.mechanism);
+    ConstrainedMechanism<Spatial> through_rows(forwarded);
+    CHECK(lockstep(m, integrator, in_place, through_rows, true) > 100);
+    CHECK(in_place.impactLoss() > 0);
+    CHECK(in_place.impactLoss() == through_rows.impactLoss());
   }
 }

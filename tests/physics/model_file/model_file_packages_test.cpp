@@ -122,3 +122,37 @@ TEST_CASE("a URDF's <mimic> is said to be not held, with the way to hold it") {
   CHECK(has(*note, "<equality><joint joint1 joint2 polycoef"));
   fs::remove_all(folder() / "mimic");
 }
+
+TEST_CASE("a URDF is read as XML: a <mimic> or </visual> in a comment or CDATA is none; XML's quoting and spacing; broken XML is one line") {
+  write("xml/meshes/collision/body.stl", tetrahedronStl(0.1f));
+  write("xml/meshes/visual/body.stl", tetrahedronStl(0.3f));
+  auto mimicNote = [](const model_file::LoadedModel& m) {
+    return std::any_of(m.notes.begin(), m.notes.end(), [](const std::string& n) { return has(n, "<mimic>"); });
+  };
+  // A <mimic> commented out, and one as CDATA text: no note.
+  std::string u = meshArmUrdf("meshes/collision/body.stl");
+  u.insert(u.find("</joint>"), "<!-- <mimic joint=\"j0\"/> --><![CDATA[<mimic joint=\"j0\"/>]]>");
+  CHECK_FALSE(mimicNote(model_file::load(write("xml/commented.urdf", u).string())));
+  // A "</visual>" in a comment inside the visual: its mesh stays a discarded visual, the collision's is read.
+  std::string v = visualAndCollisionUrdf("");
+  v.insert(v.find("<visual>") + 8, "<!-- </visual> -->");
+  const double collision = drawnSize(write("xml/plain.urdf", meshArmUrdf("meshes/collision/body.stl")));
+  CHECK(drawnSize(write("xml/comment_in_visual.urdf", v)) == doctest::Approx(collision));
+  // discardvisual = 'false' with spaces around '=' and single quotes keeps the visuals (refused, as above);
+  // one in a comment keeps nothing.
+  const std::string kept = errorOf(write("xml/kept.urdf", visualAndCollisionUrdf("<mujoco><compiler\n  discardvisual = 'false' /></mujoco>")));
+  CHECK(has(kept, "another file named 'body.stl' is named too"));
+  CHECK(drawnSize(write("xml/kept_in_comment.urdf", visualAndCollisionUrdf("<!-- <mujoco><compiler discardvisual=\"false\"/></mujoco> -->"))) ==
+        doctest::Approx(collision));
+  // Not well-formed (an element left open), with a <mimic> and twin meshes: MuJoCo's parser says so, in
+  // one line naming the file (not the two meshes' names, which a broken file cannot tell apart).
+  std::string broken = visualAndCollisionUrdf("");
+  broken.insert(broken.find("</joint>"), "<mimic joint=\"j0\"/>");
+  broken.erase(broken.find("</link>"), 7);
+  const std::string error = errorOf(write("xml/broken.urdf", broken));
+  CHECK(has(error, "broken.urdf"));
+  CHECK(has(error, "XML parse error"));
+  CHECK_FALSE(has(error, "another file named"));
+  CHECK(error.find('\n') == std::string::npos);
+  fs::remove_all(folder() / "xml");
+}

@@ -1,0 +1,139 @@
+// The tree recursions a mechanism's stage runs (chain.h positionKinematics / worldKinematics,
+// chain_world.h crbaWorld and biasForcesWorld), written once for a body count N known at compile
+// time (a fixed instantiation of ConstrainedMechanism: the model files' PUMA and five-bar, the labs)
+// or Eigen::Dynamic (chain.cpp and chain_world.cpp instantiate that). Each is the same sequence of
+// floating-point operations at either size, so M, h and the transforms are bit for bit the same;
+// a fixed N only lets the body loops unroll and the bodies' data stay in registers.
+#pragma once
+#include "physics/chain.h"
+#include "physics/det/det.h"
+#include "physics/det/sincos.h"
+
+namespace dyn::sized {
+
+template <int N, class S>
+DYN_INLINE int bodyCount(const TreeModel<S>& model) {
+  if constexpr (N == Eigen::Dynamic) return model.dof();
+  else return N;
+}
+
+// A ball's sub-body i: the first turns by pre R(Q/|Q|) R0ᵀ after its placement, the other two sit on
+// it (identity placement).
+template <bool kParentFrames, class S>
+void ballKinematics(const TreeModel<S>& model, int i, const VecIn& q, TreeData<S>& data) {
+  const auto& b = model.bodies[std::size_t(i)];
+  typename S::Transform X_up;
+  if constexpr (S::kDim == 6) {
+    const auto& ball = model.balls[std::size_t(b.ball)];
+    if (i == ball.first) {
+      const int k = b.q_index;
+      const Eigen::Quaterniond Q(q[k], q[k + 1], q[k + 2], q[k + 3]);
+      // E rotates parent coordinates into the body's: the transpose of the relative rotation.
+      const typename S::Rot E = ball.post * Q.normalized().toRotationMatrix().transpose() * ball.pre.transpose();
+      X_up = S::compose(typename S::Transform{E, S::Pos::Zero(), true}, b.X_tree);
+    } else {
+      X_up = S::translation(S::Pos::Zero());
+    }
+  }
+  if constexpr (kParentFrames) data.X_up[i] = X_up;
+  data.X_world[i] = b.parent < 0 ? X_up : S::compose(X_up, data.X_world[b.parent]);
+  data.S_w[i] = S::motionInverse(data.X_world[i], b.subspace);
+}
+
+// positionKinematics, and with kParentFrames false its world part alone (X_world, S_w).
+template <bool kParentFrames, int N, class S>
+void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
+  const int n = bodyCount<N>(model);
+  for (int i = 0; i < n; ++i) {
+    const auto& b = model.bodies[i];
+    if constexpr (kParentFrames) data.S_i[i] = b.subspace;
+    if constexpr (S::kDim == 6) {
+      // A revolute joint about a coordinate axis: X_world = X_J ∘ (X_tree ∘ X_world,parent) turns two
+      // rows, and its world axis is a row of E (spatial.h turnAbout, coordinateAxisInWorld).
+      if (b.joint == JointType::Revolute && b.coordinate_axis >= 0) {
+        double c, s;
+        det::sincos(q[b.q_index], s, c);  // det::cos and det::sin, one reduction
+        const int k = b.coordinate_axis;
+        if constexpr (kParentFrames) S::turnAbout(k, c, s, b.X_tree, nullptr, data.X_up[i]);
+        S::turnAbout(k, c, s, b.X_tree, b.parent < 0 ? nullptr : &data.X_world[b.parent], data.X_world[i]);
+        S::coordinateAxisInWorld(k, data.X_world[i], data.S_w[i]);
+        continue;
+      }
+    }
+    if (b.joint == JointType::Ball) {
+      ballKinematics<kParentFrames>(model, i, q, data);
+      continue;
+    }
+    // Joint placement then joint motion: X_up = X_J(θ_i) X_tree.
+    const typename S::Transform X_up = S::compose(S::jointTransform(b.joint == JointType::Revolute, b.axis, q[b.q_index]), b.X_tree);
+    if constexpr (kParentFrames) data.X_up[i] = X_up;
+    data.X_world[i] = b.parent < 0 ? X_up : S::compose(X_up, data.X_world[b.parent]);
+    data.S_w[i] = S::motionInverse(data.X_world[i], b.subspace);
+  }
+}
+
+// chain_world.h crbaWorld: M(θ) from world composite inertias, leaving data.I_w.
+template <int N, class S, class MatOut>
+void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
+  const int n = bodyCount<N>(model);
+  // World inertias (kept for the velocity stage), each also its composite's first term.
+  typename S::Inertia zero{};
+  if constexpr (S::kDim == 3) zero.setZero();
+  for (int i = 0; i < n; ++i) {
+    const auto& b = model.bodies[std::size_t(i)];
+    if (b.massless) data.I_w[i] = data.Ic_rb[i] = zero;
+    else if constexpr (S::kDim == 6) S::inertiaInParent(data.X_world[i], b.central, data.I_w[i], data.Ic_rb[i]);  // from the centre of mass
+    else data.I_w[i] = data.Ic_rb[i] = S::inertiaInParent(data.X_world[i], b.inertia);
+  }
+  // Composite inertias, leaves to root: in one frame they simply add.
+  for (int i = n - 1; i >= 0; --i) {
+    const int p = model.bodies[std::size_t(i)].parent;
+    if (p >= 0) data.Ic_rb[p] += data.Ic_rb[i];
+  }
+  for (int j = 0; j < n; ++j) {
+    // The force that moving joint j alone needs, seen by every joint on the way to the root (parents
+    // precede their children); the joints off that path see none. Each entry written once (M is
+    // symmetric): no zeroing pass first, which for a small M is a memset call.
+    const typename S::Vec F = S::inertiaTimes(data.Ic_rb[j], data.S_w[j]);
+    for (int r = j, i = j; r >= 0; --r)
+      if (r == i) {
+        M(i, j) = M(j, i) = S::dot(data.S_w[i], F);
+        i = model.bodies[std::size_t(i)].parent;
+      } else {
+        M(r, j) = M(j, r) = 0.0;
+      }
+  }
+}
+
+// chain_world.h biasForcesWorld: h = C θ' + G, leaving data.v_w and data.a_w.
+template <int N, class S, class VecOut>
+void biasForcesWorld(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, VecOut& h) {
+  using Vec = typename S::Vec;
+  const int n = bodyCount<N>(model);
+  // Outward: velocities, velocity-product accelerations, and each massive body's net force.
+  for (int i = 0; i < n; ++i) {
+    const auto& b = model.bodies[std::size_t(i)];
+    const Vec vJ = data.S_w[i] * qd[i];
+    data.v_w[i] = b.parent < 0 ? vJ : Vec(data.v_w[b.parent] + vJ);
+    // (A root's V_i ×m S_i θ'_i is S_i θ'_i × itself: zero. A ball's sub-body: V_parent ×m S_i θ'_i,
+    // without its siblings' rates: chain.h.)
+    int anchor = i;
+    if (b.joint == JointType::Ball) anchor = model.bodies[std::size_t(model.balls[std::size_t(b.ball)].first)].parent;
+    const Vec c = b.parent < 0 || anchor < 0 ? Vec(Vec::Zero()) : S::crossMotion(data.v_w[anchor], vJ);
+    data.a_w[i] = b.parent < 0 ? c : Vec(data.a_w[b.parent] + c);
+    if (b.massless) {
+      data.f[i].setZero();
+      continue;
+    }
+    const Vec a = data.a_w[i] - model.gravity;
+    data.f[i] = S::inertiaTimes(data.I_w[i], a) + S::crossForce(data.v_w[i], S::inertiaTimes(data.I_w[i], data.v_w[i]));
+  }
+  // Inward: each joint carries its subtree's forces (same frame: a sum).
+  for (int i = n - 1; i >= 0; --i) {
+    h[i] = S::dot(data.S_w[i], data.f[i]);
+    const int p = model.bodies[std::size_t(i)].parent;
+    if (p >= 0) data.f[p] += data.f[i];
+  }
+}
+
+}  // namespace dyn::sized
