@@ -17,4 +17,10 @@ struct IsolatedOutcome {
 // a failed fork or more than timeout_s seconds (the child is killed) as Died.
 IsolatedOutcome runIsolated(const std::function<void()>& work, double timeout_s);
 
+// For a process that is itself disposable — a batch's grader, whose death costs only the submission
+// it was grading, which the batch then grades again in a grader that isolates — runIsolated may run
+// the work in place (no fork; no timeout: the batch's own deadline holds). Its outcome is the same
+// for work that returns or throws; work that kills the process kills the caller.
+void setIsolateInPlace(bool in_place);
+
 }  // namespace dyn

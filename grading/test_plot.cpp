@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -15,6 +16,18 @@
 
 namespace dyn {
 namespace {
+
+// Test hook: DYNLAB_FAULT_INJECTION="plot-trap:NAME" aborts the drawing of the plots of a grade
+// written into a folder named NAME (out_dir, or the folder out_dir stages for), as a plotting
+// library that traps does. Unset in normal use.
+bool plotTrapInjected(const std::string& out_dir) {
+  const char* spec = std::getenv("DYNLAB_FAULT_INJECTION");
+  if (!spec) return false;
+  std::filesystem::path folder(out_dir);
+  if (folder.filename().empty()) folder = folder.parent_path();
+  if (folder.filename().string().rfind(".staging", 0) == 0) folder = folder.parent_path();
+  return ("," + std::string(spec) + ",").find(",plot-trap:" + folder.filename().string() + ",") != std::string::npos;
+}
 
 bool wordChar(unsigned char c) { return std::isalnum(c) || c == '_'; }
 
@@ -202,6 +215,7 @@ void writeTestPlots(GradeReport& r, const std::map<std::string, ScenarioRun>& ru
   // thread under a tight memory limit) costs the plots, never the grade. A plot that cannot be
   // written (a full disk) is still an error of the machine, as before.
   const IsolatedOutcome drawn = runIsolated([&] {
+    if (plotTrapInjected(out_dir)) std::abort();
     for (const Planned& p : planned) {
       const GradedTest& g = r.tests[p.test];
       writePlot(p.path, testPlotSpec(g, *g.plan, runs.at(g.test.scenario)), width_px, height_px);

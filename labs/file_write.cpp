@@ -17,6 +17,8 @@ namespace {
   throw std::system_error(err, std::generic_category(), "cannot write " + path);
 }
 
+bool deferred = false;
+
 std::string folderOf(const std::string& path) {
   const std::string dir = std::filesystem::path(path).parent_path().string();
   return dir.empty() ? "." : dir;
@@ -44,7 +46,18 @@ bool writeFaultInjected(const std::string& file_name) {
   return false;
 }
 
+void deferDurability(bool defer) { deferred = defer; }
+
+void syncFileSystem(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail(path, errno);
+  const int rc = ::syncfs(fd), err = errno;
+  ::close(fd);
+  if (rc != 0) fail(path, err);
+}
+
 void syncDirectory(const std::string& dir) {
+  if (deferred) return;
   const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
   if (fd < 0) fail(dir, errno);
   const int rc = ::fsync(fd), err = errno;
@@ -73,7 +86,7 @@ void writeFileChecked(const std::string& path, std::string_view contents, bool d
     done += std::size_t(n);
   }
   if (injected) abandon(ENOSPC);
-  if (::fsync(fd) != 0 && errno != EINVAL) abandon(errno);
+  if (!deferred && ::fsync(fd) != 0 && errno != EINVAL) abandon(errno);
   if (::close(fd) != 0) {
     const int err = errno;
     ::unlink(tmp.c_str());

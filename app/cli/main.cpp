@@ -215,7 +215,7 @@ void addGrade(CLI::App& cli, Commands& x) {
   x.g->add_flag("--inline-plots", x.grade.inline_plots, "Put each test's plot in results.json as an inline PNG (Gradescope shows "
                                                     "it to the student; 30-100 KB a plot, at most 600 KB in all)");
   x.g->add_option("--replay", x.grade.replay, "Re-grade SUBMISSION and check it matches this results.json");
-  x.g->add_option("--batch", x.grade.batch, "Grade every *.json in this directory, and each folder below it as one student (a Gradescope export); one process each");
+  x.g->add_option("--batch", x.grade.batch, "Grade every *.json in this directory, and each folder below it as one student (a Gradescope export); --jobs grader processes, each submission graded as `dynlab grade` grades it");
   x.g->add_option("--jobs", x.grade.jobs, "Submissions graded in parallel with --batch")->check(CLI::Range(1, 256));
   x.g->callback([&] {
     if (x.grade.batch.empty() && x.grade.submission.empty())

@@ -1,12 +1,13 @@
-// dynlab grade --batch DIR --jobs N --out OUT: every submission in DIR graded in its own child
-// process (a fork running `dynlab grade FILE --out OUT/<folder>`'s code), N at a time, under a lock on OUT. A grader
-// that exits with anything but 0 (graded) or 2 (invalid submission), crashes or hangs (killed after
-// its time budget) gets a results.json saying so; the batch goes on. Then OUT/gradebook.csv and
+// dynlab grade --batch DIR --jobs N --out OUT: every submission in DIR graded by one of N grader
+// processes (forks running `dynlab grade FILE --out OUT/<folder>`'s code, one submission after
+// another: batch_graders.h), under a lock on OUT. A submission whose grade exits with anything but 0
+// (graded) or 2 (invalid submission), crashes or hangs (its grader killed after its time budget)
+// gets a results.json saying so; a fresh grader takes the next one and the batch goes on. Then OUT/gradebook.csv and
 // its summary, OUT/gradebook.md.
 #include <fcntl.h>
 #include <signal.h>
+#include <poll.h>
 #include <sys/file.h>
-#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -17,16 +18,18 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
-#include <thread>
+#include <optional>
+#include <system_error>
 
 #include "app/cli/course/batch.h"
+#include "app/cli/course/batch_graders.h"
 #include "app/cli/commands.h"
 #include "app/cli/output.h"
 #include "labs/config.h"
+#include "labs/file_write.h"
 #include "labs/lab.h"
 #include "grading/escape.h"
 #include "grading/plot.h"
-#include "labs/utf8.h"
 #include "grading/student.h"
 #include "labs/variants.h"
 
@@ -43,11 +46,18 @@ using batch::Submission;
 constexpr const char* kGradeOutputs[] = {"results.json", "report.md", "report.html", "plots", ".staging"};
 
 struct Job {
+  std::size_t index = 0;  // in the batch's submissions
   Submission sub;
   fs::path out;  // OUT/<folder>
-  pid_t pid = -1;
   Clock::time_point started;
-  bool killed = false;
+  bool isolated = false;  // graded again after its grader died: plots drawn in a child of the grader
+};
+
+// A job slot: its grader process (started when first needed, and again after one ended) and the
+// submission it is grading.
+struct Slot {
+  batch::Grader grader;
+  std::optional<Job> job;
 };
 
 // OUT/.dynlab-batch.lock, flocked for the batch's life (the kernel drops it if the batch is killed).
@@ -85,44 +95,6 @@ int prepareFolder(const fs::path& folder, std::string& why) {
   return fd;
 }
 
-// Grades one submission in a child process, output and errors into its grade.log: a fork of the
-// batch running what `dynlab grade FILE --out OUT/<folder>` runs (gradeOne), without an exec, so
-// the ~150 shared libraries are loaded once per batch instead of once per submission (about half
-// of a grade's CPU time without plots). A crash or hang still takes only the child. The child dies
-// with the batch (PR_SET_PDEATHSIG), so a killed batch leaves no grader writing into OUT.
-pid_t spawnGrade(const GradeArgs& a, const Job& job, int log_fd) {
-  GradeArgs one;
-  one.submission = fs::absolute(job.sub.file).string();
-  one.out = job.out.string();
-  one.time_budget = a.time_budget;
-  one.lab = a.lab;
-  one.config = a.config;
-  one.student = job.sub.student;
-  one.plots = a.plots;
-  const pid_t parent = ::getpid();
-  std::fflush(nullptr);  // nothing the batch has buffered is written again by the child
-  const pid_t pid = ::fork();
-  if (pid != 0) return pid;
-  // The child (the batch is single-threaded, so it may run anything).
-  ::prctl(PR_SET_PDEATHSIG, SIGKILL);
-  if (::getppid() != parent) ::_exit(127);
-  const int null_fd = ::open("/dev/null", O_RDONLY);
-  if (null_fd < 0 || ::dup2(null_fd, 0) < 0 || ::dup2(log_fd, 1) < 0 || ::dup2(log_fd, 2) < 0) ::_exit(127);
-  int code = 3;
-  try {
-    code = gradeOne(one);
-  } catch (const std::exception& e) {  // as main() reports what escapes a command
-    std::string line = utf8Quotable(e.what());
-    for (char& c : line)
-      if (static_cast<unsigned char>(c) < 0x20) c = ' ';
-    std::fprintf(stderr, "error: internal: %s\n", line.c_str());
-  } catch (...) {
-    std::fprintf(stderr, "error: internal: an exception that is not a std::exception\n");
-  }
-  std::fflush(nullptr);
-  ::_exit(code);
-}
-
 // The last non-empty line of a grader's log (what it said before it failed), at most 300 bytes.
 std::string logTail(const fs::path& log) {
   std::ifstream in(log, std::ios::binary);
@@ -134,10 +106,10 @@ std::string logTail(const fs::path& log) {
 }
 
 // The row of a finished grader, from how it ended; a results.json is written for every failure.
-Row finish(const Job& job, int status, double kill_s) {
+Row finish(const Job& job, int status, bool killed, double kill_s) {
   const fs::path results = job.out / "results.json";
   Row row;
-  if (job.killed) {
+  if (killed) {
     row = batch::failedRow(job.sub, "timed out", "grading did not finish within " + std::to_string(long(kill_s)) + " s");
   } else if (WIFSIGNALED(status)) {
     row = batch::failedRow(job.sub, "crashed", "internal error: the grader stopped with signal " +
@@ -194,12 +166,83 @@ void assignPlants(const GradeArgs& args, const std::string& roster, batch::Found
   }
 }
 
-// Every submission graded, N graders at a time, each in its own process under its budget (killed past
-// it); one row each, in the order they finish, with a bar (a terminal) or a line each (a log).
+// Hands the job to its slot's grader (a fresh one if it has none, or the one it had is gone). False
+// (errno set) when no grader could be started.
+bool startJob(Slot& slot, Job job, const GradeArgs& args, const batch::Found& found, const fs::path& out,
+              std::vector<Slot>& slots) {
+  const bool in_place = args.plots && !job.isolated;
+  if (slot.grader.running() && slot.grader.in_place != in_place) batch::stopGrader(slot.grader, false);
+  for (int attempt = 0; attempt < 2; ++attempt) {
+    if (!slot.grader.running()) {
+      std::vector<batch::Grader*> others;
+      for (Slot& s : slots) others.push_back(&s.grader);
+      slot.grader = batch::startGrader(args, found.submissions, out, others, in_place);
+      if (!slot.grader.running()) return false;
+    }
+    job.started = Clock::now();
+    if (batch::sendSubmission(slot.grader, job.index)) {
+      slot.job = std::move(job);
+      return true;
+    }
+    batch::stopGrader(slot.grader, true);  // it ended while idle: a fresh one
+    errno = EPIPE;
+  }
+  return false;
+}
+
+// Waits (at most until the first deadline) for a grader to reply or end, and returns the rows of the
+// submissions that finished: graded, failed (its grader ended: a fresh one takes the next), or past
+// their deadline (the grader is killed). A submission whose grader drew its plots in place and died
+// of a signal goes to `again`, to be graded by a grader that draws them in a child, as a lone
+// `dynlab grade` does (a plotting library that dies then costs the plots, not the grade).
+std::vector<Row> collect(std::vector<Slot>& slots, Clock::duration kill_after, double kill_s, std::vector<Job>& again) {
+  std::vector<pollfd> fds;
+  auto wait = std::chrono::milliseconds(1000);
+  const auto now = Clock::now();
+  for (const Slot& s : slots) {
+    if (!s.job) continue;
+    fds.push_back({s.grader.from, POLLIN, 0});
+    const auto left = std::chrono::duration_cast<std::chrono::milliseconds>(s.job->started + kill_after - now);
+    wait = std::clamp(left + std::chrono::milliseconds(1), std::chrono::milliseconds(0), wait);
+  }
+  if (::poll(fds.data(), fds.size(), int(wait.count())) < 0 && errno != EINTR) throw std::system_error(errno, std::generic_category(), "poll");
+  std::vector<Row> rows;
+  std::size_t at = 0;
+  for (Slot& s : slots) {
+    if (!s.job) continue;
+    const short ready = fds[at++].revents;
+    if (ready != 0) {
+      const int code = batch::readExitCode(s.grader);
+      // A grade that ended in an internal error may leave its grader in a bad state: a fresh one.
+      if (code < 0 || (code != 0 && code != 2 && code != 4)) {
+        const bool in_place = s.grader.in_place;
+        const int status = batch::stopGrader(s.grader, false);
+        if (code < 0 && WIFSIGNALED(status) && in_place) {
+          again.push_back(*s.job);
+          again.back().isolated = true;
+        } else {
+          rows.push_back(finish(*s.job, code < 0 ? status : W_EXITCODE(code, 0), false, kill_s));
+        }
+      } else {
+        rows.push_back(finish(*s.job, W_EXITCODE(code, 0), false, kill_s));
+      }
+    } else if (Clock::now() - s.job->started > kill_after) {
+      batch::stopGrader(s.grader, true);
+      rows.push_back(finish(*s.job, 0, true, kill_s));
+    } else {
+      continue;
+    }
+    s.job.reset();
+  }
+  return rows;
+}
+
+// Every submission graded, N graders at a time, each submission under its budget (its grader killed
+// past it); one row each, in the order they finish, with a bar (a terminal) or a line each (a log).
 std::vector<Row> runGraders(const GradeArgs& args, const batch::Found& found, const fs::path& out, std::size_t& problems) {
   const std::size_t total = found.submissions.size();
   const bool tty = isatty(STDERR_FILENO);
-  // A grader process gets its own budget plus a margin to write its results, then it is killed.
+  // A submission gets its own budget plus a margin to write its results, then its grader is killed.
   const double kill_s = args.time_budget + std::clamp(args.time_budget, 2.0, 30.0);
   const auto kill_after = std::chrono::milliseconds(long(kill_s * 1e3));
   std::vector<Row> rows;
@@ -215,53 +258,54 @@ std::vector<Row> runGraders(const GradeArgs& args, const batch::Found& found, co
     }
     rows.push_back(std::move(r));
   };
-  std::vector<Job> pending, running;
-  for (auto it = found.submissions.rbegin(); it != found.submissions.rend(); ++it)
-    pending.push_back({*it, out / it->folder, -1, {}, false});
-  while (!pending.empty() || !running.empty()) {
-    // Keep N graders busy; a submission with nothing to grade gets its row (and results.json) at once.
-    while (!pending.empty() && int(running.size()) < std::max(1, args.jobs)) {
-      Job j = std::move(pending.back());
-      pending.pop_back();
-      std::string problem;
-      const int log_fd = prepareFolder(j.out, problem);
-      if (log_fd >= 0 && j.sub.problem.empty()) {
-        j.started = Clock::now();
-        j.pid = spawnGrade(args, j, log_fd);
-        if (j.pid < 0) problem = std::string("internal error: the grader could not be started (") + std::strerror(errno) + ")";
-      }
-      if (log_fd >= 0) ::close(log_fd);
-      if (j.pid > 0) {
-        running.push_back(std::move(j));
-        continue;
-      }
-      const Row row = j.sub.problem.empty() ? batch::failedRow(j.sub, "internal error", problem)
-                                            : batch::failedRow(j.sub, "invalid submission", j.sub.problem);
-      try {
-        if (log_fd >= 0) batch::writeFallbackResults(j.out / "results.json", row);
-      } catch (const std::exception&) {
-        // Its row says what happened; the gradebook is the record.
-      }
-      progress(row);
-    }
-    // Reap finished graders; kill the ones past their budget.
-    bool any = false;
-    for (auto it = running.begin(); it != running.end();) {
-      int status = 0;
-      if (::waitpid(it->pid, &status, WNOHANG) == 0) {
-        if (!it->killed && Clock::now() - it->started > kill_after) {
-          ::kill(it->pid, SIGKILL);
-          it->killed = true;
+  // A grader that died must not kill the batch with SIGPIPE when it is sent its next submission.
+  const auto old_sigpipe = ::signal(SIGPIPE, SIG_IGN);
+  std::vector<Slot> slots(std::size_t(std::max(1, args.jobs)));
+  std::size_t next = 0, busy = 0;
+  std::vector<Job> again;  // to be graded again, plots isolated
+  while (next < total || busy > 0 || !again.empty()) {
+    // Keep every slot busy; a submission with nothing to grade gets its row (and results.json) at once.
+    for (Slot& slot : slots) {
+      while (!slot.job && (next < total || !again.empty())) {
+        Job j;
+        if (!again.empty()) {
+          j = std::move(again.back());
+          again.pop_back();
+        } else {
+          j = {next, found.submissions[next], out / found.submissions[next].folder, {}, false};
+          ++next;
         }
-        ++it;
-        continue;
+        std::string problem;
+        const int log_fd = prepareFolder(j.out, problem);
+        if (log_fd >= 0) ::close(log_fd);
+        if (log_fd >= 0 && j.sub.problem.empty()) {
+          if (startJob(slot, j, args, found, out, slots)) {
+            ++busy;
+            break;
+          }
+          problem = std::string("internal error: the grader could not be started (") + std::strerror(errno) + ")";
+        }
+        const Row row = j.sub.problem.empty() ? batch::failedRow(j.sub, "internal error", problem)
+                                              : batch::failedRow(j.sub, "invalid submission", j.sub.problem);
+        try {
+          if (log_fd >= 0) batch::writeFallbackResults(j.out / "results.json", row);
+        } catch (const std::exception&) {
+          // Its row says what happened; the gradebook is the record.
+        }
+        progress(row);
       }
-      any = true;
-      progress(finish(*it, status, kill_s));
-      it = running.erase(it);
     }
-    if (!any) std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    if (busy == 0) continue;
+    const std::size_t retried = again.size();
+    for (Row& r : collect(slots, kill_after, kill_s, again)) {
+      --busy;
+      progress(std::move(r));
+    }
+    busy -= again.size() - retried;
   }
+  for (Slot& slot : slots)
+    if (slot.grader.running()) batch::stopGrader(slot.grader, false);
+  ::signal(SIGPIPE, old_sigpipe);
   if (tty) std::fprintf(stderr, "\n");
   return rows;
 }
@@ -312,6 +356,14 @@ int gradeBatch(const GradeArgs& a) {
   std::size_t problems = 0;
   const std::vector<Row> rows = runGraders(args, found, out, problems);
 
+  // The graders write without fsync (labs/file_write.h: deferDurability): one sync of OUT's file
+  // system puts every submission's results on disk before the gradebook that records them.
+  try {
+    syncFileSystem(out.string());
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "error: %s: the results could not be put on disk (%s)\n", termText(out.string()).c_str(), termText(e.what()).c_str());
+    return 1;
+  }
   // The gradebook, and its summary beside it (score statistics, histogram, common failure reasons).
   const fs::path book = out / "gradebook.csv", summary = out / "gradebook.md";
   const double lab_max = batch::labMaxScore(args.lab, a.config, rows);
