@@ -91,7 +91,7 @@ void JointConstraints::forces(const btMultiBody& body, double dt, std::vector<Sp
     const auto& link = body.getLink(l.joint);
     const bool turns = link.m_jointType == btMultibodyLink::eRevolute;
     const btVector3 axis = body.localDirToWorld(l.joint, turns ? link.m_axes[0].m_topVec : link.m_axes[0].m_bottomVec);
-    for (const auto [c, row, sign] : {std::tuple{l.lower, 0, 1.0}, std::tuple{l.upper, 1, -1.0}}) {
+    for (const auto& [c, row, sign] : {std::tuple{l.lower, 0, 1.0}, std::tuple{l.upper, 1, -1.0}}) {
       if (c < 0) continue;
       const double eta = l.bt->getAppliedImpulse(row) / dt;
       Spatial::Vec f = Spatial::Vec::Zero();

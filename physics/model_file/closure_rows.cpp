@@ -134,7 +134,6 @@ std::vector<bool> chooseIndependentRows(ConstrainedMechanism<Spatial>& mech, con
   // n(q0)), checked at every pose: they hold while the loop's plane turns less than the angle that would
   // lay a dropped world axis in it (the run stops, naming the loop, if a dropped row drifts: EveryClosureRow).
   if (!holdsAtEveryPose(g, kept)) kept = pivotRows({g.front()});
-  const int count = int(std::count(kept.begin(), kept.end(), true));
   if (!holdsAtEveryPose(g, kept)) {
     // Name the closures involved: those with a dropped row.
     std::string names;
