@@ -152,6 +152,6 @@ std::string defaultConfigPath(const std::string& name);
 std::string labsRoot();
 
 #define DYNLAB_REGISTER_LAB(id, summary, factory) \
-  static const bool dynlab_registered_##id = ::dyn::registerLab({#id, summary, factory})
+  static const bool dynlab_registered_##id = ::dyn::registerLab({#id, summary, factory, {}, {}})
 
 }  // namespace dyn

@@ -215,7 +215,8 @@ LoadedLab loadModelLab(const std::string& file, std::optional<double> duration, 
   entries.push_back({stem, "a model file, passive", [shared, stem](const JsonView& c) -> std::unique_ptr<Lab> {
                        const JsonView sim = c["simulation"];
                        return std::make_unique<ModelFileLab>(shared, stem, sim["dt"].number(), sim["duration"].number());
-                     }});
+                     },
+                     {}, {}});
   LoadedLab out;
   out.entry = &entries.back();
   out.config = config;
