@@ -261,9 +261,10 @@ std::vector<Row> runGraders(const GradeArgs& args, const batch::Found& found, co
   // A grader that died must not kill the batch with SIGPIPE when it is sent its next submission.
   const auto old_sigpipe = ::signal(SIGPIPE, SIG_IGN);
   std::vector<Slot> slots(std::size_t(std::max(1, args.jobs)));
-  std::size_t next = 0, busy = 0;
+  std::size_t next = 0;
+  auto busy = [&slots] { return std::any_of(slots.begin(), slots.end(), [](const Slot& s) { return s.job.has_value(); }); };
   std::vector<Job> again;  // to be graded again, plots isolated
-  while (next < total || busy > 0 || !again.empty()) {
+  while (next < total || busy() || !again.empty()) {
     // Keep every slot busy; a submission with nothing to grade gets its row (and results.json) at once.
     for (Slot& slot : slots) {
       while (!slot.job && (next < total || !again.empty())) {
@@ -279,10 +280,7 @@ std::vector<Row> runGraders(const GradeArgs& args, const batch::Found& found, co
         const int log_fd = prepareFolder(j.out, problem);
         if (log_fd >= 0) ::close(log_fd);
         if (log_fd >= 0 && j.sub.problem.empty()) {
-          if (startJob(slot, j, args, found, out, slots)) {
-            ++busy;
-            break;
-          }
+          if (startJob(slot, j, args, found, out, slots)) break;
           problem = std::string("internal error: the grader could not be started (") + std::strerror(errno) + ")";
         }
         const Row row = j.sub.problem.empty() ? batch::failedRow(j.sub, "internal error", problem)
@@ -295,13 +293,8 @@ std::vector<Row> runGraders(const GradeArgs& args, const batch::Found& found, co
         progress(row);
       }
     }
-    if (busy == 0) continue;
-    const std::size_t retried = again.size();
-    for (Row& r : collect(slots, kill_after, kill_s, again)) {
-      --busy;
-      progress(std::move(r));
-    }
-    busy -= again.size() - retried;
+    if (!busy()) continue;
+    for (Row& r : collect(slots, kill_after, kill_s, again)) progress(std::move(r));
   }
   for (Slot& slot : slots)
     if (slot.grader.running()) batch::stopGrader(slot.grader, false);
