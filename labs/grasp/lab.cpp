@@ -247,12 +247,17 @@ std::unique_ptr<Simulation> GraspLab::simulate(Engine engine) const {
     params.forces.push_back(std::make_shared<PushForce<Planar>>(BodyRef::payload(0), Planar::Pos::Zero(),
                                                                  Planar::Vec(0.0, s_.push.force.x(), s_.push.force.y()),
                                                                  ForceProfile{s_.push.start, 0.0, s_.push.duration}));
+  // The start pose assembled by the mechanism that steps it (built once). Two fingers (the default)
+  // at fixed sizes: the step's loops unrolled (mechanism.h TwoFingers).
   VecN q, v;
-  Mechanism(params).assemble(s_.pose0, Eigen::Vector3d::Zero(), q, v);
-  // Two fingers (the default) at fixed sizes: the step's loops unrolled (mechanism.h TwoFingers).
-  if (params.fingers.size() == 2)
-    return simulateMechanism(engine, std::make_unique<TwoFingers>(params), s_.step, q, v, std::make_unique<Hooks>(s_, q, v), columns_, s_.duration);
-  return simulateMechanism(engine, std::make_unique<Mechanism>(params), s_.step, q, v, std::make_unique<Hooks>(s_, q, v), columns_, s_.duration);
+  if (params.fingers.size() == 2) {
+    auto mech = std::make_unique<TwoFingers>(params);
+    mech->shape().assemble(s_.pose0, Eigen::Vector3d::Zero(), q, v);
+    return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::make_unique<Hooks>(s_, q, v), columns_, s_.duration);
+  }
+  auto mech = std::make_unique<Mechanism>(params);
+  mech->assemble(s_.pose0, Eigen::Vector3d::Zero(), q, v);
+  return simulateMechanism(engine, std::move(mech), s_.step, q, v, std::make_unique<Hooks>(s_, q, v), columns_, s_.duration);
 }
 
 MujocoTwin GraspLab::mujocoTwin() const {

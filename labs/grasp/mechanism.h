@@ -87,6 +87,8 @@ class TwoFingers final : public ConstrainedMechanism<Planar, 4, 4, 3> {
  public:
   explicit TwoFingers(const Params& params);
   bool recoverDependent(VecN& q, VecN& v) override { return shape_.recoverDependent(q, v); }
+  // The dynamically sized mechanism it keeps for the fingers' geometry (assemble, the grasp map).
+  const Mechanism& shape() const { return shape_; }
 
  private:
   Mechanism shape_;

@@ -11,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
 #include "physics/model_file/fence.h"
 #include "physics/model_file/mjcf3.h"
@@ -99,7 +100,9 @@ std::shared_ptr<const Compiled> compile(const std::string& path, std::string* wa
   // The virtual file keeps the name alone; loading it by its path keeps the file's folder as the
   // model's, where MuJoCo looks for includes and meshes.
   putFile(vfs.get(), path, path, bytes);
-  const std::vector<std::string> missing = addReferencedFiles(path, bytes, vfs.get(), package_paths);
+  // A URDF's elements read once (urdf_read.cpp): its discarded visuals for the file scan, its <mimic>s below.
+  const std::optional<UrdfFacts> urdf = isUrdfPath(path) ? std::optional<UrdfFacts>(readUrdfFacts(bytes)) : std::nullopt;
+  const std::vector<std::string> missing = addReferencedFiles(path, bytes, vfs.get(), package_paths, urdf ? &*urdf : nullptr);
   FenceLimits limits;
   limits.seconds = kParseSeconds;
   limits.memory_bytes = kParseMemoryBytes;
@@ -118,7 +121,7 @@ std::shared_ptr<const Compiled> compile(const std::string& path, std::string* wa
   // A URDF's <mimic> (a finger following another, as Bullet's and ROS's Panda write it): MuJoCo 2.2.2's
   // URDF reader drops it, so the joint moves on its own; said, with the way to hold it.
   // Its elements (urdf_read.cpp), not its text: a <mimic> commented out is none.
-  if (const std::size_t mimics = bytes.find("mimic") == std::string::npos ? 0 : readUrdfFacts(bytes).mimics; mimics > 0)
+  if (const std::size_t mimics = urdf ? urdf->mimics : 0; mimics > 0)
     out->notes.push_back(std::to_string(mimics) + " URDF <mimic> element(s) not held (MuJoCo 2.2.2's URDF reader ignores them: each such joint moves "
                          "on its own); to couple them, write the robot as MJCF with <equality><joint joint1 joint2 polycoef=\"0 1 0 0 0\"/>");
   return out;

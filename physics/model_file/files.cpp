@@ -121,15 +121,12 @@ struct DiscardedVisuals {
   bool has(const std::string& name) const { return every || names.count(name) > 0; }
 };
 
-// Null for a file other than a URDF, or a URDF that keeps its visuals.
-std::unique_ptr<DiscardedVisuals> discardedVisuals(const std::string& path, const std::string& text) {
-  const std::size_t dot = path.find_last_of('.');
-  if (dot == std::string::npos || vfsKeyExtension(path.substr(dot)) != ".urdf") return nullptr;
-  UrdfFacts facts = readUrdfFacts(text);
-  if (facts.well_formed && facts.keeps_visuals) return nullptr;
+// Null for a file other than a URDF (no facts), or a URDF that keeps its visuals.
+std::unique_ptr<DiscardedVisuals> discardedVisuals(const UrdfFacts* facts) {
+  if (!facts || (facts->well_formed && facts->keeps_visuals)) return nullptr;
   auto out = std::make_unique<DiscardedVisuals>();
-  out->every = !facts.well_formed;
-  out->names = std::move(facts.visual_only);
+  out->every = !facts->well_formed;
+  out->names = facts->visual_only;
   return out;
 }
 
@@ -189,8 +186,13 @@ void putFile(mjVFS* vfs, const std::string& path, const std::string& name, const
   std::copy(bytes.begin(), bytes.end(), static_cast<char*>(vfs->filedata[at]));
 }
 
+bool isUrdfPath(const std::string& path) {
+  const std::size_t dot = path.find_last_of('.');
+  return dot != std::string::npos && vfsKeyExtension(path.substr(dot)) == ".urdf";
+}
+
 std::vector<std::string> addReferencedFiles(const std::string& path, const std::string& bytes, mjVFS* vfs,
-                                            const std::vector<std::string>& package_paths) {
+                                            const std::vector<std::string>& package_paths, const UrdfFacts* urdf) {
   std::error_code ec;
   const fs::path main = fs::canonical(path, ec);
   if (ec) throw ModelFileError(path + ": cannot resolve its folder (" + ec.message() + ")");
@@ -209,7 +211,7 @@ std::vector<std::string> addReferencedFiles(const std::string& path, const std::
     // A URDF's discarded visuals come last: MuJoCo's URDF reader keys meshes by file name and reads the
     // collision's, so a visual of the same name (meshes/visual/link1.obj beside meshes/collision/
     // link1.obj) is checked and left out rather than refused.
-    const std::unique_ptr<DiscardedVisuals> discard = t == 0 ? discardedVisuals(path, texts[t].second) : nullptr;
+    const std::unique_ptr<DiscardedVisuals> discard = t == 0 ? discardedVisuals(urdf) : nullptr;
     scanNames(texts[t].second, texts[t].first, files, more_dirs, visuals, discard.get());
     const std::size_t visual_from = files.size();
     files.insert(files.end(), visuals.begin(), visuals.end());

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "physics/model_file/model_file.h"
+#include "physics/model_file/urdf_read.h"
 
 namespace dyn::model_file::detail {
 
@@ -84,9 +85,13 @@ class FileSearch {
 // filename), checked (a regular file inside the folders FileSearch allows, within kMaxAssetBytes,
 // kMaxAssetFiles and kMaxAssetsBytes; an included .xml or .urdf as the model file is, and scanned in
 // turn) and put into vfs under its name; a name with no such file gets a one-byte stand-in. Returns
-// those names, each with where it was looked for ("'NAME' not found (looked in …)").
+// those names, each with where it was looked for ("'NAME' not found (looked in …)"). urdf: the model's
+// facts when it is a URDF (read once by the caller: its discarded visuals are checked, not refused).
 std::vector<std::string> addReferencedFiles(const std::string& path, const std::string& bytes, mjVFS* vfs,
-                                            const std::vector<std::string>& package_paths = {});
+                                            const std::vector<std::string>& package_paths = {}, const UrdfFacts* urdf = nullptr);
+
+// Whether a model file's name ends in .urdf (any case): MuJoCo reads it as URDF.
+bool isUrdfPath(const std::string& path);
 
 // The model's geoms at qpos0 (after mj_kinematics) as drawing shapes on the tree bodies: body b moves
 // with tree body link[b] (−1: the world), whose frame origin at qpos0 is origin[b] (drawing.cpp).
