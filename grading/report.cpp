@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <vector>
 
 #include "grading/escape.h"
 #include "grading/grade.h"
@@ -280,27 +281,49 @@ std::string renderHtml(const std::string& markdown, const std::string& title, co
 
 std::string reportHtml(const GradeReport& r, const std::string& markdown, const std::string& title) {
   // cmark renders the links (small), then each becomes its image's bytes: the grader's own file
-  // names (plots/NN-slug.png) need no escaping and appear nowhere else as a src.
-  std::string html = renderHtml(markdown, title);
+  // names (plots/NN-slug.png) need no escaping and appear nowhere else as a src (nor in the base64
+  // that replaces one, which has no quotes). Put together in one pass: replacing in place moved the
+  // growing page's tail once per plot.
+  const std::string html = renderHtml(markdown, title);
+  struct Swap {
+    std::size_t at, size;
+    const std::string* png;
+  };
+  std::vector<Swap> swaps;
   for (const auto& g : r.tests) {
     if (g.plot.empty() || g.plot_png.empty()) continue;
     const std::string link = "src=\"" + g.plot + "\"";
-    if (const std::size_t at = html.find(link); at != std::string::npos)
-      html.replace(at, link.size(), "src=\"" + pngDataUri(g.plot_png) + "\"");
+    if (const std::size_t at = html.find(link); at != std::string::npos) swaps.push_back({at, link.size(), &g.plot_png});
   }
-  return html;
+  std::sort(swaps.begin(), swaps.end(), [](const Swap& a, const Swap& b) { return a.at < b.at; });
+  std::string out;
+  std::size_t size = html.size();
+  for (const Swap& s : swaps) size += s.png->size() / 3 * 4 + 64;
+  out.reserve(size);
+  std::size_t from = 0;
+  for (const Swap& s : swaps) {
+    out.append(html, from, s.at - from).append("src=\"").append(pngDataUri(*s.png)).append("\"");
+    from = s.at + s.size;
+  }
+  return out.append(html, from, std::string::npos);
 }
 
 std::string pngDataUri(const std::string& png) {
   static const char* kDigits = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::string out = "data:image/png;base64,";
-  out.reserve(out.size() + (png.size() + 2) / 3 * 4);
-  for (std::size_t i = 0; i < png.size(); i += 3) {
-    // Three bytes → four digits; a short last group is padded with '='.
-    const std::size_t n = std::min<std::size_t>(3, png.size() - i);
-    unsigned v = 0;
-    for (std::size_t k = 0; k < 3; ++k) v = v << 8 | (k < n ? static_cast<unsigned char>(png[i + k]) : 0u);
-    for (std::size_t k = 0; k < 4; ++k) out += k <= n ? kDigits[(v >> (18 - 6 * k)) & 63] : '=';
+  const std::string head = "data:image/png;base64,";
+  std::string out(head.size() + (png.size() + 2) / 3 * 4, '=');
+  std::copy(head.begin(), head.end(), out.begin());
+  char* o = out.data() + head.size();
+  const auto byte = [&](std::size_t i) { return unsigned(static_cast<unsigned char>(png[i])); };
+  std::size_t i = 0;
+  for (; i + 3 <= png.size(); i += 3, o += 4) {  // three bytes → four digits
+    const unsigned v = byte(i) << 16 | byte(i + 1) << 8 | byte(i + 2);
+    o[0] = kDigits[v >> 18], o[1] = kDigits[(v >> 12) & 63], o[2] = kDigits[(v >> 6) & 63], o[3] = kDigits[v & 63];
+  }
+  if (const std::size_t n = png.size() - i; n > 0) {  // a short last group, padded with '='
+    const unsigned v = byte(i) << 16 | (n > 1 ? byte(i + 1) << 8 : 0u);
+    o[0] = kDigits[v >> 18], o[1] = kDigits[(v >> 12) & 63];
+    if (n > 1) o[2] = kDigits[(v >> 6) & 63];
   }
   return out;
 }

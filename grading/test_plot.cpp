@@ -85,6 +85,17 @@ std::string slug(const std::string& s) {
   return out.substr(0, 40);
 }
 
+// A file's bytes in one read (a character at a time through a stream buffer cost as much as
+// writing the file); empty if it cannot be read.
+std::string fileBytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
+  if (!in) return {};
+  std::string bytes(std::size_t(std::max<std::streamoff>(0, in.tellg())), '\0');
+  in.seekg(0);
+  if (!in.read(bytes.data(), std::streamsize(bytes.size()))) return {};
+  return bytes;
+}
+
 std::string withUnit(double x, const std::string& unit) { return fmtNumber(x) + (unit.empty() || unit == "1" ? "" : " " + unit); }
 
 // An x–y plot of one test's run (the path in the plane): each column against x (solid), the
@@ -234,8 +245,7 @@ void writeTestPlots(GradeReport& r, const std::map<std::string, ScenarioRun>& ru
   }
   for (const Planned& p : planned) {
     GradedTest& g = r.tests[p.test];
-    std::ifstream in(p.path, std::ios::binary);
-    g.plot_png.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    g.plot_png = fileBytes(p.path);
     g.plot = p.name;
   }
 }

@@ -131,6 +131,14 @@ std::string base64Decode(const std::string& s) {
 
 }  // namespace
 
+TEST_CASE("a PNG's data URI is its bytes in base64, a short last group padded") {
+  // RFC 4648's test vectors, and every byte value (0xff, 0x00 and the 6-bit groups' edges).
+  const std::pair<std::string, std::string> vectors[] = {{"", ""},         {"f", "Zg=="},         {"fo", "Zm8="},
+                                                         {"foo", "Zm9v"},  {"foob", "Zm9vYg=="}, {"fooba", "Zm9vYmE="},
+                                                         {"foobar", "Zm9vYmFy"}, {std::string("\xff\x00\xfb", 3), "/wD7"}};
+  for (const auto& [bytes, digits] : vectors) CHECK(pngDataUri(bytes) == "data:image/png;base64," + digits);
+}
+
 TEST_CASE("every simulated test has a plot: the rubric's, else one derived from the metric and the lab") {
   SUBCASE("the shipped rubric (two of its tests name no plot)") {
     const fs::path dir = scratch("shipped");

@@ -36,7 +36,7 @@ void writeText(const fs::path& p, const std::string& text, bool exec = false) {
 // What grading needs on every image, as autograder-packages lists it.
 const std::vector<std::string> kRequired = {
     "build-essential", "cmake", "pkg-config", "libeigen3-dev", "libbullet-dev", "libosmesa6-dev", "libimgui-dev", "libstb-dev",
-    "nlohmann-json3-dev", "libcli11-dev", "fonts-dejavu-core", "libplplot-dev", "plplot-driver-cairo", "libzip-dev",
+    "nlohmann-json3-dev", "libcli11-dev", "fonts-dejavu-core", "libplplot-dev", "plplot-driver-cairo", "libcairo2-dev", "libzip-dev",
     "zlib1g-dev", "libcmark-gfm-dev", "libcmark-gfm-extensions-dev", "libssl-dev"};
 
 // An image's package lists: name → candidate version ("(none)": known, not installable).

@@ -3,6 +3,7 @@
 // stable. Generic (a stub lab of given loops) and on the slider crank's submission options.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -85,6 +86,24 @@ TEST_CASE("a stable loop keeps its damping and margins") {
   CHECK_FALSE(r.unstable);
   CHECK(r.metrics["m_damping"].get<double>() == doctest::Approx(0.5));
   CHECK(r.metrics["m_delay_margin"].get<double>() > 0);
+}
+
+TEST_CASE("a remembered screening answers only for the same loop, bit for bit") {
+  // ζ of m s² + k_d s + 4 is k_d / 4: loops that differ in one number, in its last bit, in the delay
+  // or in a sign of zero, screened in turn and again, each as it was screened alone.
+  const double kd = 2.0, kd_next = std::nextafter(2.0, 3.0);
+  const std::vector<LinearLoop> loops = {{"m", "a PD loop", {4, kd}, {0, 0, 1}, 0},
+                                         {"m", "a PD loop", {4, kd_next}, {0, 0, 1}, 0},
+                                         {"m", "a PD loop", {4, kd}, {0, 0, 1}, 0.01},
+                                         {"m", "a PD loop", {4, 3.0}, {0, 0, 1}, 0},
+                                         {"m", "a PD loop", {4, kd}, {-0.0, 0, 1}, 0}};
+  std::vector<json> first;
+  for (const auto& l : loops) first.push_back(screenLoops(LoopsOnly({l})).metrics);
+  CHECK(first[0]["m_damping"] != first[3]["m_damping"]);
+  CHECK(first[0]["m_max_real_pole"] != first[2]["m_max_real_pole"]);  // the delay's Padé poles
+  for (int round = 0; round < 2; ++round)
+    for (std::size_t i = loops.size(); i-- > 0;) CHECK(screenLoops(LoopsOnly({loops[i]})).metrics == first[i]);
+  CHECK(first[1]["m_damping"].get<double>() == doctest::Approx(0.5));
 }
 
 TEST_CASE("the slider crank reports both loops for every force law, and with zero motion gains") {
