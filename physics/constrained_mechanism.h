@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "physics/chain_planar_in_space.h"
 #include "physics/constrained_solve.h"
 #include "physics/integrate.h"
 #include "physics/mechanism.h"
@@ -128,6 +129,9 @@ class ConstrainedMechanism : public ConstrainedSystem {
   VecN inverseDynamics(const VecN& q, const VecN& qd, const VecN& qdd);  // M θ'' + C θ' + G (no springs, friction)
   // Λ = (J M⁻¹ Jᵀ)⁻¹ for a task Jacobian J (rows × n); empty when J M⁻¹ Jᵀ is singular.
   MatN operationalInertia(const VecN& q, const MatN& J);
+  // e_k's index when the trees move in the plane ⊥ e_k (chain_planar_in_space.h: M, h and the kinetic
+  // energy on their in-plane components), else −1. Spatial only; found once, at construction.
+  int planeNormal() const { return planar_.axis; }
   // The kinematics of the state last staged (constraint kinds read it; so may drawing code).
   const MechanismKinematics<S>& kinematics() const { return kin_; }
   // Stages a configuration (and rates) explicitly, for queries on kinematics().
@@ -185,6 +189,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
   int rows_ = 0;
   std::vector<int> offsets_, row_count_;  // per constraint: its first row, its rows (Constraint::rows)
   TreeData<S> data_;
+  PlanarTreeData planar_;  // a spatial tree moving in a plane: its planar kernels' state (axis −1: none)
   MechanismKinematics<S> kin_;
   Problem problem_;
   ConstrainedFactorT<Nj, Nr, Nl> factor_;

@@ -69,6 +69,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
                                 " constraint rows, " + std::to_string(payload) + " payload coordinates) do not match this instantiation");
   has_forces_ = !model_.forces.empty();
   for (const JointProperties& j : model_.joints) has_armature_ = has_armature_ || j.armature != 0.0;
+  if constexpr (S::kDim == 6) planar_ = PlanarTreeData(model_.tree);
   kin_.model = &model_;
   kin_.tree = &data_;
   kin_.payload_pose.assign(model_.payloads.size(), Eigen::Vector3d::Zero());
@@ -108,14 +109,15 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   const int nn = n(), kk = k(), nqt = nqTree();
   // World transforms and joint axes, unless a controller's query just staged the whole tree at θ (the
   // parent frames are treeStage's, for the body-frame queries).
-  if (!have_tree_ || q.head(nqt) != tree_q_) {
-    sized::kinematics<false, Nj>(model_.tree, q.head(nqt), data_);
+  // (A planar tree's always: treeStage's 3 × 3 products round otherwise than kinematicsPlanar.)
+  if (planar_.axis >= 0 || !have_tree_ || q.head(nqt) != tree_q_) {
+    sized::kinematicsWorldOrPlanar<Nj>(model_.tree, q.head(nqt), data_, planar_);
     have_tree_ = false;
   }
   have_velocity_ = false;
   // M from world composite inertias; the world inertias stay for the velocity stage.
   problem_.M.resize(nn, nn);
-  sized::crbaWorld<Nj>(model_.tree, data_, problem_.M);
+  sized::crbaWorldOrPlanar<Nj>(model_.tree, data_, planar_, problem_.M);
   addArmature(problem_.M);
   kin_.theta = q.head(nqt);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
@@ -197,7 +199,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   // Link velocities, each link's velocity-product acceleration and h = Cθ' + G, in world coordinates.
   problem_.h.resize(nn);
   kin_.theta_rate = qd.head(nn);
-  sized::biasForcesWorld<Nj>(model_.tree, data_, qd, problem_.h);
+  sized::biasForcesWorldOrPlanar<Nj>(model_.tree, data_, planar_, qd, problem_.h);
   // Joint springs and friction join h; friction's power for the books.
   friction_power_ = 0.0;
   if (!model_.joints.empty())
@@ -465,7 +467,7 @@ double ConstrainedMechanism<S, Nj, Nr, Nl>::kineticEnergy(const VecN& q, const V
   // The velocity stage at (q, v): usually the step's own (the trace row asks at the step's start).
   positionStage(q);
   if (!have_velocity_ || !same(v, staged_v_)) velocityStage(v);
-  double T = kineticEnergyWorld(model_.tree, data_);
+  double T = kineticEnergyWorldOrPlanar(model_.tree, data_, planar_);
   if (has_armature_)  // the rotors' ½ a θ'²
     for (int i = 0; i < n(); ++i) T += 0.5 * model_.joints[std::size_t(i)].armature * v[i] * v[i];
   for (std::size_t i = 0, off = std::size_t(n()); i < model_.payloads.size(); ++i) {
