@@ -10,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include "physics/det/det.h"
+#include "physics/det/sincos.h"
 
 // The spatial operations the tree algorithms call in their inner loops: inlined always, so their
 // 6-vectors stay in registers (a call returns them through memory, stored 8 bytes at a time and
@@ -36,7 +37,8 @@ struct Planar {
   // both the shortest code and faster than SIMD packets, whose 16-byte loads of values just stored
   // 8 bytes at a time stall the CPU (store-to-load forwarding fails).
   static Rot rotation(double angle) {  // rotates A-coords into B-coords for B turned by angle
-    const double c = det::cos(angle), s = det::sin(angle);
+    double c, s;
+    det::sincos(angle, s, c);  // det::cos and det::sin, one reduction
     return (Rot() << c, s, -s, c).finished();
   }
   static double crossScalar(const Pos& a, const Pos& b) { return a.x() * b.y() - a.y() * b.x(); }
