@@ -377,6 +377,11 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::configurationRate(const VecN& q, const
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::integrateConfiguration(VecN& q, const VecN& dx, double h) {
   if (model_.tree.balls.empty()) {
+    if constexpr (kState != Eigen::Dynamic)
+      if (q.size() == kState && dx.size() == kState) {  // Eigen's q + h dx entry by entry, unrolled
+        for (int i = 0; i < kState; ++i) q[i] += h * dx[i];
+        return;
+      }
     q += h * dx;
     return;
   }

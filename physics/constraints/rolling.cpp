@@ -51,7 +51,8 @@ void Rolling::position(const MechanismKinematics<Spatial>& k, int row, VecN& phi
   for (int j = wheel_.index; j >= 0; j = bodies[std::size_t(j)].parent) {
     double u[3];
     Spatial::linearAt(g.P, k.tree->S_w[std::size_t(j)].data(), u);
-    for (int r = 0; r < 3; ++r) J(row + r, j) += -u[r];
+    double* col = &J(row, j);  // rows row … row + 2 of column j (column-major)
+    for (int r = 0; r < 3; ++r) col[r] += -u[r];
   }
 }
 
