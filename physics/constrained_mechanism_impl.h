@@ -43,6 +43,18 @@ void setFixed(VecN& dst, const VecN& src) {
   dst = src;
 }
 
+// dst = the first `count` entries of src: unrolled where count is the fixed size N, else Eigen's copy.
+template <int N>
+void setHead(VecN& dst, const VecN& src, int count) {
+  if constexpr (N != Eigen::Dynamic)
+    if (count == N) {
+      dst.resize(N);
+      for (int i = 0; i < N; ++i) dst[i] = src[i];
+      return;
+    }
+  dst = src.head(count);
+}
+
 template <class S, int Nj, int Nr, int Nl>
 ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> model)
     : model_(std::move(model)), data_(model_.tree) {
@@ -117,7 +129,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   problem_.M.resize(nn, nn);
   sized::crbaWorld<Nj>(model_.tree, data_, problem_.M);
   addArmature(problem_.M);
-  kin_.theta = q.head(nqt);
+  setHead<Nj>(kin_.theta, q, nqt);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
   if constexpr (S::kDim == 3)
     for (int i = 0; i < nn; ++i) {
@@ -196,7 +208,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   have_last_ = false;  // the last solve was at other rates
   // Link velocities, each link's velocity-product acceleration and h = Cθ' + G, in world coordinates.
   problem_.h.resize(nn);
-  kin_.theta_rate = qd.head(nn);
+  setHead<Nj>(kin_.theta_rate, qd, nn);
   sized::biasForcesWorld<Nj>(model_.tree, data_, qd, problem_.h);
   // Joint springs and friction join h; friction's power for the books.
   friction_power_ = 0.0;
