@@ -31,16 +31,18 @@ void setZeroAt(Mat& m, int rows, int cols) {
   }
 }
 
-// dst = src, entry by entry where src has the fixed size N (unrolled), else Eigen's copy.
+// dst = src (its first `count` entries, when given), entry by entry where that is the fixed size N
+// (unrolled), else Eigen's copy.
 template <int N>
-void setFixed(VecN& dst, const VecN& src) {
+void setFixed(VecN& dst, const VecN& src, Eigen::Index count = -1) {
+  if (count < 0) count = src.size();
   if constexpr (N != Eigen::Dynamic)
-    if (src.size() == N) {
+    if (count == N) {
       dst.resize(N);
       for (int i = 0; i < N; ++i) dst[i] = src[i];
       return;
     }
-  dst = src;
+  dst = src.head(count);
 }
 
 template <class S, int Nj, int Nr, int Nl>
@@ -119,7 +121,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   problem_.M.resize(nn, nn);
   sized::crbaWorldOrPlanar<Nj>(model_.tree, data_, planar_, problem_.M);
   addArmature(problem_.M);
-  kin_.theta = q.head(nqt);
+  setFixed<Nj>(kin_.theta, q, nqt);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
   if constexpr (S::kDim == 3)
     for (int i = 0; i < nn; ++i) {
@@ -198,7 +200,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   have_last_ = false;  // the last solve was at other rates
   // Link velocities, each link's velocity-product acceleration and h = Cθ' + G, in world coordinates.
   problem_.h.resize(nn);
-  kin_.theta_rate = qd.head(nn);
+  setFixed<Nj>(kin_.theta_rate, qd, nn);
   sized::biasForcesWorldOrPlanar<Nj>(model_.tree, data_, planar_, qd, problem_.h);
   // Joint springs and friction join h; friction's power for the books.
   friction_power_ = 0.0;
@@ -379,7 +381,10 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::configurationRate(const VecN& q, const
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::integrateConfiguration(VecN& q, const VecN& dx, double h) {
   if (model_.tree.balls.empty()) {
-    q += h * dx;
+    if (kState != Eigen::Dynamic && q.size() == kState && dx.size() == kState)
+      for (int i = 0; i < kState; ++i) q[i] += h * dx[i];  // Eigen's q + h dx entry by entry, unrolled
+    else
+      q += h * dx;
     return;
   }
   const int nqt = nqTree(), kk = k();
@@ -391,7 +396,6 @@ template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::normalizeConfiguration(VecN& q) {
   if (!model_.tree.balls.empty()) dyn::normalizeConfiguration(model_.tree, q.head(nqTree()));
 }
-
 
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::metric(const VecN& q, MatN& W) {

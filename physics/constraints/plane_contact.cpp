@@ -38,6 +38,22 @@ double PlaneContact<S>::gap(const MechanismKinematics<S>& k) const {
 
 template <class S>
 void PlaneContact<S>::position(const MechanismKinematics<S>& k, int row, VecN& phi, MatN& J, MatN& A) const {
+  if constexpr (S::kDim == 6)
+    if (body_.kind == BodyRef::Kind::Link) {
+      // A spatial link (the pen's tip): the same sums as k.position and k.addDirectionJacobian, read
+      // from the tree in place (no dispatch on the body's kind, no calls). Column j: −n · (the linear
+      // velocity at c of joint j's unit motion), for the joints root → link.
+      const Pos c = S::worldPoint(k.tree->X_world[std::size_t(body_.index)], centre_b_);
+      phi[row] = -(normal_.dot(c) - params_.radius - params_.height);
+      const double* n = normal_.data();
+      const auto& bodies = k.model->tree.bodies;
+      for (int j = body_.index; j >= 0; j = bodies[std::size_t(j)].parent) {
+        double u[3];
+        S::linearAt(c, k.tree->S_w[std::size_t(j)].data(), u);
+        J(row, j) += -(n[0] * u[0] + (n[1] * u[1] + n[2] * u[2]));
+      }
+      return;
+    }
   const Pos c = k.position(body_, centre_b_);
   phi[row] = -(normal_.dot(c) - params_.radius - params_.height);
   // −n·v(c): the centre's velocity along n.
@@ -46,6 +62,22 @@ void PlaneContact<S>::position(const MechanismKinematics<S>& k, int row, VecN& p
 
 template <class S>
 void PlaneContact<S>::bias(const MechanismKinematics<S>& k, int row, VecN& b) const {
+  if constexpr (S::kDim == 6)
+    if (body_.kind == BodyRef::Kind::Link) {
+      // −n · (a_c + ω × v_c) at θ'' = 0: k.directionBias's sums on the link's world velocity and bias
+      // acceleration, read in place.
+      const std::size_t i = std::size_t(body_.index);
+      const Pos c = S::worldPoint(k.tree->X_world[i], centre_b_);
+      const double* v = k.tree->v_w[i].data();
+      double ap[3], vp[3], wv[3];
+      S::linearAt(c, k.tree->a_w[i].data(), ap);
+      S::linearAt(c, v, vp);
+      S::cross3(v, vp, wv);
+      const double a[3] = {ap[0] + wv[0], ap[1] + wv[1], ap[2] + wv[2]};
+      const double* n = normal_.data();
+      b[row] = -(n[0] * a[0] + (n[1] * a[1] + n[2] * a[2]));
+      return;
+    }
   b[row] = -k.directionBias(body_, k.position(body_, centre_b_), normal_);
 }
 

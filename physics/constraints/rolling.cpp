@@ -24,8 +24,11 @@ Rolling::Rolling(BodyRef wheel, const Pos& centre_b, const Pos& axle_b, double r
 
 Rolling::Geometry Rolling::geometry(const MechanismKinematics<Spatial>& k) const {
   Geometry g;
-  g.p = k.position(wheel_, centre_b_);
-  g.a = k.direction(wheel_, axle_b_);
+  // The wheel is a link (the constructor checks): its world transform read in place, the same sums
+  // as k.position and k.direction without their dispatch on the body's kind.
+  const Spatial::Transform& X = k.tree->X_world[std::size_t(wheel_.index)];
+  g.p = Spatial::worldPoint(X, centre_b_);
+  g.a = X.E.transpose() * axle_b_;
   g.u = kUp - kUp.dot(g.a) * g.a;
   g.un = g.u.norm();
   // A disk lying flat has no lowest point: take the one under the centre.
@@ -40,15 +43,31 @@ void Rolling::position(const MechanismKinematics<Spatial>& k, int row, VecN& phi
   phi[row] = 0.0;
   phi[row + 1] = 0.0;
   phi[row + 2] = ground_ - g.P.z();
-  // J θ' − A v_c = (ground point) − (wheel's material point at P), as a point closure with a = world.
-  k.addPointJacobian(wheel_, g.P, kTranslations, -1.0, row, J, A);
+  // J θ' − A v_c = (ground point) − (wheel's material point at P), as a point closure with a = world:
+  // column j is minus the linear velocity at P of joint j's unit motion (Spatial::linearAt), for the
+  // joints root → wheel (addPointJacobian's translation rows, without its row mask; A has no columns).
+  (void)A;
+  const auto& bodies = k.model->tree.bodies;
+  for (int j = wheel_.index; j >= 0; j = bodies[std::size_t(j)].parent) {
+    double u[3];
+    Spatial::linearAt(g.P, k.tree->S_w[std::size_t(j)].data(), u);
+    double* col = &J(row, j);  // rows row … row + 2 of column j (column-major)
+    for (int r = 0; r < 3; ++r) col[r] += -u[r];
+  }
 }
 
 void Rolling::bias(const MechanismKinematics<Spatial>& k, int row, VecN& b) const {
   const Geometry g = geometry(k);
-  Vec V;
-  const Pos a_mat = Spatial::linear(k.pointBias(wheel_, g.P, &V));
-  const Pos w = V.head<3>(), rho = g.P - g.p;
+  // The material point's classical acceleration at θ'' = 0, a_P + ω × v_P (k.linearBias's sums, read
+  // in place), and ω itself: the wheel's world velocity (ω, v) and bias acceleration.
+  const std::size_t i = std::size_t(wheel_.index);
+  const double* v = k.tree->v_w[i].data();
+  double ap[3], vp[3], wv[3];
+  Spatial::linearAt(g.P, k.tree->a_w[i].data(), ap);
+  Spatial::linearAt(g.P, v, vp);
+  Spatial::cross3(v, vp, wv);
+  const Pos a_mat(ap[0] + wv[0], ap[1] + wv[1], ap[2] + wv[2]);
+  const Pos w(v[0], v[1], v[2]), rho = g.P - g.p;
   // ḋ from a' = ω × a (zero for a disk lying flat, whose d is held at n).
   Pos d_dot = Pos::Zero();
   if (g.un > 1e-9) {

@@ -237,3 +237,38 @@ TEST_CASE("plane contact: its row is the contact point's Jacobian rows combined 
     CHECK(J.norm() + A.norm() > 0.1);  // not trivially zero
   }
 }
+
+TEST_CASE("plane contact: a spatial link's row and bias, read in place, are MechanismKinematics' bit for bit") {
+  // PlaneContact<Spatial> reads the link's X_world, S_w, v_w and a_w itself (no calls): the same sums as
+  // k.position + k.addDirectionJacobian (row) and k.directionBias (bias), on a turning 3-joint arm with a
+  // tilted normal, so every column and term counts.
+  using SPos = Spatial::Pos;
+  MechanismModel<Spatial> d;
+  d.tree.gravity << 0, 0, 0, 0, 0, -kG;
+  const Spatial::Mat I = Spatial::inertia(1.0, SPos(0.1, 0, 0), Eigen::Matrix3d::Identity() * 0.01);
+  int b = d.tree.addBody(-1, JointType::Revolute, SPos::UnitZ(), Spatial::Transform(), I);
+  b = d.tree.addBody(b, JointType::Revolute, SPos::UnitY(), Spatial::translation(SPos(0, 0, 0.3)), I);
+  b = d.tree.addBody(b, JointType::Revolute, SPos(0.3, 0.8, 0.2).normalized(), Spatial::translation(SPos(0.3, 0, 0)), I);
+  const SPos centre(0.35, 0.02, -0.01), normal = SPos(0.1, -0.2, 1.0).normalized();
+  const auto contact = std::make_shared<PlaneContact<Spatial>>(BodyRef::link(b), centre, normal, rigid());
+  d.constraints.push_back(contact);
+  ConstrainedMechanism<Spatial> mech(d);
+  VecN q(3), v(3);
+  q << 0.7, -0.4, 1.1;
+  v << 1.3, -0.8, 2.1;
+  mech.stage(q, &v);
+  const auto& k = mech.kinematics();
+  VecN phi = VecN::Zero(1), b_row = VecN::Zero(1), b_ref = VecN::Zero(1);
+  MatN J = MatN::Zero(1, 3), A = MatN::Zero(1, 0), J_ref = MatN::Zero(1, 3), A_ref = MatN::Zero(1, 0);
+  contact->position(k, 0, phi, J, A);
+  contact->bias(k, 0, b_row);
+  // (The contact's own unit normal: normalising `normal` again may move its last bits.)
+  const SPos c = k.position(BodyRef::link(b), centre), n = contact->normal();
+  k.addDirectionJacobian(BodyRef::link(b), c, n, -1.0, 0, J_ref, A_ref);
+  b_ref[0] = -k.directionBias(BodyRef::link(b), c, n);
+  CHECK(phi[0] == -(n.dot(c) - kRho - 0.0));
+  for (int j = 0; j < 3; ++j) CHECK(J(0, j) == J_ref(0, j));
+  CHECK(b_row[0] == b_ref[0]);
+  CHECK(J.norm() > 0.1);
+  CHECK(std::abs(b_row[0]) > 0.1);
+}

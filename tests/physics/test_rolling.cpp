@@ -188,3 +188,33 @@ TEST_CASE("rolling: the x, y rows have no position form; bad parameters are refu
   CHECK_THROWS(Rolling(BodyRef::link(4), Pos::Zero(), Pos::UnitY(), 0.1, 0.0, -1.0));
   CHECK_THROWS(Rolling(BodyRef::world(), Pos::Zero(), Pos::UnitY(), 0.1, 0.0, 0.8));
 }
+
+TEST_CASE("rolling: its rows, read in place, are the point Jacobian's translation rows at the contact, bit for bit") {
+  // Rolling reads the wheel's X_world and S_w itself: J must be k.addPointJacobian(wheel, P, x y z, −1)
+  // exactly, at a tilted, turned wheel (every column counts).
+  MechanismModel<Spatial> d;
+  d.tree.gravity << 0, 0, 0, 0, 0, -9.81;
+  const Spatial::Mat none = Spatial::Mat::Zero();
+  int b = d.tree.addBody(-1, JointType::Prismatic, Spatial::Pos::UnitX(), Spatial::Transform(), none);
+  b = d.tree.addBody(b, JointType::Prismatic, Spatial::Pos::UnitY(), Spatial::Transform(), none);
+  b = d.tree.addBody(b, JointType::Prismatic, Spatial::Pos::UnitZ(), Spatial::Transform(), none);
+  b = d.tree.addBody(b, JointType::Revolute, Spatial::Pos::UnitZ(), Spatial::Transform(), none);
+  b = d.tree.addBody(b, JointType::Revolute, Spatial::Pos::UnitX(), Spatial::Transform(), none);  // tilt
+  const Eigen::Vector3d I(0.005, 0.01, 0.005);
+  b = d.tree.addBody(b, JointType::Revolute, Spatial::Pos::UnitY(), Spatial::Transform(), Spatial::inertia(2.0, Spatial::Pos::Zero(), I.asDiagonal()));
+  const auto rolling = std::make_shared<Rolling>(BodyRef::link(b), Spatial::Pos::Zero(), Spatial::Pos::UnitY(), 0.1, 0.0, 0.8);
+  d.constraints.push_back(rolling);
+  ConstrainedMechanism<Spatial> mech(d);
+  VecN q(6);
+  q << 0.2, -0.3, 0.09, 0.7, 0.3, 1.9;
+  mech.stage(q);
+  const auto& k = mech.kinematics();
+  VecN phi = VecN::Zero(3);
+  MatN J = MatN::Zero(3, 6), A = MatN::Zero(3, 0), J_ref = MatN::Zero(3, 6), A_ref = MatN::Zero(3, 0);
+  rolling->position(k, 0, phi, J, A);
+  k.addPointJacobian(BodyRef::link(b), rolling->point(k), {false, false, false, true, true, true}, -1.0, 0, J_ref, A_ref);
+  for (int r = 0; r < 3; ++r)
+    for (int j = 0; j < 6; ++j) CHECK(J(r, j) == J_ref(r, j));
+  CHECK(phi[2] == -rolling->point(k).z());
+  CHECK(J.norm() > 0.1);
+}
