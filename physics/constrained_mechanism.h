@@ -160,8 +160,9 @@ class ConstrainedMechanism : public ConstrainedSystem {
   void velocityStage(const VecN& v);
   // The tree's transforms alone at θ (controller queries), cached like the position stage.
   void treeStage(const VecN& q);
-  // The solve at a state; without with_qdd, α_c, η and f only (θ'' left unset).
-  Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd = true);
+  // The solve at a state; without with_qdd, α_c, η and f only (θ'' left unset); without with_forces,
+  // θ'' and α_c only (η and f as the solve left them: the closed rows' alone when selected).
+  Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd = true, bool with_forces = true);
   // The deepest φ (= −gap) of the open rigid unilateral contacts at q, −∞ if none is open.
   double openDepth(const VecN& q);
   // True while a rigid unilateral contact is open; stepLocatingContacts with one open.
@@ -216,6 +217,13 @@ class ConstrainedMechanism : public ConstrainedSystem {
   std::vector<LimitRow> limit_rows_;
   bool only_limits_ = false;
   bool selected() const { return Nr == Eigen::Dynamic && selected_; }  // never at fixed rows (a lab's)
+  // The closed rows selected all lock a coordinate (J̃ row = −σ e_cᵀ, distinct c, no payload: joint limits
+  // at their stops): solved by elimination (constrained_solve.h factorLocked), their c and σ here.
+  bool locked_rows_ = false;
+  std::vector<int> lock_coordinate_;
+  std::vector<double> lock_sign_;
+  bool lockedCoordinates();  // sets the three from problem_.J (selectClosedRows)
+  bool factorClosedRows();   // the selected rows' factor: by elimination where they lock coordinates
   std::vector<int> closed_rows_;   // their rows, in order
   VecN phi_;
   VecN gravity_bc_;    // b_c + G_c of the payloads without external forces (b_c = 0: world axes at the centre of mass)

@@ -76,10 +76,41 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::selectClosedRows() {
       for (int j = 0; j < kk; ++j) problem_.A(i, j) = A_full_(r, j);
     }
     problem_.compliance.resize(0);  // the released rows are out of the solve
+    locked_rows_ = kk == 0 && lockedCoordinates();
     selected_ = true;
     if (only_limits_) selected_version_ = closed_version_;
   }
   return selected_;
+}
+
+// Whether every selected row locks a coordinate: one entry ±1 (J̃ = −σ e_cᵀ, σ = −J̃_c), each in its own
+// column; their coordinates and signs for the elimination (constrained_solve.h factorLocked).
+template <class S, int Nj, int Nr, int Nl>
+bool ConstrainedMechanism<S, Nj, Nr, Nl>::lockedCoordinates() {
+  lock_coordinate_.clear();
+  lock_sign_.clear();
+  lock_coordinate_.reserve(std::size_t(rows_));  // (once: no allocation in a step)
+  lock_sign_.reserve(std::size_t(rows_));
+  const int m = int(problem_.J.rows()), nn = n();
+  for (int i = 0; i < m; ++i) {
+    int column = -1;
+    for (int j = 0; j < nn; ++j)
+      if (problem_.J(i, j) != 0.0) {
+        if (column >= 0) return false;
+        column = j;
+      }
+    if (column < 0 || std::abs(problem_.J(i, column)) != 1.0) return false;
+    if (std::find(lock_coordinate_.begin(), lock_coordinate_.end(), column) != lock_coordinate_.end()) return false;
+    lock_coordinate_.push_back(column);
+    lock_sign_.push_back(-problem_.J(i, column));
+  }
+  return true;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+bool ConstrainedMechanism<S, Nj, Nr, Nl>::factorClosedRows() {
+  if (locked_rows_) return factor_.factorLocked(problem_, lock_coordinate_.data(), lock_sign_.data(), int(lock_coordinate_.size()));
+  return factor_.factor(problem_, problem_.J, problem_.A);
 }
 
 // out = the closed rows of a vector over every row (selectClosedRows), in order.

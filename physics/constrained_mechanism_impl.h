@@ -156,7 +156,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
     for (std::size_t i = 0; i < model_.constraints.size(); ++i)
       if (released_[i] && row_count_[i] == 1) phi_[offsets_[i]] = 0.0;
       else if (released_[i]) phi_.segment(offsets_[i], row_count_[i]).setZero();
-    factored_ = factor_.factor(problem_, problem_.J, problem_.A);
+    factored_ = factorClosedRows();
     setFixed<kState>(staged_q_, q);
     have_position_ = true;
     return;
@@ -239,7 +239,13 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
     }
   }
   // J'θ' − A'v_c of every constraint (of the closed ones alone, compacted, when the rows are selected:
-  // the released rows' bias is not solved for).
+  // the released rows' bias is not solved for). Joint limits alone, selected: J constant, J'θ' = 0.
+  if (only_limits_ && selected()) {
+    problem_.Jdot_qd.setZero(Eigen::Index(closed_rows_.size()));
+    setFixed<kState>(staged_v_, v);
+    have_velocity_ = true;
+    return;
+  }
   VecN bias(rows_);
   for (std::size_t i = 0; i < model_.constraints.size(); ++i)
     if (!selected() || !released_[i]) model_.constraints[i]->bias(kin_, offsets_[i], bias);
@@ -277,7 +283,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stage(const VecN& q, const VecN* v) {
 
 template <class S, int Nj, int Nr, int Nl>
 typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, Nj, Nr, Nl>::evaluate(
-    const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd) {
+    const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd, bool with_forces) {
   positionStage(q);
   // The velocity stage too is kept: the trace row's solve and the step's first stage share it.
   if (!have_velocity_ || !same(v, staged_v_)) velocityStage(v);
@@ -300,6 +306,7 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
   Solution s;
   if (!factored_) s = solveConstrainedBlockLU(problem_);
   else factor_.solve(problem_, s, with_qdd);
+  if (!with_forces) return s;  // (η compacted when the rows are selected)
   if (selected()) scatterClosedRows(s);
   // A compliant contact's η is its force, not the solve's (its row is released).
   if (any_compliant_)
@@ -341,7 +348,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::accelerations(const VecN& q, const Vec
     for (int i = 0; i < kk; ++i) a[nn + i] = s.alpha_c[i];
   };
   if (known) put(last_);
-  else put(evaluate(q, v, tau, stab));
+  else put(evaluate(q, v, tau, stab, true, false));  // θ'' and α_c alone
 }
 
 template <class S, int Nj, int Nr, int Nl>

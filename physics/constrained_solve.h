@@ -7,6 +7,10 @@
 //   tree         θ'' = M⁻¹ (τ − h − J̃ᵀ η)
 // M, Λ and the Schur complement are symmetric positive definite away from singular
 // configurations; when one is not, the whole block matrix goes to a full-pivot LU instead.
+// Rows that lock coordinates (J̃ row i = −σ_i e_cᵢᵀ, distinct cᵢ, no payload: joint limits at their
+// stops) are eliminated instead (factorLocked): J̃ θ'' = −b fixes θ''_L, the free coordinates F solve
+//   M_FF θ''_F = (τ − h)_F − M_FL θ''_L,      and   η_i = σ_i (M_cᵢ· θ'' + h_cᵢ − τ_cᵢ)
+// (row cᵢ of M θ'' + h − τ = −J̃ᵀ η): one factor and one substitution, no Λ.
 // Written once for fixed and bounded sizes (constrained.h); include this to solve fixed sizes.
 #pragma once
 #include "physics/cholesky.h"
@@ -29,6 +33,7 @@ class ConstrainedFactorT {
     n_ = int(p.M.rows());
     m_ = int(J.rows());
     k_ = int(A.cols());
+    locked_ = false;
     const int n = this->n(), m = this->m(), k = this->k();  // compile-time where the sizes are fixed
     if (!chol_M_.compute(p.M)) return false;
     // Y = L⁻¹ J̃ᵀ, and Λ = J̃ M⁻¹ J̃ᵀ = Yᵀ D⁻¹ Y.
@@ -57,10 +62,41 @@ class ConstrainedFactorT {
     return chol_S_.compute(S, k);
   }
 
+  // Factors for m rows that lock coordinates, row i J̃ = −sign[i] e_cᵀ with c = coordinate[i] (distinct),
+  // and no payload (see the top): M_FF's factor as M's with the locked rows and columns replaced by the
+  // identity's times M's largest diagonal entry (so the pivot test is M's own). Their entries of L are
+  // then zero: the free part is M_FF's factor, and what stands in a locked coordinate during a
+  // substitution never reaches a free one. False if M_FF is not clearly positive definite.
+  template <class Problem>
+  bool factorLocked(const Problem& p, const int* coordinate, const double* sign, int m) {
+    n_ = int(p.M.rows());
+    m_ = m;
+    k_ = 0;
+    locked_ = true;
+    const int n = this->n();
+    double largest = 0;
+    for (int i = 0; i < n; ++i) largest = std::max(largest, std::abs(p.M(i, i)));
+    MatRC<Nj, Nj> M = p.M;
+    Mcol_.resize(n, m);
+    for (int r = 0; r < m; ++r) {
+      const int c = coordinate[r];
+      coordinate_[r] = c;
+      sign_[r] = sign[r];
+      for (int i = 0; i < n; ++i) {
+        Mcol_(i, r) = p.M(i, c);  // M_Fc and M_cc for the right-hand side and η
+        M(i, c) = M(c, i) = 0.0;
+      }
+      M(c, c) = largest;
+    }
+    return chol_M_.compute(M);
+  }
+
   // The solution at p's right-hand side (τ − h, J'θ', A'v_c, H'w, s, b_c + G_c), with the
   // configuration last factored. Ht as in p (empty: eq. 2). Without with_qdd: α_c, η, f only.
   template <class Problem, class Solution>
   void solve(const Problem& p, Solution& s, bool with_qdd = true) const {
+    if constexpr (Nr == Eigen::Dynamic)
+      if (locked_) return solveLocked(p, s);
     const int n = this->n(), m = this->m(), k = this->k();  // compile-time where the sizes are fixed
     // y = L⁻¹ (τ − h), and r = J̃ M⁻¹ (τ − h) + H̃ (J'θ' + H'w − A'v_c − s).
     MatRC<Nj, 1> y(n);
@@ -107,6 +143,41 @@ class ConstrainedFactorT {
   }
 
  private:
+  // factorLocked's solve: θ''_L from the rows, θ''_F by one substitution, η from the locked rows of M.
+  // (θ'' is part of η's cost: always computed.)
+  template <class Problem, class Solution>
+  void solveLocked(const Problem& p, Solution& s) const {
+    const int n = this->n(), m = this->m();
+    // The locked accelerations θ''_c = σ b (b as the Schur route's bias), and (τ − h)_F − M_FL θ''_L.
+    s.qdd.resize(n);
+    for (int i = 0; i < n; ++i) s.qdd[i] = p.tau[i] - p.h[i];
+    double locked[kLockCap];
+    for (int r = 0; r < m; ++r) {
+      double b = p.Jdot_qd[r];
+      if (p.Adot_vc.size()) b -= p.Adot_vc[r];
+      if (p.Hdot_w.size()) b += p.Hdot_w[r];
+      if (p.stab.size()) b -= p.stab[r];
+      locked[r] = sign_[r] * b;
+      for (int i = 0; i < n; ++i) s.qdd[i] -= Mcol_(i, r) * locked[r];
+    }
+    // A locked entry meets only zeros of L on its way (its value never reaches a free coordinate); zero,
+    // so that not even a non-finite one could (0 · ∞).
+    for (int r = 0; r < m; ++r) s.qdd[coordinate_[r]] = 0.0;
+    chol_M_.solveInPlace(s.qdd);
+    for (int r = 0; r < m; ++r) s.qdd[coordinate_[r]] = locked[r];
+    // η_r = σ_r (M_c· θ'' + h_c − τ_c).
+    s.eta.resize(m);
+    for (int r = 0; r < m; ++r) {
+      const int c = coordinate_[r];
+      double x = 0.0;
+      for (int i = 0; i < n; ++i) x += Mcol_(i, r) * s.qdd[i];
+      s.eta[r] = sign_[r] * (x + p.h[c] - p.tau[c]);
+    }
+    s.alpha_c.resize(0);
+    s.f = s.eta;
+    s.ok = true;
+  }
+
   int n() const { return Nj == Eigen::Dynamic ? n_ : Nj; }
   int m() const { return Nr == Eigen::Dynamic ? m_ : Nr; }
   int k() const { return Nl == Eigen::Dynamic ? k_ : Nl; }
@@ -116,6 +187,12 @@ class ConstrainedFactorT {
   CholeskyN<Nl> chol_S_;
   MatRC<Nj, Nr> Y_;       // L⁻¹ J̃ᵀ
   MatRC<Nr, Nl> A_, LA_;  // Ã and Λ⁻¹ Ã
+  // factorLocked's rows: their coordinates and signs, and M's columns there (n × m).
+  static constexpr int kLockCap = Nr == Eigen::Dynamic ? kMaxDof : (Nr > 0 ? Nr : 1);
+  bool locked_ = false;
+  int coordinate_[kLockCap] = {};
+  double sign_[kLockCap] = {};
+  MatRC<Nj, Nr> Mcol_;
 };
 
 // The block LU's answer at fixed sizes (the fallback near singular configurations).
