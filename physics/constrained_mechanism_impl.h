@@ -15,35 +15,9 @@
 #include "physics/constrained_mechanism.h"
 #include "physics/constrained_mechanism_contacts.h"
 #include "physics/det/det.h"
+#include "physics/fixed_size_copy.h"
 
 namespace dyn {
-
-// m ← the zero rows × cols matrix; stores unrolled where both sizes are fixed (a lab's instantiation:
-// there a memset call costs more than the few stores).
-template <int R, int C, class Mat>
-void setZeroAt(Mat& m, int rows, int cols) {
-  m.resize(rows, cols);
-  if constexpr (R != Eigen::Dynamic && C != Eigen::Dynamic) {
-    for (int c = 0; c < C; ++c)
-      for (int r = 0; r < R; ++r) m(r, c) = 0.0;
-  } else {
-    m.setZero();
-  }
-}
-
-// dst = src (its first `count` entries, when given), entry by entry where that is the fixed size N
-// (unrolled), else Eigen's copy.
-template <int N>
-void setFixed(VecN& dst, const VecN& src, Eigen::Index count = -1) {
-  if (count < 0) count = src.size();
-  if constexpr (N != Eigen::Dynamic)
-    if (count == N) {
-      dst.resize(N);
-      for (int i = 0; i < N; ++i) dst[i] = src[i];
-      return;
-    }
-  dst = src.head(count);
-}
 
 template <class S, int Nj, int Nr, int Nl>
 ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> model)
