@@ -248,7 +248,13 @@ TEST_CASE("a rerun into the same directory leaves no stale output of the earlier
 
 TEST_CASE("dynlab bench --json: the fields of every lab, and speed with accuracy (no speed asserted)") {
   TempDir dir("bench");
-  const Result r = dynlab(dir, {"bench", "--json", "--steps", "200", "--frames", "5"});
+  // Its scratch files in a folder of its own under TMPDIR, whatever already sits there: here the
+  // names it once used for them, taken by another user's files (it failed, or wrote among them).
+  TempDir tmp("bench_tmpdir");
+  std::ofstream(tmp / "dynlab-bench") << "someone else's";
+  std::ofstream(tmp / "dynlab-bench-grade") << "someone else's";
+  const auto before = snapshot(tmp.path);
+  const Result r = dynlab(dir, {"bench", "--json", "--steps", "200", "--frames", "5"}, withEnv({{"TMPDIR", tmp.path.string()}}));
   INFO("stdout: ", r.out, "\nstderr: ", r.err);
   REQUIRE(r.code == 0);
   std::istringstream lines(r.out);
@@ -284,4 +290,5 @@ TEST_CASE("dynlab bench --json: the fields of every lab, and speed with accuracy
   }
   CHECK(labs >= 1);
   CHECK(snapshot(dir.path).empty());  // the bench leaves nothing behind
+  CHECK(snapshot(tmp.path) == before);  // nor in TMPDIR, whose files it did not touch
 }

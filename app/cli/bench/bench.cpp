@@ -9,8 +9,12 @@
 //   render, render+PNG, render+video: frames per second at 640×480 (MSAA 4, overlay on);
 //   grading: CPU seconds of a full rubric grade of the lab's instructor/good.json.
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <stdexcept>
 #include <filesystem>
 #include <iostream>
 #include <string>
@@ -27,6 +31,17 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 namespace dyn::app {
+
+ScratchDir::ScratchDir(const std::string& prefix) {
+  std::string name = (fs::temp_directory_path() / (prefix + "-XXXXXX")).string();
+  if (!mkdtemp(name.data())) throw std::runtime_error("dynlab bench: cannot make a scratch folder " + name + " (" + std::strerror(errno) + ")");
+  path_ = name;
+}
+
+ScratchDir::~ScratchDir() {
+  std::error_code ec;  // nothing to say if it is already gone
+  fs::remove_all(path_, ec);
+}
 
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
@@ -130,8 +145,8 @@ Fps frameRates(const Lab& lab, const Trace& trace, int frames) {
   auto context = makeOffscreenContext(640, 480);
   Renderer renderer(*context);
   const auto rows = frameRows(trace, lab.dt(), 30);
-  const fs::path dir = fs::temp_directory_path() / "dynlab-bench";
-  fs::create_directories(dir);
+  const ScratchDir scratch("dynlab-bench");
+  const fs::path& dir = scratch.path();
   auto run = [&](int mode) {
     std::unique_ptr<VideoWriter> video;
     if (mode == 2) video = std::make_unique<VideoWriter>((dir / "bench.mp4").string(), 640, 480, 30);
@@ -150,9 +165,7 @@ Fps frameRates(const Lab& lab, const Trace& trace, int frames) {
     return frames / std::chrono::duration<double>(Clock::now() - t0).count();
   };
   run(0);  // warm up (shader compilation, first ImGui frame)
-  Fps f{run(0), run(1), run(2)};
-  fs::remove_all(dir);
-  return f;
+  return Fps{run(0), run(1), run(2)};
 }
 
 // "integrator + drift" of a config's simulation block, as labs/ parses it for every lab.

@@ -1,6 +1,7 @@
 // Timing helpers shared by the bench commands (app/cli/bench/bench.cpp, app/cli/bench/bench_scaling.cpp, app/cli/bench/bench_model.cpp).
 #pragma once
 #include <chrono>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -58,6 +59,21 @@ struct MujocoRun {
   std::unique_ptr<Impl> impl_;
 };
 MujocoRun mujocoRun(const dyn::Lab& lab, const std::string& config_file);
+
+// A folder of this bench's own under the temporary directory (mkdtemp: a fresh name, mode 0700), removed
+// with its files when it goes: two benches at once, or a name someone else made first, never meet.
+// Throws std::runtime_error (naming the folder) when none can be made.
+class ScratchDir {
+ public:
+  explicit ScratchDir(const std::string& prefix);
+  ~ScratchDir();
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
 
 struct BenchArgs;
 // dynlab bench FILE.xml|FILE.urdf: the hand step against Bullet's and MuJoCo's for a model file (app/cli/bench/bench_model.cpp).

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <filesystem>
 
+#include "app/cli/bench/bench.h"
 #include "app/cli/commands.h"
 #include "grading/grade.h"
 #include "labs/lab.h"
@@ -45,9 +46,9 @@ json gradeThroughput(const std::string& lab, int repeats) {
   if (!std::filesystem::exists(file)) return json::object();
   GradeOptions o;
   const double plain = gradeCpu(file, o, repeats);
-  o.out_dir = (std::filesystem::temp_directory_path() / "dynlab-bench-grade").string();
+  const ScratchDir scratch("dynlab-bench-grade");
+  o.out_dir = scratch.path().string();
   const double plots = gradeCpu(file, o, std::max(1, repeats / 2));
-  std::filesystem::remove_all(o.out_dir);
   return {{"grade_cpu_s", plain},
           {"grade_cpu_s_with_plots", plots},
           {"grade_per_s_per_core", plain > 0 ? 1.0 / plain : 0.0},
