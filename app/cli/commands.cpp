@@ -341,6 +341,18 @@ int gradeReplay(const GradeArgs& a) {
     return 0;
   }
   std::printf("replay: MISMATCH, %zu difference(s):\n", diff.size());
+  // Another version's grade: its physics may round differently (docs/determinism.md), so a mismatch
+  // alone does not say the file was edited.
+  json was;  // extra_data.fingerprint.dynlab_version, if the file has one where a results.json keeps it
+  if (const auto e = expected.find("extra_data"); e != expected.end() && e->is_object())
+    if (const auto f = e->find("fingerprint"); f != e->end() && f->is_object())
+      if (const auto v = f->find("dynlab_version"); v != f->end()) was = *v;
+  if (was != json(DYNLAB_VERSION)) {
+    const std::string by = was.is_string() ? "dynlab " + was.get<std::string>() : "an unnamed dynlab version";
+    std::printf("  (graded by %s, replayed by dynlab %s: a version's physics may round differently; replay with %s to tell an "
+                "edited file from a new version)\n",
+                termText(by).c_str(), DYNLAB_VERSION, termText(by).c_str());
+  }
   // Each metric first (was → now, with its test), then the differences as JSON paths.
   for (const auto& line : metricChanges(expected, actual)) std::printf("  %s\n", termText(line).c_str());
   for (std::size_t i = 0; i < diff.size() && i < 20; ++i) std::printf("  %s\n", termText(diff[i]).c_str());

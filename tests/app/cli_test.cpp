@@ -292,3 +292,30 @@ TEST_CASE("dynlab bench --json: the fields of every lab, and speed with accuracy
   CHECK(snapshot(dir.path).empty());  // the bench leaves nothing behind
   CHECK(snapshot(tmp.path) == before);  // nor in TMPDIR, whose files it did not touch
 }
+
+TEST_CASE("grade --replay: a grade another dynlab version made is said to be one, beside its differences") {
+  TempDir dir("replay_version");
+  const std::string ex = (fs::path(DYNLAB_SOURCE_DIR) / "labs/slider_crank/examples/proportional.json").string();
+  REQUIRE(dynlab(dir, {"grade", ex, "--no-plots", "--out", "g"}).code == 0);
+  json r = json::parse(readFile(dir / "g/results.json"));
+  // This version's grade, one score edited: a mismatch, and no word of versions.
+  r["tests"][0]["score"] = 0.125;
+  writeFile(dir / "edited.json", r.dump());
+  Result out = dynlab(dir, {"grade", "--replay", "edited.json", ex});
+  CHECK(out.code == 1);
+  CHECK(out.out.find("replay: MISMATCH") != std::string::npos);
+  CHECK(out.out.find("graded by") == std::string::npos);
+  // Another version's (its physics may round differently): said, with the version to replay with.
+  r["extra_data"]["fingerprint"]["dynlab_version"] = "0.0.9";
+  writeFile(dir / "older.json", r.dump());
+  out = dynlab(dir, {"grade", "--replay", "older.json", ex});
+  CHECK(out.code == 1);
+  CHECK(out.out.find("(graded by dynlab 0.0.9, replayed by dynlab ") != std::string::npos);
+  CHECK(out.out.find("replay with dynlab 0.0.9 to tell an edited file from a new version") != std::string::npos);
+  // A fingerprint that is not an object: still one mismatch report, no crash.
+  r["extra_data"]["fingerprint"] = "x";
+  writeFile(dir / "odd.json", r.dump());
+  out = dynlab(dir, {"grade", "--replay", "odd.json", ex});
+  CHECK(out.code == 1);
+  CHECK(out.out.find("(graded by an unnamed dynlab version") != std::string::npos);
+}
