@@ -68,7 +68,14 @@ function main(port) {
   const finish = (code) => {
     server.close();
     const cleanUp = () => {
-      fs.rmSync(profile, { recursive: true, force: true });
+      // Chromium's helpers (GPU, crash handler) may still be writing the profile when the browser
+      // itself has exited: retried (ENOTEMPTY is one of the errors rmSync retries), and a profile
+      // that still cannot go is reported, not taken for the page's failure.
+      try {
+        fs.rmSync(profile, { recursive: true, force: true, maxRetries: 20, retryDelay: 50 });
+      } catch (e) {
+        console.error('page_check: could not remove ' + profile + ': ' + e.message);
+      }
       process.exit(code);
     };
     if (browser.exitCode !== null || browser.signalCode !== null) cleanUp();
