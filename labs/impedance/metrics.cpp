@@ -51,7 +51,12 @@ Fit fitStep(const std::vector<double>& t, const std::vector<double>& d, double d
   Fit best;
   auto costEvery = [&](double w, double z, std::size_t stride) {
     double c = 0;
-    for (std::size_t i = 0; i < t.size(); i += stride) c += det::pow(d[i] - ds * unitStep(w, z, t[i]), 2);
+    // The residual squared as one product: det::pow(x, 2) is x·x too (its integer powers multiply),
+    // at the cost of a call and its special cases, ~750,000 times a fit.
+    for (std::size_t i = 0; i < t.size(); i += stride) {
+      const double e = d[i] - ds * unitStep(w, z, t[i]);
+      c += e * e;
+    }
     return c;
   };
   auto cost = [&](double w, double z) { return costEvery(w, z, 1); };
