@@ -114,12 +114,12 @@ Grader startGrader(const GradeArgs& args, const std::vector<Submission>& subs, c
     for (const Grader* g : others)
       if (g->running()) ::close(g->to), ::close(g->from);
     setIsolateInPlace(in_place);
-    deferDurability(true);
+    deferDurability(true);  // the batch syncs OUT once, before its gradebook (gradeBatch)
     // A grade's large buffers (traces, plot data, PNG memory) come and go with each submission: the
     // heap keeps what it has grown to instead of giving it back and faulting it in again (the
     // system time of a batch doubled where glibc trimmed and mapped anew per submission).
     ::mallopt(M_MMAP_THRESHOLD, 32 << 20);
-    ::mallopt(M_TRIM_THRESHOLD, 256 << 20);  // the batch syncs OUT once, before its gradebook (gradeBatch)
+    ::mallopt(M_TRIM_THRESHOLD, 256 << 20);
     serve(args, subs, out, down[0], up[1]);
   }
   ::close(down[0]), ::close(up[1]);
