@@ -374,7 +374,9 @@ struct Spatial {
   // Revolute: E = R(a, q)ᵀ = c 1 + (1 − c) a aᵀ − s [a]× (Rodrigues, transposed); prismatic: r = a q.
   DYN_INLINE static Transform jointTransform(bool revolute, const Axis& a, double q) {
     if (!revolute) return {Rot::Identity(), a * q, false};
-    const double c = det::cos(q), s = det::sin(q), t = 1.0 - c;
+    double c, s;
+    det::sincos(q, s, c);  // det::cos and det::sin, one reduction
+    const double t = 1.0 - c;
     const double x = a[0], y = a[1], z = a[2];
     Rot E;
     E(0, 0) = c + t * x * x, E(0, 1) = t * x * y + s * z, E(0, 2) = t * x * z - s * y;
