@@ -160,17 +160,7 @@ void crbaPlanar(const TreeModel<Spatial>& model, const TreeData<Spatial>& data, 
     const int p = model.bodies[std::size_t(b)].parent;
     if (p >= 0) P.Ic[p] += P.Ic[b];
   }
-  // As crbaWorld: column j's force seen by each joint on its path to the root, the others zero.
-  for (int j = 0; j < n; ++j) {
-    const Planar::Vec F = P.Ic[j].times(P.S[j]);
-    for (int r = j, i = j; r >= 0; --r)
-      if (r == i) {
-        M(i, j) = M(j, i) = Planar::dot(P.S[i], F);
-        i = model.bodies[std::size_t(i)].parent;
-      } else {
-        M(r, j) = M(j, r) = 0.0;
-      }
-  }
+  fillJointSpaceInertia<Planar>(model, n, P.S, [&](int j) { return P.Ic[j].times(P.S[j]); }, M);
 }
 
 // h = C θ' + G of a planar tree after crbaPlanar: biasForcesWorld on (ω_z; v_x, v_y), leaving

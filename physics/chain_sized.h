@@ -72,6 +72,35 @@ void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
   }
 }
 
+// CRBA's last pass (crbaWorld, and chain_planar_in_space.h's crbaPlanar on 3-vectors): with F_j the
+// force that moving joint j alone needs (force(j) = I_c,j S_j), M_ij = S_i · F_j for every joint i on
+// the path from j to the root (parents precede their children), zero for the joints off it. Each
+// entry written once (M is symmetric): no zeroing pass first, which for a small M is a memset call.
+// A serial chain (each body's parent the one before it) has every i ≤ j on the path: its own loop,
+// without the walk, unrolls whole at a fixed n.
+template <class Alg, class Model, class Force, class MatOut>
+DYN_INLINE void fillJointSpaceInertia(const Model& model, int n, const std::vector<typename Alg::Vec>& axes, const Force& force, MatOut& M) {
+  bool chain = true;
+  for (int i = 0; i < n; ++i) chain = chain && model.bodies[std::size_t(i)].parent == i - 1;
+  if (chain) {
+    for (int j = 0; j < n; ++j) {
+      const typename Alg::Vec F = force(j);
+      for (int i = j; i >= 0; --i) M(i, j) = M(j, i) = Alg::dot(axes[std::size_t(i)], F);
+    }
+    return;
+  }
+  for (int j = 0; j < n; ++j) {
+    const typename Alg::Vec F = force(j);
+    for (int r = j, i = j; r >= 0; --r)
+      if (r == i) {
+        M(i, j) = M(j, i) = Alg::dot(axes[std::size_t(i)], F);
+        i = model.bodies[std::size_t(i)].parent;
+      } else {
+        M(r, j) = M(j, r) = 0.0;
+      }
+  }
+}
+
 // chain_world.h crbaWorld: M(θ) from world composite inertias, leaving data.I_w.
 template <int N, class S, class MatOut>
 void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
@@ -90,19 +119,7 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
     const int p = model.bodies[std::size_t(i)].parent;
     if (p >= 0) data.Ic_rb[p] += data.Ic_rb[i];
   }
-  for (int j = 0; j < n; ++j) {
-    // The force that moving joint j alone needs, seen by every joint on the way to the root (parents
-    // precede their children); the joints off that path see none. Each entry written once (M is
-    // symmetric): no zeroing pass first, which for a small M is a memset call.
-    const typename S::Vec F = S::inertiaTimes(data.Ic_rb[j], data.S_w[j]);
-    for (int r = j, i = j; r >= 0; --r)
-      if (r == i) {
-        M(i, j) = M(j, i) = S::dot(data.S_w[i], F);
-        i = model.bodies[std::size_t(i)].parent;
-      } else {
-        M(r, j) = M(j, r) = 0.0;
-      }
-  }
+  fillJointSpaceInertia<S>(model, n, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
 }
 
 // chain_world.h biasForcesWorld: h = C θ' + G, leaving data.v_w and data.a_w.

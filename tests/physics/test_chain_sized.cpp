@@ -1,8 +1,8 @@
 // The tree kernels at a body count fixed at compile time (physics/chain_sized.h, what a fixed
 // instantiation of the mechanism runs) against the dynamically sized ones (chain.h, chain_world.h):
-// the same transforms, M and h bit for bit on random trees with revolute joints about coordinate and
-// general axes, prismatic and ball joints, turned and plain placements, massless carriers and
-// branches; M against RNEA's columns and h against RNEA(θ, θ', 0) as an independent reference; and
+// the same transforms, M and h bit for bit on random trees and serial chains with revolute joints
+// about coordinate and general axes, prismatic and ball joints, turned and plain placements, massless
+// carriers and branches; M against RNEA's columns and h against RNEA(θ, θ', 0) as an independent reference; and
 // Spatial::compose's products written out against Eigen's; det::sincos against det::sin and det::cos.
 #include <doctest/doctest.h>
 
@@ -37,14 +37,15 @@ Spatial::Mat randomInertia(std::mt19937& rng) {
   return Spatial::inertia(2.0 * u(rng), Pos(0.1 * u(rng), -0.1 * u(rng), 0.2 * u(rng)), Ic);
 }
 
-// A random tree of exactly n bodies (a ball joint takes three), parents anywhere before.
-TreeModel<Spatial> randomTree(std::mt19937& rng, int n) {
+// A random tree of exactly n bodies (a ball joint takes three), parents anywhere before; or a serial
+// chain (each body's parent the one before it: crbaWorld's unwalked loop).
+TreeModel<Spatial> randomTree(std::mt19937& rng, int n, bool chain = false) {
   TreeModel<Spatial> t;
   t.gravity << 0, 0, 0, 0.5, -1.0, -9.81;
   std::uniform_int_distribution<int> kind(0, 5);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
   while (t.dof() < n) {
-    const int parent = std::uniform_int_distribution<int>(-1, t.dof() - 1)(rng);
+    const int parent = chain ? t.dof() - 1 : std::uniform_int_distribution<int>(-1, t.dof() - 1)(rng);
     const int k = kind(rng);
     const Spatial::Transform X = randomTransform(rng, k % 2 == 0);
     const Spatial::Mat I = k == 5 ? Spatial::Mat::Zero() : randomInertia(rng);  // some massless
@@ -70,8 +71,8 @@ VecN randomConfiguration(std::mt19937& rng, const TreeModel<Spatial>& t) {
 }
 
 template <int N>
-void checkSized(std::mt19937& rng, int* balls, int* prismatic) {
-  const TreeModel<Spatial> t = randomTree(rng, N);
+void checkSized(std::mt19937& rng, int* balls, int* prismatic, bool chain = false) {
+  const TreeModel<Spatial> t = randomTree(rng, N, chain);
   REQUIRE(t.dof() == N);
   *balls += int(t.balls.size());
   for (const auto& b : t.bodies) *prismatic += b.joint == JointType::Prismatic;
@@ -117,6 +118,8 @@ TEST_CASE("the tree kernels at a fixed body count give the dynamic ones' transfo
     checkSized<4>(rng, &balls, &prismatic);
     checkSized<6>(rng, &balls, &prismatic);
     checkSized<9>(rng, &balls, &prismatic);
+    checkSized<6>(rng, &balls, &prismatic, true);  // serial chains, as the PUMA
+    checkSized<9>(rng, &balls, &prismatic, true);
   }
   CHECK(balls > 10);  // every kind of joint was drawn
   CHECK(prismatic > 10);
