@@ -78,11 +78,15 @@ void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
 // entry written once (M is symmetric): no zeroing pass first, which for a small M is a memset call.
 // A serial chain (each body's parent the one before it) has every i ≤ j on the path: its own loop,
 // without the walk, unrolls whole at a fixed n.
-template <class Alg, class Model, class Force, class MatOut>
-DYN_INLINE void fillJointSpaceInertia(const Model& model, int n, const std::vector<typename Alg::Vec>& axes, const Force& force, MatOut& M) {
+template <class Model>
+DYN_INLINE bool isSerialChain(const Model& model, int n) {
   bool chain = true;
   for (int i = 0; i < n; ++i) chain = chain && model.bodies[std::size_t(i)].parent == i - 1;
-  if (chain) {
+  return chain;
+}
+template <class Alg, class Model, class Force, class MatOut>
+DYN_INLINE void fillJointSpaceInertia(const Model& model, int n, const std::vector<typename Alg::Vec>& axes, const Force& force, MatOut& M) {
+  if (isSerialChain(model, n)) {
     for (int j = 0; j < n; ++j) {
       const typename Alg::Vec F = force(j);
       for (int i = j; i >= 0; --i) M(i, j) = M(j, i) = Alg::dot(axes[std::size_t(i)], F);
@@ -108,6 +112,24 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
   // World inertias (kept for the velocity stage), each also its composite's first term.
   typename S::Inertia zero{};
   if constexpr (S::kDim == 3) zero.setZero();
+  if constexpr (S::kDim == 6) {
+    // A serial chain: leaves to root, each composite I_i^w + I_c,i+1 as it is written (the same sums as
+    // the pass below, without storing the body's own first and reading it back).
+    if (isSerialChain(model, n)) {
+      for (int i = n - 1; i >= 0; --i) {
+        const auto& b = model.bodies[std::size_t(i)];
+        const typename S::Inertia* child = i + 1 < n ? &data.Ic_rb[i + 1] : nullptr;
+        if (!b.massless) {
+          S::inertiaInParent(data.X_world[i], b.central, data.I_w[i], data.Ic_rb[i], child);
+          continue;
+        }
+        data.I_w[i] = data.Ic_rb[i] = zero;
+        if (child) data.Ic_rb[i] += *child;
+      }
+      fillJointSpaceInertia<S>(model, n, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
+      return;
+    }
+  }
   for (int i = 0; i < n; ++i) {
     const auto& b = model.bodies[std::size_t(i)];
     if (b.massless) data.I_w[i] = data.Ic_rb[i] = zero;

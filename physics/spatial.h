@@ -326,9 +326,11 @@ struct Spatial {
   // one rotation, no cross terms in h (cheaper than transforming the origin form).
   // Written entry by entry into out and its copy (CRBA's composite starts as the body's own): an
   // Inertia returned whole and copied is reloaded 16 bytes at a time from 8-byte stores, a
-  // store-forwarding stall.
-  DYN_INLINE static void inertiaInParent(const Transform& X, const Central& C, Inertia& out, Inertia& copy) {
-    out.m = copy.m = C.m;
+  // store-forwarding stall. With `plus` (a serial chain's child composite), the copy is out + *plus
+  // instead, each entry summed as the composite's += sums it: the same bits without a second pass.
+  DYN_INLINE static void inertiaInParent(const Transform& X, const Central& C, Inertia& out, Inertia& copy, const Inertia* plus = nullptr) {
+    out.m = C.m;
+    copy.m = plus ? C.m + plus->m : C.m;
     Pos cA;
     double B[3][3], Io[3][3];  // I_c E, and the lower triangle of Eᵀ I_c E
     if (X.turned) {
@@ -350,9 +352,20 @@ struct Spatial {
     double h[3];
     for (int i = 0; i < 3; ++i) h[i] = C.m * cA[i];
     const double mcc = h[0] * cA[0] + h[1] * cA[1] + h[2] * cA[2];  // m |c_A|²
-    for (int i = 0; i < 3; ++i) out.h[i] = copy.h[i] = h[i];
     for (int i = 0; i < 3; ++i)
-      for (int j = 0; j <= i; ++j) out.Io(i, j) = out.Io(j, i) = copy.Io(i, j) = copy.Io(j, i) = Io[i][j] - h[i] * cA[j] + (i == j ? mcc : 0.0);
+      for (int j = 0; j <= i; ++j) Io[i][j] = Io[i][j] - h[i] * cA[j] + (i == j ? mcc : 0.0);
+    for (int i = 0; i < 3; ++i) out.h[i] = h[i];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j <= i; ++j) out.Io(i, j) = out.Io(j, i) = Io[i][j];
+    if (!plus) {
+      for (int i = 0; i < 3; ++i) copy.h[i] = h[i];
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j <= i; ++j) copy.Io(i, j) = copy.Io(j, i) = Io[i][j];
+      return;
+    }
+    for (int i = 0; i < 3; ++i) copy.h[i] = h[i] + plus->h[i];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j <= i; ++j) copy.Io(i, j) = Io[i][j] + plus->Io(i, j), copy.Io(j, i) = Io[i][j] + plus->Io(j, i);
   }
   static Mat inertia(double m, const Pos& c, const Eigen::Matrix3d& Ic) {
     const Eigen::Matrix3d C = skew(c);

@@ -125,6 +125,30 @@ TEST_CASE("the tree kernels at a fixed body count give the dynamic ones' transfo
   CHECK(prismatic > 10);
 }
 
+TEST_CASE("a serial chain's M (crbaWorld's unwalked paths) equals the walked tree's bit for bit") {
+  // The same chain with a massless leaf on its root is a tree (the walk, the composite pass): its M
+  // has the chain's M in the top-left block (the leaf adds zeros, its column of M is zero).
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 100; ++trial) {
+    const int n = 2 + trial % 8;
+    const TreeModel<Spatial> chain = randomTree(rng, n, true);
+    if (chain.dof() != n) continue;
+    TreeModel<Spatial> tree = chain;
+    tree.addBody(0, JointType::Revolute, Pos::UnitX(), Spatial::translation(Pos(0.1, 0.2, 0.3)), Spatial::Mat::Zero());
+    const VecN q = randomConfiguration(rng, chain);
+    VecN qt(tree.nq());
+    qt << q, 0.4;
+    TreeData<Spatial> dc(chain), dt(tree);
+    worldKinematics(chain, q, dc);
+    worldKinematics(tree, qt, dt);
+    Eigen::MatrixXd Mc(n, n), Mt(n + 1, n + 1);
+    crbaWorld(chain, dc, Mc);
+    crbaWorld(tree, dt, Mt);
+    REQUIRE(Mc == Mt.topLeftCorner(n, n));
+    CHECK(Mt.col(n).isZero(0.0));
+  }
+}
+
 TEST_CASE("compose() written out sums as Eigen's 3x3 products: the same bits") {
   std::mt19937 rng(7);
   for (int trial = 0; trial < 200; ++trial) {
