@@ -72,18 +72,20 @@ void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
   }
 }
 
-// CRBA's last pass (crbaWorld, and chain_planar_in_space.h's crbaPlanar on 3-vectors): with F_j the
-// force that moving joint j alone needs (force(j) = I_c,j S_j), M_ij = S_i · F_j for every joint i on
-// the path from j to the root (parents precede their children), zero for the joints off it. Each
-// entry written once (M is symmetric): no zeroing pass first, which for a small M is a memset call.
-// A serial chain (each body's parent the one before it) has every i ≤ j on the path: its own loop,
-// without the walk, unrolls whole at a fixed n.
+// A serial chain: each body's parent the one before it (the PUMA, the pen, the unicycle's carriers).
 template <class Model>
 DYN_INLINE bool isSerialChain(const Model& model, int n) {
   bool chain = true;
   for (int i = 0; i < n; ++i) chain = chain && model.bodies[std::size_t(i)].parent == i - 1;
   return chain;
 }
+
+// CRBA's last pass (crbaWorld, and chain_planar_in_space.h's crbaPlanar on 3-vectors): with F_j the
+// force that moving joint j alone needs (force(j) = I_c,j S_j), M_ij = S_i · F_j for every joint i on
+// the path from j to the root (parents precede their children), zero for the joints off it. Each
+// entry written once (M is symmetric): no zeroing pass first, which for a small M is a memset call.
+// A serial chain has every i ≤ j on the path: its own loop, without the walk, unrolls whole at a
+// fixed n.
 template <class Alg, class Model, class Force, class MatOut>
 DYN_INLINE void fillJointSpaceInertia(const Model& model, int n, const std::vector<typename Alg::Vec>& axes, const Force& force, MatOut& M) {
   if (isSerialChain(model, n)) {
