@@ -163,7 +163,9 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // The solve at a state; without with_qdd, α_c, η and f only (θ'' left unset); without with_forces,
   // θ'' and α_c only (η and f as the solve left them: the closed rows' alone when selected).
   Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd = true, bool with_forces = true);
-  // The deepest φ (= −gap) of the open rigid unilateral contacts at q, −∞ if none is open.
+  // The deepest φ (= −gap) of the open rigid unilateral contacts at q, −∞ if none is open. Each φ as
+  // the position stage computes it: from the stage when it is at q; when every rigid contact is a joint
+  // limit, from q alone otherwise (no stage: the one in place, e.g. a located step's start, stays).
   double openDepth(const VecN& q);
   // True while a rigid unilateral contact is open; stepLocatingContacts with one open.
   bool anyOpenContact() const {
@@ -189,6 +191,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
   MechanismModel<S> model_;
   int rows_ = 0;
   std::vector<int> offsets_, row_count_;  // per constraint: its first row, its rows (Constraint::rows)
+  std::vector<int> row_owner_;            // per row: its constraint
   TreeData<S> data_;
   PlanarTreeData planar_;  // a spatial tree moving in a plane: its planar kernels' state (axis −1: none)
   MechanismKinematics<S> kin_;
@@ -216,6 +219,8 @@ class ConstrainedMechanism : public ConstrainedSystem {
   };
   std::vector<LimitRow> limit_rows_;
   bool only_limits_ = false;
+  // Every rigid contact is a joint limit: openDepth reads their φ from q (limit_rows_).
+  bool depth_from_q_ = false;
   bool selected() const { return Nr == Eigen::Dynamic && selected_; }  // never at fixed rows (a lab's)
   // The closed rows selected all lock a coordinate (J̃ row = −σ e_cᵀ, distinct c, no payload: joint limits
   // at their stops): solved by elimination (constrained_solve.h factorLocked), their c and σ here.

@@ -39,6 +39,10 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::limitRows() {
       if (const auto* limit = dynamic_cast<const JointLimit*>(model_.constraints[i].get()))
         limit_rows_[i] = {model_.tree.bodies[std::size_t(limit->joint())].q_index, limit->joint(), limit->sign(), limit->bound()};
   only_limits_ = !limit_rows_.empty() && std::all_of(limit_rows_.begin(), limit_rows_.end(), [](const LimitRow& l) { return l.coordinate >= 0; });
+  // openDepth's shortcut: every rigid contact a limit (φ from q).
+  depth_from_q_ = any_rigid_contact_;
+  for (std::size_t i = 0; i < model_.constraints.size(); ++i)
+    depth_from_q_ = depth_from_q_ && (!rigid_contact_[i] || limit_rows_[i].coordinate >= 0);
   if (!only_limits_) return;
   // The rows' constant J (JointLimit::position's entries), A empty of entries.
   J_full_.setZero(rows_, n());
@@ -184,8 +188,13 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
   // Touchdown: an open contact at or past its plane (φ = −gap ≥ 0) not moving away (−gap' ≥ 0).
   positionStage(q);
   int changes = 0;
+  bool any_closed = false;  // (after the touchdowns: the lift-off check's)
   for (std::size_t i = 0; i < count; ++i) {
-    if (!rigid(i) || !released_[i]) continue;
+    if (!rigid(i)) continue;
+    if (!released_[i]) {
+      any_closed = true;
+      continue;
+    }
     const int r = offsets_[i];
     if (!(phi_full_[r] >= 0.0)) continue;  // short of its plane (or stop)
     const double approach = J_full_.row(r).dot(v.head(n())) - (k() ? A_full_.row(r).dot(v.tail(k())) : 0.0);
@@ -193,6 +202,7 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
       released_[i] = 0;
       ++closed_version_;
       ++changes;
+      any_closed = true;
     }
   }
   // The plastic impact: the least-kinetic-energy velocity that satisfies every closed row, eq. (2) for
@@ -224,14 +234,22 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
     }
   }
   // Lift-off: while a closed contact's η would pull, open the one pulling most and solve again.
-  bool any_closed = false;
-  for (std::size_t i = 0; i < count; ++i) any_closed = any_closed || (rigid(i) && !released_[i]);
   for (std::size_t pass = 0; any_closed && pass < count; ++pass) {
-    const Solution s = evaluate(q, v, tau, nullptr, false);  // η alone
+    const Solution s = evaluate(q, v, tau, nullptr, false, false);  // η alone (compacted when selected)
     std::size_t worst = count;
     double most = 0.0;
-    for (std::size_t i = 0; i < count; ++i)
-      if (rigid(i) && !released_[i] && s.eta[offsets_[i]] < most) most = s.eta[offsets_[i]], worst = i;
+    if (selected()) {
+      // The closed rows in order (selectClosedRows): each closed contact's first row, constraint by
+      // constraint, as the loop below over η scattered to every row.
+      for (std::size_t j = 0; j < closed_rows_.size(); ++j) {
+        const int r = closed_rows_[j];
+        const std::size_t i = std::size_t(row_owner_[std::size_t(r)]);
+        if (rigid(i) && r == offsets_[i] && s.eta[Eigen::Index(j)] < most) most = s.eta[Eigen::Index(j)], worst = i;
+      }
+    } else {
+      for (std::size_t i = 0; i < count; ++i)
+        if (rigid(i) && !released_[i] && s.eta[offsets_[i]] < most) most = s.eta[offsets_[i]], worst = i;
+    }
     if (worst == count) break;
     released_[worst] = 1;
     ++closed_version_;
@@ -246,8 +264,17 @@ constexpr double kTouchdownDepth = 1e-13;
 
 template <class S, int Nj, int Nr, int Nl>
 double ConstrainedMechanism<S, Nj, Nr, Nl>::openDepth(const VecN& q) {
-  positionStage(q);
   double depth = -INFINITY;
+  if (depth_from_q_ && !(have_position_ && same(q, staged_q_))) {
+    // stagePosition's φ of a limit row, −σ (θ_c − θ_bound), with θ = q's tree part.
+    for (std::size_t i = 0; i < released_.size(); ++i)
+      if (rigid_contact_[i] && released_[i]) {
+        const LimitRow& l = limit_rows_[i];
+        depth = std::max(depth, -(l.sign * (q[l.coordinate] - l.bound)));
+      }
+    return depth;
+  }
+  positionStage(q);
   for (std::size_t i = 0; i < released_.size(); ++i)
     if (rigid_contact_[i] && released_[i]) depth = std::max(depth, phi_full_[offsets_[i]]);
   return depth;

@@ -26,6 +26,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
   for (const auto& c : model_.constraints) {
     offsets_.push_back(rows_);
     row_count_.push_back(c->rows());
+    row_owner_.insert(row_owner_.end(), std::size_t(c->rows()), int(offsets_.size()) - 1);
     rows_ += c->rows();
     // Rigid unilateral contacts start open (updateContacts closes them); compliant ones never close.
     const bool released = c->unilateral() || c->compliant();
@@ -112,24 +113,28 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   }
   // Every constraint's φ, J and A rows, then eq. (2) factored at this configuration.
   // (Joint limits alone: φ = −gap of each, JointLimit::position's φ; their J rows are constant.)
+  // (With limits alone φ as the solve sees it too, 0 on the released rows, in the same pass.)
   if (only_limits_) {
     for (std::size_t i = 0; i < limit_rows_.size(); ++i) {
       const LimitRow& l = limit_rows_[i];
-      phi_full_[offsets_[i]] = -(l.sign * (kin_.theta[l.coordinate] - l.bound));
+      const int r = offsets_[i];
+      phi_full_[r] = -(l.sign * (kin_.theta[l.coordinate] - l.bound));
+      phi_[r] = released_[i] ? 0.0 : phi_full_[r];
     }
   } else {
     setZeroAt<Nr, Nj>(J_full_, rows_, nn);
     setZeroAt<Nr, Nl>(A_full_, rows_, kk);
     for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->position(kin_, offsets_[i], phi_full_, J_full_, A_full_);
+    setFixed<Nr>(phi_, phi_full_);
   }
-  setFixed<Nr>(phi_, phi_full_);
   // Some rows released at dynamic sizes: the closed rows alone, compacted (selectClosedRows); φ = 0 on
   // the released ones.
   if (selectClosedRows()) {
     // (A one-row constraint's entry stored alone: GCC makes a loop over a few doubles a memset call.)
-    for (std::size_t i = 0; i < model_.constraints.size(); ++i)
-      if (released_[i] && row_count_[i] == 1) phi_[offsets_[i]] = 0.0;
-      else if (released_[i]) phi_.segment(offsets_[i], row_count_[i]).setZero();
+    if (!only_limits_)
+      for (std::size_t i = 0; i < model_.constraints.size(); ++i)
+        if (released_[i] && row_count_[i] == 1) phi_[offsets_[i]] = 0.0;
+        else if (released_[i]) phi_.segment(offsets_[i], row_count_[i]).setZero();
     factored_ = factorClosedRows();
     setFixed<kState>(staged_q_, q);
     have_position_ = true;

@@ -128,3 +128,54 @@ TEST_CASE("joint limits alone: their rows computed in place (J constant, the sel
     CHECK(in_place.impactLoss() == through_rows.impactLoss());
   }
 }
+
+namespace {
+// openDepth exposed: the deepest open limit's φ, from q alone where the stage is elsewhere (every rigid
+// contact a joint limit), and from the full position stage at q.
+class DepthProbe final : public model_file::SixJoints {
+ public:
+  using ConstrainedMechanism::ConstrainedMechanism;
+  bool stagedAt(const VecN& q) const { return have_position_ && same(q, staged_q_); }
+  double depth(const VecN& q) { return openDepth(q); }
+  double stagedDepth(const VecN& q) {
+    stage(q);
+    return openDepth(q);
+  }
+};
+}  // namespace
+
+// The look after each step at the open limits (stepToTouchdowns: is a stop crossed?) reads their φ from
+// q without a position stage; it must be the stage's own φ bit for bit, or a touchdown would be located
+// elsewhere (the lockstep above against ForwardedLimit, whose rows the mechanism does not recognise and
+// always stages, checks the located steps themselves).
+TEST_CASE("an open joint limit's depth from q alone is the position stage's φ, bit for bit") {
+  const model_file::LoadedModel m = model_file::load(model("puma560.urdf"));
+  DepthProbe probe(m.mechanism);
+  StepOptions o;
+  o.dt = m.timestep;
+  o.integrator = Integrator::SemiImplicitEuler;
+  o.drift.kind = Drift::Baumgarte;
+  const VecN tau = VecN::Zero(6);
+  VecN q = m.start_q, v = m.start_v;
+  int past = 0, compared = 0;
+  for (int k = 0; k < 1500; ++k) {
+    probe.updateContacts(q, v, tau);
+    REQUIRE(probe.stepLocatingContacts(o, tau, q, v));
+    if (k % 10) continue;
+    // About the step's end, with the stage at the end itself: the depth from q, then the stage's.
+    for (double d : {-0.5, -1e-7, 1e-7, 0.5}) {
+      VecN qd = q;
+      qd.array() += d;
+      probe.stage(q);
+      REQUIRE(!probe.stagedAt(qd));
+      const double from_q = probe.depth(qd);
+      REQUIRE(probe.stagedAt(q));  // the stage in place stays
+      const double staged = probe.stagedDepth(qd);
+      REQUIRE(from_q == staged);
+      past += from_q > 0.0;
+      ++compared;
+    }
+  }
+  CHECK(compared > 500);
+  CHECK(past > 50);  // configurations past a stop (the depth positive) among them
+}
