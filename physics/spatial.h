@@ -117,6 +117,16 @@ struct Planar {
     const double px = -X.r.y(), py = X.r.x();  // ẑ × r
     return {m, g.x() + m * px, g.y() + m * py, I(0, 0) + 2.0 * (g.x() * px + g.y() * py) + m * (px * px + py * py)};
   }
+  // The same, written number by number into out and its copy (CRBA's composite starts as the body's
+  // own): an Inertia copied whole is reloaded 16 bytes at a time from 8-byte stores, a store-forwarding
+  // stall (as Spatial's inertiaInParent).
+  DYN_INLINE static void inertiaInParent(const Transform& X, const Mat& I, Inertia& out, Inertia& copy) {
+    const Inertia A = inertiaInParent(X, I);
+    out.m = copy.m = A.m;
+    out.gx = copy.gx = A.gx;
+    out.gy = copy.gy = A.gy;
+    out.io = copy.io = A.io;
+  }
   // (Spatial's centre-of-mass form; planar transforms the origin form directly.)
   struct Central {};
   static Central central(const Mat&) { return {}; }
