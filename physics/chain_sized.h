@@ -136,7 +136,7 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
     const auto& b = model.bodies[std::size_t(i)];
     if (b.massless) data.I_w[i] = data.Ic_rb[i] = zero;
     else if constexpr (S::kDim == 6) S::inertiaInParent(data.X_world[i], b.central, data.I_w[i], data.Ic_rb[i]);  // from the centre of mass
-    else data.I_w[i] = data.Ic_rb[i] = S::inertiaInParent(data.X_world[i], b.inertia);
+    else S::inertiaInParent(data.X_world[i], b.inertia, data.I_w[i], data.Ic_rb[i]);  // planar: from the origin form
   }
   // Composite inertias, leaves to root: in one frame they simply add.
   for (int i = n - 1; i >= 0; --i) {

@@ -91,28 +91,43 @@ struct Planar {
   static Vec crossForce(const Vec& v, const Vec& f) {
     return {v[1] * f[2] - v[2] * f[1], -v[0] * f[2], v[0] * f[1]};
   }
-  // I v for a rigid-body inertia I = [[I_O, gᵀ], [g, m 1]]: (I_O ω + g·v_lin, g ω + m v_lin).
-  static Vec inertiaTimes(const Mat& I, const Vec& v) {
-    const double m = I(1, 1), gx = I(1, 0), gy = I(2, 0);
-    return {I(0, 0) * v[0] + gx * v[1] + gy * v[2], gx * v[0] + m * v[1], gy * v[0] + m * v[2]};
+  // A planar rigid-body inertia about a frame's origin in its 4 numbers: the other entries of
+  // I = [[I_O, gᵀ], [g, m 1]] are m again and zeros (g = m ẑ×c, c the centre of mass). CRBA's composite
+  // and world inertias are kept so: adding two of them is 4 sums, the same sums, in the same order, as
+  // the 3×3 form's entries that are read (inertiaTimes reads no others).
+  struct Inertia {
+    double m = 0, gx = 0, gy = 0, io = 0;  // m, g = (g_x, g_y), I_O
+    Inertia& operator+=(const Inertia& o) {
+      m += o.m, gx += o.gx, gy += o.gy, io += o.io;
+      return *this;
+    }
+    void setZero() { m = gx = gy = io = 0; }
+  };
+  static Inertia compact(const Mat& I) { return {I(1, 1), I(1, 0), I(2, 0), I(0, 0)}; }
+  // I v = (I_O ω + g·v_lin, g ω + m v_lin).
+  DYN_INLINE static Vec inertiaTimes(const Inertia& I, const Vec& v) {
+    return {I.io * v[0] + I.gx * v[1] + I.gy * v[2], I.gx * v[0] + I.m * v[1], I.gy * v[0] + I.m * v[2]};
   }
+  static Vec inertiaTimes(const Mat& I, const Vec& v) { return inertiaTimes(compact(I), v); }
   // Xᵀ I X: a rigid-body inertia I given in frame B, in frame A. Closed form of the product:
   // g_A = Eᵀ g + m ẑ×r, I_O,A = I_O + 2 (Eᵀ g)·(ẑ×r) + m |r|².
-  static Mat inertiaInParent(const Transform& X, const Mat& I) {
+  DYN_INLINE static Inertia inertiaInParent(const Transform& X, const Mat& I) {
     const double m = I(1, 1);
     const Pos g = rotateBack(X.E, I(1, 0), I(2, 0));
     const double px = -X.r.y(), py = X.r.x();  // ẑ × r
-    const double gx = g.x() + m * px, gy = g.y() + m * py;
-    Mat out;
-    out << I(0, 0) + 2.0 * (g.x() * px + g.y() * py) + m * (px * px + py * py), gx, gy,  //
-        gx, m, 0,                                                                    //
-        gy, 0, m;
-    return out;
+    return {m, g.x() + m * px, g.y() + m * py, I(0, 0) + 2.0 * (g.x() * px + g.y() * py) + m * (px * px + py * py)};
   }
-  // CRBA's composite inertias: planar ones are already compact.
-  using Inertia = Mat;
-  static const Mat& compact(const Mat& I) { return I; }
-  // (Spatial's centre-of-mass form; planar transforms the 3×3 form directly.)
+  // The same, written number by number into out and its copy (CRBA's composite starts as the body's
+  // own): an Inertia copied whole is reloaded 16 bytes at a time from 8-byte stores, a store-forwarding
+  // stall (as Spatial's inertiaInParent).
+  DYN_INLINE static void inertiaInParent(const Transform& X, const Mat& I, Inertia& out, Inertia& copy) {
+    const Inertia A = inertiaInParent(X, I);
+    out.m = copy.m = A.m;
+    out.gx = copy.gx = A.gx;
+    out.gy = copy.gy = A.gy;
+    out.io = copy.io = A.io;
+  }
+  // (Spatial's centre-of-mass form; planar transforms the origin form directly.)
   struct Central {};
   static Central central(const Mat&) { return {}; }
   // Rigid-body inertia at the body origin: mass m, centre of mass c, inertia Ic about c.
