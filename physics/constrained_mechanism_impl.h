@@ -131,10 +131,12 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
   // the released ones.
   if (selectClosedRows()) {
     // (A one-row constraint's entry stored alone: GCC makes a loop over a few doubles a memset call.)
-    if (!only_limits_)
-      for (std::size_t i = 0; i < model_.constraints.size(); ++i)
+    if (!only_limits_) {
+      for (std::size_t i = 0; i < model_.constraints.size(); ++i) {
         if (released_[i] && row_count_[i] == 1) phi_[offsets_[i]] = 0.0;
         else if (released_[i]) phi_.segment(offsets_[i], row_count_[i]).setZero();
+      }
+    }
     factored_ = factorClosedRows();
     setFixed<kState>(staged_q_, q);
     have_position_ = true;
