@@ -12,6 +12,7 @@
 #include <utility>
 
 #include "physics/det/det_internal.h"
+#include "physics/det/trig_kernels.h"
 
 namespace det {
 namespace {
@@ -20,65 +21,14 @@ using internal::biasedExponent;
 using internal::bits;
 using internal::DD;
 using internal::fromBits;
+using internal::cosKernel;
+using internal::kPio4;
+using internal::reduce;
+using internal::sinKernel;
 
-constexpr double kPio4 = 0.7853981633974483;
 constexpr double kPio2Hi = 1.5707963267948966, kPio2Lo = 6.123233995736766e-17;
 constexpr double kPi = 3.141592653589793, kPiLo = 1.2246467991473532e-16;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-// x = n π/2 + y0 + y1 with |y0 + y1| ≲ π/4, n returned mod 4. Exact reduction for |x| < 2^20 π/2
-// (π/2's first 33-bit part times n is exact). Larger |x| are first taken modulo the double nearest 2π
-// (fmod is exact): the same bits on every target, with an error of about |x|·4e-17 rad (dynlab's
-// angles stay far below 10^6 rad).
-int reduce(double x, double& y0, double& y1) {
-  if (!(std::abs(x) < 1647099.0)) x = std::fmod(x, 6.283185307179586);
-  constexpr double kToInt = 6755399441055744.0;  // 1.5·2^52: (v + kToInt) − kToInt rounds v to an integer
-  constexpr double kInvPio2 = 0.6366197723675814;
-  constexpr double kP1 = 1.5707963267341256, kP1t = 6.077100506506192e-11;
-  constexpr double kP2 = 6.077100506303966e-11, kP2t = 2.0222662487959506e-21;
-  constexpr double kP3 = 2.0222662487111665e-21, kP3t = 8.4784276603689e-32;
-  const double fn = (x * kInvPio2 + kToInt) - kToInt;
-  double r = x - fn * kP1, w = fn * kP1t;
-  y0 = r - w;
-  const int ex = biasedExponent(x);
-  if (ex - biasedExponent(y0) > 16) {  // cancellation: subtract π/2's second part exactly too
-    const double t = r;
-    w = fn * kP2;
-    r = t - w;
-    w = fn * kP2t - ((t - r) - w);
-    y0 = r - w;
-    if (ex - biasedExponent(y0) > 49) {  // and its third
-      const double t2 = r;
-      w = fn * kP3;
-      r = t2 - w;
-      w = fn * kP3t - ((t2 - r) - w);
-      y0 = r - w;
-    }
-  }
-  y1 = (r - y0) - w;
-  return int(static_cast<long long>(fn) & 3);  // fn is an integer below 2^21: n mod 4 without a call to fmod
-}
-
-// sin(x + y) for |x + y| ≤ π/4, y a tail below ulp(x) (used when tail is set).
-double sinKernel(double x, double y, bool tail) {
-  constexpr double S1 = -1.66666666666666324348e-01, S2 = 8.33333333332248946124e-03,
-                   S3 = -1.98412698298579493134e-04, S4 = 2.75573137070700676789e-06,
-                   S5 = -2.50507602534068634195e-08, S6 = 1.58969099521155010221e-10;
-  const double z = x * x, w = z * z, r = S2 + z * (S3 + z * S4) + z * w * (S5 + z * S6), v = z * x;
-  if (!tail) return x + v * (S1 + z * r);
-  return x - ((z * (0.5 * y - v * r) - y) - v * S1);
-}
-
-// cos(x + y) for |x + y| ≤ π/4.
-double cosKernel(double x, double y) {
-  constexpr double C1 = 4.16666666666666019037e-02, C2 = -1.38888888888741095749e-03,
-                   C3 = 2.48015872894767294178e-05, C4 = -2.75573143513906633035e-07,
-                   C5 = 2.08757232129817482790e-09, C6 = -1.13596475577881948265e-11;
-  const double z = x * x, w = z * z;
-  const double r = z * (C1 + z * (C2 + z * C3)) + w * w * (C4 + z * (C5 + z * C6));
-  const double hz = 0.5 * z, one_minus = 1.0 - hz;
-  return one_minus + (((1.0 - one_minus) - hz) + (z * r - x * y));
-}
 
 // The rational function of asin and acos: (asin(√z) − √z) / √z³ ≈ R(z), 0 ≤ z ≤ 1/4.
 double asinRational(double z) {
@@ -118,28 +68,6 @@ double cos(double x) {
     case 1: return -sinKernel(y0, y1, true);
     case 2: return -cosKernel(y0, y1);
     default: return sinKernel(y0, y1, true);
-  }
-}
-
-void sincos(double x, double& s, double& c) {
-  // As sin() and cos() each take it (the same branches, kernels and reduction), the reduction once.
-  if (std::abs(x) <= kPio4) {
-    s = std::abs(x) < 0x1p-26 ? x : sinKernel(x, 0.0, false);
-    c = std::abs(x) < 0x1p-27 ? 1.0 : cosKernel(x, 0.0);
-    return;
-  }
-  if (!std::isfinite(x)) {
-    s = c = x - x;
-    return;
-  }
-  double y0, y1;
-  const int n = reduce(x, y0, y1);
-  const double sk = sinKernel(y0, y1, true), ck = cosKernel(y0, y1);
-  switch (n) {
-    case 0: s = sk, c = ck; break;
-    case 1: s = ck, c = -sk; break;
-    case 2: s = -sk, c = -ck; break;
-    default: s = -ck, c = sk; break;
   }
 }
 
