@@ -142,6 +142,15 @@ class DepthProbe final : public model_file::SixJoints {
     return openDepth(q);
   }
 };
+
+// The file's step as `dynlab bench` takes it: semi-implicit Euler + Baumgarte at the file's time step.
+StepOptions eulerBaumgarte(const model_file::LoadedModel& m) {
+  StepOptions o;
+  o.dt = m.timestep;
+  o.integrator = Integrator::SemiImplicitEuler;
+  o.drift.kind = Drift::Baumgarte;
+  return o;
+}
 }  // namespace
 
 // The look after each step at the open limits (stepToTouchdowns: is a stop crossed?) reads their φ from
@@ -151,10 +160,7 @@ class DepthProbe final : public model_file::SixJoints {
 TEST_CASE("an open joint limit's depth from q alone is the position stage's φ, bit for bit") {
   const model_file::LoadedModel m = model_file::load(model("puma560.urdf"));
   DepthProbe probe(m.mechanism);
-  StepOptions o;
-  o.dt = m.timestep;
-  o.integrator = Integrator::SemiImplicitEuler;
-  o.drift.kind = Drift::Baumgarte;
+  const StepOptions o = eulerBaumgarte(m);
   const VecN tau = VecN::Zero(6);
   VecN q = m.start_q, v = m.start_v;
   int past = 0, compared = 0;
@@ -219,10 +225,7 @@ TEST_CASE("the position stage's look at the rigid contacts is the scan over ever
   model_file::SixJoints run(m.mechanism);
   StageProbe<model_file::SixJoints> in_place(m.mechanism);
   StageProbe<ConstrainedMechanism<Spatial>> through_rows(forwarded);
-  StepOptions o;
-  o.dt = m.timestep;
-  o.integrator = Integrator::SemiImplicitEuler;
-  o.drift.kind = Drift::Baumgarte;
+  const StepOptions o = eulerBaumgarte(m);
   const VecN tau = VecN::Zero(6);
   VecN q = m.start_q, v = m.start_v;
   const int count = int(m.mechanism.constraints.size());
