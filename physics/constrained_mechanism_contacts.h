@@ -291,11 +291,11 @@ template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::rigidContactsAtStage() {
   double depth = -INFINITY;
   bool closed = false;
-  if (any_rigid_contact_)
-    for (std::size_t i = 0; i < released_.size(); ++i)
-      if (!rigid_contact_[i]) continue;
-      else if (released_[i]) depth = std::max(depth, phi_full_[offsets_[i]]);
-      else closed = true;
+  for (std::size_t i = 0; any_rigid_contact_ && i < released_.size(); ++i) {
+    if (!rigid_contact_[i]) continue;
+    if (released_[i]) depth = std::max(depth, phi_full_[offsets_[i]]);
+    else closed = true;
+  }
   open_depth_ = depth, rigid_closed_ = closed, rigid_known_ = true;
 }
 
