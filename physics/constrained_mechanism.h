@@ -164,9 +164,10 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // θ'' and α_c only (η and f as the solve left them: the closed rows' alone when selected).
   Solution evaluate(const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd = true, bool with_forces = true);
   // The deepest φ (= −gap) of the open rigid unilateral contacts at q, −∞ if none is open. Each φ as
-  // the position stage computes it: from the stage when it is at q; when every rigid contact is a joint
-  // limit, from q alone otherwise (no stage: the one in place, e.g. a located step's start, stays).
-  double openDepth(const VecN& q);
+  // the position stage computes it: from the stage at q (made here if need be, or with `stage` always);
+  // without `stage`, when every rigid contact is a joint limit and the stage is elsewhere, from q alone
+  // (the stage in place, e.g. a located step's start, stays).
+  double openDepth(const VecN& q, bool stage = false);
   // True while a rigid unilateral contact is open; stepLocatingContacts with one open.
   bool anyOpenContact() const {
     if (!any_rigid_contact_) return false;
@@ -216,11 +217,25 @@ class ConstrainedMechanism : public ConstrainedSystem {
   struct LimitRow {
     int coordinate = -1, column = -1;
     double sign = 0, bound = 0;
+    // φ = −σ (θ_c − θ_bound), JointLimit::position's: how far past its stop, from θ (or q: its tree part
+    // first). The one definition the position stage and openDepth's shortcut share.
+    template <class Theta>
+    double phi(const Theta& theta) const {
+      return -(sign * (theta[coordinate] - bound));
+    }
   };
   std::vector<LimitRow> limit_rows_;
   bool only_limits_ = false;
-  // Every rigid contact is a joint limit: openDepth reads their φ from q (limit_rows_).
+  // Every rigid contact is a joint limit: openDepth may read their φ from q (limit_rows_).
   bool depth_from_q_ = false;
+  // What the position stage found of the rigid contacts (released_ does not change under a stage: a
+  // change invalidates it): the deepest φ of the open ones (−∞: none open) and whether any is closed.
+  // openDepth at the staged q and updateContacts' touchdown check read them. The limits alone find them
+  // in their φ pass; other kinds when first asked (rigid_known_ false: rigidContactsAtStage).
+  double open_depth_ = 0;
+  bool rigid_closed_ = false, rigid_known_ = false;
+  void rigidContactsAtStage();  // the two from the stage's phi_full_
+  void limitRowsAtStage();      // the limits' φ pass (only_limits_), the two with it
   bool selected() const { return Nr == Eigen::Dynamic && selected_; }  // never at fixed rows (a lab's)
   // The closed rows selected all lock a coordinate (J̃ row = −σ e_cᵀ, distinct c, no payload: joint limits
   // at their stops): solved by elimination (constrained_solve.h factorLocked), their c and σ here.

@@ -16,6 +16,7 @@
 
 #include "physics/constrained_mechanism.h"
 #include "physics/constraints/joint_limit.h"
+#include "physics/fixed_size_copy.h"
 
 namespace dyn {
 
@@ -48,6 +49,28 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::limitRows() {
   J_full_.setZero(rows_, n());
   A_full_.setZero(rows_, k());
   for (std::size_t i = 0; i < limit_rows_.size(); ++i) J_full_(offsets_[i], limit_rows_[i].column) = -limit_rows_[i].sign;
+}
+
+// The position stage's pass over joint limits alone (only_limits_): each row's φ (LimitRow::phi), φ as
+// the solve sees it (0 on the released rows), and the open ones' deepest φ and whether one is closed
+// (every limit is a rigid contact). Out of stagePosition's own code: the labs' fixed sizes never take it.
+template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::limitRowsAtStage() {
+  double depth = -INFINITY;
+  bool closed = false;
+  for (std::size_t i = 0; i < limit_rows_.size(); ++i) {
+    const int r = offsets_[i];
+    const double phi = limit_rows_[i].phi(kin_.theta);
+    phi_full_[r] = phi;
+    if (released_[i]) {
+      phi_[r] = 0.0;
+      depth = std::max(depth, phi);
+    } else {
+      phi_[r] = phi;
+      closed = true;
+    }
+  }
+  open_depth_ = depth, rigid_closed_ = closed, rigid_known_ = true;
 }
 
 // While some rows are released (a model file's joint limits away from their stops, contacts open),
@@ -185,11 +208,13 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
   if (!any_released_kind_) return 0;
   const std::size_t count = model_.constraints.size();
   auto rigid = [&](std::size_t i) { return rigid_contact_[i] != 0; };
-  // Touchdown: an open contact at or past its plane (φ = −gap ≥ 0) not moving away (−gap' ≥ 0).
+  // Touchdown: an open contact at or past its plane (φ = −gap ≥ 0) not moving away (−gap' ≥ 0); the
+  // stage knows whether any is (open_depth_) and whether any is closed already.
   positionStage(q);
+  if (!rigid_known_) rigidContactsAtStage();
   int changes = 0;
-  bool any_closed = false;  // (after the touchdowns: the lift-off check's)
-  for (std::size_t i = 0; i < count; ++i) {
+  bool any_closed = rigid_closed_;  // (after the touchdowns: the lift-off check's)
+  for (std::size_t i = 0; open_depth_ >= 0.0 && i < count; ++i) {
     if (!rigid(i)) continue;
     if (!released_[i]) {
       any_closed = true;
@@ -263,21 +288,29 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
 constexpr double kTouchdownDepth = 1e-13;
 
 template <class S, int Nj, int Nr, int Nl>
-double ConstrainedMechanism<S, Nj, Nr, Nl>::openDepth(const VecN& q) {
+void ConstrainedMechanism<S, Nj, Nr, Nl>::rigidContactsAtStage() {
   double depth = -INFINITY;
-  if (depth_from_q_ && !(have_position_ && same(q, staged_q_))) {
-    // stagePosition's φ of a limit row, −σ (θ_c − θ_bound), with θ = q's tree part.
+  bool closed = false;
+  for (std::size_t i = 0; any_rigid_contact_ && i < released_.size(); ++i) {
+    if (!rigid_contact_[i]) continue;
+    if (released_[i]) depth = std::max(depth, phi_full_[offsets_[i]]);
+    else closed = true;
+  }
+  open_depth_ = depth, rigid_closed_ = closed, rigid_known_ = true;
+}
+
+template <class S, int Nj, int Nr, int Nl>
+double ConstrainedMechanism<S, Nj, Nr, Nl>::openDepth(const VecN& q, bool stage) {
+  if (!stage && depth_from_q_ && !(have_position_ && same(q, staged_q_))) {
+    // The open limits' φ as stagePosition computes it (LimitRow::phi), with θ = q's tree part.
+    double depth = -INFINITY;
     for (std::size_t i = 0; i < released_.size(); ++i)
-      if (rigid_contact_[i] && released_[i]) {
-        const LimitRow& l = limit_rows_[i];
-        depth = std::max(depth, -(l.sign * (q[l.coordinate] - l.bound)));
-      }
+      if (rigid_contact_[i] && released_[i]) depth = std::max(depth, limit_rows_[i].phi(q));
     return depth;
   }
   positionStage(q);
-  for (std::size_t i = 0; i < released_.size(); ++i)
-    if (rigid_contact_[i] && released_[i]) depth = std::max(depth, phi_full_[offsets_[i]]);
-  return depth;
+  if (!rigid_known_) rigidContactsAtStage();
+  return open_depth_;
 }
 
 template <class S, int Nj, int Nr, int Nl>
@@ -288,12 +321,15 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::stepToTouchdowns(const StepOptions& o,
   // them the step ends as it lands, and the next step's updateContacts closes what it finds.
   for (int event = 0;; ++event) {
     if (!anyOpen()) return dyn::step(*this, sub, tau, q, v);
-    const VecN q0 = q, v0 = v;
+    VecN q0, v0;  // (entry by entry at a fixed state size: no memcpy calls)
+    setFixed<kState>(q0, q);
+    setFixed<kState>(v0, v);
     // The clock and the books advance with every step taken: a trial restarts them from here.
     const double t0 = time();
     const Books b0 = books();
     if (!dyn::step(*this, sub, tau, q, v)) return false;
-    if (event == 3 || !(openDepth(q) > 0.0)) return true;
+    // (The step's end staged: the next step's contact update starts from that stage.)
+    if (event == 3 || !(openDepth(q, true) > 0.0)) return true;
     // A crossing inside the step: bracket it from the start (φ < 0 there, else nothing to locate).
     double lo = 0.0, f_lo = openDepth(q0), hi = sub.dt, f_hi = openDepth(q), depth = f_hi;
     if (!(f_lo < 0.0)) return true;

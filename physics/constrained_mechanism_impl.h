@@ -112,20 +112,16 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
     kin_.payload_cs[i] = p.free[0] || psi != 0.0 ? Eigen::Vector2d(det::cos(psi), det::sin(psi)) : Eigen::Vector2d(1.0, 0.0);
   }
   // Every constraint's φ, J and A rows, then eq. (2) factored at this configuration.
-  // (Joint limits alone: φ = −gap of each, JointLimit::position's φ; their J rows are constant.)
-  // (With limits alone φ as the solve sees it too, 0 on the released rows, in the same pass.)
+  // (Joint limits alone: φ = −gap of each, JointLimit::position's φ, and the solve's φ with it, in one
+  // pass (limitRowsAtStage); their J rows are constant.)
   if (only_limits_) {
-    for (std::size_t i = 0; i < limit_rows_.size(); ++i) {
-      const LimitRow& l = limit_rows_[i];
-      const int r = offsets_[i];
-      phi_full_[r] = -(l.sign * (kin_.theta[l.coordinate] - l.bound));
-      phi_[r] = released_[i] ? 0.0 : phi_full_[r];
-    }
+    limitRowsAtStage();
   } else {
     setZeroAt<Nr, Nj>(J_full_, rows_, nn);
     setZeroAt<Nr, Nl>(A_full_, rows_, kk);
     for (std::size_t i = 0; i < model_.constraints.size(); ++i) model_.constraints[i]->position(kin_, offsets_[i], phi_full_, J_full_, A_full_);
     setFixed<Nr>(phi_, phi_full_);
+    rigid_known_ = false;  // (rigidContactsAtStage when asked)
   }
   // Some rows released at dynamic sizes: the closed rows alone, compacted (selectClosedRows); φ = 0 on
   // the released ones.

@@ -142,6 +142,15 @@ class DepthProbe final : public model_file::SixJoints {
     return openDepth(q);
   }
 };
+
+// The file's step as `dynlab bench` takes it: semi-implicit Euler + Baumgarte at the file's time step.
+StepOptions eulerBaumgarte(const model_file::LoadedModel& m) {
+  StepOptions o;
+  o.dt = m.timestep;
+  o.integrator = Integrator::SemiImplicitEuler;
+  o.drift.kind = Drift::Baumgarte;
+  return o;
+}
 }  // namespace
 
 // The look after each step at the open limits (stepToTouchdowns: is a stop crossed?) reads their φ from
@@ -151,10 +160,7 @@ class DepthProbe final : public model_file::SixJoints {
 TEST_CASE("an open joint limit's depth from q alone is the position stage's φ, bit for bit") {
   const model_file::LoadedModel m = model_file::load(model("puma560.urdf"));
   DepthProbe probe(m.mechanism);
-  StepOptions o;
-  o.dt = m.timestep;
-  o.integrator = Integrator::SemiImplicitEuler;
-  o.drift.kind = Drift::Baumgarte;
+  const StepOptions o = eulerBaumgarte(m);
   const VecN tau = VecN::Zero(6);
   VecN q = m.start_q, v = m.start_v;
   int past = 0, compared = 0;
@@ -178,4 +184,65 @@ TEST_CASE("an open joint limit's depth from q alone is the position stage's φ, 
   }
   CHECK(compared > 500);
   CHECK(past > 50);  // configurations past a stop (the depth positive) among them
+}
+
+namespace {
+// What a position stage keeps of the rigid contacts (constrained_mechanism.h open_depth_, rigid_closed_),
+// and the scan over every constraint it replaces: the deepest φ of the open ones, whether one is closed.
+template <class Base>
+class StageProbe final : public Base {
+ public:
+  using Base::Base;
+  bool stagedAt(const VecN& q) const { return this->have_position_ && this->same(q, this->staged_q_); }
+  void check(const VecN& q) {
+    this->stage(q);
+    double depth = -INFINITY;
+    bool closed = false;
+    for (std::size_t i = 0; i < this->released_.size(); ++i) {
+      if (!this->rigid_contact_[i]) continue;
+      if (this->released_[i]) depth = std::max(depth, this->phi_full_[this->offsets_[std::size_t(i)]]);
+      else closed = true;
+    }
+    REQUIRE(this->openDepth(q) == depth);  // at the staged q: the stage's
+    REQUIRE(this->stagedAt(q));
+    REQUIRE(this->open_depth_ == depth);
+    REQUIRE(this->rigid_closed_ == closed);
+    deepest = std::max(deepest, depth);
+    any_closed = any_closed || closed;
+  }
+  double deepest = -INFINITY;
+  bool any_closed = false;
+};
+}  // namespace
+
+// updateContacts looks for touchdowns only when the stage found an open contact at or past its plane,
+// and runs the lift-off check when it found one closed; both read at the stage, for the limits alone
+// (the PUMA file's rows computed in place) and for any kind (the same limits through their own rows).
+TEST_CASE("the position stage's look at the rigid contacts is the scan over every constraint, in any pattern of open and closed") {
+  const model_file::LoadedModel m = model_file::load(model("puma560.urdf"));
+  MechanismModel<Spatial> forwarded = m.mechanism;
+  for (auto& c : forwarded.constraints) c = std::make_shared<ForwardedLimit>(c);
+  model_file::SixJoints run(m.mechanism);
+  StageProbe<model_file::SixJoints> in_place(m.mechanism);
+  StageProbe<ConstrainedMechanism<Spatial>> through_rows(forwarded);
+  const StepOptions o = eulerBaumgarte(m);
+  const VecN tau = VecN::Zero(6);
+  VecN q = m.start_q, v = m.start_v;
+  const int count = int(m.mechanism.constraints.size());
+  for (int k = 0; k < 1500; ++k) {
+    run.updateContacts(q, v, tau);
+    REQUIRE(run.stepLocatingContacts(o, tau, q, v));
+    if (k % 10) continue;
+    // Closed in turns (every third constraint, shifted each time), then all open, then all closed.
+    for (int pattern = 0; pattern < 3; ++pattern)
+      for (int i = 0; i < count; ++i) {
+        const bool closed = pattern == 0 ? (k / 10 + i) % 3 == 0 : pattern == 2;
+        in_place.setClosed(i, closed);
+        through_rows.setClosed(i, closed);
+        if (i + 1 == count) in_place.check(q), through_rows.check(q);
+      }
+  }
+  CHECK(in_place.deepest > 0.0);  // past a stop among them
+  CHECK(in_place.any_closed);
+  CHECK(through_rows.deepest == in_place.deepest);
 }
