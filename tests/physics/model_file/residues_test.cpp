@@ -43,10 +43,7 @@ TEST_CASE("the loader snaps an axis' and an inertia's rounding residues to exact
         <body name="c" pos="0.3 0 0">
           <joint name="jc" type="hinge" axis="0 0 -1"/>
           <inertial pos="0.17 -0.23 0.29" mass="2.3" diaginertia="0.1 0.2 0.3"/>
-        </body>
-      </body>
-    </body>
-  </worldbody>
+  </body></body></body></worldbody>
 </mujoco>)");
   const model_file::LoadedModel m = model_file::load(file.string());
   const auto& bodies = m.mechanism.tree.bodies;
