@@ -89,8 +89,11 @@ struct TreeModel {
     Vec subspace = Vec::Zero();      // motion subspace S_i (set by addBody from joint and axis)
     // Spatial: the inertia about the centre of mass {m, c, I_c} (Spatial::Central, set by addBody).
     typename S::Central central{};
-    // Spatial: 0, 1 or 2 when the axis is that coordinate axis (set by addBody), else −1.
+    // Spatial: 0, 1 or 2 when the axis is that coordinate axis ±e_k exactly (set by addBody,
+    // markCoordinateAxis), else −1; coordinate_sign −1 for −e_k (a turn by θ about −e_k is one by −θ
+    // about e_k), else +1.
     int coordinate_axis = -1;
+    int coordinate_sign = 1;
     bool massless = false;           // zero inertia: a carrier (set by addBody)
     int q_index = 0;                 // where its coordinate sits in q (a ball's three: its quaternion's w)
     int ball = -1;                   // a ball's sub-body: index into balls
@@ -115,10 +118,15 @@ struct TreeModel {
     bodies.back().subspace = motionSubspace(int(bodies.size()) - 1);
     bodies.back().central = S::central(inertia);
     bodies.back().massless = S::massless(inertia);
-    if constexpr (S::kDim == 6)
-      for (int k = 0; k < 3; ++k)
-        if (bodies.back().axis == S::Axis::Unit(k)) bodies.back().coordinate_axis = k;
+    if constexpr (S::kDim == 6) markCoordinateAxis(bodies.back());
     return int(bodies.size()) - 1;
+  }
+  // Spatial: b.coordinate_axis and b.coordinate_sign from b.axis (exactly ±e_k, or neither: −1).
+  static void markCoordinateAxis(Body& b) {
+    b.coordinate_axis = -1, b.coordinate_sign = 1;
+    for (int k = 0; k < 3; ++k)
+      if (b.axis == S::Axis::Unit(k)) b.coordinate_axis = k;
+      else if (b.axis == -S::Axis::Unit(k)) b.coordinate_axis = k, b.coordinate_sign = -1;
   }
   // A ball joint (spatial): three bodies about the columns of R0 (`post`), the last carrying
   // `inertia`, the first placed by X_tree (which does not turn: frames are world-aligned at q0).

@@ -31,10 +31,13 @@ namespace dyn {
 // else −1. Every hinge's axis exactly +e_k (kinematics then turns about it by rows, spatial.h turnAbout,
 // leaving row k of each E exactly e_k), every placement's E with row and column k exactly e_k, every
 // slide's e_k component exactly 0, gravity without an angular part; no ball joint, at least one hinge.
+// (A hinge about −e_k is left to the 6-D path: kinematicsPlanar turns every hinge by +θ with S^w = +e_k.)
 inline int planeNormalAxis(const TreeModel<Spatial>& model) {
   int k = -1;
-  for (const auto& b : model.bodies)
+  for (const auto& b : model.bodies) {
+    if (b.joint == JointType::Revolute && b.coordinate_sign < 0) return -1;
     if (b.joint == JointType::Revolute && k < 0) k = b.coordinate_axis;
+  }
   if (k < 0 || model.gravity[0] != 0.0 || model.gravity[1] != 0.0 || model.gravity[2] != 0.0) return -1;
   for (const auto& b : model.bodies) {
     if (b.joint == JointType::Ball) return -1;
@@ -160,7 +163,7 @@ void crbaPlanar(const TreeModel<Spatial>& model, const TreeData<Spatial>& data, 
     const int p = model.bodies[std::size_t(b)].parent;
     if (p >= 0) P.Ic[p] += P.Ic[b];
   }
-  fillJointSpaceInertia<Planar>(model, n, P.S, [&](int j) { return P.Ic[j].times(P.S[j]); }, M);
+  fillJointSpaceInertia<Planar>(model, n, isSerialChain(model, n), P.S, [&](int j) { return P.Ic[j].times(P.S[j]); }, M);
 }
 
 // h = C θ' + G of a planar tree after crbaPlanar: biasForcesWorld on (ω_z; v_x, v_y), leaving

@@ -49,14 +49,16 @@ void kinematics(const TreeModel<S>& model, const VecIn& q, TreeData<S>& data) {
     if constexpr (kParentFrames) data.S_i[i] = b.subspace;
     if constexpr (S::kDim == 6) {
       // A revolute joint about a coordinate axis: X_world = X_J ∘ (X_tree ∘ X_world,parent) turns two
-      // rows, and its world axis is a row of E (spatial.h turnAbout, coordinateAxisInWorld).
+      // rows, and its world axis is a row of E (spatial.h turnAbout, coordinateAxisInWorld). About −e_k
+      // by θ is about e_k by −θ: sin negated, cos kept, the world axis negated (all exact).
       if (b.joint == JointType::Revolute && b.coordinate_axis >= 0) {
         double c, s;
         det::sincos(q[b.q_index], s, c);  // det::cos and det::sin, one reduction
+        if (b.coordinate_sign < 0) s = -s;
         const int k = b.coordinate_axis;
         if constexpr (kParentFrames) S::turnAbout(k, c, s, b.X_tree, nullptr, data.X_up[i]);
         S::turnAbout(k, c, s, b.X_tree, b.parent < 0 ? nullptr : &data.X_world[b.parent], data.X_world[i]);
-        S::coordinateAxisInWorld(k, data.X_world[i], data.S_w[i]);
+        S::coordinateAxisInWorld(k, b.coordinate_sign < 0, data.X_world[i], data.S_w[i]);
         continue;
       }
     }
@@ -84,11 +86,12 @@ DYN_INLINE bool isSerialChain(const Model& model, int n) {
 // force that moving joint j alone needs (force(j) = I_c,j S_j), M_ij = S_i · F_j for every joint i on
 // the path from j to the root (parents precede their children), zero for the joints off it. Each
 // entry written once (M is symmetric): no zeroing pass first, which for a small M is a memset call.
-// A serial chain has every i ≤ j on the path: its own loop, without the walk, unrolls whole at a
-// fixed n.
+// A serial chain (`serial`: isSerialChain, which the caller has evaluated already) has every i ≤ j on
+// the path: its own loop, without the walk, unrolls whole at a fixed n.
 template <class Alg, class Model, class Force, class MatOut>
-DYN_INLINE void fillJointSpaceInertia(const Model& model, int n, const std::vector<typename Alg::Vec>& axes, const Force& force, MatOut& M) {
-  if (isSerialChain(model, n)) {
+DYN_INLINE void fillJointSpaceInertia(const Model& model, int n, bool serial, const std::vector<typename Alg::Vec>& axes, const Force& force,
+                                      MatOut& M) {
+  if (serial) {
     for (int j = 0; j < n; ++j) {
       const typename Alg::Vec F = force(j);
       for (int i = j; i >= 0; --i) M(i, j) = M(j, i) = Alg::dot(axes[std::size_t(i)], F);
@@ -114,10 +117,11 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
   // World inertias (kept for the velocity stage), each also its composite's first term.
   typename S::Inertia zero{};
   if constexpr (S::kDim == 3) zero.setZero();
+  const bool serial = isSerialChain(model, n);
   if constexpr (S::kDim == 6) {
     // A serial chain: leaves to root, each composite I_i^w + I_c,i+1 as it is written (the same sums as
     // the pass below, without storing the body's own first and reading it back).
-    if (isSerialChain(model, n)) {
+    if (serial) {
       for (int i = n - 1; i >= 0; --i) {
         const auto& b = model.bodies[std::size_t(i)];
         const typename S::Inertia* child = i + 1 < n ? &data.Ic_rb[i + 1] : nullptr;
@@ -128,7 +132,7 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
         data.I_w[i] = data.Ic_rb[i] = zero;
         if (child) data.Ic_rb[i] += *child;
       }
-      fillJointSpaceInertia<S>(model, n, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
+      fillJointSpaceInertia<S>(model, n, serial, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
       return;
     }
   }
@@ -143,7 +147,7 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
     const int p = model.bodies[std::size_t(i)].parent;
     if (p >= 0) data.Ic_rb[p] += data.Ic_rb[i];
   }
-  fillJointSpaceInertia<S>(model, n, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
+  fillJointSpaceInertia<S>(model, n, serial, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
 }
 
 // chain_world.h biasForcesWorld: h = C θ' + G, leaving data.v_w and data.a_w.

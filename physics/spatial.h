@@ -6,6 +6,8 @@
 //   force   f_A = X^T f_B = (E^T n + r × E^T f, E^T f) — power preserved: V_B·f_B = V_A·f_A
 // The tree algorithms (chain.h) are written once against this interface.
 #pragma once
+#include <cmath>
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -328,11 +330,24 @@ struct Spatial {
     Eigen::Matrix3d Ic = Eigen::Matrix3d::Zero();
     bool diagonal = true;  // I_c diagonal in body axes (cylinders and boxes along them: most links)
   };
+  // A number this small against the unit (an axis' component) or against a body's inertia (a product
+  // of inertia against tr I_O) is a rounding residue: models state inertias and directions to a few
+  // digits, never to 1e-12 (a tilt of 1e-12 rad, 1e-12 kg m² in 1 kg m²), while the residues of a
+  // quarter turn (cos π/2 = 6e-17) or of the round trip I_c → I_O → I_c are a few ε = 2.2e-16, 10^4
+  // below it. Such residues are made exact zeros (here, and in physics/model_file's loader), so the
+  // coordinate-axis and diagonal-inertia paths take them.
+  static constexpr double kResidue = 1e-12;
   static Central central(const Mat& I) {
     Central out;
     massAndCom(I, out.m, out.c);
     // I_O = I_c + m(|c|² 1 − c cᵀ)
     out.Ic = I.block<3, 3>(0, 0) - out.m * (out.c.squaredNorm() * Eigen::Matrix3d::Identity() - out.c * out.c.transpose());
+    // The subtraction leaves products of a few ε m |c_i c_j| (≤ ε tr I_O) where I_c's were exactly 0:
+    // below kResidue tr I_O, a product is that residue.
+    const double residue = kResidue * (I(0, 0) + I(1, 1) + I(2, 2));
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (i != j && std::abs(out.Ic(i, j)) <= residue && std::abs(out.Ic(j, i)) <= residue) out.Ic(i, j) = 0.0;
     out.diagonal = out.Ic(0, 1) == 0 && out.Ic(0, 2) == 0 && out.Ic(1, 2) == 0 && out.Ic(1, 0) == 0 && out.Ic(2, 0) == 0 && out.Ic(2, 1) == 0;
     return out;
   }
@@ -452,10 +467,12 @@ struct Spatial {
       out.E(k, col) = E[k][col];
     }
   }
-  // The axis of a revolute joint about coordinate axis k of a body at X_world, in world coordinates
-  // at the origin: X⁻¹ (e_k, 0) = (E_kᵀ, r × E_kᵀ) (E_k: row k of E), into out.
-  DYN_INLINE static void coordinateAxisInWorld(int k, const Transform& X, Vec& out) {
+  // The axis of a revolute joint about coordinate axis k (−e_k when `negative`) of a body at X_world,
+  // in world coordinates at the origin: X⁻¹ (±e_k, 0) = (±E_kᵀ, r × ±E_kᵀ) (E_k: row k of E), into out.
+  DYN_INLINE static void coordinateAxisInWorld(int k, bool negative, const Transform& X, Vec& out) {
     for (int c = 0; c < 3; ++c) out[c] = X.turned ? X.E(k, c) : (c == k ? 1.0 : 0.0);
+    if (negative)
+      for (int c = 0; c < 3; ++c) out[c] = -out[c];
     cross3(X.r.data(), out.data(), out.data() + 3);
   }
   DYN_INLINE static Vec classicalAcceleration(const Vec& a, const Vec& v) {

@@ -97,9 +97,7 @@ void setBody(TreeModel<Spatial>& tree, int i, const Vec3& axis, const Spatial::M
   auto& b = tree.bodies[std::size_t(i)];
   b.axis = axis;
   b.subspace = tree.motionSubspace(i);
-  b.coordinate_axis = -1;
-  for (int k = 0; k < 3; ++k)
-    if (axis == Vec3::Unit(k)) b.coordinate_axis = k;
+  TreeModel<Spatial>::markCoordinateAxis(b);
   b.inertia = I;
   b.central = Spatial::central(I);
   b.massless = Spatial::massless(I);

@@ -104,6 +104,24 @@ void splitFrames(const std::vector<Frame>& frame, std::vector<int>& link, std::v
   for (const Frame& f : frame) link.push_back(f.link), origin.push_back(f.origin);
 }
 
+// MuJoCo's numbers at qpos0 carry the rounding of its frames' quarter turns (cos π/2 = 6e-17): a joint's
+// axis (0, −1, 2.2e-16) where the file says −e_y, a central inertia R diag(I) Rᵀ with products of
+// 1e-17 where the file's are 0. Such residues (Spatial::kResidue: below 1e-12 of the unit, of the
+// principal moments' sum) are made exact zeros, so the joint turns about a coordinate axis and the
+// body's inertia is diagonal where the file means it (a tilt or a product the file states stays).
+Vec3 snappedAxis(Vec3 a) {
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(a[k]) <= Spatial::kResidue) a[k] = 0.0;
+  return a.normalized();
+}
+Mat3 snappedProducts(Mat3 I) {
+  const double residue = Spatial::kResidue * I.trace();
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j)
+      if (i != j && std::abs(I(i, j)) <= residue) I(i, j) = 0.0;
+  return I;
+}
+
 // The trees: one body per joint, in MuJoCo's order (parents first), frames on the anchors; each body's
 // inertia, gravity and what to draw. Returns each MuJoCo body's frame.
 std::vector<Frame> readTree(const std::string& path, const mjModel* m, const mjData* d, LoadedModel& out) {
@@ -122,7 +140,7 @@ std::vector<Frame> readTree(const std::string& path, const mjModel* m, const mjD
         inertia.resize(std::size_t(mech.tree.dof()), Spatial::Mat::Zero());
         continue;
       }
-      const Vec3 o(d->xanchor + 3 * j), a = Vec3(d->xaxis + 3 * j).normalized();
+      const Vec3 o(d->xanchor + 3 * j), a = snappedAxis(Vec3(d->xaxis + 3 * j).normalized());
       const bool hinge = m->jnt_type[j] == mjJNT_HINGE;
       const double q0 = m->qpos0[m->jnt_qposadr[j]];
       // Frames world-aligned at q0: a hinge's placement undoes its turn at q0, a slide's its travel.
@@ -148,7 +166,7 @@ std::vector<Frame> readTree(const std::string& path, const mjModel* m, const mjD
     // parent; one fused into the world never moves).
     if (f.link < 0) continue;
     const RowMat3 R = Eigen::Map<const RowMat3>(d->ximat + 9 * b);
-    const Mat3 Ic = R * Vec3(m->body_inertia + 3 * b).asDiagonal() * R.transpose();
+    const Mat3 Ic = snappedProducts(R * Vec3(m->body_inertia + 3 * b).asDiagonal() * R.transpose());
     inertia[std::size_t(f.link)] += Spatial::inertia(m->body_mass[b], Vec3(d->xipos + 3 * b) - f.origin, Ic);
   }
   for (int i = 0; i < mech.tree.dof(); ++i) {
