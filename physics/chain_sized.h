@@ -190,23 +190,26 @@ DYN_INLINE void biasForcesSerial(const TreeModel<S>& model, TreeData<S>& data, c
   Vec v, a;  // the body's V_i and A_i, its parent's while the next is begun
 #pragma GCC unroll 8
   for (int i = 0; i < n; ++i) {
-    const Vec vJ = data.S_w[i] * qd[i];
+    // Entry by entry, not Eigen's assignments: at a dynamic size the unrolled loops make this function
+    // large enough that GCC stops inlining those (a call per sum, through memory).
+    Vec vJ;
+    for (int k = 0; k < S::kDim; ++k) vJ[k] = data.S_w[i][k] * qd[i];
     if (i == 0) {
-      v = vJ;
-      a.setZero();
+      for (int k = 0; k < S::kDim; ++k) v[k] = vJ[k], a[k] = 0.0;
     } else {
-      v = v + vJ;
-      a = a + S::crossMotion(v, vJ);
+      for (int k = 0; k < S::kDim; ++k) v[k] = v[k] + vJ[k];
+      const Vec c = S::crossMotion(v, vJ);
+      for (int k = 0; k < S::kDim; ++k) a[k] = a[k] + c[k];
     }
-    data.v_w[i] = v;
-    data.a_w[i] = a;
+    for (int k = 0; k < S::kDim; ++k) data.v_w[i][k] = v[k], data.a_w[i][k] = a[k];
   }
   netForces(model, data, n, f);
-  Vec F = f[n - 1];
+  Vec F;
+  for (int k = 0; k < S::kDim; ++k) F[k] = f[n - 1][k];
   h[n - 1] = S::dot(data.S_w[n - 1], F);
 #pragma GCC unroll 8
   for (int i = n - 2; i >= 0; --i) {
-    F = f[i] + F;
+    for (int k = 0; k < S::kDim; ++k) F[k] = f[i][k] + F[k];
     h[i] = S::dot(data.S_w[i], F);
   }
 }
