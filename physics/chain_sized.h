@@ -150,12 +150,81 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
   fillJointSpaceInertia<S>(model, n, serial, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
 }
 
+// Two doubles side by side (GCC's and Clang's vector extensions: SSE2 on x86-64, wasm SIMD or two
+// scalars in the page), for two bodies' arithmetic at once.
+typedef double Lanes2 __attribute__((vector_size(16)));
+
+// RNEA's net force on each massive body, f_i = I_i (A_i − g) + V_i ×* I_i V_i, from data.I_w, v_w and
+// a_w, into f[i] (zero on a massless body). Bodies go two at a time, one a lane (S::netForce: each lane
+// the bits of the scalar inertiaTimes and crossForce): the bodies' forces are independent, and the
+// 6-vectors of one body alone keep too many values live for 16 registers (spills).
+template <class S>
+DYN_INLINE void netForces(const TreeModel<S>& model, const TreeData<S>& data, int n, typename S::Vec* f) {
+  constexpr int D = S::kDim, K = S::kInertiaNumbers;
+  Lanes2 g[D];
+  for (int k = 0; k < D; ++k) g[k] = Lanes2{model.gravity[k], model.gravity[k]};
+#pragma GCC unroll 4
+  for (int i = 0; i < n; i += 2) {
+    const int j = i + 1 < n ? i + 1 : i;  // an odd count: the last body in both lanes
+    double A[K], B[K];
+    S::inertiaNumbers(data.I_w[i], A);
+    S::inertiaNumbers(data.I_w[j], B);
+    Lanes2 I[K], v[D], a[D], out[D];
+    for (int k = 0; k < K; ++k) I[k] = Lanes2{A[k], B[k]};
+    for (int k = 0; k < D; ++k) v[k] = Lanes2{data.v_w[i][k], data.v_w[j][k]}, a[k] = Lanes2{data.a_w[i][k], data.a_w[j][k]};
+    S::netForce(I, v, a, g, out);
+    for (int k = 0; k < D; ++k) f[i][k] = out[k][0], f[j][k] = out[k][1];
+    if (model.bodies[std::size_t(i)].massless) f[i].setZero();
+    if (model.bodies[std::size_t(j)].massless) f[j].setZero();
+  }
+}
+
+// biasForcesWorld on a serial chain without ball joints (the PUMA, the impedance arm): the parent's V
+// and A carried from body to body in registers (not read back from v_w, a_w), the root's V_parent = 0
+// and A = 0 without a sum, and on the way in each subtree's force summed in registers as h's dot
+// products read it (F_i = f_i + F_i+1, the sums the tree's f_p += f_i makes). The same floating-point
+// operations, in the same order, as the tree loop below: the same bits. data.f is not left at a fixed
+// size (nothing reads it after this; rnea in chain.cpp writes its own).
+template <int N, class S, class VecOut>
+DYN_INLINE void biasForcesSerial(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, VecOut& h) {
+  using Vec = typename S::Vec;
+  const int n = bodyCount<N>(model);
+  Vec local[N == Eigen::Dynamic ? 1 : N];
+  Vec* f = N == Eigen::Dynamic ? data.f.data() : local;  // each body's own net force
+  Vec v, a;  // the body's V_i and A_i, its parent's while the next is begun
+#pragma GCC unroll 8
+  for (int i = 0; i < n; ++i) {
+    // Entry by entry, not Eigen's assignments: at a dynamic size the unrolled loops make this function
+    // large enough that GCC stops inlining those (a call per sum, through memory).
+    Vec vJ;
+    for (int k = 0; k < S::kDim; ++k) vJ[k] = data.S_w[i][k] * qd[i];
+    if (i == 0) {
+      for (int k = 0; k < S::kDim; ++k) v[k] = vJ[k], a[k] = 0.0;
+    } else {
+      for (int k = 0; k < S::kDim; ++k) v[k] = v[k] + vJ[k];
+      const Vec c = S::crossMotion(v, vJ);
+      for (int k = 0; k < S::kDim; ++k) a[k] = a[k] + c[k];
+    }
+    for (int k = 0; k < S::kDim; ++k) data.v_w[i][k] = v[k], data.a_w[i][k] = a[k];
+  }
+  netForces(model, data, n, f);
+  Vec F;
+  for (int k = 0; k < S::kDim; ++k) F[k] = f[n - 1][k];
+  h[n - 1] = S::dot(data.S_w[n - 1], F);
+#pragma GCC unroll 8
+  for (int i = n - 2; i >= 0; --i) {
+    for (int k = 0; k < S::kDim; ++k) F[k] = f[i][k] + F[k];
+    h[i] = S::dot(data.S_w[i], F);
+  }
+}
+
 // chain_world.h biasForcesWorld: h = C θ' + G, leaving data.v_w and data.a_w.
 template <int N, class S, class VecOut>
 void biasForcesWorld(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, VecOut& h) {
   using Vec = typename S::Vec;
   const int n = bodyCount<N>(model);
-  // Outward: velocities, velocity-product accelerations, and each massive body's net force.
+  if (n > 0 && model.balls.empty() && isSerialChain(model, n)) return biasForcesSerial<N>(model, data, qd, h);
+  // Outward: velocities and velocity-product accelerations; then each massive body's net force.
   for (int i = 0; i < n; ++i) {
     const auto& b = model.bodies[std::size_t(i)];
     const Vec vJ = data.S_w[i] * qd[i];
@@ -166,13 +235,8 @@ void biasForcesWorld(const TreeModel<S>& model, TreeData<S>& data, const VecN& q
     if (b.joint == JointType::Ball) anchor = model.bodies[std::size_t(model.balls[std::size_t(b.ball)].first)].parent;
     const Vec c = b.parent < 0 || anchor < 0 ? Vec(Vec::Zero()) : S::crossMotion(data.v_w[anchor], vJ);
     data.a_w[i] = b.parent < 0 ? c : Vec(data.a_w[b.parent] + c);
-    if (b.massless) {
-      data.f[i].setZero();
-      continue;
-    }
-    const Vec a = data.a_w[i] - model.gravity;
-    data.f[i] = S::inertiaTimes(data.I_w[i], a) + S::crossForce(data.v_w[i], S::inertiaTimes(data.I_w[i], data.v_w[i]));
   }
+  netForces(model, data, n, data.f.data());
   // Inward: each joint carries its subtree's forces (same frame: a sum).
   for (int i = n - 1; i >= 0; --i) {
     h[i] = S::dot(data.S_w[i], data.f[i]);

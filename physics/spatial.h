@@ -111,6 +111,23 @@ struct Planar {
     return {I.io * v[0] + I.gx * v[1] + I.gy * v[2], I.gx * v[0] + I.m * v[1], I.gy * v[0] + I.m * v[2]};
   }
   static Vec inertiaTimes(const Mat& I, const Vec& v) { return inertiaTimes(compact(I), v); }
+  // RNEA's net force on a body, f = I (a − g) + v ×* (I v) (biasForcesWorld), on lanes T: double for one
+  // body, or a GCC/Clang vector of two doubles for two bodies at once. The products and sums of
+  // inertiaTimes and crossForce above, in their order, so each lane is their bits (packed SSE2/wasm
+  // products and sums round as scalar ones; -ffp-contract=off, no FMA). I: the Inertia's 4 numbers
+  // (inertiaNumbers), v, a, g: 3 each.
+  static constexpr int kInertiaNumbers = 4;
+  DYN_INLINE static void inertiaNumbers(const Inertia& I, double* out) { out[0] = I.m, out[1] = I.gx, out[2] = I.gy, out[3] = I.io; }
+  template <class T>
+  DYN_INLINE static void netForce(const T* I, const T* v, const T* a, const T* g, T* f) {
+    const T m = I[0], gx = I[1], gy = I[2], io = I[3];
+    const T x[3] = {a[0] - g[0], a[1] - g[1], a[2] - g[2]};
+    const T q[3] = {io * x[0] + gx * x[1] + gy * x[2], gx * x[0] + m * x[1], gy * x[0] + m * x[2]};
+    const T p[3] = {io * v[0] + gx * v[1] + gy * v[2], gx * v[0] + m * v[1], gy * v[0] + m * v[2]};
+    f[0] = q[0] + (v[1] * p[2] - v[2] * p[1]);
+    f[1] = q[1] + -v[0] * p[2];
+    f[2] = q[2] + v[0] * p[1];
+  }
   // Xᵀ I X: a rigid-body inertia I given in frame B, in frame A. Closed form of the product:
   // g_A = Eᵀ g + m ẑ×r, I_O,A = I_O + 2 (Eᵀ g)·(ẑ×r) + m |r|².
   DYN_INLINE static Inertia inertiaInParent(const Transform& X, const Mat& I) {
@@ -322,6 +339,45 @@ struct Spatial {
     cross3(I.h.data(), v.data(), hw);
     for (int i = 0; i < 3; ++i) out[i] += hu[i], out[3 + i] = I.m * v[3 + i] - hw[i];
     return out;
+  }
+  // RNEA's net force on a body, f = I (a − g) + v ×* (I v) (biasForcesWorld), on lanes T: double for one
+  // body, or a GCC/Clang vector of two doubles for two bodies at once. The products and sums of
+  // inertiaTimes and crossForce above, in their order, so each lane is their bits (packed SSE2/wasm
+  // products and sums round as scalar ones; -ffp-contract=off, no FMA). I: the Inertia's 13 numbers
+  // (inertiaNumbers: m, h, I_O row by row), v, a, g: 6 each.
+  static constexpr int kInertiaNumbers = 13;
+  DYN_INLINE static void inertiaNumbers(const Inertia& I, double* out) {
+    out[0] = I.m;
+    for (int i = 0; i < 3; ++i) out[1 + i] = I.h[i];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) out[4 + 3 * i + j] = I.Io(i, j);
+  }
+  template <class T>
+  DYN_INLINE static void cross3(const T* a, const T* b, T* o) {
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+  }
+  template <class T>
+  DYN_INLINE static void inertiaTimes(const T* I, const T* v, T* out) {  // inertiaTimes(Inertia, Vec)
+    T hu[3], hw[3];
+    for (int i = 0; i < 3; ++i) out[i] = I[4 + 3 * i] * v[0] + I[5 + 3 * i] * v[1] + I[6 + 3 * i] * v[2];
+    cross3(I + 1, v + 3, hu);
+    cross3(I + 1, v, hw);
+    for (int i = 0; i < 3; ++i) out[i] = out[i] + hu[i], out[3 + i] = I[0] * v[3 + i] - hw[i];
+  }
+  template <class T>
+  DYN_INLINE static void netForce(const T* I, const T* v, const T* a, const T* g, T* f) {
+    T x[6], q[6], p[6], c[6], t[3];
+    for (int k = 0; k < 6; ++k) x[k] = a[k] - g[k];
+    inertiaTimes(I, x, q);
+    inertiaTimes(I, v, p);
+    // crossForce(v, p): (ω × n + v × f, ω × f)
+    cross3(v, p, c);
+    cross3(v + 3, p + 3, t);
+    for (int i = 0; i < 3; ++i) c[i] = c[i] + t[i];
+    cross3(v, p + 3, c + 3);
+    for (int k = 0; k < 6; ++k) f[k] = q[k] + c[k];
   }
   // The same inertia about the centre of mass: mass m, centre c and I_c (body coordinates).
   struct Central {

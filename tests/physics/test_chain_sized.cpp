@@ -3,7 +3,9 @@
 // the same transforms, M and h bit for bit on random trees and serial chains with revolute joints
 // about coordinate and general axes, prismatic and ball joints, turned and plain placements, massless
 // carriers and branches; M against RNEA's columns and h against RNEA(θ, θ', 0) as an independent reference; and
-// Spatial::compose's products written out against Eigen's; det::sincos against det::sin and det::cos.
+// Spatial::compose's products written out against Eigen's; det::sincos against det::sin and det::cos;
+// h (bodies' net forces two at a time, serial chains in registers) against the one-body-at-a-time
+// world-frame RNEA written here, bit for bit.
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
@@ -109,7 +111,74 @@ void checkSized(std::mt19937& rng, int* balls, int* prismatic, bool chain = fals
   CHECK((hs - rnea(t, body, qd, VecN::Zero(N))).norm() <= 1e-12 * (1.0 + h.norm()));
 }
 
+// biasForcesWorld as it was written before its bodies went two at a time (Spatial::netForce's lanes)
+// and serial chains got their own loop: one body at a time, each net force from the Inertia's
+// inertiaTimes and crossForce, summed inward in data.f.
+template <int N>
+Eigen::Matrix<double, N, 1> biasForcesOneByOne(const TreeModel<Spatial>& model, TreeData<Spatial>& data, const VecN& qd) {
+  using Vec = Spatial::Vec;
+  Eigen::Matrix<double, N, 1> h;
+  std::vector<Vec> v(N), a(N), f(N);
+  for (int i = 0; i < N; ++i) {
+    const auto& b = model.bodies[std::size_t(i)];
+    const Vec vJ = data.S_w[i] * qd[i];
+    v[i] = b.parent < 0 ? vJ : Vec(v[b.parent] + vJ);
+    int anchor = i;
+    if (b.joint == JointType::Ball) anchor = model.bodies[std::size_t(model.balls[std::size_t(b.ball)].first)].parent;
+    const Vec c = b.parent < 0 || anchor < 0 ? Vec(Vec::Zero()) : Spatial::crossMotion(v[anchor], vJ);
+    a[i] = b.parent < 0 ? c : Vec(a[b.parent] + c);
+    if (b.massless) {
+      f[i].setZero();
+      continue;
+    }
+    const Vec acc = a[i] - model.gravity;
+    f[i] = Spatial::inertiaTimes(data.I_w[i], acc) + Spatial::crossForce(v[i], Spatial::inertiaTimes(data.I_w[i], v[i]));
+  }
+  for (int i = N - 1; i >= 0; --i) {
+    h[i] = Spatial::dot(data.S_w[i], f[i]);
+    const int p = model.bodies[std::size_t(i)].parent;
+    if (p >= 0) f[p] += f[i];
+  }
+  for (int i = 0; i < N; ++i) {
+    REQUIRE(data.v_w[i] == v[i]);
+    REQUIRE(data.a_w[i] == a[i]);
+  }
+  return h;
+}
+
+template <int N>
+void checkBiasOneByOne(std::mt19937& rng, bool chain, int* serial) {
+  const TreeModel<Spatial> t = randomTree(rng, N, chain);
+  REQUIRE(t.dof() == N);
+  *serial += t.balls.empty() && sized::isSerialChain(t, N);
+  const VecN q = randomConfiguration(rng, t);
+  VecN qd(N);
+  for (int i = 0; i < N; ++i) qd[i] = std::uniform_real_distribution<double>(-3.0, 3.0)(rng);
+  TreeData<Spatial> d(t);
+  Eigen::Matrix<double, N, N> M;
+  sized::kinematics<false, N>(t, q, d);
+  sized::crbaWorld<N>(t, d, M);
+  Eigen::Matrix<double, N, 1> h;
+  sized::biasForcesWorld<N>(t, d, qd, h);
+  REQUIRE(h == biasForcesOneByOne<N>(t, d, qd));
+  Eigen::VectorXd hd(N);
+  biasForcesWorld(t, d, qd, hd);  // the dynamic size: data.f's loop
+  REQUIRE(Eigen::VectorXd(h) == hd);
+}
+
 }  // namespace
+
+TEST_CASE("h with bodies two at a time (and a serial chain in registers) is one-body-at-a-time RNEA's, bit for bit") {
+  std::mt19937 rng(2611);
+  int serial = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    checkBiasOneByOne<1>(rng, true, &serial);
+    checkBiasOneByOne<5>(rng, trial % 2 == 0, &serial);  // odd: the last body in both lanes
+    checkBiasOneByOne<6>(rng, trial % 2 == 0, &serial);
+    checkBiasOneByOne<7>(rng, trial % 3 == 0, &serial);
+  }
+  CHECK(serial > 40);  // serial chains' own loop was taken
+}
 
 TEST_CASE("the tree kernels at a fixed body count give the dynamic ones' transforms, M and h bit for bit") {
   std::mt19937 rng(43);
