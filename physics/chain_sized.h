@@ -166,6 +166,11 @@ DYN_INLINE void netForces(const TreeModel<S>& model, const TreeData<S>& data, in
 #pragma GCC unroll 4
   for (int i = 0; i < n; i += 2) {
     const int j = i + 1 < n ? i + 1 : i;  // an odd count: the last body in both lanes
+    // Two massless carriers (the unicycle's): nothing to compute, as the loop before lanes skipped them.
+    if (model.bodies[std::size_t(i)].massless && model.bodies[std::size_t(j)].massless) {
+      f[i].setZero(), f[j].setZero();
+      continue;
+    }
     double A[K], B[K];
     S::inertiaNumbers(data.I_w[i], A);
     S::inertiaNumbers(data.I_w[j], B);
