@@ -393,6 +393,13 @@ struct Spatial {
   // below it. Such residues are made exact zeros (here, and in physics/model_file's loader), so the
   // coordinate-axis and diagonal-inertia paths take them.
   static constexpr double kResidue = 1e-12;
+  // Products of inertia at most kResidue · scale made exact zeros (scale: the inertia's trace).
+  static void snapProducts(Eigen::Matrix3d& I, double scale) {
+    const double residue = kResidue * scale;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (i != j && std::abs(I(i, j)) <= residue) I(i, j) = 0.0;
+  }
   static Central central(const Mat& I) {
     Central out;
     massAndCom(I, out.m, out.c);
@@ -400,10 +407,7 @@ struct Spatial {
     out.Ic = I.block<3, 3>(0, 0) - out.m * (out.c.squaredNorm() * Eigen::Matrix3d::Identity() - out.c * out.c.transpose());
     // The subtraction leaves products of a few ε m |c_i c_j| (≤ ε tr I_O) where I_c's were exactly 0:
     // below kResidue tr I_O, a product is that residue.
-    const double residue = kResidue * (I(0, 0) + I(1, 1) + I(2, 2));
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        if (i != j && std::abs(out.Ic(i, j)) <= residue && std::abs(out.Ic(j, i)) <= residue) out.Ic(i, j) = 0.0;
+    snapProducts(out.Ic, I(0, 0) + I(1, 1) + I(2, 2));
     out.diagonal = out.Ic(0, 1) == 0 && out.Ic(0, 2) == 0 && out.Ic(1, 2) == 0 && out.Ic(1, 0) == 0 && out.Ic(2, 0) == 0 && out.Ic(2, 1) == 0;
     return out;
   }

@@ -114,13 +114,6 @@ Vec3 snappedAxis(Vec3 a) {
     if (std::abs(a[k]) <= Spatial::kResidue) a[k] = 0.0;
   return a.normalized();
 }
-Mat3 snappedProducts(Mat3 I) {
-  const double residue = Spatial::kResidue * I.trace();
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 3; ++j)
-      if (i != j && std::abs(I(i, j)) <= residue) I(i, j) = 0.0;
-  return I;
-}
 
 // The trees: one body per joint, in MuJoCo's order (parents first), frames on the anchors; each body's
 // inertia, gravity and what to draw. Returns each MuJoCo body's frame.
@@ -166,7 +159,8 @@ std::vector<Frame> readTree(const std::string& path, const mjModel* m, const mjD
     // parent; one fused into the world never moves).
     if (f.link < 0) continue;
     const RowMat3 R = Eigen::Map<const RowMat3>(d->ximat + 9 * b);
-    const Mat3 Ic = snappedProducts(R * Vec3(m->body_inertia + 3 * b).asDiagonal() * R.transpose());
+    Mat3 Ic = R * Vec3(m->body_inertia + 3 * b).asDiagonal() * R.transpose();
+    Spatial::snapProducts(Ic, Ic.trace());
     inertia[std::size_t(f.link)] += Spatial::inertia(m->body_mass[b], Vec3(d->xipos + 3 * b) - f.origin, Ic);
   }
   for (int i = 0; i < mech.tree.dof(); ++i) {
