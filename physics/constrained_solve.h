@@ -76,19 +76,18 @@ class ConstrainedFactorT {
     const int n = this->n();
     double largest = 0;
     for (int i = 0; i < n; ++i) largest = std::max(largest, std::abs(p.M(i, i)));
-    MatRC<Nj, Nj> M = p.M;
+    bool locked[kCap] = {};
     Mcol_.resize(n, m);
     for (int r = 0; r < m; ++r) {
       const int c = coordinate[r];
       coordinate_[r] = c;
       sign_[r] = sign[r];
-      for (int i = 0; i < n; ++i) {
-        Mcol_(i, r) = p.M(i, c);  // M_Fc and M_cc for the right-hand side and η
-        M(i, c) = M(c, i) = 0.0;
-      }
-      M(c, c) = largest;
+      locked[c] = true;
+      for (int i = 0; i < n; ++i) Mcol_(i, r) = p.M(i, c);  // M_Fc and M_cc for the right-hand side and η
     }
-    return chol_M_.compute(M);
+    // M so modified, read in place: a copy of M (a block move the CPU starts slowly, of entries CRBA has
+    // just stored) costs more than the factor's few reads through the test.
+    return chol_M_.compute(LockedInertia<std::decay_t<decltype(p.M)>>{p.M, locked, largest});
   }
 
   // The solution at p's right-hand side (τ − h, J'θ', A'v_c, H'w, s, b_c + G_c), with the
@@ -177,6 +176,17 @@ class ConstrainedFactorT {
     s.f = s.eta;
     s.ok = true;
   }
+
+  // factorLocked's matrix: M with the locked coordinates' rows and columns the identity's times `largest`.
+  static constexpr int kCap = Nj == Eigen::Dynamic ? kMaxDof : (Nj > 0 ? Nj : 1);
+  template <class Mat>
+  struct LockedInertia {
+    const Mat& M;
+    const bool* locked;
+    double largest;
+    double operator()(int i, int j) const { return locked[i] || locked[j] ? (i == j ? largest : 0.0) : M(i, j); }
+    Eigen::Index rows() const { return M.rows(); }
+  };
 
   int n() const { return Nj == Eigen::Dynamic ? n_ : Nj; }
   int m() const { return Nr == Eigen::Dynamic ? m_ : Nr; }
