@@ -4,7 +4,8 @@
 // against the Schur-complement route on the same rows (factor(): Λ = J̃ M⁻¹ J̃ᵀ), on random M with
 // several locked rows of either sign, with and without a Baumgarte term and a bias J'θ'; the sign of η
 // (≥ 0: the stop pushes) where the answer is known in closed form; the fixed-size solve (six joints, as
-// the PUMA's engine) bit for bit as the bounded one; and a singular M_FF refused.
+// the PUMA's engine) bit for bit as the bounded one; the in-place factor as the factor of a modified copy;
+// and a singular M_FF refused.
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -170,4 +171,42 @@ TEST_CASE("locked coordinates: a singular M_FF is refused (the caller's pivoted 
   ConstrainedFactorT<Eigen::Dynamic, Eigen::Dynamic, Eigen::Dynamic> f;
   CHECK_FALSE(f.factorLocked(p, &two, &sign, 1));
   CHECK(f.factorLocked(p, &zero, &sign, 1));
+}
+
+TEST_CASE("locked coordinates: M_FF's factor read in place is the factor of M with the locked rows replaced, bit for bit") {
+  // factorLocked reads M through a view (no copy): the solve must be the one a Cholesky of the modified
+  // copy gives, M with each locked coordinate's row and column the identity's times M's largest diagonal entry.
+  Random r;
+  for (int n = 2; n <= 8; ++n)
+    for (int m = 1; m < n; ++m) {
+      std::vector<int> coordinate;
+      std::vector<double> sign;
+      lockRows(r, n, m, coordinate, sign);
+      const ConstrainedProblem p = lockedProblem(r, n, coordinate, sign, true);
+      ConstrainedFactorT<Eigen::Dynamic, Eigen::Dynamic, Eigen::Dynamic> f;
+      REQUIRE(f.factorLocked(p, coordinate.data(), sign.data(), m));
+      ConstrainedSolution s;
+      f.solve(p, s);
+      // The same steps written on the copy.
+      MatN M = p.M;
+      const double largest = p.M.diagonal().cwiseAbs().maxCoeff();
+      VecN x = p.tau - p.h;
+      std::vector<double> locked;
+      for (int i = 0; i < m; ++i) {
+        const int c = coordinate[std::size_t(i)];
+        locked.push_back(sign[std::size_t(i)] * (p.Jdot_qd[i] - p.stab[i]));
+        for (int j = 0; j < n; ++j) x[j] -= p.M(j, c) * locked.back();
+      }
+      for (int i = 0; i < m; ++i) {
+        const int c = coordinate[std::size_t(i)];
+        M.row(c).setZero(), M.col(c).setZero(), M(c, c) = largest;
+        x[c] = 0.0;
+      }
+      CholeskyN<> copy;
+      REQUIRE(copy.compute(M));
+      copy.solveInPlace(x);
+      for (int i = 0; i < m; ++i) x[coordinate[std::size_t(i)]] = locked[std::size_t(i)];
+      INFO("n = " << n << ", m = " << m);
+      CHECK(VecN(s.qdd) == x);
+    }
 }
