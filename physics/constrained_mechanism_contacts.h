@@ -136,7 +136,10 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::lockedCoordinates() {
 
 template <class S, int Nj, int Nr, int Nl>
 bool ConstrainedMechanism<S, Nj, Nr, Nl>::factorClosedRows() {
-  if (locked_rows_) return factor_.factorLocked(problem_, lock_coordinate_.data(), lock_sign_.data(), int(lock_coordinate_.size()));
+  // (Rows are selected, and so locked, at dynamic sizes alone: a fixed instantiation leaves the
+  // elimination out, whose n × 0 column block GCC warns about.)
+  if constexpr (Nr == Eigen::Dynamic)
+    if (locked_rows_) return factor_.factorLocked(problem_, lock_coordinate_.data(), lock_sign_.data(), int(lock_coordinate_.size()));
   return factor_.factor(problem_, problem_.J, problem_.A);
 }
 
