@@ -21,7 +21,8 @@ namespace lanes {
 // The central inertia's transform into world coordinates, on lanes T: from the transform X = {E, r}
 // (E column-major, as Eigen stores it: E(a, b) = E[a + 3 b]; `turned` false when E is the identity),
 // the centre c and I_c (column-major; only its diagonal read when `diagonal`), into h = m c_A and the
-// lower triangle of I_O (Io[i][j], j ≤ i). Each sum as the one-body code sums it, left to right.
+// lower triangle of I_O (Io[i][j], j ≤ i). Each sum as the one-body code sums it, left to right. One
+// rotation (Eᵀ I_c E, symmetric: six entries) and no cross terms in h: cheaper than turning the origin form.
 template <class T>
 DYN_INLINE void centralInWorld(const T* E, const T* r, const T& m, const T* c, const T* Ic, bool turned, bool diagonal, T* h,
                                T (&Io)[3][3]) {
