@@ -8,6 +8,7 @@
 #include "physics/chain.h"
 #include "physics/det/det.h"
 #include "physics/det/sincos.h"
+#include "physics/spatial_lanes.h"
 
 namespace dyn::sized {
 
@@ -110,37 +111,69 @@ DYN_INLINE void fillJointSpaceInertia(const Model& model, int n, bool serial, co
   }
 }
 
+// CRBA's world inertias I_i^w (kept for the velocity stage) of a 6-D tree, each also its composite's
+// first term; on a serial chain (`serial`) leaves to root, each composite I_i^w + I_c,i+1 as it is
+// written (the sums the composite pass makes, without storing the body's own and reading it back).
+// Bodies go two at a time, (i − 1, i) from the leaf end, one a lane (spatial_lanes.h: each lane the
+// one-body code's bits): a body's transform of its central inertia needs no other body's, and one
+// body's alone leaves most of the CPU's multipliers idle. A pair with a massless body (the unicycle's
+// carriers, nothing to compute) or whose bodies take different branches goes one body at a time.
+template <class S>
+DYN_INLINE void worldInertias(const TreeModel<S>& model, TreeData<S>& data, int n, bool serial) {
+  for (int b = n - 1; b >= 0; b -= 2) {
+    const int a = b - 1;  // −1: an odd count's root, alone
+    const auto& B = model.bodies[std::size_t(b)];
+    const typename S::Inertia* childB = serial && b + 1 < n ? &data.Ic_rb[b + 1] : nullptr;
+    const typename S::Inertia* childA = serial ? &data.Ic_rb[b] : nullptr;
+    if (a >= 0) {
+      const auto& A = model.bodies[std::size_t(a)];
+      Lanes2 h[3], Io[3][3];
+      if (!A.massless && !B.massless && lanes::worldInertiaPair(data.X_world[a], A.central, data.X_world[b], B.central, h, Io)) {
+        lanes::storeLane(1, B.central.m, h, Io, data.I_w[b], data.Ic_rb[b], childB);
+        lanes::storeLane(0, A.central.m, h, Io, data.I_w[a], data.Ic_rb[a], childA);
+        continue;
+      }
+    }
+    lanes::worldInertia(data.X_world[b], B.central, B.massless, data.I_w[b], data.Ic_rb[b], childB);
+    if (a >= 0) {
+      const auto& A = model.bodies[std::size_t(a)];
+      lanes::worldInertia(data.X_world[a], A.central, A.massless, data.I_w[a], data.Ic_rb[a], childA);
+    }
+  }
+}
+
+// fillJointSpaceInertia on a 6-D serial chain, two columns (j, j + 1) at a time, one a lane: their
+// forces F_j = I_c,j S_j (independent), then each S_i · F on both (spatial_lanes.h: the bits of
+// Spatial::inertiaTimes and dot in each lane); an odd count's last column alone.
+template <class S, class MatOut>
+DYN_INLINE void fillSerialInPairs(const TreeData<S>& data, int n, MatOut& M) {
+  for (int j = 0; j < n; j += 2) {
+    const int l = j + 1 < n ? j + 1 : j;
+    Lanes2 F[6];
+    lanes::forcePair(data.Ic_rb[j], data.S_w[j], data.Ic_rb[l], data.S_w[l], F);
+    for (int i = 0; i <= j; ++i) {
+      const Lanes2 d = lanes::dotPair(data.S_w[i], F);
+      M(i, j) = M(j, i) = d[0];
+      if (l != j) M(i, l) = M(l, i) = d[1];
+    }
+    if (l != j) M(l, l) = lanes::dotPair(data.S_w[l], F)[1];
+  }
+}
+
 // chain_world.h crbaWorld: M(θ) from world composite inertias, leaving data.I_w.
 template <int N, class S, class MatOut>
 void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
   const int n = bodyCount<N>(model);
-  // World inertias (kept for the velocity stage), each also its composite's first term.
-  typename S::Inertia zero{};
-  if constexpr (S::kDim == 3) zero.setZero();
   const bool serial = isSerialChain(model, n);
   if constexpr (S::kDim == 6) {
-    // A serial chain: leaves to root, each composite I_i^w + I_c,i+1 as it is written (the same sums as
-    // the pass below, without storing the body's own first and reading it back).
-    if (serial) {
-      for (int i = n - 1; i >= 0; --i) {
-        const auto& b = model.bodies[std::size_t(i)];
-        const typename S::Inertia* child = i + 1 < n ? &data.Ic_rb[i + 1] : nullptr;
-        if (!b.massless) {
-          S::inertiaInParent(data.X_world[i], b.central, data.I_w[i], data.Ic_rb[i], child);
-          continue;
-        }
-        data.I_w[i] = data.Ic_rb[i] = zero;
-        if (child) data.Ic_rb[i] += *child;
-      }
-      fillJointSpaceInertia<S>(model, n, serial, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
-      return;
+    worldInertias(model, data, n, serial);
+    if (serial) return fillSerialInPairs(data, n, M);
+  } else {
+    for (int i = 0; i < n; ++i) {
+      const auto& b = model.bodies[std::size_t(i)];
+      if (b.massless) data.I_w[i].setZero(), data.Ic_rb[i].setZero();
+      else S::inertiaInParent(data.X_world[i], b.inertia, data.I_w[i], data.Ic_rb[i]);  // planar: from the origin form
     }
-  }
-  for (int i = 0; i < n; ++i) {
-    const auto& b = model.bodies[std::size_t(i)];
-    if (b.massless) data.I_w[i] = data.Ic_rb[i] = zero;
-    else if constexpr (S::kDim == 6) S::inertiaInParent(data.X_world[i], b.central, data.I_w[i], data.Ic_rb[i]);  // from the centre of mass
-    else S::inertiaInParent(data.X_world[i], b.inertia, data.I_w[i], data.Ic_rb[i]);  // planar: from the origin form
   }
   // Composite inertias, leaves to root: in one frame they simply add.
   for (int i = n - 1; i >= 0; --i) {
@@ -149,10 +182,6 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
   }
   fillJointSpaceInertia<S>(model, n, serial, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
 }
-
-// Two doubles side by side (GCC's and Clang's vector extensions: SSE2 on x86-64, wasm SIMD or two
-// scalars in the page), for two bodies' arithmetic at once.
-typedef double Lanes2 __attribute__((vector_size(16)));
 
 // RNEA's net force on each massive body, f_i = I_i (A_i − g) + V_i ×* I_i V_i, from data.I_w, v_w and
 // a_w, into f[i] (zero on a massless body). Bodies go two at a time, one a lane (S::netForce: each lane

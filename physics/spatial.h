@@ -138,7 +138,7 @@ struct Planar {
   }
   // The same, written number by number into out and its copy (CRBA's composite starts as the body's
   // own): an Inertia copied whole is reloaded 16 bytes at a time from 8-byte stores, a store-forwarding
-  // stall (as Spatial's inertiaInParent).
+  // stall (as spatial_lanes.h storeInertia).
   DYN_INLINE static void inertiaInParent(const Transform& X, const Mat& I, Inertia& out, Inertia& copy) {
     const Inertia A = inertiaInParent(X, I);
     out.m = copy.m = A.m;
@@ -411,52 +411,7 @@ struct Spatial {
     out.diagonal = out.Ic(0, 1) == 0 && out.Ic(0, 2) == 0 && out.Ic(1, 2) == 0 && out.Ic(1, 0) == 0 && out.Ic(2, 0) == 0 && out.Ic(2, 1) == 0;
     return out;
   }
-  // Xᵀ I X from the centre-of-mass form: the centre c_A = r + Eᵀ c, the central inertia turned
-  // (Eᵀ I_c E, symmetric: six entries), then about A's origin, I_O = Eᵀ I_c E + m(|c_A|² 1 − c_A c_Aᵀ), h = m c_A:
-  // one rotation, no cross terms in h (cheaper than transforming the origin form).
-  // Written entry by entry into out and its copy (CRBA's composite starts as the body's own): an
-  // Inertia returned whole and copied is reloaded 16 bytes at a time from 8-byte stores, a
-  // store-forwarding stall. With `plus` (a serial chain's child composite), the copy is out + *plus
-  // instead, each entry summed as the composite's += sums it: the same bits without a second pass.
-  DYN_INLINE static void inertiaInParent(const Transform& X, const Central& C, Inertia& out, Inertia& copy, const Inertia* plus = nullptr) {
-    out.m = C.m;
-    copy.m = plus ? C.m + plus->m : C.m;
-    Pos cA;
-    double B[3][3], Io[3][3];  // I_c E, and the lower triangle of Eᵀ I_c E
-    if (X.turned) {
-      for (int i = 0; i < 3; ++i) cA[i] = X.r[i] + X.E(0, i) * C.c[0] + X.E(1, i) * C.c[1] + X.E(2, i) * C.c[2];
-      if (C.diagonal) {
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) B[i][j] = C.Ic(i, i) * X.E(i, j);
-      } else {
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j) B[i][j] = C.Ic(i, 0) * X.E(0, j) + C.Ic(i, 1) * X.E(1, j) + C.Ic(i, 2) * X.E(2, j);
-      }
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j <= i; ++j) Io[i][j] = X.E(0, i) * B[0][j] + X.E(1, i) * B[1][j] + X.E(2, i) * B[2][j];
-    } else {
-      for (int i = 0; i < 3; ++i) cA[i] = X.r[i] + C.c[i];
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j <= i; ++j) Io[i][j] = C.Ic(i, j);
-    }
-    double h[3];
-    for (int i = 0; i < 3; ++i) h[i] = C.m * cA[i];
-    const double mcc = h[0] * cA[0] + h[1] * cA[1] + h[2] * cA[2];  // m |c_A|²
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j <= i; ++j) Io[i][j] = Io[i][j] - h[i] * cA[j] + (i == j ? mcc : 0.0);
-    for (int i = 0; i < 3; ++i) out.h[i] = h[i];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j <= i; ++j) out.Io(i, j) = out.Io(j, i) = Io[i][j];
-    if (!plus) {
-      for (int i = 0; i < 3; ++i) copy.h[i] = h[i];
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j <= i; ++j) copy.Io(i, j) = copy.Io(j, i) = Io[i][j];
-      return;
-    }
-    for (int i = 0; i < 3; ++i) copy.h[i] = h[i] + plus->h[i];
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j <= i; ++j) copy.Io(i, j) = Io[i][j] + plus->Io(i, j), copy.Io(j, i) = Io[i][j] + plus->Io(j, i);
-  }
+  // (Xᵀ I X from this form, one body or two at a time: spatial_lanes.h centralInWorld.)
   static Mat inertia(double m, const Pos& c, const Eigen::Matrix3d& Ic) {
     const Eigen::Matrix3d C = skew(c);
     Mat I;

@@ -5,11 +5,13 @@
 // carriers and branches; M against RNEA's columns and h against RNEA(θ, θ', 0) as an independent reference; and
 // Spatial::compose's products written out against Eigen's; det::sincos against det::sin and det::cos;
 // h (bodies' net forces two at a time, serial chains in registers) against the one-body-at-a-time
-// world-frame RNEA written here, bit for bit.
+// world-frame RNEA written here, bit for bit; and M and the world inertias (two bodies and two columns
+// at a time, spatial_lanes.h) against the one-body-at-a-time CRBA written here, bit for bit.
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <random>
 #include <vector>
@@ -166,7 +168,103 @@ void checkBiasOneByOne(std::mt19937& rng, bool chain, int* serial) {
   REQUIRE(Eigen::VectorXd(h) == hd);
 }
 
+
+// crbaWorld as it was written before its bodies and columns went two at a time (spatial_lanes.h): one
+// body at a time, each world inertia from the centre-of-mass form (Spatial::inertiaInParent as it was),
+// composites summed in a pass, each column's force from Spatial::inertiaTimes, M_ij = S_i · F_j on j's
+// path, zero off it. Leaves I_w and Ic in world and composite.
+Spatial::Inertia worldInertiaOneBody(const Spatial::Transform& X, const Spatial::Central& C) {
+  Spatial::Inertia out;
+  out.m = C.m;
+  Pos cA;
+  double B[3][3], Io[3][3];
+  if (X.turned) {
+    for (int i = 0; i < 3; ++i) cA[i] = X.r[i] + X.E(0, i) * C.c[0] + X.E(1, i) * C.c[1] + X.E(2, i) * C.c[2];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        B[i][j] = C.diagonal ? C.Ic(i, i) * X.E(i, j) : C.Ic(i, 0) * X.E(0, j) + C.Ic(i, 1) * X.E(1, j) + C.Ic(i, 2) * X.E(2, j);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j <= i; ++j) Io[i][j] = X.E(0, i) * B[0][j] + X.E(1, i) * B[1][j] + X.E(2, i) * B[2][j];
+  } else {
+    for (int i = 0; i < 3; ++i) cA[i] = X.r[i] + C.c[i];
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j <= i; ++j) Io[i][j] = C.Ic(i, j);
+  }
+  for (int i = 0; i < 3; ++i) out.h[i] = C.m * cA[i];
+  const double mcc = out.h[0] * cA[0] + out.h[1] * cA[1] + out.h[2] * cA[2];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j <= i; ++j) out.Io(i, j) = out.Io(j, i) = Io[i][j] - out.h[i] * cA[j] + (i == j ? mcc : 0.0);
+  return out;
+}
+
+Eigen::MatrixXd crbaOneByOne(const TreeModel<Spatial>& model, const TreeData<Spatial>& data, std::vector<Spatial::Inertia>& world,
+                             std::vector<Spatial::Inertia>& composite) {
+  const int n = model.dof();
+  world.assign(std::size_t(n), Spatial::Inertia{});
+  for (int i = 0; i < n; ++i)
+    if (!model.bodies[std::size_t(i)].massless) world[std::size_t(i)] = worldInertiaOneBody(data.X_world[i], model.bodies[std::size_t(i)].central);
+  composite = world;
+  for (int i = n - 1; i >= 0; --i)
+    if (model.bodies[std::size_t(i)].parent >= 0) composite[std::size_t(model.bodies[std::size_t(i)].parent)] += composite[std::size_t(i)];
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
+  for (int j = 0; j < n; ++j) {
+    const Spatial::Vec F = Spatial::inertiaTimes(composite[std::size_t(j)], data.S_w[j]);
+    for (int i = j; i >= 0; i = model.bodies[std::size_t(i)].parent) M(i, j) = M(j, i) = Spatial::dot(data.S_w[i], F);
+  }
+  return M;
+}
+
+bool sameBits(const Spatial::Inertia& a, const Spatial::Inertia& b) {
+  return std::memcmp(&a.m, &b.m, sizeof(double)) == 0 && std::memcmp(a.h.data(), b.h.data(), sizeof(double) * 3) == 0 &&
+         std::memcmp(a.Io.data(), b.Io.data(), sizeof(double) * 9) == 0;
+}
+
+// A random tree or chain whose massive bodies' central inertias are made diagonal about half the time
+// (the lanes' other branch), and about a third of its bodies massless (pairs of them, and pairs of one
+// of each, are then common).
+template <int N>
+void checkCrbaOneByOne(std::mt19937& rng, bool chain, int* pairs) {
+  TreeModel<Spatial> t = randomTree(rng, N, chain);
+  REQUIRE(t.dof() == N);
+  std::uniform_int_distribution<int> coin(0, 5);
+  for (auto& b : t.bodies) {
+    const int k = coin(rng);
+    if (k <= 1) b.massless = true, b.central = Spatial::Central{};
+    else if (k <= 3 && !b.massless) b.central.Ic = Eigen::Matrix3d(b.central.Ic.diagonal().asDiagonal()), b.central.diagonal = true;
+  }
+  for (int i = 0; i + 1 < N; ++i) *pairs += !t.bodies[std::size_t(i)].massless && !t.bodies[std::size_t(i + 1)].massless;
+  const VecN q = randomConfiguration(rng, t);
+  TreeData<Spatial> d(t);
+  sized::kinematics<false, N>(t, q, d);
+  Eigen::Matrix<double, N, N> M;
+  sized::crbaWorld<N>(t, d, M);
+  std::vector<Spatial::Inertia> world, composite;
+  const Eigen::MatrixXd M1 = crbaOneByOne(t, d, world, composite);
+  REQUIRE(std::memcmp(M.data(), M1.data(), sizeof(double) * N * N) == 0);  // the signs of zeros too
+  for (int i = 0; i < N; ++i) {
+    REQUIRE(sameBits(d.I_w[i], world[std::size_t(i)]));
+    REQUIRE(sameBits(d.Ic_rb[i], composite[std::size_t(i)]));
+  }
+  Eigen::MatrixXd Md(N, N);
+  TreeData<Spatial> dd(t);
+  worldKinematics(t, q, dd);
+  crbaWorld(t, dd, Md);  // the dynamic size
+  REQUIRE(std::memcmp(Md.data(), M1.data(), sizeof(double) * N * N) == 0);
+}
 }  // namespace
+
+TEST_CASE("M with bodies' world inertias and M's columns two at a time is one-body-at-a-time CRBA's, bit for bit") {
+  std::mt19937 rng(4302);
+  int pairs = 0;
+  for (int trial = 0; trial < 80; ++trial) {
+    checkCrbaOneByOne<1>(rng, true, &pairs);
+    checkCrbaOneByOne<2>(rng, trial % 2 == 0, &pairs);
+    checkCrbaOneByOne<5>(rng, trial % 2 == 0, &pairs);  // odd: the root alone, the last column alone
+    checkCrbaOneByOne<6>(rng, trial % 2 == 0, &pairs);
+    checkCrbaOneByOne<7>(rng, trial % 3 == 0, &pairs);
+  }
+  CHECK(pairs > 200);  // massive neighbours: the lanes were taken
+}
 
 TEST_CASE("h with bodies two at a time (and a serial chain in registers) is one-body-at-a-time RNEA's, bit for bit") {
   std::mt19937 rng(2611);
