@@ -166,11 +166,10 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
   const int n = bodyCount<N>(model);
   const bool serial = isSerialChain(model, n);
   if constexpr (S::kDim == 6) {
-    worldInertias(model, data, n, serial);
-    // (Columns in pairs from four bodies on: with three, the pen's, the lanes' packing costs more than
-    // the pairs save, 0.327 -> 0.337 µs a step; scalar below, over the composites just summed.)
+    worldInertias(model, data, n, serial);  // a serial chain's composites summed with them
+    // (Columns in pairs from four bodies on: with three, the pen's, the lanes' packing cost more than
+    // the pairs saved in a harness, 0.327 -> 0.337 µs a step; the scalar fill below.)
     if (serial && n >= 4) return fillSerialInPairs(data, n, M);
-    if (serial) return fillJointSpaceInertia<S>(model, n, serial, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
   } else {
     for (int i = 0; i < n; ++i) {
       const auto& b = model.bodies[std::size_t(i)];
@@ -178,11 +177,13 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
       else S::inertiaInParent(data.X_world[i], b.inertia, data.I_w[i], data.Ic_rb[i]);  // planar: from the origin form
     }
   }
-  // Composite inertias, leaves to root: in one frame they simply add.
-  for (int i = n - 1; i >= 0; --i) {
-    const int p = model.bodies[std::size_t(i)].parent;
-    if (p >= 0) data.Ic_rb[p] += data.Ic_rb[i];
-  }
+  // Composite inertias, leaves to root: in one frame they simply add (a 6-D serial chain's are summed
+  // already, by worldInertias).
+  if (S::kDim != 6 || !serial)
+    for (int i = n - 1; i >= 0; --i) {
+      const int p = model.bodies[std::size_t(i)].parent;
+      if (p >= 0) data.Ic_rb[p] += data.Ic_rb[i];
+    }
   fillJointSpaceInertia<S>(model, n, serial, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
 }
 
