@@ -1,5 +1,5 @@
 // dynlab bench: speed is measured here, never asserted in tests.
-//   hand vs Bullet: median µs per step of each engine on the lab's default config, and the ratio,
+//   hand vs Bullet: µs per step of each engine (the median of 50-step blocks, timing.h) on the lab's default config, and the ratio,
 //     for the engine alone (advance the state one dt with the control held: the headline) and for
 //     the full simulation step (+ controller and trace row: energy, residual, constraint force);
 //   and speed with accuracy: the hand engine also with Bullet's order of method (labs/settings.h
@@ -10,6 +10,7 @@
 //   grading: CPU seconds of a full rubric grade of the lab's instructor/good.json.
 #include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -43,38 +44,14 @@ ScratchDir::~ScratchDir() {
   fs::remove_all(path_, ec);
 }
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[v.size() / 2];
-}
-
-Ratio ratio(const std::vector<double>& slow, const std::vector<double>& fast) {
-  std::vector<double> r;
-  for (std::size_t k = 0; k < slow.size() && k < fast.size(); ++k)
-    if (fast[k] > 0) r.push_back(slow[k] / fast[k]);
-  if (r.empty()) return {};
-  std::sort(r.begin(), r.end());
-  return {r[r.size() / 2], r[r.size() / 4], r[(3 * r.size()) / 4]};
-}
-
-double clockOverhead() {
-  using Micros = std::chrono::duration<double, std::micro>;
-  std::vector<double> pairs(2001);
-  for (double& p : pairs) {
-    const auto t0 = Clock::now();
-    p = Micros(Clock::now() - t0).count();
-  }
-  return median(pairs);
-}
-
 namespace {
 
-// Wall times per step, µs, less the clock reads' own cost (clockOverhead), on every engine alike.
+// Wall times per step, µs, on every engine alike (bench.h: timedRun, timedEach).
 struct StepTimes {
-  double full = 0;    // median Simulation::step: controller, trace row, engine
-  double engine = 0;  // median Simulation::advanceEngine after each (untimed) step: the engine alone
+  double full = 0;    // Simulation::step (controller, trace row, engine): the median block's
+  double engine = 0;  // Simulation::advanceEngine after each (untimed) step, the engine alone: the median block's
   bool has_engine = false;
-  std::vector<double> full_blocks, engine_blocks;  // the same medians, block by block
+  std::vector<double> full_blocks, engine_blocks;  // each block's µs per step
 };
 
 // The runs compared, timed in turn in short blocks (hand, Bullet, hand, ... 50 steps each): this
@@ -92,44 +69,45 @@ constexpr int kBlock = 50;
 // no controller), its times as out's last entry.
 std::vector<StepTimes> stepMicros(const std::vector<TimedRun>& runs, int steps, MujocoRun& mujoco) {
   const std::size_t count = runs.size();
-  std::vector<double> mj_all;
   StepTimes mj;
-  auto mujocoBlock = [&](double clock, std::vector<double>& blocks) {
-    if (mujoco.timed()) blocks.push_back(timedBlock(kBlock, clock, mj_all, [] { return true; }, [&] { return mujoco.step(); }));
+  auto mujocoBlock = [&](std::vector<double>& blocks) {
+    if (mujoco.timed()) blocks.push_back(timedRun(kBlock, [&] { return mujoco.step(); }));
   };
   std::vector<double> row;
   std::vector<StepTimes> out(count);
-  std::vector<std::vector<double>> full(count), alone(count);
   const double clock = clockOverhead();
   std::vector<std::unique_ptr<Simulation>> sims;
   auto restart = [&](std::size_t i) { sims[i] = runs[i].lab->simulate(runs[i].engine); };
   for (const TimedRun& r : runs) sims.push_back(r.lab->simulate(r.engine));
-  // One block of run i: the full step, or the engine alone every other step with the torque of the
-  // step before held (500 Hz control). Short runs wrap around.
-  auto block = [&](std::size_t i, bool engine_alone, std::vector<double>& all) {
+  // One block of run i: full steps back to back, or the engine alone every other step with the torque
+  // of the step before held (500 Hz control). Short runs wrap around.
+  auto block = [&](std::size_t i, bool engine_alone) {
     if (engine_alone)  // the step untimed (a failed one restarts the run), then the engine alone timed
-      return timedBlock(kBlock, clock, all, [&] { return sims[i]->step(row) || (restart(i), false); },
-                        [&] { return sims[i]->advanceEngine(); });
-    return timedBlock(kBlock, clock, all, [] { return true; }, [&] { return sims[i]->step(row) || (restart(i), false); });
+      return timedEach(kBlock, clock, [&] { return sims[i]->step(row) || (restart(i), false); },
+                       [&] { return sims[i]->advanceEngine(); });
+    return timedRun(kBlock, [&] { return sims[i]->step(row) || (restart(i), false); });
   };
   const int rounds = std::max(1, steps / kBlock);
   for (int r = 0; r < rounds; ++r) {
-    for (std::size_t i = 0; i < count; ++i) out[i].full_blocks.push_back(block(i, false, full[i]));
-    mujocoBlock(clock, mj.full_blocks);
+    for (std::size_t i = 0; i < count; ++i) out[i].full_blocks.push_back(block(i, false));
+    mujocoBlock(mj.full_blocks);
   }
   for (std::size_t i = 0; i < count; ++i) restart(i);
   if (mujoco.timed()) mujoco.restart();
   for (int r = 0; r < rounds; ++r) {
-    for (std::size_t i = 0; i < count; ++i) out[i].engine_blocks.push_back(block(i, true, alone[i]));
-    mujocoBlock(clock, mj.engine_blocks);
+    for (std::size_t i = 0; i < count; ++i) out[i].engine_blocks.push_back(block(i, true));
+    mujocoBlock(mj.engine_blocks);
   }
-  for (std::size_t i = 0; i < count; ++i) {
-    out[i].full = median(full[i]);
-    out[i].engine = median(alone[i]);
-    out[i].has_engine = !alone[i].empty();
+  auto any = [](const std::vector<double>& v) { return std::any_of(v.begin(), v.end(), [](double x) { return !std::isnan(x); }); };
+  for (StepTimes& t : out) {
+    t.full = median(t.full_blocks);
+    t.engine = median(t.engine_blocks);
+    t.has_engine = any(t.engine_blocks);
   }
   if (mujoco.timed()) {
-    mj.full = mj.engine = median(mj_all);
+    std::vector<double> both = mj.full_blocks;
+    both.insert(both.end(), mj.engine_blocks.begin(), mj.engine_blocks.end());
+    mj.full = mj.engine = median(both);
     mj.has_engine = true;
     out.push_back(mj);
   }
@@ -313,9 +291,9 @@ int bench(const BenchArgs& a) {
     } else {
       std::printf("%s\n", entry.name.c_str());
       if (alone)
-        std::printf("  engine step     hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median; advance one dt, control held)\n",
+        std::printf("  engine step     hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median block of 50; advance one dt, control held)\n",
                     hand, bullet, speedup.median);
-      std::printf("  full step       hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median; + controller, trace row)\n",
+      std::printf("  full step       hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median block of 50; + controller, trace row)\n",
                   hand_t.full, bullet_t.full, speedup_full.median);
       std::printf("  speed and error of whole runs against the reference (hand, %s, dt %g s):\n", scheme.c_str(), lab.dt());
       std::printf("    hand   %-34s %6.2f µs   reference\n", scheme.c_str(), hand);

@@ -1,7 +1,7 @@
 // dynlab bench FILE: a mechanism from a model file, timed as app/cli/bench/bench.cpp times labs. Passive from the
 // file's pose at rest, at the file's time step, four engines in turn in blocks of 50 steps (the
 // clock's speed wanders within milliseconds: engines timed one after the other catch different
-// phases), each step timed alone less the clock's own cost:
+// phases), each block's steps timed together (bench.h timedRun: the clock ticks every ~10 ns):
 //   hand   semi-implicit Euler + Baumgarte  (first order: Bullet's and MuJoCo's order; the headline)
 //   hand   RK4 + projection                 (dynlab model's run: the reference for accuracy)
 //   Bullet btMultiBody, semi-implicit Euler  (physics/bullet)
@@ -38,7 +38,6 @@
 namespace dyn::app {
 namespace {
 
-using Clock = std::chrono::steady_clock;
 constexpr int kBlock = 50;
 constexpr double kAccuracyRun = 2.0;  // s: each engine's run from the file's pose, against the hand RK4 run
 
@@ -48,8 +47,7 @@ struct Engine {
   std::function<bool()> step;
   std::function<void()> restart;
   std::function<void(VecN&, VecN&)> state;
-  std::vector<double> blocks;  // median µs per step of each block
-  std::vector<double> all;     // every step's µs
+  std::vector<double> blocks;  // µs per step of each block (bench.h timedRun: NaN for a block left out)
 };
 
 // The engines from the file's pose at rest.
@@ -168,11 +166,14 @@ void build(const model_file::LoadedModel& m, double dt, bool beside, Engines& e)
 // Every engine's steps timed in blocks, in turn; a run that fails (or leaves the finite numbers)
 // starts again from the file's pose.
 void timeBlocks(std::vector<Engine>& engines, int steps) {
-  const double clock = clockOverhead();
   const int rounds = std::max(1, steps / kBlock);
   for (int r = 0; r < rounds; ++r)
-    for (Engine& e : engines)
-      e.blocks.push_back(timedBlock(kBlock, clock, e.all, [] { return true; }, [&] { return e.step() || (e.restart(), false); }));
+    for (Engine& e : engines) e.blocks.push_back(timedRun(kBlock, [&] { return e.step() || (e.restart(), false); }));
+}
+
+// Steps in the blocks that counted.
+int stepsTimed(const Engine& e) {
+  return kBlock * int(std::count_if(e.blocks.begin(), e.blocks.end(), [](double x) { return !std::isnan(x); }));
 }
 
 // Accuracy over `steps` steps from the file's pose: the largest |φ|∞ (the description's, at each
@@ -264,7 +265,7 @@ int benchModel(const BenchArgs& a) {
       const Ratio r = ratio(list[i].blocks, euler.blocks);
       out["engines"].push_back({{"engine", list[i].name},
                                 {"scheme", list[i].scheme},
-                                {"us_per_step", median(list[i].all)},
+                                {"us_per_step", median(list[i].blocks)},
                                 {"over_hand_first_order", r.median},
                                 {"over_hand_first_order_quartiles", {r.low, r.high}},
                                 {"max_closure_residual", acc[i].residual},
@@ -289,7 +290,7 @@ int benchModel(const BenchArgs& a) {
                 "(|λ| dt %.3g, joint '%s'): their hand RK4 costs %d times the row below\n",
                 sub, fastest.rate * dt, termName(fastest.joint).c_str(), sub);
   if (!beside.empty()) std::printf("  %s\n", termName(mujoco_left_out, 1000).c_str());
-  std::printf("  %d steps per engine timed in blocks of %d, in turn; ratios block by block: median (middle half)\n", int(euler.all.size()), kBlock);
+  std::printf("  %d steps per engine timed in blocks of %d, in turn; ratios block by block: median (middle half)\n", stepsTimed(euler), kBlock);
   std::printf("  engine             µs/step   over hand, 1st order   max |φ|∞     max |q − q_ref|∞ over 2 s (ref: hand RK4)\n");
   for (std::size_t i = 0; i < list.size(); ++i) {
     const Engine& e = list[i];
@@ -298,7 +299,7 @@ int benchModel(const BenchArgs& a) {
     if (i == 0) std::snprintf(text, sizeof text, "1x");
     else std::snprintf(text, sizeof text, "%.1fx (%.1f-%.1f)", r.median, r.low, r.high);
     const std::string label = e.name + (i == 0 ? ", Euler" : i == 1 ? ", RK4" : "");
-    std::printf("  %-16s %9.2f   %-22s %-12.2g %.2g%s\n", label.c_str(), median(e.all), text, acc[i].residual, acc[i].error,
+    std::printf("  %-16s %9.2f   %-22s %-12.2g %.2g%s\n", label.c_str(), median(e.blocks), text, acc[i].residual, acc[i].error,
                 acc[i].complete ? "" : " (the 2 s run stopped: non-finite state)");
   }
   // A residual whose rows' velocity form is the larger share (Bullet's gear row on the 2F-85): the positions' own.

@@ -9,7 +9,7 @@
 //     hand ABA               positionKinematics, velocityKinematics, aba: O(N)
 //     hand CRBA + Cholesky   rnea (θ'' = 0), crba, Eigen LLT: O(N²) to form M, O(N³) to factor it
 //     Bullet btMultiBody     physics/bullet/bullet_chain.h (Featherstone's ABA inside Bullet)
-//   Median µs per step over at least kMinSteps steps and kBudget seconds each (fewer steps for the
+//   Mean µs per step (outliers left out) over at least kMinSteps steps and kBudget seconds each (fewer steps for the
 //   slowest: the CRBA at N = 1,000 takes tenths of a second a step).
 //   Agreement: the tip after 0.5 s, hand ABA against Bullet and against the CRBA route, from the same
 //   state with the same scheme: what is left is rounding (and, later in a run, its growth: a falling
@@ -113,8 +113,9 @@ std::unique_ptr<Stepper> makeStepper(Engine e, const TreeModel<Planar>& tree) {
   return std::make_unique<HandStepper>(tree, e == kCrba);
 }
 
-// Median µs per step from the outstretched start, each step timed alone (less the clock's own cost).
-double medianStepMicros(Engine e, const TreeModel<Planar>& tree, double clock_us, int& steps) {
+// µs per step from the outstretched start, each step timed alone (less the clock's own cost): their
+// mean without outliers (bench.h timedEach: a median would stick to the clock's ~10 ns ticks).
+double stepMicros(Engine e, const TreeModel<Planar>& tree, double clock_us, int& steps) {
   using Micros = std::chrono::duration<double, std::micro>;
   auto s = makeStepper(e, tree);
   std::vector<double> t;
@@ -126,7 +127,7 @@ double medianStepMicros(Engine e, const TreeModel<Planar>& tree, double clock_us
     t.push_back(Micros(Clock::now() - t0).count() - clock_us);
   }
   steps = int(t.size());
-  return median(std::move(t));
+  return meanWithoutOutliers(t);
 }
 
 // The tip after kAgreeTime s.
@@ -181,7 +182,7 @@ Image drawFigure(const std::vector<Row>& rows, int width, int height) {
     plcol0(kAxis);
     plbox("bcnlst", 0, 0, "bcnlstv", 0, 0);
     plcol0(kInk);
-    pllab("links N", "µs per step (median)", "");
+    pllab("links N", "µs per step (mean)", "");
     plmtex("t", 1.5, 0.5, 0.5, "Step cost of an open planar chain, dt = 1 ms, first order");
     // Guides through the ABA line's first point (∝ N) and the CRBA line's last point (∝ N³).
     const double gx[2] = {xlo, xhi};
@@ -268,7 +269,7 @@ int benchScaling(const BenchArgs& a) {
     Row r;
     r.n = n;
     for (int e = 0; e < kEngines; ++e) {
-      r.us[e] = medianStepMicros(Engine(e), tree, clock_us, r.steps[e]);
+      r.us[e] = stepMicros(Engine(e), tree, clock_us, r.steps[e]);
       progress.set(rows.size() * (kEngines + 1) + std::size_t(e) + 1);
     }
     const Eigen::Vector2d tip = tipAfter(kAba, tree);
@@ -302,7 +303,7 @@ int benchScaling(const BenchArgs& a) {
     return 0;
   }
   std::printf("Step cost of an open planar chain: 0.30 m, 1 kg uniform links, falling from outstretched with τ = 0;\n"
-              "dt = 1 ms, semi-implicit Euler in all three; median µs per step. tip: |Δ tip position| after %.1f s\n"
+              "dt = 1 ms, semi-implicit Euler in all three; mean µs per step. tip: |Δ tip position| after %.1f s\n"
               "between the hand ABA run and the Bullet (or CRBA) run from the same start.\n\n",
               kAgreeTime);
   std::printf("%6s  %18s  %26s  %18s  %10s  %10s  %12s  %12s\n", "links", "hand ABA", "hand CRBA + Cholesky",

@@ -1,0 +1,62 @@
+// The bench's clock work (app/cli/bench/): step times in blocks, their medians and ratios. Nothing
+// here asserts a speed; tests/app/bench_timing_test.cpp checks the statistics on made-up readings.
+#pragma once
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+namespace dyn::app {
+
+// The middle value (0 for none); NaN entries (blocks left out, timedRun) are skipped.
+double median(std::vector<double> v);
+// The clock reads' cost (µs) as a call timed alone sees it, subtracted from each such call (timedEach):
+// a sub-microsecond step is not charged the timer's own ~11 ns.
+double clockOverhead();
+// How many times slower `slow` is than `fast`, block by block (timed side by side): the median, and
+// the middle half of the blocks' ratios (how much the measurement itself moves). Pairs with a NaN
+// block are skipped.
+struct Ratio {
+  double median = 0, low = 0, high = 0;  // median, 25th and 75th percentiles
+};
+Ratio ratio(const std::vector<double>& slow, const std::vector<double>& fast);
+
+// The two timing loops of every bench, each giving one block's µs per call.
+// The clock here ticks every ~10 ns: a 0.3 µs step timed alone reads 0.30 or 0.31 µs, and a median of
+// such readings sticks to one tick (3 % of a ratio at that size). So a block is never summarised by
+// its median call:
+//  * timedRun: the calls back to back, timed together with one pair of clock reads (the tick and
+//    the reads' cost spread over the block). NaN (the block left out) when a call failed: its
+//    restart would be timed with the steps.
+//  * timedEach: where untimed work must run between the calls (before(), skipping the call when
+//    false), each call timed alone, less the reads' cost `clock` (clockOverhead), and the block's
+//    mean taken: a tick's phase is random, so the mean of many readings is not stuck to ticks.
+//    Calls that took over twice the block's median are left out of the mean (an interrupt or a
+//    preemption, not the step). timed() returns true when its call counts. NaN when none counted.
+template <class Timed>
+double timedRun(int calls, Timed&& timed) {
+  using Clock = std::chrono::steady_clock;
+  bool all = true;
+  const auto t0 = Clock::now();
+  for (int k = 0; k < calls; ++k) all = timed() && all;
+  const double t = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
+  return all && calls > 0 ? t / calls : std::nan("");
+}
+// The mean of the readings within twice their median, plus two ticks (NaN for none).
+double meanWithoutOutliers(const std::vector<double>& readings);
+template <class Before, class Timed>
+double timedEach(int calls, double clock, Before&& before, Timed&& timed) {
+  using Clock = std::chrono::steady_clock;
+  using Micros = std::chrono::duration<double, std::micro>;
+  std::vector<double> times;
+  times.reserve(std::size_t(calls));
+  for (int k = 0; k < calls; ++k) {
+    if (!before()) continue;
+    const auto t0 = Clock::now();
+    const bool counted = timed();
+    const double t = Micros(Clock::now() - t0).count() - clock;
+    if (counted) times.push_back(t);
+  }
+  return meanWithoutOutliers(times);
+}
+
+}  // namespace dyn::app
