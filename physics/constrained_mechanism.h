@@ -236,6 +236,11 @@ class ConstrainedMechanism : public ConstrainedSystem {
   double open_depth_ = 0;
   bool rigid_closed_ = false, rigid_known_ = false;
   void rigidContactsAtStage();  // the two from the stage's phi_full_
+  // The position stage at q with the two known (updateContacts' touchdown check, openDepth).
+  void stagedContacts(const VecN& q) {
+    positionStage(q);
+    if (!rigid_known_) rigidContactsAtStage();
+  }
   void limitRowsAtStage();      // the limits' φ pass (only_limits_), the two with it
   bool selected() const { return Nr == Eigen::Dynamic && selected_; }  // never at fixed rows (a lab's)
   // The closed rows selected all lock a coordinate (J̃ row = −σ e_cᵀ, distinct c, no payload: joint limits
