@@ -20,6 +20,7 @@
 
 #include "labs/lab.h"
 #include "physics/constrained_mechanism.h"
+#include "physics/fixed_size_copy.h"
 #include "physics/bullet/bullet_mechanism.h"
 
 namespace dyn {
@@ -52,7 +53,12 @@ class HandEngine final : public MechanismEngine {
  public:
   HandEngine(M& mech, const StepOptions& options, VecN q0, VecN v0)
       : mech_(mech), options_(options), q_(std::move(q0)), v_(std::move(v0)), forces_(mech.model().constraints.size()) {}
-  void state(VecN& q, VecN& v) const override { q = q_, v = v_; }
+  // Entry by entry at the mechanism's fixed state size (the bench's engine-alone step ends with this
+  // copy): Eigen's copy of a bounded vector loops with size tests.
+  void state(VecN& q, VecN& v) const override {
+    setFixed<M::kState>(q, q_);
+    setFixed<M::kState>(v, v_);
+  }
   bool step(const VecN& tau, bool with_forces) override {
     // Unilateral contacts close (with an impact on v) or open at the step's start ...
     mech_.updateContacts(q_, v_, tau);

@@ -28,6 +28,9 @@ class ConstrainedMechanism : public ConstrainedSystem {
   using Solution = ConstrainedSolutionT<Nj, Nr, Nl>;
   using Vec = typename S::Vec;
   using Pos = typename S::Pos;
+  // The state's size when the instantiation fixes it (n + k), else Dynamic: copies of q and v at that
+  // size unroll (fixed_size_copy.h setFixed), here and in the engines that hold a state.
+  static constexpr int kState = Nj == Eigen::Dynamic || Nl == Eigen::Dynamic ? Eigen::Dynamic : Nj + Nl;
 
   // Throws std::invalid_argument when the description does not validate or does not fit the sizes.
   explicit ConstrainedMechanism(MechanismModel<S> model);
@@ -143,8 +146,6 @@ class ConstrainedMechanism : public ConstrainedSystem {
   void positionStage(const VecN& q) {
     if (!have_position_ || !same(q, staged_q_)) stagePosition(q);
   }
-  // The state's size when the instantiation fixes it (n + k), else Dynamic.
-  static constexpr int kState = Nj == Eigen::Dynamic || Nl == Eigen::Dynamic ? Eigen::Dynamic : Nj + Nl;
   // a == b (sizes too), entry by entry as Eigen's ==; unrolled at fixed sizes: the stages' cache checks
   // run several times a step, and Eigen's loop over a bounded size costs more than the comparison.
   static bool same(const VecN& a, const VecN& b) {
@@ -235,6 +236,11 @@ class ConstrainedMechanism : public ConstrainedSystem {
   double open_depth_ = 0;
   bool rigid_closed_ = false, rigid_known_ = false;
   void rigidContactsAtStage();  // the two from the stage's phi_full_
+  // The position stage at q with the two known (updateContacts' touchdown check, openDepth).
+  void stagedContacts(const VecN& q) {
+    positionStage(q);
+    if (!rigid_known_) rigidContactsAtStage();
+  }
   void limitRowsAtStage();      // the limits' φ pass (only_limits_), the two with it
   bool selected() const { return Nr == Eigen::Dynamic && selected_; }  // never at fixed rows (a lab's)
   // The closed rows selected all lock a coordinate (J̃ row = −σ e_cᵀ, distinct c, no payload: joint limits

@@ -213,8 +213,7 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
   auto rigid = [&](std::size_t i) { return rigid_contact_[i] != 0; };
   // Touchdown: an open contact at or past its plane (φ = −gap ≥ 0) not moving away (−gap' ≥ 0); the
   // stage knows whether any is (open_depth_) and whether any is closed already.
-  positionStage(q);
-  if (!rigid_known_) rigidContactsAtStage();
+  stagedContacts(q);
   int changes = 0;
   bool any_closed = rigid_closed_;  // (after the touchdowns: the lift-off check's)
   for (std::size_t i = 0; open_depth_ >= 0.0 && i < count; ++i) {
@@ -311,8 +310,7 @@ double ConstrainedMechanism<S, Nj, Nr, Nl>::openDepth(const VecN& q, bool stage)
       if (rigid_contact_[i] && released_[i]) depth = std::max(depth, limit_rows_[i].phi(q));
     return depth;
   }
-  positionStage(q);
-  if (!rigid_known_) rigidContactsAtStage();
+  stagedContacts(q);
   return open_depth_;
 }
 
