@@ -6,7 +6,8 @@
 // Spatial::compose's products written out against Eigen's; det::sincos against det::sin and det::cos;
 // h (bodies' net forces two at a time, serial chains in registers) against the one-body-at-a-time
 // world-frame RNEA written here, bit for bit; and M and the world inertias (two bodies and two columns
-// at a time, spatial_lanes.h) against the one-body-at-a-time CRBA written here, bit for bit.
+// at a time, spatial_lanes.h) against the one-body-at-a-time CRBA written here, bit for bit (an unturned
+// pair's too, after the stack is dirtied: no lane read unloaded).
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
@@ -252,6 +253,36 @@ void checkCrbaOneByOne(std::mt19937& rng, bool chain, int* pairs) {
   REQUIRE(std::memcmp(Md.data(), M1.data(), sizeof(double) * N * N) == 0);
 }
 }  // namespace
+
+// Stack memory below the caller filled with a non-zero pattern: a kernel called next that reads a lane
+// it never wrote reads this, not a lucky zero.
+[[gnu::noinline]] void dirtyStack() {
+  volatile double junk[2048];
+  for (int i = 0; i < 2048; ++i) junk[i] = 0.5 + i;
+}
+
+TEST_CASE("an untransformed pair's world inertias (both in the world's axes, diagonal I_c) are one body's bits") {
+  // Two prismatic joints on translated placements: both bodies' X_world unturned, so the pair's lanes
+  // take centralInWorld's untransformed branch, which reads I_c's off-diagonal (zero) entries too.
+  TreeModel<Spatial> t;
+  t.gravity << 0, 0, 0, 0, 0, -9.81;
+  const Eigen::Matrix3d Ic = Eigen::Vector3d(0.02, 0.03, 0.01).asDiagonal();
+  t.addBody(-1, JointType::Prismatic, Pos(0.3, 0.5, 0.1).normalized(), Spatial::translation(Pos(0.1, 0.2, 0.3)),
+            Spatial::inertia(1.5, Pos(0.1, -0.1, 0.2), Ic));
+  t.addBody(0, JointType::Prismatic, Pos::UnitZ(), Spatial::translation(Pos(0.0, 0.4, 0.0)), Spatial::inertia(0.7, Pos(-0.2, 0.1, 0.05), Ic));
+  REQUIRE(t.bodies[0].central.diagonal);
+  REQUIRE(t.bodies[1].central.diagonal);
+  VecN q(2);
+  q << 0.3, -0.4;
+  TreeData<Spatial> d(t);
+  sized::kinematics<false, 2>(t, q, d);
+  REQUIRE(!d.X_world[0].turned);
+  REQUIRE(!d.X_world[1].turned);
+  Eigen::Matrix<double, 2, 2> M;
+  dirtyStack();
+  sized::crbaWorld<2>(t, d, M);
+  for (int i = 0; i < 2; ++i) CHECK(sameBits(d.I_w[i], worldInertiaOneBody(d.X_world[i], t.bodies[std::size_t(i)].central)));
+}
 
 TEST_CASE("M with bodies' world inertias and M's columns two at a time is one-body-at-a-time CRBA's, bit for bit") {
   std::mt19937 rng(4302);
