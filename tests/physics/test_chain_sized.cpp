@@ -7,7 +7,8 @@
 // h (bodies' net forces two at a time, serial chains in registers) against the one-body-at-a-time
 // world-frame RNEA written here, bit for bit; and M and the world inertias (two bodies and two columns
 // at a time, spatial_lanes.h) against the one-body-at-a-time CRBA written here, bit for bit (an unturned
-// pair's too, after the stack is dirtied: no lane read unloaded).
+// pair's too, after the stack is dirtied: no lane read unloaded); and CRBA
+// with the bias forces in one pass (crbaAndBiasSerial) against the two apart, bit for bit.
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
@@ -252,7 +253,60 @@ void checkCrbaOneByOne(std::mt19937& rng, bool chain, int* pairs) {
   crbaWorld(t, dd, Md);  // the dynamic size
   REQUIRE(std::memcmp(Md.data(), M1.data(), sizeof(double) * N * N) == 0);
 }
+// crbaAndBiasSerial (CRBA and the bias forces in one pass) against crbaWorld then biasForcesWorld on
+// a random serial chain (massless bodies and diagonal central inertias as checkCrbaOneByOne draws them),
+// bit for bit: M, h and every body's I_w, Ic_rb, v_w and a_w. A chain with a ball joint or a tree is
+// not the fused kernel's (fusedSerial false).
+template <int N>
+void checkFused(std::mt19937& rng, bool chain, int* fused) {
+  TreeModel<Spatial> t = randomTree(rng, N, chain);
+  REQUIRE(t.dof() == N);
+  std::uniform_int_distribution<int> coin(0, 5);
+  for (auto& b : t.bodies) {
+    const int k = coin(rng);
+    if (k == 0) b.massless = true, b.central = Spatial::Central{};
+    else if (k <= 2 && !b.massless) b.central.Ic = Eigen::Matrix3d(b.central.Ic.diagonal().asDiagonal()), b.central.diagonal = true;
+  }
+  const bool fits = t.balls.empty() && sized::isSerialChain(t, N);
+  REQUIRE(sized::fusedSerial<N>(t) == fits);
+  if (!fits) return;
+  ++*fused;
+  const VecN q = randomConfiguration(rng, t);
+  VecN qd(N);
+  for (int i = 0; i < N; ++i) qd[i] = std::uniform_real_distribution<double>(-3.0, 3.0)(rng);
+  TreeData<Spatial> apart(t), once(t);
+  sized::kinematics<false, N>(t, q, apart);
+  sized::kinematics<false, N>(t, q, once);
+  Eigen::Matrix<double, N, N> M, Mf;
+  Eigen::Matrix<double, N, 1> h, hf;
+  sized::crbaWorld<N>(t, apart, M);
+  sized::biasForcesWorld<N>(t, apart, qd, h);
+  sized::crbaAndBiasSerial<N>(t, once, qd, Mf, hf);
+  REQUIRE(std::memcmp(M.data(), Mf.data(), sizeof(double) * N * N) == 0);  // the signs of zeros too
+  REQUIRE(std::memcmp(h.data(), hf.data(), sizeof(double) * N) == 0);
+  for (int i = 0; i < N; ++i) {
+    REQUIRE(sameBits(apart.I_w[i], once.I_w[i]));
+    REQUIRE(sameBits(apart.Ic_rb[i], once.Ic_rb[i]));
+    REQUIRE(std::memcmp(apart.v_w[i].data(), once.v_w[i].data(), sizeof(double) * 6) == 0);
+    REQUIRE(std::memcmp(apart.a_w[i].data(), once.a_w[i].data(), sizeof(double) * 6) == 0);
+  }
+}
 }  // namespace
+
+TEST_CASE("CRBA and the bias forces in one pass give crbaWorld's and biasForcesWorld's bits") {
+  std::mt19937 rng(8243);
+  int fused = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    checkFused<1>(rng, true, &fused);
+    checkFused<2>(rng, true, &fused);
+    checkFused<3>(rng, trial % 4 != 0, &fused);  // the scalar columns (fewer than four bodies)
+    checkFused<4>(rng, true, &fused);
+    checkFused<5>(rng, trial % 4 != 0, &fused);  // odd: the root alone in worldInertias
+    checkFused<6>(rng, trial % 4 != 0, &fused);
+    checkFused<7>(rng, true, &fused);
+  }
+  CHECK(fused > 250);  // most chains drew no ball joint
+}
 
 // Stack memory below the caller filled with a non-zero pattern: a kernel called next that reads a lane
 // it never wrote reads this, not a lucky zero.
