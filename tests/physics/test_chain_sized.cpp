@@ -221,19 +221,24 @@ bool sameBits(const Spatial::Inertia& a, const Spatial::Inertia& b) {
          std::memcmp(a.Io.data(), b.Io.data(), sizeof(double) * 9) == 0;
 }
 
-// A random tree or chain whose massive bodies' central inertias are made diagonal about half the time
-// (the lanes' other branch), and about a third of its bodies massless (pairs of them, and pairs of one
-// of each, are then common).
-template <int N>
-void checkCrbaOneByOne(std::mt19937& rng, bool chain, int* pairs) {
-  TreeModel<Spatial> t = randomTree(rng, N, chain);
-  REQUIRE(t.dof() == N);
+// A random tree or chain (randomTree) whose bodies a die (0-5) makes massless below `massless`, or,
+// massive, gives a diagonal central inertia (the lanes' other branch) below `diagonal`: pairs of
+// massless bodies, and of one of each, are then common.
+TreeModel<Spatial> randomTreeMixed(std::mt19937& rng, int n, bool chain, int massless, int diagonal) {
+  TreeModel<Spatial> t = randomTree(rng, n, chain);
   std::uniform_int_distribution<int> coin(0, 5);
   for (auto& b : t.bodies) {
     const int k = coin(rng);
-    if (k <= 1) b.massless = true, b.central = Spatial::Central{};
-    else if (k <= 3 && !b.massless) b.central.Ic = Eigen::Matrix3d(b.central.Ic.diagonal().asDiagonal()), b.central.diagonal = true;
+    if (k < massless) b.massless = true, b.central = Spatial::Central{};
+    else if (k < diagonal && !b.massless) b.central.Ic = Eigen::Matrix3d(b.central.Ic.diagonal().asDiagonal()), b.central.diagonal = true;
   }
+  return t;
+}
+
+template <int N>
+void checkCrbaOneByOne(std::mt19937& rng, bool chain, int* pairs) {
+  const TreeModel<Spatial> t = randomTreeMixed(rng, N, chain, 2, 4);
+  REQUIRE(t.dof() == N);
   for (int i = 0; i + 1 < N; ++i) *pairs += !t.bodies[std::size_t(i)].massless && !t.bodies[std::size_t(i + 1)].massless;
   const VecN q = randomConfiguration(rng, t);
   TreeData<Spatial> d(t);
@@ -253,20 +258,15 @@ void checkCrbaOneByOne(std::mt19937& rng, bool chain, int* pairs) {
   crbaWorld(t, dd, Md);  // the dynamic size
   REQUIRE(std::memcmp(Md.data(), M1.data(), sizeof(double) * N * N) == 0);
 }
+
 // crbaAndBiasSerial (CRBA and the bias forces in one pass) against crbaWorld then biasForcesWorld on
 // a random serial chain (massless bodies and diagonal central inertias as checkCrbaOneByOne draws them),
 // bit for bit: M, h and every body's I_w, Ic_rb, v_w and a_w. A chain with a ball joint or a tree is
 // not the fused kernel's (fusedSerial false).
 template <int N>
 void checkFused(std::mt19937& rng, bool chain, int* fused) {
-  TreeModel<Spatial> t = randomTree(rng, N, chain);
+  const TreeModel<Spatial> t = randomTreeMixed(rng, N, chain, 1, 3);
   REQUIRE(t.dof() == N);
-  std::uniform_int_distribution<int> coin(0, 5);
-  for (auto& b : t.bodies) {
-    const int k = coin(rng);
-    if (k == 0) b.massless = true, b.central = Spatial::Central{};
-    else if (k <= 2 && !b.massless) b.central.Ic = Eigen::Matrix3d(b.central.Ic.diagonal().asDiagonal()), b.central.diagonal = true;
-  }
   const bool fits = t.balls.empty() && sized::isSerialChain(t, N);
   REQUIRE(sized::fusedSerial<N>(t) == fits);
   if (!fits) return;
@@ -310,9 +310,10 @@ TEST_CASE("CRBA and the bias forces in one pass give crbaWorld's and biasForcesW
 
 // Stack memory below the caller filled with a non-zero pattern: a kernel called next that reads a lane
 // it never wrote reads this, not a lucky zero.
-[[gnu::noinline]] void dirtyStack() {
+[[gnu::noinline]] double dirtyStack() {
   volatile double junk[2048];
   for (int i = 0; i < 2048; ++i) junk[i] = 0.5 + i;
+  return junk[2047];
 }
 
 TEST_CASE("an untransformed pair's world inertias (both in the world's axes, diagonal I_c) are one body's bits") {
@@ -333,7 +334,7 @@ TEST_CASE("an untransformed pair's world inertias (both in the world's axes, dia
   REQUIRE(!d.X_world[0].turned);
   REQUIRE(!d.X_world[1].turned);
   Eigen::Matrix<double, 2, 2> M;
-  dirtyStack();
+  REQUIRE(dirtyStack() > 0.0);
   sized::crbaWorld<2>(t, d, M);
   for (int i = 0; i < 2; ++i) CHECK(sameBits(d.I_w[i], worldInertiaOneBody(d.X_world[i], t.bodies[std::size_t(i)].central)));
 }
