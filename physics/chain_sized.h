@@ -111,6 +111,38 @@ DYN_INLINE void fillJointSpaceInertia(const Model& model, int n, bool serial, co
   }
 }
 
+// RNEA's net force on one body, f_i = I_i (A_i − g) + V_i ×* I_i V_i (netForces' one lane, T = double),
+// from data.I_w, v_w and a_w; zero on a massless body.
+template <class S>
+DYN_INLINE void netForceOne(const TreeModel<S>& model, const TreeData<S>& data, int i, typename S::Vec& f) {
+  if (model.bodies[std::size_t(i)].massless) {
+    f.setZero();
+    return;
+  }
+  double I[S::kInertiaNumbers];
+  S::inertiaNumbers(data.I_w[i], I);
+  S::netForce(I, data.v_w[i].data(), data.a_w[i].data(), model.gravity.data(), f.data());
+}
+
+// netForces on a pair whose world inertias are still in lanes (worldInertias: m, h and I_O's lower
+// triangle; I_O is symmetric, its (i, j) above the diagonal the (j, i) stored): the numbers netForces
+// reads back from data.I_w, without the stores' round trip.
+template <class S>
+DYN_INLINE void netForcePair(const TreeModel<S>& model, const TreeData<S>& data, int a, int b, const Lanes2& m, const Lanes2* h,
+                             const Lanes2 (&Io)[3][3], typename S::Vec* f) {
+  Lanes2 I[S::kInertiaNumbers], v[6], acc[6], g[6], out[6];
+  I[0] = m;
+  for (int i = 0; i < 3; ++i) I[1 + i] = h[i];
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) I[4 + 3 * i + j] = j <= i ? Io[i][j] : Io[j][i];
+  for (int k = 0; k < 6; ++k) {
+    v[k] = Lanes2{data.v_w[a][k], data.v_w[b][k]}, acc[k] = Lanes2{data.a_w[a][k], data.a_w[b][k]};
+    g[k] = Lanes2{model.gravity[k], model.gravity[k]};
+  }
+  S::netForce(I, v, acc, g, out);
+  for (int k = 0; k < 6; ++k) f[a][k] = out[k][0], f[b][k] = out[k][1];
+}
+
 // CRBA's world inertias I_i^w (kept for the velocity stage) of a 6-D tree, each also its composite's
 // first term; on a serial chain (`serial`) leaves to root, each composite I_i^w + I_c,i+1 as it is
 // written (the sums the composite pass makes, without storing the body's own and reading it back).
@@ -118,8 +150,10 @@ DYN_INLINE void fillJointSpaceInertia(const Model& model, int n, bool serial, co
 // one-body code's bits): a body's transform of its central inertia needs no other body's, and one
 // body's alone leaves most of the CPU's multipliers idle. A pair with a massless body (the unicycle's
 // carriers, nothing to compute) or whose bodies take different branches goes one body at a time.
+// With f (crbaAndBiasSerial: data.v_w and a_w staged), each body's RNEA net force too, from its world
+// inertia as it is made (netForcePair, netForceOne: netForces' bits).
 template <class S>
-DYN_INLINE void worldInertias(const TreeModel<S>& model, TreeData<S>& data, int n, bool serial) {
+DYN_INLINE void worldInertias(const TreeModel<S>& model, TreeData<S>& data, int n, bool serial, typename S::Vec* f = nullptr) {
   for (int b = n - 1; b >= 0; b -= 2) {
     const int a = b - 1;  // −1: an odd count's root, alone
     const auto& B = model.bodies[std::size_t(b)];
@@ -131,13 +165,16 @@ DYN_INLINE void worldInertias(const TreeModel<S>& model, TreeData<S>& data, int 
       if (!A.massless && !B.massless && lanes::worldInertiaPair(data.X_world[a], A.central, data.X_world[b], B.central, h, Io)) {
         lanes::storeLane(1, B.central.m, h, Io, data.I_w[b], data.Ic_rb[b], childB);
         lanes::storeLane(0, A.central.m, h, Io, data.I_w[a], data.Ic_rb[a], childA);
+        if (f) netForcePair(model, data, a, b, Lanes2{A.central.m, B.central.m}, h, Io, f);
         continue;
       }
     }
     lanes::worldInertia(data.X_world[b], B.central, B.massless, data.I_w[b], data.Ic_rb[b], childB);
+    if (f) netForceOne(model, data, b, f[b]);
     if (a >= 0) {
       const auto& A = model.bodies[std::size_t(a)];
       lanes::worldInertia(data.X_world[a], A.central, A.massless, data.I_w[a], data.Ic_rb[a], childA);
+      if (f) netForceOne(model, data, a, f[a]);
     }
   }
 }
@@ -217,18 +254,12 @@ DYN_INLINE void netForces(const TreeModel<S>& model, const TreeData<S>& data, in
   }
 }
 
-// biasForcesWorld on a serial chain without ball joints (the PUMA, the impedance arm): the parent's V
-// and A carried from body to body in registers (not read back from v_w, a_w), the root's V_parent = 0
-// and A = 0 without a sum, and on the way in each subtree's force summed in registers as h's dot
-// products read it (F_i = f_i + F_i+1, the sums the tree's f_p += f_i makes). The same floating-point
-// operations, in the same order, as the tree loop below: the same bits. data.f is not left at a fixed
-// size (nothing reads it after this; rnea in chain.cpp writes its own).
-template <int N, class S, class VecOut>
-DYN_INLINE void biasForcesSerial(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, VecOut& h) {
+// biasForcesSerial's way out: V_i = V_i−1 + S_i θ'_i and A_i = A_i−1 + V_i ×m S_i θ'_i, the parent's V
+// and A carried in registers (not read back from v_w, a_w), the root's V_parent = 0 and A = 0 without a
+// sum; into data.v_w and data.a_w.
+template <int N, class S>
+DYN_INLINE void velocitiesSerial(TreeData<S>& data, int n, const VecN& qd) {
   using Vec = typename S::Vec;
-  const int n = bodyCount<N>(model);
-  Vec local[N == Eigen::Dynamic ? 1 : N];
-  Vec* f = N == Eigen::Dynamic ? data.f.data() : local;  // each body's own net force
   Vec v, a;  // the body's V_i and A_i, its parent's while the next is begun
 #pragma GCC unroll 8
   for (int i = 0; i < n; ++i) {
@@ -245,8 +276,13 @@ DYN_INLINE void biasForcesSerial(const TreeModel<S>& model, TreeData<S>& data, c
     }
     for (int k = 0; k < S::kDim; ++k) data.v_w[i][k] = v[k], data.a_w[i][k] = a[k];
   }
-  netForces(model, data, n, f);
-  Vec F;
+}
+
+// biasForcesSerial's way in: each subtree's force summed in registers as h's dot products read it
+// (F_i = f_i + F_i+1, the sums the tree's f_p += f_i makes), h_i = S_i · F_i.
+template <class S, class VecOut>
+DYN_INLINE void forcesInSerial(const TreeData<S>& data, int n, const typename S::Vec* f, VecOut& h) {
+  typename S::Vec F;
   for (int k = 0; k < S::kDim; ++k) F[k] = f[n - 1][k];
   h[n - 1] = S::dot(data.S_w[n - 1], F);
 #pragma GCC unroll 8
@@ -254,6 +290,46 @@ DYN_INLINE void biasForcesSerial(const TreeModel<S>& model, TreeData<S>& data, c
     for (int k = 0; k < S::kDim; ++k) F[k] = f[i][k] + F[k];
     h[i] = S::dot(data.S_w[i], F);
   }
+}
+
+// biasForcesWorld on a serial chain without ball joints (the PUMA, the impedance arm): velocitiesSerial,
+// netForces, forcesInSerial. The same floating-point operations, in the same order, as the tree loop
+// below: the same bits. data.f is not left at a fixed size (nothing reads it after this; rnea in
+// chain.cpp writes its own).
+template <int N, class S, class VecOut>
+DYN_INLINE void biasForcesSerial(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, VecOut& h) {
+  const int n = bodyCount<N>(model);
+  typename S::Vec local[N == Eigen::Dynamic ? 1 : N];
+  typename S::Vec* f = N == Eigen::Dynamic ? data.f.data() : local;  // each body's own net force
+  velocitiesSerial<N>(data, n, qd);
+  netForces(model, data, n, f);
+  forcesInSerial(data, n, f, h);
+}
+
+// crbaWorld and biasForcesWorld at once on a 6-D serial chain without ball joints (both stages at one
+// state: constrained_mechanism_impl.h stageBoth): the velocities out, then each pair of bodies' world
+// inertias, composites and net forces while their numbers are in lanes (worldInertias with f), M's
+// columns, the forces in. Each quantity the same floating-point operations in the same order as the two
+// apart (a body's net force in a lane of its own, whichever pair it is in): the same M, h, I_w, Ic_rb,
+// v_w and a_w bits; saved: netForces reading back the world inertias stored a stage before.
+template <int N, class S, class MatOut, class VecOut>
+void crbaAndBiasSerial(const TreeModel<S>& model, TreeData<S>& data, const VecN& qd, MatOut& M, VecOut& h) {
+  static_assert(S::kDim == 6, "6-D chains: worldInertias' lanes");
+  const int n = bodyCount<N>(model);
+  typename S::Vec local[N == Eigen::Dynamic ? 1 : N];
+  typename S::Vec* f = N == Eigen::Dynamic ? data.f.data() : local;
+  velocitiesSerial<N>(data, n, qd);
+  worldInertias(model, data, n, true, f);
+  if (n >= 4) fillSerialInPairs(data, n, M);
+  else fillJointSpaceInertia<S>(model, n, true, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
+  forcesInSerial(data, n, f, h);
+}
+
+// Whether crbaAndBiasSerial fits a tree: a 6-D serial chain of at least one body without ball joints.
+template <int N, class S>
+bool fusedSerial(const TreeModel<S>& model) {
+  const int n = bodyCount<N>(model);
+  return S::kDim == 6 && n > 0 && model.balls.empty() && isSerialChain(model, n);
 }
 
 // chain_world.h biasForcesWorld: h = C θ' + G, leaving data.v_w and data.a_w.

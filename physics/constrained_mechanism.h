@@ -157,8 +157,12 @@ class ConstrainedMechanism : public ConstrainedSystem {
       }
     return a.size() == b.size() && a == b;
   }
-  void stagePosition(const VecN& q);
-  void velocityStage(const VecN& v);
+  // With qd (stageBoth), h = C θ' + G too, in CRBA's pass; velocityStage then with h_staged.
+  void stagePosition(const VecN& q, const VecN* qd = nullptr);
+  void velocityStage(const VecN& v, bool h_staged = false);
+  // Both stages at (q, v) where the position is not staged at q: on a 6-D serial chain without a
+  // payload (fused_), CRBA and the bias forces in one pass (chain_sized.h crbaAndBiasSerial).
+  void stageBoth(const VecN& q, const VecN& v);
   // The tree's transforms alone at θ (controller queries), cached like the position stage.
   void treeStage(const VecN& q);
   // The solve at a state; without with_qdd, α_c, η and f only (θ'' left unset); without with_forces,
@@ -281,6 +285,7 @@ class ConstrainedMechanism : public ConstrainedSystem {
   double external_power_ = 0, friction_power_ = 0;
   bool has_forces_ = false;  // the model has external forces (fixed at construction)
   bool has_armature_ = false;  // some joint has armature (fixed at construction): M_ii += a_i
+  bool fused_ = false;  // stageBoth's one pass fits the tree (fixed at construction)
 };
 
 }  // namespace dyn

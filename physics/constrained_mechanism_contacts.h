@@ -329,7 +329,9 @@ bool ConstrainedMechanism<S, Nj, Nr, Nl>::stepToTouchdowns(const StepOptions& o,
     const double t0 = time();
     const Books b0 = books();
     if (!dyn::step(*this, sub, tau, q, v)) return false;
-    // (The step's end staged: the next step's contact update starts from that stage.)
+    // (The step's end staged, both stages at once: the next step's contact update and solve start
+    // from them.)
+    stage(q, &v);
     if (event == 3 || !(openDepth(q, true) > 0.0)) return true;
     // A crossing inside the step: bracket it from the start (φ < 0 there, else nothing to locate).
     double lo = 0.0, f_lo = openDepth(q0), hi = sub.dt, f_hi = openDepth(q), depth = f_hi;

@@ -47,6 +47,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
   has_forces_ = !model_.forces.empty();
   for (const JointProperties& j : model_.joints) has_armature_ = has_armature_ || j.armature != 0.0;
   if constexpr (S::kDim == 6) planar_ = PlanarTreeData(model_.tree);
+  if constexpr (S::kDim == 6) fused_ = planar_.axis < 0 && model_.payloads.empty() && sized::fusedSerial<Nj>(model_.tree);
   kin_.model = &model_;
   kin_.tree = &data_;
   kin_.payload_pose.assign(model_.payloads.size(), Eigen::Vector3d::Zero());
@@ -82,7 +83,7 @@ ConstrainedMechanism<S, Nj, Nr, Nl>::ConstrainedMechanism(MechanismModel<S> mode
 }
 
 template <class S, int Nj, int Nr, int Nl>
-void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
+void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q, const VecN* qd) {
   const int nn = n(), kk = k(), nqt = nqTree();
   // World transforms and joint axes, unless a controller's query just staged the whole tree at θ (the
   // parent frames are treeStage's, for the body-frame queries).
@@ -92,9 +93,15 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q) {
     have_tree_ = false;
   }
   have_velocity_ = false;
-  // M from world composite inertias; the world inertias stay for the velocity stage.
+  // M from world composite inertias; the world inertias stay for the velocity stage. With θ' (stageBoth,
+  // fused_): the velocity stage's h in the same pass.
   problem_.M.resize(nn, nn);
-  sized::crbaWorldOrPlanar<Nj>(model_.tree, data_, planar_, problem_.M);
+  if constexpr (S::kDim == 6)
+    if (qd) {
+      problem_.h.resize(nn);
+      sized::crbaAndBiasSerial<Nj>(model_.tree, data_, *qd, problem_.M, problem_.h);
+    }
+  if (!qd) sized::crbaWorldOrPlanar<Nj>(model_.tree, data_, planar_, problem_.M);
   addArmature(problem_.M);
   setFixed<Nj>(kin_.theta, q, nqt);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.
@@ -168,7 +175,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::treeStage(const VecN& q) {
 }
 
 template <class S, int Nj, int Nr, int Nl>
-void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
+void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v, bool h_staged) {
   const int nn = n();
   // θ' (without a payload, v itself: no copy).
   VecN head;
@@ -178,7 +185,7 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
   // Link velocities, each link's velocity-product acceleration and h = Cθ' + G, in world coordinates.
   problem_.h.resize(nn);
   setFixed<Nj>(kin_.theta_rate, qd, nn);
-  sized::biasForcesWorldOrPlanar<Nj>(model_.tree, data_, planar_, qd, problem_.h);
+  if (!h_staged) sized::biasForcesWorldOrPlanar<Nj>(model_.tree, data_, planar_, qd, problem_.h);
   // Joint springs and friction join h; friction's power for the books.
   friction_power_ = 0.0;
   if (!model_.joints.empty())
@@ -253,7 +260,15 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::velocityStage(const VecN& v) {
 }
 
 template <class S, int Nj, int Nr, int Nl>
+void ConstrainedMechanism<S, Nj, Nr, Nl>::stageBoth(const VecN& q, const VecN& v) {
+  const bool fuse = fused_ && v.size() == n();  // (θ' is v itself: no payload coordinates)
+  stagePosition(q, fuse ? &v : nullptr);
+  velocityStage(v, fuse);
+}
+
+template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::stage(const VecN& q, const VecN* v) {
+  if (v && !(have_position_ && same(q, staged_q_))) return stageBoth(q, *v);
   positionStage(q);
   if (v) velocityStage(*v);
 }
@@ -261,9 +276,10 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stage(const VecN& q, const VecN* v) {
 template <class S, int Nj, int Nr, int Nl>
 typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, Nj, Nr, Nl>::evaluate(
     const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd, bool with_forces) {
-  positionStage(q);
-  // The velocity stage too is kept: the trace row's solve and the step's first stage share it.
-  if (!have_velocity_ || !same(v, staged_v_)) velocityStage(v);
+  // Both stages are kept (the trace row's solve and the step's first stage share them); both made at
+  // once when the position is new.
+  if (!have_position_ || !same(q, staged_q_)) stageBoth(q, v);
+  else if (!have_velocity_ || !same(v, staged_v_)) velocityStage(v);
   // τ: the tree torques, optionally followed by generalised forces on the payload coordinates
   // (an external push w on the payload: M_c α_c + b_c + G_c = Aᵀ f + w).
   if (tau.size() != n() && tau.size() != n() + k())

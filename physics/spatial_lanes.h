@@ -7,7 +7,7 @@
 // product or sum of the same two numbers (IEEE 754, round to nearest; -ffp-contract=off: never an
 // FMA), so a lane that does the scalar code's operations in the scalar code's order gives its bits.
 // The code below is written once on a lane type T: T = double is the one-body path (a lone body, an
-// odd chain's root, a pair whose bodies take different branches), T = Lanes2 two bodies.
+// odd chain's root, a pair whose bodies take different branches or are unturned), T = Lanes2 two bodies.
 #pragma once
 #include "physics/spatial.h"
 
@@ -76,19 +76,20 @@ DYN_INLINE void worldInertia(const Spatial::Transform& X, const Spatial::Central
   storeInertia(massless ? 0.0 : C.m, h, Io, out, comp, child);
 }
 
-// Two massive bodies' world inertias, body a in lane 0 and b in lane 1, when both take the same
-// branches (turned, diagonal); their h and I_O's lower triangle into h and Io. False (nothing done)
-// otherwise: the caller takes them one at a time.
+// Two massive bodies' world inertias, body a in lane 0 and b in lane 1, when both are turned (X_world's
+// E not the identity) and take the same branch (diagonal); their h and I_O's lower triangle into h and
+// Io. False (nothing done) otherwise: the caller takes them one at a time. (An unturned pair, rare, goes
+// one at a time: centralInWorld's unturned branch reads I_c's lower triangle whole, which a diagonal
+// pair's lanes do not hold.)
 DYN_INLINE bool worldInertiaPair(const Spatial::Transform& Xa, const Spatial::Central& Ca, const Spatial::Transform& Xb,
                                  const Spatial::Central& Cb, Lanes2* h, Lanes2 (&Io)[3][3]) {
-  if (Xa.turned != Xb.turned || Ca.diagonal != Cb.diagonal) return false;
+  if (!Xa.turned || !Xb.turned || Ca.diagonal != Cb.diagonal) return false;
   Lanes2 E[9], r[3], c[3], Ic[9];
   for (int k = 0; k < 3; ++k) r[k] = Lanes2{Xa.r[k], Xb.r[k]}, c[k] = Lanes2{Ca.c[k], Cb.c[k]};
-  if (Xa.turned)
-    for (int k = 0; k < 9; ++k) E[k] = Lanes2{Xa.E.data()[k], Xb.E.data()[k]};
+  for (int k = 0; k < 9; ++k) E[k] = Lanes2{Xa.E.data()[k], Xb.E.data()[k]};
   for (int k = 0; k < 9; ++k)
     if (!Ca.diagonal || k % 4 == 0) Ic[k] = Lanes2{Ca.Ic.data()[k], Cb.Ic.data()[k]};
-  centralInWorld(E, r, Lanes2{Ca.m, Cb.m}, c, Ic, Xa.turned, Ca.diagonal, h, Io);
+  centralInWorld(E, r, Lanes2{Ca.m, Cb.m}, c, Ic, true, Ca.diagonal, h, Io);
   return true;
 }
 

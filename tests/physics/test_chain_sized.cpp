@@ -6,7 +6,9 @@
 // Spatial::compose's products written out against Eigen's; det::sincos against det::sin and det::cos;
 // h (bodies' net forces two at a time, serial chains in registers) against the one-body-at-a-time
 // world-frame RNEA written here, bit for bit; and M and the world inertias (two bodies and two columns
-// at a time, spatial_lanes.h) against the one-body-at-a-time CRBA written here, bit for bit.
+// at a time, spatial_lanes.h) against the one-body-at-a-time CRBA written here, bit for bit (an unturned
+// pair's too, after the stack is dirtied: no lane read unloaded); and CRBA
+// with the bias forces in one pass (crbaAndBiasSerial) against the two apart, bit for bit.
 #include <doctest/doctest.h>
 
 #include <Eigen/Geometry>
@@ -219,19 +221,24 @@ bool sameBits(const Spatial::Inertia& a, const Spatial::Inertia& b) {
          std::memcmp(a.Io.data(), b.Io.data(), sizeof(double) * 9) == 0;
 }
 
-// A random tree or chain whose massive bodies' central inertias are made diagonal about half the time
-// (the lanes' other branch), and about a third of its bodies massless (pairs of them, and pairs of one
-// of each, are then common).
-template <int N>
-void checkCrbaOneByOne(std::mt19937& rng, bool chain, int* pairs) {
-  TreeModel<Spatial> t = randomTree(rng, N, chain);
-  REQUIRE(t.dof() == N);
+// A random tree or chain (randomTree) whose bodies a die (0-5) makes massless below `massless`, or,
+// massive, gives a diagonal central inertia (the lanes' other branch) below `diagonal`: pairs of
+// massless bodies, and of one of each, are then common.
+TreeModel<Spatial> randomTreeMixed(std::mt19937& rng, int n, bool chain, int massless, int diagonal) {
+  TreeModel<Spatial> t = randomTree(rng, n, chain);
   std::uniform_int_distribution<int> coin(0, 5);
   for (auto& b : t.bodies) {
     const int k = coin(rng);
-    if (k <= 1) b.massless = true, b.central = Spatial::Central{};
-    else if (k <= 3 && !b.massless) b.central.Ic = Eigen::Matrix3d(b.central.Ic.diagonal().asDiagonal()), b.central.diagonal = true;
+    if (k < massless) b.massless = true, b.central = Spatial::Central{};
+    else if (k < diagonal && !b.massless) b.central.Ic = Eigen::Matrix3d(b.central.Ic.diagonal().asDiagonal()), b.central.diagonal = true;
   }
+  return t;
+}
+
+template <int N>
+void checkCrbaOneByOne(std::mt19937& rng, bool chain, int* pairs) {
+  const TreeModel<Spatial> t = randomTreeMixed(rng, N, chain, 2, 4);
+  REQUIRE(t.dof() == N);
   for (int i = 0; i + 1 < N; ++i) *pairs += !t.bodies[std::size_t(i)].massless && !t.bodies[std::size_t(i + 1)].massless;
   const VecN q = randomConfiguration(rng, t);
   TreeData<Spatial> d(t);
@@ -251,7 +258,86 @@ void checkCrbaOneByOne(std::mt19937& rng, bool chain, int* pairs) {
   crbaWorld(t, dd, Md);  // the dynamic size
   REQUIRE(std::memcmp(Md.data(), M1.data(), sizeof(double) * N * N) == 0);
 }
+
+// crbaAndBiasSerial (CRBA and the bias forces in one pass) against crbaWorld then biasForcesWorld on
+// a random serial chain (massless bodies and diagonal central inertias as checkCrbaOneByOne draws them),
+// bit for bit: M, h and every body's I_w, Ic_rb, v_w and a_w. A chain with a ball joint or a tree is
+// not the fused kernel's (fusedSerial false).
+template <int N>
+void checkFused(std::mt19937& rng, bool chain, int* fused) {
+  const TreeModel<Spatial> t = randomTreeMixed(rng, N, chain, 1, 3);
+  REQUIRE(t.dof() == N);
+  const bool fits = t.balls.empty() && sized::isSerialChain(t, N);
+  REQUIRE(sized::fusedSerial<N>(t) == fits);
+  if (!fits) return;
+  ++*fused;
+  const VecN q = randomConfiguration(rng, t);
+  VecN qd(N);
+  for (int i = 0; i < N; ++i) qd[i] = std::uniform_real_distribution<double>(-3.0, 3.0)(rng);
+  TreeData<Spatial> apart(t), once(t);
+  sized::kinematics<false, N>(t, q, apart);
+  sized::kinematics<false, N>(t, q, once);
+  Eigen::Matrix<double, N, N> M, Mf;
+  Eigen::Matrix<double, N, 1> h, hf;
+  sized::crbaWorld<N>(t, apart, M);
+  sized::biasForcesWorld<N>(t, apart, qd, h);
+  sized::crbaAndBiasSerial<N>(t, once, qd, Mf, hf);
+  REQUIRE(std::memcmp(M.data(), Mf.data(), sizeof(double) * N * N) == 0);  // the signs of zeros too
+  REQUIRE(std::memcmp(h.data(), hf.data(), sizeof(double) * N) == 0);
+  for (int i = 0; i < N; ++i) {
+    REQUIRE(sameBits(apart.I_w[i], once.I_w[i]));
+    REQUIRE(sameBits(apart.Ic_rb[i], once.Ic_rb[i]));
+    REQUIRE(std::memcmp(apart.v_w[i].data(), once.v_w[i].data(), sizeof(double) * 6) == 0);
+    REQUIRE(std::memcmp(apart.a_w[i].data(), once.a_w[i].data(), sizeof(double) * 6) == 0);
+  }
+}
 }  // namespace
+
+TEST_CASE("CRBA and the bias forces in one pass give crbaWorld's and biasForcesWorld's bits") {
+  std::mt19937 rng(8243);
+  int fused = 0;
+  for (int trial = 0; trial < 60; ++trial) {
+    checkFused<1>(rng, true, &fused);
+    checkFused<2>(rng, true, &fused);
+    checkFused<3>(rng, trial % 4 != 0, &fused);  // the scalar columns (fewer than four bodies)
+    checkFused<4>(rng, true, &fused);
+    checkFused<5>(rng, trial % 4 != 0, &fused);  // odd: the root alone in worldInertias
+    checkFused<6>(rng, trial % 4 != 0, &fused);
+    checkFused<7>(rng, true, &fused);
+  }
+  CHECK(fused > 250);  // most chains drew no ball joint
+}
+
+// Stack memory below the caller filled with a non-zero pattern: a kernel called next that reads a lane
+// it never wrote reads this, not a lucky zero.
+[[gnu::noinline]] double dirtyStack() {
+  volatile double junk[2048];
+  for (int i = 0; i < 2048; ++i) junk[i] = 0.5 + i;
+  return junk[2047];
+}
+
+TEST_CASE("an untransformed pair's world inertias (both in the world's axes, diagonal I_c) are one body's bits") {
+  // Two prismatic joints on translated placements: both bodies' X_world unturned, so the pair's lanes
+  // take centralInWorld's untransformed branch, which reads I_c's off-diagonal (zero) entries too.
+  TreeModel<Spatial> t;
+  t.gravity << 0, 0, 0, 0, 0, -9.81;
+  const Eigen::Matrix3d Ic = Eigen::Vector3d(0.02, 0.03, 0.01).asDiagonal();
+  t.addBody(-1, JointType::Prismatic, Pos(0.3, 0.5, 0.1).normalized(), Spatial::translation(Pos(0.1, 0.2, 0.3)),
+            Spatial::inertia(1.5, Pos(0.1, -0.1, 0.2), Ic));
+  t.addBody(0, JointType::Prismatic, Pos::UnitZ(), Spatial::translation(Pos(0.0, 0.4, 0.0)), Spatial::inertia(0.7, Pos(-0.2, 0.1, 0.05), Ic));
+  REQUIRE(t.bodies[0].central.diagonal);
+  REQUIRE(t.bodies[1].central.diagonal);
+  VecN q(2);
+  q << 0.3, -0.4;
+  TreeData<Spatial> d(t);
+  sized::kinematics<false, 2>(t, q, d);
+  REQUIRE(!d.X_world[0].turned);
+  REQUIRE(!d.X_world[1].turned);
+  Eigen::Matrix<double, 2, 2> M;
+  REQUIRE(dirtyStack() > 0.0);
+  sized::crbaWorld<2>(t, d, M);
+  for (int i = 0; i < 2; ++i) CHECK(sameBits(d.I_w[i], worldInertiaOneBody(d.X_world[i], t.bodies[std::size_t(i)].central)));
+}
 
 TEST_CASE("M with bodies' world inertias and M's columns two at a time is one-body-at-a-time CRBA's, bit for bit") {
   std::mt19937 rng(4302);
