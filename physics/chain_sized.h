@@ -197,6 +197,15 @@ DYN_INLINE void fillSerialInPairs(const TreeData<S>& data, int n, MatOut& M) {
   }
 }
 
+// M's columns on a 6-D serial chain whose composites worldInertias has summed: in pairs from four
+// bodies on (with three, the pen's, the lanes' packing cost more than the pairs saved in a harness,
+// 0.327 -> 0.337 µs a step), else the scalar fill.
+template <class S, class MatOut>
+DYN_INLINE void fillSerialColumns(const TreeModel<S>& model, const TreeData<S>& data, int n, MatOut& M) {
+  if (n >= 4) return fillSerialInPairs(data, n, M);
+  fillJointSpaceInertia<S>(model, n, true, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
+}
+
 // chain_world.h crbaWorld: M(θ) from world composite inertias, leaving data.I_w.
 template <int N, class S, class MatOut>
 void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
@@ -204,9 +213,7 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
   const bool serial = isSerialChain(model, n);
   if constexpr (S::kDim == 6) {
     worldInertias(model, data, n, serial);  // a serial chain's composites summed with them
-    // (Columns in pairs from four bodies on: with three, the pen's, the lanes' packing cost more than
-    // the pairs saved in a harness, 0.327 -> 0.337 µs a step; the scalar fill below.)
-    if (serial && n >= 4) return fillSerialInPairs(data, n, M);
+    if (serial) return fillSerialColumns(model, data, n, M);
   } else {
     for (int i = 0; i < n; ++i) {
       const auto& b = model.bodies[std::size_t(i)];
@@ -214,13 +221,11 @@ void crbaWorld(const TreeModel<S>& model, TreeData<S>& data, MatOut& M) {
       else S::inertiaInParent(data.X_world[i], b.inertia, data.I_w[i], data.Ic_rb[i]);  // planar: from the origin form
     }
   }
-  // Composite inertias, leaves to root: in one frame they simply add (a 6-D serial chain's are summed
-  // already, by worldInertias).
-  if (S::kDim != 6 || !serial)
-    for (int i = n - 1; i >= 0; --i) {
-      const int p = model.bodies[std::size_t(i)].parent;
-      if (p >= 0) data.Ic_rb[p] += data.Ic_rb[i];
-    }
+  // Composite inertias, leaves to root: in one frame they simply add.
+  for (int i = n - 1; i >= 0; --i) {
+    const int p = model.bodies[std::size_t(i)].parent;
+    if (p >= 0) data.Ic_rb[p] += data.Ic_rb[i];
+  }
   fillJointSpaceInertia<S>(model, n, serial, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
 }
 
@@ -320,8 +325,7 @@ void crbaAndBiasSerial(const TreeModel<S>& model, TreeData<S>& data, const VecN&
   typename S::Vec* f = N == Eigen::Dynamic ? data.f.data() : local;
   velocitiesSerial<N>(data, n, qd);
   worldInertias(model, data, n, true, f);
-  if (n >= 4) fillSerialInPairs(data, n, M);
-  else fillJointSpaceInertia<S>(model, n, true, data.S_w, [&](int j) { return S::inertiaTimes(data.Ic_rb[j], data.S_w[j]); }, M);
+  fillSerialColumns(model, data, n, M);
   forcesInSerial(data, n, f, h);
 }
 

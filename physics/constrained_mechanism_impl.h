@@ -98,12 +98,14 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stagePosition(const VecN& q, const Vec
   // M from world composite inertias; the world inertias stay for the velocity stage. With θ' (stageBoth,
   // fused_): the velocity stage's h in the same pass.
   problem_.M.resize(nn, nn);
+  bool fused = false;  // (only stageBoth passes θ', and only where fused_: 6-D)
   if constexpr (S::kDim == 6)
     if (qd) {
       problem_.h.resize(nn);
       sized::crbaAndBiasSerial<Nj>(model_.tree, data_, *qd, problem_.M, problem_.h);
+      fused = true;
     }
-  if (!qd) sized::crbaWorldOrPlanar<Nj>(model_.tree, data_, planar_, problem_.M);
+  if (!fused) sized::crbaWorldOrPlanar<Nj>(model_.tree, data_, planar_, problem_.M);
   addArmature(problem_.M);
   setFixed<Nj>(kin_.theta, q, nqt);
   // Planar link angles: the parent's, the placement's, and the joint's own for a revolute.

@@ -10,7 +10,6 @@
 //   grading: CPU seconds of a full rubric grade of the lab's instructor/good.json.
 #include <algorithm>
 #include <cerrno>
-#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -46,7 +45,7 @@ ScratchDir::~ScratchDir() {
 
 namespace {
 
-// Wall times per step, µs, on every engine alike (bench.h: timedRun, timedEach).
+// Wall times per step, µs, on every engine alike (timing.h: timedRun, timedEach).
 struct StepTimes {
   double full = 0;    // Simulation::step (controller, trace row, engine): the median block's
   double engine = 0;  // Simulation::advanceEngine after each (untimed) step, the engine alone: the median block's
@@ -63,7 +62,6 @@ struct TimedRun {
   const Lab* lab;
   Engine engine;
 };
-constexpr int kBlock = 50;
 
 // With a MuJoCo run (mujoco timed()): its steps timed last in each round (both passes alike: it has
 // no controller), its times as out's last entry.
@@ -103,11 +101,10 @@ std::vector<StepTimes> stepMicros(const std::vector<TimedRun>& runs, int steps, 
     for (std::size_t i = 0; i < count; ++i) out[i].engine_blocks.push_back(block(i, true));
     mujocoBlock(mj.engine_blocks, true);
   }
-  auto any = [](const std::vector<double>& v) { return std::any_of(v.begin(), v.end(), [](double x) { return !std::isnan(x); }); };
   for (StepTimes& t : out) {
     t.full = median(t.full_blocks);
     t.engine = median(t.engine_blocks);
-    t.has_engine = any(t.engine_blocks);
+    t.has_engine = countedBlocks(t.engine_blocks) > 0;
   }
   if (mujoco.timed()) {
     mj.full = median(mj.full_blocks);
@@ -295,10 +292,10 @@ int bench(const BenchArgs& a) {
     } else {
       std::printf("%s\n", entry.name.c_str());
       if (alone)
-        std::printf("  engine step     hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median block of 50; advance one dt, control held)\n",
-                    hand, bullet, speedup.median);
-      std::printf("  full step       hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median block of 50; + controller, trace row)\n",
-                  hand_t.full, bullet_t.full, speedup_full.median);
+        std::printf("  engine step     hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median block of %d; advance one dt, control held)\n",
+                    hand, bullet, speedup.median, kBlock);
+      std::printf("  full step       hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median block of %d; + controller, trace row)\n",
+                  hand_t.full, bullet_t.full, speedup_full.median, kBlock);
       std::printf("  speed and error of whole runs against the reference (hand, %s, dt %g s):\n", scheme.c_str(), lab.dt());
       std::printf("    hand   %-34s %6.2f µs   reference\n", scheme.c_str(), hand);
       // The first-order ratio with the middle half of its blocks; the Bullet line's errors aligned under it.

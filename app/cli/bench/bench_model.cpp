@@ -1,7 +1,7 @@
 // dynlab bench FILE: a mechanism from a model file, timed as app/cli/bench/bench.cpp times labs. Passive from the
 // file's pose at rest, at the file's time step, four engines in turn in blocks of 50 steps (the
 // clock's speed wanders within milliseconds: engines timed one after the other catch different
-// phases), each block's steps timed together (bench.h timedRun: the clock ticks every ~10 ns):
+// phases), each block's steps timed together (timing.h timedRun: the clock ticks every ~10 ns):
 //   hand   semi-implicit Euler + Baumgarte  (first order: Bullet's and MuJoCo's order; the headline)
 //   hand   RK4 + projection                 (dynlab model's run: the reference for accuracy)
 //   Bullet btMultiBody, semi-implicit Euler  (physics/bullet)
@@ -38,7 +38,6 @@
 namespace dyn::app {
 namespace {
 
-constexpr int kBlock = 50;
 constexpr double kAccuracyRun = 2.0;  // s: each engine's run from the file's pose, against the hand RK4 run
 
 // One engine as the bench drives it: a step from its own state, back to the start, and its state.
@@ -47,7 +46,7 @@ struct Engine {
   std::function<bool()> step;
   std::function<void()> restart;
   std::function<void(VecN&, VecN&)> state;
-  std::vector<double> blocks;  // µs per step of each block (bench.h timedRun: NaN for a block left out)
+  std::vector<double> blocks;  // µs per step of each block (timing.h timedRun: NaN for a block left out)
 };
 
 // The engines from the file's pose at rest.
@@ -171,11 +170,6 @@ void timeBlocks(std::vector<Engine>& engines, int steps) {
     for (Engine& e : engines) e.blocks.push_back(timedRun(kBlock, [&] { return e.step() || (e.restart(), false); }));
 }
 
-// Steps in the blocks that counted.
-int stepsTimed(const Engine& e) {
-  return kBlock * int(std::count_if(e.blocks.begin(), e.blocks.end(), [](double x) { return !std::isnan(x); }));
-}
-
 // Accuracy over `steps` steps from the file's pose: the largest |φ|∞ (the description's, at each
 // engine's state, over every closure row) and the largest |q − q_ref|∞ against the reference run's states.
 struct Accuracy {
@@ -290,7 +284,7 @@ int benchModel(const BenchArgs& a) {
                 "(|λ| dt %.3g, joint '%s'): their hand RK4 costs %d times the row below\n",
                 sub, fastest.rate * dt, termName(fastest.joint).c_str(), sub);
   if (!beside.empty()) std::printf("  %s\n", termName(mujoco_left_out, 1000).c_str());
-  std::printf("  %d steps per engine timed in blocks of %d, in turn; ratios block by block: median (middle half)\n", stepsTimed(euler), kBlock);
+  std::printf("  %d steps per engine timed in blocks of %d, in turn; ratios block by block: median (middle half)\n", kBlock * countedBlocks(euler.blocks), kBlock);
   std::printf("  engine             µs/step   over hand, 1st order   max |φ|∞     max |q − q_ref|∞ over 2 s (ref: hand RK4)\n");
   for (std::size_t i = 0; i < list.size(); ++i) {
     const Engine& e = list[i];

@@ -13,6 +13,10 @@ double median(std::vector<double> v) {
   return v.empty() ? 0 : v[v.size() / 2];
 }
 
+int countedBlocks(const std::vector<double>& blocks) {
+  return int(std::count_if(blocks.begin(), blocks.end(), [](double x) { return !std::isnan(x); }));
+}
+
 double meanWithoutOutliers(const std::vector<double>& readings) {
   const double limit = 2 * median(readings) + 0.02;
   double sum = 0;

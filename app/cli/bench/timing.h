@@ -7,8 +7,14 @@
 
 namespace dyn::app {
 
+// The steps of a block: every bench's engines take turns in blocks this long (the machine's speed
+// wanders within milliseconds: side by side, each block catches the same phase).
+constexpr int kBlock = 50;
+
 // The middle value (0 for none); NaN entries (blocks left out, timedRun) are skipped.
 double median(std::vector<double> v);
+// The blocks that were timed (not NaN).
+int countedBlocks(const std::vector<double>& blocks);
 // The clock reads' cost (µs) as a call timed alone sees it, subtracted from each such call (timedEach):
 // a sub-microsecond step is not charged the timer's own ~11 ns.
 double clockOverhead();
