@@ -41,10 +41,23 @@ class Simulation {
   // which stoppedSentence() completes. A lab's own watchdog (a grasp that slipped) writes the whole
   // sentence itself, starting "stopped: " and naming the time.
   virtual std::string failure() const { return {}; }
-  // The engine alone, for `dynlab bench`: advance the state one more step with the control of the
-  // last step() held (no controller, no trace row; it uses up one step of the run). False once the
-  // run is over, or if the lab does not offer it.
-  virtual bool advanceEngine() { return false; }
+  // The engine alone, for `dynlab bench`: advance the state one more step under the torque τ (no
+  // controller, no trace row; it uses up one step of the run). The bench replays the torques another
+  // run of the same lab applied (appliedTorque after each of its step()s), so that this run takes the
+  // lab's own path with nothing timed but the engine. False once the run is over, or if the lab does
+  // not offer it.
+  virtual bool advanceEngine(const VecN& tau) {
+    (void)tau;
+    return false;
+  }
+  // The torque the last step() applied over its step: empty before the first, after the row at the
+  // run's end (no step follows it), and where advanceEngine is not offered.
+  virtual VecN appliedTorque() const { return {}; }
+  // The state (q, v) the next step starts from; false where advanceEngine is not offered.
+  virtual bool engineState(VecN& q, VecN& v) const {
+    (void)q, (void)v;
+    return false;
+  }
   // The engine in one line, when it can say more than its name (Bullet: the multibody it built from the
   // description, where it cut the loops, the solver's effort); empty otherwise.
   virtual std::string describeEngine() const { return {}; }

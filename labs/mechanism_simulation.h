@@ -154,7 +154,7 @@ class MechanismSimulation final : public Simulation {
     tau_ = hooks_->torque(t, q_, v_);
     const double energy = model_->energy(q_, v_), residual = residualNow();
     const double work = work_;
-    advance(true, t);
+    advance(true, t, tau_);
     const StepRecord r{engine_, t, q_, v_, tau_, stepper_->forces(), energy, residual, work};
     hooks_->row(r, row);
     // The next state, the books up to it, then what the sensors saw.
@@ -193,11 +193,16 @@ class MechanismSimulation final : public Simulation {
     return true;
   }
 
-  bool advanceEngine() override {
+  bool advanceEngine(const VecN& tau) override {
     if (k_ >= steps_ || !failure_.empty()) return false;
-    advance(false, double(k_) * dt_);
+    advance(false, double(k_) * dt_, tau);
     stepper_->state(q_, v_);
     ++k_;
+    return true;
+  }
+  VecN appliedTorque() const override { return k_ == 0 || closed_ ? VecN() : tau_; }
+  bool engineState(VecN& q, VecN& v) const override {
+    q = q_, v = v_;
     return true;
   }
 
@@ -208,9 +213,9 @@ class MechanismSimulation final : public Simulation {
  private:
   // |φ(q)| of the present state, and for velocity-level kinds (rolling) |J θ' − A v_c| as well: they have no φ.
   double residualNow() const { return model_->holonomic() ? model_->residual(q_) : model_->residual(q_, v_); }
-  void advance(bool with_forces, double t) {
+  void advance(bool with_forces, double t, const VecN& tau) {
     stepper_->setTime(t);
-    if (!stepper_->step(tau_, with_forces) && failure_.empty()) failure_ = stepper_->failure();
+    if (!stepper_->step(tau, with_forces) && failure_.empty()) failure_ = stepper_->failure();
   }
   Engine engine_;
   std::unique_ptr<M> model_;

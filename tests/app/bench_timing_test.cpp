@@ -44,13 +44,3 @@ TEST_CASE("timedRun: µs per call of a block, left out when a call failed") {
   CHECK(std::isnan(timedRun(50, [&] { return ++calls != 7; })));
   CHECK(calls == 50);  // the block still runs to its end (the engines take turns in whole blocks)
 }
-
-TEST_CASE("timedEach: only the calls before() let through and timed() counted") {
-  int before = 0, timed = 0;
-  const double t = timedEach(
-      40, 0.0, [&] { return ++before % 2 == 0; }, [&] { return ++timed, timed % 5 != 0; });
-  CHECK(before == 40);
-  CHECK(timed == 20);
-  CHECK(t >= 0.0);
-  CHECK(std::isnan(timedEach(10, 0.0, [] { return false; }, [] { return true; })));
-}

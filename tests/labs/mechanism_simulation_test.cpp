@@ -3,11 +3,15 @@
 //    "energy_drift" metric: W the work of τ, of external forces and of joint friction, integrated
 //    with the motion's RK4 stages) falls at fourth order when dt halves, and is at the integrator's
 //    error (a trapezoid's books fell at second order and read 1e-6…1e-5 J at 1 ms);
-//  * Bullet's books (held forces × displacement) keep E − E0 − W within a first-order engine's error.
+//  * Bullet's books (held forces × displacement) keep E − E0 − W within a first-order engine's error;
+//  * the engine alone (`dynlab bench`'s engine pass) replaying the torques a full run applied takes
+//    that run's states bit for bit, on both engines of every lab that offers it.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "labs/run.h"
 #include "tests/labs/lab_fixture.h"
@@ -58,4 +62,41 @@ TEST_CASE("Bullet's books: E − E0 − W stays within a first-order engine's er
     MESSAGE(std::string(lab) << ": Bullet |E − E0 − W| " << d << " J");
     CHECK_MESSAGE(d < 5e-2, lab);
   }
+}
+
+TEST_CASE("the engine alone, replaying a full run's torques, takes that run's states bit for bit") {
+  // The bench times the engine pass on such a replay: it must step the states the lab's own run steps
+  // (contacts closing and opening, limits, the controller's torques at 1 kHz), not a run of its own.
+  int offered = 0;
+  for (const LabEntry& entry : labRegistry()) {
+    const auto lab = test::LabFixture(entry.name).makeLab();
+    const long whole = std::lround(lab->duration() / lab->dt()), kMost = 600;  // its first 0.6 s at 1 ms
+    for (Engine engine : {Engine::Hand, Engine::Bullet}) {
+      const std::string engine_name = name(engine);
+      CAPTURE(entry.name);
+      CAPTURE(engine_name);
+      const auto full = lab->simulate(engine), alone = lab->simulate(engine);
+      std::vector<double> row;
+      VecN q1, v1, q2, v2, last;
+      int steps = 0, differing = 0;
+      while (steps < kMost && full->step(row)) {
+        const VecN tau = full->appliedTorque();
+        if (tau.size() == 0) break;  // the row at the run's end, or no engine alone
+        REQUIRE(alone->advanceEngine(tau));
+        last = tau;
+        REQUIRE(full->engineState(q1, v1));
+        REQUIRE(alone->engineState(q2, v2));
+        // (bitwise: == on every entry, and the same sizes)
+        if (!(q1.size() == q2.size() && v1.size() == v2.size() && q1 == q2 && v1 == v2)) ++differing;
+        ++steps;
+      }
+      if (steps == 0) continue;  // a data lab's replayed file run: no engine alone
+      ++offered;
+      CHECK(steps == std::min(whole, kMost));
+      CHECK(differing == 0);
+      if (steps == whole) CHECK_FALSE(alone->advanceEngine(last));  // the run is over
+    }
+  }
+  MESSAGE(offered, " runs replayed");
+  CHECK(offered >= 2);
 }

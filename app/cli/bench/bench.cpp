@@ -1,6 +1,6 @@
 // dynlab bench: speed is measured here, never asserted in tests.
 //   hand vs Bullet: µs per step of each engine (the median of 50-step blocks, timing.h) on the lab's default config, and the ratio,
-//     for the engine alone (advance the state one dt with the control held: the headline) and for
+//     for the engine alone (advance the state one dt under the torques a full run applied: the headline) and for
 //     the full simulation step (+ controller and trace row: energy, residual, constraint force);
 //   and speed with accuracy: the hand engine also with Bullet's order of method (labs/settings.h
 //     firstOrderPatch: one dynamics evaluation per step, as Bullet's own step), each run's error
@@ -11,12 +11,14 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <stdexcept>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <string>
 
 #include "app/cli/bench/bench.h"
@@ -45,10 +47,10 @@ ScratchDir::~ScratchDir() {
 
 namespace {
 
-// Wall times per step, µs, on every engine alike (timing.h: timedRun, timedEach).
+// Wall times per step, µs, on every engine alike (timing.h timedRun: each block's steps back to back).
 struct StepTimes {
   double full = 0;    // Simulation::step (controller, trace row, engine): the median block's
-  double engine = 0;  // Simulation::advanceEngine after each (untimed) step, the engine alone: the median block's
+  double engine = 0;  // Simulation::advanceEngine replaying a full run's torques, the engine alone: the median block's
   bool has_engine = false;
   std::vector<double> full_blocks, engine_blocks;  // each block's µs per step
 };
@@ -63,43 +65,79 @@ struct TimedRun {
   Engine engine;
 };
 
+// The engine pass: each run's engine alone is a second run of the same lab, replaying the torques the
+// first (full steps, untimed) applied, so it takes the lab's own path with only the engine timed.
+class EngineReplay {
+ public:
+  explicit EngineReplay(const std::vector<TimedRun>& runs) : runs_(runs), full_(runs.size()), alone_(runs.size()) {
+    for (std::size_t i = 0; i < runs.size(); ++i) restart(i);
+  }
+  // One block of run i's engine alone, timed back to back (NaN: left out, both runs started again).
+  double block(std::size_t i) {
+    if (!record(i)) return std::nan("");
+    std::size_t k = 0;
+    const double t = timedRun(kBlock, [&] { return alone_[i]->advanceEngine(torques_[k++]); });
+    if (std::isnan(t)) restart(i);
+    return t;
+  }
+
+ private:
+  void restart(std::size_t i) {
+    full_[i] = runs_[i].lab->simulate(runs_[i].engine);
+    alone_[i] = runs_[i].lab->simulate(runs_[i].engine);
+  }
+  // The next kBlock torques of run i's full run; where it ends or fails inside the block both runs start
+  // again and the block is taken from the start. False if no whole block can be had (a short run, or
+  // a lab without the engine alone: appliedTorque empty).
+  bool record(std::size_t i) {
+    for (int attempt = 0; attempt < 2; ++attempt) {
+      torques_.clear();
+      while (int(torques_.size()) < kBlock && full_[i]->step(row_)) {
+        VecN tau = full_[i]->appliedTorque();
+        if (tau.size() == 0) break;  // the row at the run's end (no step), or no engine alone
+        torques_.push_back(std::move(tau));
+      }
+      if (int(torques_.size()) == kBlock) return true;
+      restart(i);
+    }
+    return false;
+  }
+  const std::vector<TimedRun>& runs_;
+  std::vector<std::unique_ptr<Simulation>> full_, alone_;
+  std::vector<VecN> torques_;
+  std::vector<double> row_;
+};
+
 // With a MuJoCo run (mujoco timed()): its steps timed last in each round (both passes alike: it has
 // no controller), its times as out's last entry.
 std::vector<StepTimes> stepMicros(const std::vector<TimedRun>& runs, int steps, MujocoRun& mujoco) {
   const std::size_t count = runs.size();
-  const double clock = clockOverhead();
   StepTimes mj;
-  // MuJoCo's steps timed as the hand's in each pass, so that a ratio compares readings taken alike: back
-  // to back in the full pass, each alone in the engine pass (a call timed alone reads a few per cent
-  // less than its share of a block, as measured side by side on MuJoCo's step).
-  auto mujocoBlock = [&](std::vector<double>& blocks, bool alone) {
-    if (!mujoco.timed()) return;
-    auto step = [&] { return mujoco.step(); };
-    blocks.push_back(alone ? timedEach(kBlock, clock, [] { return true; }, step) : timedRun(kBlock, step));
+  // Every engine's steps are timed back to back in both passes, MuJoCo's as the others': in the engine
+  // pass the hand's and Bullet's replay torques a full run computed untimed before the block (the
+  // controller's work between two timed steps would leave each to start from its leavings: +18 % on the
+  // pen's step with the same instructions, which MuJoCo's, back to back, never paid).
+  auto mujocoBlock = [&](std::vector<double>& blocks) {
+    if (mujoco.timed()) blocks.push_back(timedRun(kBlock, [&] { return mujoco.step(); }));
   };
   std::vector<double> row;
   std::vector<StepTimes> out(count);
   std::vector<std::unique_ptr<Simulation>> sims;
   auto restart = [&](std::size_t i) { sims[i] = runs[i].lab->simulate(runs[i].engine); };
   for (const TimedRun& r : runs) sims.push_back(r.lab->simulate(r.engine));
-  // One block of run i: full steps back to back, or the engine alone every other step with the torque
-  // of the step before held (500 Hz control). Short runs wrap around.
-  auto block = [&](std::size_t i, bool engine_alone) {
-    if (engine_alone)  // the step untimed (a failed one restarts the run), then the engine alone timed
-      return timedEach(kBlock, clock, [&] { return sims[i]->step(row) || (restart(i), false); },
-                       [&] { return sims[i]->advanceEngine(); });
-    return timedRun(kBlock, [&] { return sims[i]->step(row) || (restart(i), false); });
-  };
+  // One block of run i's full steps, back to back (a failed one restarts the run; short runs wrap around).
+  auto block = [&](std::size_t i) { return timedRun(kBlock, [&] { return sims[i]->step(row) || (restart(i), false); }); };
   const int rounds = std::max(1, steps / kBlock);
   for (int r = 0; r < rounds; ++r) {
-    for (std::size_t i = 0; i < count; ++i) out[i].full_blocks.push_back(block(i, false));
-    mujocoBlock(mj.full_blocks, false);
+    for (std::size_t i = 0; i < count; ++i) out[i].full_blocks.push_back(block(i));
+    mujocoBlock(mj.full_blocks);
   }
-  for (std::size_t i = 0; i < count; ++i) restart(i);
+  sims.clear();
+  EngineReplay replay(runs);
   if (mujoco.timed()) mujoco.restart();
   for (int r = 0; r < rounds; ++r) {
-    for (std::size_t i = 0; i < count; ++i) out[i].engine_blocks.push_back(block(i, true));
-    mujocoBlock(mj.engine_blocks, true);
+    for (std::size_t i = 0; i < count; ++i) out[i].engine_blocks.push_back(replay.block(i));
+    mujocoBlock(mj.engine_blocks);
   }
   for (StepTimes& t : out) {
     t.full = median(t.full_blocks);
@@ -292,7 +330,7 @@ int bench(const BenchArgs& a) {
     } else {
       std::printf("%s\n", entry.name.c_str());
       if (alone)
-        std::printf("  engine step     hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median block of %d; advance one dt, control held)\n",
+        std::printf("  engine step     hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median block of %d; the controller's torques replayed)\n",
                     hand, bullet, speedup.median, kBlock);
       std::printf("  full step       hand %.2f µs   Bullet %.2f µs   Bullet/hand %.1fx   (median block of %d; + controller, trace row)\n",
                   hand_t.full, bullet_t.full, speedup_full.median, kBlock);

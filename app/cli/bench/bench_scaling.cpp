@@ -114,7 +114,7 @@ std::unique_ptr<Stepper> makeStepper(Engine e, const TreeModel<Planar>& tree) {
 }
 
 // µs per step from the outstretched start, each step timed alone (less the clock's own cost): their
-// mean without outliers (timing.h timedEach: a median would stick to the clock's ~10 ns ticks).
+// mean without outliers (timing.h meanWithoutOutliers: a median would stick to the clock's ~10 ns ticks).
 double stepMicros(Engine e, const TreeModel<Planar>& tree, double clock_us, int& steps) {
   using Micros = std::chrono::duration<double, std::micro>;
   auto s = makeStepper(e, tree);

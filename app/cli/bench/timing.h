@@ -15,7 +15,7 @@ constexpr int kBlock = 50;
 double median(std::vector<double> v);
 // The blocks that were timed (not NaN).
 int countedBlocks(const std::vector<double>& blocks);
-// The clock reads' cost (µs) as a call timed alone sees it, subtracted from each such call (timedEach):
+// The clock reads' cost (µs) as a call timed alone sees it (bench_scaling's steps, each timed alone):
 // a sub-microsecond step is not charged the timer's own ~11 ns.
 double clockOverhead();
 // How many times slower `slow` is than `fast`, block by block (timed side by side): the median, and
@@ -26,18 +26,11 @@ struct Ratio {
 };
 Ratio ratio(const std::vector<double>& slow, const std::vector<double>& fast);
 
-// The two timing loops of every bench, each giving one block's µs per call.
-// The clock here ticks every ~10 ns: a 0.3 µs step timed alone reads 0.30 or 0.31 µs, and a median of
-// such readings sticks to one tick (3 % of a ratio at that size). So a block is never summarised by
-// its median call:
-//  * timedRun: the calls back to back, timed together with one pair of clock reads (the tick and
-//    the reads' cost spread over the block). NaN (the block left out) when a call failed: its
-//    restart would be timed with the steps.
-//  * timedEach: where untimed work must run between the calls (before(), skipping the call when
-//    false), each call timed alone, less the reads' cost `clock` (clockOverhead), and the block's
-//    mean taken: a tick's phase is random, so the mean of many readings is not stuck to ticks.
-//    Calls that took over twice the block's median are left out of the mean (an interrupt or a
-//    preemption, not the step). timed() returns true when its call counts. NaN when none counted.
+// A block's time. The clock here ticks every ~10 ns: a 0.3 µs step timed alone reads 0.30 or 0.31 µs,
+// and a median of such readings sticks to one tick (3 % of a ratio at that size). So a block is never
+// summarised by its median call: its calls run back to back, timed together with one pair of clock
+// reads (the tick and the reads' cost spread over the block). NaN (the block left out) when a call
+// failed: its restart would be timed with the steps.
 template <class Timed>
 double timedRun(int calls, Timed&& timed) {
   using Clock = std::chrono::steady_clock;
@@ -47,22 +40,8 @@ double timedRun(int calls, Timed&& timed) {
   const double t = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
   return all && calls > 0 ? t / calls : std::nan("");
 }
-// The mean of the readings within twice their median, plus two ticks (NaN for none).
+// The mean of the readings within twice their median, plus two ticks (NaN for none): calls timed one
+// at a time (bench_scaling), where a median would stick to a tick and an interrupt is not the step.
 double meanWithoutOutliers(const std::vector<double>& readings);
-template <class Before, class Timed>
-double timedEach(int calls, double clock, Before&& before, Timed&& timed) {
-  using Clock = std::chrono::steady_clock;
-  using Micros = std::chrono::duration<double, std::micro>;
-  std::vector<double> times;
-  times.reserve(std::size_t(calls));
-  for (int k = 0; k < calls; ++k) {
-    if (!before()) continue;
-    const auto t0 = Clock::now();
-    const bool counted = timed();
-    const double t = Micros(Clock::now() - t0).count() - clock;
-    if (counted) times.push_back(t);
-  }
-  return meanWithoutOutliers(times);
-}
 
 }  // namespace dyn::app
