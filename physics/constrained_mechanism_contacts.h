@@ -212,7 +212,9 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
   const std::size_t count = model_.constraints.size();
   auto rigid = [&](std::size_t i) { return rigid_contact_[i] != 0; };
   // Touchdown: an open contact at or past its plane (φ = −gap ≥ 0) not moving away (−gap' ≥ 0); the
-  // stage knows whether any is (open_depth_) and whether any is closed already.
+  // stage knows whether any is (open_depth_) and whether any is closed already. A new position is staged
+  // with its rates (stageBoth: one pass where the tree allows it): the step's solve reads both.
+  if (!have_position_ || !same(q, staged_q_)) stageBoth(q, v);
   stagedContacts(q);
   int changes = 0;
   bool any_closed = rigid_closed_;  // (after the touchdowns: the lift-off check's)
