@@ -448,8 +448,16 @@ struct Spatial {
   //   row i ← c E_i + s E_j,  row j ← c E_j − s E_i,  row k unchanged  (12 products, not a full 27).
   // Written entry by entry into out: a Transform built on the stack and then copied whole is reloaded
   // 16 bytes at a time from its 8-byte stores, which stalls on store forwarding (a tenth of the step).
+  // The axis index a constant in each of three copies, so that the rows mixed stay in registers (a row
+  // picked at run time is a stack array's).
   DYN_INLINE static void turnAbout(int k, double c, double s, const Transform& X_tree, const Transform* P, Transform& out) {
-    const int i = k == 2 ? 0 : k + 1, j = i == 2 ? 0 : i + 1;
+    if (k == 0) turnAboutAxis<0>(c, s, X_tree, P, out);
+    else if (k == 1) turnAboutAxis<1>(c, s, X_tree, P, out);
+    else turnAboutAxis<2>(c, s, X_tree, P, out);
+  }
+  template <int k>
+  DYN_INLINE static void turnAboutAxis(double c, double s, const Transform& X_tree, const Transform* P, Transform& out) {
+    constexpr int i = k == 2 ? 0 : k + 1, j = i == 2 ? 0 : i + 1;
     // X_tree ∘ P = {E_tree E_P, r_P + E_Pᵀ r_tree}, summed as Eigen's products sum (x0 + (x1 + x2)): the
     // same bits as compose().
     double E[3][3], r[3];
