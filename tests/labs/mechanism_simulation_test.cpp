@@ -70,7 +70,7 @@ TEST_CASE("the engine alone, replaying a full run's torques, takes that run's st
   int offered = 0;
   for (const LabEntry& entry : labRegistry()) {
     const auto lab = test::LabFixture(entry.name).makeLab();
-    const long whole = std::lround(lab->duration() / lab->dt()), kMost = 600;  // its first 0.6 s at 1 ms
+    const long whole = std::lround(lab->duration() / lab->dt()), kMost = 600;  // its first 600 steps
     for (Engine engine : {Engine::Hand, Engine::Bullet}) {
       const std::string engine_name = name(engine);
       CAPTURE(entry.name);
