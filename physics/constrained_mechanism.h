@@ -163,6 +163,13 @@ class ConstrainedMechanism : public ConstrainedSystem {
   // Both stages at (q, v) where the position is not staged at q: on a 6-D serial chain without a
   // payload (fused_), CRBA and the bias forces in one pass (chain_sized.h crbaAndBiasSerial).
   void stageBoth(const VecN& q, const VecN& v);
+  // stageBoth when the position staged is not q's (true); false, and nothing staged, when it is. The
+  // one test of a new position for the callers that have the rates (stage, evaluate, updateContacts).
+  bool stageBothIfNew(const VecN& q, const VecN& v) {
+    if (have_position_ && same(q, staged_q_)) return false;
+    stageBoth(q, v);
+    return true;
+  }
   // The tree's transforms alone at θ (controller queries), cached like the position stage.
   void treeStage(const VecN& q);
   // The solve at a state; without with_qdd, α_c, η and f only (θ'' left unset); without with_forces,
@@ -240,9 +247,11 @@ class ConstrainedMechanism : public ConstrainedSystem {
   double open_depth_ = 0;
   bool rigid_closed_ = false, rigid_known_ = false;
   void rigidContactsAtStage();  // the two from the stage's phi_full_
-  // The position stage at q with the two known (updateContacts' touchdown check, openDepth).
-  void stagedContacts(const VecN& q) {
-    positionStage(q);
+  // The position stage at q with the two known (updateContacts' touchdown check, openDepth); with the
+  // rates v, a new position staged with them (stageBothIfNew).
+  void stagedContacts(const VecN& q, const VecN* v = nullptr) {
+    if (v) stageBothIfNew(q, *v);
+    else positionStage(q);
     if (!rigid_known_) rigidContactsAtStage();
   }
   void limitRowsAtStage();      // the limits' φ pass (only_limits_), the two with it

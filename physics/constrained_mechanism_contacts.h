@@ -214,8 +214,7 @@ int ConstrainedMechanism<S, Nj, Nr, Nl>::updateContacts(const VecN& q, VecN& v, 
   // Touchdown: an open contact at or past its plane (φ = −gap ≥ 0) not moving away (−gap' ≥ 0); the
   // stage knows whether any is (open_depth_) and whether any is closed already. A new position is staged
   // with its rates (stageBoth: one pass where the tree allows it): the step's solve reads both.
-  if (!have_position_ || !same(q, staged_q_)) stageBoth(q, v);
-  stagedContacts(q);
+  stagedContacts(q, &v);
   int changes = 0;
   bool any_closed = rigid_closed_;  // (after the touchdowns: the lift-off check's)
   for (std::size_t i = 0; open_depth_ >= 0.0 && i < count; ++i) {

@@ -272,9 +272,8 @@ void ConstrainedMechanism<S, Nj, Nr, Nl>::stageBoth(const VecN& q, const VecN& v
 
 template <class S, int Nj, int Nr, int Nl>
 void ConstrainedMechanism<S, Nj, Nr, Nl>::stage(const VecN& q, const VecN* v) {
-  if (v && !(have_position_ && same(q, staged_q_))) return stageBoth(q, *v);
-  positionStage(q);
-  if (v) velocityStage(*v);
+  if (!v) return positionStage(q);
+  if (!stageBothIfNew(q, *v)) velocityStage(*v);
 }
 
 template <class S, int Nj, int Nr, int Nl>
@@ -282,8 +281,7 @@ typename ConstrainedMechanism<S, Nj, Nr, Nl>::Solution ConstrainedMechanism<S, N
     const VecN& q, const VecN& v, const VecN& tau, const VecN* stab, bool with_qdd, bool with_forces) {
   // Both stages are kept (the trace row's solve and the step's first stage share them); both made at
   // once when the position is new.
-  if (!have_position_ || !same(q, staged_q_)) stageBoth(q, v);
-  else if (!have_velocity_ || !same(v, staged_v_)) velocityStage(v);
+  if (!stageBothIfNew(q, v) && (!have_velocity_ || !same(v, staged_v_))) velocityStage(v);
   // τ: the tree torques, optionally followed by generalised forces on the payload coordinates
   // (an external push w on the payload: M_c α_c + b_c + G_c = Aᵀ f + w).
   if (tau.size() != n() && tau.size() != n() + k())
